@@ -1,0 +1,1 @@
+"""atmos: real-time atmospheric effects for Python games and demo scenes."""

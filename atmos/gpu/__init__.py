@@ -1,0 +1,6 @@
+"""GPU access: one context type for windows and headless EGL, and GLSL loading with readable errors."""
+from atmos.gpu.context import GpuContext, GpuError, MIN_GL_VERSION, create_headless, from_current
+from atmos.gpu.shaders import ShaderError, load_source
+
+__all__ = ["GpuContext", "GpuError", "MIN_GL_VERSION", "create_headless", "from_current",
+           "ShaderError", "load_source"]

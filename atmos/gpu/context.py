@@ -1,0 +1,142 @@
+"""One GPU context type for a pyglet window and for headless EGL rendering into an offscreen framebuffer."""
+from __future__ import annotations
+
+import weakref
+
+import moderngl
+import numpy as np
+
+from atmos.gpu.shaders import build_program
+
+MIN_GL_VERSION = 430  # compute shaders
+
+
+class GpuError(RuntimeError):
+    """No usable OpenGL, or one older than atmos needs; the message says which and what to do."""
+
+
+def _check_version(ctx: moderngl.Context) -> None:
+    if ctx.version_code < MIN_GL_VERSION:
+        raise GpuError(
+            f"atmos needs OpenGL 4.3 or newer (compute shaders); this context is OpenGL "
+            f"{ctx.info.get('GL_VERSION', ctx.version_code)} on {ctx.info.get('GL_RENDERER', 'an unknown renderer')}. "
+            "Update the graphics driver, or use Mesa's llvmpipe (LIBGL_ALWAYS_SOFTWARE=1).")
+
+
+def create_headless(size: tuple[int, int] = (640, 360), backend: str = "egl") -> "GpuContext":
+    """A standalone context (EGL by default) that renders into an offscreen framebuffer of ``size``."""
+    try:
+        ctx = moderngl.create_standalone_context(backend=backend)
+    except Exception as error:  # moderngl/glcontext raise plain Exceptions with the loader's message
+        raise GpuError(
+            f"no usable OpenGL: creating a headless {backend.upper()} context failed ({error}). "
+            "Install Mesa's EGL and DRI drivers (Debian: libegl1 libegl-mesa0 libgl1-mesa-dri) "
+            "or a GPU driver with EGL.") from None
+    try:
+        _check_version(ctx)
+    except GpuError:
+        ctx.release()
+        raise
+    return GpuContext(ctx, size, headless=True)
+
+
+def from_current(size: tuple[int, int]) -> "GpuContext":
+    """Wrap the OpenGL context current in this thread (a pyglet window's); draws go to its screen."""
+    try:
+        ctx = moderngl.create_context()
+    except Exception as error:
+        raise GpuError(f"no usable OpenGL in the window: {error}") from None
+    _check_version(ctx)
+    return GpuContext(ctx, size, headless=False)
+
+
+class GpuContext:
+    """A moderngl context, the framebuffer frames are drawn into, and a cache of compiled programs.
+
+    Everything made through :meth:`track` or :meth:`program` is released by :meth:`release`.
+    """
+
+    def __init__(self, ctx: moderngl.Context, size: tuple[int, int], headless: bool):
+        self.ctx = ctx
+        self.headless = headless
+        self.size = (0, 0)
+        self._programs: dict[tuple, object] = {}
+        self._tracked: "weakref.WeakSet" = weakref.WeakSet()
+        self._offscreen: list = []
+        self.target: moderngl.Framebuffer = ctx.screen
+        self.resize(size)
+
+    # -- framebuffer -----------------------------------------------------------------------
+    def resize(self, size: tuple[int, int]) -> None:
+        """Set the frame size; a minimized window (0 in either axis) keeps a 1×1 target."""
+        size = (max(1, int(size[0])), max(1, int(size[1])))
+        if size == self.size:
+            return
+        self.size = size
+        if self.headless:
+            old = self._offscreen
+            color = self.ctx.texture(size, 4)
+            depth = self.ctx.depth_renderbuffer(size)
+            self.target = self.ctx.framebuffer([color], depth)
+            self.target.use()  # never leave a released framebuffer bound
+            self._offscreen = [self.target, color, depth]
+            for obj in old:
+                obj.release()
+        else:
+            self.target = self.ctx.screen
+
+    def read_pixels(self) -> np.ndarray:
+        """The current frame as uint8 RGB, shape (height, width, 3), first row at the top."""
+        w, h = self.size
+        data = self.target.read(viewport=(0, 0, w, h), components=3, alignment=1)
+        return np.frombuffer(data, np.uint8).reshape(h, w, 3)[::-1].copy()
+
+    # -- programs and lifetime ---------------------------------------------------------------
+    def program(self, defines: dict | None = None, **stages: str):
+        """A compiled program from ``shaders/`` files, compiled once per (files, defines).
+
+        ``gpu.program(vertex_shader="sky.vert", fragment_shader="sky.frag")`` or
+        ``gpu.program(compute_shader="volume.comp", defines={"N": 4})``.
+        """
+        key = (tuple(sorted(stages.items())), tuple(sorted((defines or {}).items())))
+        program = self._programs.get(key)
+        if program is None:
+            program = self._programs[key] = build_program(self.ctx, stages, defines)
+        return program
+
+    @property
+    def compiled_files(self) -> set[str]:
+        """Names of every shader file compiled so far (tests use this to prove culled passes compile nothing)."""
+        return {name for stages, _ in self._programs for _, name in stages}
+
+    def track(self, obj):
+        """Register a GL object to be released with this context; returns it."""
+        self._tracked.add(obj)
+        return obj
+
+    def release(self) -> None:
+        """Release every tracked object, program and offscreen target, then the context itself."""
+        for obj in list(self._tracked):
+            obj.release()
+        for program in self._programs.values():
+            program.release()
+        for obj in self._offscreen:
+            obj.release()
+        self._programs.clear()
+        self._offscreen.clear()
+        if self.headless:
+            self.ctx.release()
+
+    def check(self, where: str = "") -> None:
+        """Raise if OpenGL has recorded an error (``GL_NO_ERROR`` otherwise)."""
+        error = self.ctx.error
+        if error != "GL_NO_ERROR":
+            raise GpuError(f"OpenGL error {error}" + (f" after {where}" if where else ""))
+
+    def info(self) -> dict:
+        """Renderer, version and the limits atmos cares about."""
+        info = self.ctx.info
+        keys = ["GL_VENDOR", "GL_RENDERER", "GL_VERSION", "GL_MAX_TEXTURE_SIZE", "GL_MAX_3D_TEXTURE_SIZE",
+                "GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS", "GL_MAX_COMPUTE_WORK_GROUP_COUNT",
+                "GL_MAX_COMPUTE_WORK_GROUP_SIZE", "GL_MAX_SHADER_STORAGE_BLOCK_SIZE", "GL_MAX_SAMPLES"]
+        return {k: info[k] for k in keys if k in info}

@@ -1,0 +1,1 @@
+"""Runnable demo scenes: ``atmos demo NAME`` (see atmos.demo_registry)."""

@@ -1,0 +1,1 @@
+"""Effect plugins shipped with atmos, importable as ``atmos.plugins.<name>``."""

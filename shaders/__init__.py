@@ -1,0 +1,1 @@
+"""GLSL sources, located at run time through importlib.resources (see atmos.gpu.shaders)."""

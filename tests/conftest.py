@@ -1,0 +1,33 @@
+"""Shared fixtures: one headless EGL context for the whole session; every GL test ends on GL_NO_ERROR."""
+import os
+
+import pytest
+
+from atmos.gpu import create_headless
+
+os.environ.setdefault("ATMOS_HEADLESS", "1")
+
+
+@pytest.fixture(scope="session")
+def gpu():
+    """The session's headless GpuContext (Mesa llvmpipe here, the NVIDIA driver on a GPU machine)."""
+    context = create_headless((256, 144))
+    yield context
+    context.release()
+
+
+@pytest.fixture
+def ctx(gpu):
+    """The session's moderngl.Context; the test fails if it leaves an OpenGL error behind."""
+    gpu.ctx.error  # clear errors left by earlier tests' teardown
+    yield gpu.ctx
+    assert gpu.ctx.error == "GL_NO_ERROR"
+
+
+@pytest.fixture
+def rng(request):
+    """A fresh random generator per test; the seed is printed so a failure can be replayed."""
+    import numpy as np
+    seed = int.from_bytes(os.urandom(4), "little")
+    print(f"rng seed {seed}")
+    return np.random.default_rng(seed)
