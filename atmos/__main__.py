@@ -1,0 +1,3 @@
+from atmos.cli import main
+import sys
+sys.exit(main())

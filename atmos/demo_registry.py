@@ -1,0 +1,34 @@
+"""Demo scenes: modules of ``atmos.demos`` with ``TITLE`` and ``build(app, settings)``."""
+from __future__ import annotations
+
+import importlib
+import pkgutil
+from dataclasses import dataclass
+
+DEFAULT_DEMO = "testbed"
+
+
+@dataclass
+class DemoSettings:
+    size: tuple[int, int] = (960, 540)
+    seed: int = 0
+    frames: int | None = None     # None: until the window closes (headless: the demo's DEFAULT_FRAMES)
+    headless: bool = False
+
+
+def list_demos() -> dict[str, str]:
+    """Demo name -> one-line title."""
+    import atmos.demos
+    demos = {}
+    for info in pkgutil.iter_modules(atmos.demos.__path__):
+        if not info.name.startswith("_"):
+            demos[info.name] = load_demo(info.name).TITLE
+    return demos
+
+
+def load_demo(name: str):
+    import atmos.demos
+    known = [i.name for i in pkgutil.iter_modules(atmos.demos.__path__) if not i.name.startswith("_")]
+    if name not in known:
+        raise ValueError(f"unknown demo {name!r}; available: {', '.join(sorted(known))} (atmos demo --list)")
+    return importlib.import_module(f"atmos.demos.{name}")

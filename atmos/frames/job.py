@@ -1,0 +1,249 @@
+"""A simulation chain split into slices, computed a few slices per frame into texture set C.
+
+A :class:`SlicedJob` is a list of :class:`SliceStage` (for clouds: region volume → automaton step
+→ smoothing → density maps → shading). One *step* runs every slice of every stage, in order,
+writing into ``triple.c`` and reading the previous result ``triple.b``. When the last slice of a
+step finishes the triple rotates, so readers, who only ever get ``(A, B, t)`` from :meth:`view`,
+never see a half-written set.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+from atmos.frames.texture_sets import TextureSet, TripleSet
+
+Measure = Callable[[Callable[[], None]], float]
+"""Runs the given callable (one slice) and returns how long it took in milliseconds."""
+
+
+def perf_measure(run: Callable[[], None]) -> float:
+    """Wall time of ``run()`` in ms with ``time.perf_counter`` (submission cost unless the GPU is synced)."""
+    start = time.perf_counter()
+    run()
+    return (time.perf_counter() - start) * 1000.0
+
+
+def synced_measure(ctx) -> Measure:
+    """A measure that waits for the GPU (``ctx.finish()``) before and after the slice, so it times the GPU work.
+
+    GPU timer queries are meaningless on llvmpipe; plug a timer-query measure in where they are not.
+    """
+    def measure(run: Callable[[], None]) -> float:
+        ctx.finish()
+        start = time.perf_counter()
+        run()
+        ctx.finish()
+        return (time.perf_counter() - start) * 1000.0
+    return measure
+
+
+@dataclass
+class SliceContext:
+    """What a slice sees: where to write (``target`` = C), what to read (``previous`` = B), which slice."""
+
+    job: "SlicedJob"
+    step: int                 # index of the step being computed (0 for the first)
+    stage: "SliceStage"
+    slice: int                # index of this slice inside its stage
+    slices: int               # number of slices of this stage in this step
+    target: TextureSet        # triple.c, being written
+    previous: TextureSet      # triple.b, the newest completed result (read only)
+    state: dict               # the job's scratch space, kept across slices and steps
+
+    @property
+    def gpu(self):
+        return self.job.triple.gpu
+
+
+class SliceStage:
+    """One stage of a chain: ``slices`` pieces of work (an int, or a callable asked at the start of each step).
+
+    ``run(slice_index, job_ctx)`` does one slice, writing into ``job_ctx.target``.
+    """
+
+    def __init__(self, name: str, slices: int | Callable[[], int], run: Callable[[int, SliceContext], None]):
+        if not callable(run):
+            raise ValueError(f"stage {name!r}: run must be callable as run(slice_index, job_ctx); got {run!r}")
+        if not callable(slices):
+            _check_count(name, slices)
+        self.name = name
+        self.slices = slices
+        self.run = run
+
+    def count(self) -> int:
+        """This step's number of slices."""
+        return _check_count(self.name, self.slices() if callable(self.slices) else self.slices)
+
+    def __repr__(self) -> str:
+        return f"SliceStage({self.name!r}, slices={self.slices!r})"
+
+
+def _check_count(name: str, value) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+        raise ValueError(f"stage {name!r}: slices must be an int >= 0 (or a callable returning one); got {value!r}")
+    return value
+
+
+@dataclass
+class JobStats:
+    """Counters for one job; the scheduler resets the per-frame ones at each tick."""
+
+    slices_last_frame: int = 0
+    ms_last_frame: float = 0.0
+    steps: int = 0
+    slices_total: int = 0
+    ms_total: float = 0.0
+    stage_ms: dict = field(default_factory=dict)   # stage name → moving average of its slice cost (ms)
+
+    @property
+    def mean_slice_ms(self) -> float:
+        return self.ms_total / self.slices_total if self.slices_total else 0.0
+
+
+class SlicedJob:
+    """A chain of sliced stages writing into ``triple.c``; see the module docstring.
+
+    ``begin(step)`` is called before the first slice of each step, with the index of the step about
+    to be computed (equal to the number of completed steps), to advance simulation parameters.
+    """
+
+    EMA = 0.25  # weight of the newest sample in the per-stage cost estimate
+
+    def __init__(self, name: str, stages: list[SliceStage], triple: TripleSet,
+                 begin: Callable[[int], None] | None = None):
+        if not stages:
+            raise ValueError(f"job {name!r} needs at least one SliceStage; got none")
+        for stage in stages:
+            if not isinstance(stage, SliceStage):
+                raise ValueError(f"job {name!r}: stages must be SliceStage objects; got {stage!r}")
+        self.name = name
+        self.stages = list(stages)
+        self.triple = triple
+        self.begin = begin
+        self.step = 0
+        self.state: dict = {}
+        self.stats = JobStats()
+        self._plan: list[int] | None = None   # slices per stage of the current step, fixed when it begins
+        self._total = 0
+        self._done = 0
+        self._stage = 0                        # cursor: stage index and slice inside it
+        self._slice = 0
+
+    # -- progress ---------------------------------------------------------------------------
+    @property
+    def slices_in_step(self) -> int:
+        """Slices of the current step (fixed when it begins; the stages' current counts before that)."""
+        return self._total if self._plan is not None else sum(stage.count() for stage in self.stages)
+
+    @property
+    def slices_done(self) -> int:
+        return self._done
+
+    @property
+    def progress(self) -> float:
+        """Slices done / slices in this step, in [0, 1): also the interpolation factor between A and B."""
+        return self._done / self._total if self._plan is not None and self._total else 0.0
+
+    @property
+    def ready(self) -> bool:
+        """True once two steps are complete, so that A and B both hold results (see :meth:`prime`)."""
+        return self.step >= 2
+
+    @property
+    def next_stage(self) -> SliceStage:
+        """The stage the next slice belongs to."""
+        if self._plan is None:
+            return next((s for s in self.stages if s.count() > 0), self.stages[0])
+        return self.stages[self._stage]
+
+    def view(self) -> tuple[TextureSet, TextureSet, float]:
+        """(A, B, t) for readers: draw mix(A, B, t). Never returns C."""
+        return self.triple.a, self.triple.b, self.progress
+
+    # -- running ----------------------------------------------------------------------------
+    def _begin_step(self) -> None:
+        if self.begin is not None:
+            self.begin(self.step)
+        plan = [stage.count() for stage in self.stages]
+        total = sum(plan)
+        if total == 0:
+            raise ValueError(f"job {self.name!r}: step {self.step} has no slices (every stage returned 0); "
+                             "a step needs at least one slice to write texture set C")
+        self._plan, self._total, self._done = plan, total, 0
+        self._stage, self._slice = 0, 0
+        while self._plan[self._stage] == 0:
+            self._stage += 1
+
+    def _run_one(self, measure: Measure) -> None:
+        if self._plan is None:
+            self._begin_step()
+        stage = self.stages[self._stage]
+        job_ctx = SliceContext(self, self.step, stage, self._slice, self._plan[self._stage],
+                               self.triple.c, self.triple.b, self.state)
+
+        def run() -> None:
+            stage.run(job_ctx.slice, job_ctx)
+            # image writes must be visible to the next slice and, after rotation, to texture reads
+            self.triple.gpu.ctx.memory_barrier()
+
+        ms = measure(run)
+        stats = self.stats
+        stats.slices_last_frame += 1
+        stats.ms_last_frame += ms
+        stats.slices_total += 1
+        stats.ms_total += ms
+        previous = stats.stage_ms.get(stage.name)
+        stats.stage_ms[stage.name] = ms if previous is None else previous + self.EMA * (ms - previous)
+
+        self._done += 1
+        self._slice += 1
+        while self._stage < len(self._plan) and self._slice >= self._plan[self._stage]:
+            self._stage += 1
+            self._slice = 0
+        if self._done >= self._total:
+            self.triple.rotate()
+            self.step += 1
+            self.stats.steps = self.step
+            self._plan = None
+            self._done = self._total = 0
+            self._stage = self._slice = 0
+
+    def run_slices(self, n: int, *, measure: Measure | None = None) -> int:
+        """Run ``n`` slices (crossing into the next step when one completes); returns the slices run.
+
+        When the last slice of a step finishes: ``triple.rotate()``, ``step += 1``, progress back to 0.
+        ``measure`` times each slice (default: :func:`perf_measure`, no GPU sync).
+        """
+        if isinstance(n, bool) or not isinstance(n, int) or n < 0:
+            raise ValueError(f"run_slices(n): n must be an int >= 0; got {n!r}")
+        measure = measure or perf_measure
+        for _ in range(n):
+            self._run_one(measure)
+        return n
+
+    def run_step(self, *, measure: Measure | None = None) -> None:
+        """Run every remaining slice of the current step now (naive mode); ends with a rotation."""
+        measure = measure or perf_measure
+        step = self.step
+        while self.step == step:
+            self._run_one(measure)
+
+    def prime(self, *, measure: Measure | None = None) -> None:
+        """Run whole steps until two are complete, so A and B both hold results before the first frame."""
+        while self.step < 2:
+            self.run_step(measure=measure)
+
+    def expected_slice_ms(self) -> float | None:
+        """Estimated cost of the next slice from its stage's measured costs (None before any measurement)."""
+        estimate = self.stats.stage_ms.get(self.next_stage.name)
+        if estimate is None and self.stats.slices_total:
+            estimate = self.stats.mean_slice_ms
+        return estimate
+
+    def release(self) -> None:
+        self.triple.release()
+
+    def __repr__(self) -> str:
+        return f"SlicedJob({self.name!r}, step={self.step}, progress={self.progress:.3f})"

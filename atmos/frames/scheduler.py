@@ -1,0 +1,143 @@
+"""Hands out each frame's slices of the registered :class:`~atmos.frames.job.SlicedJob` objects.
+
+Modes:
+
+* ``"sliced"`` — each :meth:`FrameScheduler.tick` runs ``slices_per_frame`` slices, round robin over
+  the jobs; or, with ``time_budget_ms``, as many slices as their measured cost allows (always at
+  least one per frame, so progress never stalls). A job completes at most one step per tick: a
+  second rotation in the same frame would throw away a result that was never shown.
+* ``"naive"`` — each tick runs a whole step of every job (the frame pays for it: the reference for
+  the benchmarks).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from atmos.frames.job import Measure, SlicedJob, perf_measure, synced_measure
+
+MODES = ("sliced", "naive")
+
+
+@dataclass(frozen=True)
+class FrameStats:
+    """One job's numbers as of the last tick."""
+
+    slices_last_frame: int
+    ms_last_frame: float
+    steps: int
+    mean_slice_ms: float
+    progress: float
+
+
+class FrameScheduler:
+    """Runs one frame's worth of slices of every added job per :meth:`tick`.
+
+    ``measure`` times one slice (a callable that runs its argument and returns milliseconds): by
+    default ``time.perf_counter`` around the slice, with ``ctx.finish()`` before and after when
+    ``sync`` is true. ``sync`` defaults to true exactly when a time budget is in use (the budget
+    needs the GPU cost; without one, syncing would only stall the pipeline).
+    """
+
+    def __init__(self, mode: str = "sliced", slices_per_frame: int = 1, time_budget_ms: float | None = None,
+                 measure: Measure | None = None, sync: bool | None = None):
+        if mode not in MODES:
+            raise ValueError(f"FrameScheduler mode {mode!r}: allowed are {', '.join(repr(m) for m in MODES)}")
+        if isinstance(slices_per_frame, bool) or not isinstance(slices_per_frame, int) or slices_per_frame < 1:
+            raise ValueError(f"FrameScheduler slices_per_frame={slices_per_frame!r}: allowed is an int >= 1")
+        if time_budget_ms is not None:
+            if isinstance(time_budget_ms, bool) or not isinstance(time_budget_ms, (int, float)) \
+                    or not time_budget_ms > 0 or time_budget_ms == float("inf"):
+                raise ValueError(f"FrameScheduler time_budget_ms={time_budget_ms!r}: allowed is a finite "
+                                 "number of milliseconds > 0, or None for a fixed slices_per_frame")
+        if measure is not None and not callable(measure):
+            raise ValueError(f"FrameScheduler measure={measure!r}: allowed is None or a callable "
+                             "measure(run) -> milliseconds")
+        self.mode = mode
+        self.slices_per_frame = slices_per_frame
+        self.time_budget_ms = None if time_budget_ms is None else float(time_budget_ms)
+        self.measure = measure
+        self.sync = (time_budget_ms is not None) if sync is None else bool(sync)
+        self.jobs: list[SlicedJob] = []
+        self.frame = 0
+        self.slices_last_frame = 0
+        self.ms_last_frame = 0.0
+        self._next = 0  # round-robin start
+
+    # -- jobs -------------------------------------------------------------------------------
+    def add(self, job: SlicedJob) -> SlicedJob:
+        if any(j is job for j in self.jobs):
+            raise ValueError(f"job {job.name!r} is already in this FrameScheduler")
+        if any(j.name == job.name for j in self.jobs):
+            raise ValueError(f"a job named {job.name!r} is already in this FrameScheduler; job names must be unique "
+                             f"(they key stats); present: {', '.join(j.name for j in self.jobs)}")
+        self.jobs.append(job)
+        return job
+
+    def remove(self, job: SlicedJob) -> None:
+        for index, present in enumerate(self.jobs):
+            if present is job:
+                del self.jobs[index]
+                if self.jobs:
+                    self._next %= len(self.jobs)
+                return
+        raise ValueError(f"job {getattr(job, 'name', job)!r} is not in this FrameScheduler; "
+                         f"present: {', '.join(j.name for j in self.jobs) or 'none'}")
+
+    def __contains__(self, job) -> bool:
+        return any(j is job for j in self.jobs)
+
+    # -- frames -----------------------------------------------------------------------------
+    def _measure_for(self, job: SlicedJob) -> Measure:
+        if self.measure is not None:
+            return self.measure
+        return synced_measure(job.triple.gpu.ctx) if self.sync else perf_measure
+
+    def tick(self) -> None:
+        """Run one frame's worth of slices."""
+        self.frame += 1
+        for job in self.jobs:
+            job.stats.slices_last_frame = 0
+            job.stats.ms_last_frame = 0.0
+        if self.jobs:
+            if self.mode == "naive":
+                for job in self.jobs:
+                    job.run_step(measure=self._measure_for(job))
+            else:
+                self._tick_sliced()
+        self.slices_last_frame = sum(job.stats.slices_last_frame for job in self.jobs)
+        self.ms_last_frame = sum(job.stats.ms_last_frame for job in self.jobs)
+
+    def _tick_sliced(self) -> None:
+        jobs = self.jobs[self._next:] + self.jobs[:self._next]
+        self._next = (self._next + 1) % len(self.jobs)
+        start_steps = {id(job): job.step for job in jobs}
+        active = list(jobs)
+        ran = 0
+        spent = 0.0
+        budget = self.time_budget_ms
+        while active:
+            for job in list(active):
+                if budget is None:
+                    if ran >= self.slices_per_frame:
+                        return
+                elif ran:
+                    expected = job.expected_slice_ms()
+                    if expected is not None and spent + expected > budget:
+                        active.remove(job)   # does not fit; a job with cheaper slices still may
+                        continue
+                before = job.stats.ms_last_frame
+                job.run_slices(1, measure=self._measure_for(job))
+                spent += job.stats.ms_last_frame - before
+                ran += 1
+                if job.step != start_steps[id(job)]:
+                    active.remove(job)       # at most one rotation per job per frame
+
+    @property
+    def stats(self) -> dict[str, FrameStats]:
+        """Per job name: slices run last frame, steps completed, mean slice ms (and ms last frame, progress)."""
+        return {job.name: FrameStats(job.stats.slices_last_frame, job.stats.ms_last_frame, job.step,
+                                     job.stats.mean_slice_ms, job.progress) for job in self.jobs}
+
+    def __repr__(self) -> str:
+        budget = f"time_budget_ms={self.time_budget_ms}" if self.time_budget_ms else f"slices_per_frame={self.slices_per_frame}"
+        return f"FrameScheduler({self.mode!r}, {budget}, jobs={[j.name for j in self.jobs]})"

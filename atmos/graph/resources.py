@@ -1,0 +1,111 @@
+"""Transient texture descriptions and the pool that recycles textures between passes and frames."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import moderngl
+
+DTYPES = ("f1", "f2", "f4", "u1", "u2", "u4", "i1", "i2", "i4")
+FILTERS = ("linear", "nearest")
+
+
+@dataclass(frozen=True)
+class TextureDesc:
+    """What a transient texture looks like; equal descs share pooled textures (it is the pool key).
+
+    ``size`` is (w, h) or (w, h, d) for a 3D texture. A ``depth`` texture must be 2D and ignores
+    ``components``/``dtype``. Integer dtypes (``u*``, ``i*``) need ``filter="nearest"``.
+    """
+
+    size: tuple[int, ...]
+    components: int = 4
+    dtype: str = "f2"
+    depth: bool = False
+    filter: str = "linear"
+
+    def __post_init__(self):
+        try:
+            size = tuple(int(s) for s in self.size)
+        except (TypeError, ValueError):
+            raise ValueError(f"TextureDesc.size must be (w, h) or (w, h, d) of positive ints, got {self.size!r}") from None
+        if len(size) not in (2, 3) or min(size) < 1 or any(s != o for s, o in zip(size, self.size)):
+            raise ValueError(f"TextureDesc.size must be (w, h) or (w, h, d) of positive ints, got {self.size!r}")
+        object.__setattr__(self, "size", size)
+        if self.components not in (1, 2, 3, 4):
+            raise ValueError(f"TextureDesc.components must be 1, 2, 3 or 4, got {self.components!r}")
+        if self.dtype not in DTYPES:
+            raise ValueError(f"TextureDesc.dtype must be one of {', '.join(DTYPES)}, got {self.dtype!r}")
+        if self.filter not in FILTERS:
+            raise ValueError(f"TextureDesc.filter must be 'linear' or 'nearest', got {self.filter!r}")
+        if self.depth and len(size) != 2:
+            raise ValueError(f"a depth TextureDesc must have a 2D size (w, h), got {size!r}")
+        if not self.depth and self.dtype[0] in "ui" and self.filter != "nearest":
+            raise ValueError(f"integer TextureDesc dtype {self.dtype!r} needs filter='nearest' "
+                             "(OpenGL cannot filter integer textures linearly)")
+
+    def __str__(self) -> str:
+        size = "x".join(map(str, self.size))
+        if self.depth:
+            return f"{size} depth {self.filter}"
+        return f"{size} {self.components}x{self.dtype} {self.filter}"
+
+
+class TexturePool:
+    """Textures keyed by :class:`TextureDesc`: ``acquire`` reuses a free one of an equal desc, else creates one."""
+
+    def __init__(self, gpu):
+        self.gpu = gpu
+        self.allocations = 0  # textures ever created
+        self._free: dict[TextureDesc, list] = {}
+        self._desc: dict[int, tuple[TextureDesc, object]] = {}  # id(texture) -> (desc, texture), all pooled
+        self._in_use: set[int] = set()
+
+    def acquire(self, desc: TextureDesc):
+        """A texture matching ``desc``, free until :meth:`release` gives it back."""
+        free = self._free.get(desc)
+        texture = free.pop() if free else self._create(desc)
+        self._in_use.add(id(texture))
+        return texture
+
+    def release(self, texture) -> None:
+        """Give ``texture`` back to the free list of its desc."""
+        key = id(texture)
+        if key not in self._desc:
+            raise ValueError("TexturePool.release: this texture was not acquired from this pool")
+        if key not in self._in_use:
+            raise ValueError("TexturePool.release: this texture was already released")
+        self._in_use.discard(key)
+        self._free.setdefault(self._desc[key][0], []).append(texture)
+
+    @property
+    def textures(self) -> int:
+        """Textures the pool holds now (free and in use)."""
+        return len(self._desc)
+
+    @property
+    def in_use(self) -> int:
+        """Textures acquired and not yet released."""
+        return len(self._in_use)
+
+    def release_all(self) -> None:
+        """Free the GL memory of every pooled texture, free or in use; the pool starts empty again."""
+        for _, texture in self._desc.values():
+            texture.release()
+        self._free.clear()
+        self._desc.clear()
+        self._in_use.clear()
+
+    def _create(self, desc: TextureDesc):
+        ctx = self.gpu.ctx
+        if desc.depth:
+            texture = ctx.depth_texture(desc.size)
+            texture.compare_func = ""  # sample as a plain sampler2D
+        elif len(desc.size) == 3:
+            texture = ctx.texture3d(desc.size, desc.components, dtype=desc.dtype)
+        else:
+            texture = ctx.texture(desc.size, desc.components, dtype=desc.dtype)
+        mode = moderngl.LINEAR if desc.filter == "linear" else moderngl.NEAREST
+        texture.filter = (mode, mode)
+        self.allocations += 1
+        self._desc[id(texture)] = (desc, texture)
+        return texture

@@ -1,0 +1,82 @@
+"""Per-pass GPU time queries in a small ring, read a couple of frames late so they never stall."""
+from __future__ import annotations
+
+import time
+from contextlib import contextmanager
+
+RING = 3  # queries per pass; the one read back was issued RING - 1 frames ago
+
+
+class _Ring:
+    __slots__ = ("queries", "cpu_ms", "pending", "frame")
+
+    def __init__(self):
+        self.queries: list = [None] * RING
+        self.cpu_ms = [0.0] * RING
+        self.pending = [False] * RING
+        self.frame = 0
+
+
+class PassTimers:
+    """GPU (``ctx.query(time=True)``) and CPU (``perf_counter``) time of each pass.
+
+    ``results`` maps pass name -> (gpu_ms, cpu_ms) of the latest measurement whose GPU result has
+    been read back; a frame's query is read ``RING - 1`` frames later, so results lag a little.
+    GL time queries cannot nest: a pass must not run its own time query while timed.
+    """
+
+    def __init__(self, ctx):
+        self.ctx = ctx
+        self.results: dict[str, tuple[float, float]] = {}
+        self._rings: dict[str, _Ring] = {}
+        self._spare: list = []  # moderngl 5.13 cannot release a Query: recycle them instead
+
+    @contextmanager
+    def measure(self, name: str):
+        """Time the body as one frame of pass ``name``."""
+        ring = self._rings.get(name)
+        if ring is None:
+            ring = self._rings[name] = _Ring()
+        slot = ring.frame % RING
+        old = (ring.frame - (RING - 1)) % RING  # issued RING - 1 frames ago
+        if ring.frame >= RING - 1 and ring.pending[old]:
+            self._collect(name, ring, old)
+        if ring.pending[slot]:  # only when RING == 1; kept for safety
+            self._collect(name, ring, slot)
+        query = ring.queries[slot]
+        if query is None:
+            query = ring.queries[slot] = self._spare.pop() if self._spare else self.ctx.query(time=True)
+        start = time.perf_counter()
+        with query:
+            yield
+        ring.cpu_ms[slot] = (time.perf_counter() - start) * 1000.0
+        ring.pending[slot] = True
+        ring.frame += 1
+
+    def _collect(self, name: str, ring: _Ring, slot: int) -> None:
+        self.results[name] = (ring.queries[slot].elapsed / 1e6, ring.cpu_ms[slot])
+        ring.pending[slot] = False
+
+    def forget(self, name: str) -> None:
+        """Drop the queries and results of pass ``name`` (removed or culled)."""
+        ring = self._rings.pop(name, None)
+        self.results.pop(name, None)
+        if ring:
+            self._spare += [query for query in ring.queries if query is not None]
+
+    def keep_only(self, names) -> None:
+        """Forget every pass not in ``names``."""
+        for name in set(self._rings) | set(self.results):
+            if name not in names:
+                self.forget(name)
+
+    def release(self) -> None:
+        """Release every query (where moderngl can; else they go with the context) and clear the results."""
+        for name in list(self._rings):
+            self.forget(name)
+        for query in self._spare:
+            release = getattr(query, "release", None)
+            if release:
+                release()
+        self._spare.clear()
+        self.results.clear()

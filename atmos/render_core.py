@@ -1,0 +1,75 @@
+"""The passes every rendered scene has: clear (creates the HDR colour and depth) and present (to the screen)."""
+from __future__ import annotations
+
+from atmos.graph import PassBuilder, PassContext, RenderPass, TextureDesc
+from atmos.plugin import Plugin
+
+SCREEN = "screen"
+COLOR = "color"
+DEPTH = "depth"
+
+
+def color_desc(gpu) -> TextureDesc:
+    return TextureDesc(gpu.size, components=4, dtype="f2")
+
+
+def depth_desc(gpu) -> TextureDesc:
+    return TextureDesc(gpu.size, depth=True)
+
+
+class ClearPass(RenderPass):
+    """Creates the scene's HDR ``color`` and ``depth`` textures and clears them."""
+    name = "clear"
+
+    def __init__(self, gpu, color=(0.0, 0.0, 0.0)):
+        self.gpu = gpu
+        self.color = color
+
+    def setup(self, builder: PassBuilder) -> None:
+        builder.create(COLOR, color_desc(self.gpu))
+        builder.create(DEPTH, depth_desc(self.gpu))
+
+    def execute(self, frame: PassContext) -> None:
+        fbo = frame.framebuffer(color=[COLOR], depth=DEPTH)
+        fbo.use()
+        fbo.clear(*self.color, 1.0, depth=1.0)
+
+
+class PresentPass(RenderPass):
+    """Tone-maps the HDR ``color`` into the screen (window or offscreen target), with sRGB gamma."""
+    name = "present"
+
+    def __init__(self, gpu, exposure: float = 1.0):
+        self.gpu = gpu
+        self.exposure = exposure
+        self.program = None
+
+    def setup(self, builder: PassBuilder) -> None:
+        builder.read(COLOR)
+        builder.write(SCREEN)
+
+    def prepare(self, gpu) -> None:
+        self.program = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="core/present.frag")
+
+    def execute(self, frame: PassContext) -> None:
+        target = frame.texture(SCREEN)
+        target.use()
+        frame.gpu.ctx.disable(frame.gpu.ctx.DEPTH_TEST | frame.gpu.ctx.BLEND)
+        frame.texture(COLOR).use(0)
+        self.program["exposure"].value = self.exposure
+        frame.fullscreen(self.program)
+
+
+class RenderCorePlugin(Plugin):
+    """Imports the screen into the render graph and adds the clear and present passes."""
+
+    def __init__(self, clear_color=(0.0, 0.0, 0.0), exposure: float = 1.0):
+        self.clear_color = clear_color
+        self.exposure = exposure
+
+    def build(self, app) -> None:
+        if app.graph is None:
+            return
+        app.graph.import_texture(SCREEN, lambda: app.gpu.target)
+        app.graph.add_pass(ClearPass(app.gpu, self.clear_color))
+        app.graph.add_pass(PresentPass(app.gpu, self.exposure))

@@ -1,0 +1,44 @@
+"""A cheap analytic sky: horizon-to-zenith gradient, a sun disc and glow. Draws the whole background."""
+from atmos.camera import Camera, set_camera_uniforms
+from atmos.graph import PassBuilder, PassContext, RenderPass
+from atmos.lighting import Sun
+from atmos.plugin import Plugin
+from atmos.render_core import COLOR, DEPTH
+
+
+class SkyGradientPass(RenderPass):
+    name = "sky_gradient"
+
+    def __init__(self, plugin: "SkyGradientPlugin"):
+        self.plugin = plugin
+        self.program = None
+
+    def setup(self, builder: PassBuilder) -> None:
+        builder.write(COLOR)
+
+    def prepare(self, gpu) -> None:
+        self.program = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="sky_gradient/sky.frag")
+
+    def execute(self, frame: PassContext) -> None:
+        app = frame.data["app"]
+        gpu = frame.gpu
+        frame.framebuffer(color=[COLOR]).use()
+        gpu.ctx.disable(gpu.ctx.DEPTH_TEST | gpu.ctx.BLEND)
+        set_camera_uniforms(self.program, app.resource(Camera), gpu.size[0] / gpu.size[1])
+        sun = app.get_resource(Sun) or Sun()
+        self.program["sun_dir"].value = tuple(sun.direction)
+        self.program["sun_color"].value = tuple(sun.color)
+        self.program["zenith"].value = self.plugin.zenith
+        self.program["horizon"].value = self.plugin.horizon
+        self.program["ground"].value = self.plugin.ground
+        frame.fullscreen(self.program)
+
+
+class SkyGradientPlugin(Plugin):
+    """Sky colours (linear HDR): ``zenith`` overhead, ``horizon`` at eye level, ``ground`` below it."""
+
+    def __init__(self, zenith=(0.15, 0.35, 0.8), horizon=(0.75, 0.85, 1.0), ground=(0.35, 0.33, 0.3)):
+        self.zenith, self.horizon, self.ground = zenith, horizon, ground
+
+    def build(self, app) -> None:
+        app.graph.add_pass(SkyGradientPass(self))

@@ -1,0 +1,22 @@
+#version 430
+// Ground: anti-aliased checker in albedo, Lambert sun light plus sky ambient, distance haze.
+in vec3 v_world;
+out vec4 frag;
+uniform vec3 camera_pos;
+uniform vec3 sun_dir;
+uniform vec3 sun_color;
+uniform vec3 albedo;
+uniform float tile;
+
+void main() {
+    vec2 p = v_world.xz / tile;
+    vec2 w = fwidth(p) + 1e-4;
+    vec2 i = 2.0 * (abs(fract((p - 0.5 * w) * 0.5) - 0.5) - abs(fract((p + 0.5 * w) * 0.5) - 0.5)) / w;
+    float checker = 0.5 - 0.5 * i.x * i.y;
+    vec3 base = albedo * mix(0.8, 1.1, checker);
+    vec3 s = normalize(sun_dir);
+    vec3 light = sun_color * max(s.y, 0.0) + vec3(0.25, 0.3, 0.4) * smoothstep(-0.2, 0.2, s.y) + 0.02;
+    float dist = length(v_world - camera_pos);
+    vec3 haze = vec3(0.7, 0.8, 0.95) * smoothstep(-0.2, 0.2, s.y);
+    frag = vec4(mix(base * light, haze, 1.0 - exp(-dist * 0.0015)), 1.0);
+}

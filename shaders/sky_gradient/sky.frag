@@ -1,0 +1,25 @@
+#version 430
+// Sky gradient: view ray from the inverse view-projection; zenith/horizon blend, sun disc and glow.
+in vec2 v_uv;
+out vec4 frag;
+uniform mat4 inv_view_proj;
+uniform vec3 camera_pos;
+uniform vec3 sun_dir;
+uniform vec3 sun_color;
+uniform vec3 zenith;
+uniform vec3 horizon;
+uniform vec3 ground;
+
+void main() {
+    vec4 p = inv_view_proj * vec4(v_uv * 2.0 - 1.0, 1.0, 1.0);
+    vec3 dir = normalize(p.xyz / p.w - camera_pos);
+    vec3 s = normalize(sun_dir);
+    float up = dir.y;
+    vec3 sky = mix(horizon, zenith, pow(clamp(up, 0.0, 1.0), 0.6));
+    sky = mix(sky, ground, smoothstep(0.0, -0.08, up));
+    float cosang = dot(dir, s);
+    float day = smoothstep(-0.15, 0.1, s.y);
+    sky *= mix(0.05, 1.0, day);
+    sky += sun_color * day * (0.25 * pow(max(cosang, 0.0), 32.0) + 20.0 * smoothstep(0.9995, 0.9998, cosang));
+    frag = vec4(sky, 1.0);
+}

@@ -1,0 +1,58 @@
+#version 430
+// Test volume ray march: density = mix(A, B, t); Beer-Lambert extinction, a short light march toward
+// the sun, stopped at scene depth. Output premultiplied: rgb = in-scattered light, a = transmittance
+// (blend ONE, SRC_ALPHA gives light + transmittance * scene).
+in vec2 v_uv;
+out vec4 frag;
+layout(binding = 0) uniform sampler3D density_a;
+layout(binding = 1) uniform sampler3D density_b;
+layout(binding = 2) uniform sampler2D scene_depth;
+uniform mat4 inv_view_proj;
+uniform vec3 camera_pos;
+uniform vec3 sun_dir;
+uniform vec3 sun_color;
+uniform vec3 box_min;
+uniform vec3 box_max;
+uniform float t;
+
+const float SIGMA = 1.2;   // extinction per metre at density 1
+
+float density(vec3 world) {
+    vec3 uvw = (world - box_min) / (box_max - box_min);
+    if (any(lessThan(uvw, vec3(0.0))) || any(greaterThan(uvw, vec3(1.0)))) return 0.0;
+    return mix(texture(density_a, uvw).r, texture(density_b, uvw).r, t);
+}
+
+void main() {
+    vec2 ndc = v_uv * 2.0 - 1.0;
+    vec4 far_p = inv_view_proj * vec4(ndc, 1.0, 1.0);
+    vec3 dir = normalize(far_p.xyz / far_p.w - camera_pos);
+    float z = texture(scene_depth, v_uv).r;
+    vec4 hit = inv_view_proj * vec4(ndc, z * 2.0 - 1.0, 1.0);
+    float scene_dist = z >= 1.0 ? 1e30 : length(hit.xyz / hit.w - camera_pos);
+
+    vec3 inv = 1.0 / dir;
+    vec3 t0 = (box_min - camera_pos) * inv, t1 = (box_max - camera_pos) * inv;
+    float enter = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), max(min(t0.z, t1.z), 0.0));
+    float leave = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), min(max(t0.z, t1.z), scene_dist));
+    vec3 light = vec3(0.0);
+    float trans = 1.0;
+    if (leave > enter) {
+        float dt = (leave - enter) / float(MARCH_STEPS);
+        vec3 s = normalize(sun_dir);
+        float day = smoothstep(-0.1, 0.1, s.y);
+        vec3 ambient = vec3(0.35, 0.42, 0.55) * mix(0.1, 1.0, day);
+        for (int i = 0; i < MARCH_STEPS && trans > 0.01; ++i) {
+            vec3 p = camera_pos + dir * (enter + (float(i) + 0.5) * dt);
+            float d = density(p);
+            if (d < 1e-3) continue;
+            float od = 0.0;
+            for (int j = 1; j <= 4; ++j) od += density(p + s * float(j) * 1.5) * 1.5;
+            float step_t = exp(-SIGMA * d * dt);
+            vec3 lit = sun_color * day * exp(-SIGMA * od) + ambient;
+            light += trans * (1.0 - step_t) * lit;
+            trans *= step_t;
+        }
+    }
+    frag = vec4(light, trans);
+}

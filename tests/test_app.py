@@ -1,0 +1,103 @@
+from dataclasses import dataclass
+
+import pytest
+
+from atmos.app import App
+from atmos.plugin import Plugin, PluginGroup, discover_plugins
+
+
+@dataclass(slots=True)
+class Position:
+    x: float = 0.0
+
+
+@dataclass(slots=True)
+class Velocity:
+    v: float = 1.0
+
+
+def move(app):
+    for _, (p, v) in app.world.get_components(Position, Velocity):
+        p.x += v.v
+
+
+def test_two_apps_never_share_entities():
+    a, b = App(), App()
+    a.world.create_entity(Position(), Velocity())
+    a.world.create_entity(Position(), Velocity())
+    b.world.create_entity(Position())
+    a.add_system(move, label="move")
+    b.add_system(move, label="move")
+    a.run_frames(3)
+    b.run_frames(3)
+    assert a.world.entity_count() == 2 and b.world.entity_count() == 1
+    assert [p.x for _, p in a.world.get_component(Position)] == [3.0, 3.0]
+    assert [p.x for _, p in b.world.get_component(Position)] == [0.0]
+    a.close()
+    assert b.world.entity_count() == 1
+    b.close()
+
+
+class Counter(Plugin):
+    def __init__(self, log):
+        self.log = log
+
+    def build(self, app):
+        self.log.append(("build", self.name))
+
+    def finish(self, app):
+        self.log.append(("finish", self.name))
+
+    def cleanup(self, app):
+        self.log.append(("cleanup", self.name))
+
+
+class First(Counter):
+    pass
+
+
+class Second(Counter):
+    pass
+
+
+class Third(Counter):
+    pass
+
+
+def test_plugin_lifecycle_and_group_editing():
+    log = []
+    group = PluginGroup(First(log), Third(log)).add_before(Third, Second(log))
+    app = App().add_plugins(group)
+    app.startup()
+    app.close()
+    assert log == [("build", "First"), ("build", "Second"), ("build", "Third"),
+                   ("finish", "First"), ("finish", "Second"), ("finish", "Third"),
+                   ("cleanup", "Third"), ("cleanup", "Second"), ("cleanup", "First")]
+
+
+def test_group_disable_and_errors():
+    log = []
+    group = PluginGroup(First(log), Second(log)).disable(First)
+    assert [p.name for p in group] == ["Second"]
+    with pytest.raises(ValueError, match="Third is not in PluginGroup; it holds: Second"):
+        group.disable(Third)
+    app = App()
+    app.add_plugins(First(log))
+    with pytest.raises(ValueError, match="First was added twice"):
+        app.add_plugins(First(log))
+    with pytest.raises(TypeError, match="Plugin or PluginGroup"):
+        app.add_plugins(object())
+    app.close()
+
+
+def test_missing_resource_is_a_clear_error():
+    app = App()
+    with pytest.raises(KeyError, match="no Position resource"):
+        app.resource(Position)
+    app.close()
+
+
+def test_entry_point_discovery_finds_the_shipped_plugins():
+    found = discover_plugins()
+    assert {"ground", "sky_gradient", "overlay", "test_volume"} <= set(found)
+    assert all(issubclass(cls, Plugin) for cls in found.values())

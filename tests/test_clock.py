@@ -1,0 +1,38 @@
+import pytest
+
+from atmos.app import App
+from atmos.clock import FixedClock
+
+
+def test_fixed_steps_accumulate():
+    clock = FixedClock(step=0.1, max_frame_dt=1.0, max_steps=10)
+    assert [clock.advance(0.04) for _ in range(5)] == [0, 0, 1, 0, 1]
+
+
+def test_hitch_does_not_burst():
+    clock = FixedClock(step=1 / 30, max_frame_dt=0.1, max_steps=4)
+    for _ in range(10):
+        clock.advance(1 / 30)
+    steps = clock.advance(2.0)                 # a 2-second hitch
+    assert steps <= 3 and clock.dt == pytest.approx(0.1)
+    assert [clock.advance(1 / 30) for _ in range(3)] in ([1, 1, 1], [1, 1, 2], [2, 1, 1], [1, 2, 1])
+
+
+def test_simulate_stage_runs_once_per_fixed_step():
+    app = App(fixed_step=0.05, max_frame_dt=0.5)
+    count = []
+    app.add_system(lambda app: count.append(app.clock.dt), "simulate", label="count")
+    app.run_frames(10, dt=0.025)            # 0.25 s -> 5 steps
+    assert len(count) == 5 and app.clock.time == pytest.approx(0.25)
+    app.close()
+
+
+@pytest.mark.parametrize("dt", [-1.0, float("nan"), 0.0])
+def test_bad_frame_delta_advances_nothing(dt):
+    clock = FixedClock()
+    assert clock.advance(dt) == 0 and clock.dt == 0.0
+
+
+def test_bad_clock_parameters():
+    with pytest.raises(ValueError, match="step > 0"):
+        FixedClock(step=0)

@@ -1,0 +1,472 @@
+"""Render graph: ordering, validation, culling, transient texture pooling, a real GPU frame, timings, dumps."""
+import numpy as np
+import pytest
+
+from atmos.graph import GraphError, PassContext, RenderGraph, RenderPass, TextureDesc, TexturePool
+
+VERT = "lib/fullscreen.vert"
+SMALL = TextureDesc((8, 8))
+
+
+class P(RenderPass):
+    """A configurable test pass that records what the graph does with it."""
+
+    def __init__(self, name, creates=None, reads=(), writes=(), side=False, before=(), after=(),
+                 shader=None, run=None):
+        self.name, self.before, self.after = name, tuple(before), tuple(after)
+        self.creates, self.reads, self.writes, self.side = dict(creates or {}), reads, writes, side
+        self.shader, self.run = shader, run
+        self.setups = self.prepared = self.executed = self.released = 0
+        self.program = None
+        self.seen = {}
+
+    def setup(self, builder):
+        self.setups += 1
+        for name, desc in self.creates.items():
+            builder.create(name, desc)
+        for name in self.reads:
+            builder.read(name)
+        for name in self.writes:
+            builder.write(name)
+        if self.side:
+            builder.side_effect()
+
+    def prepare(self, gpu):
+        self.prepared += 1
+        if self.shader:
+            self.program = gpu.program(vertex_shader=VERT, fragment_shader=self.shader)
+
+    def execute(self, frame):
+        self.executed += 1
+        self.seen = {n: frame.texture(n) for n in [*self.creates, *self.reads, *self.writes]}
+        if self.run:
+            self.run(self, frame)
+
+    def release(self):
+        self.released += 1
+
+
+@pytest.fixture
+def screen(ctx):
+    """A small imported texture standing in for the screen."""
+    texture = ctx.texture((8, 8), 4)
+    yield texture
+    texture.release()
+
+
+@pytest.fixture
+def graph(gpu, ctx):
+    g = RenderGraph(gpu)
+    yield g
+    g.release()
+
+
+def names(compiled):
+    return compiled.kept
+
+
+# -- ordering ----------------------------------------------------------------------------------
+def test_order_follows_dependencies_with_registration_tie_break(graph):
+    graph.import_texture("screen", object())
+    graph.add_pass(P("present", reads=["b"], writes=["screen"]))
+    graph.add_pass(P("second", reads=["a"], creates={"b": SMALL}))
+    graph.add_pass(P("first", creates={"a": SMALL}))
+    graph.add_pass(P("hud", writes=["screen"], after=["present"]))
+    graph.add_pass(P("independent1", side=True))
+    graph.add_pass(P("independent2", side=True))
+    assert names(graph.compile()) == ["first", "second", "present", "hud", "independent1", "independent2"]
+
+
+def test_writers_precede_pure_readers_and_hints_order_writers(graph):
+    graph.add_pass(P("reader", reads=["x"], side=True))
+    graph.add_pass(P("w1", writes=["x"]))
+    graph.add_pass(P("w2", reads=["x"], writes=["x"]))  # read-modify-write
+    graph.add_pass(P("make", creates={"x": SMALL}))
+    assert names(graph.compile()) == ["make", "w1", "w2", "reader"]
+
+    graph.remove_pass("w1")
+    w1 = P("w1", writes=["x"], after=["w2"])
+    graph.add_pass(w1)
+    assert names(graph.compile()) == ["make", "w2", "w1", "reader"]
+
+
+def test_compile_is_idempotent(graph):
+    a = graph.add_pass(P("a", side=True))
+    first = graph.compile()
+    assert graph.compile() is first and a.setups == 1
+    graph.add_pass(P("b", side=True))
+    assert graph.compile() is not first and a.setups == 2
+
+
+def test_resize_and_invalidate_recompile(gpu, graph):
+    sizes = []
+
+    class Sized(P):
+        def setup(self, builder):
+            builder.create("c", TextureDesc(gpu.size))
+            builder.side_effect()
+
+    graph.add_pass(Sized("sized", run=lambda p, f: sizes.append(f.texture("c").size)))
+    first = graph.compile()
+    assert graph.compile() is first
+    graph.invalidate()
+    second = graph.compile()
+    assert second is not first
+    old = gpu.size
+    try:
+        gpu.resize((old[0] // 2, old[1] // 2))
+        graph.execute()
+        assert graph.compile() is not second and sizes == [gpu.size]
+    finally:
+        gpu.resize(old)
+
+
+def test_cycle_names_the_passes(graph):
+    graph.add_pass(P("a", creates={"x": SMALL}, side=True, after=["c"]))
+    graph.add_pass(P("b", reads=["x"], creates={"y": SMALL}))
+    graph.add_pass(P("c", reads=["y"], side=True))
+    graph.add_pass(P("bystander", side=True))
+    with pytest.raises(GraphError, match="cycle") as info:
+        graph.compile()
+    message = str(info.value)
+    assert all(f"'{n}'" in message for n in "abc") and "bystander" not in message
+    assert "after='c'" in message  # says which edge closes it
+
+
+def test_hint_cycle_and_unknown_hint(graph):
+    graph.add_pass(P("a", side=True, before=["b"]))
+    graph.add_pass(P("b", side=True, before=["a"]))
+    with pytest.raises(GraphError, match=r"cycle between passes '(a|b)', '(a|b)'"):
+        graph.compile()
+    graph.remove_pass("b")
+    graph.add_pass(P("b", side=True, after=["ghost"]))
+    with pytest.raises(GraphError, match=r"'b' must run after 'ghost'.*no pass 'ghost'"):
+        graph.compile()
+
+
+# -- validation ---------------------------------------------------------------------------------
+def test_reading_an_unknown_resource_is_an_error(graph):
+    graph.add_pass(P("fog", reads=["depth"], side=True))
+    with pytest.raises(GraphError, match=r"pass 'fog' reads 'depth'.*no pass creates"):
+        graph.compile()
+
+
+def test_writing_an_unknown_resource_is_an_error(graph):
+    graph.add_pass(P("fog", writes=["color"]))
+    with pytest.raises(GraphError, match=r"pass 'fog' writes 'color'.*no pass creates"):
+        graph.compile()
+
+
+def test_two_creators_is_an_error(graph):
+    graph.add_pass(P("sky", creates={"color": SMALL}))
+    graph.add_pass(P("clouds", creates={"color": SMALL}))
+    with pytest.raises(GraphError, match=r"'sky' and 'clouds' both create 'color'"):
+        graph.compile()
+
+
+def test_creating_an_imported_name_is_an_error(graph):
+    graph.import_texture("screen", object())
+    graph.add_pass(P("sky", creates={"screen": SMALL}))
+    with pytest.raises(GraphError, match=r"'sky' creates 'screen'.*imported"):
+        graph.compile()
+
+
+def test_duplicate_and_missing_pass_names(graph):
+    graph.add_pass(P("sky"))
+    with pytest.raises(GraphError, match="already has a pass named 'sky'"):
+        graph.add_pass(P("sky"))
+    with pytest.raises(GraphError, match="no name"):
+        graph.add_pass(P(""))
+    with pytest.raises(GraphError, match="no pass 'fog'"):
+        graph.remove_pass("fog")
+
+
+def test_texture_desc_validation():
+    assert TextureDesc([4, 4]).size == (4, 4) and TextureDesc((4, 4)) == TextureDesc([4, 4])
+    assert hash(TextureDesc((4, 4, 4), 1, "f4")) == hash(TextureDesc((4, 4, 4), 1, "f4"))
+    with pytest.raises(ValueError, match=r"\(w, h\) or \(w, h, d\)"):
+        TextureDesc((4,))
+    with pytest.raises(ValueError, match=r"\(w, h\) or \(w, h, d\)"):
+        TextureDesc((0, 4))
+    with pytest.raises(ValueError, match="1, 2, 3 or 4"):
+        TextureDesc((4, 4), components=5)
+    with pytest.raises(ValueError, match="one of f1, f2, f4"):
+        TextureDesc((4, 4), dtype="f8")
+    with pytest.raises(ValueError, match="'linear' or 'nearest'"):
+        TextureDesc((4, 4), filter="cubic")
+    with pytest.raises(ValueError, match="depth.*2D"):
+        TextureDesc((4, 4, 4), depth=True)
+    with pytest.raises(ValueError, match="filter='nearest'"):
+        TextureDesc((4, 4), 1, "u4")
+    TextureDesc((4, 4), 1, "u4", filter="nearest")
+
+
+# -- culling ------------------------------------------------------------------------------------
+def test_unread_chain_is_culled_wholly(graph, screen):
+    graph.import_texture("screen", screen)
+    graph.add_pass(P("noise", creates={"noise": SMALL}))
+    graph.add_pass(P("fog", reads=["noise"], creates={"fog_color": SMALL}))
+    graph.add_pass(P("sky", writes=["screen"]))
+    compiled = graph.compile()
+    assert names(compiled) == ["sky"]
+    assert set(compiled.culled) == {"noise", "fog"}
+    assert compiled.culled["fog"] == "nothing reads texture 'fog_color'"
+    assert "only culled passes read texture 'noise' (fog)" in compiled.culled["noise"]
+
+
+def test_chain_feeding_a_kept_pass_is_kept(graph, screen):
+    graph.import_texture("screen", screen)
+    graph.add_pass(P("noise", creates={"noise": SMALL}))
+    graph.add_pass(P("fog", reads=["noise"], creates={"fog_color": SMALL}))
+    graph.add_pass(P("unused", reads=["noise"], creates={"junk": SMALL}))
+    graph.add_pass(P("compose", reads=["fog_color"], writes=["screen"]))
+    graph.add_pass(P("stats", reads=["noise"], side=True))
+    compiled = graph.compile()
+    assert names(compiled) == ["noise", "fog", "compose", "stats"]
+    assert list(compiled.culled) == ["unused"]
+
+
+def test_writing_an_import_or_side_effect_keeps_a_pass(graph, screen):
+    graph.import_texture("screen", screen)
+    graph.import_texture("history", screen)
+    graph.add_pass(P("to_screen", writes=["screen"]))
+    graph.add_pass(P("reads_import_only", reads=["history"]))
+    graph.add_pass(P("debug", side=True))
+    compiled = graph.compile()
+    assert names(compiled) == ["to_screen", "debug"]
+    assert compiled.culled == {"reads_import_only": "declares no outputs and no side effect"}
+
+
+def test_culled_passes_compile_no_shaders_and_allocate_no_textures(gpu, graph, screen):
+    odd = TextureDesc((3, 5), 2, "f4")  # a desc no kept pass uses
+    graph.import_texture("screen", screen)
+    culled = graph.add_pass(P("culled", creates={"fog_color": odd}, shader="test/graph_culled.frag"))
+    kept = graph.add_pass(P("kept", creates={"tmp": SMALL}, shader="test/graph_gradient.frag"))
+    graph.add_pass(P("present", reads=["tmp"], writes=["screen"]))
+    for _ in range(3):
+        graph.execute()
+    assert "test/graph_culled.frag" not in gpu.compiled_files
+    assert "test/graph_gradient.frag" in gpu.compiled_files
+    assert culled.prepared == culled.executed == 0
+    assert kept.prepared == 1 and kept.executed == 3
+    assert graph.pool.allocations == 1 and graph.pool.in_use == 0
+    assert odd not in graph.pool._free
+
+
+# -- transient textures ---------------------------------------------------------------------------
+def test_pool_reuses_equal_descs(gpu, ctx):
+    pool = TexturePool(gpu)
+    a = pool.acquire(SMALL)
+    b = pool.acquire(SMALL)
+    assert a is not b and pool.allocations == 2
+    pool.release(a)
+    assert pool.acquire(SMALL) is a and pool.allocations == 2
+    c = pool.acquire(TextureDesc((8, 8), filter="nearest"))
+    assert c is not a and pool.allocations == 3
+    volume = pool.acquire(TextureDesc((4, 4, 4), 1, "f4"))
+    depth = pool.acquire(TextureDesc((8, 8), depth=True))
+    assert volume.size == (4, 4, 4) and volume.components == 1 and depth.depth
+    stranger = ctx.texture((1, 1), 1)
+    with pytest.raises(ValueError, match="not acquired from this pool"):
+        pool.release(stranger)
+    stranger.release()
+    pool.release(b)
+    with pytest.raises(ValueError, match="already released"):
+        pool.release(b)
+    pool.release_all()
+    assert pool.textures == 0 and pool.in_use == 0
+    assert all(type(t.mglo).__name__ == "InvalidObject" for t in (a, b, c, volume, depth))
+
+
+def test_steady_frames_allocate_nothing(graph, screen):
+    graph.import_texture("screen", screen)
+    graph.add_pass(P("a", creates={"x": SMALL}))
+    graph.add_pass(P("b", reads=["x"], creates={"y": SMALL}))
+    graph.add_pass(P("c", reads=["x", "y"], writes=["screen"]))
+    graph.execute()
+    first = graph.pool.allocations
+    assert first == 2  # x and y overlap: two textures
+    for _ in range(20):
+        graph.execute()
+        assert graph.pool.in_use == 0
+    assert graph.pool.allocations == first
+
+
+def test_textures_with_disjoint_lifetimes_alias(graph, screen):
+    other = TextureDesc((8, 8), 1, "f4")
+    graph.import_texture("screen", screen)
+    p1 = graph.add_pass(P("p1", creates={"a": SMALL}))
+    p2 = graph.add_pass(P("p2", reads=["a"], creates={"mid": other}))
+    p3 = graph.add_pass(P("p3", reads=["mid"], creates={"b": SMALL}))
+    p4 = graph.add_pass(P("p4", reads=["b"], writes=["screen"]))
+    compiled = graph.compile()
+    assert compiled.resources["a"].lifetime == (0, 1) and compiled.resources["b"].lifetime == (2, 3)
+    graph.execute()
+    assert p1.seen["a"] is p2.seen["a"] and p3.seen["b"] is p4.seen["b"]
+    assert p1.seen["a"] is p3.seen["b"]  # same desc, lifetimes don't overlap: one texture
+    assert p2.seen["mid"] is not p1.seen["a"]
+    assert graph.pool.allocations == 2
+
+
+def test_undeclared_texture_is_an_error(graph, screen):
+    def peek(p, frame):
+        frame.texture("screen")
+    graph.add_pass(P("sneaky", side=True, run=peek))
+    graph.import_texture("screen", screen)
+    with pytest.raises(GraphError, match="'sneaky' uses 'screen' but did not declare it"):
+        graph.execute()
+
+
+# -- a real frame -----------------------------------------------------------------------------------
+def _fill(p, frame):
+    frame.framebuffer(color=["color"]).use()
+    frame.fullscreen(p.program)
+
+
+def _swizzle(p, frame):
+    frame.texture("color").use(location=0)
+    p.program["src"].value = 0
+    frame.framebuffer(color=["target"]).use()
+    frame.fullscreen(p.program)
+
+
+def test_two_pass_frame_renders_expected_pixels(gpu, graph):
+    w, h = gpu.size
+    graph.import_texture("target", lambda: gpu.target)
+    graph.add_pass(P("gradient", creates={"color": TextureDesc((w, h))},
+                     shader="test/graph_gradient.frag", run=_fill))
+    graph.add_pass(P("swizzle", reads=["color"], writes=["target"],
+                     shader="test/graph_swizzle.frag", run=_swizzle))
+    gpu.target.clear(0.0, 0.0, 0.0, 1.0)
+    graph.execute()
+    pixels = gpu.read_pixels().astype(int)  # (h, w, rgb), top row first
+    ramp = (np.arange(w) + 0.5) / w  # v_uv.x at pixel centres
+    expected = np.empty((h, w, 3))
+    expected[..., 0] = 0.5            # blue of the gradient
+    expected[..., 1] = ramp[None, :]  # red ramp moved to green
+    expected[..., 2] = 0.5            # green 0.25 doubled
+    assert np.abs(pixels - np.round(expected * 255)).max() <= 1
+    assert pixels[0, 0, 1] <= 1 and pixels[0, -1, 1] >= 254
+
+
+def test_callable_import_is_resolved_every_frame(gpu, graph, ctx):
+    red, green = ctx.texture((4, 4), 4), ctx.texture((4, 4), 4)
+    red.write(np.tile([255, 0, 0, 255], 16).astype(np.uint8).tobytes())
+    green.write(np.tile([0, 255, 0, 255], 16).astype(np.uint8).tobytes())
+    out = ctx.texture((4, 4), 4)
+    current = [red]
+
+    def copy(p, frame):
+        fbo = frame.framebuffer(color=["out"])
+        ctx.copy_framebuffer(fbo, frame.framebuffer(color=["src"]))
+
+    graph.import_texture("src", lambda: current[0])
+    graph.import_texture("out", out)
+    copier = graph.add_pass(P("copy", reads=["src"], writes=["out"], run=copy))
+    compiled = graph.compile()
+    graph.execute()
+    assert copier.seen["src"] is red
+    assert np.frombuffer(out.read(), np.uint8)[:4].tolist() == [255, 0, 0, 255]
+    current[0] = green
+    graph.execute()
+    assert copier.seen["src"] is green and graph.compile() is compiled and copier.setups == 1
+    assert np.frombuffer(out.read(), np.uint8)[:4].tolist() == [0, 255, 0, 255]
+    graph.import_texture("src", red)  # replacing a known import's source does not recompile either
+    graph.execute()
+    assert copier.seen["src"] is red and graph.compile() is compiled
+    graph.release()
+    for texture in (red, green, out):
+        texture.release()
+
+
+def test_execute_data_reaches_passes(graph):
+    got = {}
+
+    def grab(p, frame):
+        assert isinstance(frame, PassContext)
+        got.update(frame.data, name=frame.pass_name, gpu=frame.gpu)
+
+    graph.add_pass(P("grab", side=True, run=grab))
+    graph.execute(app="the app", dt=0.5)
+    assert got == {"app": "the app", "dt": 0.5, "name": "grab", "gpu": graph.gpu}
+
+
+def test_framebuffers_are_cached(graph, screen):
+    fbos = []
+    graph.import_texture("screen", screen)
+    graph.add_pass(P("draw", creates={"c": SMALL, "d": TextureDesc((8, 8), depth=True)}, writes=["screen"],
+                     run=lambda p, f: fbos.append((f.framebuffer(["c"], depth="d"), f.framebuffer(["screen"])))))
+    for _ in range(4):
+        graph.execute()
+    assert len({id(a) for a, _ in fbos}) == 1 and len({id(b) for _, b in fbos}) == 1
+    assert fbos[0][0] is not fbos[0][1]
+
+
+# -- timings, dumps, lifetime --------------------------------------------------------------------
+def test_timings_cover_kept_passes_only(graph, screen):
+    graph.import_texture("screen", screen)
+    graph.add_pass(P("a", creates={"x": SMALL}))
+    graph.add_pass(P("b", reads=["x"], writes=["screen"]))
+    graph.add_pass(P("culled", creates={"y": SMALL}))
+    for _ in range(5):
+        graph.execute()
+    assert set(graph.timings) == {"a", "b"}
+    for gpu_ms, cpu_ms in graph.timings.values():
+        assert gpu_ms >= 0.0 and cpu_ms >= 0.0
+    graph.remove_pass("b")
+    graph.add_pass(P("b2", reads=["x"], writes=["screen"]))
+    graph.compile()
+    assert "b" not in graph.timings
+    graph.timings_enabled = False
+    before = dict(graph.timings)
+    for _ in range(4):
+        graph.execute()
+    assert graph.timings == before
+
+
+def test_dump_and_dot_show_kept_and_culled(graph, screen):
+    graph.import_texture("screen", screen)
+    graph.add_pass(P("sky", creates={"sky_color": TextureDesc((64, 32))}))
+    graph.add_pass(P("fog", reads=["sky_color"], creates={"fog_color": SMALL}))
+    graph.add_pass(P("present", reads=["sky_color"], writes=["screen"]))
+    text = graph.dump()
+    assert "1. sky" in text and "2. present" in text
+    assert "culled:" in text and "fog" in text and "nothing reads texture 'fog_color'" in text
+    assert "64x32 4xf2 linear" in text and "imported" in text and "never allocated" in text
+    dot = graph.to_dot()
+    assert dot.startswith("digraph") and dot.rstrip().endswith("}")
+    assert '"pass:sky" [shape=box' in dot and 'label="1. sky"' in dot
+    assert '"pass:fog" [shape=box, style="dashed,filled"' in dot
+    assert "peripheries=2" in dot and '"res:sky_color" [shape=ellipse' in dot
+    assert '"pass:sky" -> "res:sky_color" [label="create"]' in dot
+    assert '"res:sky_color" -> "pass:present" [label="read"]' in dot
+    assert '"pass:present" -> "res:screen" [label="write"]' in dot
+
+
+def test_release_frees_everything(gpu, ctx, screen):
+    graph = RenderGraph(gpu)
+    graph.import_texture("screen", screen)
+    fbos = []
+    a = graph.add_pass(P("a", creates={"x": SMALL}, shader="test/graph_gradient.frag",
+                         run=lambda p, f: (fbos.append(f.framebuffer(["x"])), f.framebuffer(["x"]).use(),
+                                           f.fullscreen(p.program))))
+    b = graph.add_pass(P("b", reads=["x"], writes=["screen"]))
+    culled = graph.add_pass(P("culled", creates={"y": SMALL}))
+    for _ in range(3):
+        graph.execute()
+    texture = a.seen["x"]
+    graph.release()
+    assert a.released == b.released == 1 and culled.released == 0  # never prepared: nothing to release
+    assert graph.pool.textures == 0 and graph.timings == {}
+    released = type(texture.mglo)
+    assert released.__name__ == "InvalidObject" and type(fbos[0].mglo).__name__ == "InvalidObject"
+    graph.execute()  # still usable: passes are prepared again
+    assert a.prepared == 2 and graph.pool.allocations == 2
+    graph.release()
+
+
+def test_remove_pass_releases_it(graph):
+    p = graph.add_pass(P("a", side=True))
+    graph.execute()
+    graph.remove_pass("a")
+    assert p.released == 1 and graph.compile().kept == []

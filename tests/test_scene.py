@@ -1,0 +1,78 @@
+"""Whole scenes: what a scene leaves out costs nothing; long runs leak nothing; resizing is safe."""
+import numpy as np
+import pytest
+
+from atmos.app import App
+from atmos.defaults import DefaultPlugins
+from atmos.gpu import create_headless
+from atmos.plugins.ground import GroundPlugin
+from atmos.plugins.sky_gradient import SkyGradientPlugin
+from atmos.plugins.test_volume import TestVolumePlugin
+
+
+@pytest.fixture
+def fresh_gpu():
+    gpu = create_headless((96, 54))
+    yield gpu
+    assert gpu.ctx.error == "GL_NO_ERROR"
+    gpu.release()
+
+
+def scene(gpu, *plugins):
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(), *plugins)
+    app.startup()
+    return app
+
+
+def test_scene_without_an_effect_runs_compiles_and_allocates_none_of_it(fresh_gpu):
+    app = scene(fresh_gpu)
+    app.run_frames(3)
+    dump = app.graph.dump()
+    assert "test_volume" not in dump
+    assert not any(f.startswith("test_volume/") for f in fresh_gpu.compiled_files)
+    allocated = app.graph.pool.allocations
+    app.close()
+
+    app = scene(fresh_gpu, TestVolumePlugin(resolution=(16, 8, 16), slices=4))
+    app.run_frames(3)
+    assert "test_volume" in app.graph.dump()
+    assert {"test_volume/density.comp", "test_volume/march.frag"} <= fresh_gpu.compiled_files
+    assert app.graph.pool.allocations >= allocated
+    app.close()
+
+
+def test_long_run_allocates_nothing_per_frame(fresh_gpu):
+    app = scene(fresh_gpu, TestVolumePlugin(resolution=(16, 8, 16), slices=4))
+    app.run_frames(5)
+    pool, tracked, programs = app.graph.pool.allocations, len(fresh_gpu._tracked), len(fresh_gpu._programs)
+    app.run_frames(200)
+    assert app.graph.pool.allocations == pool
+    assert len(fresh_gpu._tracked) == tracked and len(fresh_gpu._programs) == programs
+    app.close()
+
+
+def test_volume_animates_through_the_three_sets(fresh_gpu):
+    plugin = TestVolumePlugin(resolution=(16, 8, 16), slices=4)
+    app = scene(fresh_gpu, plugin)
+    seen = []
+    for _ in range(12):
+        app.update(1 / 30)
+        a, b, t = plugin.job.view()
+        seen.append((plugin.job.step, round(t, 3)))
+    steps = [s for s, _ in seen]
+    assert steps == sorted(steps) and steps[-1] - steps[0] == 3     # 12 frames, 4 slices per step
+    assert sorted({t for _, t in seen}) == [0.0, 0.25, 0.5, 0.75]
+    app.close()
+
+
+@pytest.mark.parametrize("size", [(1, 1), (0, 0), (333, 77)])
+def test_resize_including_minimized_window(fresh_gpu, size):
+    app = scene(fresh_gpu)
+    app.run_frames(1)
+    fresh_gpu.resize(size)
+    app.graph.invalidate()
+    app.run_frames(2)
+    img = fresh_gpu.read_pixels()
+    assert img.shape[:2] == (max(1, size[1]), max(1, size[0])) and np.isfinite(img).all()
+    app.close()
+    fresh_gpu.resize((96, 54))
