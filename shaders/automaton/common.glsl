@@ -1,0 +1,24 @@
+// Shared declarations of the cloud automaton shaders (see plugins/automaton/automaton.py).
+// Dispatch: 1D invocation index spread over a 2D grid of 64-wide groups.
+
+#define PRECISION_BITS 16
+#define PLANES 17            // threshold bit planes 0..16 (plane 16 set <=> T == 65536, p == 1)
+
+uniform ivec3 u_size;        // nx, ny, nz (cells)
+uniform int u_nwx;           // words per x row = ceil(nx / 32)
+uniform uint u_count;        // invocations that do work (words or cells)
+
+// Stochastic rules 0 extinction, 1 humidity, 2 activation.
+// u_mode: 0 = rule off (p == 0 everywhere), 1 = scalar threshold u_threshold, 2 = per-cell array.
+uniform uvec3 u_mode;
+uniform uvec3 u_threshold;   // T = floor(p * 65536 + 0.5) in [0, 65536] for mode 1
+uniform uvec2 u_keys[3 * PRECISION_BITS];   // stream keys (ka, kb) of (seed, step, rule, plane)
+
+uint invocation_index() {
+    return gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * (gl_NumWorkGroups.x * gl_WorkGroupSize.x);
+}
+
+// uint threshold of a float32 probability in [0, 1]: exact in float32 (p * 65536 < 2^23).
+uint quantize(float p) {
+    return uint(floor(p * 65536.0 + 0.5));
+}
