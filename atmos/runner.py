@@ -77,7 +77,7 @@ def run_window(name: str, settings: DemoSettings) -> None:
         if times is not None and frames[0] % 30 == 0:
             window.set_caption(f"atmos — {name} — {times.summary()}")
         if settings.frames and frames[0] >= settings.frames:
-            window.close()
+            pyglet.app.exit()  # closing inside on_draw would disturb pyglet's window iteration
 
     @window.event
     def on_resize(width, height):
@@ -112,3 +112,4 @@ def run_window(name: str, settings: DemoSettings) -> None:
     finally:
         app.close()
         gpu.release()
+        window.close()

@@ -399,3 +399,12 @@ def test_failed_slice_is_retried(gpu, ctx):
     job.run_step()
     assert calls == [0, 1, 1, 2] and job.step == 1 and triple.generation == 1
     triple.release()
+
+
+def test_gpu_measure_times_a_slice(ctx):
+    from atmos.frames import gpu_measure, timer_query_measure
+    ran = []
+    for measure in (gpu_measure(ctx), timer_query_measure(ctx)):
+        ms = measure(lambda: ran.append(1))
+        assert ms >= 0.0 and ms == ms
+    assert ran == [1, 1]

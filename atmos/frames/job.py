@@ -39,6 +39,28 @@ def synced_measure(ctx) -> Measure:
     return measure
 
 
+def timer_query_measure(ctx) -> Measure:
+    """A measure from an OpenGL timer query around the slice: the GPU's own time for its commands.
+
+    Reading the result waits for the slice to finish on the GPU, which the budget needs anyway.
+    """
+    query = ctx.query(time=True)
+
+    def measure(run: Callable[[], None]) -> float:
+        with query:
+            run()
+        return query.elapsed / 1e6
+    return measure
+
+
+def gpu_measure(ctx) -> Measure:
+    """The best GPU-cost measure for ``ctx``: timer queries on a real GPU, synced wall time on a
+    software rasterizer (llvmpipe reports meaningless timer-query results)."""
+    renderer = ctx.info.get("GL_RENDERER", "").lower()
+    software = any(name in renderer for name in ("llvmpipe", "softpipe", "swrast"))
+    return synced_measure(ctx) if software else timer_query_measure(ctx)
+
+
 @dataclass
 class SliceContext:
     """What a slice sees: where to write (``target`` = C), what to read (``previous`` = B), which slice."""

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from atmos.frames.job import Measure, SlicedJob, perf_measure, synced_measure
+from atmos.frames.job import Measure, SlicedJob, gpu_measure, perf_measure
 
 MODES = ("sliced", "naive")
 
@@ -33,8 +33,8 @@ class FrameScheduler:
     """Runs one frame's worth of slices of every added job per :meth:`tick`.
 
     ``measure`` times one slice (a callable that runs its argument and returns milliseconds): by
-    default ``time.perf_counter`` around the slice, with ``ctx.finish()`` before and after when
-    ``sync`` is true. ``sync`` defaults to true exactly when a time budget is in use (the budget
+    default ``time.perf_counter`` around the slice, or, when ``sync`` is true, the GPU's cost of the
+    slice (:func:`~atmos.frames.job.gpu_measure`: timer queries on a GPU, synced wall time on llvmpipe). ``sync`` defaults to true exactly when a time budget is in use (the budget
     needs the GPU cost; without one, syncing would only stall the pipeline).
     """
 
@@ -90,7 +90,7 @@ class FrameScheduler:
     def _measure_for(self, job: SlicedJob) -> Measure:
         if self.measure is not None:
             return self.measure
-        return synced_measure(job.triple.gpu.ctx) if self.sync else perf_measure
+        return gpu_measure(job.triple.gpu.ctx) if self.sync else perf_measure
 
     def tick(self) -> None:
         """Run one frame's worth of slices."""
