@@ -4,61 +4,19 @@ A and B hold the last two completed results and are what readers draw (interpola
 set the slices of the current step write into. When C is complete the sets rotate
 (A←B, B←C, C←old A), so no texture is ever read while it is half written.
 
-Texture descriptions are duck-typed: any object with ``size`` ((w, h) or (w, h, d)),
-``components``, ``dtype``, ``depth`` and ``filter`` works, ``atmos.graph.resources.TextureDesc``
-included.
+Textures are described by :class:`atmos.graph.TextureDesc`, as the render graph's are.
 """
 from __future__ import annotations
 
 from typing import Iterator, Mapping
 
-import moderngl
+from atmos.graph.resources import TextureDesc
 
-_DTYPE_BYTES = {"f1": 1, "u1": 1, "i1": 1, "f2": 2, "u2": 2, "i2": 2, "f4": 4, "u4": 4, "i4": 4}
-_FILTERS = {"linear": (moderngl.LINEAR, moderngl.LINEAR), "nearest": (moderngl.NEAREST, moderngl.NEAREST)}
-
-
-def _describe(desc) -> str:
-    return f"{type(desc).__name__}(size={getattr(desc, 'size', '?')}, dtype={getattr(desc, 'dtype', '?')!r})"
-
-
-def make_texture(gpu, desc, clear: bool = True):
-    """A moderngl texture for ``desc``, tracked by ``gpu`` (released with it).
-
-    2D sizes give ``ctx.texture`` (or ``ctx.depth_texture`` when ``desc.depth``), 3D sizes
-    ``ctx.texture3d``. ``filter`` is ``"linear"`` or ``"nearest"``. Colour textures are filled
-    with zeros when ``clear`` is true, so a set never holds undefined data.
-    """
-    size = tuple(int(s) for s in getattr(desc, "size", ()))
-    components = int(getattr(desc, "components", 4))
-    dtype = getattr(desc, "dtype", "f2")
-    depth = bool(getattr(desc, "depth", False))
-    filter_name = getattr(desc, "filter", "linear")
-    if len(size) not in (2, 3) or any(s < 1 for s in size):
-        raise ValueError(f"texture size {getattr(desc, 'size', None)!r} in {_describe(desc)}: "
-                         "allowed are (width, height) or (width, height, depth), each at least 1")
-    if filter_name not in _FILTERS:
-        raise ValueError(f"texture filter {filter_name!r} in {_describe(desc)}: allowed are 'linear', 'nearest'")
-    if depth:
-        if len(size) != 2:
-            raise ValueError(f"depth texture {_describe(desc)} must be 2D: 3D depth textures are not supported")
-        texture = gpu.ctx.depth_texture(size)
-    else:
-        if dtype not in _DTYPE_BYTES:
-            raise ValueError(f"texture dtype {dtype!r} in {_describe(desc)}: allowed are {', '.join(_DTYPE_BYTES)}")
-        if components not in (1, 2, 3, 4):
-            raise ValueError(f"texture components {components} in {_describe(desc)}: allowed are 1, 2, 3, 4")
-        if len(size) == 2:
-            texture = gpu.ctx.texture(size, components, dtype=dtype)
-        else:
-            texture = gpu.ctx.texture3d(size, components, dtype=dtype)
-        if clear:
-            texels = 1
-            for s in size:
-                texels *= s
-            texture.write(bytes(texels * components * _DTYPE_BYTES[dtype]))
-    texture.filter = _FILTERS[filter_name]
-    return gpu.track(texture)
+def make_texture(gpu, desc: TextureDesc, clear: bool = True):
+    """A zero-filled moderngl texture for ``desc``, tracked by ``gpu`` (released with it)."""
+    if not isinstance(desc, TextureDesc):
+        raise ValueError(f"texture description {desc!r}: allowed is an atmos.graph.TextureDesc")
+    return gpu.track(desc.create(gpu.ctx, clear=clear))
 
 
 class TextureSet:

@@ -43,6 +43,24 @@ class TextureDesc:
             raise ValueError(f"integer TextureDesc dtype {self.dtype!r} needs filter='nearest' "
                              "(OpenGL cannot filter integer textures linearly)")
 
+    def create(self, ctx: moderngl.Context, clear: bool = False):
+        """A new moderngl texture of this description (colour textures zero-filled when ``clear``)."""
+        if self.depth:
+            texture = ctx.depth_texture(self.size)
+            texture.compare_func = ""  # sample as a plain sampler2D
+        elif len(self.size) == 3:
+            texture = ctx.texture3d(self.size, self.components, dtype=self.dtype)
+        else:
+            texture = ctx.texture(self.size, self.components, dtype=self.dtype)
+        if clear and not self.depth:
+            texels = 1
+            for s in self.size:
+                texels *= s
+            texture.write(bytes(texels * self.components * int(self.dtype[1])))
+        mode = moderngl.LINEAR if self.filter == "linear" else moderngl.NEAREST
+        texture.filter = (mode, mode)
+        return texture
+
     def __str__(self) -> str:
         size = "x".join(map(str, self.size))
         if self.depth:
@@ -96,16 +114,7 @@ class TexturePool:
         self._in_use.clear()
 
     def _create(self, desc: TextureDesc):
-        ctx = self.gpu.ctx
-        if desc.depth:
-            texture = ctx.depth_texture(desc.size)
-            texture.compare_func = ""  # sample as a plain sampler2D
-        elif len(desc.size) == 3:
-            texture = ctx.texture3d(desc.size, desc.components, dtype=desc.dtype)
-        else:
-            texture = ctx.texture(desc.size, desc.components, dtype=desc.dtype)
-        mode = moderngl.LINEAR if desc.filter == "linear" else moderngl.NEAREST
-        texture.filter = (mode, mode)
+        texture = desc.create(self.gpu.ctx)
         self.allocations += 1
         self._desc[id(texture)] = (desc, texture)
         return texture

@@ -1,0 +1,60 @@
+"""ECS components of the weather layer (thesis sec. 4.3.3.3 and 4.3.3.5).
+
+One entity per weather ellipsoid, carrying one :class:`Ellipsoid`. The rules mutate the component
+in place every step; entities are created and deleted only by the rules that demand it (creation
+toward the target density, death at the lifetime, leaving the region, removal above the target).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(slots=True)
+class Ellipsoid:
+    """A weather ellipsoid: where clouds may form (sec. 4.3.2/4.3.3).
+
+    ``x, y, z``: centre in world cells (the simulation volume's cell (0, 0, 0) covers
+    ``[origin, origin + 1)``), y is height. ``rx, ry, rz``: full-size radii in cells along the
+    ellipsoid's own axes. ``yaw``: orientation, radians around the height axis (the thesis stores
+    "two components for scaling in x and y" and "an orientation attribute", so one angle suffices);
+    the local x axis points along world (cos yaw, 0, sin yaw). ``age`` and ``lifetime`` in seconds;
+    the ellipsoid dies in the first step where ``age >= lifetime``. ``drift_x, drift_z``: the
+    ellipsoid's constant personal wind offset (cells/s). ``vx, vy, vz``: the velocity applied in the
+    last step (wind + offset). ``scale``: the shrink factor of the radii, 1 until ``shrink_time``
+    before the end of the lifetime, then falling linearly to 0.
+    """
+    x: float = 0.0
+    y: float = 0.0
+    z: float = 0.0
+    rx: float = 1.0
+    ry: float = 1.0
+    rz: float = 1.0
+    yaw: float = 0.0
+    age: float = 0.0
+    lifetime: float = 1.0
+    drift_x: float = 0.0
+    drift_z: float = 0.0
+    vx: float = 0.0
+    vy: float = 0.0
+    vz: float = 0.0
+    scale: float = 1.0
+
+    @property
+    def remaining(self) -> float:
+        """Seconds of lifetime left."""
+        return self.lifetime - self.age
+
+
+@dataclass(slots=True)
+class VolumeOrigin:
+    """World position (in cells) of the simulation volume's cell (0, 0, 0); moves with the viewer.
+
+    An App resource of :class:`atmos.plugins.weather.WeatherPlugin`: game code moves it, the
+    weather rules put the region boundings around it, and the region volume is rendered at it.
+    """
+    x: float = 0.0
+    y: float = 0.0
+    z: float = 0.0
+
+    def as_tuple(self) -> tuple[float, float, float]:
+        return (self.x, self.y, self.z)
