@@ -365,3 +365,33 @@ def test_release(make):
     ca.release()
     with pytest.raises(RuntimeError, match="released"):
         ca.step()
+
+
+@pytest.mark.parametrize("layout", ["packed", "cell"])
+def test_step_with_region_texture_equals_step_with_arrays(ctx, rng, layout):
+    """The weather region's probability texture drives a step on the GPU exactly like float32 arrays."""
+    from atmos.plugins.weather import RegionVolume, WeatherParams
+    shape = (37, 6, 11)
+    params = WeatherParams(hum_scale=0.3, act_scale=0.05, ext_scale=0.2, volume_shape=shape)
+    ellipsoids = np.zeros((6, 8), np.float32)
+    ellipsoids[:, :3] = rng.uniform(0, 1, (6, 3)) * shape
+    ellipsoids[:, 3] = rng.uniform(0, 6.28, 6)
+    ellipsoids[:, 4:7] = rng.uniform(2, 8, (6, 3))
+    region = RegionVolume(ctx, shape)
+    region.render(ellipsoids)
+    texture = region.probabilities(params)
+    p_hum, p_act, p_ext = region.download_probabilities()
+    state = [rng.random(shape) < 0.3 for _ in range(3)]
+    a, b = CloudAutomaton(ctx, shape, seed=5, layout=layout), CloudAutomaton(ctx, shape, seed=5, layout=layout)
+    for ca in (a, b):
+        ca.upload(*state)
+    for _ in range(3):
+        a.step_with_texture(texture, shift=(1, -1))
+        b.step(p_ext=p_ext, p_hum=p_hum, p_act=p_act, shift=(1, -1))
+    for x, y in zip(a.download(), b.download()):
+        assert np.array_equal(x, y)
+    bad = ctx.texture3d((2, 2, 2), 4)
+    with pytest.raises(ValueError, match="Texture3D of size"):
+        a.step_with_texture(bad)
+    for obj in (a, b, region, bad):
+        obj.release()

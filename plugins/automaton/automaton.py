@@ -161,6 +161,7 @@ class CloudAutomaton:
         self._prob_buffers: list = [None, None, None]
         self._staging = None
         self._prob_cache: list = [None, None, None]   # the array last uploaded per rule (identity)
+        self._prog_texture = None                      # made on the first step_with_texture
         for prog in (self._prog_step, self._prog_advect, self._prog_pack):
             if prog is not None:
                 self._set(prog, "u_size", shape)
@@ -229,6 +230,10 @@ class CloudAutomaton:
             else:
                 modes.append(0 if value == 0 else 1)
                 thresholds.append(value)
+        self._run_step(modes, thresholds, shifts)
+
+    def _run_step(self, modes, thresholds, shifts) -> None:
+        """Dispatch growth + stochastic rules (``modes``: 0 off, 1 scalar, 2 per-cell) + advection."""
         ka, kb = stream_key(self.seed, self.step_count, _RULE_IDS, _PLANE_IDS)
         keys = np.stack([ka, kb], axis=-1).astype("<u4").tobytes()
 
@@ -271,7 +276,7 @@ class CloudAutomaton:
         if self._released:
             return
         self._released = True
-        objects = [self._prog_step, self._prog_advect, self._prog_pack, self._shifts, self._dummy,
+        objects = [self._prog_step, self._prog_advect, self._prog_pack, self._prog_texture, self._shifts, self._dummy,
                    self._staging, *self._state, *self._prob_buffers]
         for obj in objects:
             if obj is not None:
@@ -360,18 +365,53 @@ class CloudAutomaton:
         if p is self._prob_cache[rule]:
             return
         data = np.ascontiguousarray(p.transpose(2, 1, 0), dtype="<f4").tobytes()
-        if self.layout == "cell":
-            if self._prob_buffers[rule] is None:
-                self._prob_buffers[rule] = self.ctx.buffer(reserve=4 * self._cells)
-            self._prob_buffers[rule].write(data)
-        else:
-            if self._staging is None:
-                self._staging = self.ctx.buffer(reserve=4 * self._cells)
-            if self._prob_buffers[rule] is None:
-                self._prob_buffers[rule] = self.ctx.buffer(reserve=4 * PLANES * self._count)
-            self._staging.write(data)
-            self._staging.bind_to_storage_buffer(6)
-            self._prob_buffers[rule].bind_to_storage_buffer(7)
-            self._prog_pack.run(*self._grid)
-            self.ctx.memory_barrier(moderngl.SHADER_STORAGE_BARRIER_BIT)
+        self._store_probability(rule, lambda buffer: buffer.write(data))
         self._prob_cache[rule] = p
+
+    def _store_probability(self, rule: int, fill) -> None:
+        """``fill(buffer)`` writes per-cell float32 probabilities [x + nx*(y + ny*z)] into ``buffer``;
+        they become the rule's per-cell probabilities (threshold planes in the packed layout)."""
+        if self._prob_buffers[rule] is None:
+            size = 4 * (self._cells if self.layout == "cell" else PLANES * self._count)
+            self._prob_buffers[rule] = self.ctx.buffer(reserve=size)
+        if self.layout == "cell":
+            fill(self._prob_buffers[rule])
+            return
+        if self._staging is None:
+            self._staging = self.ctx.buffer(reserve=4 * self._cells)
+        fill(self._staging)
+        self._staging.bind_to_storage_buffer(6)
+        self._prob_buffers[rule].bind_to_storage_buffer(7)
+        self._prog_pack.run(*self._grid)
+        self.ctx.memory_barrier(moderngl.SHADER_STORAGE_BARRIER_BIT)
+
+    def step_with_texture(self, probabilities, shift=(0, 0)) -> None:
+        """One step with per-cell probabilities read on the GPU from a 3D texture of ``shape``
+        whose channels are (p_hum, p_act, p_ext, ·) — the weather region volume's
+        ``prob_texture`` — so a region-driven step makes no CPU round trip. Same result as
+        :meth:`step` with those values as float32 arrays."""
+        self._check_alive()
+        if not isinstance(probabilities, moderngl.Texture3D) or tuple(probabilities.size) != self.shape \
+                or probabilities.components < 3:
+            raise ValueError(f"probabilities must be a moderngl.Texture3D of size {self.shape} with channels "
+                             f"(p_hum, p_act, p_ext[, ·]); got {probabilities!r}")
+        shifts = self._check_shift(shift)
+        if self._prog_texture is None:
+            self._prog_texture = build_program(self.ctx, {"compute_shader": "automaton/from_texture.comp"})
+            self._set(self._prog_texture, "u_size", self.shape)
+        cells = self._prog_texture
+        groups = -(-self._cells // _GROUP)
+        grid = (min(groups, 65535), -(-groups // 65535), 1)
+
+        def fill_from(channel):
+            def fill(buffer):
+                probabilities.use(0)
+                buffer.bind_to_storage_buffer(6)
+                self._set(cells, "u_channel", channel)
+                cells.run(*grid)
+                self.ctx.memory_barrier(moderngl.SHADER_STORAGE_BARRIER_BIT)
+            return fill
+        for rule, channel in zip(range(3), (2, 0, 1)):      # RULES order: ext, hum, act
+            self._store_probability(rule, fill_from(channel))
+            self._prob_cache[rule] = probabilities
+        self._run_step(modes=(2, 2, 2), thresholds=(0, 0, 0), shifts=shifts)
