@@ -1,0 +1,133 @@
+"""Fog post-process after Zdrojewska, "Real time rendering of heterogenous fog" (homogeneous and
+Perlin-turbulence heterogeneous fog), as a plugin with one render-graph pass, and :func:`apply_fog`.
+
+Modes: ``linear`` (eq. 2), ``exp`` (eq. 3), ``exp2`` (eq. 4), ``hetero_exp`` (eq. 6) and
+``hetero_exp2`` (eq. 7) with the turbulence of eq. (5) from 1-4 octaves of tileable 3D gradient noise
+(GPU-made textures or procedural); the blend is eq. (1). See :class:`FogSettings` for every knob.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from atmos.plugin import Plugin
+from atmos.plugins.fog.noise import NoiseVolumes
+from atmos.plugins.fog.post import FogPass, draw_state, fog_program, restore_state, set_fog_uniforms
+from atmos.plugins.fog.programs import gl_context
+from atmos.plugins.fog.settings import MODES, FogSettings
+
+__all__ = ["FogPlugin", "FogSettings", "FogPass", "apply_fog", "MODES"]
+
+
+class FogPlugin(Plugin):
+    """Adds the ``fog`` pass. ``FogPlugin(settings)`` or ``FogPlugin(mode="hetero_exp2", density=0.044,
+    ...)`` with :class:`FogSettings` fields; ``time_offset`` shifts the noise animation clock."""
+
+    def __init__(self, settings: FogSettings | None = None, *, time_offset: float = 0.0, **fields):
+        base = settings if settings is not None else FogSettings()
+        self.settings = replace(base, **fields).validated()
+        self.time_offset = float(time_offset)
+        self.fog_pass: FogPass | None = None
+
+    def configure(self, settings: FogSettings | None = None, **fields) -> FogSettings:
+        """Validate, then swap in new settings (all or nothing); the pass adapts next frame."""
+        self.settings = replace(settings or self.settings, **fields).validated()
+        return self.settings
+
+    def build(self, app) -> None:
+        self.fog_pass = FogPass(self)
+        app.graph.add_pass(self.fog_pass)
+
+    def cleanup(self, app) -> None:
+        if self.fog_pass is not None:
+            self.fog_pass.release()
+
+
+def apply_fog(ctx, color, distance, mode: str = "exp2", density: float = 0.044, fog_color=(0.8, 0.8, 0.8),
+              start: float = 0.0, end: float = 100.0, *, positions=None, time: float = 0.0,
+              far: float = np.inf, **noise) -> np.ndarray:
+    """Fog ``color`` (float32 (H, W, 3)) at ``distance`` (float32 (H, W), +inf = sky) on the GPU with
+    the pass's shader; returns float32 (H, W, 3).
+
+    Heterogeneous modes need ``positions`` (H, W, 3) world positions (finite) and take the noise
+    settings of :class:`FogSettings` (``octaves``, ``resolutions``, ``winds``, ``tile_size``,
+    ``amplitude``, ``noise``, ``texels_per_cell``, ``seed``) as keywords, plus ``time`` (s);
+    ``sky="keep"`` leaves sky pixels alone, else they are fogged at distance ``far``.
+    ``ctx`` is a moderngl context or a GpuContext.
+    """
+    unknown = set(noise) - set(FogSettings.__dataclass_fields__)
+    if unknown:
+        raise ValueError(f"apply_fog got unknown keyword(s) {', '.join(sorted(unknown))}; allowed: "
+                         f"{', '.join(f for f in FogSettings.__dataclass_fields__ if f not in ('mode', 'density', 'fog_color', 'start', 'end'))}, positions, time, far")
+    settings = FogSettings(mode=mode, density=density, fog_color=fog_color, start=start, end=end,
+                           **noise).validated()
+    color, distance, positions = _check_inputs(color, distance, positions, settings)
+    far = float(far)
+    if np.isnan(far) or far < 0:
+        raise ValueError(f"far must be >= 0 or +inf, got {far!r}")
+    h, w = distance.shape
+    gl = gl_context(ctx)
+    prog = fog_program(ctx, settings, from_depth=False)
+    made, volumes, bound = [], None, gl.fbo
+    try:
+        target = gl.texture((w, h), 4, np.dstack([color, np.ones((h, w), np.float32)]).tobytes(), dtype="f4")
+        made.append(target)
+        dist_tex = gl.texture((w, h), 1, distance.tobytes(), dtype="f4")
+        made.append(dist_tex)
+        pos_tex = gl.texture((w, h), 3, positions.tobytes(), dtype="f4")
+        made.append(pos_tex)
+        for tex in (dist_tex, pos_tex):
+            tex.filter = (gl.NEAREST, gl.NEAREST)
+        fbo = gl.framebuffer([target])
+        made.append(fbo)
+        vao = gl.vertex_array(prog, [])
+        made.append(vao)
+        if settings.heterogeneous and settings.noise == "texture":
+            volumes = NoiseVolumes(ctx, settings)
+            volumes.use(3)
+        dist_tex.use(0)
+        pos_tex.use(1)
+        set_fog_uniforms(prog, settings, time)
+        prog["fog_far"].value = far
+        fbo.use()
+        gl.viewport = (0, 0, w, h)
+        draw_state(gl)
+        vao.render(gl.TRIANGLES, vertices=3)
+        restore_state(gl)
+        out = np.frombuffer(fbo.read(components=4, dtype="f4"), np.float32).reshape(h, w, 4)
+        return out[..., :3].copy()
+    finally:
+        bound.use()  # never leave a released framebuffer bound
+        if volumes is not None:
+            volumes.release()
+        for obj in reversed(made):
+            obj.release()
+
+
+def _check_inputs(color, distance, positions, settings):
+    color = np.asarray(color)
+    distance = np.asarray(distance)
+    if distance.ndim != 2 or min(distance.shape) < 1:
+        raise ValueError(f"distance must be float32 (H, W) with H, W >= 1, got shape {distance.shape}")
+    h, w = distance.shape
+    if color.shape != (h, w, 3):
+        raise ValueError(f"color must be float32 (H, W, 3) = ({h}, {w}, 3) to match distance, got shape {color.shape}")
+    color = np.ascontiguousarray(color, np.float32)
+    distance = np.ascontiguousarray(distance, np.float32)
+    if not np.isfinite(color).all():
+        raise ValueError("color must be finite (RGB in [0, 1]); it holds NaN or inf")
+    if np.isnan(distance).any() or (distance < 0).any() or np.isneginf(distance).any():
+        raise ValueError("distance must be >= 0 metres or +inf (sky); it holds NaN or negative values")
+    if settings.heterogeneous:
+        if positions is None:
+            raise ValueError(f"mode {settings.mode!r} needs positions=(H, W, 3) world positions for the noise")
+        positions = np.asarray(positions)
+        if positions.shape != (h, w, 3):
+            raise ValueError(f"positions must be float32 (H, W, 3) = ({h}, {w}, 3), got shape {positions.shape}")
+        if not np.isfinite(positions).all():
+            raise ValueError("positions must be finite world coordinates (use any finite point for sky pixels)")
+        positions = np.ascontiguousarray(positions, np.float32)
+    else:
+        positions = np.zeros((h, w, 3), np.float32)
+    return color, distance, positions

@@ -1,0 +1,148 @@
+"""Tileable 3D gradient noise: the GPU volumes (``shaders/fog/noise.comp``) and their float64 reference.
+
+Octave i is periodic gradient noise n_i with an integer lattice of period P_i = ``resolutions[i]``
+cells per tile (gradients: one of Perlin's 12 cube-edge vectors, picked by ``lowbias32``-based
+:func:`atmos.hashing.hash_counter` of the wrapped cell index, exactly as ``shaders/fog/noise.glsl``).
+A world point x maps to tile coordinates u_i = R_y(turn_i) (x - wind_i t) / tile_size and to lattice
+coordinates u_i P_i. The texture variant stores n_i at texel centres, (j + 0.5) / texels_per_cell
+lattice units, in a (P_i texels_per_cell)^3 r32f volume sampled with repeat + trilinear filtering.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from atmos.hashing import hash_counter, stream_key
+from atmos.plugins.fog.programs import gl_context, program
+
+FOG_RULE = 0xF06  # stream id of the fog gradients: stream_key(seed, 0, FOG_RULE, octave)
+GRADIENTS = np.array([(1, 1, 0), (-1, 1, 0), (1, -1, 0), (-1, -1, 0), (1, 0, 1), (-1, 0, 1),
+                      (1, 0, -1), (-1, 0, -1), (0, 1, 1), (0, -1, 1), (0, 1, -1), (0, -1, -1)], np.float64)
+
+
+def octave_key(seed: int, octave: int) -> tuple[int, int]:
+    """The (ka, kb) hash keys of one octave's gradients."""
+    ka, kb = stream_key(seed, 0, FOG_RULE, octave)
+    return int(ka), int(kb)
+
+
+def _fade(t):
+    return t * t * t * (t * (t * 6.0 - 15.0) + 10.0)
+
+
+def periodic_noise(q, period: int, key) -> np.ndarray:
+    """float64 noise at lattice coordinates ``q`` (..., 3); periodic with ``period`` on every axis."""
+    q = np.asarray(q, np.float64)
+    q = q - period * np.floor(q / period)
+    c = np.floor(q)
+    f = q - c
+    i = c.astype(np.int64)
+    u = _fade(f)
+    total = np.zeros(q.shape[:-1])
+    for corner in np.ndindex(2, 2, 2):
+        w = (i + corner) % period
+        counter = w[..., 0] + period * (w[..., 1] + period * w[..., 2])
+        g = GRADIENTS[hash_counter(counter, *key) % np.uint32(12)]
+        weight = np.prod(np.where(np.array(corner, bool), u, 1.0 - u), axis=-1)
+        total += weight * np.sum(g * (f - corner), axis=-1)
+    return total
+
+
+def noise_volume_ref(period: int, texels_per_cell: int, key) -> np.ndarray:
+    """What noise.comp writes: the (n, n, n) volume indexed [x, y, z], n = period * texels_per_cell."""
+    n = period * texels_per_cell
+    j = (np.arange(n) + 0.5) / texels_per_cell
+    q = np.stack(np.meshgrid(j, j, j, indexing="ij"), axis=-1)
+    return periodic_noise(q, period, key)
+
+
+def sample_repeat_trilinear(volume: np.ndarray, u) -> np.ndarray:
+    """GL ``texture()`` of ``volume`` [x, y, z] at normalised ``u`` (..., 3): repeat wrap, linear filter."""
+    shape = np.array(volume.shape)
+    x = np.asarray(u, np.float64) * shape - 0.5
+    i0 = np.floor(x).astype(np.int64)
+    t = x - i0
+    out = np.zeros(x.shape[:-1])
+    for corner in np.ndindex(2, 2, 2):
+        idx = (i0 + corner) % shape
+        weight = np.prod(np.where(np.array(corner, bool), t, 1.0 - t), axis=-1)
+        out += weight * volume[idx[..., 0], idx[..., 1], idx[..., 2]]
+    return out
+
+
+def tile_coords(world, time: float, wind, turn: float, tile_size: float) -> np.ndarray:
+    """u = R_y(turn) (world - wind * time) / tile_size, as in shaders/fog/factor.glsl."""
+    p = np.asarray(world, np.float64) - np.asarray(wind, np.float64) * time
+    c, s = math.cos(turn), math.sin(turn)
+    return np.stack([c * p[..., 0] - s * p[..., 2], p[..., 1], s * p[..., 0] + c * p[..., 2]], -1) / tile_size
+
+
+def turbulence_ref(world, time: float, settings, volumes: list | None = None) -> np.ndarray:
+    """Eq. (5): sum_i noise_i(x) / 2^i, noise_i = clamp(0.5 + 0.5 amplitude n_i, 0, 1), float64.
+
+    ``volumes`` (the octaves' reference or read-back volumes) selects the texture variant;
+    None evaluates the noise procedurally.
+    """
+    total = 0.0
+    for i in range(settings.octaves):
+        u = tile_coords(world, time, settings.winds[i], settings.turns[i], settings.tile_size)
+        period = settings.resolutions[i]
+        if volumes is None:
+            n = periodic_noise(u * period, period, octave_key(settings.seed, i))
+        else:
+            n = sample_repeat_trilinear(volumes[i], u)
+        total = total + np.clip(0.5 + 0.5 * settings.amplitude * n, 0.0, 1.0) / 2.0**i
+    return total
+
+
+class NoiseVolumes:
+    """The octaves' tileable noise textures, made on the GPU by ``fog/noise.comp`` (r32f, repeat, linear).
+
+    ``fill`` prefills every texel first (tests pass NaN to prove each texel is written)."""
+
+    def __init__(self, target, settings, fill: float | None = None):
+        ctx = gl_context(target)
+        shader = program(target, compute_shader="fog/noise.comp")
+        self.key = (settings.seed, settings.resolutions[:settings.octaves], settings.texels_per_cell)
+        self.textures = []
+        try:
+            for i in range(settings.octaves):
+                period, tpc = settings.resolutions[i], settings.texels_per_cell
+                n = period * tpc
+                tex = ctx.texture3d((n, n, n), 1, dtype="f4")
+                self.textures.append(tex)
+                if fill is not None:  # tests: a sentinel that any texel the shader misses keeps
+                    tex.write(np.full(n ** 3, fill, np.float32).tobytes())
+                tex.repeat_x = tex.repeat_y = tex.repeat_z = True
+                tex.filter = (ctx.LINEAR, ctx.LINEAR)
+                tex.bind_to_image(0, read=False, write=True)
+                shader["period"].value = period
+                shader["texels_per_cell"].value = tpc
+                shader["key"].value = octave_key(settings.seed, i)
+                groups = math.ceil(n / 4)
+                shader.run(groups, groups, groups)
+            ctx.memory_barrier()
+        except Exception:
+            self.release()
+            raise
+
+    def matches(self, settings) -> bool:
+        return self.key == (settings.seed, settings.resolutions[:settings.octaves], settings.texels_per_cell)
+
+    def use(self, first_unit: int = 3) -> None:
+        for i, tex in enumerate(self.textures):
+            tex.use(first_unit + i)
+
+    def read(self) -> list[np.ndarray]:
+        """The volumes as float32 arrays indexed [x, y, z] (for tests)."""
+        out = []
+        for tex in self.textures:
+            n = tex.size[0]
+            out.append(np.frombuffer(tex.read(), np.float32).reshape(n, n, n).transpose(2, 1, 0).copy())
+        return out
+
+    def release(self) -> None:
+        for tex in self.textures:
+            tex.release()
+        self.textures = []

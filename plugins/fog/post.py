@@ -1,0 +1,110 @@
+"""The fog post-process pass: reads ``depth``, blends the fog over ``color`` by eq. (1)."""
+from __future__ import annotations
+
+import math
+
+from atmos.camera import Camera, set_camera_uniforms
+from atmos.graph import PassBuilder, PassContext, RenderPass
+from atmos.plugins.fog.noise import NoiseVolumes, octave_key
+from atmos.plugins.fog.programs import program
+from atmos.plugins.fog.settings import MODES
+from atmos.render_core import COLOR, DEPTH
+
+FRAGMENT = "fog/fog.frag"
+VERTEX = "lib/fullscreen.vert"
+
+
+def fog_program(target, settings, from_depth: bool):
+    """The fog program for ``settings`` (one compiled variant per mode, octave count and noise kind)."""
+    defines = {"FOG_MODE": MODES[settings.mode], "FOG_OCTAVES": settings.octaves,
+               "FOG_PROCEDURAL": int(settings.noise == "procedural"), "FOG_FROM_DEPTH": int(from_depth)}
+    return program(target, defines, vertex_shader=VERTEX, fragment_shader=FRAGMENT)
+
+
+def _set(prog, name, values) -> None:
+    """Write a uniform (array) if the compiler kept it; arrays are cut to their kept length."""
+    if name not in prog:
+        return
+    uniform = prog[name]
+    if isinstance(values, list):
+        values = values[:uniform.array_length] if uniform.array_length > 1 else values[0]
+    uniform.value = values
+
+
+def set_fog_uniforms(prog, settings, time: float) -> None:
+    """The factor's uniforms (fog/factor.glsl) and the fog colour and sky handling (fog/fog.frag)."""
+    _set(prog, "fog_density", settings.density)
+    _set(prog, "fog_start", settings.start)
+    _set(prog, "fog_end", settings.end)
+    _set(prog, "fog_color", settings.fog_color)
+    _set(prog, "fog_sky_keep", int(settings.sky == "keep"))
+    if not settings.heterogeneous:
+        return
+    periods = list(settings.resolutions) + [2] * (4 - len(settings.resolutions))
+    _set(prog, "fog_time", float(time))
+    _set(prog, "fog_tile", settings.tile_size)
+    _set(prog, "fog_amplitude", settings.amplitude)
+    _set(prog, "fog_period", periods)
+    _set(prog, "fog_key", [octave_key(settings.seed, i) for i in range(4)])
+    _set(prog, "fog_wind", list(settings.winds))
+    _set(prog, "fog_turn", [(math.cos(a), math.sin(a)) for a in settings.turns])
+
+
+def draw_state(ctx) -> None:
+    """No depth test; blend (ONE, SRC_ALPHA): target = rgb + a * target."""
+    ctx.disable(ctx.DEPTH_TEST)
+    ctx.enable(ctx.BLEND)
+    ctx.blend_func = ctx.ONE, ctx.SRC_ALPHA
+
+
+def restore_state(ctx) -> None:
+    ctx.disable(ctx.BLEND)
+    ctx.blend_func = ctx.SRC_ALPHA, ctx.ONE_MINUS_SRC_ALPHA
+
+
+class FogPass(RenderPass):
+    """Fullscreen fog over the scene: distance from depth via the inverse view-projection."""
+    name = "fog"
+
+    def __init__(self, plugin):
+        self.plugin = plugin
+        self.gpu = None
+        self.volumes: NoiseVolumes | None = None
+
+    def setup(self, builder: PassBuilder) -> None:
+        builder.read(DEPTH)
+        builder.write(COLOR)
+
+    def prepare(self, gpu) -> None:
+        self.gpu = gpu
+        self._sync(self.plugin.settings)
+
+    def _sync(self, settings):
+        """Compile the variant and (re)make noise volumes when the settings need other ones."""
+        prog = fog_program(self.gpu, settings, from_depth=True)
+        wants = settings.heterogeneous and settings.noise == "texture"
+        if self.volumes is not None and (not wants or not self.volumes.matches(settings)):
+            self.volumes.release()
+            self.volumes = None
+        if wants and self.volumes is None:
+            self.volumes = NoiseVolumes(self.gpu, settings)
+        return prog
+
+    def execute(self, frame: PassContext) -> None:
+        app, gpu = frame.data["app"], frame.gpu
+        settings = self.plugin.settings
+        prog = self._sync(settings)
+        frame.framebuffer(color=[COLOR]).use()
+        draw_state(gpu.ctx)
+        frame.texture(DEPTH).use(0)
+        if self.volumes is not None:
+            self.volumes.use(3)
+        set_camera_uniforms(prog, app.resource(Camera), gpu.size[0] / gpu.size[1])
+        set_fog_uniforms(prog, settings, app.clock.frame_time + self.plugin.time_offset)
+        frame.fullscreen(prog)
+        restore_state(gpu.ctx)
+
+    def release(self) -> None:
+        if self.volumes is not None:
+            self.volumes.release()
+            self.volumes = None
