@@ -38,6 +38,7 @@ class App:
     # -- building --------------------------------------------------------------------------
     def add_plugins(self, *plugins: Plugin | PluginGroup) -> "App":
         """Build plugins (and every plugin of a group) into this App, in order."""
+        self._activate()
         for item in plugins:
             for plugin in (item if isinstance(item, PluginGroup) else [item]):
                 if not isinstance(plugin, Plugin):
@@ -74,7 +75,7 @@ class App:
         """Finish plugins, check the schedule (unknown labels and cycles fail here), run ``startup``."""
         if self._started:
             return
-        self.world.activate()
+        self._activate()
         for plugin in self.plugins:
             plugin.finish(self)
         self.schedule.build()
@@ -91,7 +92,7 @@ class App:
             now = time.perf_counter()
             frame_dt = now - getattr(self, "_last", now)
             self._last = now
-        self.world.activate()
+        self._activate()
         steps = self.clock.advance(frame_dt)
         self.schedule.run("update", self)
         for _ in range(steps):
@@ -104,8 +105,15 @@ class App:
         for _ in range(n):
             self.update(dt)
 
+    def _activate(self) -> None:
+        """Make this App's ECS world and GL context the current ones."""
+        self.world.activate()
+        if self.gpu is not None:
+            self.gpu.make_current()
+
     def close(self) -> None:
         """Release every plugin's GL objects, the render graph and the ECS world."""
+        self._activate()
         for plugin in reversed(self.plugins):
             plugin.cleanup(self)
         if self.graph is not None:

@@ -20,7 +20,7 @@ from atmos.plugins.automaton import CloudAutomaton
 from atmos.plugins.clouds import DensityMaps, Smoother, read_volume, reference, slice_range
 
 ROOT = Path(__file__).resolve().parents[1]
-THESIS_MS = {"smoothing": 6.024, "density maps": 0.588}   # Table 8.1, GeForce 8700M GT, 256x32x256
+THESIS_MS = {"smoothing": 6.024, "density maps": 0.588, "region volume": 5.26}  # Table 8.1, 8700M GT, 256x32x256
 
 
 def cloud_field(rng, shape, blobs: int = 14) -> np.ndarray:
@@ -44,6 +44,28 @@ def median_ms(ctx, run, runs: int) -> float:
         ctx.finish()
         times.append((time.perf_counter() - start) * 1e3)
     return statistics.median(times)
+
+
+def region_volume_ms(gpu, shape, runs: int) -> dict[int, float]:
+    """ms to render the region volume (and its probabilities) from n random weather ellipsoids."""
+    from atmos.plugins.weather import RegionVolume, WeatherParams
+    rng = np.random.default_rng(1)
+    region = RegionVolume(gpu, shape)
+    params = WeatherParams(volume_shape=shape)
+    result = {}
+    for n in (100, 1000):
+        e = np.zeros((n, 8), np.float32)
+        e[:, :3] = rng.uniform(0, 1, (n, 3)) * shape
+        e[:, 3] = rng.uniform(0, 6.3, n)
+        e[:, 4:7] = rng.uniform((6, 2, 6), (20, 6, 20), (n, 3))
+
+        def run():
+            region.render(e)
+            region.probabilities(params)
+        run()
+        result[n] = median_ms(gpu.ctx, run, runs)
+    region.release()
+    return result
 
 
 def plot(maps: DensityMaps, density: np.ndarray, path: Path) -> None:
@@ -129,11 +151,14 @@ def main() -> None:
             state.release()
     print(f"{f'density maps, {maps.bands} bands, {maps.grid[0]}x{maps.grid[1]}':34s} {dm_whole:9.2f} "
           f"{dm_part:16.3f} {THESIS_MS['density maps']:10.3f} {dm_ref:9.0f}")
+    region_ms = region_volume_ms(gpu, shape, args.runs)
+    for n, ms in region_ms.items():
+        print(f"{f'region volume, {n} ellipsoids':34s} {ms:9.2f} {'':16s} {THESIS_MS['region volume']:10.3f}")
     maxes = maps.read_max_maps()
     print(f"max maps read back: {maxes.nbytes} bytes; segments to draw: {(maxes[0] > 0).sum()} of "
           f"{maxes[0].size} columns, {(maxes[1:] > 0).sum()} of {maxes[1:].size} band segments")
     print("thesis Table 8.1 (GeForce 8700M GT, pixel shaders, 256x32x256): volume smoothing "
-          "6.024 ms, density map computation 0.588 ms")
+          "6.024 ms, density map computation 0.588 ms, region volume 5.26 ms")
     plot(maps, density, args.out)
     print(f"wrote {args.out}")
     dm_tex.release()

@@ -18,7 +18,9 @@ def gpu():
 
 @pytest.fixture
 def ctx(gpu):
-    """The session's moderngl.Context; the test fails if it leaves an OpenGL error behind."""
+    """The session's moderngl.Context (made current: tests that make contexts of their own switch
+    away from it); the test fails if it leaves an OpenGL error behind."""
+    gpu.make_current()
     gpu.ctx.error  # clear errors left by earlier tests' teardown
     yield gpu.ctx
     assert gpu.ctx.error == "GL_NO_ERROR"

@@ -46,7 +46,8 @@ def test_gpu_noise_volumes_match_reference_and_fill_every_texel(gpu, ctx, rng, t
     for vol, ref in zip(got, reference_volumes(settings)):
         assert vol.shape == ref.shape and not np.isnan(vol).any()
         np.testing.assert_allclose(vol, ref, atol=1e-5)  # float32 texel positions
-        assert 0.15 < ref.std() < 0.45 and np.abs(ref).max() <= 1.0
+        # 3D Perlin noise with the 12 edge gradients peaks a little above 1 (about 1.04)
+        assert 0.15 < ref.std() < 0.45 and np.abs(ref).max() <= 1.04
 
 
 def test_noise_is_periodic_and_continuous_across_the_tile_edge(rng):

@@ -76,3 +76,18 @@ def test_resize_including_minimized_window(fresh_gpu, size):
     assert img.shape[:2] == (max(1, size[1]), max(1, size[0])) and np.isfinite(img).all()
     app.close()
     fresh_gpu.resize((96, 54))
+
+
+def test_two_apps_on_two_contexts_render_alternately():
+    """moderngl never switches contexts itself; each App makes its own current for its frame."""
+    gpus = [create_headless((48, 27)), create_headless((48, 27))]
+    apps = [scene(g) for g in gpus]
+    for _ in range(3):
+        for app in apps:
+            app.update(1 / 30)
+    images = [g.read_pixels() for g in gpus]
+    for app, g in zip(apps, gpus):
+        assert g.ctx.error == "GL_NO_ERROR"
+        app.close()
+        g.release()
+    assert images[0].std() > 5 and np.array_equal(images[0], images[1])

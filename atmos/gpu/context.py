@@ -23,6 +23,19 @@ def _check_version(ctx: moderngl.Context) -> None:
             "Update the graphics driver, or use Mesa's llvmpipe (LIBGL_ALWAYS_SOFTWARE=1).")
 
 
+def release_gl(obj) -> None:
+    """Release a moderngl object; a framebuffer is never left bound.
+
+    moderngl re-binds the last bound framebuffer after it makes a new one, and binding a released
+    one is GL_INVALID_OPERATION; so a bound framebuffer is swapped for framebuffer 0 first.
+    """
+    if isinstance(obj, moderngl.Framebuffer):
+        ctx = obj.ctx
+        if ctx.fbo is not None and ctx.fbo.glo == obj.glo:
+            ctx.detect_framebuffer(0).use()
+    obj.release()
+
+
 def create_headless(size: tuple[int, int] = (640, 360), backend: str = "egl") -> "GpuContext":
     """A standalone context (EGL by default) that renders into an offscreen framebuffer of ``size``."""
     try:
@@ -66,27 +79,33 @@ class GpuContext:
         self.target: moderngl.Framebuffer = ctx.screen
         self.resize(size)
 
+    def make_current(self) -> None:
+        """Make this the thread's current OpenGL context. moderngl does not switch contexts by
+        itself: with two contexts in one process (two headless Apps, a tool beside a game), GL
+        calls go to whichever was made current last. App.update and the methods here call it."""
+        self.ctx.__enter__()
+
     # -- framebuffer -----------------------------------------------------------------------
     def resize(self, size: tuple[int, int]) -> None:
         """Set the frame size; a minimized window (0 in either axis) keeps a 1×1 target."""
         size = (max(1, int(size[0])), max(1, int(size[1])))
         if size == self.size:
             return
+        self.make_current()
         self.size = size
         if self.headless:
-            old = self._offscreen
+            for obj in self._offscreen:
+                release_gl(obj)
             color = self.ctx.texture(size, 4)
             depth = self.ctx.depth_renderbuffer(size)
             self.target = self.ctx.framebuffer([color], depth)
-            self.target.use()  # never leave a released framebuffer bound
             self._offscreen = [self.target, color, depth]
-            for obj in old:
-                obj.release()
         else:
             self.target = self.ctx.screen
 
     def read_pixels(self) -> np.ndarray:
         """The current frame as uint8 RGB, shape (height, width, 3), first row at the top."""
+        self.make_current()
         w, h = self.size
         data = self.target.read(viewport=(0, 0, w, h), components=3, alignment=1)
         return np.frombuffer(data, np.uint8).reshape(h, w, 3)[::-1].copy()
@@ -116,12 +135,13 @@ class GpuContext:
 
     def release(self) -> None:
         """Release every tracked object, program and offscreen target, then the context itself."""
+        self.make_current()
         for obj in list(self._tracked):
             obj.release()
         for program in self._programs.values():
             program.release()
         for obj in self._offscreen:
-            obj.release()
+            release_gl(obj)
         self._programs.clear()
         self._offscreen.clear()
         if self.headless:

@@ -5,6 +5,7 @@ from collections import OrderedDict
 
 import moderngl
 
+from atmos.gpu.context import release_gl
 from atmos.graph.errors import GraphError
 
 FRAMEBUFFER_CACHE = 64  # framebuffers kept per graph, least recently used dropped first
@@ -79,9 +80,7 @@ class PassContext:
 
     def _drop(self, key) -> None:
         fbo, _ = self._framebuffers.pop(key)
-        if self.gpu.ctx.fbo is fbo:  # never leave a released framebuffer bound (moderngl rebinds it)
-            self.gpu.target.use()
-        fbo.release()
+        release_gl(fbo)
 
     def _begin_frame(self, data: dict, textures: dict) -> None:
         self.data = data

@@ -11,6 +11,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from atmos.gpu.context import release_gl
 from atmos.plugin import Plugin
 from atmos.plugins.fog.noise import NoiseVolumes
 from atmos.plugins.fog.post import FogPass, draw_state, fog_program, restore_state, set_fog_uniforms
@@ -69,7 +70,7 @@ def apply_fog(ctx, color, distance, mode: str = "exp2", density: float = 0.044, 
     h, w = distance.shape
     gl = gl_context(ctx)
     prog = fog_program(ctx, settings, from_depth=False)
-    made, volumes, bound = [], None, gl.fbo
+    made, volumes = [], None
     try:
         target = gl.texture((w, h), 4, np.dstack([color, np.ones((h, w), np.float32)]).tobytes(), dtype="f4")
         made.append(target)
@@ -98,11 +99,10 @@ def apply_fog(ctx, color, distance, mode: str = "exp2", density: float = 0.044, 
         out = np.frombuffer(fbo.read(components=4, dtype="f4"), np.float32).reshape(h, w, 4)
         return out[..., :3].copy()
     finally:
-        bound.use()  # never leave a released framebuffer bound
         if volumes is not None:
             volumes.release()
         for obj in reversed(made):
-            obj.release()
+            release_gl(obj)
 
 
 def _check_inputs(color, distance, positions, settings):

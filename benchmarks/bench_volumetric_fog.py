@@ -1,0 +1,111 @@
+"""Volumetric fog: image error against a 1024-step march versus time per frame, 8..128 view steps.
+
+Plain script: prints a table and writes out/bench_volumetric_fog.png. On llvmpipe only the ratios
+between rows mean anything; absolute numbers need a real GPU.
+
+    python benchmarks/bench_volumetric_fog.py [--size 320x180] [--frames 9]
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import time
+
+import numpy as np
+
+from atmos.app import App
+from atmos.camera import Camera
+from atmos.defaults import DefaultPlugins
+from atmos.demos.volumetric_fog import FOG
+from atmos.gpu import create_headless
+from atmos.graph import RenderPass
+from atmos.lighting import Sun
+from atmos.plugins.ground import GroundPlugin
+from atmos.plugins.sky_gradient import SkyGradientPlugin
+from atmos.plugins.volumetric_fog import VolumetricFogPlugin
+from atmos.render_core import COLOR
+
+STEPS = (8, 16, 32, 64, 128)
+REFERENCE_STEPS = 1024
+
+
+class ReadColor(RenderPass):
+    """Reads the HDR colour back each frame (which also waits for the GPU to finish the frame)."""
+    name = "read_color"
+
+    def setup(self, builder):
+        builder.read(COLOR)
+        builder.side_effect()
+
+    def execute(self, frame):
+        w, h = frame.gpu.size
+        self.image = np.frombuffer(frame.texture(COLOR).read(), np.float16).reshape(h, w, 4)[..., :3].astype(float)
+
+
+def measure(app, plugin, reader, steps: int, frames: int):
+    """(image, median wall ms per frame, fog pass GPU ms) with ``steps`` view samples."""
+    plugin.configure(steps=steps)
+    app.run_frames(2)                                       # warm up (and fill the timer ring)
+    wall = []
+    for _ in range(frames):
+        start = time.perf_counter()
+        app.update(1 / 60)
+        wall.append((time.perf_counter() - start) * 1000)
+    gpu_ms = app.graph.timings.get("volumetric_fog", (float("nan"),))[0]
+    return reader.image.copy(), float(np.median(wall)), gpu_ms
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--size", default="320x180")
+    parser.add_argument("--frames", type=int, default=9)
+    args = parser.parse_args()
+    size = tuple(int(v) for v in args.size.split("x"))
+    gpu = create_headless(size)
+    plugin = VolumetricFogPlugin(animate=False, **FOG)
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(), plugin)
+    app.insert_resource(Sun.from_angles(elevation_deg=18.0, azimuth_deg=120.0))
+    cam = app.resource(Camera)
+    cam.position = np.array([28.0, 14.0, 91.0])
+    cam.look_at((0.0, 4.0, 0.0))
+    reader = app.graph.add_pass(ReadColor())
+
+    reference, ref_wall, ref_gpu = measure(app, plugin, reader, REFERENCE_STEPS, max(1, args.frames // 2))
+    signal = np.sqrt(np.mean(reference ** 2))
+    rows = []
+    for steps in STEPS:
+        image, wall, gpu_ms = measure(app, plugin, reader, steps, args.frames)
+        rmse = float(np.sqrt(np.mean((image - reference) ** 2)))
+        rows.append((steps, rmse, rmse / signal, wall, gpu_ms))
+    rows.append((REFERENCE_STEPS, 0.0, 0.0, ref_wall, ref_gpu))
+    info = gpu.info()
+    app.close()
+    gpu.release()
+
+    print(f"volumetric fog, {size[0]}x{size[1]}, octaves {FOG['octaves']}, light steps 4, "
+          f"renderer {info.get('GL_RENDERER', '?')}")
+    print(f"{'steps':>6} {'RMSE':>10} {'rel. RMSE':>10} {'ms/frame':>10} {'fog GPU ms':>11}")
+    for steps, rmse, rel, wall, gpu_ms in rows:
+        print(f"{steps:>6} {rmse:>10.5f} {rel:>10.5f} {wall:>10.2f} {gpu_ms:>11.2f}")
+
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6, 4))
+    xs = [r[3] for r in rows[:-1]]
+    ax.loglog(xs, [r[1] for r in rows[:-1]], "o-")
+    for steps, rmse, _, wall, _ in rows[:-1]:
+        ax.annotate(f"{steps}", (wall, rmse), textcoords="offset points", xytext=(5, 5))
+    ax.set_xlabel("ms per frame (whole frame, wall clock)")
+    ax.set_ylabel(f"image RMSE vs {REFERENCE_STEPS} steps (linear HDR)")
+    ax.set_title(f"volumetric fog error vs run time ({size[0]}x{size[1]}, {info.get('GL_RENDERER', '?').split(' (')[0]})",
+                 fontsize=9)
+    ax.grid(True, which="both", alpha=0.3)
+    os.makedirs("out", exist_ok=True)
+    fig.tight_layout()
+    fig.savefig("out/bench_volumetric_fog.png", dpi=100)
+    print("wrote out/bench_volumetric_fog.png")
+
+
+if __name__ == "__main__":
+    main()

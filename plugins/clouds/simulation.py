@@ -1,0 +1,162 @@
+"""The cloud simulation chain as a sliced job into three texture sets (thesis 7.1).
+
+One simulation step = region volume (weather rules + ellipsoids rendered into the region volume
+and its probabilities) → automaton step (driven by the region's probability texture, advected by
+the wind and by the volume's own motion) → smoothing (``smoothing_slices`` z ranges) → density
+maps (the same z ranges; the tiny max maps are read back once per step). The frame scheduler runs
+a few slices per frame into set C while the renderer draws sets A and B interpolated; nothing but
+the max maps comes back to the CPU.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from atmos.frames import SlicedJob, SliceStage, TripleSet
+from atmos.graph import TextureDesc
+from atmos.plugins.automaton import CloudAutomaton
+from atmos.plugins.clouds.density_maps import DensityMaps
+from atmos.plugins.clouds.smoothing import Smoother, slice_range
+from atmos.plugins.weather import RegionVolume, VolumeOrigin, WeatherParams, ellipsoid_array, step_weather
+
+
+@dataclass
+class CloudSettings:
+    """How the cloud chain is computed (the weather itself is :class:`WeatherParams`).
+
+    ``step_seconds``: weather time one simulation step represents. ``layout``: automaton layout
+    ("packed" or "cell"). ``density_dtype``: "f2" or "f4" smoothed density. ``radius`` and
+    ``weights``: smoothing neighbourhood (eq. 2.11). ``band_height`` and ``group_size``: density
+    maps per height band and the sprite-group grid they are max-downsampled to.
+    ``smoothing_slices``: z ranges the smoothing and density maps are split into.
+    ``cover_threshold``: a column counts as covered when its summed density exceeds this (cells).
+    """
+    step_seconds: float = 1.0
+    layout: str = "packed"
+    density_dtype: str = "f2"
+    radius: tuple = (1, 1, 1)
+    weights: str = "tent"
+    band_height: int = 4
+    group_size: tuple = (32, 32)
+    smoothing_slices: int = 4
+    cover_threshold: float = 0.5
+
+    def validate(self, shape) -> "CloudSettings":
+        if not (math.isfinite(self.step_seconds) and self.step_seconds > 0):
+            raise ValueError(f"CloudSettings.step_seconds must be a finite number > 0, got {self.step_seconds!r}")
+        if not isinstance(self.smoothing_slices, int) or not 1 <= self.smoothing_slices <= shape[2]:
+            raise ValueError(f"CloudSettings.smoothing_slices must be an int in 1..{shape[2]} (the volume depth), "
+                             f"got {self.smoothing_slices!r}")
+        if not (math.isfinite(self.cover_threshold) and self.cover_threshold >= 0):
+            raise ValueError(f"CloudSettings.cover_threshold must be a finite number >= 0, got {self.cover_threshold!r}")
+        return self
+
+
+class CloudSimulation:
+    """Weather ellipsoids in ``world`` → cloud density volumes, a few slices per frame.
+
+    ``origin`` is the :class:`VolumeOrigin` (moved by the game with the viewer). Readers use
+    :meth:`view` (sets A and B, the interpolation factor) and :meth:`max_maps` (empty-space
+    skipping); set ``textures["density"]`` is the smoothed density, ``maps_of(set).sums`` its
+    top-view sums (layer 0 all heights, then one per height band).
+    """
+
+    def __init__(self, gpu, world, params: WeatherParams, settings: CloudSettings | None = None,
+                 seed: int = 0, origin: VolumeOrigin | None = None):
+        self.params = params.validate()
+        shape = tuple(params.volume_shape)
+        self.settings = (settings or CloudSettings()).validate(shape)
+        self.shape = shape
+        self.world = world
+        self.origin = origin or VolumeOrigin()
+        self.rng = np.random.default_rng(seed)
+        self.gpu = gpu
+        s = self.settings
+        made = []
+        try:
+            self.region = RegionVolume(gpu, shape)
+            made.append(self.region)
+            self.automaton = CloudAutomaton(gpu.ctx, shape, seed=seed, layout=s.layout)
+            made.append(self.automaton)
+            self.smoother = Smoother.for_automaton(self.automaton, s.radius, s.weights)
+            made.append(self.smoother)
+            self.triple = TripleSet(gpu, {"density": TextureDesc(shape, 1, s.density_dtype)})
+            made.append(self.triple)
+            self._maps = {id(t): DensityMaps(gpu.ctx, shape, s.band_height, s.group_size) for t in self.triple.sets}
+            made += list(self._maps.values())
+        except Exception:
+            for obj in made:
+                obj.release()
+            raise
+        self._max_maps = {key: np.zeros((1 + m.bands, *m.grid), np.float32) for key, m in self._maps.items()}
+        self._drift = np.zeros(2)          # sub-cell wind displacement not yet applied
+        self._last_origin = np.array(self.origin.as_tuple())
+        n = s.smoothing_slices
+        self.job = SlicedJob("clouds", [
+            SliceStage("region", 1, self._region_slice),
+            SliceStage("automaton", 1, self._automaton_slice),
+            SliceStage("smoothing", n, self._smoothing_slice),
+            SliceStage("density_maps", n, self._maps_slice),
+        ], self.triple)
+
+    # -- stages ------------------------------------------------------------------------------
+    def _region_slice(self, index: int, job) -> None:
+        origin = self.origin.as_tuple()
+        step_weather(self.world, self.params, self.rng, self.settings.step_seconds, origin)
+        self.region.render(ellipsoid_array(self.world, origin))
+        self.region.probabilities(self.params)
+
+    def _automaton_slice(self, index: int, job) -> None:
+        self.automaton.step_with_texture(self.region.prob_texture, shift=self._next_shift())
+
+    def _smoothing_slice(self, index: int, job) -> None:
+        z0, z1 = slice_range(self.shape[2], index, job.slices)
+        self.smoother.run(self.automaton.state_buffer, job.target["density"], z0, z1)
+
+    def _maps_slice(self, index: int, job) -> None:
+        z0, z1 = slice_range(self.shape[2], index, job.slices)
+        maps = self._maps[id(job.target)]
+        maps.run(job.target["density"], z0, z1)
+        if index == job.slices - 1:
+            self._max_maps[id(job.target)] = maps.read_max_maps()
+
+    def _next_shift(self) -> tuple[int, int]:
+        """Whole cells the contents move this step: the wind's drift minus the volume's own motion."""
+        origin = np.array(self.origin.as_tuple())
+        moved = origin - self._last_origin
+        self._last_origin = origin
+        wind = np.asarray(self.params.wind, float)
+        self._drift += wind[[0, 2]] * self.settings.step_seconds - moved[[0, 2]]
+        shift = np.trunc(self._drift)
+        self._drift -= shift
+        limit = max(self.shape) + 1            # larger shifts empty the volume all the same
+        return int(np.clip(shift[0], -limit, limit)), int(np.clip(shift[1], -limit, limit))
+
+    # -- readers -----------------------------------------------------------------------------
+    def view(self):
+        """(A, B, t): draw mix(A["density"], B["density"], t)."""
+        return self.job.view()
+
+    def maps_of(self, texture_set) -> DensityMaps:
+        """The density maps computed from ``texture_set``'s density."""
+        return self._maps[id(texture_set)]
+
+    def max_maps(self) -> np.ndarray:
+        """Elementwise max of the max maps of A and B, shape (1 + bands, gx, gz): a segment whose
+        value is 0 is empty in both interpolated steps and may be skipped (7.2.2)."""
+        a, b, _ = self.view()
+        return np.maximum(self._max_maps[id(a)], self._max_maps[id(b)])
+
+    def cover(self) -> float:
+        """Covered fraction of the sky in the newest completed step (B): columns whose summed
+        density exceeds ``cover_threshold``. Reads a top-view map back: a diagnostic, not per frame."""
+        _, b, _ = self.view()
+        sums = self.maps_of(b).read_sums()[0]
+        return float((sums > self.settings.cover_threshold).mean())
+
+    def release(self) -> None:
+        for obj in (self.region, self.automaton, self.smoother, self.triple, *self._maps.values()):
+            obj.release()
+        self._maps.clear()

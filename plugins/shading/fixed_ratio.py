@@ -1,0 +1,33 @@
+"""The thesis's shading model (sec. 5.2), kept for comparison in the benchmark.
+
+Each slice multiplies the previous slice's attenuation (bilinear at the shifted position) by a
+fixed ratio ``exp(-sigma * rho)`` whatever the angle of the light, starting from 1 on the light-side
+slice, and stores it in 8 bits (``levels=255``). An oblique ray crosses ``1/|cos|`` times more
+medium per slice than that, so low suns come out too bright. Float64 twin:
+``reference.shear_warp_scheme(..., fixed_ratio=True, levels=255)``.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from atmos.plugins.shading.shear_warp import ShearWarpShader, context_of, read_volume, upload_volume
+from atmos.plugins.shading import reference as ref
+
+THESIS_LEVELS = 255
+
+
+def compute_fixed_ratio(ctx, density, sun_dir, sigma, levels: int = THESIS_LEVELS) -> np.ndarray:
+    """Transmittance by the thesis's fixed-ratio model (float32 (nx, ny, nz)); checks like compute_transmittance."""
+    ctx = context_of(ctx)
+    density = ref.check_density(density)
+    ref.check_sun_dir(sun_dir)
+    ref.check_sigma(sigma)
+    shader = ShearWarpShader(ctx, density.shape, model="fixed-ratio", levels=levels)
+    texture = upload_volume(ctx, density)
+    try:
+        shader.begin(texture, sun_dir, sigma)
+        shader.run_all()
+        return read_volume(shader.result)
+    finally:
+        texture.release()
+        shader.release()

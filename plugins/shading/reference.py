@@ -1,0 +1,374 @@
+"""Float64 numpy side of cloud shading: input checks, slice geometry, the exact reference, and the scheme.
+
+The quantity (index space, voxel ``i`` centred at integer ``i``, the volume is the box
+``[-0.5, n-0.5]`` per axis)::
+
+    T(p) = exp(-sigma * integral_0^t_exit rho(p + s u) ds)
+
+``u`` is the unit sun direction, ``rho`` the density interpolated trilinearly between voxel centres,
+clamped to the edge value in the outer half cell, and zero outside the box.
+
+* :func:`transmittance_exact` integrates this *exactly* (to float64 rounding): because every ray
+  starts on a voxel centre, all rays cross the integer planes (where the trilinear pieces change) and
+  the half-integer planes (the box faces) at the same distances ``m / (2|u_a|)``. Between two such
+  distances the density along the ray is a product of three linear functions of ``s`` -- a cubic --
+  which two-point Gauss-Legendre integrates exactly. The trilinear weights at each Gauss point are
+  the same for every voxel, so each point costs a few separable ``np.take`` lerps over the volume.
+* :func:`shear_warp_scheme` is the shear-warp algorithm of :mod:`.shear_warp` in float64 (same
+  geometry, same formulas), so the GPU can be compared with its own algorithm tightly and the
+  algorithm with the exact reference separately. ``fixed_ratio=True`` gives the thesis's model.
+"""
+from __future__ import annotations
+
+import math
+import numbers
+
+import numpy as np
+
+SCALES = (1, 2, 4)
+MAJOR_ORDER = (1, 0, 2)          # ties for the slicing axis go to y, then x, then z
+LATERAL = {0: (1, 2), 1: (0, 2), 2: (0, 1)}
+TAU_MAX = 1e30                   # optical depth is clamped here: exp(-TAU_MAX) == 0, never inf - inf
+SIGMA_MAX = 3.0e38               # largest sigma handed to float32 shaders
+
+
+# -- input checks ----------------------------------------------------------------------------------
+def check_density(density) -> np.ndarray:
+    """``density`` as a float32 (nx, ny, nz) array, or a ValueError saying what is allowed."""
+    try:
+        array = np.asarray(density)
+    except Exception:
+        array = None
+    if array is None or array.dtype.kind not in "fiu" or array.ndim != 3 or min(array.shape, default=0) < 1:
+        what = "not an array" if array is None else f"dtype {array.dtype}, shape {array.shape}"
+        raise ValueError(f"density must be a real-valued array of shape (nx, ny, nz), each >= 1 "
+                         f"(y is height); got {what}")
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = np.ascontiguousarray(array, dtype=np.float32)
+    bad = ~np.isfinite(out)
+    if bad.any():
+        raise ValueError(f"density must be finite (and within float32 range); {int(bad.sum())} value(s) are not, "
+                         f"first at index {tuple(int(i) for i in np.argwhere(bad)[0])}")
+    if (out < 0).any():
+        raise ValueError(f"density must be >= 0; {int((out < 0).sum())} value(s) are negative "
+                         f"(min {float(out.min())!r})")
+    return out
+
+
+def check_sun_dir(sun_dir) -> np.ndarray:
+    """The unit float64 direction toward the sun, or a ValueError (allowed: a finite 3-vector, length > 0)."""
+    try:
+        d = np.asarray(sun_dir, dtype=np.float64)
+    except (TypeError, ValueError):
+        d = None
+    if d is None or d.shape != (3,):
+        raise ValueError(f"sun_dir must be a 3-vector (x, y, z) pointing toward the sun; got {sun_dir!r}")
+    if not np.isfinite(d).all():
+        raise ValueError(f"sun_dir must be finite; got {tuple(d)}")
+    big = np.abs(d).max()
+    if big == 0:
+        raise ValueError("sun_dir must have a length > 0; got the zero vector")
+    d = d / big
+    return d / np.linalg.norm(d)
+
+
+def check_sigma(sigma) -> float:
+    """``sigma`` as a float, or a ValueError (allowed: a finite real number >= 0)."""
+    if isinstance(sigma, (bool, np.bool_)) or not isinstance(sigma, numbers.Real):
+        raise ValueError(f"sigma must be a real number >= 0 (extinction per cell length at density 1); got {sigma!r}")
+    value = float(sigma)
+    if not math.isfinite(value) or value < 0:
+        raise ValueError(f"sigma must be finite and >= 0 (extinction per cell length at density 1); got {sigma!r}")
+    return value
+
+
+def check_scale(scale) -> int:
+    if isinstance(scale, (bool, np.bool_)) or not isinstance(scale, numbers.Integral) or int(scale) not in SCALES:
+        raise ValueError(f"scale must be one of {SCALES} (full, half, quarter resolution); got {scale!r}")
+    return int(scale)
+
+
+def check_shape(shape) -> tuple[int, int, int]:
+    try:
+        shape = tuple(shape)
+    except TypeError:
+        shape = None
+    if shape is None or len(shape) != 3 or not all(isinstance(n, numbers.Integral) and not isinstance(n, bool)
+                                                 and n >= 1 for n in shape):
+        raise ValueError(f"shape must be three ints >= 1 (nx, ny, nz); got {shape!r}")
+    return tuple(int(n) for n in shape)
+
+
+# -- geometry --------------------------------------------------------------------------------------
+def shading_shape(shape, scale: int) -> tuple[int, int, int]:
+    """Shading grid for ``scale``: ceil(n / scale) per axis (the same box, coarser cells)."""
+    return tuple(-(-int(n) // scale) for n in shape)
+
+
+class SlicePlan:
+    """How the shear-warp walks a grid of ``shape`` cells of size ``spacing`` (fine cells) for unit ``u``.
+
+    ``axis`` slicing axis (largest |u/spacing|, ties y, x, z), ``lateral`` the other two,
+    ``sign`` +1 when the sun is toward +axis, ``step`` the index-space step toward the sun
+    (``step[axis] == sign``), ``length`` its length in fine cells, ``order`` the slices in order.
+    """
+
+    def __init__(self, shape, u: np.ndarray, spacing=(1.0, 1.0, 1.0)):
+        self.shape = tuple(int(n) for n in shape)
+        spacing = np.asarray(spacing, dtype=np.float64)
+        w = u / spacing
+        self.axis = max(MAJOR_ORDER, key=lambda a: (abs(w[a]), -MAJOR_ORDER.index(a)))
+        self.lateral = LATERAL[self.axis]
+        self.sign = 1 if w[self.axis] > 0 else -1
+        self.step = w / abs(w[self.axis])
+        self.step[self.axis] = float(self.sign)
+        self.length = float(np.linalg.norm(spacing * self.step))
+        n = self.shape[self.axis]
+        self.order = list(range(n - 1, -1, -1)) if self.sign > 0 else list(range(n))
+
+    @property
+    def count(self) -> int:
+        return len(self.order)
+
+
+def exit_fraction(q, v: float, n: int):
+    """Fraction of one step ``v`` (one lateral axis) before a ray from integer ``q`` leaves [-0.5, n-0.5]."""
+    q = np.asarray(q, dtype=np.float64)
+    if v > 0:
+        return (n - 0.5 - q) / v
+    if v < 0:
+        return (q + 0.5) / -v
+    return np.full_like(q, np.inf)
+
+
+# -- interpolation ---------------------------------------------------------------------------------
+def trilinear(volume: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Clamp-to-edge trilinear samples of ``volume`` at index-space ``points`` (..., 3)."""
+    n = np.array(volume.shape)
+    p = np.clip(points, 0, n - 1)
+    i0 = np.floor(p).astype(np.int64)
+    fr = p - i0
+    i1 = np.minimum(i0 + 1, n - 1)
+    out = np.zeros(p.shape[:-1])
+    for cx in (0, 1):
+        wx = fr[..., 0] if cx else 1 - fr[..., 0]
+        ix = i1[..., 0] if cx else i0[..., 0]
+        for cy in (0, 1):
+            wy = fr[..., 1] if cy else 1 - fr[..., 1]
+            iy = i1[..., 1] if cy else i0[..., 1]
+            for cz in (0, 1):
+                wz = fr[..., 2] if cz else 1 - fr[..., 2]
+                iz = i1[..., 2] if cz else i0[..., 2]
+                out += wx * wy * wz * volume[ix, iy, iz]
+    return out
+
+
+def bilinear(plane: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Clamp-to-edge bilinear samples of ``plane`` at (..., 2) positions."""
+    n = np.array(plane.shape)
+    p = np.clip(y, 0, n - 1)
+    i0 = np.floor(p).astype(np.int64)
+    fr = p - i0
+    i1 = np.minimum(i0 + 1, n - 1)
+    a = plane[i0[..., 0], i0[..., 1]] * (1 - fr[..., 1]) + plane[i0[..., 0], i1[..., 1]] * fr[..., 1]
+    b = plane[i1[..., 0], i0[..., 1]] * (1 - fr[..., 1]) + plane[i1[..., 0], i1[..., 1]] * fr[..., 1]
+    return a * (1 - fr[..., 0]) + b * fr[..., 0]
+
+
+def catmull_rom(t: np.ndarray) -> tuple:
+    """Catmull-Rom weights of the taps at -1, 0, 1, 2 for fractions ``t``."""
+    t2, t3 = t * t, t * t * t
+    return (0.5 * (-t3 + 2 * t2 - t), 0.5 * (3 * t3 - 5 * t2 + 2), 0.5 * (-3 * t3 + 4 * t2 + t), 0.5 * (t3 - t2))
+
+
+def taps(i: np.ndarray, n: int, v: float) -> tuple[np.ndarray, np.ndarray]:
+    """Index and sign of lateral tap ``i`` of a slice of ``n`` texels whose sun-facing side (the
+    one ``v`` points to) mirrors *oddly* about the face (optical depth 0 there, linear through it);
+    the other side clamps to the edge."""
+    sign = np.ones(np.shape(i))
+    if v > 0:
+        beyond = i > n - 1
+        i = np.where(beyond, 2 * n - 1 - i, i)
+        sign = np.where(beyond, -1.0, 1.0)
+    elif v < 0:
+        beyond = i < 0
+        i = np.where(beyond, -1 - i, i)
+        sign = np.where(beyond, -1.0, 1.0)
+    return np.clip(i, 0, n - 1), sign
+
+
+def cubic(plane: np.ndarray, y: np.ndarray, v=(0.0, 0.0)) -> np.ndarray:
+    """Bicubic (Catmull-Rom) samples of the previous slice's optical depth at (..., 2) positions.
+
+    Taps beyond a sun-facing face are odd mirrors (:func:`taps`); the result is limited to the range
+    of the four nearest taps and to >= 0, so optical depth never drops along a ray."""
+    n = plane.shape
+    i0 = np.floor(y).astype(np.int64)
+    fr = y - i0
+    w = catmull_rom(fr[..., 0]), catmull_rom(fr[..., 1])
+    out = np.zeros(y.shape[:-1])
+    lo = np.full(y.shape[:-1], np.inf)
+    hi = np.full(y.shape[:-1], -np.inf)
+    ta = [taps(i0[..., 0] + k - 1, n[0], v[0]) for k in range(4)]
+    tb = [taps(i0[..., 1] + k - 1, n[1], v[1]) for k in range(4)]
+    for i in range(4):
+        for k in range(4):
+            value = plane[ta[i][0], tb[k][0]] * ta[i][1] * tb[k][1]
+            out += w[0][i] * w[1][k] * value
+            if i in (1, 2) and k in (1, 2):
+                lo = np.minimum(lo, value)
+                hi = np.maximum(hi, value)
+    return np.maximum(np.clip(out, lo, hi), 0.0)
+
+
+def lerp_matrix(positions: np.ndarray, n: int) -> np.ndarray:
+    """(len(positions), n) matrix of clamp-to-edge linear-interpolation weights (1D, index space)."""
+    p = np.clip(positions, 0, n - 1)
+    i0 = np.floor(p).astype(np.int64)
+    fr = p - i0
+    i1 = np.minimum(i0 + 1, n - 1)
+    m = np.zeros((len(p), n))
+    rows = np.arange(len(p))
+    np.add.at(m, (rows, i0), 1 - fr)
+    np.add.at(m, (rows, i1), fr)
+    return m
+
+
+def _apply(volume: np.ndarray, mats) -> np.ndarray:
+    for axis, m in enumerate(mats):
+        volume = np.moveaxis(np.tensordot(m, volume, axes=([1], [axis])), 0, axis)
+    return volume
+
+
+def downsample(density: np.ndarray, scale: int) -> np.ndarray:
+    """Coarse density for ``scale``: the mean of scale**3 trilinear samples per coarse cell (GPU's rule)."""
+    if scale == 1:
+        return np.asarray(density, dtype=np.float64)
+    mats = []
+    for n, m in zip(density.shape, shading_shape(density.shape, scale)):
+        h = n / m
+        sub = ((np.arange(m)[:, None] + (np.arange(scale)[None, :] + 0.5) / scale) * h - 0.5).ravel()
+        mats.append(lerp_matrix(sub, n).reshape(m, scale, n).mean(axis=1))
+    return _apply(np.asarray(density, dtype=np.float64), mats)
+
+
+def upsample(coarse: np.ndarray, shape) -> np.ndarray:
+    """Trilinear samples of a coarse grid at the fine voxel centres of ``shape`` (the same box)."""
+    mats = [lerp_matrix((np.arange(n) + 0.5) * m / n - 0.5, m) for n, m in zip(shape, coarse.shape)]
+    return _apply(coarse, mats)
+
+
+# -- the exact reference ---------------------------------------------------------------------------
+def exit_distance(shape, u: np.ndarray) -> np.ndarray:
+    """Distance (cells) from every voxel centre along ``u`` to the box boundary, shape ``shape``."""
+    t = np.full(shape, np.inf)
+    for a, n in enumerate(shape):
+        if u[a] == 0:
+            continue
+        i = np.arange(n, dtype=np.float64)
+        d = (n - 0.5 - i) / u[a] if u[a] > 0 else (i + 0.5) / -u[a]
+        t = np.minimum(t, d.reshape([-1 if k == a else 1 for k in range(3)]))
+    return t
+
+
+def optical_depth_exact(density, sun_dir) -> np.ndarray:
+    """Exact ``integral rho ds`` from every voxel centre toward the sun (float64, see module docstring)."""
+    d = np.asarray(density, dtype=np.float64)
+    u = check_sun_dir(sun_dir)
+    shape = d.shape
+    t_exit = exit_distance(shape, u)
+    t_max = float(t_exit.max())
+    breaks = [np.zeros(1), np.array([t_max])]
+    for a, n in enumerate(shape):
+        if u[a] != 0:
+            m = np.arange(1, 2 * n + 1)
+            breaks.append(m[m / (2 * abs(u[a])) < t_max] / (2 * abs(u[a])))
+    breaks = np.unique(np.concatenate(breaks))
+    g = 0.5 / math.sqrt(3.0)
+    idx = [np.arange(n) for n in shape]
+    tau = np.zeros(shape)
+    for t0, t1 in zip(breaks[:-1], breaks[1:]):
+        inside = t_exit > 0.5 * (t0 + t1)
+        if not inside.any():
+            continue
+        for t in (0.5 * (t0 + t1) - g * (t1 - t0), 0.5 * (t0 + t1) + g * (t1 - t0)):
+            v = d
+            for a, n in enumerate(shape):
+                o = t * u[a]
+                fl = math.floor(o)
+                fr = o - fl
+                i0 = np.clip(idx[a] + fl, 0, n - 1)
+                i1 = np.clip(idx[a] + fl + 1, 0, n - 1)
+                v = np.take(v, i0, axis=a) * (1 - fr) + np.take(v, i1, axis=a) * fr
+            tau += np.where(inside, 0.5 * (t1 - t0) * v, 0.0)
+    return tau
+
+
+def transmittance_exact(density, sun_dir, sigma) -> np.ndarray:
+    """Float64 exact transmittance toward the sun of every voxel centre (see module docstring)."""
+    d = check_density(density)
+    s = check_sigma(sigma)
+    if s == 0:
+        return np.ones(d.shape)
+    with np.errstate(over="ignore"):
+        return np.exp(-np.minimum(s * optical_depth_exact(d, sun_dir), TAU_MAX))
+
+
+# -- the shear-warp scheme in float64 --------------------------------------------------------------
+def shear_warp_scheme(density, sun_dir, sigma, scale: int = 1, fixed_ratio: bool = False,
+                      levels: int = 0) -> np.ndarray:
+    """The GPU shear-warp algorithm in float64 (returns T on the fine grid of ``density``).
+
+    True-path model: for voxel q of slice j, ``f`` = the fraction of one step toward the sun before
+    the ray leaves the box (1 inside, 0.5 on the light-side slice, less near a lateral face)::
+
+        f >= 1:  tau = tau_prev(q + v) + sigma * L * (rho(q) + rho(q + v)) / 2
+        f <  1:  tau = sigma * f * L * (rho(q) + rho(q + f v)) / 2
+
+    ``tau_prev`` is bicubic in the previous slice, limited, odd-mirrored across a sun-facing face
+    (``cubic``: 0 on the face, no diffusion of the linear profile there), ``L``
+    the true length of one slice step. ``fixed_ratio``: the thesis's model, ``T = T_prev(q + v) *
+    exp(-sigma * rho(q + v))`` per slice whatever the angle, 1 on the light-side slice, optionally
+    rounded to ``levels`` steps (255: 8-bit storage).
+    """
+    fine = check_density(density)
+    u = check_sun_dir(sun_dir)
+    sigma = min(check_sigma(sigma), SIGMA_MAX)
+    scale = check_scale(scale)
+    d = downsample(fine.astype(np.float64), scale)
+    spacing = np.array(fine.shape) / np.array(d.shape)
+    plan = SlicePlan(d.shape, u, spacing)
+    a, (b, c) = plan.axis, plan.lateral
+    dp = np.transpose(d, (a, b, c))
+    na, nb, nc = dp.shape
+    vb, vc = plan.step[b], plan.step[c]
+    qb, qc = np.meshgrid(np.arange(nb, dtype=np.float64), np.arange(nc, dtype=np.float64), indexing="ij")
+    fl = np.minimum(exit_fraction(qb, vb, nb), exit_fraction(qc, vc, nc))
+    step = np.array([plan.sign, vb, vc])
+    out = np.empty_like(dp)
+    prev = None
+    for j in plan.order:
+        p = np.stack([np.full_like(qb, j), qb, qc], axis=-1)
+        y = np.stack([qb + vb, qc + vc], axis=-1)
+        if fixed_ratio:
+            if prev is None:
+                value = np.ones_like(qb)
+            else:
+                value = bilinear(prev, y) * np.exp(-sigma * trilinear(dp, p + step))
+                if levels:
+                    value = np.round(value * levels) / levels
+            out[j] = value
+        else:
+            f = np.minimum(fl, 0.5 if prev is None else 1.0)
+            rho0 = dp[j]
+            with np.errstate(over="ignore", invalid="ignore"):
+                full = f >= 1
+                rho1 = trilinear(dp, p + np.where(full, 1.0, f)[..., None] * step)
+                tau = sigma * (0.5 * rho0 + 0.5 * rho1) * (np.where(full, 1.0, f) * plan.length)
+                if prev is not None:
+                    tau = tau + np.where(full, cubic(prev, y, (vb, vc)), 0.0)
+                value = np.minimum(tau, TAU_MAX)
+            out[j] = np.exp(-value)
+        prev = value
+    result = np.transpose(out, np.argsort((a, b, c)))
+    return upsample(result, fine.shape) if scale > 1 else result

@@ -1,0 +1,75 @@
+"""The four tileable octave textures of the cloud layer, baked on the GPU (``sky_layer/octave.comp``)."""
+from __future__ import annotations
+
+import math
+
+import moderngl
+import numpy as np
+
+from atmos.plugins.sky_layer.params import SkyLayerParams
+from atmos.plugins.sky_layer.reference import light_shift, octave_key
+
+OCTAVES = 4
+
+
+class OctaveTextures:
+    """Four RGBA float textures (repeat, mipmapped); octave k has base_frequency·2^k cells per tile and
+    channel c its noise c light-march steps toward the sun. :meth:`bake` (re)computes them."""
+
+    def __init__(self, gpu):
+        self.gpu = gpu
+        self.textures: list = []
+        self.bakes = 0
+        self.baked_for: tuple | None = None    # (texture settings, light shift) of the last bake
+        self._program = None
+
+    def bake(self, params: SkyLayerParams, sun_dir) -> None:
+        """Fill the textures for ``params`` and the sun direction (re-allocating on a size change)."""
+        ctx = self.gpu.ctx
+        if self._program is None:
+            self._program = self.gpu.program(compute_shader="sky_layer/octave.comp")
+        if not self.textures or self.textures[0].size != (params.size, params.size):
+            self.release()
+            for _ in range(OCTAVES):
+                tex = self.gpu.track(ctx.texture((params.size, params.size), 4, dtype="f4"))
+                tex.repeat_x = tex.repeat_y = True
+                self.textures.append(tex)
+        shift = light_shift(sun_dir, params.light_step)
+        prog = self._program
+        prog["light_shift"].value = tuple(shift)
+        groups = math.ceil(params.size / 8)
+        for k, tex in enumerate(self.textures):
+            prog["frequency"].value = float(params.base_frequency * 2 ** k)
+            prog["key"].value = octave_key(params.seed, k)
+            tex.bind_to_image(0, read=False, write=True)
+            prog.run(groups, groups)
+        ctx.memory_barrier()
+        for tex in self.textures:
+            tex.build_mipmaps()
+            tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+        self.bakes += 1
+        self.baked_for = (params.texture_key(), tuple(shift))
+
+    def needs_bake(self, params: SkyLayerParams, sun_dir, tolerance: float) -> bool:
+        """True before the first bake, after a texture setting changed, or once the light shift moved by
+        more than ``tolerance`` of a light step (the sun turned)."""
+        if self.baked_for is None or self.baked_for[0] != params.texture_key():
+            return True
+        moved = np.linalg.norm(light_shift(sun_dir, params.light_step) - self.baked_for[1])
+        return moved > tolerance * params.light_step
+
+    def download(self, k: int) -> np.ndarray:
+        """Octave ``k`` as float64 (size, size, 4) indexed [x, y, channel]."""
+        tex = self.textures[k]
+        w, h = tex.size
+        return np.frombuffer(tex.read(), np.float32).reshape(h, w, 4).transpose(1, 0, 2).astype(np.float64)
+
+    def use(self, first_unit: int = 0) -> None:
+        for k, tex in enumerate(self.textures):
+            tex.use(first_unit + k)
+
+    def release(self) -> None:
+        for tex in self.textures:
+            tex.release()
+        self.textures = []
+        self.baked_for = None

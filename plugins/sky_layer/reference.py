@@ -1,0 +1,58 @@
+"""numpy float64 references of the cloud layer: tiling octaves, fbm, remap and shading."""
+from __future__ import annotations
+
+import numpy as np
+
+from atmos.plugins.volumetric_fog.noise import key, value_noise
+
+WEIGHTS = np.array([0.5, 0.25, 0.125, 0.0625])
+RAY = np.array([0.0, 0.2, 0.4, 0.6])
+
+
+def octave_key(seed: int, octave: int) -> int:
+    """The lattice key of octave ``octave`` (a different noise per octave)."""
+    return int(key((seed + 0x9E3779B1 * octave) % 2**32))
+
+
+def tile_noise(uv: np.ndarray, frequency: float, k) -> np.ndarray:
+    """4D value noise on two circles of radius frequency/2π: periodic with period 1 in u and v."""
+    a = 2 * np.pi * np.asarray(uv, np.float64)
+    r = frequency / (2 * np.pi)
+    x = r * np.stack([np.cos(a[..., 0]), np.sin(a[..., 0]), np.cos(a[..., 1]), np.sin(a[..., 1])], axis=-1)
+    return value_noise(x, k)
+
+
+def octave_texture(size: int, frequency: float, k, light_shift) -> np.ndarray:
+    """(size, size, 4) indexed [x, y, channel]: channel c sampled at texel/size + c·light_shift."""
+    i = np.arange(size) / size
+    uv = np.stack(np.meshgrid(i, i, indexing="ij"), axis=-1)
+    shift = np.asarray(light_shift, np.float64)
+    return np.stack([tile_noise(uv + c * shift, frequency, k) for c in range(4)], axis=-1)
+
+
+def light_shift(sun_dir, light_step: float) -> np.ndarray:
+    """uv step toward the sun: light_step along the sun's horizontal direction (0 with the sun overhead)."""
+    xz = np.array([sun_dir[0], sun_dir[2]], np.float64)
+    n = np.linalg.norm(xz)
+    return xz / n * light_step if n > 1e-6 else np.zeros(2)
+
+
+def fbm(samples) -> np.ndarray:
+    """Σ_k w_k n_k with w = 1/2, 1/4, 1/8, 1/16; samples (4 octaves, ..., 4 channels)."""
+    return np.tensordot(WEIGHTS, np.asarray(samples, np.float64), axes=1)
+
+
+def remap(fbm_value, emptiness: float, sharpness: float) -> np.ndarray:
+    """(clamp(f, emptiness, sharpness) − emptiness) / (sharpness − emptiness), in [0, 1]."""
+    f = np.asarray(fbm_value, np.float64)
+    return (np.clip(f, emptiness, sharpness) - emptiness) / (sharpness - emptiness)
+
+
+def shade(fbm_rgba, params, light, fade=1.0) -> np.ndarray:
+    """Premultiplied (rgb·α, 1 − α) of fbm samples (..., 4), as ``sky_layer_shade`` in GLSL."""
+    d = remap(fbm_rgba, params.emptiness, params.sharpness)
+    amount = (np.maximum(d - RAY, 0.0) * 0.25).sum(-1)
+    alpha = np.clip(params.thickness * amount, 0.0, 1.0) * np.asarray(fade, np.float64)
+    lit, color = np.asarray(params.lit_color), np.asarray(params.color)
+    rgb = (lit + (color - lit) * amount[..., None]) * np.asarray(light, np.float64)
+    return np.concatenate([rgb * alpha[..., None], (1.0 - alpha)[..., None]], axis=-1)

@@ -1,0 +1,58 @@
+"""Parameter checks whose ValueErrors name the setting, what was given and what is allowed.
+
+Shared by the fog and sky-layer parameter classes (a candidate for ``atmos/`` itself).
+"""
+from __future__ import annotations
+
+import math
+import operator
+
+
+def check_vec(owner: str, name: str, value, n: int, kind: str = "finite") -> tuple:
+    """``n`` finite floats; ``kind`` 'positive' or 'non-negative' narrows them."""
+    try:
+        v = tuple(float(x) for x in value)
+    except (TypeError, ValueError):
+        v = ()
+    ok = len(v) == n and all(math.isfinite(x) for x in v)
+    if ok and kind == "positive":
+        ok = min(v) > 0
+    elif ok and kind == "non-negative":
+        ok = min(v) >= 0
+    if not ok:
+        raise ValueError(f"{owner}.{name} must be {n} {kind} numbers, got {value!r}")
+    return v
+
+
+def check_num(owner: str, name: str, value, lo: float | None = None, hi: float | None = None,
+              lo_open: bool = False) -> float:
+    """A finite float within [lo, hi] (``lo_open``: strictly above lo)."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        v = math.nan
+    ok = math.isfinite(v) and (lo is None or (v > lo if lo_open else v >= lo)) and (hi is None or v <= hi)
+    if not ok:
+        bounds = [t for t in ("" if lo is None else f"{'>' if lo_open else '>='} {lo}",
+                              "" if hi is None else f"<= {hi}") if t]
+        raise ValueError(f"{owner}.{name} must be a finite number{' ' + ' and '.join(bounds) if bounds else ''}, "
+                         f"got {value!r}")
+    return v
+
+
+def check_int(owner: str, name: str, value, lo: int, hi: int) -> int:
+    """A whole number in lo..hi (bools are refused)."""
+    try:
+        v = None if isinstance(value, bool) else operator.index(value)
+    except TypeError:
+        v = None
+    if v is None or not lo <= v <= hi:
+        raise ValueError(f"{owner}.{name} must be a whole number {lo}..{hi}, got {value!r}")
+    return v
+
+
+def check_known(owner: str, changes: dict, known) -> None:
+    """Refuse names that are not settings of ``owner``."""
+    unknown = sorted(set(changes) - set(known))
+    if unknown:
+        raise ValueError(f"unknown {owner} setting(s) {', '.join(unknown)}; known: {', '.join(sorted(known))}")

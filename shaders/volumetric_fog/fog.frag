@@ -1,0 +1,17 @@
+#version 430
+// Volumetric FBM fog over the scene, stopped at scene depth; blend ONE, SRC_ALPHA.
+#include "lib/hash.glsl"
+#include "lib/value_noise.glsl"
+#include "lib/view_ray.glsl"
+#include "volumetric_fog/medium.glsl"
+in vec2 v_uv;
+out vec4 frag;
+layout(binding = 0) uniform sampler2D scene_depth;
+uniform mat4 inv_view_proj;
+uniform vec3 camera_pos;
+
+void main() {
+    vec3 dir = view_ray_dir(v_uv, inv_view_proj, camera_pos);
+    float dist = view_ray_distance(v_uv, texture(scene_depth, v_uv).r, inv_view_proj, camera_pos, 1e30);
+    frag = fog_march(camera_pos, dir, dist);
+}

@@ -1,0 +1,294 @@
+"""Volumetric FBM fog: GPU FBM and march against the float64 reference, extremes, checks, the pass in a scene."""
+import math
+
+import numpy as np
+import pytest
+
+from atmos.app import App
+from atmos.camera import Camera
+from atmos.defaults import DefaultPlugins
+from atmos.gpu import create_headless
+from atmos.gpu.shaders import build_program
+from atmos.graph import RenderPass
+from atmos.lighting import Sun
+from atmos.plugins.ground import GroundPlugin
+from atmos.plugins.volumetric_fog import FogParams, VolumetricFogPlugin
+from atmos.plugins.volumetric_fog import noise, reference
+from atmos.plugins.volumetric_fog.plugin import set_medium_uniforms, sun_terms
+from atmos.render_core import COLOR, DEPTH
+
+EPS32 = 2.0 ** -24
+
+
+# -- GPU helpers -----------------------------------------------------------------------------------
+def gpu_fbm(ctx, points, octaves, seed):
+    prog = build_program(ctx, {"compute_shader": "volumetric_fog/fbm_points.comp"})
+    n = len(points)
+    pts = np.zeros((n, 4), np.float32)
+    pts[:, :3] = points
+    src = ctx.buffer(pts.tobytes())
+    dst = ctx.buffer(np.full(n, np.nan, np.float32).tobytes())
+    try:
+        src.bind_to_storage_buffer(0)
+        dst.bind_to_storage_buffer(1)
+        prog["count"].value, prog["octaves"].value, prog["seed"].value = n, octaves, seed
+        prog.run(-(-n // 64))
+        ctx.memory_barrier()
+        return np.frombuffer(dst.read(), np.float32).astype(np.float64)
+    finally:
+        src.release(), dst.release(), prog.release()
+
+
+def gpu_march(ctx, origins, dirs, limits, params, sun, time=0.0):
+    prog = build_program(ctx, {"compute_shader": "volumetric_fog/march_rays.comp"})
+    n = len(origins)
+    rays = np.zeros((n, 8), np.float32)
+    rays[:, :3], rays[:, 3], rays[:, 4:7] = origins, limits, dirs
+    src = ctx.buffer(rays.tobytes())
+    dst = ctx.buffer(np.full((n, 4), np.nan, np.float32).tobytes())
+    try:
+        src.bind_to_storage_buffer(0)
+        dst.bind_to_storage_buffer(1)
+        set_medium_uniforms(prog, params, sun, time)
+        prog["count"].value = n
+        prog.run(-(-n // 16))
+        ctx.memory_barrier()
+        return np.frombuffer(dst.read(), np.float32).reshape(n, 4).astype(np.float64)
+    finally:
+        src.release(), dst.release(), prog.release()
+
+
+def ref_march(origins, dirs, limits, params, sun, time=0.0):
+    s, sun_light, ambient_light = sun_terms(sun, params)
+    return reference.march(origins, dirs, limits, params, s, sun_light, ambient_light, time)
+
+
+def fbm_tolerance(points, octaves):
+    """Float32 error bound: octave i sees coordinates |p|·Π(2+k/10); its noise (slope <= 1.5 per axis)
+    moves by at most 2^-(i+1)·min(1, 6·|coord|·eps32), plus rounding of the sum."""
+    mag = np.abs(points).max(axis=-1) + 1.0
+    tol = np.full(len(points), 1e-6)
+    growth = 1.0
+    for i in range(octaves):
+        tol += 0.5 ** (i + 1) * np.minimum(1.0, 6.0 * mag * growth * 4 * EPS32)
+        growth *= 2.0 + i / 10.0
+    return tol
+
+
+# -- FBM ---------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("octaves", [1, 3, 8, 16])
+def test_gpu_fbm_matches_float64_reference(ctx, rng, octaves):
+    n = 4096
+    points = rng.uniform(-60, 60, (n, 3)) * rng.choice([0.01, 0.1, 1.0], (n, 1))
+    points = points.astype(np.float32).astype(np.float64)        # the GPU sees float32 inputs
+    seed = int(rng.integers(0, 2**32))
+    got = gpu_fbm(ctx, points, octaves, seed)
+    want = noise.fbm(points, octaves, seed)
+    assert np.isfinite(got).all(), "every output written"
+    err = np.abs(got - want)
+    tol = fbm_tolerance(points, octaves)
+    assert (err <= tol).all(), f"max error {err.max():.3g}, worst excess {(err - tol).max():.3g}"
+    assert got.std() > 0.03, "noise is not flat"
+    assert (want >= 0).all() and (want < 1 - 2.0 ** -octaves).all()
+
+
+def test_noise_at_lattice_points_equals_hash_exactly(ctx, rng):
+    cells = rng.integers(-10**6, 10**6, (1024, 3)).astype(np.float64)
+    seed = int(rng.integers(0, 2**32))
+    got = gpu_fbm(ctx, cells, 1, seed)
+    assert np.array_equal(got, 0.5 * noise.lattice(cells.astype(np.int64), noise.key(seed)))
+
+
+def test_value_noise_is_smooth_and_in_range(rng):
+    k = noise.key(7)
+    x = rng.uniform(-5, 5, (2000, 3))
+    v = noise.value_noise(x, k)
+    assert (v >= 0).all() and (v < 1).all()
+    h = 1e-6                                            # continuous with slope <= 1.5 per axis
+    for axis in range(3):
+        dx = np.zeros(3)
+        dx[axis] = h
+        assert np.abs(noise.value_noise(x + dx, k) - v).max() <= 1.5 * h * 1.0001
+
+
+def test_fbm_extreme_inputs_stay_finite_and_in_range(ctx):
+    points = np.array([[0, 0, 0], [1e6, -1e6, 1e6], [-3e7, 2e7, 1e7], [1e9, 1e9, -1e9],
+                       [3.4e38, -3.4e38, 1.0], [1e-30, -1e-30, 0]], np.float64)
+    for octaves in (1, 16):
+        got = gpu_fbm(ctx, points, octaves, 123)
+        assert np.isfinite(got).all() and (got >= 0).all() and (got < 1).all(), got
+    ref = noise.fbm(points, 16, 123)
+    assert np.isfinite(ref).all() and (ref >= 0).all() and (ref < 1).all()
+
+
+def test_octave_rotation_is_orthonormal():
+    assert np.allclose(noise.ROTATION @ noise.ROTATION.T, np.eye(3))
+
+
+# -- the march ---------------------------------------------------------------------------------------
+def random_rays(rng, n, params, spread=1.5):
+    radius = (params.bias + 1) / params.falloff if params.falloff > 0 else 30.0
+    origins = np.asarray(params.center) + rng.uniform(-spread, spread, (n, 3)) * radius * np.asarray(params.scale)
+    targets = np.asarray(params.center) + rng.uniform(-0.4, 0.4, (n, 3)) * radius * np.asarray(params.scale)
+    dirs = np.where(rng.random((n, 1)) < 0.7, targets - origins, rng.normal(size=(n, 3)))
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    limits = np.where(rng.random(n) < 0.3, rng.uniform(1, 80, n), 1e30)
+    return (origins.astype(np.float32).astype(np.float64), dirs.astype(np.float32).astype(np.float64),
+            limits.astype(np.float32).astype(np.float64))
+
+
+def test_gpu_march_matches_float64_reference(ctx, rng):
+    params = FogParams(center=tuple(rng.uniform(-5, 5, 3)), scale=(1.5, 0.6, 1.2), bias=0.1, falloff=0.05,
+                       frequency=float(rng.uniform(0.1, 0.3)), octaves=5, seed=int(rng.integers(0, 2**32)),
+                       wind=(1.0, 0.0, -0.5), absorption=float(rng.uniform(0.1, 0.4)), steps=40,
+                       light_steps=4, light_step=2.5, max_distance=150.0)
+    sun = Sun.from_angles(float(rng.uniform(10, 70)), float(rng.uniform(0, 360)))
+    origins, dirs, limits = random_rays(rng, 256, params)
+    got = gpu_march(ctx, origins, dirs, limits, params, sun, time=1.25)
+    want = ref_march(origins, dirs, limits, params, sun, time=1.25)
+    assert np.isfinite(got).all(), "every ray written"
+    assert (want[:, 3] < 0.9).sum() > 20 and (want[:, 3] > 0.999).sum() > 5, "rays both through and past the fog"
+    # float32 noise can flip an early exit (T or Tl near 0.01): the skipped tail is <= 1% of the light
+    tol = 2e-3 + 1.5e-2 * np.abs(want).max(axis=0)
+    err = np.abs(got - want)
+    assert (err <= tol).all(), f"max error {err.max(axis=0)} > {tol}"
+    assert np.median(err[:, :3]) < 1e-4
+
+
+def test_march_converges_with_steps_and_exits_early():
+    params = FogParams(center=(0, 0, 0), scale=(1, 1, 1), octaves=4, absorption=0.2, light_steps=2)
+    sun = Sun.from_angles(40)
+    o, d, lim = np.array([[0.0, 0.0, -40.0]]), np.array([[0.0, 0.0, 1.0]]), np.array([1e30])
+    ref = ref_march(o, d, lim, params.replace(steps=1024), sun)
+    errs = [np.abs(ref_march(o, d, lim, params.replace(steps=s), sun) - ref).max() for s in (8, 32, 128)]
+    assert errs[2] < errs[0] and errs[2] < 0.02
+    thick = ref_march(o, d, lim, params.replace(absorption=50.0, steps=256), sun)
+    assert 0 < thick[0, 3] <= 0.01 and np.isfinite(thick).all()
+
+
+@pytest.mark.parametrize("change", [
+    dict(absorption=0.0), dict(absorption=1e4), dict(steps=1), dict(steps=1024, octaves=2),
+    dict(light_steps=0), dict(falloff=0.0, max_distance=60.0), dict(bias=-5.0), dict(octaves=16, steps=8),
+    dict(frequency=1e3), dict(max_distance=1e-3)])
+def test_march_extremes_finite_and_as_reference(ctx, rng, change):
+    params = FogParams(center=(0, 0, 0), scale=(1, 1, 1), octaves=3, steps=16, light_steps=3).replace(**change)
+    origins = np.array([[0.0, 0.0, 0.0], [0.0, 5.0, -60.0], [1e3, 0, 0], [0.0, 0.0, -25.0]])
+    dirs = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [-1.0, 0, 0], [0.0, 0.0, 1.0]])
+    limits = np.array([1e30, 1e30, 2e3, 0.0])
+    for sun in (Sun.from_angles(45), Sun.from_angles(-60), Sun(np.zeros(3))):
+        got = gpu_march(ctx, origins, dirs, limits, params, sun)
+        want = ref_march(origins, dirs, limits, params, sun)
+        assert np.isfinite(got).all() and (got >= 0).all() and (got[:, 3] <= 1).all()
+        assert np.allclose(got[3], [0, 0, 0, 1]), "zero-length ray: no fog"
+        if change.get("frequency", 0) < 100 and change.get("octaves", 3) < 16:
+            assert np.allclose(got, want, atol=3e-3 + 1.5e-2 * np.abs(want).max()), (got, want)
+    if params.absorption == 0 or params.bias == -5.0:
+        assert np.array_equal(got, np.tile([0, 0, 0, 1.0], (4, 1)))
+
+
+# -- parameters ----------------------------------------------------------------------------------------
+@pytest.mark.parametrize("change, message", [
+    (dict(octaves=0), "FogParams.octaves must be a whole number 1..16, got 0"),
+    (dict(octaves=17), "1..16"), (dict(octaves=2.5), "whole number"), (dict(octaves=True), "whole number"),
+    (dict(steps=0), "FogParams.steps must be a whole number 1..1024"), (dict(steps=2000), "1..1024"),
+    (dict(light_steps=-1), "0..32"), (dict(light_step=0), "light_step must be a finite number > 0"), (dict(absorption=-1), "FogParams.absorption must be a finite number >= 0"),
+    (dict(absorption=math.nan), "absorption"), (dict(frequency=0), "frequency must be a finite number > 0"),
+    (dict(scale=(1, 0, 1)), "FogParams.scale must be 3 positive numbers"), (dict(center=(1, 2)), "center"),
+    (dict(ambient=(-1, 0, 0)), "non-negative"), (dict(max_distance=math.inf), "max_distance"),
+    (dict(seed=-1), "0..4294967295"), (dict(colour=(1, 1, 1)), "unknown FogParams setting(s) colour; known:"),
+])
+def test_bad_settings_are_refused_and_nothing_is_applied(change, message):
+    plugin = VolumetricFogPlugin(steps=20)
+    before = plugin.params
+    with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(")", r"\)").replace(".", r"\.")):
+        plugin.configure(**{"light_step": 0.5, **change})
+    assert plugin.params is before
+    with pytest.raises(ValueError):
+        VolumetricFogPlugin(**change)
+
+
+# -- the pass in a scene --------------------------------------------------------------------------------
+class Capture(RenderPass):
+    """Test pass: copies the final HDR colour and depth to numpy."""
+    name = "capture"
+
+    def __init__(self):
+        self.color = self.depth = None
+
+    def setup(self, builder):
+        builder.read(COLOR)
+        builder.read(DEPTH)
+        builder.side_effect()
+
+    def execute(self, frame):
+        w, h = frame.gpu.size
+        self.color = np.frombuffer(frame.texture(COLOR).read(), np.float16).reshape(h, w, 4).astype(np.float64)
+        self.depth = np.frombuffer(frame.texture(DEPTH).read(), np.float32).reshape(h, w).astype(np.float64)
+
+
+@pytest.fixture
+def small_gpu():
+    gpu = create_headless((64, 40))
+    yield gpu
+    assert gpu.ctx.error == "GL_NO_ERROR"
+    gpu.release()
+
+
+def render(gpu, *plugins, camera_at=(0.0, 6.0, 45.0), target=(0.0, 2.0, 0.0)):
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), GroundPlugin(), *plugins)
+    app.insert_resource(Sun.from_angles(30.0, 60.0))
+    cam = app.resource(Camera)
+    cam.position = np.array(camera_at)
+    cam.look_at(target)
+    capture = app.graph.add_pass(Capture())
+    app.run_frames(1)
+    app.close()
+    return capture, cam
+
+
+def test_pass_blends_the_reference_march_over_the_scene_stopping_at_depth(small_gpu, tmp_path):
+    params = FogParams(octaves=4, steps=24, light_steps=3, absorption=0.15)
+    bg, cam = render(small_gpu)
+    fog, _ = render(small_gpu, VolumetricFogPlugin(params, animate=False))
+    assert np.isfinite(fog.color).all()
+    save_png(tmp_path, "fog_pass.png", fog.color)
+    h, w = fog.depth.shape
+    ys, xs = np.meshgrid(np.arange(0, h, 3), np.arange(0, w, 3), indexing="ij")
+    ys, xs = ys.ravel(), xs.ravel()
+    inv = np.linalg.inv(cam.view_projection(w / h))
+    ndc = np.stack([(xs + 0.5) / w * 2 - 1, (ys + 0.5) / h * 2 - 1], axis=1)   # row 0 is the bottom
+    far = (inv @ np.c_[ndc, np.ones(len(xs)), np.ones(len(xs))].T).T
+    dirs = far[:, :3] / far[:, 3:] - cam.position
+    z = bg.depth[ys, xs]
+    hit = (inv @ np.c_[ndc, z * 2 - 1, np.ones(len(xs))].T).T
+    limits = np.where(z >= 1, 1e30, np.linalg.norm(hit[:, :3] / hit[:, 3:] - cam.position, axis=1))
+    march = ref_march(np.tile(cam.position, (len(xs), 1)), dirs, limits, params, Sun.from_angles(30.0, 60.0))
+    want = march[:, :3] + march[:, 3:] * bg.color[ys, xs, :3]
+    got = fog.color[ys, xs, :3]
+    assert (z < 1).sum() > 10 and (z >= 1).sum() > 10, "ground and sky pixels both tested"
+    assert (march[:, 3] < 0.8).sum() > 10, "the fog is visible"
+    assert np.allclose(got, want, atol=4e-3, rtol=2e-2), np.abs(got - want).max()
+
+
+def save_png(folder, name, hdr):
+    from PIL import Image
+    img = np.clip(hdr[::-1, :, :3] / (1 + hdr[::-1, :, :3]), 0, 1) ** (1 / 2.2)
+    Image.fromarray((img * 255).astype(np.uint8)).save(folder / name)
+
+
+def test_scene_without_fog_compiles_and_runs_none_of_it(small_gpu):
+    app = App(small_gpu).add_plugins(DefaultPlugins(overlay=False), GroundPlugin())
+    app.run_frames(2)
+    assert "volumetric_fog" not in app.graph.dump()
+    assert not any(f.startswith("volumetric_fog/") for f in small_gpu.compiled_files)
+    app.close()
+
+
+def test_volumetric_fog_demo_runs_headless(tmp_path, capsys):
+    from PIL import Image
+    from atmos.cli import main
+    out = tmp_path / "fog"
+    assert main(["demo", "volumetric_fog", "--headless", "--frames", "3", "--size", "64x36",
+                 "--out", str(out), "--quiet"]) == 0
+    img = np.asarray(Image.open(out / "frame_00002.png"), float)
+    assert img.std() > 5, "not a blank frame"
