@@ -169,3 +169,32 @@ def test_bad_settings(gpu, ctx, settings, message):
     with pytest.raises(ValueError, match=message):
         app.add_plugins(CloudsPlugin(params(), settings))
     app.close()
+
+
+def test_shading_stage_lights_each_step_with_the_sun_of_its_start(gpu, ctx):
+    """Transmittance in a completed set = one-shot shading of that set's density with the sun as it
+    was when the step began, however much the sun moved while the step was sliced over frames."""
+    from atmos.lighting import Sun
+    from atmos.plugins.shading import compute_transmittance
+    settings = CloudSettings(smoothing_slices=2, group_size=(8, 8), sigma=0.8, cell_size=(2.0, 1.0, 2.0),
+                             shading_slices_per_run=4)
+    app, sim = clouds_app(gpu, params(), settings)
+    sun = Sun.from_angles(30.0, 10.0)
+    app.insert_resource(sun)
+    for _ in range(20):
+        sim.job.run_step()
+    start_sun = sim.sun_in_cells()
+    step = sim.job.step
+    frames = 0
+    while sim.job.step == step:               # slice the next step over frames with a moving sun
+        sun.direction = Sun.from_angles(30.0 + 2 * frames, 10.0 + 5 * frames).direction
+        app.update(1 / 30)
+        frames += 1
+    assert frames > 5
+    _, b, _ = sim.view()
+    density = read_volume(b["density"])
+    expected = compute_transmittance(gpu.ctx, density, start_sun, 0.8)
+    got = read_volume(b["transmittance"])
+    assert density.max() > 0.5 and got.min() < 0.9, "clouds cast light shadows"
+    assert np.abs(got - expected).max() < 2e-3        # f2 storage
+    app.close()

@@ -1,6 +1,7 @@
 """CloudsPlugin: the cloud simulation chain added to an App and fed to its frame scheduler."""
 from __future__ import annotations
 
+from atmos.lighting import Sun
 from atmos.plugin import Plugin
 from atmos.plugins.clouds.simulation import CloudSettings, CloudSimulation
 from atmos.plugins.weather import VolumeOrigin, WeatherParams
@@ -9,7 +10,8 @@ from atmos.plugins.weather import VolumeOrigin, WeatherParams
 class CloudsPlugin(Plugin):
     """Weather ellipsoids → region volume → automaton → smoothing → density maps, sliced over frames.
 
-    Resources it adds: ``WeatherParams`` (change ``cloud_density`` at run time to move the cover),
+    The shading stage reads the ``Sun`` resource's direction when a step starts (DaylightPlugin
+    moves it). Resources it adds: ``WeatherParams`` (change ``cloud_density`` at run time to move the cover),
     ``VolumeOrigin`` (move it with the viewer; one already present is used) and the
     :class:`CloudSimulation` (readers take ``view()`` and ``max_maps()`` from it).
     ``warmup_steps`` whole steps run at start-up, so a scene can open on formed clouds.
@@ -29,7 +31,11 @@ class CloudsPlugin(Plugin):
         if app.gpu is None:
             raise ValueError("CloudsPlugin needs an App with a GPU context (App(gpu))")
         origin = app.get_resource(VolumeOrigin) or VolumeOrigin()
-        self.simulation = CloudSimulation(app.gpu, app.world, self.params, self.settings, self.seed, origin)
+        default_sun = Sun()
+
+        def sun():
+            return (app.get_resource(Sun) or default_sun).direction
+        self.simulation = CloudSimulation(app.gpu, app.world, self.params, self.settings, self.seed, origin, sun)
         app.insert_resource(self.params)
         app.insert_resource(origin)
         app.insert_resource(self.simulation)

@@ -3,7 +3,8 @@
 One simulation step = region volume (weather rules + ellipsoids rendered into the region volume
 and its probabilities) → automaton step (driven by the region's probability texture, advected by
 the wind and by the volume's own motion) → smoothing (``smoothing_slices`` z ranges) → density
-maps (the same z ranges; the tiny max maps are read back once per step). The frame scheduler runs
+maps (the same z ranges; the tiny max maps are read back once per step) → shading (inverse
+shear-warp transmittance toward the sun, a few light-space slices per job slice; optional). The frame scheduler runs
 a few slices per frame into set C while the renderer draws sets A and B interpolated; nothing but
 the max maps comes back to the CPU.
 """
@@ -19,6 +20,9 @@ from atmos.graph import TextureDesc
 from atmos.plugins.automaton import CloudAutomaton
 from atmos.plugins.clouds.density_maps import DensityMaps
 from atmos.plugins.clouds.smoothing import Smoother, slice_range
+from atmos.plugins.shading.reference import check_scale, check_sigma, shading_shape
+from atmos.plugins.shading.scattering import Scattering
+from atmos.plugins.shading.shear_warp import ShadingStage, ShearWarpShader
 from atmos.plugins.weather import RegionVolume, VolumeOrigin, WeatherParams, ellipsoid_array, step_weather
 
 
@@ -32,6 +36,11 @@ class CloudSettings:
     maps per height band and the sprite-group grid they are max-downsampled to.
     ``smoothing_slices``: z ranges the smoothing and density maps are split into.
     ``cover_threshold``: a column counts as covered when its summed density exceeds this (cells).
+    Shading (thesis ch. 5): ``shading`` on or off; ``sigma`` extinction per cell length at density
+    1; ``scattering`` single or Harris multiple forward scattering (:class:`Scattering`);
+    ``shading_scale`` 1, 2 or 4 (full, half, quarter resolution); ``shading_slices_per_run``
+    light-space slices per job slice; ``cell_size`` the world size of a cell (x, y, z), so the sun
+    direction is taken into cell units (cells need not be cubes).
     """
     step_seconds: float = 1.0
     layout: str = "packed"
@@ -42,6 +51,12 @@ class CloudSettings:
     group_size: tuple = (32, 32)
     smoothing_slices: int = 4
     cover_threshold: float = 0.5
+    shading: bool = True
+    sigma: float = 0.6
+    scattering: Scattering | None = None
+    shading_scale: int = 1
+    shading_slices_per_run: int = 8
+    cell_size: tuple = (1.0, 1.0, 1.0)
 
     def validate(self, shape) -> "CloudSettings":
         if not (math.isfinite(self.step_seconds) and self.step_seconds > 0):
@@ -51,20 +66,26 @@ class CloudSettings:
                              f"got {self.smoothing_slices!r}")
         if not (math.isfinite(self.cover_threshold) and self.cover_threshold >= 0):
             raise ValueError(f"CloudSettings.cover_threshold must be a finite number >= 0, got {self.cover_threshold!r}")
+        if len(self.cell_size) != 3 or not all(math.isfinite(c) and c > 0 for c in self.cell_size):
+            raise ValueError(f"CloudSettings.cell_size must be three finite numbers > 0 (x, y, z), got {self.cell_size!r}")
+        check_sigma(self.sigma)
+        check_scale(self.shading_scale)
         return self
 
 
 class CloudSimulation:
     """Weather ellipsoids in ``world`` → cloud density volumes, a few slices per frame.
 
-    ``origin`` is the :class:`VolumeOrigin` (moved by the game with the viewer). Readers use
-    :meth:`view` (sets A and B, the interpolation factor) and :meth:`max_maps` (empty-space
-    skipping); set ``textures["density"]`` is the smoothed density, ``maps_of(set).sums`` its
-    top-view sums (layer 0 all heights, then one per height band).
+    ``origin`` is the :class:`VolumeOrigin` (moved by the game with the viewer); ``sun`` a
+    zero-argument callable giving the world direction toward the sun (read when a step starts).
+    Readers use :meth:`view` (sets A and B, the interpolation factor) and :meth:`max_maps`
+    (empty-space skipping); a set's ``["density"]`` is the smoothed density,
+    ``["transmittance"]`` (with shading) the transmittance toward the sun at the shading scale,
+    and ``maps_of(set).sums`` the top-view sums (layer 0 all heights, then one per height band).
     """
 
     def __init__(self, gpu, world, params: WeatherParams, settings: CloudSettings | None = None,
-                 seed: int = 0, origin: VolumeOrigin | None = None):
+                 seed: int = 0, origin: VolumeOrigin | None = None, sun=None):
         self.params = params.validate()
         shape = tuple(params.volume_shape)
         self.settings = (settings or CloudSettings()).validate(shape)
@@ -73,6 +94,8 @@ class CloudSimulation:
         self.origin = origin or VolumeOrigin()
         self.rng = np.random.default_rng(seed)
         self.gpu = gpu
+        self.sun = sun or (lambda: np.array([0.3, 0.35, -0.88]))
+        self.shader = None
         s = self.settings
         made = []
         try:
@@ -82,7 +105,12 @@ class CloudSimulation:
             made.append(self.automaton)
             self.smoother = Smoother.for_automaton(self.automaton, s.radius, s.weights)
             made.append(self.smoother)
-            self.triple = TripleSet(gpu, {"density": TextureDesc(shape, 1, s.density_dtype)})
+            descs = {"density": TextureDesc(shape, 1, s.density_dtype)}
+            if s.shading:
+                descs["transmittance"] = TextureDesc(shading_shape(shape, s.shading_scale), 1, "f2")
+                self.shader = ShearWarpShader(gpu.ctx, shape, s.shading_scale)
+                made.append(self.shader)
+            self.triple = TripleSet(gpu, descs)
             made.append(self.triple)
             self._maps = {id(t): DensityMaps(gpu.ctx, shape, s.band_height, s.group_size) for t in self.triple.sets}
             made += list(self._maps.values())
@@ -94,12 +122,17 @@ class CloudSimulation:
         self._drift = np.zeros(2)          # sub-cell wind displacement not yet applied
         self._last_origin = np.array(self.origin.as_tuple())
         n = s.smoothing_slices
-        self.job = SlicedJob("clouds", [
+        stages = [
             SliceStage("region", 1, self._region_slice),
             SliceStage("automaton", 1, self._automaton_slice),
             SliceStage("smoothing", n, self._smoothing_slice),
             SliceStage("density_maps", n, self._maps_slice),
-        ], self.triple)
+        ]
+        if s.shading:
+            extinction = (s.scattering or Scattering()).extinction(s.sigma)
+            stages.append(ShadingStage(self.shader, self.sun_in_cells, extinction,
+                                       slices_per_run=s.shading_slices_per_run))
+        self.job = SlicedJob("clouds", stages, self.triple)
 
     # -- stages ------------------------------------------------------------------------------
     def _region_slice(self, index: int, job) -> None:
@@ -134,6 +167,10 @@ class CloudSimulation:
         limit = max(self.shape) + 1            # larger shifts empty the volume all the same
         return int(np.clip(shift[0], -limit, limit)), int(np.clip(shift[1], -limit, limit))
 
+    def sun_in_cells(self) -> np.ndarray:
+        """The sun direction in cell units (what the shear-warp needs when cells are not cubes)."""
+        return np.asarray(self.sun(), float) / np.asarray(self.settings.cell_size, float)
+
     # -- readers -----------------------------------------------------------------------------
     def view(self):
         """(A, B, t): draw mix(A["density"], B["density"], t)."""
@@ -157,6 +194,7 @@ class CloudSimulation:
         return float((sums > self.settings.cover_threshold).mean())
 
     def release(self) -> None:
-        for obj in (self.region, self.automaton, self.smoother, self.triple, *self._maps.values()):
-            obj.release()
+        for obj in (self.region, self.automaton, self.smoother, self.triple, self.shader, *self._maps.values()):
+            if obj is not None:
+                obj.release()
         self._maps.clear()
