@@ -19,3 +19,12 @@ class Sun:
     def from_angles(cls, elevation_deg: float, azimuth_deg: float = 0.0, color=(1.0, 0.95, 0.85)) -> "Sun":
         e, a = math.radians(elevation_deg), math.radians(azimuth_deg)
         return cls(np.array([math.sin(a) * math.cos(e), math.sin(e), -math.cos(a) * math.cos(e)]), color)
+
+
+def sun_and_day(sun: Sun) -> tuple[np.ndarray, float]:
+    """(unit direction toward the sun, daylight 0..1 = smoothstep(-0.15, 0.1, sun height) like the sky)."""
+    s = np.asarray(sun.direction, np.float64)
+    norm = np.linalg.norm(s)
+    s = s / norm if np.isfinite(norm) and norm > 1e-9 else np.array([0.0, 1.0, 0.0])
+    day = float(np.clip((s[1] + 0.15) / 0.25, 0.0, 1.0))
+    return s, day * day * (3 - 2 * day)

@@ -13,7 +13,8 @@ from atmos.graph import RenderPass
 from atmos.lighting import Sun
 from atmos.plugins.ground import GroundPlugin
 from atmos.plugins.volumetric_fog import FogParams, VolumetricFogPlugin
-from atmos.plugins.volumetric_fog import noise, reference
+from atmos import value_noise as noise
+from atmos.plugins.volumetric_fog import reference
 from atmos.plugins.volumetric_fog.plugin import set_medium_uniforms, sun_terms
 from atmos.render_core import COLOR, DEPTH
 

@@ -89,6 +89,17 @@ class PassContext:
     def _begin_pass(self, name: str, declared: frozenset[str]) -> None:
         self.pass_name = name
         self._declared = declared
+        ctx = self.gpu.ctx                # every pass starts from the same GL state
+        ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST | moderngl.CULL_FACE)
+        ctx.blend_func = moderngl.DEFAULT_BLENDING
+        ctx.blend_equation = moderngl.FUNC_ADD
+
+    def blend_transmittance(self) -> None:
+        """Blend a participating medium's (in-scattered light, transmittance T) over the colour:
+        rgb = light + T · rgb, alpha kept. What fog, clouds and volumes output."""
+        ctx = self.gpu.ctx
+        ctx.enable(moderngl.BLEND)
+        ctx.blend_func = moderngl.ONE, moderngl.SRC_ALPHA, moderngl.ZERO, moderngl.ONE
 
     def _end_frame(self) -> None:
         self.pass_name = ""

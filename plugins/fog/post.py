@@ -51,10 +51,10 @@ def set_fog_uniforms(prog, settings, time: float) -> None:
 
 
 def draw_state(ctx) -> None:
-    """No depth test; blend (ONE, SRC_ALPHA): target = rgb + a * target."""
+    """No depth test; blend (ONE, SRC_ALPHA) on colour: target = rgb + a * target; alpha kept."""
     ctx.disable(ctx.DEPTH_TEST)
     ctx.enable(ctx.BLEND)
-    ctx.blend_func = ctx.ONE, ctx.SRC_ALPHA
+    ctx.blend_func = ctx.ONE, ctx.SRC_ALPHA, ctx.ZERO, ctx.ONE
 
 
 def restore_state(ctx) -> None:

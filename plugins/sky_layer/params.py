@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, fields, replace
 
-from atmos.plugins.volumetric_fog.checks import check_int, check_known, check_num, check_vec
+from atmos.checks import check_int, check_known, check_num, check_vec
 
 _OWNER = "SkyLayerParams"
 MIN_GAP = 1e-3          # sharpness − emptiness must be at least this (the remap divides by it)

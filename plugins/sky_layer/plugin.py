@@ -10,7 +10,7 @@ from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
 from atmos.plugins.sky_layer.octaves import OctaveTextures
 from atmos.plugins.sky_layer.params import SkyLayerParams
-from atmos.plugins.volumetric_fog.plugin import sun_and_day
+from atmos.lighting import sun_and_day
 
 
 def layer_light(sun: Sun) -> tuple[np.ndarray, np.ndarray]:
@@ -46,11 +46,8 @@ class SkyLayerPass(RenderPass):
         s, light = layer_light(app.get_resource(Sun) or Sun())
         if plugin.octaves.needs_bake(params, s, plugin.rebake_tolerance):
             plugin.octaves.bake(params, s)
-        ctx = gpu.ctx
         frame.framebuffer(color=[COLOR]).use()
-        ctx.disable(ctx.DEPTH_TEST)
-        ctx.enable(ctx.BLEND)
-        ctx.blend_func = ctx.ONE, ctx.SRC_ALPHA, ctx.ZERO, ctx.ONE     # alpha of "color" stays
+        frame.blend_transmittance()
         plugin.octaves.use(0)
         frame.texture(DEPTH).use(4)
         set_camera_uniforms(p, app.resource(Camera), gpu.size[0] / gpu.size[1])
@@ -60,8 +57,6 @@ class SkyLayerPass(RenderPass):
             p[name].value = getattr(params, name)
         p["light"].value = tuple(light)
         frame.fullscreen(p)
-        ctx.disable(ctx.BLEND)
-        ctx.blend_func = ctx.SRC_ALPHA, ctx.ONE_MINUS_SRC_ALPHA
 
     def release(self) -> None:
         if self.plugin.octaves is not None:

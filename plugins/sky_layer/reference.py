@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.plugins.volumetric_fog.noise import key, value_noise
+from atmos.value_noise import key, value_noise
 
 WEIGHTS = np.array([0.5, 0.25, 0.125, 0.0625])
 RAY = np.array([0.0, 0.2, 0.4, 0.6])

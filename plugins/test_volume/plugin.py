@@ -87,9 +87,7 @@ class TestVolumePass(RenderPass):
         app, gpu, p = frame.data["app"], frame.gpu, self.program
         a, b, t = self.plugin.job.view()
         frame.framebuffer(color=[COLOR]).use()
-        gpu.ctx.disable(gpu.ctx.DEPTH_TEST)
-        gpu.ctx.enable(gpu.ctx.BLEND)
-        gpu.ctx.blend_func = gpu.ctx.ONE, gpu.ctx.SRC_ALPHA
+        frame.blend_transmittance()
         a["density"].use(0)
         b["density"].use(1)
         frame.texture(DEPTH).use(2)
@@ -102,5 +100,3 @@ class TestVolumePass(RenderPass):
         p["box_min"].value = tuple(c - s / 2 for c, s in zip(box.center, box.size))
         p["box_max"].value = tuple(c + s / 2 for c, s in zip(box.center, box.size))
         frame.fullscreen(p)
-        gpu.ctx.disable(gpu.ctx.BLEND)
-        gpu.ctx.blend_func = gpu.ctx.SRC_ALPHA, gpu.ctx.ONE_MINUS_SRC_ALPHA

@@ -5,19 +5,10 @@ import numpy as np
 
 from atmos.camera import Camera, set_camera_uniforms
 from atmos.graph import PassBuilder, PassContext, RenderPass
-from atmos.lighting import Sun
+from atmos.lighting import Sun, sun_and_day
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
 from atmos.plugins.volumetric_fog.params import FogParams
-
-
-def sun_and_day(sun: Sun) -> tuple[np.ndarray, float]:
-    """(unit direction toward the sun, daylight 0..1 = smoothstep(-0.15, 0.1, sun height) like the sky)."""
-    s = np.asarray(sun.direction, np.float64)
-    norm = np.linalg.norm(s)
-    s = s / norm if np.isfinite(norm) and norm > 1e-9 else np.array([0.0, 1.0, 0.0])
-    day = float(np.clip((s[1] + 0.15) / 0.25, 0.0, 1.0))
-    return s, day * day * (3 - 2 * day)
 
 
 def sun_terms(sun: Sun, params: FogParams):
@@ -59,17 +50,12 @@ class VolumetricFogPass(RenderPass):
 
     def execute(self, frame: PassContext) -> None:
         app, gpu, p = frame.data["app"], frame.gpu, self.program
-        ctx = gpu.ctx
         frame.framebuffer(color=[COLOR]).use()
-        ctx.disable(ctx.DEPTH_TEST)
-        ctx.enable(ctx.BLEND)
-        ctx.blend_func = ctx.ONE, ctx.SRC_ALPHA, ctx.ZERO, ctx.ONE     # alpha of "color" stays
+        frame.blend_transmittance()
         frame.texture(DEPTH).use(0)
         set_camera_uniforms(p, app.resource(Camera), gpu.size[0] / gpu.size[1])
         set_medium_uniforms(p, self.plugin.params, app.get_resource(Sun) or Sun(), self.plugin.time(app))
         frame.fullscreen(p)
-        ctx.disable(ctx.BLEND)
-        ctx.blend_func = ctx.SRC_ALPHA, ctx.ONE_MINUS_SRC_ALPHA
 
 
 class VolumetricFogPlugin(Plugin):

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.plugins.volumetric_fog.noise import fbm
+from atmos.value_noise import fbm
 from atmos.plugins.volumetric_fog.params import FogParams
 
 

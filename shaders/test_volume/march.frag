@@ -1,7 +1,7 @@
 #version 430
 // Test volume ray march: density = mix(A, B, t); Beer-Lambert extinction, a short light march toward
 // the sun, stopped at scene depth. Output premultiplied: rgb = in-scattered light, a = transmittance
-// (blend ONE, SRC_ALPHA gives light + transmittance * scene).
+// (PassContext.blend_transmittance gives light + transmittance * scene).
 in vec2 v_uv;
 out vec4 frag;
 layout(binding = 0) uniform sampler3D density_a;
@@ -15,6 +15,8 @@ uniform vec3 box_min;
 uniform vec3 box_max;
 uniform float t;
 
+#include "lib/view_ray.glsl"
+
 const float SIGMA = 1.2;   // extinction per metre at density 1
 
 float density(vec3 world) {
@@ -24,12 +26,9 @@ float density(vec3 world) {
 }
 
 void main() {
-    vec2 ndc = v_uv * 2.0 - 1.0;
-    vec4 far_p = inv_view_proj * vec4(ndc, 1.0, 1.0);
-    vec3 dir = normalize(far_p.xyz / far_p.w - camera_pos);
-    float z = texture(scene_depth, v_uv).r;
-    vec4 hit = inv_view_proj * vec4(ndc, z * 2.0 - 1.0, 1.0);
-    float scene_dist = z >= 1.0 ? 1e30 : length(hit.xyz / hit.w - camera_pos);
+    vec3 dir = view_ray_dir(v_uv, inv_view_proj, camera_pos);
+    float z = texelFetch(scene_depth, ivec2(gl_FragCoord.xy), 0).r;
+    float scene_dist = view_ray_distance(v_uv, z, inv_view_proj, camera_pos, 1e30);
 
     vec3 inv = 1.0 / dir;
     vec3 t0 = (box_min - camera_pos) * inv, t1 = (box_max - camera_pos) * inv;

@@ -1,6 +1,6 @@
 """Parameter checks whose ValueErrors name the setting, what was given and what is allowed.
 
-Shared by the fog and sky-layer parameter classes (a candidate for ``atmos/`` itself).
+Shared by parameter classes of the plugins (volumetric fog, sky layer, ...).
 """
 from __future__ import annotations
 
