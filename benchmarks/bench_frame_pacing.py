@@ -14,7 +14,6 @@ import argparse
 import os
 import sys
 import time
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -22,16 +21,7 @@ import numpy as np
 from atmos.frames import FrameScheduler, SlicedJob, SliceStage, TripleSet
 from atmos.gpu import create_headless
 
-try:
-    from atmos.graph.resources import TextureDesc
-except ImportError:  # frames only duck-types descriptions
-    @dataclass(frozen=True)
-    class TextureDesc:
-        size: tuple
-        components: int = 4
-        dtype: str = "f2"
-        depth: bool = False
-        filter: str = "linear"
+from atmos.graph import TextureDesc
 
 VOLUME = (128, 32, 128)
 SLICES = 32

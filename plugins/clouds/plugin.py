@@ -46,6 +46,7 @@ class CloudsPlugin(Plugin):
 
     def cleanup(self, app) -> None:
         if self.simulation is not None:
-            app.frames.remove(self.simulation.job)
+            if self.simulation.job in app.frames:      # a scene may have paused the simulation
+                app.frames.remove(self.simulation.job)
             self.simulation.release()
             self.simulation = None
