@@ -1,6 +1,8 @@
 """The passes every rendered scene has: clear (creates the HDR colour and depth) and present (to the screen)."""
 from __future__ import annotations
 
+import numpy as np
+
 from atmos.graph import PassBuilder, PassContext, RenderPass, TextureDesc
 from atmos.plugin import Plugin
 
@@ -58,6 +60,25 @@ class PresentPass(RenderPass):
         frame.texture(COLOR).use(0)
         self.program["exposure"].value = self.exposure
         frame.fullscreen(self.program)
+
+
+class CapturePass(RenderPass):
+    """Copies the final HDR ``color`` (float, (h, w, 4)) and ``depth`` ((h, w)) to numpy each frame,
+    rows bottom-up as OpenGL stores them. For tests, tools and HDR screenshots; a side effect."""
+    name = "capture"
+
+    def __init__(self):
+        self.color = self.depth = None
+
+    def setup(self, builder: PassBuilder) -> None:
+        builder.read(COLOR)
+        builder.read(DEPTH)
+        builder.side_effect()
+
+    def execute(self, frame: PassContext) -> None:
+        w, h = frame.gpu.size
+        self.color = np.frombuffer(frame.texture(COLOR).read(), np.float16).reshape(h, w, 4).astype(np.float64)
+        self.depth = np.frombuffer(frame.texture(DEPTH).read(), np.float32).reshape(h, w).astype(np.float64)
 
 
 class RenderCorePlugin(Plugin):

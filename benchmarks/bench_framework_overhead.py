@@ -6,8 +6,6 @@ frame on the 2-core CI machine. Run: .venv/bin/python -m pytest benchmarks/bench
 """
 from dataclasses import dataclass
 
-import pytest
-
 from atmos.app import App
 from atmos.gpu import create_headless
 from atmos.graph import RenderPass, TextureDesc

@@ -1,6 +1,4 @@
 """sky_layer: the 2D dynamic cloud layer drifting over a sky gradient and the ground."""
-import math
-
 import numpy as np
 
 from atmos.camera import Camera

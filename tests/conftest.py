@@ -33,3 +33,12 @@ def rng(request):
     seed = int.from_bytes(os.urandom(4), "little")
     print(f"rng seed {seed}")
     return np.random.default_rng(seed)
+
+
+@pytest.fixture
+def fresh_gpu():
+    """A GpuContext of its own (64×40) for tests that count compiled shaders or allocations."""
+    context = create_headless((64, 40))
+    yield context
+    assert context.ctx.error == "GL_NO_ERROR"
+    context.release()

@@ -1,5 +1,4 @@
 """Cloud automaton: GPU (packed and cell layouts) against the numpy reference, bit for bit."""
-import moderngl
 import numpy as np
 import pytest
 

@@ -5,7 +5,7 @@ import pytest
 
 from atmos.app import App
 from atmos.lighting import Sun
-from atmos.plugins.daylight import DaylightPlugin, TimeOfDay, solar_direction
+from atmos.plugins.daylight import DaylightPlugin, solar_direction
 
 
 def elevation(d):

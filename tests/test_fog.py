@@ -14,7 +14,7 @@ from atmos.plugins.fog.noise import (NoiseVolumes, noise_volume_ref, octave_key,
                                      sample_repeat_trilinear)
 from atmos.plugins.sky_gradient import SkyGradientPlugin
 from atmos.plugins.terrain import TerrainPlugin, heightfield
-from atmos.render_core import COLOR, DEPTH
+from atmos.render_core import CapturePass, COLOR, DEPTH
 
 SMALL = (4, 8, 16, 32)
 TOL = 2e-4          # float32 GPU vs float64 reference
@@ -185,21 +185,6 @@ class KnownScene(RenderPass):
         frame.texture(DEPTH).write(self.depth.astype(np.float32).tobytes())
 
 
-class Probe(RenderPass):
-    """Reads back the fogged colour and the depth it was made from."""
-    name = "probe"
-
-    def setup(self, builder):
-        builder.read(COLOR)
-        builder.read(DEPTH)
-        builder.side_effect()
-
-    def execute(self, frame):
-        w, h = frame.gpu.size
-        self.color = np.frombuffer(frame.texture(COLOR).read(), np.float16).reshape(h, w, 4).astype(np.float64)
-        self.depth = np.frombuffer(frame.texture(DEPTH).read(), np.float32).reshape(h, w).astype(np.float64)
-
-
 @pytest.mark.parametrize("mode,noise,sky", [("exp", "texture", "fog"), ("hetero_exp2", "procedural", "keep"),
                                             ("hetero_exp", "texture", "fog")])
 def test_fog_pass_on_a_known_depth_buffer_matches_reference(rng, mode, noise, sky):
@@ -215,7 +200,7 @@ def test_fog_pass_on_a_known_depth_buffer_matches_reference(rng, mode, noise, sk
         depth[:3, :] = 1.0                                   # sky rows
         settings = FogSettings(mode=mode, density=0.03, noise=noise, sky=sky, resolutions=SMALL,
                                tile_size=64.0, seed=int(rng.integers(2**32))).validated()
-        probe = Probe()
+        probe = CapturePass()
         app = App(gpu).add_plugins(DefaultPlugins(overlay=False))
         app.graph.add_pass(KnownScene(color, depth))
         app.add_plugins(FogPlugin(settings))

@@ -10,14 +10,6 @@ from atmos.plugins.sky_gradient import SkyGradientPlugin
 from atmos.plugins.test_volume import TestVolumePlugin
 
 
-@pytest.fixture
-def fresh_gpu():
-    gpu = create_headless((96, 54))
-    yield gpu
-    assert gpu.ctx.error == "GL_NO_ERROR"
-    gpu.release()
-
-
 def scene(gpu, *plugins):
     app = App(gpu).add_plugins(DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(), *plugins)
     app.startup()
@@ -75,7 +67,7 @@ def test_resize_including_minimized_window(fresh_gpu, size):
     img = fresh_gpu.read_pixels()
     assert img.shape[:2] == (max(1, size[1]), max(1, size[0])) and np.isfinite(img).all()
     app.close()
-    fresh_gpu.resize((96, 54))
+    fresh_gpu.resize((64, 40))
 
 
 def test_two_apps_on_two_contexts_render_alternately():

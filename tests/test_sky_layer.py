@@ -7,15 +7,13 @@ import pytest
 from atmos.app import App
 from atmos.camera import Camera
 from atmos.defaults import DefaultPlugins
-from atmos.gpu import create_headless
 from atmos.gpu.shaders import build_program
-from atmos.graph import RenderPass
 from atmos.lighting import Sun
 from atmos.plugins.ground import GroundPlugin
 from atmos.plugins.sky_layer import SkyLayerParams, SkyLayerPlugin, reference
 from atmos.plugins.sky_layer.octaves import OctaveTextures
 from atmos.plugins.sky_layer.plugin import layer_light, scroll_offsets
-from atmos.render_core import COLOR, DEPTH
+from atmos.render_core import CapturePass
 
 
 # -- octave textures ---------------------------------------------------------------------------------
@@ -114,32 +112,6 @@ def test_remap_reference():
 
 
 # -- the pass in a scene --------------------------------------------------------------------------------
-class Capture(RenderPass):
-    """Test pass: copies the final HDR colour and depth to numpy."""
-    name = "capture"
-
-    def __init__(self):
-        self.color = self.depth = None
-
-    def setup(self, builder):
-        builder.read(COLOR)
-        builder.read(DEPTH)
-        builder.side_effect()
-
-    def execute(self, frame):
-        w, h = frame.gpu.size
-        self.color = np.frombuffer(frame.texture(COLOR).read(), np.float16).reshape(h, w, 4).astype(np.float64)
-        self.depth = np.frombuffer(frame.texture(DEPTH).read(), np.float32).reshape(h, w).astype(np.float64)
-
-
-@pytest.fixture
-def small_gpu():
-    gpu = create_headless((64, 40))
-    yield gpu
-    assert gpu.ctx.error == "GL_NO_ERROR"
-    gpu.release()
-
-
 SUN = Sun.from_angles(35.0, 200.0)
 
 
@@ -149,7 +121,7 @@ def render(gpu, *plugins, frames=1, pitch=0.25, yaw=0.3):
     cam = app.resource(Camera)
     cam.position = np.array([123.0, 3.0, -77.0])
     cam.yaw, cam.pitch = yaw, pitch
-    capture = app.graph.add_pass(Capture())
+    capture = app.graph.add_pass(CapturePass())
     app.run_frames(frames)
     return app, capture, cam
 
@@ -168,13 +140,13 @@ def bilinear(tex, uv):
     return out
 
 
-def test_pass_draws_the_reference_layer_on_the_sky_only(small_gpu, tmp_path):
+def test_pass_draws_the_reference_layer_on_the_sky_only(fresh_gpu, tmp_path):
     params = SkyLayerParams(size=32, base_frequency=12, tile_size=40000.0, altitude=1200.0,
                             wind=((0.11, 0.0), (0.0, 0.37), (0.0, -0.2), (-0.9, 0.0)))
     plugin = SkyLayerPlugin(params, animate=False)
-    app0, bg, cam = render(small_gpu)
+    app0, bg, cam = render(fresh_gpu)
     app0.close()
-    app, got, _ = render(small_gpu, plugin)
+    app, got, _ = render(fresh_gpu, plugin)
     textures = [plugin.octaves.download(k) for k in range(4)]
     app.close()
     save_png(tmp_path, "sky_layer_pass.png", got.color)
@@ -213,9 +185,9 @@ def save_png(folder, name, hdr):
     Image.fromarray((img * 255).astype(np.uint8)).save(folder / name)
 
 
-def test_layer_scrolls_with_time_and_rebakes_only_when_the_sun_turns(small_gpu):
+def test_layer_scrolls_with_time_and_rebakes_only_when_the_sun_turns(fresh_gpu):
     plugin = SkyLayerPlugin(size=32, rebake_tolerance=0.05)
-    app, cap, _ = render(small_gpu, plugin, pitch=0.6)
+    app, cap, _ = render(fresh_gpu, plugin, pitch=0.6)
     first = cap.color.copy()
     app.run_frames(30, dt=1 / 10)
     assert np.abs(cap.color - first).mean() > 1e-3, "the clouds drift"
@@ -242,10 +214,10 @@ def test_octaves_scroll_at_different_speeds_and_directions():
     assert (scroll_offsets(wind, 1e9) >= 0).all() and (scroll_offsets(wind, 1e9) < 1).all()
 
 
-def test_camera_above_the_layer_and_looking_down_draws_nothing(small_gpu):
-    app0, bg, _ = render(small_gpu, pitch=0.3)
+def test_camera_above_the_layer_and_looking_down_draws_nothing(fresh_gpu):
+    app0, bg, _ = render(fresh_gpu, pitch=0.3)
     app0.close()
-    app, got, _ = render(small_gpu, SkyLayerPlugin(size=16, altitude=-10.0), pitch=0.3)
+    app, got, _ = render(fresh_gpu, SkyLayerPlugin(size=16, altitude=-10.0), pitch=0.3)
     app.close()
     assert np.array_equal(got.color, bg.color)
 
@@ -269,11 +241,11 @@ def test_bad_settings_are_refused_and_nothing_is_applied(change, message):
         SkyLayerPlugin(**change)
 
 
-def test_scene_without_the_layer_compiles_and_runs_none_of_it(small_gpu):
-    app = App(small_gpu).add_plugins(DefaultPlugins(overlay=False), GroundPlugin())
+def test_scene_without_the_layer_compiles_and_runs_none_of_it(fresh_gpu):
+    app = App(fresh_gpu).add_plugins(DefaultPlugins(overlay=False), GroundPlugin())
     app.run_frames(2)
     assert "sky_layer" not in app.graph.dump()
-    assert not any(f.startswith("sky_layer/") for f in small_gpu.compiled_files)
+    assert not any(f.startswith("sky_layer/") for f in fresh_gpu.compiled_files)
     app.close()
 
 

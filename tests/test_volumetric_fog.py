@@ -7,16 +7,14 @@ import pytest
 from atmos.app import App
 from atmos.camera import Camera
 from atmos.defaults import DefaultPlugins
-from atmos.gpu import create_headless
 from atmos.gpu.shaders import build_program
-from atmos.graph import RenderPass
 from atmos.lighting import Sun
 from atmos.plugins.ground import GroundPlugin
 from atmos.plugins.volumetric_fog import FogParams, VolumetricFogPlugin
 from atmos import value_noise as noise
 from atmos.plugins.volumetric_fog import reference
 from atmos.plugins.volumetric_fog.plugin import set_medium_uniforms, sun_terms
-from atmos.render_core import COLOR, DEPTH
+from atmos.render_core import CapturePass
 
 EPS32 = 2.0 ** -24
 
@@ -209,48 +207,22 @@ def test_bad_settings_are_refused_and_nothing_is_applied(change, message):
 
 
 # -- the pass in a scene --------------------------------------------------------------------------------
-class Capture(RenderPass):
-    """Test pass: copies the final HDR colour and depth to numpy."""
-    name = "capture"
-
-    def __init__(self):
-        self.color = self.depth = None
-
-    def setup(self, builder):
-        builder.read(COLOR)
-        builder.read(DEPTH)
-        builder.side_effect()
-
-    def execute(self, frame):
-        w, h = frame.gpu.size
-        self.color = np.frombuffer(frame.texture(COLOR).read(), np.float16).reshape(h, w, 4).astype(np.float64)
-        self.depth = np.frombuffer(frame.texture(DEPTH).read(), np.float32).reshape(h, w).astype(np.float64)
-
-
-@pytest.fixture
-def small_gpu():
-    gpu = create_headless((64, 40))
-    yield gpu
-    assert gpu.ctx.error == "GL_NO_ERROR"
-    gpu.release()
-
-
 def render(gpu, *plugins, camera_at=(0.0, 6.0, 45.0), target=(0.0, 2.0, 0.0)):
     app = App(gpu).add_plugins(DefaultPlugins(overlay=False), GroundPlugin(), *plugins)
     app.insert_resource(Sun.from_angles(30.0, 60.0))
     cam = app.resource(Camera)
     cam.position = np.array(camera_at)
     cam.look_at(target)
-    capture = app.graph.add_pass(Capture())
+    capture = app.graph.add_pass(CapturePass())
     app.run_frames(1)
     app.close()
     return capture, cam
 
 
-def test_pass_blends_the_reference_march_over_the_scene_stopping_at_depth(small_gpu, tmp_path):
+def test_pass_blends_the_reference_march_over_the_scene_stopping_at_depth(fresh_gpu, tmp_path):
     params = FogParams(octaves=4, steps=24, light_steps=3, absorption=0.15)
-    bg, cam = render(small_gpu)
-    fog, _ = render(small_gpu, VolumetricFogPlugin(params, animate=False))
+    bg, cam = render(fresh_gpu)
+    fog, _ = render(fresh_gpu, VolumetricFogPlugin(params, animate=False))
     assert np.isfinite(fog.color).all()
     save_png(tmp_path, "fog_pass.png", fog.color)
     h, w = fog.depth.shape
@@ -277,11 +249,11 @@ def save_png(folder, name, hdr):
     Image.fromarray((img * 255).astype(np.uint8)).save(folder / name)
 
 
-def test_scene_without_fog_compiles_and_runs_none_of_it(small_gpu):
-    app = App(small_gpu).add_plugins(DefaultPlugins(overlay=False), GroundPlugin())
+def test_scene_without_fog_compiles_and_runs_none_of_it(fresh_gpu):
+    app = App(fresh_gpu).add_plugins(DefaultPlugins(overlay=False), GroundPlugin())
     app.run_frames(2)
     assert "volumetric_fog" not in app.graph.dump()
-    assert not any(f.startswith("volumetric_fog/") for f in small_gpu.compiled_files)
+    assert not any(f.startswith("volumetric_fog/") for f in fresh_gpu.compiled_files)
     app.close()
 
 

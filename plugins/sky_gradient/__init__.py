@@ -3,7 +3,7 @@ from atmos.camera import Camera, set_camera_uniforms
 from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.lighting import Sun
 from atmos.plugin import Plugin
-from atmos.render_core import COLOR, DEPTH
+from atmos.render_core import COLOR
 
 
 class SkyGradientPass(RenderPass):

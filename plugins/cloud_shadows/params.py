@@ -1,0 +1,50 @@
+"""CloudShadowParams: the settings of the ground shadows, checked as a whole before any is used."""
+from __future__ import annotations
+
+from dataclasses import dataclass, fields, replace
+
+from atmos.checks import check_known, check_num, check_vec
+
+_OWNER = "CloudShadowParams"
+
+
+@dataclass(frozen=True)
+class CloudShadowParams:
+    """Where the cloud layer is and how dark its shadow is (world units are metres, y is up).
+
+    ``base_altitude``: world height of the bottom of the simulation volume; cell ``(i, j, k)`` has
+    its centre at ``((origin.x + i + 0.5)·cx, base_altitude + (j + 0.5)·cy, (origin.z + k + 0.5)·cz)``
+    with ``origin`` the :class:`~atmos.plugins.weather.VolumeOrigin` (in cells).
+    ``cell_size``: (cx, cy, cz) metres per cell; ``None`` takes the simulation's ``CloudSettings.cell_size``.
+    ``sigma``: extinction per cell length at density 1; ``None`` takes ``CloudSettings.sigma``.
+    ``strength``: k in ``exp(−sigma·k·sum)`` (0: no shadows, > 1: darker than physical).
+    ``direct_fraction``: the part of a surface's light that is direct sunlight (what a cloud can
+    block); the rest (sky ambient) is kept. ``horizon_fade``: shadows fade in while the sun's height
+    (the y of its unit direction, sin of its elevation) rises from 0 to this, so a grazing sun, whose
+    projection runs far, fades them out, and a sun at or below the horizon casts none.
+    """
+
+    base_altitude: float = 200.0
+    cell_size: tuple | None = None
+    sigma: float | None = None
+    strength: float = 1.0
+    direct_fraction: float = 0.75
+    horizon_fade: float = 0.1
+
+    def __post_init__(self):
+        o = _OWNER
+        checked = dict(
+            base_altitude=check_num(o, "base_altitude", self.base_altitude),
+            cell_size=None if self.cell_size is None else check_vec(o, "cell_size", self.cell_size, 3, "positive"),
+            sigma=None if self.sigma is None else check_num(o, "sigma", self.sigma, 0.0),
+            strength=check_num(o, "strength", self.strength, 0.0),
+            direct_fraction=check_num(o, "direct_fraction", self.direct_fraction, 0.0, 1.0),
+            horizon_fade=check_num(o, "horizon_fade", self.horizon_fade, 0.0, 1.0, lo_open=True),
+        )
+        for name, value in checked.items():
+            object.__setattr__(self, name, value)
+
+    def replace(self, **changes) -> "CloudShadowParams":
+        """A checked copy with ``changes``; unknown names and bad values raise ValueError."""
+        check_known(_OWNER, changes, [f.name for f in fields(self)])
+        return replace(self, **changes)

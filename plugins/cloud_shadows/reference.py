@@ -1,0 +1,61 @@
+"""numpy float64 reference of the ground-shadow factor (thesis 7.3.1), and the sun weight both sides use.
+
+A surface point P is projected along the direction toward the sun onto the middle plane of the cloud
+layer, Q = P + s·max(y_mid − P.y, 0)/s.y, and the top-view summed density (layer 0 of the density
+maps, mix(A, B, t)) is read there bilinearly, zero outside the volume. The optical depth
+``tau = sigma·strength·sum·above`` (``above``: the fraction of the layer's height above P, 1 on the
+ground below it, 0 above its top) dims the direct light only:
+``factor = mix(1, exp(−tau), weight)`` with ``weight`` from :func:`direct_weight`.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from atmos.plugins.cloud_shadows.layer import CloudLayer
+from atmos.plugins.shading.reference import bilinear
+
+MIN_SUN_HEIGHT = 1e-4   # the projection's divisor never gets smaller (weight is 0 there anyway)
+
+
+def unit_sun(direction) -> np.ndarray | None:
+    """The unit direction toward the sun, or None when it is not a finite non-zero vector."""
+    s = np.asarray(direction, np.float64).reshape(3)
+    norm = np.linalg.norm(s)
+    return s / norm if np.isfinite(norm) and norm > 1e-12 else None
+
+
+def direct_weight(sun_direction, sun_color, params) -> float:
+    """How much of the light shadows can take away: ``direct_fraction`` × smoothstep(0,
+    ``horizon_fade``, sun height), and 0 when the sun has no colour (night) or no direction."""
+    s = unit_sun(sun_direction)
+    if s is None or not max(float(c) for c in sun_color) > 0.0:
+        return 0.0
+    x = float(np.clip(s[1] / params.horizon_fade, 0.0, 1.0))
+    return params.direct_fraction * x * x * (3.0 - 2.0 * x)
+
+
+def zero_border_bilinear(plane: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """Bilinear samples of a 2D ``plane`` at texel coordinates ``p`` (..., 2), texel i centred at i,
+    zero outside (OpenGL's clamp-to-border with a black border)."""
+    n = np.array(plane.shape, np.float64)
+    inside = np.all((p > -1.0) & (p < n), axis=-1)
+    q = np.where(inside[..., None], p, -1.0) + 1.0
+    return np.where(inside, bilinear(np.pad(np.asarray(plane, np.float64), 1), q), 0.0)
+
+
+def shadow_factor(points, sums_a, sums_b, t: float, sun_direction, weight: float, extinction: float,
+                  layer: CloudLayer) -> np.ndarray:
+    """Factor (...,) the colour at world ``points`` (..., 3) is multiplied by; ``sums_a/b`` (nx, nz)
+    the all-heights top-view maps of sets A and B; ``extinction`` = sigma·strength."""
+    points = np.asarray(points, np.float64)
+    s = unit_sun(sun_direction)
+    if s is None or weight <= 0.0:
+        return np.ones(points.shape[:-1])
+    sums = (1.0 - t) * np.asarray(sums_a, np.float64) + t * np.asarray(sums_b, np.float64)
+    mid = layer.bottom + 0.5 * layer.thickness
+    y = points[..., 1]
+    run = np.maximum(mid - y, 0.0) / max(s[1], MIN_SUN_HEIGHT)
+    q = points + run[..., None] * s
+    column = zero_border_bilinear(sums, layer.map_coords(q[..., 0], q[..., 2]))
+    above = np.clip((layer.bottom + layer.thickness - y) / layer.thickness, 0.0, 1.0)
+    return 1.0 - weight * (1.0 - np.exp(-extinction * column * above))

@@ -1,0 +1,59 @@
+"""SkyParams: every setting of the Preetham sky, checked as a whole before any of it is used."""
+from __future__ import annotations
+
+from dataclasses import dataclass, fields, replace
+
+from atmos.checks import check_known, check_num, check_vec
+from atmos.plugins.shading.scattering import NIGHT_SKY
+from atmos.plugins.sky.preetham import TURBIDITY_RANGE, check_turbidity
+
+_OWNER = "SkyParams"
+
+
+@dataclass(frozen=True)
+class SkyParams:
+    """Look of the sky: haze, brightness in the HDR pipeline, sun disc, night and stars.
+
+    ``scale``: HDR units per kcd/m² of Preetham luminance (0.05 puts a clear noon zenith near 0.4,
+    beside the sun colour ≈ 1 of ``sky_light``); ``sun_size_deg``: angular radius of the disc;
+    ``sun_gain``: disc radiance per unit of the Sun resource's colour; ``night``: the sky colour
+    once the sun is well below the horizon; ``star_density``: fraction of star-grid cells holding
+    a star; ``star_brightness``: HDR radiance of the brightest star; ``twinkle``: 0 steady .. 1 full.
+    """
+
+    turbidity: float = 2.5
+    scale: float = 0.05
+    sun_size_deg: float = 0.5
+    sun_gain: float = 20.0
+    night: tuple = tuple(NIGHT_SKY)
+    stars: bool = True
+    star_density: float = 0.08
+    star_brightness: float = 4.0
+    twinkle: float = 0.4
+
+    def __post_init__(self):
+        o = _OWNER
+        if not isinstance(self.stars, bool):
+            raise ValueError(f"{o}.stars must be True or False, got {self.stars!r}")
+        try:
+            turbidity = check_turbidity(self.turbidity)
+        except ValueError:
+            raise ValueError(f"{o}.turbidity must be a number in {list(TURBIDITY_RANGE)} "
+                             f"(2 clear .. 10 hazy), got {self.turbidity!r}") from None
+        checked = dict(
+            turbidity=turbidity,
+            scale=check_num(o, "scale", self.scale, 0.0, 1e3, lo_open=True),
+            sun_size_deg=check_num(o, "sun_size_deg", self.sun_size_deg, 0.0, 5.0, lo_open=True),
+            sun_gain=check_num(o, "sun_gain", self.sun_gain, 0.0, 1e4),
+            night=check_vec(o, "night", self.night, 3, "non-negative"),
+            star_density=check_num(o, "star_density", self.star_density, 0.0, 1.0),
+            star_brightness=check_num(o, "star_brightness", self.star_brightness, 0.0, 1e4),
+            twinkle=check_num(o, "twinkle", self.twinkle, 0.0, 1.0),
+        )
+        for name, value in checked.items():
+            object.__setattr__(self, name, value)
+
+    def replace(self, **changes) -> "SkyParams":
+        """A checked copy with ``changes``; unknown names and bad values raise ValueError."""
+        check_known(_OWNER, changes, [f.name for f in fields(self)])
+        return replace(self, **changes)

@@ -1,0 +1,68 @@
+"""The whole sky colour in float64 numpy, as ``shaders/sky/sky.glsl`` draws it.
+
+``sky_radiance`` (the diffuse sky, for anyone who wants the sky's light in a direction):
+``mix(night, scale · preetham, day) · below``, where ``day`` fades the Preetham sky out over twilight
+(the sun's height, sin elevation, from ``DAY_FADE[1]`` down to ``DAY_FADE[0]``) and ``below`` dims
+views under the horizon toward ``GROUND_DIM`` over view heights 0..-``BELOW_FADE``.
+``sky_color`` adds the sun disc (``sun_gain`` × the Sun resource's colour inside ``sun_size_deg``,
+soft over the outer ``DISC_EDGE`` of its radius) and the stars of :mod:`atmos.plugins.sky.stars`.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from atmos.plugins.shading.scattering import NIGHT_SKY
+from atmos.plugins.sky.params import SkyParams
+from atmos.plugins.sky.preetham import angle_between, check_turbidity, preetham_rgb, unit_vectors
+from atmos.plugins.sky.stars import smoothstep, star_field
+
+DEFAULT_SCALE = SkyParams.scale
+DAY_FADE = (-0.2, 0.02)      # sun height (sin elevation): night below the first, full Preetham day above the second
+GROUND_DIM = 0.3
+BELOW_FADE = 0.1
+DISC_EDGE = 0.25
+
+
+def daylight(sun_y) -> np.ndarray:
+    """0 (night) .. 1 (day): how much of the Preetham sky is shown for a sun at height ``sun_y``."""
+    return smoothstep(*DAY_FADE, sun_y)
+
+
+def below_horizon(view_y) -> np.ndarray:
+    """1 above the horizon, down to GROUND_DIM under it."""
+    return 1.0 + (GROUND_DIM - 1.0) * smoothstep(0.0, -BELOW_FADE, view_y)
+
+
+def sky_radiance(view_dir, sun_dir, turbidity: float = 2.5, scale: float = DEFAULT_SCALE,
+                 night=tuple(NIGHT_SKY)) -> np.ndarray:
+    """(..., 3) linear HDR sky colour (no sun disc, no stars) for view directions ``view_dir`` (..., 3)
+    and the direction toward the sun ``sun_dir`` (3,); any direction, sun above or below the horizon."""
+    check_turbidity(turbidity)
+    v = unit_vectors(view_dir, "view_dir")
+    s = unit_vectors(sun_dir, "sun_dir").reshape(3)
+    day = daylight(s[1])
+    rgb = np.asarray(night, np.float64) * (1.0 - day) + scale * preetham_rgb(v, s, turbidity) * day
+    return rgb * below_horizon(v[..., 1])[..., None]
+
+
+def sun_disc(view_dir, sun_dir, sun_color, size_deg: float, gain: float) -> np.ndarray:
+    """(..., 3) the sun disc's radiance: ``gain · sun_color`` inside, soft edge (unit directions)."""
+    r = math.radians(size_deg)
+    inside = 1.0 - smoothstep(r * (1.0 - DISC_EDGE), r, angle_between(view_dir, sun_dir))
+    return gain * inside[..., None] * np.asarray(sun_color, np.float64)
+
+
+def sky_color(view_dir, sun_dir, sun_color, params: SkyParams | None = None, time: float = 0.0,
+              pixel_angle: float = 0.0) -> np.ndarray:
+    """(..., 3) what the sky pass writes: sky radiance, sun disc and (if ``params.stars``) stars."""
+    p = params or SkyParams()
+    v = unit_vectors(view_dir, "view_dir")
+    s = unit_vectors(sun_dir, "sun_dir").reshape(3)
+    rgb = np.asarray(p.night, np.float64) * (1.0 - daylight(s[1])) \
+        + p.scale * preetham_rgb(v, s, p.turbidity) * daylight(s[1])
+    rgb = rgb + sun_disc(v, s, sun_color, p.sun_size_deg, p.sun_gain)
+    if p.stars:
+        rgb = rgb + star_field(v, s[1], time, pixel_angle, p.star_density, p.star_brightness, p.twinkle)
+    return rgb * below_horizon(v[..., 1])[..., None]

@@ -1,0 +1,40 @@
+#version 430
+// Reference image of the cloud layer: MARCH_STEPS midpoint samples per view ray through the
+// layer's box, density and light trilinear from mix(A, B, t), extinction sigma per cell length
+// (path measured in cells), stopped at scene depth. Premultiplied: rgb = light, a = 1 - transmittance.
+#include "cloud_render/volume.glsl"
+#include "lib/view_ray.glsl"
+in vec2 v_uv;
+out vec4 frag;
+layout(binding = 5) uniform sampler2D scene_depth;
+uniform mat4 inv_view_proj;
+uniform vec3 camera_pos;
+uniform vec3 layer_min;
+uniform vec3 layer_max;
+uniform vec3 cell_size;
+uniform float sigma;
+
+void main() {
+    vec3 dir = view_ray_dir(v_uv, inv_view_proj, camera_pos);
+    float scene = view_ray_distance(v_uv, texture(scene_depth, v_uv).r, inv_view_proj, camera_pos, 1e30);
+    vec3 safe = mix(dir, vec3(1e-12), lessThan(abs(dir), vec3(1e-12)));
+    vec3 t0 = (layer_min - camera_pos) / safe, t1 = (layer_max - camera_pos) / safe;
+    float enter = max(max(max(min(t0.x, t1.x), min(t0.y, t1.y)), min(t0.z, t1.z)), 0.0);
+    float leave = min(min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z)), scene);
+    vec3 light = vec3(0.0);
+    float trans = 1.0;
+    if (leave > enter) {
+        float dt = (leave - enter) / float(MARCH_STEPS);
+        float step_cells = dt * length(dir / cell_size);
+        vec3 extent = layer_max - layer_min;
+        for (int i = 0; i < MARCH_STEPS && trans > 1e-4; ++i) {
+            vec3 uvw = (camera_pos + dir * (enter + (float(i) + 0.5) * dt) - layer_min) / extent;
+            float d = cloud_density(uvw);
+            if (d <= 0.0) continue;
+            float a = 1.0 - exp(-sigma * d * step_cells);
+            light += trans * a * cloud_light(uvw);
+            trans *= 1.0 - a;
+        }
+    }
+    frag = vec4(light, 1.0 - trans);
+}

@@ -1,0 +1,56 @@
+#version 430
+// Cloud ground shadows (thesis 7.3.1): the scene point behind each pixel is projected along the
+// direction toward the sun onto the middle of the cloud layer, where the top-view summed density
+// mix(A, B, t) (layer 0 of the density maps) gives the optical depth. Output is the factor the
+// colour is multiplied by (blend ZERO, SRC_COLOR); plugins/cloud_shadows/reference.py is the same in numpy.
+#include "lib/view_ray.glsl"
+out vec4 frag;
+layout(binding = 0) uniform sampler2DArray sums_a;
+layout(binding = 1) uniform sampler2DArray sums_b;
+layout(binding = 2) uniform sampler2D scene_depth;
+uniform mat4 inv_view_proj;
+uniform vec3 camera_pos;
+uniform vec3 sun_dir;          // unit, toward the sun
+uniform float weight;          // direct_fraction × horizon fade (reference.direct_weight)
+uniform float extinction;      // sigma × strength, per cell of summed density
+uniform float t;               // interpolation factor between A and B
+uniform vec2 origin_xz;        // VolumeOrigin x, z in cells
+uniform vec3 cell_size;
+uniform float base_altitude;
+uniform ivec3 shape;
+
+const float MIN_SUN_HEIGHT = 1e-4;
+
+float column(ivec2 c) {
+    if (any(lessThan(c, ivec2(0))) || any(greaterThanEqual(c, shape.xz))) return 0.0;
+    return mix(texelFetch(sums_a, ivec3(c, 0), 0).r, texelFetch(sums_b, ivec3(c, 0), 0).r, t);
+}
+
+// Bilinear, texel i centred at i, zero outside the volume.
+float column_sum(vec2 p) {
+    if (any(lessThanEqual(p, vec2(-1.0))) || any(greaterThanEqual(p, vec2(shape.xz)))) return 0.0;
+    vec2 i0 = floor(p);
+    vec2 f = p - i0;
+    ivec2 i = ivec2(i0);
+    return mix(mix(column(i), column(i + ivec2(1, 0)), f.x),
+               mix(column(i + ivec2(0, 1)), column(i + ivec2(1, 1)), f.x), f.y);
+}
+
+void main() {
+    ivec2 pixel = ivec2(gl_FragCoord.xy);
+    float depth = texelFetch(scene_depth, pixel, 0).r;
+    if (depth >= 1.0 || weight <= 0.0) {
+        frag = vec4(1.0);
+        return;
+    }
+    vec2 uv = gl_FragCoord.xy / vec2(textureSize(scene_depth, 0));
+    vec3 p = camera_pos + view_ray_dir(uv, inv_view_proj, camera_pos)
+                        * view_ray_distance(uv, depth, inv_view_proj, camera_pos, 0.0);
+    float thickness = float(shape.y) * cell_size.y;
+    float run = max(base_altitude + 0.5 * thickness - p.y, 0.0) / max(sun_dir.y, MIN_SUN_HEIGHT);
+    vec3 q = p + run * sun_dir;
+    vec2 texel = q.xz / cell_size.xz - origin_xz - 0.5;
+    float above = clamp((base_altitude + thickness - p.y) / thickness, 0.0, 1.0);
+    float tau = extinction * column_sum(texel) * above;
+    frag = vec4(vec3(1.0 - weight * (1.0 - exp(-tau))), 1.0);
+}
