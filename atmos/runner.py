@@ -54,6 +54,12 @@ def run_headless(name: str, settings: DemoSettings, out: str | None, progress: b
         gpu.release()
 
 
+def slowest_passes(app, n: int = 3) -> str:
+    """The ``n`` render passes with the most GPU time (timer queries), e.g. 'clouds 4.1 ms, sky 0.8 ms'."""
+    timings = sorted(app.graph.timings.items(), key=lambda kv: -kv[1][0])[:n]
+    return ", ".join(f"{name} {gpu_ms:.1f} ms" for name, (gpu_ms, _) in timings)
+
+
 def run_window(name: str, settings: DemoSettings) -> None:
     """Open a window: ESC quits, F1 toggles the frame-time overlay, WASD/QE + mouse drag fly the camera."""
     import pyglet
@@ -75,7 +81,7 @@ def run_window(name: str, settings: DemoSettings) -> None:
         frames[0] += 1
         times = app.get_resource(FrameTimes)
         if times is not None and frames[0] % 30 == 0:
-            window.set_caption(f"atmos — {name} — {times.summary()}")
+            window.set_caption(f"atmos — {name} — {times.summary()} — {slowest_passes(app)}")
         if settings.frames and frames[0] >= settings.frames:
             pyglet.app.exit()  # closing inside on_draw would disturb pyglet's window iteration
 

@@ -60,9 +60,7 @@ def sky_color(view_dir, sun_dir, sun_color, params: SkyParams | None = None, tim
     p = params or SkyParams()
     v = unit_vectors(view_dir, "view_dir")
     s = unit_vectors(sun_dir, "sun_dir").reshape(3)
-    rgb = np.asarray(p.night, np.float64) * (1.0 - daylight(s[1])) \
-        + p.scale * preetham_rgb(v, s, p.turbidity) * daylight(s[1])
-    rgb = rgb + sun_disc(v, s, sun_color, p.sun_size_deg, p.sun_gain)
+    extra = sun_disc(v, s, sun_color, p.sun_size_deg, p.sun_gain)
     if p.stars:
-        rgb = rgb + star_field(v, s[1], time, pixel_angle, p.star_density, p.star_brightness, p.twinkle)
-    return rgb * below_horizon(v[..., 1])[..., None]
+        extra = extra + star_field(v, s[1], time, pixel_angle, p.star_density, p.star_brightness, p.twinkle)
+    return sky_radiance(v, s, p.turbidity, p.scale, p.night) + extra * below_horizon(v[..., 1])[..., None]

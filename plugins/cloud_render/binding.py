@@ -1,0 +1,40 @@
+"""Binding the simulation's A/B textures and the light model to a program (``cloud_render/volume.glsl``)."""
+from __future__ import annotations
+
+import moderngl
+
+from atmos.lighting import Sun
+from atmos.plugins.cloud_render.light import sun_light
+
+UNITS = (0, 1, 2, 3)        # density_a, density_b, trans_a, trans_b
+
+
+def clamp_sampler(ctx: moderngl.Context):
+    """Linear, clamp-to-edge: the volume's outer half cells hold the edge value, never wrap around."""
+    return ctx.sampler(filter=(moderngl.LINEAR, moderngl.LINEAR), repeat_x=False, repeat_y=False, repeat_z=False)
+
+
+def bind_volume(program, sim, sampler, sun: Sun | None) -> float:
+    """Bind mix(A, B, t)'s textures to units 0..3 with ``sampler`` and set ``t``, ``has_shading``,
+    ``sun_color``, ``ambient``; returns t. Call :func:`unbind_volume` when the draw is done."""
+    a, b, t = sim.view()
+    shading = "transmittance" in a
+    a["density"].use(0)
+    b["density"].use(1)
+    light = "transmittance" if shading else "density"      # without shading: a placeholder, unread
+    a[light].use(2)
+    b[light].use(3)
+    for unit in UNITS:
+        sampler.use(unit)
+    color, ambient = sun_light(sun)
+    program["t"].value = float(t)
+    for name, value in (("has_shading", int(shading)), ("sun_color", color), ("ambient", ambient)):
+        if name in program:
+            program[name].value = value
+    return float(t)
+
+
+def unbind_volume(sampler) -> None:
+    """Unbind the sampler from units 0..3 so later passes sample with their textures' own settings."""
+    for unit in UNITS:
+        sampler.clear(unit)

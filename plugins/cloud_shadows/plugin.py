@@ -1,0 +1,79 @@
+"""CloudShadowsPlugin: darkens the scene's surfaces where the cloud layer blocks the sun (thesis 7.3.1)."""
+from __future__ import annotations
+
+from atmos.camera import Camera, set_camera_uniforms
+from atmos.graph import PassBuilder, PassContext, RenderPass
+from atmos.lighting import Sun
+from atmos.plugin import Plugin
+from atmos.plugins.cloud_shadows.layer import CloudLayer
+from atmos.plugins.cloud_shadows.params import CloudShadowParams
+from atmos.plugins.cloud_shadows.reference import direct_weight, unit_sun
+from atmos.plugins.clouds.simulation import CloudSimulation
+from atmos.plugins.weather import VolumeOrigin
+from atmos.render_core import COLOR, DEPTH
+
+
+class CloudShadowsPass(RenderPass):
+    """Multiplies "color" by the shadow factor where "depth" has geometry (blend ZERO, SRC_COLOR)."""
+    name = "cloud_shadows"
+
+    def __init__(self, plugin: "CloudShadowsPlugin"):
+        self.plugin = plugin
+        self.program = None
+
+    def setup(self, builder: PassBuilder) -> None:
+        builder.read(DEPTH)
+        builder.write(COLOR)
+
+    def prepare(self, gpu) -> None:
+        self.program = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="cloud_shadows/shadow.frag")
+
+    def execute(self, frame: PassContext) -> None:
+        app, gpu, p = frame.data["app"], frame.gpu, self.program
+        params = self.plugin.params
+        sun = app.get_resource(Sun) or Sun()
+        weight = direct_weight(sun.direction, sun.color, params)
+        if weight <= 0.0 or params.strength == 0.0:
+            return                                  # no direct light to take away: nothing to draw
+        sim = app.resource(CloudSimulation)
+        layer = CloudLayer.of(sim, app.get_resource(VolumeOrigin) or sim.origin, params)
+        sigma = sim.settings.sigma if params.sigma is None else params.sigma
+        a, b, t = sim.view()
+        frame.framebuffer(color=[COLOR]).use()
+        ctx = gpu.ctx
+        ctx.disable(ctx.DEPTH_TEST)
+        ctx.enable(ctx.BLEND)
+        ctx.blend_func = ctx.ZERO, ctx.SRC_COLOR
+        sim.maps_of(a).sums.use(0)
+        sim.maps_of(b).sums.use(1)
+        frame.texture(DEPTH).use(2)
+        set_camera_uniforms(p, app.resource(Camera), gpu.size[0] / gpu.size[1])
+        p["sun_dir"].value = tuple(unit_sun(sun.direction))
+        p["weight"].value = weight
+        p["extinction"].value = sigma * params.strength
+        p["t"].value = t
+        p["origin_xz"].value = (layer.origin[0], layer.origin[2])
+        p["cell_size"].value = layer.cell_size
+        p["base_altitude"].value = layer.base_altitude
+        p["shape"].value = layer.shape
+        frame.fullscreen(p)
+        ctx.disable(ctx.BLEND)
+        ctx.blend_func = ctx.SRC_ALPHA, ctx.ONE_MINUS_SRC_ALPHA
+
+
+class CloudShadowsPlugin(Plugin):
+    """Ground shadows of the clouds of a CloudsPlugin (add it after the passes that draw the ground
+    or terrain, before the clouds themselves); ``params``: :class:`CloudShadowParams`, or its fields
+    as keywords. Set ``plugin.params = plugin.params.replace(...)`` to change them while running."""
+
+    def __init__(self, params: CloudShadowParams | None = None, **fields):
+        if params is not None and fields:
+            raise ValueError("give CloudShadowsPlugin either a CloudShadowParams or its fields as keywords, not both")
+        self.params = params if params is not None else CloudShadowParams(**fields)
+        if not isinstance(self.params, CloudShadowParams):
+            raise ValueError(f"CloudShadowsPlugin params must be a CloudShadowParams, got {type(self.params).__name__}")
+
+    def build(self, app) -> None:
+        if app.graph is None:
+            raise ValueError("CloudShadowsPlugin needs an App with a GPU context (App(gpu))")
+        app.graph.add_pass(CloudShadowsPass(self))
