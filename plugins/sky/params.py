@@ -14,7 +14,7 @@ _OWNER = "SkyParams"
 class SkyParams:
     """Look of the sky: haze, brightness in the HDR pipeline, sun disc, night and stars.
 
-    ``scale``: HDR units per kcd/m² of Preetham luminance (0.05 puts a clear noon zenith near 0.4,
+    ``scale``: HDR units per kcd/m² of Preetham luminance (0.03 puts a clear noon zenith near 0.25,
     beside the sun colour ≈ 1 of ``sky_light``); ``sun_size_deg``: angular radius of the disc;
     ``sun_gain``: disc radiance per unit of the Sun resource's colour; ``night``: the sky colour
     once the sun is well below the horizon; ``star_density``: fraction of star-grid cells holding
@@ -22,7 +22,7 @@ class SkyParams:
     """
 
     turbidity: float = 2.5
-    scale: float = 0.05
+    scale: float = 0.03
     sun_size_deg: float = 0.5
     sun_gain: float = 20.0
     night: tuple = tuple(NIGHT_SKY)

@@ -87,8 +87,14 @@ def zenith_Yxy(turbidity: float, theta_s: float) -> np.ndarray:
 
 
 def angle_between(u: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Angle between unit vectors, accurate near 0 too: 2 asin(|u − v| / 2)."""
-    return 2.0 * np.arcsin(np.clip(0.5 * np.linalg.norm(u - v, axis=-1), 0.0, 1.0))
+    """Angle between unit vectors, well conditioned everywhere: 2 atan2(|u − v|, |u + v|). (GPU asin
+    and acos can be far less precise than atan: Mesa llvmpipe's asin is off by up to 8e-4.)"""
+    return 2.0 * np.arctan2(np.linalg.norm(u - v, axis=-1), np.linalg.norm(u + v, axis=-1))
+
+
+def sun_zenith_angle(s: np.ndarray) -> float:
+    """θs of a unit sun direction, π/2 for a sun on or below the horizon."""
+    return float(np.arctan2(np.hypot(s[0], s[2]), s[1])) if s[1] > 0 else 0.5 * np.pi
 
 
 def xyY_to_srgb(x, y, big_y) -> np.ndarray:
@@ -102,7 +108,7 @@ def preetham_rgb(view_dir, sun_dir, turbidity) -> np.ndarray:
     t = check_turbidity(turbidity)
     v = unit_vectors(view_dir, "view_dir")
     s = unit_vectors(sun_dir, "sun_dir").reshape(3)
-    theta_s = np.arccos(np.clip(s[1], 0.0, 1.0))
+    theta_s = sun_zenith_angle(s)
     coef = perez_coefficients(t)
     ratio = perez(coef, np.maximum(v[..., 1], COS_FLOOR), angle_between(v, s)) / perez(coef, 1.0, theta_s)
     big_y, x, y = np.moveaxis(zenith_Yxy(t, theta_s) * ratio, -1, 0)

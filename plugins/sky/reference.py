@@ -5,7 +5,8 @@
 (the sun's height, sin elevation, from ``DAY_FADE[1]`` down to ``DAY_FADE[0]``) and ``below`` dims
 views under the horizon toward ``GROUND_DIM`` over view heights 0..-``BELOW_FADE``.
 ``sky_color`` adds the sun disc (``sun_gain`` × the Sun resource's colour inside ``sun_size_deg``,
-soft over the outer ``DISC_EDGE`` of its radius) and the stars of :mod:`atmos.plugins.sky.stars`.
+soft over the outer ``DISC_EDGE`` of its radius, measured as the chord |v − s| so the GPU needs no
+inverse trigonometry there) and the stars of :mod:`atmos.plugins.sky.stars`.
 """
 from __future__ import annotations
 
@@ -15,10 +16,9 @@ import numpy as np
 
 from atmos.plugins.shading.scattering import NIGHT_SKY
 from atmos.plugins.sky.params import SkyParams
-from atmos.plugins.sky.preetham import angle_between, check_turbidity, preetham_rgb, unit_vectors
+from atmos.plugins.sky.preetham import check_turbidity, preetham_rgb, unit_vectors
 from atmos.plugins.sky.stars import smoothstep, star_field
 
-DEFAULT_SCALE = SkyParams.scale
 DAY_FADE = (-0.2, 0.02)      # sun height (sin elevation): night below the first, full Preetham day above the second
 GROUND_DIM = 0.3
 BELOW_FADE = 0.1
@@ -35,7 +35,7 @@ def below_horizon(view_y) -> np.ndarray:
     return 1.0 + (GROUND_DIM - 1.0) * smoothstep(0.0, -BELOW_FADE, view_y)
 
 
-def sky_radiance(view_dir, sun_dir, turbidity: float = 2.5, scale: float = DEFAULT_SCALE,
+def sky_radiance(view_dir, sun_dir, turbidity: float = SkyParams.turbidity, scale: float = SkyParams.scale,
                  night=tuple(NIGHT_SKY)) -> np.ndarray:
     """(..., 3) linear HDR sky colour (no sun disc, no stars) for view directions ``view_dir`` (..., 3)
     and the direction toward the sun ``sun_dir`` (3,); any direction, sun above or below the horizon."""
@@ -47,10 +47,15 @@ def sky_radiance(view_dir, sun_dir, turbidity: float = 2.5, scale: float = DEFAU
     return rgb * below_horizon(v[..., 1])[..., None]
 
 
+def disc_chords(size_deg: float) -> tuple[float, float]:
+    """Chord lengths |v − s| where the disc's soft edge starts and ends."""
+    r = math.radians(size_deg)
+    return 2.0 * math.sin(0.5 * r * (1.0 - DISC_EDGE)), 2.0 * math.sin(0.5 * r)
+
+
 def sun_disc(view_dir, sun_dir, sun_color, size_deg: float, gain: float) -> np.ndarray:
     """(..., 3) the sun disc's radiance: ``gain · sun_color`` inside, soft edge (unit directions)."""
-    r = math.radians(size_deg)
-    inside = 1.0 - smoothstep(r * (1.0 - DISC_EDGE), r, angle_between(view_dir, sun_dir))
+    inside = 1.0 - smoothstep(*disc_chords(size_deg), np.linalg.norm(view_dir - sun_dir, axis=-1))
     return gain * inside[..., None] * np.asarray(sun_color, np.float64)
 
 

@@ -4,7 +4,8 @@ The view direction picks a cell of a cube-map grid (``STAR_GRID`` cells per face
 counter-based hash (:mod:`atmos.hashing`, bit for bit as on the GPU) decides whether it holds a star,
 where in the cell's middle it sits, how bright it is, its tint and how it twinkles. A star is a
 Gaussian in cell units that is exactly 0 from ``STAR_CUT`` cells out, well inside its own cell, so
-a direction on a cell border never sees a star (float32 and float64 agree there). Stars smaller than
+a direction on a cell border never sees a star (float32 and float64 agree there). Twinkling is
+periodic in ``TWINKLE_PERIOD`` so the time can be wrapped and the phase stays precise in float32. Stars smaller than
 a pixel are widened to half a pixel with the same total light; they fade in as the sun sets and out
 toward the horizon.
 """
@@ -23,6 +24,8 @@ STAR_SIGMA_MAX = 0.1                # widest a star gets for coarse pixels, cell
 STAR_CUT = (0.2, 0.3)               # the Gaussian is tapered to 0 over these distances, cells
 STAR_NIGHT = (-0.18, -0.05)         # stars fade in as the sun's height (sin elevation) drops through this
 STAR_HORIZON = 0.15                 # ... and in over view heights 0..STAR_HORIZON
+TWINKLE_PERIOD = 64.0               # seconds after which the twinkling repeats (time is wrapped to it)
+TWINKLE_CYCLES = (32, 96)           # each star twinkles a whole number of times in that period
 TINTS = (np.array([1.0, 0.82, 0.65]), np.array([0.75, 0.85, 1.0]))
 
 
@@ -43,8 +46,9 @@ def cube_cell(v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     on_y = ~on_x & (a[..., 1] >= a[..., 2])
     face = np.where(on_x, np.where(v[..., 0] > 0, 0, 1),
                     np.where(on_y, np.where(v[..., 1] > 0, 2, 3), np.where(v[..., 2] > 0, 4, 5)))
-    uv = np.where(on_x[..., None], v[..., [1, 2]] / a[..., 0:1],
-                  np.where(on_y[..., None], v[..., [0, 2]] / a[..., 1:2], v[..., [0, 1]] / a[..., 2:3]))
+    major = np.where(on_x, a[..., 0], np.where(on_y, a[..., 1], a[..., 2]))[..., None]
+    pair = np.where(on_x[..., None], v[..., [1, 2]], np.where(on_y[..., None], v[..., [0, 2]], v[..., [0, 1]]))
+    uv = pair / major
     p = (uv * 0.5 + 0.5) * STAR_GRID
     return face, p, np.clip(np.floor(p), 0, STAR_GRID - 1)
 
@@ -70,9 +74,10 @@ def star_field(view_dir, sun_y: float, time: float, pixel_angle: float, density:
     sigma = max(STAR_SIGMA, min(0.5 * pixel_cells, STAR_SIGMA_MAX))
     profile = (STAR_SIGMA / sigma) ** 2 * np.exp(-0.5 * (d / sigma) ** 2) * (1.0 - smoothstep(*STAR_CUT, d))
     bright = 0.05 + 0.95 * _unit16(h2, 0) ** 8
-    phase = 2.0 * math.pi * _unit16(h2, 16)
-    freq = 1.5 + 3.0 * _unit16(h3, 0)
-    tw = 1.0 + twinkle * np.sin(time * freq + phase)
+    lo, hi = TWINKLE_CYCLES
+    cycles = lo + (h3 & np.uint32(0xFFFF)) % np.uint32(hi - lo)
+    t = float(time) % TWINKLE_PERIOD
+    tw = 1.0 + twinkle * np.sin(2.0 * math.pi * np.mod(cycles * t / TWINKLE_PERIOD + _unit16(h2, 16), 1.0))
     tint = TINTS[0] + (TINTS[1] - TINTS[0]) * _unit16(h3, 16)[..., None]
     fade = (1.0 - smoothstep(*STAR_NIGHT, sun_y)) * smoothstep(0.0, STAR_HORIZON, v[..., 1])
     amount = np.where(present, brightness * bright * tw * profile * fade, 0.0)

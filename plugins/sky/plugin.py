@@ -1,0 +1,58 @@
+"""SkyPlugin and its pass: the Preetham sky with sun disc, night and stars as the scene's background."""
+from __future__ import annotations
+
+from atmos.camera import Camera
+from atmos.graph import PassBuilder, PassContext, RenderPass
+from atmos.lighting import Sun, sun_and_day
+from atmos.plugin import Plugin
+from atmos.plugins.sky.params import SkyParams
+from atmos.plugins.sky.shader import set_sky_uniforms, set_view_basis, sky_defines
+from atmos.render_core import COLOR
+
+
+class SkyPass(RenderPass):
+    """Writes the sky into every pixel of ``color`` (later passes draw over it), from the Sun resource."""
+    name = "sky"
+
+    def __init__(self, plugin: "SkyPlugin"):
+        self.plugin = plugin
+        self.program = None
+
+    def setup(self, builder: PassBuilder) -> None:
+        builder.write(COLOR)
+
+    def prepare(self, gpu) -> None:
+        self.program = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="sky/sky.frag",
+                                   defines=sky_defines())
+
+    def execute(self, frame: PassContext) -> None:
+        app, gpu, p = frame.data["app"], frame.gpu, self.program
+        frame.framebuffer(color=[COLOR]).use()
+        gpu.ctx.disable(gpu.ctx.DEPTH_TEST | gpu.ctx.BLEND)
+        camera = app.resource(Camera)
+        set_view_basis(p, camera, gpu.size[0] / gpu.size[1])
+        sun = app.get_resource(Sun) or Sun()
+        s, _ = sun_and_day(sun)
+        set_sky_uniforms(p, self.plugin.params, s, sun.color, app.clock.frame_time,
+                         camera.fov_y / max(1, gpu.size[1]))
+        frame.fullscreen(p)
+
+
+class SkyPlugin(Plugin):
+    """The Preetham analytic sky (pass "sky"); ``SkyParams`` fields as keyword arguments (or ``params=``).
+
+    ``configure(**changes)`` changes settings at run time, all checked before any is applied.
+    """
+
+    def __init__(self, params: SkyParams | None = None, **settings):
+        if params is not None and not isinstance(params, SkyParams):
+            raise ValueError(f"params must be a SkyParams, got {type(params).__name__}")
+        base = params if params is not None else SkyParams()
+        self.params = base.replace(**settings) if settings else base
+
+    def configure(self, **changes) -> SkyParams:
+        self.params = self.params.replace(**changes)
+        return self.params
+
+    def build(self, app) -> None:
+        app.graph.add_pass(SkyPass(self))
