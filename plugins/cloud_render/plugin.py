@@ -1,0 +1,198 @@
+"""CloudRenderPlugin: the CloudSimulation's clouds as point sprites (thesis ch. 6, 7.2).
+
+Drawing: one static vertex buffer holds the ``gx × gz`` local cells of a sprite group (the density
+maps' ``group_size``); the segments a frame draws go, back to front, into an instance buffer of
+``(gi, j, gk)`` and the whole layer is ONE instanced draw (instances are rasterized in order, so
+the order holds; per-draw uniforms would cost a Python call per segment). The vertex shader fetches
+density and transmittance as mix(A, B, t), throws empty cells out of the view volume, sizes the
+sprite from distance and density, and colours it sun × T + ambient; the fragment shader applies
+the soft particle. Blending is premultiplied (ONE, ONE_MINUS_SRC_ALPHA), so "color"'s alpha stays
+in [0, 1]; the depth test runs against the scene's "depth" with depth writes off.
+
+Opacity: a sprite of world diameter D = ``size_factor × max(cx, cz) × (0.5 + 0.5 min(density, 1))``
+has centre optical depth ``tau = sigma × density × V / l / (pi D² / 12)`` (V the cell volume, l its
+cube-root length, sigma per cell length), so its optical depth summed over the screen equals the
+cell's — what the reference ray marcher integrates (exact for cubic cells). Sprites under a pixel
+are drawn 1 pixel wide with their opacity scaled by their area in pixels.
+"""
+from __future__ import annotations
+
+import math
+
+import moderngl
+import numpy as np
+
+from atmos.camera import Camera
+from atmos.graph import PassBuilder, PassContext, RenderPass
+from atmos.lighting import Sun
+from atmos.plugin import Plugin
+from atmos.plugins.cloud_render.binding import bind_volume, clamp_sampler, unbind_volume
+from atmos.plugins.cloud_render.layout import CloudLayout
+from atmos.plugins.cloud_render.particle import PROFILE_AREA, particle_texture
+from atmos.plugins.cloud_render.segments import SegmentStats, select_segments
+from atmos.plugins.clouds.simulation import CloudSimulation
+from atmos.plugins.weather import VolumeOrigin
+from atmos.render_core import COLOR, DEPTH
+
+
+def _number(name: str, value, lo: float, lo_open: bool = True, none_ok: bool = False):
+    if value is None and none_ok:
+        return None
+    ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
+    ok = ok and math.isfinite(float(value)) and (float(value) > lo if lo_open else float(value) >= lo)
+    if not ok:
+        raise ValueError(f"CloudRenderPlugin.{name} must be a finite number {'>' if lo_open else '>='} {lo}"
+                         f"{' or None' if none_ok else ''}, got {value!r}")
+    return None if value is None else float(value)
+
+
+class CloudRenderPlugin(Plugin):
+    """Point-sprite clouds; add it after CloudsPlugin.
+
+    ``base_altitude``: world y of the layer's bottom (placement: :mod:`.layout`). ``size_factor``:
+    sprite diameter in cells at density 1 (≥ ~3 hides the grid; 2 shows stripes). ``sigma``: extinction
+    per cell length at density 1 (None: the simulation's ``CloudSettings.sigma``). ``frustum_culling``
+    and ``empty_space_skipping`` switch the two culling tests; ``max_point_size`` caps sprite pixels
+    (None: the GL limit). ``enabled`` False skips drawing. After each frame ``stats`` holds the
+    :class:`SegmentStats` counters.
+    """
+
+    def __init__(self, base_altitude: float = 100.0, size_factor: float = 3.0, sigma: float | None = None,
+                 frustum_culling: bool = True, empty_space_skipping: bool = True,
+                 max_point_size: float | None = None):
+        if not isinstance(base_altitude, (int, float)) or isinstance(base_altitude, bool) \
+                or not math.isfinite(base_altitude):
+            raise ValueError(f"CloudRenderPlugin.base_altitude must be a finite number (world y of the "
+                             f"layer's bottom), got {base_altitude!r}")
+        for name, flag in (("frustum_culling", frustum_culling), ("empty_space_skipping", empty_space_skipping)):
+            if not isinstance(flag, bool):
+                raise ValueError(f"CloudRenderPlugin.{name} must be True or False, got {flag!r}")
+        size_factor = _number("size_factor", size_factor, 0.0)
+        sigma = _number("sigma", sigma, 0.0, lo_open=False, none_ok=True)
+        max_point_size = _number("max_point_size", max_point_size, 1.0, lo_open=False, none_ok=True)
+        self.base_altitude = float(base_altitude)
+        self.size_factor, self.sigma, self.max_point_size = size_factor, sigma, max_point_size
+        self.frustum_culling, self.empty_space_skipping = frustum_culling, empty_space_skipping
+        self.enabled = True
+        self.stats = SegmentStats()
+
+    def build(self, app) -> None:
+        if app.graph is None:
+            raise ValueError("CloudRenderPlugin needs an App with a GPU context (App(gpu))")
+        if app.get_resource(CloudSimulation) is None:
+            raise ValueError("CloudRenderPlugin draws the CloudSimulation: add CloudsPlugin before it")
+        app.graph.add_pass(CloudSpritePass(self))
+
+    # -- shared with the reference ray marcher --------------------------------------------------
+    def layout(self, sim: CloudSimulation, origin: VolumeOrigin | None) -> CloudLayout:
+        """The volume's world placement now, column boxes padded by the largest sprite radius."""
+        maps = sim.maps_of(sim.view()[0])
+        o = origin.as_tuple() if origin is not None else (0.0, 0.0, 0.0)
+        cell = tuple(float(c) for c in sim.settings.cell_size)
+        return CloudLayout(sim.shape, cell, (o[0], o[2]), self.base_altitude, maps.group_size,
+                           pad=0.5 * self.size_factor * max(cell[0], cell[2]))
+
+    def extinction(self, sim: CloudSimulation) -> float:
+        return float(sim.settings.sigma if self.sigma is None else self.sigma)
+
+
+def sprite_uniforms(plugin, sim, layout: CloudLayout, camera: Camera, aspect: float, height: int,
+                    point_limit: float) -> dict:
+    """The uniforms of ``cloud_render/sprite.vert`` but view_proj and the volume's (:func:`bind_volume`)."""
+    cell = np.asarray(layout.cell, np.float64)
+    tau_scale = plugin.extinction(sim) * cell.prod() / np.cbrt(cell.prod()) / (PROFILE_AREA / 4.0)
+    limit = point_limit if plugin.max_point_size is None else min(point_limit, plugin.max_point_size)
+    return {"volume_shape": tuple(int(n) for n in layout.shape), "group_size": tuple(layout.group),
+            "layer_min": tuple(float(v) for v in layout.lo), "cell_size": tuple(float(c) for c in cell),
+            "base_diameter": float(plugin.size_factor * max(cell[0], cell[2])),
+            "pixel_scale": float(height) / 2.0 * float(camera.projection(aspect)[1, 1]),
+            "max_point_size": float(limit), "tau_scale": float(tau_scale)}
+
+
+class CloudSpritePass(RenderPass):
+    """Pass "clouds": reads "depth", blends the sprites into "color"."""
+    name = "clouds"
+
+    def __init__(self, plugin: CloudRenderPlugin):
+        self.plugin = plugin
+        self.program = self.particle = self.sampler = None
+        self.vbo = self.instances = self.vao = None
+        self._group = None
+
+    def setup(self, builder: PassBuilder) -> None:
+        builder.read(DEPTH)
+        builder.write(COLOR)
+
+    def prepare(self, gpu) -> None:
+        self.program = gpu.program(vertex_shader="cloud_render/sprite.vert", fragment_shader="cloud_render/sprite.frag")
+        self.particle = particle_texture(gpu.ctx)
+        self.sampler = clamp_sampler(gpu.ctx)
+        limit = gpu.ctx.info.get("GL_POINT_SIZE_RANGE", (1.0, 64.0))[1]
+        self.point_limit = float(limit)
+
+    def _buffers(self, gpu, group, shape) -> None:
+        """The group's vertex buffer and an instance buffer for every segment (made once per group size)."""
+        if self._group == (group, shape):
+            return
+        self._release_buffers()
+        gx, gz = group
+        local = np.stack(np.meshgrid(np.arange(gx), np.arange(gz), indexing="ij"), -1).reshape(-1, 2)
+        grid = (-(-shape[0] // gx)) * (-(-shape[2] // gz)) * shape[1]
+        self.vbo = gpu.ctx.buffer(local.astype(np.int32).tobytes())
+        self.instances = gpu.ctx.buffer(reserve=12 * grid)
+        self.vao = gpu.ctx.vertex_array(self.program, [(self.vbo, "2i", "in_cell"),
+                                                       (self.instances, "3i/i", "in_segment")])
+        self._group = (group, shape)
+
+    def execute(self, frame: PassContext) -> None:
+        plugin = self.plugin
+        app, gpu = frame.data["app"], frame.gpu
+        sim: CloudSimulation = app.resource(CloudSimulation)
+        camera: Camera = app.resource(Camera)
+        if not plugin.enabled:
+            return
+        aspect = gpu.size[0] / gpu.size[1]
+        layout = plugin.layout(sim, app.get_resource(VolumeOrigin))
+        view_proj = camera.view_projection(aspect)
+        maps = sim.maps_of(sim.view()[0])
+        segments, plugin.stats = select_segments(
+            layout, camera.position, view_proj if plugin.frustum_culling else None,
+            sim.max_maps() if plugin.empty_space_skipping else None, maps.band_height)
+        if not len(segments):
+            return
+        self._buffers(gpu, layout.group, layout.shape)
+        self.instances.write(segments.tobytes())
+        ctx, p = gpu.ctx, self.program
+        p["view_proj"].write(np.asarray(camera.view_projection(aspect), np.float32).T.tobytes())
+        for name, value in sprite_uniforms(plugin, sim, layout, camera, aspect, gpu.size[1], self.point_limit).items():
+            p[name].value = value
+        fbo = frame.framebuffer(color=[COLOR], depth=DEPTH)
+        fbo.use()
+        fbo.depth_mask = False
+        ctx.enable(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.PROGRAM_POINT_SIZE)
+        ctx.depth_func = "<="          # a tiny near plane rounds far depths to 1.0: still in front of the sky
+        ctx.blend_func = moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA
+        bind_volume(p, sim, self.sampler, app.get_resource(Sun))
+        self.particle.use(4)
+        try:
+            self.vao.render(moderngl.POINTS, vertices=layout.group[0] * layout.group[1], instances=len(segments))
+        finally:
+            unbind_volume(self.sampler)
+            fbo.depth_mask = True
+            ctx.depth_func = "<"
+            ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.PROGRAM_POINT_SIZE)
+            ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
+
+    def _release_buffers(self) -> None:
+        for obj in (self.vao, self.instances, self.vbo):
+            if obj is not None:
+                obj.release()
+        self.vao = self.instances = self.vbo = None
+        self._group = None
+
+    def release(self) -> None:
+        self._release_buffers()
+        for obj in (self.particle, self.sampler):
+            if obj is not None:
+                obj.release()
+        self.particle = self.sampler = None

@@ -1,0 +1,320 @@
+"""Point-sprite clouds: the vertex stage against its numpy reference, culling against independent
+CPU tests, pictures that show clouds (saved to out/), and the extremes."""
+from pathlib import Path
+
+import moderngl
+import numpy as np
+import pytest
+from PIL import Image
+
+from atmos.app import App
+from atmos.camera import Camera
+from atmos.defaults import DefaultPlugins
+from atmos.gpu.shaders import load_source
+from atmos.lighting import Sun
+from atmos.plugins.cloud_render import (CloudLayout, CloudReferencePlugin, CloudRenderPlugin, select_segments,
+                                        sun_light)
+from atmos.plugins.cloud_render.binding import bind_volume, clamp_sampler, unbind_volume
+from atmos.plugins.cloud_render.example import example_weather
+from atmos.plugins.cloud_render.plugin import sprite_uniforms
+from atmos.plugins.cloud_render.reference import group_cells, sprite_vertices
+from atmos.plugins.clouds import CloudSettings, CloudsPlugin, read_volume
+from atmos.plugins.ground import GroundPlugin
+from atmos.plugins.sky_gradient import SkyGradientPlugin
+
+OUT = Path(__file__).resolve().parents[1] / "out"
+SHAPE = (48, 12, 48)
+CELL = (20.0, 15.0, 20.0)
+BASE = 300.0
+
+
+def scene(gpu, cloud_density=60, shading_scale=1, warmup=25, seed=3, sun=(25.0, 40.0), reference=False, adaption=4,
+          **render):
+    settings = CloudSettings(smoothing_slices=2, group_size=(16, 16), cell_size=CELL, shading_scale=shading_scale)
+    app = App(gpu)
+    app.insert_resource(Sun.from_angles(*sun))
+    renderer = CloudRenderPlugin(base_altitude=BASE, **render)
+    plugins = [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(),
+               CloudsPlugin(example_weather(SHAPE, cloud_density, density_adaption=adaption), settings, seed=seed, warmup_steps=warmup), renderer]
+    if reference:
+        plugins.append(CloudReferencePlugin(renderer, steps=192, enabled=False))
+    app.add_plugins(*plugins)
+    app.startup()
+    return app, renderer
+
+
+def look(app, position, target, **camera):
+    cam = app.resource(Camera)
+    cam.position = np.array(position, float)
+    cam.look_at(target)
+    cam.far = 6000.0
+    for key, value in camera.items():
+        setattr(cam, key, value)
+
+
+CENTER = (SHAPE[0] * CELL[0] / 2, BASE + SHAPE[1] * CELL[1] / 2, SHAPE[2] * CELL[2] / 2)
+BELOW = ((480.0, 60.0, 1250.0), (480.0, 400.0, 480.0))
+ABOVE = ((480.0, 900.0, 1200.0), (480.0, 360.0, 450.0))
+
+
+def frame(app, gpu):
+    app.update(1 / 60)
+    assert gpu.ctx.error == "GL_NO_ERROR"
+    return gpu.read_pixels().astype(float)
+
+
+# -- the vertex stage against numpy ----------------------------------------------------------------
+@pytest.mark.parametrize("shading_scale", [1, 2])
+def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale):
+    app, renderer = scene(gpu, shading_scale=shading_scale, seed=int(rng.integers(1000)))
+    app.run_frames(int(rng.integers(1, 5)))          # t somewhere between steps
+    from atmos.plugins.clouds import CloudSimulation
+    sim = app.resource(CloudSimulation)
+    a, b, t = sim.view()
+    cam = app.resource(Camera)
+    look(app, rng.uniform([0, 0, 0], [960, 1000, 960]), CENTER)
+    layout = renderer.layout(sim, None)
+    aspect, height = 16 / 9, 144
+    gx, gz = layout.grid
+    segments = np.stack(np.meshgrid(np.arange(gx), np.arange(SHAPE[1]), np.arange(gz), indexing="ij"), -1)
+    segments = rng.permutation(segments.reshape(-1, 3)).astype(np.int32)
+    uniforms = sprite_uniforms(renderer, sim, layout, cam, aspect, height, 255.0)
+    vp = cam.view_projection(aspect)
+
+    src, _ = load_source("cloud_render/sprite.vert")
+    names = ["gl_Position", "gl_PointSize", "v_light", "v_tau", "v_coverage"]
+    prog = ctx.program(vertex_shader=src, varyings=names)
+    sampler = clamp_sampler(ctx)
+    vbo = ctx.buffer(group_cells(layout.group).tobytes())
+    inst = ctx.buffer(segments.tobytes())
+    vao = ctx.vertex_array(prog, [(vbo, "2i", "in_cell"), (inst, "3i/i", "in_segment")])
+    n = len(segments) * layout.group[0] * layout.group[1]
+    out = ctx.buffer(np.full(n * 10, np.nan, np.float32).tobytes())
+    try:
+        prog["view_proj"].write(np.asarray(vp, np.float32).T.tobytes())
+        for name, value in uniforms.items():
+            prog[name].value = value
+        sun = app.resource(Sun)
+        bind_volume(prog, sim, sampler, sun)
+        vao.transform(out, moderngl.POINTS, vertices=len(group_cells(layout.group)), instances=len(segments))
+        unbind_volume(sampler)
+        got = np.frombuffer(out.read(), np.float32).reshape(n, 10).astype(np.float64)
+    finally:
+        for obj in (vao, out, inst, vbo, sampler, prog):
+            obj.release()
+    assert np.isfinite(got).all(), "every output element written"
+    color, ambient = sun_light(sun)
+    trans = [read_volume(s["transmittance"]) for s in (a, b)]
+    ref = sprite_vertices(read_volume(a["density"]), read_volume(b["density"]), *trans, t, segments, uniforms,
+                          vp, color, ambient)
+    vis = ref["visible"]
+    assert 0 < vis.sum() < n, "the test needs empty and full cells"
+    scale = np.abs(ref["position"]).max(axis=1, keepdims=True)
+    np.testing.assert_allclose(got[:, :4] / scale, ref["position"] / scale, atol=2e-5)   # float32 matrix products
+    np.testing.assert_allclose(got[:, 4], ref["size"], rtol=2e-5)
+    light_tol = 2e-5 if shading_scale == 1 else 5e-3        # linear filtering weights on the GPU
+    np.testing.assert_allclose(got[:, 5:8], ref["light"], atol=light_tol)
+    np.testing.assert_allclose(got[:, 8], ref["tau"], rtol=2e-5)
+    np.testing.assert_allclose(got[:, 9], ref["coverage"], rtol=2e-5, atol=1e-7)
+    app.close()
+
+
+# -- frustum culling and empty-space skipping ------------------------------------------------------
+def frustum_reference(layout, view_proj):
+    """Independent test: a box is outside when all 8 corners, in clip space, fail one clip inequality."""
+    lo, hi = layout.column_boxes()
+    corners = np.stack([np.stack([(hi if bx else lo)[..., 0], (hi if by else lo)[..., 1], (hi if bz else lo)[..., 2]], -1)
+                        for bx in (0, 1) for by in (0, 1) for bz in (0, 1)], -2)            # (gx, gz, 8, 3)
+    clip = np.concatenate([corners, np.ones(corners.shape[:-1] + (1,))], -1) @ view_proj.T
+    x, y, z, w = np.moveaxis(clip, -1, 0)
+    fails = [x < -w, x > w, y < -w, y > w, z < -w, z > w]
+    return np.any([f.all(-1) for f in fails], axis=0)
+
+
+def test_frustum_culling_equals_an_independent_cpu_test(rng):
+    layout = CloudLayout((256, 32, 256), (20.0, 10.0, 20.0), tuple(rng.uniform(-50, 50, 2)), 500.0, (16, 16), pad=30.0)
+    checked = 0
+    for _ in range(300):
+        cam = Camera(position=rng.uniform([-3000, -200, -3000], [8000, 2000, 8000]), yaw=rng.uniform(-np.pi, np.pi),
+                     pitch=rng.uniform(-1.5, 1.5), fov_y=rng.uniform(0.2, 2.5),
+                     near=10 ** rng.uniform(-4, 1), far=10 ** rng.uniform(2.5, 7))
+        vp = cam.view_projection(rng.uniform(0.3, 3.0))
+        segments, stats = select_segments(layout, cam.position, vp)
+        outside = frustum_reference(layout, vp)
+        drawn = np.zeros(layout.grid, bool)
+        drawn[segments[:, 0], segments[:, 2]] = True
+        np.testing.assert_array_equal(drawn, ~outside)
+        assert stats.columns_frustum_culled == outside.sum()
+        assert stats.segments_drawn == (~outside).sum() * 32
+        checked += outside.any() and not outside.all()
+    assert checked > 50, "enough cameras with a partly culled layer"
+
+
+@pytest.mark.parametrize("cloud_density", [15, 60])
+def test_empty_space_skipping_never_skips_density_in_a_or_b(gpu, ctx, cloud_density):
+    app, renderer = scene(gpu, cloud_density=cloud_density, warmup=12)
+    renderer.frustum_culling = False
+    from atmos.plugins.clouds import CloudSimulation
+    sim = app.resource(CloudSimulation)
+    for _ in range(6):
+        app.run_frames(3)
+        a, b, _ = sim.view()
+        both = np.maximum(read_volume(a["density"]), read_volume(b["density"]))
+        layout = renderer.layout(sim, None)
+        gx, gz = layout.grid
+        bh = sim.settings.band_height
+        full = np.zeros((gx, SHAPE[1], gz), bool)              # segment's band holds density
+        for gi in range(gx):
+            for gk in range(gz):
+                col = both[gi * 16:(gi + 1) * 16, :, gk * 16:(gk + 1) * 16]
+                for j in range(SHAPE[1]):
+                    full[gi, j, gk] = (col[:, (j // bh) * bh:(j // bh + 1) * bh] > 0).any()
+        segments, stats = select_segments(layout, app.resource(Camera).position, None, sim.max_maps(), bh)
+        drawn = np.zeros_like(full)
+        drawn[segments[:, 0], segments[:, 1], segments[:, 2]] = True
+        np.testing.assert_array_equal(drawn, full)
+        has_density = np.zeros_like(full)
+        for j in range(SHAPE[1]):
+            has_density[:, j] = (both[:, j].reshape(gx, 16, gz, 16) > 0).any(axis=(1, 3))
+        assert not (has_density & ~drawn).any()
+        assert stats.segments_empty == (~full).sum()
+    app.close()
+
+
+def test_draw_order_is_back_to_front():
+    layout = CloudLayout((64, 8, 64), (10.0, 10.0, 10.0), (0.0, 0.0), 100.0, (16, 16))
+    for cam_y, expect in ((0.0, "down"), (1000.0, "up"), (140.0, "inside")):
+        segments, _ = select_segments(layout, (-500.0, cam_y, 320.0))
+        gi = segments[:, 0]
+        assert (np.diff(gi) <= 0).all(), "columns far to near along x"
+        js = segments[:8, 1]
+        if expect == "down":
+            assert list(js) == list(range(7, -1, -1))
+        elif expect == "up":
+            assert list(js) == list(range(8))
+        else:
+            assert list(js[:2]) == [7, 0] or list(js[:2]) == [0, 7]
+
+
+# -- pictures ----------------------------------------------------------------------------------------
+def save(img, name):
+    OUT.mkdir(exist_ok=True)
+    Image.fromarray(img.clip(0, 255).astype(np.uint8)).save(OUT / name)
+
+
+@pytest.mark.parametrize("view", ["below", "above"])
+def test_cloud_images_show_clouds_near_the_reference_and_move(gpu, ctx, view):
+    gpu.resize((320, 180))
+    try:
+        app, renderer = scene(gpu, reference=True)
+        ref_plugin = next(p for p in app.plugins if isinstance(p, CloudReferencePlugin))
+        look(app, *(BELOW if view == "below" else ABOVE))
+        img = frame(app, gpu)
+        save(img, f"cloud_render_{view}.png")
+        renderer.enabled = False
+        app.graph.execute(app=app)
+        empty = gpu.read_pixels().astype(float)
+        ref_plugin.enabled = True
+        app.graph.execute(app=app)
+        ref = gpu.read_pixels().astype(float)
+        save(ref, f"cloud_render_{view}_reference.png")
+        renderer.enabled, ref_plugin.enabled = True, False
+        assert img.std() > 3, "not blank"
+        diff = np.abs(img - empty).sum(-1)
+        assert diff.mean() > 1.5 and (diff > 20).mean() > 0.05, "the clouds show against the empty sky"
+        rmse, rmse_empty = np.sqrt(((img - ref) ** 2).mean()), np.sqrt(((empty - ref) ** 2).mean())
+        assert rmse < 0.5 * rmse_empty, f"sprites far from the ray-marched reference: {rmse:.1f} vs {rmse_empty:.1f}"
+        app.run_frames(40)
+        later = frame(app, gpu)
+        save(later, f"cloud_render_{view}_later.png")
+        assert np.abs(later - img).mean() > 0.3, "the clouds move"
+        app.close()
+    finally:
+        gpu.resize((256, 144))
+
+
+# -- extremes ------------------------------------------------------------------------------------
+EXTREMES = {
+    "inside": dict(position=CENTER, target=(0.0, CENTER[1], 0.0)),
+    "on_a_particle": dict(position=(10 * 20 + 10.0, BASE + 5 * 15 + 7.5, 20 * 20 + 10.0), target=CENTER),
+    "near_far": dict(position=BELOW[0], target=BELOW[1], near=1e-5, far=1e8),
+    "tiny_sprites": dict(position=(480.0, 30000.0, 480.0), target=CENTER, size_factor=0.05),
+    "far_away": dict(position=(-60000.0, 2000.0, 480.0), target=CENTER),
+}
+
+
+@pytest.mark.parametrize("case", sorted(EXTREMES))
+def test_extreme_cameras(gpu, ctx, case):
+    spec = dict(EXTREMES[case])
+    render = {"size_factor": spec.pop("size_factor")} if "size_factor" in spec else {}
+    app, renderer = scene(gpu, warmup=15, **render)
+    look(app, spec.pop("position"), spec.pop("target"), **spec)
+    img = frame(app, gpu)
+    save(img, f"cloud_render_extreme_{case}.png")
+    assert np.isfinite(img).all() and img.std() > 0.5
+    if case == "inside":
+        assert renderer.stats.segments_drawn > 0
+    app.close()
+
+
+@pytest.mark.parametrize("size", [(1, 1), (0, 0), (333, 77)])
+def test_tiny_and_minimized_targets(gpu, ctx, size):
+    app, renderer = scene(gpu, warmup=10)
+    look(app, *BELOW)
+    app.run_frames(1)
+    gpu.resize(size)
+    app.graph.invalidate()
+    try:
+        img = frame(app, gpu)
+        assert img.shape[:2] == (max(1, size[1]), max(1, size[0]))
+    finally:
+        app.close()
+        gpu.resize((256, 144))
+
+
+def test_sun_below_the_horizon_leaves_ambient_only(gpu, ctx):
+    night = Sun.from_angles(-10.0, 40.0)
+    color, ambient = sun_light(night)
+    assert color == (0.0, 0.0, 0.0) and ambient == tuple(night.ambient)
+    assert sun_light(Sun.from_angles(30.0))[0] == pytest.approx(Sun().color)
+    app, renderer = scene(gpu, sun=(-10.0, 40.0), warmup=15)
+    look(app, *BELOW)
+    img = frame(app, gpu)
+    save(img, "cloud_render_night.png")
+    assert renderer.stats.segments_drawn > 0 and np.isfinite(img).all()
+    app.close()
+
+
+@pytest.mark.parametrize("cloud_density", [0, 1000])
+def test_zero_and_full_cover(gpu, ctx, cloud_density):
+    app, renderer = scene(gpu, cloud_density=cloud_density, warmup=25, adaption=50)
+    look(app, *BELOW)
+    img = frame(app, gpu)
+    save(img, f"cloud_render_cover_{cloud_density}.png")
+    from atmos.plugins.clouds import CloudSimulation
+    cover = app.resource(CloudSimulation).cover()
+    if cloud_density == 0:
+        assert cover == 0 and renderer.stats.segments_drawn == 0
+    else:
+        assert cover > 0.7 and renderer.stats.segments_drawn > 0
+    app.close()
+
+
+# -- bad input -------------------------------------------------------------------------------------
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(base_altitude=float("nan")), "base_altitude must be a finite number"),
+    (dict(size_factor=0), "size_factor must be a finite number > 0"),
+    (dict(sigma=-1.0), "sigma must be a finite number >= 0"),
+    (dict(frustum_culling="yes"), "frustum_culling must be True or False"),
+    (dict(max_point_size=0.5), "max_point_size must be a finite number >= 1"),
+])
+def test_bad_parameters_are_refused(kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        CloudRenderPlugin(**kwargs)
+
+
+def test_needs_the_cloud_simulation(gpu):
+    with pytest.raises(ValueError, match="add CloudsPlugin before it"):
+        App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudRenderPlugin())
+    with pytest.raises(ValueError, match="steps must be an int in 1..65536"):
+        CloudReferencePlugin(CloudRenderPlugin(), steps=0)
