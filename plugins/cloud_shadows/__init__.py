@@ -1,12 +1,12 @@
 """Cloud shadows on the ground (thesis 7.3.1): the top-view density map projected along the light.
 
 ``CloudShadowsPlugin`` adds the "cloud_shadows" pass (reads "depth", multiplies "color");
-``CloudShadowParams`` its settings; ``CloudLayer`` the world placement of the cloud cells;
+``CloudShadowParams`` its settings; ``cloud_layout`` the volume's world placement (the sprite
+renderer's :class:`~atmos.plugins.cloud_render.layout.CloudLayout`);
 ``reference`` the numpy float64 shadow factor the GPU is tested against.
 """
 from atmos.plugins.cloud_shadows import reference
-from atmos.plugins.cloud_shadows.layer import CloudLayer
 from atmos.plugins.cloud_shadows.params import CloudShadowParams
-from atmos.plugins.cloud_shadows.plugin import CloudShadowsPass, CloudShadowsPlugin
+from atmos.plugins.cloud_shadows.plugin import CloudShadowsPass, CloudShadowsPlugin, cloud_layout
 
-__all__ = ["CloudLayer", "CloudShadowParams", "CloudShadowsPass", "CloudShadowsPlugin", "reference"]
+__all__ = ["CloudShadowParams", "CloudShadowsPass", "CloudShadowsPlugin", "cloud_layout", "reference"]

@@ -5,12 +5,20 @@ from atmos.camera import Camera, set_camera_uniforms
 from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.lighting import Sun
 from atmos.plugin import Plugin
-from atmos.plugins.cloud_shadows.layer import CloudLayer
+from atmos.plugins.cloud_render.layout import CloudLayout
 from atmos.plugins.cloud_shadows.params import CloudShadowParams
 from atmos.plugins.cloud_shadows.reference import direct_weight, unit_sun
 from atmos.plugins.clouds.simulation import CloudSimulation
 from atmos.plugins.weather import VolumeOrigin
 from atmos.render_core import COLOR, DEPTH
+
+
+def cloud_layout(sim: CloudSimulation, origin: VolumeOrigin, params: CloudShadowParams) -> CloudLayout:
+    """The volume's world placement: ``params.base_altitude``, ``params.cell_size`` (or the
+    simulation's), the VolumeOrigin's x and z."""
+    cell = params.cell_size if params.cell_size is not None else sim.settings.cell_size
+    return CloudLayout(tuple(sim.shape), tuple(float(c) for c in cell), (float(origin.x), float(origin.z)),
+                       params.base_altitude, tuple(sim.settings.group_size))
 
 
 class CloudShadowsPass(RenderPass):
@@ -36,7 +44,7 @@ class CloudShadowsPass(RenderPass):
         if weight <= 0.0 or params.strength == 0.0:
             return                                  # no direct light to take away: nothing to draw
         sim = app.resource(CloudSimulation)
-        layer = CloudLayer.of(sim, app.get_resource(VolumeOrigin) or sim.origin, params)
+        layout = cloud_layout(sim, app.get_resource(VolumeOrigin) or sim.origin, params)
         sigma = sim.settings.sigma if params.sigma is None else params.sigma
         a, b, t = sim.view()
         frame.framebuffer(color=[COLOR]).use()
@@ -52,10 +60,9 @@ class CloudShadowsPass(RenderPass):
         p["weight"].value = weight
         p["extinction"].value = sigma * params.strength
         p["t"].value = t
-        p["origin_xz"].value = (layer.origin[0], layer.origin[2])
-        p["cell_size"].value = layer.cell_size
-        p["base_altitude"].value = layer.base_altitude
-        p["shape"].value = layer.shape
+        p["layer_min"].value = tuple(float(v) for v in layout.lo)
+        p["cell_size"].value = layout.cell
+        p["shape"].value = layout.shape
         frame.fullscreen(p)
         ctx.disable(ctx.BLEND)
         ctx.blend_func = ctx.SRC_ALPHA, ctx.ONE_MINUS_SRC_ALPHA

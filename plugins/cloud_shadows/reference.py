@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.plugins.cloud_shadows.layer import CloudLayer
+from atmos.plugins.cloud_render.layout import CloudLayout
 from atmos.plugins.shading.reference import bilinear
 
 MIN_SUN_HEIGHT = 1e-4   # the projection's divisor never gets smaller (weight is 0 there anyway)
@@ -44,18 +44,20 @@ def zero_border_bilinear(plane: np.ndarray, p: np.ndarray) -> np.ndarray:
 
 
 def shadow_factor(points, sums_a, sums_b, t: float, sun_direction, weight: float, extinction: float,
-                  layer: CloudLayer) -> np.ndarray:
+                  layout: CloudLayout) -> np.ndarray:
     """Factor (...,) the colour at world ``points`` (..., 3) is multiplied by; ``sums_a/b`` (nx, nz)
-    the all-heights top-view maps of sets A and B; ``extinction`` = sigma·strength."""
+    the all-heights top-view maps of sets A and B; ``extinction`` = sigma·strength; ``layout`` the
+    volume's world placement (the sprite renderer's rule)."""
     points = np.asarray(points, np.float64)
     s = unit_sun(sun_direction)
     if s is None or weight <= 0.0:
         return np.ones(points.shape[:-1])
     sums = (1.0 - t) * np.asarray(sums_a, np.float64) + t * np.asarray(sums_b, np.float64)
-    mid = layer.bottom + 0.5 * layer.thickness
+    lo, hi, cell = layout.lo, layout.hi, np.asarray(layout.cell, np.float64)
     y = points[..., 1]
-    run = np.maximum(mid - y, 0.0) / max(s[1], MIN_SUN_HEIGHT)
+    run = np.maximum(0.5 * (lo[1] + hi[1]) - y, 0.0) / max(s[1], MIN_SUN_HEIGHT)
     q = points + run[..., None] * s
-    column = zero_border_bilinear(sums, layer.map_coords(q[..., 0], q[..., 2]))
-    above = np.clip((layer.bottom + layer.thickness - y) / layer.thickness, 0.0, 1.0)
+    texel = (q[..., [0, 2]] - lo[[0, 2]]) / cell[[0, 2]] - 0.5        # map texel (i, k) centred at (i, k)
+    column = zero_border_bilinear(sums, texel)
+    above = np.clip((hi[1] - y) / (hi[1] - lo[1]), 0.0, 1.0)
     return 1.0 - weight * (1.0 - np.exp(-extinction * column * above))

@@ -14,9 +14,8 @@ uniform vec3 sun_dir;          // unit, toward the sun
 uniform float weight;          // direct_fraction × horizon fade (reference.direct_weight)
 uniform float extinction;      // sigma × strength, per cell of summed density
 uniform float t;               // interpolation factor between A and B
-uniform vec2 origin_xz;        // VolumeOrigin x, z in cells
+uniform vec3 layer_min;        // world corner of cell (0, 0, 0): (origin.x·cx, base_altitude, origin.z·cz)
 uniform vec3 cell_size;
-uniform float base_altitude;
 uniform ivec3 shape;
 
 const float MIN_SUN_HEIGHT = 1e-4;
@@ -47,10 +46,10 @@ void main() {
     vec3 p = camera_pos + view_ray_dir(uv, inv_view_proj, camera_pos)
                         * view_ray_distance(uv, depth, inv_view_proj, camera_pos, 0.0);
     float thickness = float(shape.y) * cell_size.y;
-    float run = max(base_altitude + 0.5 * thickness - p.y, 0.0) / max(sun_dir.y, MIN_SUN_HEIGHT);
+    float run = max(layer_min.y + 0.5 * thickness - p.y, 0.0) / max(sun_dir.y, MIN_SUN_HEIGHT);
     vec3 q = p + run * sun_dir;
-    vec2 texel = q.xz / cell_size.xz - origin_xz - 0.5;
-    float above = clamp((base_altitude + thickness - p.y) / thickness, 0.0, 1.0);
+    vec2 texel = (q.xz - layer_min.xz) / cell_size.xz - 0.5;
+    float above = clamp((layer_min.y + thickness - p.y) / thickness, 0.0, 1.0);
     float tau = extinction * column_sum(texel) * above;
     frag = vec4(vec3(1.0 - weight * (1.0 - exp(-tau))), 1.0);
 }

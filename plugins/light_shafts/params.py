@@ -1,0 +1,66 @@
+"""LightShaftParams: the settings of the light shafts, checked as a whole before any is used."""
+from __future__ import annotations
+
+from dataclasses import dataclass, fields, replace
+
+from atmos.checks import check_int, check_known, check_num
+
+MAX_SAMPLES = 256
+MAX_DOWNSAMPLE = 8
+_OWNER = "LightShaftParams"
+
+
+@dataclass(frozen=True)
+class LightShaftParams:
+    """Occlusion mask, radial blur toward the sun (GPU Gems 3, ch. 13) and when the effect shows.
+
+    Mask: sky pixels (depth 1) whose luminance exceeds ``threshold`` (linear HDR) keep the excess,
+    at most ``ceiling`` (so the sun disc does not outshine the sky around it), in their own colour, times ``exp(−(r/radius)²)``, r the distance from the sun's screen position
+    in screen heights: only the sky near the sun casts shafts (thesis 7.3.2). Clouds drawn over the
+    sky darken it there, so they cut the shafts.
+    Blur, per pixel: ``samples`` taps on the way to the sun covering ``density`` of it; tap i
+    (1-based) weighs ``weight · decay^(i−1)``; the sum times ``exposure`` is added to the colour.
+    ``downsample``: mask and blur at 1/downsample of the frame size (read when the render graph
+    compiles, i.e. at start-up and on resize).
+    Fades (1 → 0): ``horizon_fade``: the sun's height (y of its unit direction) from this down to 0;
+    ``front_fade``: the cosine between the view direction and the sun from this down to 0 (behind
+    the camera: none); ``edge_fade``: the sun's screen position from the screen edge to this far
+    outside it (in screen widths/heights).
+    """
+
+    samples: int = 48
+    density: float = 0.9
+    decay: float = 0.96
+    weight: float = 0.06
+    exposure: float = 0.5
+    threshold: float = 0.6
+    ceiling: float = 1.0
+    radius: float = 0.4
+    downsample: int = 2
+    horizon_fade: float = 0.1
+    front_fade: float = 0.3
+    edge_fade: float = 0.5
+
+    def __post_init__(self):
+        o = _OWNER
+        checked = dict(
+            samples=check_int(o, "samples", self.samples, 1, MAX_SAMPLES),
+            density=check_num(o, "density", self.density, 0.0, 1.0, lo_open=True),
+            decay=check_num(o, "decay", self.decay, 0.0, 1.0, lo_open=True),
+            weight=check_num(o, "weight", self.weight, 0.0),
+            exposure=check_num(o, "exposure", self.exposure, 0.0),
+            threshold=check_num(o, "threshold", self.threshold, 0.0),
+            ceiling=check_num(o, "ceiling", self.ceiling, 0.0, lo_open=True),
+            radius=check_num(o, "radius", self.radius, 0.0, lo_open=True),
+            downsample=check_int(o, "downsample", self.downsample, 1, MAX_DOWNSAMPLE),
+            horizon_fade=check_num(o, "horizon_fade", self.horizon_fade, 0.0, 1.0, lo_open=True),
+            front_fade=check_num(o, "front_fade", self.front_fade, 0.0, 1.0, lo_open=True),
+            edge_fade=check_num(o, "edge_fade", self.edge_fade, 0.0, lo_open=True),
+        )
+        for name, value in checked.items():
+            object.__setattr__(self, name, value)
+
+    def replace(self, **changes) -> "LightShaftParams":
+        """A checked copy with ``changes``; unknown names and bad values raise ValueError."""
+        check_known(_OWNER, changes, [f.name for f in fields(self)])
+        return replace(self, **changes)

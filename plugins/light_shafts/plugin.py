@@ -1,0 +1,108 @@
+"""LightShaftsPlugin: shafts of light from the sky near the sun, cut by clouds and geometry (thesis 7.3.2)."""
+from __future__ import annotations
+
+import math
+
+from atmos.camera import Camera
+from atmos.graph import PassBuilder, PassContext, RenderPass, TextureDesc
+from atmos.lighting import Sun
+from atmos.plugin import Plugin
+from atmos.plugins.light_shafts.params import LightShaftParams
+from atmos.plugins.light_shafts.screen_sun import screen_sun
+from atmos.render_core import COLOR, DEPTH
+
+MASK = "light_shafts_mask"
+BLUR = "light_shafts_blur"
+
+
+def blur_uniforms(program, sun_uv, params: LightShaftParams, strength: float) -> None:
+    """Set the radial blur's uniforms (shaders/light_shafts/blur.frag)."""
+    program["sun_uv"].value = tuple(sun_uv)
+    program["samples"].value = params.samples
+    program["density"].value = params.density
+    program["decay"].value = params.decay
+    program["weight"].value = params.weight
+    program["scale"].value = params.exposure * strength
+
+
+class LightShaftsPass(RenderPass):
+    """Mask (reads "color", "depth") → radial blur → added onto "color" (blend ONE, ONE).
+
+    The mask and the blur are transients at 1/``downsample`` of the frame; "color" is only sampled
+    while the mask is drawn and only written by the last draw, so it is never read and written at once.
+    """
+    name = "light_shafts"
+
+    def __init__(self, plugin: "LightShaftsPlugin"):
+        self.plugin = plugin
+        self.mask = self.blur = self.composite = None
+
+    def setup(self, builder: PassBuilder) -> None:
+        w, h = self.plugin.gpu.size
+        d = self.plugin.params.downsample
+        desc = TextureDesc((math.ceil(w / d), math.ceil(h / d)), components=4, dtype="f2")
+        builder.create(MASK, desc)
+        builder.create(BLUR, desc)
+        builder.read(COLOR)
+        builder.read(DEPTH)
+        builder.write(COLOR)
+
+    def prepare(self, gpu) -> None:
+        fullscreen = "lib/fullscreen.vert"
+        self.mask = gpu.program(vertex_shader=fullscreen, fragment_shader="light_shafts/mask.frag")
+        self.blur = gpu.program(vertex_shader=fullscreen, fragment_shader="light_shafts/blur.frag")
+        self.composite = gpu.program(vertex_shader=fullscreen, fragment_shader="light_shafts/composite.frag")
+
+    def execute(self, frame: PassContext) -> None:
+        app, gpu, params = frame.data["app"], frame.gpu, self.plugin.params
+        w, h = gpu.size
+        sun = app.get_resource(Sun) or Sun()
+        where = screen_sun(app.resource(Camera), w / h, sun.direction, params)
+        if where.strength <= 0.0 or params.exposure == 0.0 or params.weight == 0.0:
+            return                                      # sun behind, below or far off-screen
+        ctx = gpu.ctx
+        ctx.disable(ctx.DEPTH_TEST | ctx.BLEND)
+        mask = frame.texture(MASK)
+        frame.framebuffer(color=[MASK]).use()
+        frame.texture(COLOR).use(0)
+        frame.texture(DEPTH).use(1)
+        self.mask["mask_size"].value = mask.size
+        self.mask["sun_uv"].value = where.uv
+        self.mask["threshold"].value = params.threshold
+        self.mask["ceiling"].value = params.ceiling
+        self.mask["radius"].value = params.radius
+        self.mask["aspect"].value = w / h
+        frame.fullscreen(self.mask)
+
+        frame.framebuffer(color=[BLUR]).use()
+        mask.use(0)
+        blur_uniforms(self.blur, where.uv, params, where.strength)
+        frame.fullscreen(self.blur)
+
+        frame.framebuffer(color=[COLOR]).use()
+        frame.texture(BLUR).use(0)
+        ctx.enable(ctx.BLEND)
+        ctx.blend_func = ctx.ONE, ctx.ONE
+        frame.fullscreen(self.composite)
+        ctx.disable(ctx.BLEND)
+        ctx.blend_func = ctx.SRC_ALPHA, ctx.ONE_MINUS_SRC_ALPHA
+
+
+class LightShaftsPlugin(Plugin):
+    """Screen-space light shafts around the sun; add it after everything that draws the sky, the
+    clouds and the scene. ``params``: :class:`LightShaftParams`, or its fields as keywords; set
+    ``plugin.params = plugin.params.replace(...)`` to change them while running."""
+
+    def __init__(self, params: LightShaftParams | None = None, **fields):
+        if params is not None and fields:
+            raise ValueError("give LightShaftsPlugin either a LightShaftParams or its fields as keywords, not both")
+        self.params = params if params is not None else LightShaftParams(**fields)
+        if not isinstance(self.params, LightShaftParams):
+            raise ValueError(f"LightShaftsPlugin params must be a LightShaftParams, got {type(self.params).__name__}")
+        self.gpu = None
+
+    def build(self, app) -> None:
+        if app.graph is None:
+            raise ValueError("LightShaftsPlugin needs an App with a GPU context (App(gpu))")
+        self.gpu = app.gpu
+        app.graph.add_pass(LightShaftsPass(self))

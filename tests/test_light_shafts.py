@@ -1,0 +1,211 @@
+"""Light shafts (thesis 7.3.2): radial blur and whole pass against the float64 references, extremes, a look."""
+import math
+
+import numpy as np
+import pytest
+
+from atmos.app import App
+from atmos.camera import Camera
+from atmos.defaults import DefaultPlugins
+from atmos.gpu import create_headless
+from atmos.lighting import Sun
+from atmos.plugins.ground import GroundPlugin
+from atmos.plugins.light_shafts import LightShaftParams, LightShaftsPlugin, blur_uniforms, reference, screen_sun
+from atmos.plugins.sky_gradient import SkyGradientPlugin
+from atmos.plugins.test_volume import TestVolumePlugin, VolumeBox
+from atmos.render_core import CapturePass
+from test_cloud_shadows import FillPass, pass_plugin, save_png
+
+
+def random_params(rng, **fixed) -> LightShaftParams:
+    values = dict(samples=int(rng.integers(1, 65)), density=rng.uniform(0.2, 1.0), decay=rng.uniform(0.8, 1.0),
+                  weight=rng.uniform(0.01, 0.2), exposure=rng.uniform(0.2, 2.0), threshold=rng.uniform(0.0, 1.0), ceiling=rng.uniform(0.1, 3.0),
+                  radius=rng.uniform(0.1, 1.0))
+    values.update(fixed)
+    return LightShaftParams(**values)
+
+
+def gpu_blur(gpu, mask: np.ndarray, sun_uv, params, strength=1.0) -> np.ndarray:
+    """The blur shader alone on an (h, w, 3) mask; the output (float32) starts as NaN everywhere."""
+    ctx = gpu.ctx
+    h, w = mask.shape[:2]
+    rgba = np.concatenate([mask, np.zeros((h, w, 1))], -1).astype(np.float16)
+    src = ctx.texture((w, h), 4, rgba.tobytes(), dtype="f2")
+    dst = ctx.texture((w, h), 4, np.full((h, w, 4), np.nan, np.float32).tobytes(), dtype="f4")
+    fbo = ctx.framebuffer([dst])
+    program = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="light_shafts/blur.frag")
+    vao = ctx.vertex_array(program, [])
+    try:
+        fbo.use()
+        ctx.disable(ctx.BLEND | ctx.DEPTH_TEST)
+        src.use(0)
+        blur_uniforms(program, sun_uv, params, strength)
+        vao.render(vertices=3)
+        return np.frombuffer(dst.read(), np.float32).reshape(h, w, 4).astype(np.float64)
+    finally:
+        gpu.target.use()
+        for obj in (vao, fbo, dst, src):
+            obj.release()
+
+
+@pytest.mark.parametrize("where", ["random", "centre", "pixel_centre", "edge", "outside", "far_outside"])
+def test_blur_matches_reference_on_small_random_masks(gpu, ctx, rng, where):
+    w, h = (int(n) for n in rng.integers(3, 24, 2))
+    mask = rng.uniform(0, 4, (h, w, 3)).astype(np.float16).astype(np.float64)
+    sun_uv = {"random": rng.uniform(-0.5, 1.5, 2), "centre": (0.5, 0.5), "pixel_centre": (0.5 / w, 1.5 / h),
+              "edge": (1.0, rng.uniform(0, 1)), "outside": (rng.uniform(1.2, 3), rng.uniform(-2, -0.2)),
+              "far_outside": (64.0, -64.0)}[where]
+    params = random_params(rng)
+    strength = rng.uniform(0.1, 1.0)
+    out = gpu_blur(gpu, mask, sun_uv, params, strength)
+    assert np.isfinite(out).all(), "every texel written, none NaN"
+    expected = reference.radial_blur(mask, sun_uv, params, strength)
+    assert np.allclose(out[..., :3], expected, rtol=1e-4, atol=1e-5 * expected.max())
+    assert np.all(out[..., 3] == 0.0)
+    assert expected.max() > 0 or where == "far_outside"     # taps may all leave the mask then
+
+
+def test_blur_reference_by_hand():
+    """One bright texel: the shaft runs from it away from the sun, falling off by decay per tap."""
+    mask = np.zeros((1, 9, 1))
+    mask[0, 2] = 1.0                                    # x centre uv = 2.5 / 9
+    p = LightShaftParams(samples=4, density=1.0, decay=0.5, weight=1.0, exposure=1.0)
+    out = reference.radial_blur(mask, (0.5 / 9, 0.5), p)[0, :, 0]   # sun at pixel 0's centre
+    # pixel x takes taps at x - i·x/4 (i = 1..4), tap i weighing 0.5^(i-1): pixel 4 hits 2 with tap 2,
+    # pixel 8 with tap 3, pixel 6 half-hits it (at 1.5) with tap 3, pixel 2 itself with tap 1 (at 1.5)
+    assert out[4] == pytest.approx(0.5) and out[8] == pytest.approx(0.25) and out[6] == pytest.approx(0.125)
+    assert out[2] == pytest.approx(0.5)
+    assert out[0] == 0.0 and out[1] == 0.0              # nothing between the bright texel and the sun
+
+
+def sun_toward(cam: Camera, size, uv) -> np.ndarray:
+    """The direction toward a sun seen at screen ``uv``."""
+    x, y = uv
+    ndc = np.array([2 * x - 1, 2 * y - 1, 1.0, 1.0])
+    far = np.linalg.inv(cam.view_projection(size[0] / size[1])) @ ndc
+    d = far[:3] / far[3] - cam.position
+    return d / np.linalg.norm(d)
+
+
+def shafts_app(gpu, params, scene=False, extra=()):
+    fill, probe = FillPass(), CapturePass()
+    drawn = [SkyGradientPlugin(), GroundPlugin(), *extra] if scene else [pass_plugin(fill)]
+    plugin = LightShaftsPlugin(params)
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), *drawn, plugin, pass_plugin(probe))
+    app.startup()
+    return app, plugin, fill, probe
+
+
+def test_pass_matches_reference_on_random_frames(gpu, ctx, rng):
+    size = gpu.size
+    w, h = size
+    params = random_params(rng, downsample=1)
+    app, _, fill, probe = shafts_app(gpu, params)
+    cam = app.resource(Camera)
+    cam.position = rng.uniform(-50, 50, 3)
+    cam.yaw, cam.pitch = rng.uniform(-math.pi, math.pi), rng.uniform(0.6, 0.9)   # sun well above the horizon
+    sun_uv = rng.uniform(0.1, 0.9, 2)
+    app.insert_resource(Sun(sun_toward(cam, size, sun_uv)))
+    color = rng.uniform(0.0, 3.0, (h, w, 4))
+    depth = np.where(rng.random((h, w)) < 0.5, 1.0, rng.uniform(0.5, 0.99, (h, w)))
+    fill.color, fill.depth = color, depth
+    app.graph.execute(app=app)
+    assert ctx.error == "GL_NO_ERROR"
+    where = screen_sun(cam, w / h, app.resource(Sun).direction, params)
+    assert np.allclose(where.uv, sun_uv, atol=1e-9) and where.strength > 0
+    before = color.astype(np.float16).astype(np.float64)
+    mask = reference.occlusion_mask(before, probe.depth, where.uv, params)
+    shafts = reference.radial_blur(mask, where.uv, params, where.strength)
+    assert np.isfinite(probe.color).all()
+    # three f2 round trips (mask, blur, sum) bound the error
+    assert np.allclose(probe.color[..., :3], before[..., :3] + shafts, rtol=3e-3, atol=1e-3)
+    assert np.array_equal(probe.color[..., 3], before[..., 3])
+    assert shafts.max() > 0.01, "the random frame has shafts to compare"
+    app.close()
+
+
+def test_screen_sun_fades():
+    cam = Camera(position=np.array([0.0, 0.0, 0.0]))
+    cam.look_at((0.0, 0.3, -1.0))
+    p = LightShaftParams()
+    ahead = screen_sun(cam, 16 / 9, cam.forward(), p)
+    assert ahead.uv == pytest.approx((0.5, 0.5)) and ahead.strength == pytest.approx(1.0)
+    assert screen_sun(cam, 16 / 9, -cam.forward(), p).strength == 0.0               # behind the camera
+    assert screen_sun(cam, 16 / 9, (0.0, -0.2, -1.0), p).strength == 0.0             # below the horizon
+    assert screen_sun(cam, 16 / 9, (1.0, 0.3, 0.0), p).strength == 0.0               # 90° off: far outside
+    assert screen_sun(cam, 16 / 9, (0, 0, 0), p).strength == 0.0                      # no direction
+    side = screen_sun(cam, 1.0, sun_toward(cam, (1, 1), (1.0, 0.5)), p)             # on the screen edge
+    assert side.uv[0] == pytest.approx(1.0) and side.strength == pytest.approx(1.0, abs=0.05)
+    grazing = screen_sun(cam, 1.0, sun_toward(cam, (1, 1), (1.0 + p.edge_fade / 2, 0.5)), p)
+    assert 0.0 < grazing.strength < side.strength                                   # fading out past it
+    almost_behind = screen_sun(cam, 1.0, (1.0, 0.3, -0.01), p)
+    assert all(np.isfinite(almost_behind.uv)) and almost_behind.strength == 0.0
+    for bad in (dict(samples=0), dict(samples=1000), dict(decay=1.5), dict(downsample=0), dict(radius=0.0),
+                dict(exposure=-1.0), dict(density=math.inf)):
+        with pytest.raises(ValueError, match=next(iter(bad))):
+            LightShaftParams(**bad)
+
+
+@pytest.mark.parametrize("case", ["behind", "below", "edge", "centre", "far_outside", "tiny", "minimized"])
+def test_extremes_no_nan_no_gl_error(case):
+    size = {"tiny": (1, 1), "minimized": (0, 0)}.get(case, (96, 54))
+    gpu = create_headless(size)
+    app, plugin, _, probe = shafts_app(gpu, LightShaftParams(), scene=True)
+    cam = app.resource(Camera)
+    cam.position = np.array([0.0, 5.0, 0.0])
+    cam.look_at((0.0, 8.0, -20.0))
+    uv = {"edge": (1.0, 0.6), "centre": (0.5, 0.5), "far_outside": (9.0, 0.5)}.get(case, (0.5, 0.7))
+    sun = sun_toward(cam, gpu.size, uv)
+    if case == "behind":
+        sun = -cam.forward() + np.array([0.0, 0.5, 0.0])
+    elif case == "below":
+        sun = np.array([0.0, -0.1, -1.0])
+    app.insert_resource(Sun(sun))
+    plugin.params = plugin.params.replace(exposure=0.0)
+    app.graph.execute(app=app)
+    base = probe.color.copy()
+    plugin.params = plugin.params.replace(exposure=0.5)
+    app.graph.execute(app=app)
+    assert gpu.ctx.error == "GL_NO_ERROR"
+    assert np.isfinite(probe.color).all() and np.isfinite(gpu.read_pixels()).all()
+    added = probe.color - base
+    assert added.min() >= 0.0
+    if case in ("behind", "below", "far_outside"):
+        assert np.array_equal(probe.color, base)
+    elif case in ("edge", "centre"):
+        assert added[..., :3].max() > 0.05
+    app.close()
+    gpu.release()
+
+
+def test_shafts_around_clouds_at_sunset_look_right():
+    """A low orange sun just above drifting cloud blobs: a glow streaked by the clouds' shadows."""
+    gpu = create_headless((480, 270))
+    box = VolumeBox(center=(0.0, 16.0, -40.0), size=(70.0, 14.0, 30.0))
+    params = LightShaftParams(exposure=1.0, threshold=0.3)
+    probe = CapturePass()
+    plugin = LightShaftsPlugin(params)
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False),
+                               SkyGradientPlugin(zenith=(0.06, 0.1, 0.25), horizon=(0.55, 0.4, 0.3)), GroundPlugin(),
+                               TestVolumePlugin(resolution=(32, 16, 32), slices=4, box=box), plugin, pass_plugin(probe))
+    app.startup()
+    cam = app.resource(Camera)
+    cam.position = np.array([0.0, 3.0, 20.0])
+    cam.look_at((0.0, 14.0, -40.0))
+    app.insert_resource(Sun(sun_toward(cam, gpu.size, (0.42, 0.52)), color=(1.0, 0.6, 0.3)))
+    shots = []
+    for n in range(2):
+        app.run_frames(12, 1 / 30)
+        shots.append(gpu.read_pixels())
+        save_png(f"light_shafts_{n + 1}.png", shots[-1])
+    with_shafts = probe.color.copy()
+    plugin.params = params.replace(exposure=0.0)
+    app.graph.execute(app=app)
+    save_png("light_shafts_without.png", gpu.read_pixels())
+    added = (with_shafts - probe.color)[..., :3].max(-1)
+    assert gpu.ctx.error == "GL_NO_ERROR" and np.isfinite(with_shafts).all()
+    assert 0.02 < (added > 0.05).mean() < 0.9, "shafts cover part of the frame"
+    assert added.min() >= 0.0
+    assert np.abs(shots[0].astype(float) - shots[1].astype(float)).mean() > 0.5, "they change as the clouds move"
+    app.close()
+    gpu.release()
