@@ -73,7 +73,7 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale)
     a, b, t = sim.view()
     cam = app.resource(Camera)
     look(app, rng.uniform([0, 0, 0], [960, 1000, 960]), CENTER)
-    layout = renderer.layout(sim, None)
+    layout = renderer.layout(sim)
     aspect, height = 16 / 9, 144
     gx, gz = layout.grid
     segments = np.stack(np.meshgrid(np.arange(gx), np.arange(SHAPE[1]), np.arange(gz), indexing="ij"), -1)
@@ -160,7 +160,7 @@ def test_empty_space_skipping_never_skips_density_in_a_or_b(gpu, ctx, cloud_dens
         app.run_frames(3)
         a, b, _ = sim.view()
         both = np.maximum(read_volume(a["density"]), read_volume(b["density"]))
-        layout = renderer.layout(sim, None)
+        layout = renderer.layout(sim)
         gx, gz = layout.grid
         bh = sim.settings.band_height
         full = np.zeros((gx, SHAPE[1], gz), bool)              # segment's band holds density

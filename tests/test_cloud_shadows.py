@@ -12,7 +12,7 @@ from atmos.gpu import create_headless
 from atmos.graph import PassBuilder, RenderPass
 from atmos.lighting import Sun
 from atmos.plugin import Plugin
-from atmos.plugins.cloud_render.layout import CloudLayout
+from atmos.plugins.clouds.layout import CloudLayout
 from atmos.plugins.cloud_shadows import CloudShadowParams, CloudShadowsPlugin, cloud_layout, reference
 from atmos.plugins.clouds import CloudSettings, CloudSimulation, CloudsPlugin
 from atmos.plugins.ground import GroundPlugin
@@ -131,7 +131,7 @@ def test_gpu_matches_reference_on_random_scenes(gpu, ctx, rng):
     origin.x, origin.z = rng.uniform(-12, -4, 2)
     sun = Sun.from_angles(rng.uniform(20, 85), rng.uniform(0, 360), color=tuple(rng.uniform(0.2, 2, 3)))
     app.insert_resource(sun)
-    layout = cloud_layout(sim, origin, params)
+    layout = cloud_layout(sim, params)
     centre = (np.array([origin.x, 0.0, origin.z]) + np.array([nx, 0.0, nz]) / 2) * cell
     centre[1] = (layout.lo[1] + layout.hi[1]) / 2
     shadow = centre - sun.direction * centre[1] / sun.direction[1]      # where the layer's shadow falls

@@ -6,7 +6,7 @@ world; :mod:`.segments` picks and orders the sprite groups; :mod:`.reference` is
 reference of the sprite vertex stage; ``CloudReferencePlugin`` ray-marches the reference image.
 """
 from atmos.plugins.cloud_render.frustum import boxes_outside, frustum_planes
-from atmos.plugins.cloud_render.layout import CloudLayout
+from atmos.plugins.clouds.layout import CloudLayout
 from atmos.plugins.cloud_render.light import sun_light
 from atmos.plugins.cloud_render.plugin import CloudRenderPlugin, CloudSpritePass
 from atmos.plugins.cloud_render.raymarch import CloudReferencePlugin

@@ -27,11 +27,10 @@ from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.lighting import Sun
 from atmos.plugin import Plugin
 from atmos.plugins.cloud_render.binding import bind_volume, clamp_sampler, unbind_volume
-from atmos.plugins.cloud_render.layout import CloudLayout
+from atmos.plugins.clouds.layout import CloudLayout
 from atmos.plugins.cloud_render.particle import PROFILE_AREA, particle_texture
 from atmos.plugins.cloud_render.segments import SegmentStats, select_segments
 from atmos.plugins.clouds.simulation import CloudSimulation
-from atmos.plugins.weather import VolumeOrigin
 from atmos.render_core import COLOR, DEPTH
 
 
@@ -49,7 +48,8 @@ def _number(name: str, value, lo: float, lo_open: bool = True, none_ok: bool = F
 class CloudRenderPlugin(Plugin):
     """Point-sprite clouds; add it after CloudsPlugin.
 
-    ``base_altitude``: world y of the layer's bottom (placement: :mod:`.layout`). ``size_factor``:
+    ``base_altitude``: world y of the layer's bottom (None: ``CloudSettings.base_altitude``; placement:
+    :mod:`atmos.plugins.clouds.layout`). ``size_factor``:
     sprite diameter in cells at density 1 (≥ ~3 hides the grid; 2 shows stripes). ``sigma``: extinction
     per cell length at density 1 (None: the simulation's ``CloudSettings.sigma``). ``frustum_culling``
     and ``empty_space_skipping`` switch the two culling tests; ``max_point_size`` caps sprite pixels
@@ -57,11 +57,11 @@ class CloudRenderPlugin(Plugin):
     :class:`SegmentStats` counters.
     """
 
-    def __init__(self, base_altitude: float = 100.0, size_factor: float = 3.0, sigma: float | None = None,
+    def __init__(self, base_altitude: float | None = None, size_factor: float = 3.0, sigma: float | None = None,
                  frustum_culling: bool = True, empty_space_skipping: bool = True,
                  max_point_size: float | None = None):
-        if not isinstance(base_altitude, (int, float)) or isinstance(base_altitude, bool) \
-                or not math.isfinite(base_altitude):
+        if base_altitude is not None and (not isinstance(base_altitude, (int, float)) or isinstance(base_altitude, bool)
+                                          or not math.isfinite(base_altitude)):
             raise ValueError(f"CloudRenderPlugin.base_altitude must be a finite number (world y of the "
                              f"layer's bottom), got {base_altitude!r}")
         for name, flag in (("frustum_culling", frustum_culling), ("empty_space_skipping", empty_space_skipping)):
@@ -70,7 +70,7 @@ class CloudRenderPlugin(Plugin):
         size_factor = _number("size_factor", size_factor, 0.0)
         sigma = _number("sigma", sigma, 0.0, lo_open=False, none_ok=True)
         max_point_size = _number("max_point_size", max_point_size, 1.0, lo_open=False, none_ok=True)
-        self.base_altitude = float(base_altitude)
+        self.base_altitude = None if base_altitude is None else float(base_altitude)
         self.size_factor, self.sigma, self.max_point_size = size_factor, sigma, max_point_size
         self.frustum_culling, self.empty_space_skipping = frustum_culling, empty_space_skipping
         self.enabled = True
@@ -84,13 +84,10 @@ class CloudRenderPlugin(Plugin):
         app.graph.add_pass(CloudSpritePass(self))
 
     # -- shared with the reference ray marcher --------------------------------------------------
-    def layout(self, sim: CloudSimulation, origin: VolumeOrigin | None) -> CloudLayout:
+    def layout(self, sim: CloudSimulation) -> CloudLayout:
         """The volume's world placement now, column boxes padded by the largest sprite radius."""
-        maps = sim.maps_of(sim.view()[0])
-        o = origin.as_tuple() if origin is not None else (0.0, 0.0, 0.0)
-        cell = tuple(float(c) for c in sim.settings.cell_size)
-        return CloudLayout(sim.shape, cell, (o[0], o[2]), self.base_altitude, maps.group_size,
-                           pad=0.5 * self.size_factor * max(cell[0], cell[2]))
+        cell = sim.settings.cell_size
+        return sim.layout(self.base_altitude, pad=0.5 * self.size_factor * max(cell[0], cell[2]))
 
     def extinction(self, sim: CloudSimulation) -> float:
         return float(sim.settings.sigma if self.sigma is None else self.sigma)
@@ -152,7 +149,7 @@ class CloudSpritePass(RenderPass):
         if not plugin.enabled:
             return
         aspect = gpu.size[0] / gpu.size[1]
-        layout = plugin.layout(sim, app.get_resource(VolumeOrigin))
+        layout = plugin.layout(sim)
         view_proj = camera.view_projection(aspect)
         maps = sim.maps_of(sim.view()[0])
         segments, plugin.stats = select_segments(

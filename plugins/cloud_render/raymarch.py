@@ -17,7 +17,6 @@ from atmos.plugin import Plugin
 from atmos.plugins.cloud_render.binding import bind_volume, clamp_sampler, unbind_volume
 from atmos.plugins.cloud_render.plugin import CloudRenderPlugin
 from atmos.plugins.clouds.simulation import CloudSimulation
-from atmos.plugins.weather import VolumeOrigin
 from atmos.render_core import COLOR, DEPTH
 
 
@@ -59,7 +58,7 @@ class CloudMarchPass(RenderPass):
         app, gpu, p = frame.data["app"], frame.gpu, self.program
         sim = app.resource(CloudSimulation)
         renderer = self.plugin.renderer
-        layout = renderer.layout(sim, app.get_resource(VolumeOrigin))
+        layout = renderer.layout(sim)
         frame.framebuffer(color=[COLOR]).use()
         ctx = gpu.ctx
         ctx.disable(moderngl.DEPTH_TEST)

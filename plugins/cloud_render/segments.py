@@ -19,7 +19,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from atmos.plugins.cloud_render.frustum import boxes_outside, frustum_planes
-from atmos.plugins.cloud_render.layout import CloudLayout
+from atmos.plugins.clouds.layout import CloudLayout
 
 
 @dataclass

@@ -2,7 +2,7 @@
 
 ``CloudShadowsPlugin`` adds the "cloud_shadows" pass (reads "depth", multiplies "color");
 ``CloudShadowParams`` its settings; ``cloud_layout`` the volume's world placement (the sprite
-renderer's :class:`~atmos.plugins.cloud_render.layout.CloudLayout`);
+renderer's :class:`~atmos.plugins.clouds.layout.CloudLayout`);
 ``reference`` the numpy float64 shadow factor the GPU is tested against.
 """
 from atmos.plugins.cloud_shadows import reference

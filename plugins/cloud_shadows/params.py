@@ -12,7 +12,8 @@ _OWNER = "CloudShadowParams"
 class CloudShadowParams:
     """Where the cloud layer is and how dark its shadow is (world units are metres, y is up).
 
-    ``base_altitude``: world height of the bottom of the simulation volume; cell ``(i, j, k)`` has
+    ``base_altitude``: world height of the bottom of the simulation volume (None: the simulation's
+    ``CloudSettings.base_altitude``); cell ``(i, j, k)`` has
     its centre at ``((origin.x + i + 0.5)·cx, base_altitude + (j + 0.5)·cy, (origin.z + k + 0.5)·cz)``
     with ``origin`` the :class:`~atmos.plugins.weather.VolumeOrigin` (in cells).
     ``cell_size``: (cx, cy, cz) metres per cell; ``None`` takes the simulation's ``CloudSettings.cell_size``.
@@ -24,7 +25,7 @@ class CloudShadowParams:
     projection runs far, fades them out, and a sun at or below the horizon casts none.
     """
 
-    base_altitude: float = 200.0
+    base_altitude: float | None = None
     cell_size: tuple | None = None
     sigma: float | None = None
     strength: float = 1.0
@@ -34,7 +35,7 @@ class CloudShadowParams:
     def __post_init__(self):
         o = _OWNER
         checked = dict(
-            base_altitude=check_num(o, "base_altitude", self.base_altitude),
+            base_altitude=None if self.base_altitude is None else check_num(o, "base_altitude", self.base_altitude),
             cell_size=None if self.cell_size is None else check_vec(o, "cell_size", self.cell_size, 3, "positive"),
             sigma=None if self.sigma is None else check_num(o, "sigma", self.sigma, 0.0),
             strength=check_num(o, "strength", self.strength, 0.0),

@@ -5,20 +5,17 @@ from atmos.camera import Camera, set_camera_uniforms
 from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.lighting import Sun
 from atmos.plugin import Plugin
-from atmos.plugins.cloud_render.layout import CloudLayout
+from atmos.plugins.clouds.layout import CloudLayout
 from atmos.plugins.cloud_shadows.params import CloudShadowParams
 from atmos.plugins.cloud_shadows.reference import direct_weight, unit_sun
 from atmos.plugins.clouds.simulation import CloudSimulation
-from atmos.plugins.weather import VolumeOrigin
 from atmos.render_core import COLOR, DEPTH
 
 
-def cloud_layout(sim: CloudSimulation, origin: VolumeOrigin, params: CloudShadowParams) -> CloudLayout:
-    """The volume's world placement: ``params.base_altitude``, ``params.cell_size`` (or the
-    simulation's), the VolumeOrigin's x and z."""
-    cell = params.cell_size if params.cell_size is not None else sim.settings.cell_size
-    return CloudLayout(tuple(sim.shape), tuple(float(c) for c in cell), (float(origin.x), float(origin.z)),
-                       params.base_altitude, tuple(sim.settings.group_size))
+def cloud_layout(sim: CloudSimulation, params: CloudShadowParams) -> CloudLayout:
+    """The volume's world placement (:meth:`CloudSimulation.layout`), with ``params.base_altitude``
+    and ``params.cell_size`` where they are set."""
+    return sim.layout(params.base_altitude, params.cell_size)
 
 
 class CloudShadowsPass(RenderPass):
@@ -44,7 +41,7 @@ class CloudShadowsPass(RenderPass):
         if weight <= 0.0 or params.strength == 0.0:
             return                                  # no direct light to take away: nothing to draw
         sim = app.resource(CloudSimulation)
-        layout = cloud_layout(sim, app.get_resource(VolumeOrigin) or sim.origin, params)
+        layout = cloud_layout(sim, params)
         sigma = sim.settings.sigma if params.sigma is None else params.sigma
         a, b, t = sim.view()
         frame.framebuffer(color=[COLOR]).use()

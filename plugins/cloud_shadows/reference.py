@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.plugins.cloud_render.layout import CloudLayout
+from atmos.plugins.clouds.layout import CloudLayout
 from atmos.plugins.shading.reference import bilinear
 
 MIN_SUN_HEIGHT = 1e-4   # the projection's divisor never gets smaller (weight is 0 there anyway)

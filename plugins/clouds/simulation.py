@@ -19,6 +19,7 @@ from atmos.frames import SlicedJob, SliceStage, TripleSet
 from atmos.graph import TextureDesc
 from atmos.plugins.automaton import CloudAutomaton
 from atmos.plugins.clouds.density_maps import DensityMaps
+from atmos.plugins.clouds.layout import CloudLayout
 from atmos.plugins.clouds.smoothing import Smoother, slice_range
 from atmos.plugins.shading.reference import check_scale, check_sigma, shading_shape
 from atmos.plugins.shading.scattering import Scattering
@@ -36,6 +37,7 @@ class CloudSettings:
     maps per height band and the sprite-group grid they are max-downsampled to.
     ``smoothing_slices``: z ranges the smoothing and density maps are split into.
     ``cover_threshold``: a column counts as covered when its summed density exceeds this (cells).
+    ``base_altitude``: world y of the volume's bottom (see :mod:`atmos.plugins.clouds.layout`).
     Shading (thesis ch. 5): ``shading`` on or off; ``sigma`` extinction per cell length at density
     1; ``scattering`` single or Harris multiple forward scattering (:class:`Scattering`);
     ``shading_scale`` 1, 2 or 4 (full, half, quarter resolution); ``shading_slices_per_run``
@@ -57,6 +59,7 @@ class CloudSettings:
     shading_scale: int = 1
     shading_slices_per_run: int = 8
     cell_size: tuple = (1.0, 1.0, 1.0)
+    base_altitude: float = 100.0
 
     def validate(self, shape) -> "CloudSettings":
         if not (math.isfinite(self.step_seconds) and self.step_seconds > 0):
@@ -66,6 +69,8 @@ class CloudSettings:
                              f"got {self.smoothing_slices!r}")
         if not (math.isfinite(self.cover_threshold) and self.cover_threshold >= 0):
             raise ValueError(f"CloudSettings.cover_threshold must be a finite number >= 0, got {self.cover_threshold!r}")
+        if not math.isfinite(self.base_altitude):
+            raise ValueError(f"CloudSettings.base_altitude must be a finite number (metres), got {self.base_altitude!r}")
         if len(self.cell_size) != 3 or not all(math.isfinite(c) and c > 0 for c in self.cell_size):
             raise ValueError(f"CloudSettings.cell_size must be three finite numbers > 0 (x, y, z), got {self.cell_size!r}")
         check_sigma(self.sigma)
@@ -166,6 +171,16 @@ class CloudSimulation:
         self._drift -= shift
         limit = max(self.shape) + 1            # larger shifts empty the volume all the same
         return int(np.clip(shift[0], -limit, limit)), int(np.clip(shift[1], -limit, limit))
+
+    def layout(self, base_altitude: float | None = None, cell_size=None, pad: float = 0.0) -> CloudLayout:
+        """Where the volume is in the world now (the VolumeOrigin moves it): the placement the
+        renderer, the ground shadows and the light shafts share. ``base_altitude`` and ``cell_size``
+        default to the settings'; ``pad`` widens the column boxes (the sprite radius)."""
+        s = self.settings
+        cell = tuple(float(c) for c in (s.cell_size if cell_size is None else cell_size))
+        base = float(s.base_altitude if base_altitude is None else base_altitude)
+        return CloudLayout(tuple(self.shape), cell, (float(self.origin.x), float(self.origin.z)), base,
+                           tuple(s.group_size), pad)
 
     def sun_in_cells(self) -> np.ndarray:
         """The sun direction in cell units (what the shear-warp needs when cells are not cubes)."""
