@@ -5,7 +5,7 @@ import importlib
 import pkgutil
 from dataclasses import dataclass
 
-DEFAULT_DEMO = "testbed"
+DEFAULT_DEMO = "sunset"
 
 
 @dataclass
