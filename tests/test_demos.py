@@ -1,5 +1,4 @@
 """Every demo renders a few headless frames that are not blank (the CLI tests cover the file output)."""
-import numpy as np
 import pytest
 
 from atmos.demo_registry import DemoSettings, list_demos
