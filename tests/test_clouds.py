@@ -198,3 +198,10 @@ def test_shading_stage_lights_each_step_with_the_sun_of_its_start(gpu, ctx):
     assert density.max() > 0.5 and got.min() < 0.9, "clouds cast light shadows"
     assert np.abs(got - expected).max() < 2e-3        # f2 storage
     app.close()
+
+
+def test_volume_larger_than_the_gpu_allows_is_a_clear_error(gpu, ctx):
+    app = App(gpu)
+    with pytest.raises(ValueError, match="too big for this GPU"):
+        app.add_plugins(CloudsPlugin(params((8192, 64, 8192))))
+    app.close()
