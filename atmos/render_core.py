@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.graph import PassBuilder, PassContext, RenderPass, TextureDesc
+from atmos.graph import FullscreenPass, PassBuilder, PassContext, RenderPass, TextureDesc
 from atmos.plugin import Plugin
 
 SCREEN = "screen"
@@ -37,28 +37,17 @@ class ClearPass(RenderPass):
         fbo.clear(*self.color, 1.0, depth=1.0)
 
 
-class PresentPass(RenderPass):
+class PresentPass(FullscreenPass):
     """Tone-maps the HDR ``color`` into the screen (window or offscreen target), with sRGB gamma."""
     name = "present"
-
-    def __init__(self, gpu, exposure: float = 1.0):
-        self.gpu = gpu
-        self.exposure = exposure
-        self.program = None
-
-    def setup(self, builder: PassBuilder) -> None:
-        builder.read(COLOR)
-        builder.write(SCREEN)
-
-    def prepare(self, gpu) -> None:
-        self.program = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="core/present.frag")
+    fragment = "core/present.frag"
+    reads = (COLOR,)
+    writes = (SCREEN,)
 
     def execute(self, frame: PassContext) -> None:
-        target = frame.texture(SCREEN)
-        target.use()
-        frame.gpu.ctx.disable(frame.gpu.ctx.DEPTH_TEST | frame.gpu.ctx.BLEND)
+        frame.texture(SCREEN).use()
         frame.texture(COLOR).use(0)
-        self.program["exposure"].value = self.exposure
+        self.program["exposure"].value = self.plugin.exposure
         frame.fullscreen(self.program)
 
 
@@ -93,4 +82,4 @@ class RenderCorePlugin(Plugin):
             return
         app.graph.import_texture(SCREEN, lambda: app.gpu.target)
         app.graph.add_pass(ClearPass(app.gpu, self.clear_color))
-        app.graph.add_pass(PresentPass(app.gpu, self.exposure))
+        app.graph.add_pass(PresentPass(self))

@@ -2,10 +2,11 @@
 from atmos.graph.compiler import CompiledGraph, ResourceInfo
 from atmos.graph.errors import GraphError
 from atmos.graph.frame import PassContext
+from atmos.graph.fullscreen import FullscreenPass
 from atmos.graph.graph import RenderGraph
 from atmos.graph.passes import PassBuilder, RenderPass
 from atmos.graph.resources import TextureDesc, TexturePool
 from atmos.graph.timing import PassTimers
 
 __all__ = ["RenderGraph", "RenderPass", "PassBuilder", "PassContext", "TextureDesc", "TexturePool",
-           "GraphError", "CompiledGraph", "ResourceInfo", "PassTimers"]
+           "GraphError", "CompiledGraph", "ResourceInfo", "PassTimers", "FullscreenPass"]

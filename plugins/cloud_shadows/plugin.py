@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from atmos.camera import Camera, set_camera_uniforms
-from atmos.graph import PassBuilder, PassContext, RenderPass
+from atmos.graph import FullscreenPass, PassContext
 from atmos.lighting import Sun
 from atmos.plugin import Plugin
 from atmos.plugins.clouds.layout import CloudLayout
@@ -18,20 +18,11 @@ def cloud_layout(sim: CloudSimulation, params: CloudShadowParams) -> CloudLayout
     return sim.layout(params.base_altitude, params.cell_size)
 
 
-class CloudShadowsPass(RenderPass):
+class CloudShadowsPass(FullscreenPass):
     """Multiplies "color" by the shadow factor where "depth" has geometry (blend ZERO, SRC_COLOR)."""
     name = "cloud_shadows"
-
-    def __init__(self, plugin: "CloudShadowsPlugin"):
-        self.plugin = plugin
-        self.program = None
-
-    def setup(self, builder: PassBuilder) -> None:
-        builder.read(DEPTH)
-        builder.write(COLOR)
-
-    def prepare(self, gpu) -> None:
-        self.program = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="cloud_shadows/shadow.frag")
+    fragment = "cloud_shadows/shadow.frag"
+    reads = (DEPTH,)
 
     def execute(self, frame: PassContext) -> None:
         app, gpu, p = frame.data["app"], frame.gpu, self.program

@@ -5,24 +5,15 @@ the clouds in 3D.
 """
 from __future__ import annotations
 
-from atmos.graph import PassBuilder, PassContext, RenderPass
+from atmos.graph import FullscreenPass, PassContext
 from atmos.plugin import Plugin
 from atmos.plugins.clouds.simulation import CloudSimulation
 from atmos.render_core import COLOR
 
 
-class CloudTopViewPass(RenderPass):
+class CloudTopViewPass(FullscreenPass):
     name = "cloud_top_view"
-
-    def __init__(self, plugin: "CloudTopViewPlugin"):
-        self.plugin = plugin
-        self.program = None
-
-    def setup(self, builder: PassBuilder) -> None:
-        builder.write(COLOR)
-
-    def prepare(self, gpu) -> None:
-        self.program = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="clouds/top_view.frag")
+    fragment = "clouds/top_view.frag"
 
     def execute(self, frame: PassContext) -> None:
         sim = frame.data["app"].resource(CloudSimulation)

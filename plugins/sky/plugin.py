@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from atmos.camera import Camera
-from atmos.graph import PassBuilder, PassContext, RenderPass
+from atmos.graph import FullscreenPass, PassContext
 from atmos.lighting import Sun, sun_and_day
 from atmos.plugin import Plugin
 from atmos.plugins.sky.params import SkyParams
@@ -10,20 +10,13 @@ from atmos.plugins.sky.shader import set_sky_uniforms, set_view_basis, sky_defin
 from atmos.render_core import COLOR
 
 
-class SkyPass(RenderPass):
+class SkyPass(FullscreenPass):
     """Writes the sky into every pixel of ``color`` (later passes draw over it), from the Sun resource."""
     name = "sky"
+    fragment = "sky/sky.frag"
 
-    def __init__(self, plugin: "SkyPlugin"):
-        self.plugin = plugin
-        self.program = None
-
-    def setup(self, builder: PassBuilder) -> None:
-        builder.write(COLOR)
-
-    def prepare(self, gpu) -> None:
-        self.program = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="sky/sky.frag",
-                                   defines=sky_defines())
+    def defines(self) -> dict:
+        return sky_defines()
 
     def execute(self, frame: PassContext) -> None:
         app, gpu, p = frame.data["app"], frame.gpu, self.program

@@ -1,23 +1,14 @@
 """A cheap analytic sky: horizon-to-zenith gradient, a sun disc and glow. Draws the whole background."""
 from atmos.camera import Camera, set_camera_uniforms
-from atmos.graph import PassBuilder, PassContext, RenderPass
+from atmos.graph import FullscreenPass, PassContext
 from atmos.lighting import Sun
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR
 
 
-class SkyGradientPass(RenderPass):
+class SkyGradientPass(FullscreenPass):
     name = "sky_gradient"
-
-    def __init__(self, plugin: "SkyGradientPlugin"):
-        self.plugin = plugin
-        self.program = None
-
-    def setup(self, builder: PassBuilder) -> None:
-        builder.write(COLOR)
-
-    def prepare(self, gpu) -> None:
-        self.program = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="sky_gradient/sky.frag")
+    fragment = "sky_gradient/sky.frag"
 
     def execute(self, frame: PassContext) -> None:
         app = frame.data["app"]

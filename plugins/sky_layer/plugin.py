@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from atmos.camera import Camera, set_camera_uniforms
-from atmos.graph import PassBuilder, PassContext, RenderPass
+from atmos.graph import FullscreenPass, PassContext
 from atmos.lighting import Sun
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
@@ -24,20 +24,14 @@ def scroll_offsets(wind, time: float) -> np.ndarray:
     return np.mod(np.asarray(wind, np.float64) * float(time), 1.0)
 
 
-class SkyLayerPass(RenderPass):
+class SkyLayerPass(FullscreenPass):
     """Reads ``depth``; blends the clouds over ``color`` (ONE, SRC_ALPHA) where depth is 1."""
     name = "sky_layer"
-
-    def __init__(self, plugin: "SkyLayerPlugin"):
-        self.plugin = plugin
-        self.program = None
-
-    def setup(self, builder: PassBuilder) -> None:
-        builder.read(DEPTH)
-        builder.write(COLOR)
+    fragment = "sky_layer/layer.frag"
+    reads = (DEPTH,)
 
     def prepare(self, gpu) -> None:
-        self.program = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="sky_layer/layer.frag")
+        super().prepare(gpu)
         self.plugin.octaves = OctaveTextures(gpu)
 
     def execute(self, frame: PassContext) -> None:

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 from atmos.camera import Camera, set_camera_uniforms
 from atmos.frames import SlicedJob, SliceStage, TripleSet
-from atmos.graph import PassBuilder, PassContext, RenderPass, TextureDesc
+from atmos.graph import FullscreenPass, PassContext, TextureDesc
 from atmos.lighting import Sun
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
@@ -66,22 +66,14 @@ class TestVolumePlugin(Plugin):
             self.triple = None
 
 
-class TestVolumePass(RenderPass):
+class TestVolumePass(FullscreenPass):
     """Ray-marches mix(A, B, t) inside the box, occluded by scene depth, blended over the colour."""
     name = "test_volume"
+    fragment = "test_volume/march.frag"
+    reads = (DEPTH,)
 
-    def __init__(self, plugin: TestVolumePlugin):
-        self.plugin = plugin
-        self.program = None
-
-    def setup(self, builder: PassBuilder) -> None:
-        builder.read(DEPTH)
-        builder.write(COLOR)
-
-    def prepare(self, gpu) -> None:
-        self.program = gpu.program(vertex_shader="lib/fullscreen.vert",
-                                   fragment_shader="test_volume/march.frag",
-                                   defines={"MARCH_STEPS": self.plugin.march_steps})
+    def defines(self) -> dict:
+        return {"MARCH_STEPS": self.plugin.march_steps}
 
     def execute(self, frame: PassContext) -> None:
         app, gpu, p = frame.data["app"], frame.gpu, self.program

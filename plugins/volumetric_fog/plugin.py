@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from atmos.camera import Camera, set_camera_uniforms
-from atmos.graph import PassBuilder, PassContext, RenderPass
+from atmos.graph import FullscreenPass, PassContext
 from atmos.lighting import Sun, sun_and_day
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
@@ -33,20 +33,11 @@ def set_medium_uniforms(program, params: FogParams, sun: Sun, time: float) -> No
             program[name].value = value
 
 
-class VolumetricFogPass(RenderPass):
+class VolumetricFogPass(FullscreenPass):
     """Reads ``depth``, blends (in-scattered light, transmittance) over ``color`` with ONE, SRC_ALPHA."""
     name = "volumetric_fog"
-
-    def __init__(self, plugin: "VolumetricFogPlugin"):
-        self.plugin = plugin
-        self.program = None
-
-    def setup(self, builder: PassBuilder) -> None:
-        builder.read(DEPTH)
-        builder.write(COLOR)
-
-    def prepare(self, gpu) -> None:
-        self.program = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="volumetric_fog/fog.frag")
+    fragment = "volumetric_fog/fog.frag"
+    reads = (DEPTH,)
 
     def execute(self, frame: PassContext) -> None:
         app, gpu, p = frame.data["app"], frame.gpu, self.program

@@ -1,0 +1,31 @@
+"""FullscreenPass: a pass that draws one fullscreen-triangle program (the shape of most effects)."""
+from __future__ import annotations
+
+from atmos.graph.passes import PassBuilder, RenderPass
+
+
+class FullscreenPass(RenderPass):
+    """Subclass with ``name``, ``fragment`` (a file under ``shaders/``), ``reads`` and ``writes``
+    (resource names) and, if needed, :meth:`defines`; ``execute`` binds a target and calls
+    ``frame.fullscreen(self.program)``. ``plugin`` is the plugin that made the pass (its settings)."""
+    fragment: str = ""
+    reads: tuple[str, ...] = ()
+    writes: tuple[str, ...] = ("color",)
+
+    def __init__(self, plugin=None):
+        self.plugin = plugin
+        self.program = None
+
+    def defines(self) -> dict:
+        """Compile-time constants of the fragment shader (``#define`` name value)."""
+        return {}
+
+    def setup(self, builder: PassBuilder) -> None:
+        for name in self.reads:
+            builder.read(name)
+        for name in self.writes:
+            builder.write(name)
+
+    def prepare(self, gpu) -> None:
+        self.program = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader=self.fragment,
+                                   defines=self.defines())
