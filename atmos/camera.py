@@ -32,6 +32,12 @@ class Camera:
         self.pitch = math.atan2(d[1], math.hypot(d[0], d[2]))
         return self
 
+    def orbit(self, target, radius: float, height: float, angle: float) -> "Camera":
+        """Stand on a circle of ``radius`` around ``target`` at ``height``, at ``angle`` (radians),
+        looking at ``target``: the scripted camera of headless demo runs."""
+        self.position = np.array([target[0] + radius * math.sin(angle), height, target[2] + radius * math.cos(angle)])
+        return self.look_at(target)
+
     def view(self) -> np.ndarray:
         f = self.forward()
         r = self.right()

@@ -28,3 +28,18 @@ def sun_and_day(sun: Sun) -> tuple[np.ndarray, float]:
     s = s / norm if np.isfinite(norm) and norm > 1e-9 else np.array([0.0, 1.0, 0.0])
     day = float(np.clip((s[1] + 0.15) / 0.25, 0.0, 1.0))
     return s, day * day * (3 - 2 * day)
+
+
+def scene_sun(app) -> Sun:
+    """The App's Sun resource, or the default sun for a scene that has none."""
+    return app.get_resource(Sun) or _DEFAULT_SUN
+
+
+def set_sun_uniforms(program, sun: Sun) -> None:
+    """Write ``sun_dir`` and ``sun_color`` where the program has them."""
+    for name, value in (("sun_dir", sun.direction), ("sun_color", sun.color)):
+        if name in program:
+            program[name].value = tuple(float(v) for v in value)
+
+
+_DEFAULT_SUN = Sun()

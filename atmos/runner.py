@@ -17,6 +17,7 @@ def build_app(name: str, settings: DemoSettings, gpu, *extra_plugins) -> App:
     """A started App for demo ``name`` on ``gpu``, with ``extra_plugins`` added after the demo's."""
     demo = load_demo(name)
     app = App(gpu)
+    app.insert_resource(settings)           # demos read it (headless runs script their camera)
     try:
         demo.build(app, settings)
         app.add_plugins(*extra_plugins)

@@ -51,7 +51,6 @@ def place_camera(app) -> None:
 def build(app, settings, fog_preset: str | None = None) -> FogPlugin:
     name = fog_preset or os.environ.get("ATMOS_FOG_PRESET", "fig6")
     fog = FogPlugin(preset(name), sky="fog", tile_size=NOISE_TILE)
-    app.insert_resource(settings)
     app.insert_resource(Sun.from_angles(elevation_deg=30.0, azimuth_deg=-30.0))
     app.add_plugins(DefaultPlugins(overlay=not settings.headless), SkyGradientPlugin(), TerrainPlugin(size=TERRAIN_SIZE, relief=10.0), fog)
     cam = app.resource(Camera)

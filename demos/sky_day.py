@@ -34,7 +34,6 @@ def face_the_sun(app) -> None:
 
 
 def build(app, settings) -> None:
-    app.insert_resource(settings)
     app.add_plugins(DefaultPlugins(overlay=not settings.headless),
                     DaylightPlugin(hours=17.0, speed=HOURS_PER_SECOND, latitude=45.0, day_of_year=172.0),
                     SkyPlugin(), GroundPlugin())

@@ -23,7 +23,6 @@ def turn_camera(app) -> None:
 
 
 def build(app, settings) -> None:
-    app.insert_resource(settings)
     app.insert_resource(Sun.from_angles(elevation_deg=25.0, azimuth_deg=30.0))
     app.add_plugins(DefaultPlugins(overlay=not settings.headless), SkyGradientPlugin(), GroundPlugin(),
                     SkyLayerPlugin(seed=settings.seed))

@@ -1,5 +1,4 @@
 """testbed: ground plane, sky gradient and an animated test volume through the sliced scheduler."""
-import math
 
 import numpy as np
 
@@ -19,14 +18,10 @@ def orbit_camera(app) -> None:
     """Headless runs circle the volume slowly; in a window the fly camera is yours."""
     if not app.resource(DemoSettings).headless:
         return
-    cam = app.resource(Camera)
-    a = 0.6 + 0.15 * app.clock.frame_time
-    cam.position = np.array([34.0 * math.sin(a), 12.0, 34.0 * math.cos(a)])
-    cam.look_at((0.0, 6.0, 0.0))
+    app.resource(Camera).orbit((0.0, 6.0, 0.0), 34.0, 12.0, 0.6 + 0.15 * app.clock.frame_time)
 
 
 def build(app, settings) -> None:
-    app.insert_resource(settings)
     app.insert_resource(Sun.from_angles(elevation_deg=35.0, azimuth_deg=40.0))
     app.add_plugins(DefaultPlugins(overlay=not settings.headless), SkyGradientPlugin(), GroundPlugin(),
                     TestVolumePlugin())

@@ -1,5 +1,4 @@
 """volumetric_fog: a bank of ray-marched FBM fog drifting over the ground, lit by a low sun."""
-import math
 
 import numpy as np
 
@@ -20,14 +19,10 @@ def orbit_camera(app) -> None:
     """Headless runs circle the fog bank slowly; in a window the fly camera is yours."""
     if not app.resource(DemoSettings).headless:
         return
-    cam = app.resource(Camera)
-    a = 0.3 + 0.05 * app.clock.frame_time
-    cam.position = np.array([95.0 * math.sin(a), 14.0, 95.0 * math.cos(a)])
-    cam.look_at((0.0, 4.0, 0.0))
+    app.resource(Camera).orbit((0.0, 4.0, 0.0), 95.0, 14.0, 0.3 + 0.05 * app.clock.frame_time)
 
 
 def build(app, settings) -> None:
-    app.insert_resource(settings)
     app.insert_resource(Sun.from_angles(elevation_deg=18.0, azimuth_deg=120.0))
     app.add_plugins(DefaultPlugins(overlay=not settings.headless), SkyGradientPlugin(), GroundPlugin(),
                     VolumetricFogPlugin(seed=settings.seed, **FOG))

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from atmos.camera import Camera, set_camera_uniforms
 from atmos.graph import FullscreenPass, PassContext
-from atmos.lighting import Sun
+from atmos.lighting import scene_sun
 from atmos.plugin import Plugin
 from atmos.plugins.clouds.layout import CloudLayout
 from atmos.plugins.cloud_shadows.params import CloudShadowParams
@@ -27,7 +27,7 @@ class CloudShadowsPass(FullscreenPass):
     def execute(self, frame: PassContext) -> None:
         app, gpu, p = frame.data["app"], frame.gpu, self.program
         params = self.plugin.params
-        sun = app.get_resource(Sun) or Sun()
+        sun = scene_sun(app)
         weight = direct_weight(sun.direction, sun.color, params)
         if weight <= 0.0 or params.strength == 0.0:
             return                                  # no direct light to take away: nothing to draw
@@ -37,7 +37,6 @@ class CloudShadowsPass(FullscreenPass):
         a, b, t = sim.view()
         frame.framebuffer(color=[COLOR]).use()
         ctx = gpu.ctx
-        ctx.disable(ctx.DEPTH_TEST)
         ctx.enable(ctx.BLEND)
         ctx.blend_func = ctx.ZERO, ctx.SRC_COLOR
         sim.maps_of(a).sums.use(0)
@@ -52,8 +51,6 @@ class CloudShadowsPass(FullscreenPass):
         p["cell_size"].value = layout.cell
         p["shape"].value = layout.shape
         frame.fullscreen(p)
-        ctx.disable(ctx.BLEND)
-        ctx.blend_func = ctx.SRC_ALPHA, ctx.ONE_MINUS_SRC_ALPHA
 
 
 class CloudShadowsPlugin(Plugin):

@@ -19,7 +19,6 @@ class CloudTopViewPass(FullscreenPass):
         sim = frame.data["app"].resource(CloudSimulation)
         a, b, t = sim.view()
         frame.framebuffer(color=[COLOR]).use()
-        frame.gpu.ctx.disable(frame.gpu.ctx.BLEND | frame.gpu.ctx.DEPTH_TEST)
         sim.maps_of(a).sums.use(0)
         sim.maps_of(b).sums.use(1)
         self.program["t"].value = t

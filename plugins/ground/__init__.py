@@ -3,7 +3,7 @@ import numpy as np
 
 from atmos.camera import Camera, set_camera_uniforms
 from atmos.graph import PassBuilder, PassContext, RenderPass
-from atmos.lighting import Sun
+from atmos.lighting import scene_sun, set_sun_uniforms
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
 
@@ -27,19 +27,14 @@ class GroundPass(RenderPass):
         self.vao = gpu.track(gpu.ctx.vertex_array(self.program, [(self.vbo, "2f", "in_xz")]))
 
     def execute(self, frame: PassContext) -> None:
-        app = frame.data["app"]
-        gpu = frame.gpu
+        app, gpu = frame.data["app"], frame.gpu
         frame.framebuffer(color=[COLOR], depth=DEPTH).use()
         gpu.ctx.enable(gpu.ctx.DEPTH_TEST)
-        gpu.ctx.disable(gpu.ctx.BLEND)
         set_camera_uniforms(self.program, app.resource(Camera), gpu.size[0] / gpu.size[1])
-        sun = app.get_resource(Sun) or Sun()
-        self.program["sun_dir"].value = tuple(sun.direction)
-        self.program["sun_color"].value = tuple(sun.color)
+        set_sun_uniforms(self.program, scene_sun(app))
         self.program["albedo"].value = self.plugin.albedo
         self.program["tile"].value = self.plugin.tile
         self.vao.render(gpu.ctx.TRIANGLE_STRIP)
-        gpu.ctx.disable(gpu.ctx.DEPTH_TEST)
 
     def release(self) -> None:
         for obj in (self.vao, self.vbo):

@@ -5,7 +5,7 @@ import math
 
 from atmos.camera import Camera
 from atmos.graph import PassBuilder, PassContext, RenderPass, TextureDesc
-from atmos.lighting import Sun
+from atmos.lighting import scene_sun
 from atmos.plugin import Plugin
 from atmos.plugins.light_shafts.params import LightShaftParams
 from atmos.plugins.light_shafts.screen_sun import screen_sun
@@ -56,12 +56,11 @@ class LightShaftsPass(RenderPass):
     def execute(self, frame: PassContext) -> None:
         app, gpu, params = frame.data["app"], frame.gpu, self.plugin.params
         w, h = gpu.size
-        sun = app.get_resource(Sun) or Sun()
+        sun = scene_sun(app)
         where = screen_sun(app.resource(Camera), w / h, sun.direction, params)
         if where.strength <= 0.0 or params.exposure == 0.0 or params.weight == 0.0:
             return                                      # sun behind, below or far off-screen
         ctx = gpu.ctx
-        ctx.disable(ctx.DEPTH_TEST | ctx.BLEND)
         mask = frame.texture(MASK)
         frame.framebuffer(color=[MASK]).use()
         frame.texture(COLOR).use(0)
@@ -84,8 +83,6 @@ class LightShaftsPass(RenderPass):
         ctx.enable(ctx.BLEND)
         ctx.blend_func = ctx.ONE, ctx.ONE
         frame.fullscreen(self.composite)
-        ctx.disable(ctx.BLEND)
-        ctx.blend_func = ctx.SRC_ALPHA, ctx.ONE_MINUS_SRC_ALPHA
 
 
 class LightShaftsPlugin(Plugin):

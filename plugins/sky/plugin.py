@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from atmos.camera import Camera
 from atmos.graph import FullscreenPass, PassContext
-from atmos.lighting import Sun, sun_and_day
+from atmos.lighting import scene_sun, sun_and_day
 from atmos.plugin import Plugin
 from atmos.plugins.sky.params import SkyParams
 from atmos.plugins.sky.shader import set_sky_uniforms, set_view_basis, sky_defines
@@ -21,10 +21,9 @@ class SkyPass(FullscreenPass):
     def execute(self, frame: PassContext) -> None:
         app, gpu, p = frame.data["app"], frame.gpu, self.program
         frame.framebuffer(color=[COLOR]).use()
-        gpu.ctx.disable(gpu.ctx.DEPTH_TEST | gpu.ctx.BLEND)
         camera = app.resource(Camera)
         set_view_basis(p, camera, gpu.size[0] / gpu.size[1])
-        sun = app.get_resource(Sun) or Sun()
+        sun = scene_sun(app)
         s, _ = sun_and_day(sun)
         set_sky_uniforms(p, self.plugin.params, s, sun.color, app.clock.frame_time,
                          camera.fov_y / max(1, gpu.size[1]))

@@ -1,7 +1,7 @@
 """A cheap analytic sky: horizon-to-zenith gradient, a sun disc and glow. Draws the whole background."""
 from atmos.camera import Camera, set_camera_uniforms
 from atmos.graph import FullscreenPass, PassContext
-from atmos.lighting import Sun
+from atmos.lighting import scene_sun, set_sun_uniforms
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR
 
@@ -11,14 +11,10 @@ class SkyGradientPass(FullscreenPass):
     fragment = "sky_gradient/sky.frag"
 
     def execute(self, frame: PassContext) -> None:
-        app = frame.data["app"]
-        gpu = frame.gpu
+        app, gpu = frame.data["app"], frame.gpu
         frame.framebuffer(color=[COLOR]).use()
-        gpu.ctx.disable(gpu.ctx.DEPTH_TEST | gpu.ctx.BLEND)
         set_camera_uniforms(self.program, app.resource(Camera), gpu.size[0] / gpu.size[1])
-        sun = app.get_resource(Sun) or Sun()
-        self.program["sun_dir"].value = tuple(sun.direction)
-        self.program["sun_color"].value = tuple(sun.color)
+        set_sun_uniforms(self.program, scene_sun(app))
         self.program["zenith"].value = self.plugin.zenith
         self.program["horizon"].value = self.plugin.horizon
         self.program["ground"].value = self.plugin.ground

@@ -5,12 +5,11 @@ import numpy as np
 
 from atmos.camera import Camera, set_camera_uniforms
 from atmos.graph import FullscreenPass, PassContext
-from atmos.lighting import Sun
+from atmos.lighting import Sun, scene_sun, sun_and_day
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
 from atmos.plugins.sky_layer.octaves import OctaveTextures
 from atmos.plugins.sky_layer.params import SkyLayerParams
-from atmos.lighting import sun_and_day
 
 
 def layer_light(sun: Sun) -> tuple[np.ndarray, np.ndarray]:
@@ -37,7 +36,7 @@ class SkyLayerPass(FullscreenPass):
     def execute(self, frame: PassContext) -> None:
         app, gpu, p, plugin = frame.data["app"], frame.gpu, self.program, self.plugin
         params = plugin.params
-        s, light = layer_light(app.get_resource(Sun) or Sun())
+        s, light = layer_light(scene_sun(app))
         if plugin.octaves.needs_bake(params, s, plugin.rebake_tolerance):
             plugin.octaves.bake(params, s)
         frame.framebuffer(color=[COLOR]).use()

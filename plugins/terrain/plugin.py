@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from atmos.camera import Camera, set_camera_uniforms
 from atmos.graph import PassBuilder, PassContext, RenderPass
-from atmos.lighting import Sun
+from atmos.lighting import scene_sun, set_sun_uniforms
 from atmos.plugin import Plugin
 from atmos.plugins.terrain.heightfield import heightfield, triangle_count
 from atmos.render_core import COLOR, DEPTH
@@ -33,14 +33,10 @@ class TerrainPass(RenderPass):
         app, gpu = frame.data["app"], frame.gpu
         frame.framebuffer(color=[COLOR], depth=DEPTH).use()
         gpu.ctx.enable(gpu.ctx.DEPTH_TEST)
-        gpu.ctx.disable(gpu.ctx.BLEND)
         set_camera_uniforms(self.program, app.resource(Camera), gpu.size[0] / gpu.size[1])
-        sun = app.get_resource(Sun) or Sun()
-        self.program["sun_dir"].value = tuple(sun.direction)
-        self.program["sun_color"].value = tuple(sun.color)
+        set_sun_uniforms(self.program, scene_sun(app))
         self.program["relief"].value = self.plugin.relief
         self.vao.render(gpu.ctx.TRIANGLES)
-        gpu.ctx.disable(gpu.ctx.DEPTH_TEST)
 
     def release(self) -> None:
         for obj in (self.vao, self.vbo, self.ibo):

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from atmos.camera import Camera, set_camera_uniforms
 from atmos.frames import SlicedJob, SliceStage, TripleSet
 from atmos.graph import FullscreenPass, PassContext, TextureDesc
-from atmos.lighting import Sun
+from atmos.lighting import scene_sun, set_sun_uniforms
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
 
@@ -84,9 +84,7 @@ class TestVolumePass(FullscreenPass):
         b["density"].use(1)
         frame.texture(DEPTH).use(2)
         set_camera_uniforms(p, app.resource(Camera), gpu.size[0] / gpu.size[1])
-        sun = app.get_resource(Sun) or Sun()
-        p["sun_dir"].value = tuple(sun.direction)
-        p["sun_color"].value = tuple(sun.color)
+        set_sun_uniforms(p, scene_sun(app))
         p["t"].value = t
         box = self.plugin.box
         p["box_min"].value = tuple(c - s / 2 for c, s in zip(box.center, box.size))

@@ -5,7 +5,7 @@ import numpy as np
 
 from atmos.camera import Camera, set_camera_uniforms
 from atmos.graph import FullscreenPass, PassContext
-from atmos.lighting import Sun, sun_and_day
+from atmos.lighting import Sun, scene_sun, sun_and_day
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
 from atmos.plugins.volumetric_fog.params import FogParams
@@ -45,7 +45,7 @@ class VolumetricFogPass(FullscreenPass):
         frame.blend_transmittance()
         frame.texture(DEPTH).use(0)
         set_camera_uniforms(p, app.resource(Camera), gpu.size[0] / gpu.size[1])
-        set_medium_uniforms(p, self.plugin.params, app.get_resource(Sun) or Sun(), self.plugin.time(app))
+        set_medium_uniforms(p, self.plugin.params, scene_sun(app), self.plugin.time(app))
         frame.fullscreen(p)
 
 
