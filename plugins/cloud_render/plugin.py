@@ -27,6 +27,7 @@ from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.lighting import Sun
 from atmos.plugin import Plugin
 from atmos.plugins.cloud_render.binding import bind_volume, clamp_sampler, unbind_volume
+from atmos.plugins.cloud_render.offscreen import MAX_DOWNSAMPLE, OffscreenClouds
 from atmos.plugins.clouds.layout import CloudLayout
 from atmos.plugins.cloud_render.particle import PROFILE_AREA, particle_texture
 from atmos.plugins.cloud_render.segments import SegmentStats, select_segments
@@ -53,13 +54,14 @@ class CloudRenderPlugin(Plugin):
     sprite diameter in cells at density 1 (≥ ~3 hides the grid; 2 shows stripes). ``sigma``: extinction
     per cell length at density 1 (None: the simulation's ``CloudSettings.sigma``). ``frustum_culling``
     and ``empty_space_skipping`` switch the two culling tests; ``max_point_size`` caps sprite pixels
-    (None: the GL limit). ``enabled`` False skips drawing. After each frame ``stats`` holds the
-    :class:`SegmentStats` counters.
+    (None: the GL limit). ``downsample`` (1..8): draw the sprites off screen at 1/downsample of the
+    frame size and upsample them (:mod:`.offscreen`; 2 fills a quarter of the pixels). ``enabled``
+    False skips drawing. After each frame ``stats`` holds the :class:`SegmentStats` counters.
     """
 
     def __init__(self, base_altitude: float | None = None, size_factor: float = 3.0, sigma: float | None = None,
                  frustum_culling: bool = True, empty_space_skipping: bool = True,
-                 max_point_size: float | None = None):
+                 max_point_size: float | None = None, downsample: int = 1):
         if base_altitude is not None and (not isinstance(base_altitude, (int, float)) or isinstance(base_altitude, bool)
                                           or not math.isfinite(base_altitude)):
             raise ValueError(f"CloudRenderPlugin.base_altitude must be a finite number (world y of the "
@@ -75,12 +77,29 @@ class CloudRenderPlugin(Plugin):
         self.frustum_culling, self.empty_space_skipping = frustum_culling, empty_space_skipping
         self.enabled = True
         self.stats = SegmentStats()
+        self.gpu = self._graph = None
+        self.downsample = downsample
+
+    @property
+    def downsample(self) -> int:
+        return self._downsample
+
+    @downsample.setter
+    def downsample(self, value: int) -> None:
+        """Checked; a running App's render graph recompiles for the new target size."""
+        if not isinstance(value, (int, np.integer)) or isinstance(value, bool) or not 1 <= value <= MAX_DOWNSAMPLE:
+            raise ValueError(f"CloudRenderPlugin.downsample must be an int in 1..{MAX_DOWNSAMPLE} "
+                             f"(1: sprites drawn at full resolution), got {value!r}")
+        self._downsample = int(value)
+        if self._graph is not None:
+            self._graph.invalidate()
 
     def build(self, app) -> None:
         if app.graph is None:
             raise ValueError("CloudRenderPlugin needs an App with a GPU context (App(gpu))")
         if app.get_resource(CloudSimulation) is None:
             raise ValueError("CloudRenderPlugin draws the CloudSimulation: add CloudsPlugin before it")
+        self.gpu, self._graph = app.gpu, app.graph
         app.graph.add_pass(CloudSpritePass(self))
 
     # -- shared with the reference ray marcher --------------------------------------------------
@@ -107,21 +126,25 @@ def sprite_uniforms(plugin, sim, layout: CloudLayout, camera: Camera, aspect: fl
 
 
 class CloudSpritePass(RenderPass):
-    """Pass "clouds": reads "depth", blends the sprites into "color"."""
+    """Pass "clouds": reads "depth", blends the sprites into "color" (with ``downsample`` > 1 through
+    the low-res "cloud_color"/"cloud_depth" it creates)."""
     name = "clouds"
 
     def __init__(self, plugin: CloudRenderPlugin):
         self.plugin = plugin
-        self.program = self.particle = self.sampler = None
+        self.program = self.particle = self.sampler = self.offscreen = None
         self.vbo = self.instances = self.vao = None
         self._group = None
 
     def setup(self, builder: PassBuilder) -> None:
         builder.read(DEPTH)
         builder.write(COLOR)
+        if self.plugin.downsample > 1:
+            OffscreenClouds.declare(builder, self.plugin.gpu.size, self.plugin.downsample)
 
     def prepare(self, gpu) -> None:
         self.program = gpu.program(vertex_shader="cloud_render/sprite.vert", fragment_shader="cloud_render/sprite.frag")
+        self.offscreen = OffscreenClouds(gpu)
         self.particle = particle_texture(gpu.ctx)
         self.sampler = clamp_sampler(gpu.ctx)
         limit = gpu.ctx.info.get("GL_POINT_SIZE_RANGE", (1.0, 64.0))[1]
@@ -159,12 +182,15 @@ class CloudSpritePass(RenderPass):
             return
         self._buffers(gpu, layout.group, layout.shape)
         self.instances.write(segments.tobytes())
-        ctx, p = gpu.ctx, self.program
+        ctx, p, factor = gpu.ctx, self.program, plugin.downsample
+        if factor == 1:
+            fbo = frame.framebuffer(color=[COLOR], depth=DEPTH)
+            fbo.use()
+        else:
+            fbo = self.offscreen.begin(frame, factor)
         p["view_proj"].write(np.asarray(camera.view_projection(aspect), np.float32).T.tobytes())
-        for name, value in sprite_uniforms(plugin, sim, layout, camera, aspect, gpu.size[1], self.point_limit).items():
+        for name, value in sprite_uniforms(plugin, sim, layout, camera, aspect, fbo.size[1], self.point_limit).items():
             p[name].value = value
-        fbo = frame.framebuffer(color=[COLOR], depth=DEPTH)
-        fbo.use()
         fbo.depth_mask = False
         ctx.enable(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.PROGRAM_POINT_SIZE)
         ctx.depth_func = "<="          # a tiny near plane rounds far depths to 1.0: still in front of the sky
@@ -179,6 +205,8 @@ class CloudSpritePass(RenderPass):
             ctx.depth_func = "<"
             ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.PROGRAM_POINT_SIZE)
             ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
+        if factor > 1:
+            self.offscreen.end(frame, factor, camera.near, camera.far)
 
     def _release_buffers(self) -> None:
         for obj in (self.vao, self.instances, self.vbo):

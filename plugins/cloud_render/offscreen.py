@@ -1,0 +1,76 @@
+"""Off-screen clouds at 1/``factor`` of the frame size, upsampled onto the frame (GPU Gems 3, ch. 23).
+
+Filling sprite pixels is most of the cloud pass's cost; at factor 2 the sprites fill a quarter of
+the pixels. Three draws: ``far_depth.frag`` writes each block's farthest scene depth into the
+low-res depth target (so a sprite seen through any pixel of the block is drawn); the sprites are
+drawn into the cleared low-res colour target against it; ``composite.frag`` blends the result onto
+the frame — bilinear inside surfaces, nearest-depth at geometry edges. References:
+:mod:`.offscreen_reference`.
+"""
+from __future__ import annotations
+
+import math
+
+import moderngl
+
+from atmos.graph import PassBuilder, PassContext, TextureDesc
+from atmos.render_core import COLOR, DEPTH
+
+CLOUD_COLOR = "cloud_color"
+CLOUD_DEPTH = "cloud_depth"
+MAX_DOWNSAMPLE = 8
+EDGE = 0.1           # relative view-depth difference between a pixel and a low-res texel that makes an edge
+
+
+def low_size(size, factor: int) -> tuple[int, int]:
+    """The low-res target's size: every pixel of the frame falls in one block."""
+    return math.ceil(size[0] / factor), math.ceil(size[1] / factor)
+
+
+class OffscreenClouds:
+    """The low-res targets' declarations and the depth and composite draws of a cloud pass
+    (programs belong to the GpuContext)."""
+
+    def __init__(self, gpu):
+        fullscreen = "lib/fullscreen.vert"
+        self.far_depth = gpu.program(vertex_shader=fullscreen, fragment_shader="cloud_render/far_depth.frag")
+        self.composite = gpu.program(vertex_shader=fullscreen, fragment_shader="cloud_render/composite.frag")
+
+    @staticmethod
+    def declare(builder: PassBuilder, size, factor: int) -> None:
+        low = low_size(size, factor)
+        builder.create(CLOUD_COLOR, TextureDesc(low, components=4, dtype="f2", filter="nearest"))
+        builder.create(CLOUD_DEPTH, TextureDesc(low, depth=True, filter="nearest"))
+
+    def begin(self, frame: PassContext, factor: int):
+        """Write the low-res depth, clear the low-res colour; returns the framebuffer to draw sprites into."""
+        ctx = frame.gpu.ctx
+        frame.framebuffer(depth=CLOUD_DEPTH).use()
+        frame.texture(DEPTH).use(0)
+        self.far_depth["factor"].value = factor
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.depth_func = "1"
+        try:
+            frame.fullscreen(self.far_depth)
+        finally:
+            ctx.depth_func = "<"
+            ctx.disable(moderngl.DEPTH_TEST)
+        fbo = frame.framebuffer(color=[CLOUD_COLOR], depth=CLOUD_DEPTH)
+        fbo.depth_mask = False              # clear the colour only: the sprites test the depth just written
+        fbo.clear(0.0, 0.0, 0.0, 0.0)
+        fbo.use()                           # clear() re-binds the framebuffer bound before it
+        return fbo
+
+    def end(self, frame: PassContext, factor: int, near: float, far: float) -> None:
+        """Blend the low-res clouds onto "color" (premultiplied, ONE, ONE_MINUS_SRC_ALPHA)."""
+        ctx = frame.gpu.ctx
+        frame.framebuffer(color=[COLOR]).use()
+        for unit, name in enumerate((CLOUD_COLOR, CLOUD_DEPTH, DEPTH)):
+            frame.texture(name).use(unit)
+        p = self.composite
+        p["factor"].value = factor
+        p["inv_near_far"].value = (1.0 / near, 1.0 / far)
+        p["edge"].value = EDGE
+        ctx.enable(moderngl.BLEND)
+        ctx.blend_func = moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA
+        frame.fullscreen(p)
