@@ -17,6 +17,7 @@ from atmos.plugins.cloud_render import (CloudLayout, CloudReferencePlugin, Cloud
 from atmos.plugins.cloud_render.binding import bind_volume, clamp_sampler, unbind_volume
 from atmos.plugins.cloud_render.example import example_weather
 from atmos.plugins.cloud_render.plugin import sprite_uniforms
+from atmos.plugins.cloud_render.segments import column_levels, max_level
 from atmos.plugins.cloud_render.reference import group_cells, sprite_vertices
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin, read_volume
 from atmos.plugins.ground import GroundPlugin
@@ -64,8 +65,8 @@ def frame(app, gpu):
 
 
 # -- the vertex stage against numpy ----------------------------------------------------------------
-@pytest.mark.parametrize("shading_scale", [1, 2])
-def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale):
+@pytest.mark.parametrize("shading_scale, level", [(1, 0), (2, 0), (1, 1), (2, 2)])
+def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale, level):
     app, renderer = scene(gpu, shading_scale=shading_scale, seed=int(rng.integers(1000)))
     app.run_frames(int(rng.integers(1, 5)))          # t somewhere between steps
     from atmos.plugins.clouds import CloudSimulation
@@ -76,8 +77,9 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale)
     layout = renderer.layout(sim)
     aspect, height = 16 / 9, 144
     gx, gz = layout.grid
-    segments = np.stack(np.meshgrid(np.arange(gx), np.arange(SHAPE[1]), np.arange(gz), indexing="ij"), -1)
-    segments = rng.permutation(segments.reshape(-1, 3)).astype(np.int32)
+    segments = np.stack(np.meshgrid(np.arange(gx), np.arange(SHAPE[1] >> level), np.arange(gz), [level],
+                                    indexing="ij"), -1)
+    segments = rng.permutation(segments.reshape(-1, 4)).astype(np.int32)
     uniforms = sprite_uniforms(renderer, sim, layout, cam, aspect, height, 255.0)
     vp = cam.view_projection(aspect)
 
@@ -85,10 +87,10 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale)
     names = ["gl_Position", "gl_PointSize", "v_light", "v_tau", "v_coverage"]
     prog = ctx.program(vertex_shader=src, varyings=names)
     sampler = clamp_sampler(ctx)
-    vbo = ctx.buffer(group_cells(layout.group).tobytes())
     inst = ctx.buffer(segments.tobytes())
-    vao = ctx.vertex_array(prog, [(vbo, "2i", "in_cell"), (inst, "3i/i", "in_segment")])
-    n = len(segments) * layout.group[0] * layout.group[1]
+    vao = ctx.vertex_array(prog, [(inst, "4i/i", "in_segment")])
+    blocks = len(group_cells(layout.group, level))
+    n = len(segments) * blocks
     out = ctx.buffer(np.full(n * 10, np.nan, np.float32).tobytes())
     try:
         prog["view_proj"].write(np.asarray(vp, np.float32).T.tobytes())
@@ -96,11 +98,11 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale)
             prog[name].value = value
         sun = app.resource(Sun)
         bind_volume(prog, sim, sampler, sun)
-        vao.transform(out, moderngl.POINTS, vertices=len(group_cells(layout.group)), instances=len(segments))
+        vao.transform(out, moderngl.POINTS, vertices=blocks, instances=len(segments))
         unbind_volume(sampler)
         got = np.frombuffer(out.read(), np.float32).reshape(n, 10).astype(np.float64)
     finally:
-        for obj in (vao, out, inst, vbo, sampler, prog):
+        for obj in (vao, out, inst, sampler, prog):
             obj.release()
     assert np.isfinite(got).all(), "every output element written"
     color, ambient = sun_light(sun)
@@ -178,7 +180,34 @@ def test_empty_space_skipping_never_skips_density_in_a_or_b(gpu, ctx, cloud_dens
             has_density[:, j] = (both[:, j].reshape(gx, 16, gz, 16) > 0).any(axis=(1, 3))
         assert not (has_density & ~drawn).any()
         assert stats.segments_empty == (~full).sum()
+        # with levels of detail: a block is drawn where any of its slices has density
+        segments, stats = select_segments(layout, (-500.0, 200.0, 480.0), None, sim.max_maps(), bh,
+                                          lod_pixels=20.0, pixel_scale=400.0)
+        assert sum(n > 0 for n in stats.columns_by_level) >= 2, "the test needs several levels"
+        covered = np.zeros_like(full)
+        for gi, j, gk, level in segments:
+            covered[gi, j << level:(j + 1) << level, gk] = True
+        assert not (has_density & ~covered).any()
     app.close()
+
+
+def test_levels_of_detail_follow_pixel_size_and_fall_along_the_draw_order(rng):
+    assert max_level((32, 32), 32) == 2 and max_level((16, 8), 12) == 2 and max_level((6, 6), 8) == 1
+    assert max_level((32, 32), 5) == 0
+    np.testing.assert_array_equal(column_levels([10.0, 100.0, 199.0, 200.0, 400.0, 1e9], 400.0, 4.0, 2),
+                                  [0, 0, 0, 1, 2, 2])          # a cell spans 400 / distance pixels
+    assert (column_levels([1e-9, 0.0], 400.0, 4.0, 2) == 0).all()
+    layout = CloudLayout((128, 16, 128), (20.0, 10.0, 20.0), (0.0, 0.0), 600.0, (16, 16))
+    for _ in range(20):
+        cam = rng.uniform([-3000, 0, -3000], [5000, 1500, 5000])
+        segments, stats = select_segments(layout, cam, lod_pixels=float(rng.uniform(1, 16)),
+                                          pixel_scale=float(rng.uniform(100, 1000)))
+        assert (np.diff(segments[:, 3]) <= 0).all(), "coarser levels first"
+        assert sum(stats.columns_by_level) == 64
+        per_level = [(segments[:, 3] == L).sum() // (16 >> L) for L in range(3)]
+        assert per_level == [c for c in stats.columns_by_level] + [0] * (3 - len(stats.columns_by_level))
+        blocks = (16 >> segments[:, 3]) ** 2
+        assert stats.sprites == blocks.sum()
 
 
 def test_draw_order_is_back_to_front():
@@ -231,6 +260,24 @@ def test_cloud_images_show_clouds_near_the_reference_and_move(gpu, ctx, view):
         app.close()
     finally:
         gpu.resize((256, 144))
+
+
+def test_levels_of_detail_look_like_full_detail(gpu, ctx):
+    app, renderer = scene(gpu, warmup=20)
+    look(app, *BELOW)
+    full = frame(app, gpu)
+    sprites = renderer.stats.sprites
+    renderer.lod_pixels = 6.0
+    lod = frame(app, gpu)
+    save(lod, "cloud_render_lod.png")
+    assert sum(n > 0 for n in renderer.stats.columns_by_level) >= 2, "the test needs several levels in one draw"
+    assert renderer.stats.sprites < 0.6 * sprites
+    renderer.enabled = False
+    empty = frame(app, gpu)
+    app.close()
+    signal = np.sqrt(((full - empty) ** 2).mean())
+    rmse = np.sqrt(((lod - full) ** 2).mean())
+    assert signal > 5 and rmse < 0.2 * signal, f"levels of detail: RMSE {rmse:.2f} against the clouds' {signal:.2f}"
 
 
 # -- extremes ------------------------------------------------------------------------------------
@@ -307,6 +354,7 @@ def test_zero_and_full_cover(gpu, ctx, cloud_density):
     (dict(sigma=-1.0), "sigma must be a finite number >= 0"),
     (dict(frustum_culling="yes"), "frustum_culling must be True or False"),
     (dict(max_point_size=0.5), "max_point_size must be a finite number >= 1"),
+    (dict(lod_pixels=0.0), r"lod_pixels must be a finite number > 0\.0 or None"),
 ])
 def test_bad_parameters_are_refused(kwargs, message):
     with pytest.raises(ValueError, match=message):

@@ -27,10 +27,10 @@ from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.lighting import Sun
 from atmos.plugin import Plugin
 from atmos.plugins.cloud_render.binding import bind_volume, clamp_sampler, unbind_volume
-from atmos.plugins.cloud_render.offscreen import MAX_DOWNSAMPLE, OffscreenClouds
+from atmos.plugins.cloud_render.offscreen import MAX_DOWNSAMPLE, OffscreenClouds, low_size
 from atmos.plugins.clouds.layout import CloudLayout
 from atmos.plugins.cloud_render.particle import PROFILE_AREA, particle_texture
-from atmos.plugins.cloud_render.segments import SegmentStats, select_segments
+from atmos.plugins.cloud_render.segments import MAX_LEVEL, SegmentStats, max_level, select_segments
 from atmos.plugins.clouds.simulation import CloudSimulation
 from atmos.render_core import COLOR, DEPTH
 
@@ -55,13 +55,15 @@ class CloudRenderPlugin(Plugin):
     per cell length at density 1 (None: the simulation's ``CloudSettings.sigma``). ``frustum_culling``
     and ``empty_space_skipping`` switch the two culling tests; ``max_point_size`` caps sprite pixels
     (None: the GL limit). ``downsample`` (1..8): draw the sprites off screen at 1/downsample of the
-    frame size and upsample them (:mod:`.offscreen`; 2 fills a quarter of the pixels). ``enabled``
-    False skips drawing. After each frame ``stats`` holds the :class:`SegmentStats` counters.
+    frame size and upsample them (:mod:`.offscreen`; 2 fills a quarter of the pixels).
+    ``lod_pixels``: level of detail — columns where a block of 2^L cells spans at most this many
+    target pixels are drawn one sprite per block (L ≤ 2, :mod:`.segments`); None: every cell.
+    ``enabled`` False skips drawing. After each frame ``stats`` holds the :class:`SegmentStats` counters.
     """
 
     def __init__(self, base_altitude: float | None = None, size_factor: float = 3.0, sigma: float | None = None,
                  frustum_culling: bool = True, empty_space_skipping: bool = True,
-                 max_point_size: float | None = None, downsample: int = 1):
+                 max_point_size: float | None = None, downsample: int = 1, lod_pixels: float | None = None):
         if base_altitude is not None and (not isinstance(base_altitude, (int, float)) or isinstance(base_altitude, bool)
                                           or not math.isfinite(base_altitude)):
             raise ValueError(f"CloudRenderPlugin.base_altitude must be a finite number (world y of the "
@@ -72,6 +74,7 @@ class CloudRenderPlugin(Plugin):
         size_factor = _number("size_factor", size_factor, 0.0)
         sigma = _number("sigma", sigma, 0.0, lo_open=False, none_ok=True)
         max_point_size = _number("max_point_size", max_point_size, 1.0, lo_open=False, none_ok=True)
+        self.lod_pixels = _number("lod_pixels", lod_pixels, 0.0, none_ok=True)
         self.base_altitude = None if base_altitude is None else float(base_altitude)
         self.size_factor, self.sigma, self.max_point_size = size_factor, sigma, max_point_size
         self.frustum_culling, self.empty_space_skipping = frustum_culling, empty_space_skipping
@@ -105,11 +108,15 @@ class CloudRenderPlugin(Plugin):
     # -- shared with the reference ray marcher --------------------------------------------------
     def layout(self, sim: CloudSimulation) -> CloudLayout:
         """The volume's world placement now, column boxes padded by the largest sprite radius."""
-        cell = sim.settings.cell_size
-        return sim.layout(self.base_altitude, pad=0.5 * self.size_factor * max(cell[0], cell[2]))
+        cell, group = sim.settings.cell_size, sim.settings.group_size
+        blocks = 1 if self.lod_pixels is None else 1 << max_level(group, sim.shape[1], MAX_LEVEL)
+        return sim.layout(self.base_altitude, pad=0.5 * self.size_factor * max(cell[0], cell[2]) * blocks)
 
     def extinction(self, sim: CloudSimulation) -> float:
         return float(sim.settings.sigma if self.sigma is None else self.sigma)
+
+
+COMMAND_BYTES = 20
 
 
 def sprite_uniforms(plugin, sim, layout: CloudLayout, camera: Camera, aspect: float, height: int,
@@ -133,7 +140,7 @@ class CloudSpritePass(RenderPass):
     def __init__(self, plugin: CloudRenderPlugin):
         self.plugin = plugin
         self.program = self.particle = self.sampler = self.offscreen = None
-        self.vbo = self.instances = self.vao = None
+        self.instances = self.commands = self.vao = None
         self._group = None
 
     def setup(self, builder: PassBuilder) -> None:
@@ -151,18 +158,29 @@ class CloudSpritePass(RenderPass):
         self.point_limit = float(limit)
 
     def _buffers(self, gpu, group, shape) -> None:
-        """The group's vertex buffer and an instance buffer for every segment (made once per group size)."""
+        """An instance buffer for every segment and one draw command per level (made once per group size)."""
         if self._group == (group, shape):
             return
         self._release_buffers()
         gx, gz = group
-        local = np.stack(np.meshgrid(np.arange(gx), np.arange(gz), indexing="ij"), -1).reshape(-1, 2)
         grid = (-(-shape[0] // gx)) * (-(-shape[2] // gz)) * shape[1]
-        self.vbo = gpu.ctx.buffer(local.astype(np.int32).tobytes())
-        self.instances = gpu.ctx.buffer(reserve=12 * grid)
-        self.vao = gpu.ctx.vertex_array(self.program, [(self.vbo, "2i", "in_cell"),
-                                                       (self.instances, "3i/i", "in_segment")])
+        self.instances = gpu.ctx.buffer(reserve=16 * grid)
+        self.commands = gpu.ctx.buffer(reserve=COMMAND_BYTES * (MAX_LEVEL + 1))
+        self.vao = gpu.ctx.vertex_array(self.program, [(self.instances, "4i/i", "in_segment")])
         self._group = (group, shape)
+
+    def _draw(self, segments: np.ndarray, group) -> None:
+        """Every level's run of segments as one instanced draw of its blocks, all in one multi-draw:
+        commands (blocks per group, segments, first vertex 0, first instance), farthest level first.
+        moderngl strides array commands by 20 bytes (the indexed layout), hence the zero pad."""
+        levels = segments[:, 3]
+        starts = np.flatnonzero(np.r_[True, levels[1:] != levels[:-1]])
+        counts = np.diff(np.r_[starts, len(levels)])
+        blocks = (group[0] >> levels[starts]) * (group[1] >> levels[starts])
+        zero = np.zeros_like(counts)
+        commands = np.stack([blocks, counts, zero, starts, zero], -1).astype(np.uint32)
+        self.commands.write(commands.tobytes())
+        self.vao.render_indirect(self.commands, moderngl.POINTS, count=len(commands))
 
     def execute(self, frame: PassContext) -> None:
         plugin = self.plugin
@@ -175,21 +193,24 @@ class CloudSpritePass(RenderPass):
         layout = plugin.layout(sim)
         view_proj = camera.view_projection(aspect)
         maps = sim.maps_of(sim.view()[0])
+        ctx, p, factor = gpu.ctx, self.program, plugin.downsample
+        uniforms = sprite_uniforms(plugin, sim, layout, camera, aspect, low_size(gpu.size, factor)[1],
+                                   self.point_limit)
         segments, plugin.stats = select_segments(
             layout, camera.position, view_proj if plugin.frustum_culling else None,
-            sim.max_maps() if plugin.empty_space_skipping else None, maps.band_height)
+            sim.max_maps() if plugin.empty_space_skipping else None, maps.band_height,
+            plugin.lod_pixels, uniforms["pixel_scale"], MAX_LEVEL)
         if not len(segments):
             return
         self._buffers(gpu, layout.group, layout.shape)
         self.instances.write(segments.tobytes())
-        ctx, p, factor = gpu.ctx, self.program, plugin.downsample
         if factor == 1:
             fbo = frame.framebuffer(color=[COLOR], depth=DEPTH)
             fbo.use()
         else:
             fbo = self.offscreen.begin(frame, factor)
-        p["view_proj"].write(np.asarray(camera.view_projection(aspect), np.float32).T.tobytes())
-        for name, value in sprite_uniforms(plugin, sim, layout, camera, aspect, fbo.size[1], self.point_limit).items():
+        p["view_proj"].write(np.asarray(view_proj, np.float32).T.tobytes())
+        for name, value in uniforms.items():
             p[name].value = value
         fbo.depth_mask = False
         ctx.enable(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.PROGRAM_POINT_SIZE)
@@ -198,7 +219,7 @@ class CloudSpritePass(RenderPass):
         bind_volume(p, sim, self.sampler, app.get_resource(Sun))
         self.particle.use(4)
         try:
-            self.vao.render(moderngl.POINTS, vertices=layout.group[0] * layout.group[1], instances=len(segments))
+            self._draw(segments, layout.group)
         finally:
             unbind_volume(self.sampler)
             fbo.depth_mask = True
@@ -209,10 +230,10 @@ class CloudSpritePass(RenderPass):
             self.offscreen.end(frame, factor, camera.near, camera.far)
 
     def _release_buffers(self) -> None:
-        for obj in (self.vao, self.instances, self.vbo):
+        for obj in (self.vao, self.instances, self.commands):
             if obj is not None:
                 obj.release()
-        self.vao = self.instances = self.vbo = None
+        self.vao = self.instances = self.commands = None
         self._group = None
 
     def release(self) -> None:

@@ -3,7 +3,7 @@
 Given the densities and transmittances of sets A and B (``[x, y, z]`` arrays, the transmittance at
 its own shading resolution), the segments and the uniforms, it returns what every
 (instance, vertex) outputs, instance-major like the GPU: the clip position (``CULLED`` for empty
-cells and cells past the edge), point size, light colour, centre optical depth and coverage.
+blocks and blocks past the edge), point size, light colour, centre optical depth and coverage.
 """
 from __future__ import annotations
 
@@ -14,43 +14,55 @@ from atmos.plugins.shading.reference import trilinear
 CULLED = np.array([0.0, 0.0, 2.0, 1.0])
 
 
-def group_cells(group) -> np.ndarray:
-    """The static vertex buffer: local (x, z) of a group, x-major, (gx·gz, 2) int32."""
+def group_cells(group, level: int = 0) -> np.ndarray:
+    """The block origins (in cells) of one group at ``level``, x-major like gl_VertexID, (n, 2) int32."""
     gx, gz = group
-    return np.stack(np.meshgrid(np.arange(gx), np.arange(gz), indexing="ij"), -1).reshape(-1, 2).astype(np.int32)
+    step = 1 << level
+    return np.stack(np.meshgrid(np.arange(0, gx, step), np.arange(0, gz, step), indexing="ij"),
+                    -1).reshape(-1, 2).astype(np.int32)
 
 
 def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, uniforms: dict, view_proj,
                     sun_color, ambient) -> dict:
-    """Arrays over (instances × vertices): ``position`` (n, 4), ``size``, ``light`` (n, 3), ``tau``,
-    ``coverage``, ``visible``. ``trans_a``/``trans_b`` None: no shading (T = 1)."""
+    """Arrays over the vertices of every segment (gi, j, gk, level), in order: ``position`` (n, 4),
+    ``size``, ``light`` (n, 3), ``tau``, ``coverage``, ``visible``. ``trans_a``/``trans_b`` None: no
+    shading (T = 1)."""
     u = uniforms
     shape = np.array(u["volume_shape"])
     gx, gz = u["group_size"]
-    local = group_cells((gx, gz))
     seg = np.asarray(segments, np.int64)
-    cells = np.stack([seg[:, None, 0] * gx + local[None, :, 0], np.broadcast_to(seg[:, None, 1], (len(seg), len(local))),
-                      seg[:, None, 2] * gz + local[None, :, 1]], -1).reshape(-1, 3)
-    inside = (cells < shape).all(-1)
-    c = np.minimum(cells, shape - 1)
-    a = np.asarray(density_a, np.float64)[c[:, 0], c[:, 1], c[:, 2]]
-    b = np.asarray(density_b, np.float64)[c[:, 0], c[:, 1], c[:, 2]]
-    d = a * (1.0 - t) + b * t
-    visible = inside & (d > 0)
+    d_full = np.asarray(density_a, np.float64) * (1.0 - t) + np.asarray(density_b, np.float64) * t
+    padded = np.pad(d_full, [(0, 1 << int(seg[:, 3].max(initial=0)))] * 3)   # cells past the edge are empty
+    cells, sums, spans = [], [], []
+    for gi, j, gk, level in seg:
+        s = 1 << level
+        local = group_cells((gx, gz), level)
+        origin = np.stack([gi * gx + local[:, 0], np.full(len(local), j * s), gk * gz + local[:, 1]], -1)
+        offsets = np.stack(np.meshgrid(*[np.arange(s)] * 3, indexing="ij"), -1).reshape(-1, 3)
+        idx = np.minimum(origin[:, None, :] + offsets[None], np.array(padded.shape) - 1)
+        sums.append(padded[idx[..., 0], idx[..., 1], idx[..., 2]].sum(1))
+        cells.append(origin)
+        spans.append(np.full(len(local), s))
+    c = np.concatenate(cells)
+    total = np.concatenate(sums)
+    s = np.concatenate(spans).astype(np.float64)
+    inside = (c < shape).all(-1)
+    visible = inside & (total > 0)
+    d = total / s ** 3
+    center = c + 0.5 * s[:, None]
     if trans_a is None:
         T = np.ones(len(c))
     else:
-        points = (c + 0.5) / shape * np.array(np.shape(trans_a)) - 0.5
+        points = center / shape * np.array(np.shape(trans_a)) - 0.5
         T = trilinear(np.asarray(trans_a, np.float64), points) * (1 - t) + \
             trilinear(np.asarray(trans_b, np.float64), points) * t
-    world = np.asarray(u["layer_min"]) + (c + 0.5) * np.asarray(u["cell_size"])
+    world = np.asarray(u["layer_min"]) + center * np.asarray(u["cell_size"])
     clip = np.concatenate([world, np.ones((len(c), 1))], 1) @ np.asarray(view_proj, np.float64).T
-    diameter = u["base_diameter"] * (0.5 + 0.5 * np.minimum(d, 1.0))
+    diameter = s * u["base_diameter"] * (0.5 + 0.5 * np.minimum(d, 1.0))
     px = diameter * u["pixel_scale"] / np.maximum(clip[:, 3], 1e-6)
-    out = {"position": np.where(visible[:, None], clip, CULLED),
-           "size": np.where(visible, np.clip(px, 1.0, u["max_point_size"]), 1.0),
-           "light": np.where(visible[:, None], np.outer(T, sun_color) + np.asarray(ambient), 0.0),
-           "tau": np.where(visible, u["tau_scale"] * d / np.maximum(diameter, 1e-30) ** 2, 0.0),
-           "coverage": np.where(visible, np.clip(px, 0.0, 1.0) ** 2, 0.0),
-           "visible": visible}
-    return out
+    return {"position": np.where(visible[:, None], clip, CULLED),
+            "size": np.where(visible, np.clip(px, 1.0, u["max_point_size"]), 1.0),
+            "light": np.where(visible[:, None], np.outer(T, sun_color) + np.asarray(ambient), 0.0),
+            "tau": np.where(visible, u["tau_scale"] * total / np.maximum(diameter, 1e-30) ** 2, 0.0),
+            "coverage": np.where(visible, np.clip(px, 0.0, 1.0) ** 2, 0.0),
+            "visible": visible}

@@ -1,6 +1,13 @@
-"""Which sprite groups a frame draws, and in which order (thesis 6.2, 7.2.1, 7.2.2).
+"""Which sprite groups a frame draws, at which level of detail, and in which order (thesis 6.2,
+7.2.1, 7.2.2).
 
-A *segment* is one group of ``gx × gz`` cells of one height slice: ``(gi, j, gk)``. Culling:
+A *segment* is one group of ``gx × gz`` cells of one height slice: ``(gi, j, gk, 0)``. At level of
+detail ``L`` it is ``(gi, j, gk, L)``: the group's cells in blocks of ``s = 2^L`` per side, slices
+``[j·s, (j+1)·s)``, one sprite per block (``gx/s × gz/s`` sprites). A column's level is the
+largest ``L`` ≤ ``max_level`` whose block still spans at most ``lod_pixels`` pixels at the
+column's centre distance (a cell of ``max(cx, cz)`` spans ``max(cx, cz) · pixel_scale / distance``),
+so far columns draw up to 8^L fewer sprites; off (level 0 everywhere) with ``lod_pixels=None``.
+Culling:
 
 * frustum (7.2.1): a column's padded box (all height slices together) outside one of the 6
   frustum planes culls the whole column;
@@ -8,9 +15,11 @@ A *segment* is one group of ``gx × gz`` cells of one height slice: ``(gi, j, gk
   two interpolated steps): a column whose map [0] is 0 is skipped; otherwise slice ``j`` is skipped
   where its band's map ``[1 + j // band_height]`` is 0.
 
-Order, back to front: columns by distance of their centre from the camera, farthest first; inside
-a column, slices by ``|slice height − camera height|``, farthest first — bottom-up for a camera
-above the layer, top-down below it, and from both ends toward the camera's height inside it.
+Order, back to front: columns by distance of their centre from the camera, farthest first (so
+levels never rise along the order); inside a column, slices (blocks) by ``|centre height − camera
+height|``, farthest first — bottom-up for a camera above the layer, top-down below it, and from
+both ends toward the camera's height inside it. A level-``L`` block is skipped as empty only if
+all its slices are.
 """
 from __future__ import annotations
 
@@ -20,6 +29,9 @@ import numpy as np
 
 from atmos.plugins.cloud_render.frustum import boxes_outside, frustum_planes
 from atmos.plugins.clouds.layout import CloudLayout
+
+
+MAX_LEVEL = 2          # blocks of up to 4³ cells
 
 
 @dataclass
@@ -32,16 +44,39 @@ class SegmentStats:
     segments_frustum_culled: int = 0
     segments_empty: int = 0
     segments_drawn: int = 0
-    sprites: int = 0          # vertices submitted: segments_drawn × group cells
+    sprites: int = 0          # vertices submitted: Σ segments_drawn × sprites per group at its level
+    columns_by_level: tuple = (0,)   # columns drawn (not culled) at level 0, 1, ...
 
     def as_dict(self) -> dict:
         return {f.name: getattr(self, f.name) for f in fields(self)}
 
 
-def select_segments(layout: CloudLayout, camera_pos, view_proj=None, max_maps=None,
-                    band_height: int = 1) -> tuple[np.ndarray, SegmentStats]:
-    """(segments int32 (n, 3) as (gi, j, gk) in draw order, stats). ``view_proj=None``: no frustum
-    culling; ``max_maps=None``: no empty-space skipping."""
+def max_level(group, shape_y: int, limit: int = MAX_LEVEL) -> int:
+    """The deepest level of detail a group size allows: 2^L must divide gx, gz and the layer's height."""
+    level = 0
+    while level < limit and all(n % (2 << level) == 0 for n in (*group, shape_y)):
+        level += 1
+    return level
+
+
+def column_levels(distance, cell_px: float, lod_pixels: float | None, top: int) -> np.ndarray:
+    """Level per column: the largest L ≤ ``top`` with ``2^L · cell_px / distance ≤ lod_pixels``."""
+    distance = np.asarray(distance, np.float64)
+    if lod_pixels is None or top == 0:
+        return np.zeros(distance.shape, np.int32)
+    span = cell_px / np.maximum(distance, 1e-30)               # pixels one cell spans there
+    with np.errstate(divide="ignore"):
+        level = np.floor(np.log2(lod_pixels / span))
+    return np.clip(level, 0, top).astype(np.int32)
+
+
+def select_segments(layout: CloudLayout, camera_pos, view_proj=None, max_maps=None, band_height: int = 1,
+                    lod_pixels: float | None = None, pixel_scale: float = 0.0,
+                    top_level: int = MAX_LEVEL) -> tuple[np.ndarray, SegmentStats]:
+    """(segments int32 (n, 4) as (gi, j, gk, level) in draw order, stats). ``view_proj=None``: no
+    frustum culling; ``max_maps=None``: no empty-space skipping; ``lod_pixels=None``: level 0 only
+    (else ``pixel_scale`` is the target's pixels per world unit at distance 1, and levels go up to
+    ``min(top_level, max_level(group, ny))``)."""
     gx, gz = layout.grid
     ny = layout.shape[1]
     cam = np.asarray(camera_pos, np.float64)
@@ -66,10 +101,24 @@ def select_segments(layout: CloudLayout, camera_pos, view_proj=None, max_maps=No
         stats.segments_empty = stats.columns_empty * ny + int((keep[..., None] & ~slice_ok).sum())
     cols = np.argwhere(keep)                                       # (C, 2) as (gi, gk)
     centers = (lo[cols[:, 0], cols[:, 1]] + hi[cols[:, 0], cols[:, 1]]) / 2
-    cols = cols[np.argsort(-np.linalg.norm(centers - cam, axis=1), kind="stable")]
-    slices = np.argsort(-np.abs(layout.slice_heights() - cam[1]), kind="stable")
-    ci, si = np.nonzero(slice_ok[cols[:, 0], cols[:, 1]][:, slices])
-    segments = np.stack([cols[ci, 0], slices[si], cols[ci, 1]], -1).astype(np.int32)
+    distance = np.linalg.norm(centers - cam, axis=1)
+    order = np.argsort(-distance, kind="stable")
+    cols, distance = cols[order], distance[order]
+    top = min(top_level, max_level(layout.group, ny))
+    levels = column_levels(distance, max(layout.cell[0], layout.cell[2]) * pixel_scale, lod_pixels, top)
+    stats.columns_by_level = tuple(int((levels == L).sum()) for L in range(top + 1))
+    parts = []
+    for level in range(top, -1, -1):                               # levels fall along the order
+        mine = cols[levels == level]
+        s = 1 << level
+        blocks = -(-ny // s)
+        ok = slice_ok[mine[:, 0], mine[:, 1]]
+        ok = np.pad(ok, ((0, 0), (0, blocks * s - ny))).reshape(len(mine), blocks, s).any(-1)
+        heights = layout.base + (np.arange(blocks) * s + 0.5 * s) * layout.cell[1]
+        slices = np.argsort(-np.abs(heights - cam[1]), kind="stable")
+        ci, si = np.nonzero(ok[:, slices])
+        parts.append(np.stack([mine[ci, 0], slices[si], mine[ci, 1], np.full(len(ci), level)], -1))
+        stats.sprites += len(ci) * (layout.group[0] // s) * (layout.group[1] // s)
+    segments = np.concatenate(parts).astype(np.int32)
     stats.segments_drawn = len(segments)
-    stats.sprites = len(segments) * layout.group[0] * layout.group[1]
     return segments, stats
