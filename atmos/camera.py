@@ -96,14 +96,38 @@ def fly_camera(app, speed: float = 20.0, turn: float = 0.004) -> None:
     cam.pitch = float(np.clip(cam.pitch, -1.55, 1.55))
 
 
+def view_basis(camera: Camera, aspect: float) -> np.ndarray:
+    """3×3 matrix M with ``M @ (ndc_x, ndc_y, 1)`` along the view ray through that point of the screen:
+    columns right·tan(fov_x/2), up·tan(fov_y/2), forward (so the ray's forward component is 1: the
+    point at view depth z is ``camera.position + z · ray``). The same rays as unprojecting with the
+    inverse view-projection, but independent of the near and far planes (unprojecting in float32
+    breaks down at far/near ~ 1e11). The ``view_basis`` uniform of ``lib/view_ray.glsl``."""
+    f, r = camera.forward(), camera.right()
+    ty = math.tan(0.5 * camera.fov_y)
+    return np.column_stack([r * ty * max(aspect, 1e-6), np.cross(r, f) * ty, f])
+
+
+def gl_matrix3(m: np.ndarray) -> bytes:
+    """A 3×3 numpy matrix as the column-major float32 bytes a GLSL mat3 uniform expects."""
+    return np.asarray(m, np.float32).T.tobytes()
+
+
 def set_camera_uniforms(program, camera: Camera, aspect: float) -> None:
-    """Write ``view_proj``, ``inv_view_proj``, ``camera_pos``, ``near``, ``far`` where the program has them."""
-    vp = camera.view_projection(aspect)
-    values = {"view_proj": gl_matrix(vp), "inv_view_proj": gl_matrix(np.linalg.inv(vp))}
-    for name, data in values.items():
-        if name in program:
-            program[name].write(data)
-    for name, value in (("camera_pos", tuple(camera.position)), ("near", camera.near), ("far", camera.far)):
+    """Write the camera uniforms ``program`` has (the compiler drops unused ones): ``view_proj``,
+    ``inv_view_proj``, ``view_basis`` (:func:`view_basis`), ``camera_pos``, ``near``, ``far``.
+
+    ``view_basis``, ``camera_pos``, ``near`` and ``far`` are what ``lib/view_ray.glsl`` needs for
+    view rays and distances from depth at any far/near ratio; prefer them to ``inv_view_proj``."""
+    if "view_proj" in program or "inv_view_proj" in program:
+        vp = camera.view_projection(aspect)
+        if "view_proj" in program:
+            program["view_proj"].write(gl_matrix(vp))
+        if "inv_view_proj" in program:
+            program["inv_view_proj"].write(gl_matrix(np.linalg.inv(vp)))
+    if "view_basis" in program:
+        program["view_basis"].write(gl_matrix3(view_basis(camera, aspect)))
+    for name, value in (("camera_pos", tuple(float(c) for c in camera.position)), ("near", float(camera.near)),
+                        ("far", float(camera.far))):
         if name in program:
             program[name].value = value
 

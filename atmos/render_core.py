@@ -1,4 +1,31 @@
-"""The passes every rendered scene has: clear (creates the HDR colour and depth) and present (to the screen)."""
+"""The passes every rendered scene has: clear (creates the HDR colour and depth) and present (to the screen).
+
+The ``color`` target's alpha: how much each pixel is occluded from the sky
+-------------------------------------------------------------------------
+``color.rgb`` is linear HDR radiance; ``color.a`` is how much of the pixel hides the sky behind it:
+**0 = open sky, 1 = opaque geometry or opaque cloud** (in between: partly covered, e.g. a cloud edge).
+Every pass that writes ``color`` keeps to it; the light shafts' occlusion mask reads it
+(:class:`atmos.plugins.light_shafts.LightShaftParams`), so bright sunlit clouds over the sky cut the
+shafts instead of casting them.
+
+- The clear pass clears alpha to 0 (nothing drawn is open sky); the sky passes (``sky``,
+  ``sky_gradient``) write alpha 0.
+- Opaque geometry (``ground``, ``terrain``, the clouds' top view) writes alpha 1 (blending off).
+- Layers that cover the sky blend premultiplied ``(light, coverage a)`` with (ONE, ONE_MINUS_SRC_ALPHA)
+  on colour *and* alpha (:meth:`PassContext.blend_over`): ``alpha = a + (1 − a) · alpha``. The cloud
+  sprites and the reference march (``cloud_render``), the 2D cloud layer (``sky_layer``) and the test
+  volume do so.
+- Participating media in the air between the camera and everything (``fog``, ``volumetric_fog``)
+  blend ``(light, transmittance)`` with (ONE, SRC_ALPHA) on colour and keep alpha
+  (:meth:`PassContext.blend_transmittance`): fog is not an occluder. The sky seen through it stays
+  sky; what the fog does to it (dimmed toward the fog colour) is in the colour, which the shaft mask
+  thresholds, so the sun seen through thin fog still casts (dimmed) shafts and a uniformly fogged
+  sky only glows.
+- Passes that modulate surfaces (``cloud_shadows``: colour × factor) or add light (the light shafts'
+  composite) keep alpha.
+- ``present`` writes alpha 1 to the screen whatever ``color.a`` is; the frame-time overlay blended
+  onto the screen keeps it 1.
+"""
 from __future__ import annotations
 
 import numpy as np
@@ -20,7 +47,8 @@ def depth_desc(gpu) -> TextureDesc:
 
 
 class ClearPass(RenderPass):
-    """Creates the scene's HDR ``color`` and ``depth`` textures and clears them."""
+    """Creates the scene's HDR ``color`` and ``depth`` textures and clears them: colour to
+    ``(*color, 0)`` (alpha 0: open sky, see the module docstring), depth to 1."""
     name = "clear"
 
     def __init__(self, gpu, color=(0.0, 0.0, 0.0)):
@@ -34,11 +62,12 @@ class ClearPass(RenderPass):
     def execute(self, frame: PassContext) -> None:
         fbo = frame.framebuffer(color=[COLOR], depth=DEPTH)
         fbo.use()
-        fbo.clear(*self.color, 1.0, depth=1.0)
+        fbo.clear(*self.color, 0.0, depth=1.0)
 
 
 class PresentPass(FullscreenPass):
-    """Tone-maps the HDR ``color`` into the screen (window or offscreen target), with sRGB gamma."""
+    """Tone-maps the HDR ``color`` into the screen (window or offscreen target), with sRGB gamma;
+    the screen's alpha is 1 (``color.a``, the sky occlusion, is not shown)."""
     name = "present"
     fragment = "core/present.frag"
     reads = (COLOR,)

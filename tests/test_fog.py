@@ -185,13 +185,16 @@ class KnownScene(RenderPass):
         frame.texture(DEPTH).write(self.depth.astype(np.float32).tobytes())
 
 
-@pytest.mark.parametrize("mode,noise,sky", [("exp", "texture", "fog"), ("hetero_exp2", "procedural", "keep"),
-                                            ("hetero_exp", "texture", "fog")])
-def test_fog_pass_on_a_known_depth_buffer_matches_reference(rng, mode, noise, sky):
+@pytest.mark.parametrize("mode,noise,sky,planes", [("exp", "texture", "fog", (0.5, 200.0)),
+                                                   ("hetero_exp2", "procedural", "keep", (0.5, 200.0)),
+                                                   ("hetero_exp", "texture", "fog", (0.5, 200.0)),
+                                                   ("hetero_exp", "procedural", "fog", (0.1, 1e10))])
+def test_fog_pass_on_a_known_depth_buffer_matches_reference(rng, mode, noise, sky, planes):
     w, h = 48, 27
     gpu = create_headless((w, h))
     try:
-        cam = Camera(position=np.array([3.0, 8.0, 40.0]), near=0.5, far=200.0).look_at((0.0, 2.0, 0.0))
+        near, far = planes
+        cam = Camera(position=np.array([3.0, 8.0, 40.0]), near=near, far=far).look_at((0.0, 2.0, 0.0))
         color = np.dstack([rng.random((h, w, 3)), np.ones((h, w))])
         view_depth = rng.uniform(1.0, 150.0, (h, w))
         proj = cam.projection(w / h)

@@ -9,11 +9,15 @@ from atmos.camera import Camera
 from atmos.defaults import DefaultPlugins
 from atmos.gpu import create_headless
 from atmos.lighting import Sun
+from atmos.graph import PassBuilder, RenderPass
 from atmos.plugins.ground import GroundPlugin
 from atmos.plugins.light_shafts import LightShaftParams, LightShaftsPlugin, blur_uniforms, reference, screen_sun
+from atmos.plugins.light_shafts.plugin import MASK
+from atmos.plugins.sky import SkyPlugin
 from atmos.plugins.sky_gradient import SkyGradientPlugin
+from atmos.plugins.terrain import TerrainPlugin
 from atmos.plugins.test_volume import TestVolumePlugin, VolumeBox
-from atmos.render_core import CapturePass
+from atmos.render_core import COLOR, CapturePass
 from test_cloud_shadows import FillPass, pass_plugin, save_png
 
 
@@ -107,6 +111,8 @@ def test_pass_matches_reference_on_random_frames(gpu, ctx, rng):
     sun_uv = rng.uniform(0.1, 0.9, 2)
     app.insert_resource(Sun(sun_toward(cam, size, sun_uv)))
     color = rng.uniform(0.0, 3.0, (h, w, 4))
+    pick = rng.random((h, w))           # alpha (sky occlusion): open sky, opaque, partial, out of range
+    color[..., 3] = np.where(pick < 0.3, 0.0, np.where(pick < 0.45, 1.0, rng.uniform(-0.3, 1.3, (h, w))))
     depth = np.where(rng.random((h, w)) < 0.5, 1.0, rng.uniform(0.5, 0.99, (h, w)))
     fill.color, fill.depth = color, depth
     app.graph.execute(app=app)
@@ -121,6 +127,139 @@ def test_pass_matches_reference_on_random_frames(gpu, ctx, rng):
     assert np.allclose(probe.color[..., :3], before[..., :3] + shafts, rtol=3e-3, atol=1e-3)
     assert np.array_equal(probe.color[..., 3], before[..., 3])
     assert shafts.max() > 0.01, "the random frame has shafts to compare"
+    app.close()
+
+
+class BrightLayerPass(RenderPass):
+    """Premultiplied (rgb·a, a) over screen rectangles, blended like the cloud sprites (ONE,
+    ONE_MINUS_SRC_ALPHA on colour and alpha), no depth: a sunlit cloud drawn over the sky."""
+    name = "test_bright_layer"
+
+    def __init__(self, rects):
+        self.rects = rects              # [((x, y, w, h) in pixels, rgb, alpha)]
+        self.program = None
+
+    def setup(self, builder: PassBuilder) -> None:
+        builder.write(COLOR)
+
+    def prepare(self, gpu) -> None:
+        self.program = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="test/solid.frag")
+
+    def execute(self, frame) -> None:
+        ctx = frame.gpu.ctx
+        frame.framebuffer(color=[COLOR]).use()
+        ctx.enable(ctx.BLEND)
+        ctx.blend_func = ctx.ONE, ctx.ONE_MINUS_SRC_ALPHA
+        try:
+            for rect, rgb, alpha in self.rects:
+                ctx.scissor = rect
+                self.program["color"].value = (*(np.asarray(rgb, float) * alpha), alpha)
+                frame.fullscreen(self.program)
+        finally:
+            ctx.scissor = None
+
+
+class CaptureBefore(CapturePass):
+    """The capture, declared a writer of "color" too, so it keeps its place before the shafts."""
+    name = "capture_before_shafts"
+
+    def setup(self, builder: PassBuilder) -> None:
+        super().setup(builder)
+        builder.write(COLOR)
+
+
+class MaskProbe(RenderPass):
+    """Copies the light shafts' occlusion mask (h, w, 4) to numpy."""
+    name = "test_mask_probe"
+
+    def __init__(self):
+        self.mask = None
+
+    def setup(self, builder: PassBuilder) -> None:
+        builder.read(MASK)
+        builder.side_effect()
+
+    def execute(self, frame) -> None:
+        tex = frame.texture(MASK)
+        w, h = tex.size
+        self.mask = np.frombuffer(tex.read(), np.float16).reshape(h, w, 4).astype(np.float64)
+
+
+def test_bright_cloud_over_the_sky_cuts_the_mask_through_alpha(gpu, ctx):
+    """A layer brighter than the sun's glow, drawn over the sky next to the sun: the old rule (bright
+    sky pixels are sky) kept it in the mask; with color.a (sky occlusion) it is cut, partly where
+    it is partly transparent, and the open sky around it still casts."""
+    w, h = gpu.size
+    params = LightShaftParams(downsample=1, threshold=0.6, ceiling=3.0, radius=0.6)
+    opaque = ((int(0.55 * w), int(0.45 * h), int(0.15 * w), int(0.25 * h)), (6.0, 5.5, 5.0), 1.0)
+    half = ((int(0.25 * w), int(0.45 * h), int(0.15 * w), int(0.25 * h)), (6.0, 5.5, 5.0), 0.5)
+    before, probe = CaptureBefore(), MaskProbe()
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(),
+                               pass_plugin(BrightLayerPass([opaque, half])), pass_plugin(before),
+                               LightShaftsPlugin(params), pass_plugin(probe))
+    app.startup()
+    cam = app.resource(Camera)
+    cam.position = np.array([0.0, 2.0, 0.0])
+    cam.yaw, cam.pitch = 0.3, 0.25
+    sun_uv = (0.5, 0.55)
+    app.insert_resource(Sun(sun_toward(cam, gpu.size, sun_uv)))
+    app.graph.execute(app=app)
+    assert ctx.error == "GL_NO_ERROR"
+    color, depth = before.color, before.depth
+    where = screen_sun(cam, w / h, app.resource(Sun).direction, params)
+    assert np.allclose(where.uv, sun_uv, atol=1e-9)
+
+    def inside(rect):
+        (x, y, rw, rh), _, _ = rect
+        return (slice(y + 1, y + rh - 1), slice(x + 1, x + rw - 1))
+
+    # the convention after the sky and ground passes and the layer: sky 0, ground 1, layer its coverage
+    sky = depth >= 1.0
+    layer = np.zeros((h, w), bool)
+    for rect in (opaque, half):
+        (x, y, rw, rh), _, _ = rect
+        layer[y:y + rh, x:x + rw] = True
+    assert sky.mean() > 0.3 and (~sky).mean() > 0.1
+    assert np.all(color[sky & ~layer, 3] == 0.0) and np.all(color[~sky & ~layer, 3] == 1.0)
+    assert np.all(color[inside(opaque)][..., 3] == 1.0)
+    assert np.allclose(color[inside(half)][..., 3][sky[inside(half)]], 0.5, atol=1e-3)
+
+    want = reference.occlusion_mask(color, depth, where.uv, params)
+    luminance_only = reference.occlusion_mask(np.concatenate([color[..., :3], np.zeros((h, w, 1))], -1), depth,
+                                              where.uv, params)
+    got = probe.mask[..., :3]
+    assert np.isfinite(got).all() and np.all(probe.mask[..., 3] == 0.0)
+    assert np.allclose(got, want, rtol=3e-3, atol=1e-3), np.abs(got - want).max()
+    assert luminance_only[inside(opaque)].min() > 0.2, "the old rule would have kept the bright layer as sky"
+    assert got[inside(opaque)].max() == 0.0, "the opaque layer is cut from the mask"
+    kept = luminance_only[inside(half)].sum(-1)
+    assert np.allclose(got[inside(half)].sum(-1), 0.5 * kept, rtol=5e-3, atol=1e-3)
+    open_near_sun = sky & ~layer & (reference.pixel_uv(w, h)[..., 0] < 0.55) & (reference.pixel_uv(w, h)[..., 1] > 0.7)
+    assert got[open_near_sun].max() > 0.05, "the open sky next to the layer still casts shafts"
+    app.close()
+
+
+@pytest.mark.parametrize("scene", ["clear", "sky_gradient+ground", "sky+terrain"])
+def test_colour_alpha_is_the_sky_occlusion_and_the_screen_alpha_is_one(gpu, ctx, scene):
+    """color.a (atmos.render_core): 0 on the open sky (or nothing drawn), 1 on opaque geometry; the
+    screen gets alpha 1 from present."""
+    drawn = {"clear": [], "sky_gradient+ground": [SkyGradientPlugin(), GroundPlugin()],
+             "sky+terrain": [SkyPlugin(), TerrainPlugin()]}[scene]
+    probe = CapturePass()
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), *drawn, pass_plugin(probe))
+    app.startup()
+    cam = app.resource(Camera)
+    cam.position = np.array([0.0, 30.0, 0.0])
+    cam.yaw, cam.pitch = 0.4, -0.05
+    app.insert_resource(Sun(np.array([0.3, 0.4, -1.0])))
+    app.graph.execute(app=app)
+    sky = probe.depth >= 1.0
+    assert np.all(probe.color[sky, 3] == 0.0) and np.all(probe.color[~sky, 3] == 1.0)
+    if scene != "clear":
+        assert 0.1 < sky.mean() < 0.9
+    w, h = gpu.size
+    screen = np.frombuffer(gpu.target.read(viewport=(0, 0, w, h), components=4, alignment=1), np.uint8)
+    assert np.all(screen.reshape(h, w, 4)[..., 3] == 255)
     app.close()
 
 

@@ -96,10 +96,20 @@ class PassContext:
 
     def blend_transmittance(self) -> None:
         """Blend a participating medium's (in-scattered light, transmittance T) over the colour:
-        rgb = light + T · rgb, alpha kept. What fog, clouds and volumes output."""
+        rgb = light + T · rgb, alpha kept: the medium does not occlude the sky (``color.a``, see
+        :mod:`atmos.render_core`). What the fog passes output."""
         ctx = self.gpu.ctx
         ctx.enable(moderngl.BLEND)
         ctx.blend_func = moderngl.ONE, moderngl.SRC_ALPHA, moderngl.ZERO, moderngl.ONE
+
+    def blend_over(self) -> None:
+        """Blend a premultiplied layer (light, coverage a = 1 − T) over the colour, (ONE, ONE_MINUS_SRC_ALPHA)
+        on colour and alpha: rgb = light + (1 − a) · rgb and alpha = a + (1 − a) · alpha, so the layer
+        adds its coverage to the sky occlusion in ``color.a`` (see :mod:`atmos.render_core`). What
+        clouds and cloud layers output."""
+        ctx = self.gpu.ctx
+        ctx.enable(moderngl.BLEND)
+        ctx.blend_func = (moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA, moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA)
 
     def _end_frame(self) -> None:
         self.pass_name = ""

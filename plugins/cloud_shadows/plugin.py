@@ -38,7 +38,7 @@ class CloudShadowsPass(FullscreenPass):
         frame.framebuffer(color=[COLOR]).use()
         ctx = gpu.ctx
         ctx.enable(ctx.BLEND)
-        ctx.blend_func = ctx.ZERO, ctx.SRC_COLOR
+        ctx.blend_func = ctx.ZERO, ctx.SRC_COLOR, ctx.ZERO, ctx.ONE    # alpha (sky occlusion) kept
         sim.maps_of(a).sums.use(0)
         sim.maps_of(b).sums.use(1)
         frame.texture(DEPTH).use(2)

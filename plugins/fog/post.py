@@ -51,7 +51,11 @@ def set_fog_uniforms(prog, settings, time: float) -> None:
 
 
 def draw_state(ctx) -> None:
-    """No depth test; blend (ONE, SRC_ALPHA) on colour: target = rgb + a * target; alpha kept."""
+    """No depth test; blend (ONE, SRC_ALPHA) on colour: target = rgb + a * target; alpha kept.
+
+    ``color.a`` is the sky occlusion (:mod:`atmos.render_core`); fog is a medium, not an occluder, so
+    a fogged sky (``sky="fog"``) is still sky there: the light shafts see it by its colour, which the
+    fog has already pulled toward the fog colour (only what stays brighter than their threshold casts)."""
     ctx.disable(ctx.DEPTH_TEST)
     ctx.enable(ctx.BLEND)
     ctx.blend_func = ctx.ONE, ctx.SRC_ALPHA, ctx.ZERO, ctx.ONE

@@ -1,5 +1,6 @@
 """Light shafts near the sun (thesis 7.3.2) as a screen-space effect: an occlusion mask of the bright
-sky near the sun (clouds and geometry cut it), blurred radially toward the sun and added on.
+open sky near the sun (clouds and geometry cut it through the colour target's alpha, the sky
+occlusion of :mod:`atmos.render_core`), blurred radially toward the sun and added on.
 
 ``LightShaftsPlugin`` adds the "light_shafts" pass; ``LightShaftParams`` its settings;
 ``screen_sun`` where the sun is on screen and the fades; ``reference`` numpy float64 mask and blur.

@@ -15,9 +15,12 @@ class LightShaftParams:
     """Occlusion mask, radial blur toward the sun (GPU Gems 3, ch. 13) and when the effect shows.
 
     Mask: sky pixels (depth 1) whose luminance exceeds ``threshold`` (linear HDR) keep the excess,
-    at most ``ceiling`` (so the sun disc does not outshine the sky around it), in their own colour, times ``exp(−(r/radius)²)``, r the distance from the sun's screen position
-    in screen heights: only the sky near the sun casts shafts (thesis 7.3.2). Clouds drawn over the
-    sky darken it there, so they cut the shafts.
+    at most ``ceiling`` (so the sun disc does not outshine the sky around it), in their own colour,
+    times how open to the sky they are, ``1 − color.a``, times ``exp(−(r/radius)²)``, r the distance
+    from the sun's screen position in screen heights: only the open sky near the sun casts shafts
+    (thesis 7.3.2). ``color.a`` is the sky occlusion every pass keeps (:mod:`atmos.render_core`):
+    0 on open sky, 1 on opaque geometry or cloud, the coverage on cloud edges. So clouds drawn over
+    the sky cut the shafts however brightly the sun lights them; fog tints the sky but keeps it sky.
     Blur, per pixel: ``samples`` taps on the way to the sun covering ``density`` of it; tap i
     (1-based) weighs ``weight · decay^(i−1)``; the sum times ``exposure`` is added to the colour.
     ``downsample``: mask and blur at 1/downsample of the frame size (read when the render graph

@@ -26,7 +26,8 @@ def blur_uniforms(program, sun_uv, params: LightShaftParams, strength: float) ->
 
 
 class LightShaftsPass(RenderPass):
-    """Mask (reads "color", "depth") → radial blur → added onto "color" (blend ONE, ONE).
+    """Mask (reads "color" with its alpha, the sky occlusion, and "depth") → radial blur → added onto
+    "color" (blend ONE, ONE; alpha kept).
 
     The mask and the blur are transients at 1/``downsample`` of the frame; "color" is only sampled
     while the mask is drawn and only written by the last draw, so it is never read and written at once.

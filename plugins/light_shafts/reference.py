@@ -19,11 +19,15 @@ def pixel_uv(w: int, h: int) -> np.ndarray:
 
 def occlusion_mask(color, depth, sun_uv, params) -> np.ndarray:
     """(h, w, 3): the sky (depth >= 1) brighter than ``threshold``, by its excess luminance (at most
-    ``ceiling``), near the sun."""
-    c = np.maximum(np.asarray(color, np.float64)[..., :3], 0.0)
+    ``ceiling``) times how open to the sky it is, ``1 − clip(color.a, 0, 1)`` (``color.a``: the sky
+    occlusion of :mod:`atmos.render_core`), near the sun. ``color``: (h, w, 4) RGBA."""
+    color = np.asarray(color, np.float64)
+    if color.ndim != 3 or color.shape[-1] != 4:
+        raise ValueError(f"occlusion_mask needs (h, w, 4) RGBA colour (alpha: sky occlusion), got shape {color.shape}")
+    c = np.maximum(color[..., :3], 0.0)
     h, w = c.shape[:2]
     lum = c @ LUMA
-    excess = np.clip(lum - params.threshold, 0.0, params.ceiling)
+    excess = np.clip(lum - params.threshold, 0.0, params.ceiling) * (1.0 - np.clip(color[..., 3], 0.0, 1.0))
     bright = c * (excess / np.maximum(lum, 1e-4))[..., None]
     r = np.linalg.norm((pixel_uv(w, h) - np.asarray(sun_uv)) * np.array([w / h, 1.0]), axis=-1)
     near = np.exp(-(r / params.radius) ** 2)

@@ -68,6 +68,8 @@ class OverlayPass(RenderPass):
         self.data.use(0)
         gpu.ctx.viewport = (4, 4, w, h) if gpu.size[0] > w + 8 else (0, 0, w, h)
         gpu.ctx.enable(gpu.ctx.BLEND)
+        # over the screen; its alpha stays what present wrote (1)
+        gpu.ctx.blend_func = gpu.ctx.SRC_ALPHA, gpu.ctx.ONE_MINUS_SRC_ALPHA, gpu.ctx.ZERO, gpu.ctx.ONE
         frame.fullscreen(self.program)
         gpu.ctx.disable(gpu.ctx.BLEND)
         gpu.ctx.viewport = (0, 0, *gpu.size)

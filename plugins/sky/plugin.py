@@ -1,12 +1,12 @@
 """SkyPlugin and its pass: the Preetham sky with sun disc, night and stars as the scene's background."""
 from __future__ import annotations
 
-from atmos.camera import Camera
+from atmos.camera import Camera, set_camera_uniforms
 from atmos.graph import FullscreenPass, PassContext
 from atmos.lighting import scene_sun, sun_and_day
 from atmos.plugin import Plugin
 from atmos.plugins.sky.params import SkyParams
-from atmos.plugins.sky.shader import set_sky_uniforms, set_view_basis, sky_defines
+from atmos.plugins.sky.shader import set_sky_uniforms, sky_defines
 from atmos.render_core import COLOR
 
 
@@ -22,7 +22,7 @@ class SkyPass(FullscreenPass):
         app, gpu, p = frame.data["app"], frame.gpu, self.program
         frame.framebuffer(color=[COLOR]).use()
         camera = app.resource(Camera)
-        set_view_basis(p, camera, gpu.size[0] / gpu.size[1])
+        set_camera_uniforms(p, camera, gpu.size[0] / gpu.size[1])      # view_basis
         sun = scene_sun(app)
         s, _ = sun_and_day(sun)
         set_sky_uniforms(p, self.plugin.params, s, sun.color, app.clock.frame_time,

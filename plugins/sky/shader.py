@@ -5,6 +5,7 @@ import math
 
 import numpy as np
 
+from atmos.camera import gl_matrix3, view_basis
 from atmos.plugins.sky import reference as ref, stars
 from atmos.plugins.sky.params import SkyParams
 from atmos.plugins.sky.preetham import COS_FLOOR, unit_vectors
@@ -23,18 +24,9 @@ def sky_defines() -> dict:
             "TWINKLE_CYCLES_HI": stars.TWINKLE_CYCLES[1]}
 
 
-def view_basis(camera, aspect: float) -> np.ndarray:
-    """3×3 matrix M with ``M @ (ndc_x, ndc_y, 1)`` along the view ray through that point of the screen:
-    columns right·tan(fov_x/2), up·tan(fov_y/2), forward. The same rays as unprojecting with the inverse
-    view-projection, but independent of the near and far planes (that breaks down at far/near ~ 1e11)."""
-    f, r = camera.forward(), camera.right()
-    ty = math.tan(0.5 * camera.fov_y)
-    return np.column_stack([r * ty * max(aspect, 1e-6), np.cross(r, f) * ty, f])
-
-
 def set_view_basis(program, camera, aspect: float) -> None:
-    """Write the ``view_basis`` uniform of ``sky/sky.frag``."""
-    program["view_basis"].write(np.asarray(view_basis(camera, aspect), np.float32).T.tobytes())
+    """Write the ``view_basis`` uniform of ``sky/sky.frag`` (:func:`atmos.camera.view_basis`)."""
+    program["view_basis"].write(gl_matrix3(view_basis(camera, aspect)))
 
 
 def set_sky_uniforms(program, params: SkyParams, sun_dir, sun_color, time: float = 0.0,

@@ -24,7 +24,8 @@ def scroll_offsets(wind, time: float) -> np.ndarray:
 
 
 class SkyLayerPass(FullscreenPass):
-    """Reads ``depth``; blends the clouds over ``color`` (ONE, SRC_ALPHA) where depth is 1."""
+    """Reads ``depth``; blends the clouds over ``color`` where depth is 1, premultiplied (ONE,
+    ONE_MINUS_SRC_ALPHA on colour and alpha), so ``color.a`` gains their cover of the sky."""
     name = "sky_layer"
     fragment = "sky_layer/layer.frag"
     reads = (DEPTH,)
@@ -40,7 +41,7 @@ class SkyLayerPass(FullscreenPass):
         if plugin.octaves.needs_bake(params, s, plugin.rebake_tolerance):
             plugin.octaves.bake(params, s)
         frame.framebuffer(color=[COLOR]).use()
-        frame.blend_transmittance()
+        frame.blend_over()
         plugin.octaves.use(0)
         frame.texture(DEPTH).use(4)
         set_camera_uniforms(p, app.resource(Camera), gpu.size[0] / gpu.size[1])

@@ -49,10 +49,10 @@ def remap(fbm_value, emptiness: float, sharpness: float) -> np.ndarray:
 
 
 def shade(fbm_rgba, params, light, fade=1.0) -> np.ndarray:
-    """Premultiplied (rgb·α, 1 − α) of fbm samples (..., 4), as ``sky_layer_shade`` in GLSL."""
+    """Premultiplied (rgb·α, α) of fbm samples (..., 4), as ``sky_layer_shade`` in GLSL (α: coverage)."""
     d = remap(fbm_rgba, params.emptiness, params.sharpness)
     amount = (np.maximum(d - RAY, 0.0) * 0.25).sum(-1)
     alpha = np.clip(params.thickness * amount, 0.0, 1.0) * np.asarray(fade, np.float64)
     lit, color = np.asarray(params.lit_color), np.asarray(params.color)
     rgb = (lit + (color - lit) * amount[..., None]) * np.asarray(light, np.float64)
-    return np.concatenate([rgb * alpha[..., None], (1.0 - alpha)[..., None]], axis=-1)
+    return np.concatenate([rgb * alpha[..., None], alpha[..., None]], axis=-1)

@@ -67,7 +67,8 @@ class TestVolumePlugin(Plugin):
 
 
 class TestVolumePass(FullscreenPass):
-    """Ray-marches mix(A, B, t) inside the box, occluded by scene depth, blended over the colour."""
+    """Ray-marches mix(A, B, t) inside the box, occluded by scene depth, blended over the colour
+    premultiplied (:meth:`PassContext.blend_over`): it covers the sky like a cloud."""
     name = "test_volume"
     fragment = "test_volume/march.frag"
     reads = (DEPTH,)
@@ -79,7 +80,7 @@ class TestVolumePass(FullscreenPass):
         app, gpu, p = frame.data["app"], frame.gpu, self.program
         a, b, t = self.plugin.job.view()
         frame.framebuffer(color=[COLOR]).use()
-        frame.blend_transmittance()
+        frame.blend_over()
         a["density"].use(0)
         b["density"].use(1)
         frame.texture(DEPTH).use(2)

@@ -34,7 +34,8 @@ def set_medium_uniforms(program, params: FogParams, sun: Sun, time: float) -> No
 
 
 class VolumetricFogPass(FullscreenPass):
-    """Reads ``depth``, blends (in-scattered light, transmittance) over ``color`` with ONE, SRC_ALPHA."""
+    """Reads ``depth``, blends (in-scattered light, transmittance) over ``color`` with ONE, SRC_ALPHA;
+    alpha (the sky occlusion of :mod:`atmos.render_core`) kept: the medium tints the sky, it does not hide it."""
     name = "volumetric_fog"
     fragment = "volumetric_fog/fog.frag"
     reads = (DEPTH,)

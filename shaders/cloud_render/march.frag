@@ -7,16 +7,18 @@
 in vec2 v_uv;
 out vec4 frag;
 layout(binding = 5) uniform sampler2D scene_depth;
-uniform mat4 inv_view_proj;
+uniform mat3 view_basis;       // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
 uniform vec3 camera_pos;
+uniform float near;
+uniform float far;
 uniform vec3 layer_min;
 uniform vec3 layer_max;
 uniform vec3 cell_size;
 uniform float sigma;
 
 void main() {
-    vec3 dir = view_ray_dir(v_uv, inv_view_proj, camera_pos);
-    float scene = view_ray_distance(v_uv, texture(scene_depth, v_uv).r, inv_view_proj, camera_pos, 1e30);
+    vec3 dir = view_ray_dir(v_uv, view_basis);
+    float scene = view_ray_distance(v_uv, texture(scene_depth, v_uv).r, view_basis, near, far, 1e30);
     vec3 safe = mix(dir, vec3(1e-12), lessThan(abs(dir), vec3(1e-12)));
     vec3 t0 = (layer_min - camera_pos) / safe, t1 = (layer_max - camera_pos) / safe;
     float enter = max(max(max(min(t0.x, t1.x), min(t0.y, t1.y)), min(t0.z, t1.z)), 0.0);

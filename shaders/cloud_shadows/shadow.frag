@@ -8,8 +8,10 @@ out vec4 frag;
 layout(binding = 0) uniform sampler2DArray sums_a;
 layout(binding = 1) uniform sampler2DArray sums_b;
 layout(binding = 2) uniform sampler2D scene_depth;
-uniform mat4 inv_view_proj;
+uniform mat3 view_basis;       // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
 uniform vec3 camera_pos;
+uniform float near;
+uniform float far;
 uniform vec3 sun_dir;          // unit, toward the sun
 uniform float weight;          // direct_fraction × horizon fade (reference.direct_weight)
 uniform float extinction;      // sigma × strength, per cell of summed density
@@ -43,8 +45,7 @@ void main() {
         return;
     }
     vec2 uv = gl_FragCoord.xy / vec2(textureSize(scene_depth, 0));
-    vec3 p = camera_pos + view_ray_dir(uv, inv_view_proj, camera_pos)
-                        * view_ray_distance(uv, depth, inv_view_proj, camera_pos, 0.0);
+    vec3 p = camera_pos + view_ray(uv, view_basis) * view_depth(depth, near, far);
     float thickness = float(shape.y) * cell_size.y;
     float run = max(layer_min.y + 0.5 * thickness - p.y, 0.0) / max(sun_dir.y, MIN_SUN_HEIGHT);
     vec3 q = p + run * sun_dir;

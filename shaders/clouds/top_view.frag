@@ -1,6 +1,6 @@
 #version 430
 // Cloud field from above: summed density (layer 0 of the density maps) of A and B mixed by t,
-// drawn as white clouds over a blue sea, letterboxed to a square.
+// drawn as white clouds over a blue sea, letterboxed to a square. Alpha 1: an opaque picture, no sky.
 in vec2 v_uv;
 out vec4 frag;
 layout(binding = 0) uniform sampler2DArray sums_a;

@@ -1,7 +1,7 @@
 #version 430
 // Fog post-process: f from fog/factor.glsl, output premultiplied for blend (ONE, SRC_ALPHA):
 // rgb = (1 - f) * fog_color, a = f, so the target becomes f * C_current + (1 - f) * C_fog, eq. (1).
-// FOG_FROM_DEPTH 1: distance and position from the scene depth and the inverse view-projection;
+// FOG_FROM_DEPTH 1: distance and position from the scene depth and the camera (lib/view_ray.glsl);
 // 0 (apply_fog): from a distance texture (+inf = sky) and a world-position texture.
 in vec2 v_uv;
 out vec4 frag;
@@ -9,9 +9,12 @@ out vec4 frag;
 uniform vec3 fog_color;
 uniform int fog_sky_keep;    // 1: sky pixels are left to the sky
 #if FOG_FROM_DEPTH
+#include "lib/view_ray.glsl"
 layout(binding = 0) uniform sampler2D scene_depth;
-uniform mat4 inv_view_proj;
+uniform mat3 view_basis;     // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
 uniform vec3 camera_pos;
+uniform float near;
+uniform float far;
 #else
 layout(binding = 0) uniform sampler2D fog_distance;
 layout(binding = 1) uniform sampler2D fog_position;
@@ -22,9 +25,10 @@ void main() {
 #if FOG_FROM_DEPTH
     float z = texelFetch(scene_depth, ivec2(gl_FragCoord.xy), 0).r;   // exact texel: no blend across edges
     bool sky = z >= 1.0;
-    vec4 h = inv_view_proj * vec4(v_uv * 2.0 - 1.0, min(z, 1.0) * 2.0 - 1.0, 1.0);
-    vec3 world = h.xyz / h.w;                 // sky: the far-plane point of this pixel
-    float d = length(world - camera_pos);
+    vec3 ray = view_ray(v_uv, view_basis);
+    float view_z = sky ? far : view_depth(z, near, far);
+    vec3 world = camera_pos + ray * view_z;   // sky: the far-plane point of this pixel
+    float d = view_z * length(ray);
 #else
     ivec2 px = ivec2(gl_FragCoord.xy);
     float d = texelFetch(fog_distance, px, 0).r;

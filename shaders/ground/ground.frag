@@ -1,5 +1,6 @@
 #version 430
 // Ground: anti-aliased checker in albedo, Lambert sun light plus sky ambient, distance haze.
+// Alpha 1: opaque, hides the sky (color.a is the sky occlusion, atmos/render_core.py).
 in vec3 v_world;
 out vec4 frag;
 uniform vec3 camera_pos;

@@ -1,10 +1,12 @@
 #version 430
 // The sky pass: a full-screen background of sky/sky.glsl along each pixel's view ray.
+// Alpha 0: open sky (color.a is the sky occlusion, atmos/render_core.py).
 in vec2 v_uv;
 out vec4 frag;
-uniform mat3 view_basis;    // plugins/sky/shader.py:view_basis (rays independent of near/far)
+uniform mat3 view_basis;    // atmos.camera.view_basis (rays independent of near/far)
+#include "lib/view_ray.glsl"
 #include "sky/sky.glsl"
 
 void main() {
-    frag = vec4(sky_color(normalize(view_basis * vec3(v_uv * 2.0 - 1.0, 1.0))), 1.0);
+    frag = vec4(sky_color(view_ray_dir(v_uv, view_basis)), 0.0);
 }

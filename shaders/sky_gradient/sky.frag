@@ -1,9 +1,10 @@
 #version 430
-// Sky gradient: view ray from the inverse view-projection; zenith/horizon blend, sun disc and glow.
+// Sky gradient: zenith/horizon blend, sun disc and glow along each pixel's view ray.
+// Alpha 0: open sky (color.a is the sky occlusion, atmos/render_core.py).
+#include "lib/view_ray.glsl"
 in vec2 v_uv;
 out vec4 frag;
-uniform mat4 inv_view_proj;
-uniform vec3 camera_pos;
+uniform mat3 view_basis;       // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
 uniform vec3 sun_dir;
 uniform vec3 sun_color;
 uniform vec3 zenith;
@@ -11,8 +12,7 @@ uniform vec3 horizon;
 uniform vec3 ground;
 
 void main() {
-    vec4 p = inv_view_proj * vec4(v_uv * 2.0 - 1.0, 1.0, 1.0);
-    vec3 dir = normalize(p.xyz / p.w - camera_pos);
+    vec3 dir = view_ray_dir(v_uv, view_basis);
     vec3 s = normalize(sun_dir);
     float up = dir.y;
     vec3 sky = mix(horizon, zenith, pow(clamp(up, 0.0, 1.0), 0.6));
@@ -21,5 +21,5 @@ void main() {
     float day = smoothstep(-0.15, 0.1, s.y);
     sky *= mix(0.05, 1.0, day);
     sky += sun_color * day * (0.25 * pow(max(cosang, 0.0), 32.0) + 20.0 * smoothstep(0.9995, 0.9998, cosang));
-    frag = vec4(sky, 1.0);
+    frag = vec4(sky, 0.0);
 }

@@ -1,6 +1,8 @@
 #version 430
 // The cloud layer on the sky: where nothing was drawn (depth 1), the view ray meets the plane
 // y = altitude; the four scrolling octaves give fbm (one fetch each), shaded by sky_layer/layer.glsl.
+// Premultiplied (light, coverage), blended ONE, ONE_MINUS_SRC_ALPHA on colour and alpha: the layer
+// adds its cover to color.a, the sky occlusion (atmos/render_core.py).
 #include "lib/view_ray.glsl"
 #include "sky_layer/layer.glsl"
 in vec2 v_uv;
@@ -10,7 +12,7 @@ layout(binding = 1) uniform sampler2D octave1;
 layout(binding = 2) uniform sampler2D octave2;
 layout(binding = 3) uniform sampler2D octave3;
 layout(binding = 4) uniform sampler2D scene_depth;
-uniform mat4 inv_view_proj;
+uniform mat3 view_basis;       // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
 uniform vec3 camera_pos;
 uniform vec2 offsets[4];       // scroll of each octave (tiles, wrapped to [0, 1))
 uniform float altitude;
@@ -24,9 +26,9 @@ uniform vec3 lit_color;
 uniform vec3 light;
 
 void main() {
-    frag = vec4(0.0, 0.0, 0.0, 1.0);
+    frag = vec4(0.0);                              // no cover: colour and alpha kept
     if (texture(scene_depth, v_uv).r < 1.0) return;
-    vec3 dir = view_ray_dir(v_uv, inv_view_proj, camera_pos);
+    vec3 dir = view_ray_dir(v_uv, view_basis);
     float t = (altitude - camera_pos.y) / max(dir.y, 1e-6);
     if (dir.y <= 1e-6 || t <= 0.0) return;
     vec2 uv = (camera_pos.xz - floor(camera_pos.xz / tile_size) * tile_size + dir.xz * t) / tile_size;

@@ -3,7 +3,8 @@
 //   d      = (clamp(fbm, emptiness, sharpness) - emptiness) / (sharpness - emptiness)
 //   amount = dot(max(d - (0, 0.2, 0.4, 0.6), 0), 1/4)
 //   alpha  = clamp(thickness * amount, 0, 1) * fade;  rgb = mix(lit_color, color, amount) * light
-// Returned premultiplied for blending ONE, SRC_ALPHA: (rgb * alpha, 1 - alpha).
+// Returned premultiplied with its coverage, for blending ONE, ONE_MINUS_SRC_ALPHA on colour and alpha
+// (PassContext.blend_over): (rgb * alpha, alpha); color.a then gains the layer's cover of the sky.
 
 const vec4 SKY_LAYER_WEIGHTS = vec4(0.5, 0.25, 0.125, 0.0625);
 const vec4 SKY_LAYER_RAY = vec4(0.0, 0.2, 0.4, 0.6);
@@ -18,5 +19,5 @@ vec4 sky_layer_shade(vec4 fbm, float emptiness, float sharpness, float thickness
     float amount = dot(max(d - SKY_LAYER_RAY, 0.0), vec4(0.25));
     float alpha = clamp(thickness * amount, 0.0, 1.0) * fade;
     vec3 rgb = mix(lit_color, color, amount) * light;
-    return vec4(rgb * alpha, 1.0 - alpha);
+    return vec4(rgb * alpha, alpha);
 }

@@ -1,5 +1,5 @@
 #version 430
-// Test helper: sky_layer_shade for `count` (fbm samples, fade) inputs into premultiplied outputs.
+// Test helper: sky_layer_shade for `count` (fbm samples, fade) inputs into premultiplied (rgb·α, α) outputs.
 #include "sky_layer/layer.glsl"
 layout(local_size_x = 64) in;
 struct Input { vec4 fbm; vec4 fade; };

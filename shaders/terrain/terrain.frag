@@ -1,5 +1,6 @@
 #version 430
 // Terrain: grass on flat ground, rock on slopes, lighter tops; Lambert sun light plus sky ambient.
+// Alpha 1: opaque, hides the sky (color.a is the sky occlusion, atmos/render_core.py).
 in vec3 v_world;
 in vec3 v_normal;
 out vec4 frag;

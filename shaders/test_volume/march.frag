@@ -1,14 +1,17 @@
 #version 430
 // Test volume ray march: density = mix(A, B, t); Beer-Lambert extinction, a short light march toward
-// the sun, stopped at scene depth. Output premultiplied: rgb = in-scattered light, a = transmittance
-// (PassContext.blend_transmittance gives light + transmittance * scene).
+// the sun, stopped at scene depth. Output premultiplied: rgb = in-scattered light, a = coverage
+// 1 - transmittance (PassContext.blend_over gives light + transmittance * scene, and adds the
+// coverage to color.a, the sky occlusion of atmos/render_core.py: the volume is a cloud).
 in vec2 v_uv;
 out vec4 frag;
 layout(binding = 0) uniform sampler3D density_a;
 layout(binding = 1) uniform sampler3D density_b;
 layout(binding = 2) uniform sampler2D scene_depth;
-uniform mat4 inv_view_proj;
+uniform mat3 view_basis;       // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
 uniform vec3 camera_pos;
+uniform float near;
+uniform float far;
 uniform vec3 sun_dir;
 uniform vec3 sun_color;
 uniform vec3 box_min;
@@ -26,9 +29,9 @@ float density(vec3 world) {
 }
 
 void main() {
-    vec3 dir = view_ray_dir(v_uv, inv_view_proj, camera_pos);
+    vec3 dir = view_ray_dir(v_uv, view_basis);
     float z = texelFetch(scene_depth, ivec2(gl_FragCoord.xy), 0).r;
-    float scene_dist = view_ray_distance(v_uv, z, inv_view_proj, camera_pos, 1e30);
+    float scene_dist = view_ray_distance(v_uv, z, view_basis, near, far, 1e30);
 
     vec3 inv = 1.0 / dir;
     vec3 t0 = (box_min - camera_pos) * inv, t1 = (box_max - camera_pos) * inv;
@@ -53,5 +56,5 @@ void main() {
             trans *= step_t;
         }
     }
-    frag = vec4(light, trans);
+    frag = vec4(light, 1.0 - trans);
 }

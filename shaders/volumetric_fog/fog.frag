@@ -7,11 +7,13 @@
 in vec2 v_uv;
 out vec4 frag;
 layout(binding = 0) uniform sampler2D scene_depth;
-uniform mat4 inv_view_proj;
+uniform mat3 view_basis;       // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
 uniform vec3 camera_pos;
+uniform float near;
+uniform float far;
 
 void main() {
-    vec3 dir = view_ray_dir(v_uv, inv_view_proj, camera_pos);
-    float dist = view_ray_distance(v_uv, texture(scene_depth, v_uv).r, inv_view_proj, camera_pos, 1e30);
+    vec3 dir = view_ray_dir(v_uv, view_basis);
+    float dist = view_ray_distance(v_uv, texture(scene_depth, v_uv).r, view_basis, near, far, 1e30);
     frag = fog_march(camera_pos, dir, dist);
 }
