@@ -4,12 +4,14 @@ the sprite image's error against a ray-marched reference versus frame time.
 A plain script (``python benchmarks/bench_cloud_render.py [--quick]``):
 
 1. 256×32×256 cells at 1024×768 (``--quick``: 128×16×128 at 512×384, labelled), low / medium /
-   high cover (cover measured with ``sim.cover()``), no culling / frustum culling / frustum +
-   empty-space skipping; render-graph time only (no simulation slices), ``ctx.finish()`` per
-   frame, median of 20 frames; printed beside the thesis's fps and speed-ups.
+   high cover (cover measured with ``sim.cover()``): the thesis's rows (no culling, frustum culling
+   (VFD), VFD + empty-space skipping (ESS), full resolution) and ours (the sprites off screen at
+   1/2 resolution, plus levels of detail); render-graph time of the whole frame (sky, ground,
+   clouds; no simulation slices), ``ctx.finish()`` per frame, median of 20 frames; printed beside
+   the thesis's fps and speed-ups.
 2. 96×16×96 cells at 480×360: RMSE (display values 0..1) of the sprite image against a
-   1024-sample ray march of the same volume, per group size × sprite size factor × culling,
-   against frame time; a table and ``out/bench_cloud_render.png``.
+   1024-sample ray march of the same volume against frame time, per group size × sprite size
+   factor × culling, and per downsample × level of detail; a table and ``out/bench_cloud_render.png``.
 
 On llvmpipe (no GPU) only the ratios measured side by side in this run mean anything.
 """
@@ -36,7 +38,6 @@ OUT = Path(__file__).resolve().parents[1] / "out" / "bench_cloud_render.png"
 THESIS = {"low": (33, 95, 118), "medium": (25, 51, 55), "high": (11, 21, 33)}   # fps: none, VFD, VFD+ESS
 THESIS_SPEEDUP = {"low": 3.6, "medium": 2.2, "high": 3.0}
 COVERS = {"low": 50, "medium": 150, "high": 400}      # ellipsoids (cloud_density) for 256 wide; scaled by area
-MODES = {"none": (False, False), "frustum": (True, False), "frustum+ESS": (True, True)}
 BASE = 600.0
 
 
@@ -75,42 +76,64 @@ def render_ms(app, frames=20) -> float:
     return float(np.median(times[2:]) * 1e3)
 
 
+CONFIGS = {   # label: (frustum, ESS, downsample, lod_pixels)
+    "none": (False, False, 1, None),
+    "VFD": (True, False, 1, None),
+    "VFD+ESS": (True, True, 1, None),
+    "1/2 res, none": (False, False, 2, None),
+    "1/2 res, VFD+ESS": (True, True, 2, None),
+    "1/2 res, VFD+ESS+LOD 4px": (True, True, 2, 4.0),
+    "1/2 res, VFD+ESS+LOD 8px": (True, True, 2, 8.0),
+}
+
+
+def configure(renderer, frustum, ess, downsample, lod_pixels) -> None:
+    renderer.frustum_culling, renderer.empty_space_skipping = frustum, ess
+    renderer.downsample, renderer.lod_pixels = downsample, lod_pixels
+
+
 def culling_table(quick: bool) -> None:
     shape, size = ((128, 16, 128), (512, 384)) if quick else ((256, 32, 256), (1024, 768))
     cell = (20.0, 10.0, 20.0)
     gpu = create_headless(size)
     print(f"\n1) frame time, {shape[0]}x{shape[1]}x{shape[2]} cells, {size[0]}x{size[1]}, group 32x32, "
           f"{gpu.ctx.info['GL_RENDERER']}" + ("  [--quick: SMALLER than the thesis's setup]" if quick else ""))
-    print(f"{'cover':>8} {'actual':>7} | {'mode':>12} {'ms':>8} {'fps':>7} {'segments':>9} {'speed-up':>8} |"
-          f" {'thesis fps':>10} {'thesis x':>8}")
+    print("   thesis rows: full resolution, no LOD (Tables 8.2-8.4); ours add the off-screen 1/2-res target "
+          "and levels of detail")
+    print(f"{'cover':>6} {'actual':>6} | {'config':>25} {'ms':>7} {'fps':>6} {'sprites':>8} {'x none':>6} "
+          f"{'x same-res none':>15} | {'thesis fps':>10} {'thesis x':>8}")
     area = shape[0] * shape[2] / 256 ** 2
     for level, density in COVERS.items():
         app, renderer, _ = make_app(gpu, shape, max(1, round(density * area)), (32, 32), cell)
         place_camera(app, shape, cell)
         cover = app.resource(CloudSimulation).cover()
-        base_ms = None
-        for i, (mode, (vfd, ess)) in enumerate(MODES.items()):
-            renderer.frustum_culling, renderer.empty_space_skipping = vfd, ess
+        none_ms = {}
+        for i, (label, config) in enumerate(CONFIGS.items()):
+            configure(renderer, *config)
             ms = render_ms(app, 8 if quick else 20)
-            base_ms = base_ms or ms
-            thesis = THESIS[level][i]
-            speed = f"x{base_ms / ms:.1f}"
-            ts = f"x{THESIS[level][i] / THESIS[level][0]:.1f}"
-            print(f"{level:>8} {cover:>7.0%} | {mode:>12} {ms:>8.1f} {1e3 / ms:>7.1f} "
-                  f"{renderer.stats.segments_drawn:>9} {speed:>8} | {thesis:>10} {ts:>8}")
-        print(f"{'':>8} {'':>7} | goal: our frustum+ESS speed-up >= thesis x{THESIS_SPEEDUP[level]}")
+            none_ms.setdefault(config[2], ms)                # the first row at each resolution is "none"
+            thesis = (f"{THESIS[level][i]:>10} {THESIS[level][i] / THESIS[level][0]:>7.1f}x" if i < 3 else "")
+            print(f"{level:>6} {cover:>6.0%} | {label:>25} {ms:>7.1f} {1e3 / ms:>6.1f} {renderer.stats.sprites:>8} "
+                  f"{none_ms[1] / ms:>5.1f}x {none_ms[config[2]] / ms:>14.1f}x | {thesis}")
+        print(f"{'':>6} {'':>6} | goal: culling speed-up >= thesis x{THESIS_SPEEDUP[level]}")
         app.close()
     gpu.release()
 
 
 def error_table():
+    """Rows (group, size factor, culling, downsample, lod_pixels, ms, RMSE, sprites)."""
     shape, size, cell = (96, 16, 96), (480, 360), (20.0, 15.0, 20.0)
     gpu = create_headless(size)
     print(f"\n2) error vs run time, {shape[0]}x{shape[1]}x{shape[2]} cells, {size[0]}x{size[1]}, "
           "RMSE of display values (0..1) against a 1024-sample ray march")
-    print(f"{'group':>6} {'size':>5} {'culling':>8} {'ms':>8} {'RMSE':>8} {'segments':>9}")
+    print(f"{'group':>6} {'size':>5} {'culling':>8} {'downsample':>10} {'LOD px':>7} {'ms':>8} {'RMSE':>8} "
+          f"{'sprites':>8}")
+    sweeps = {8: [(f, c, 1, None) for f in (1.5, 2.0, 3.0, 4.0) for c in (False, True)],
+              16: [(f, c, 1, None) for f in (1.5, 2.0, 3.0, 4.0) for c in (False, True)]
+              + [(3.0, True, k, lod) for k in (1, 2, 4) for lod in (None, 2.0, 4.0, 8.0) if (k, lod) != (1, None)],
+              32: [(f, c, 1, None) for f in (1.5, 2.0, 3.0, 4.0) for c in (False, True)]}
     rows = []
-    for group in (8, 16, 32):
+    for group, configs in sweeps.items():
         app, renderer, reference = make_app(gpu, shape, 80, (group, group), cell, reference_steps=1024, warmup=20)
         cam = app.resource(Camera)
         cam.position = np.array([200.0, BASE - 150.0, 1700.0])
@@ -120,15 +143,14 @@ def error_table():
         app.graph.execute(app=app)
         ref = gpu.read_pixels() / 255.0
         renderer.enabled, reference.enabled = True, False
-        for size_factor in (1.5, 2.0, 3.0, 4.0):
-            for culling in (False, True):
-                renderer.size_factor = size_factor
-                renderer.frustum_culling = renderer.empty_space_skipping = culling
-                ms = render_ms(app, 6)
-                rmse = float(np.sqrt(((gpu.read_pixels() / 255.0 - ref) ** 2).mean()))
-                rows.append((group, size_factor, culling, ms, rmse))
-                print(f"{group:>6} {size_factor:>5} {'on' if culling else 'off':>8} {ms:>8.1f} {rmse:>8.4f} "
-                      f"{renderer.stats.segments_drawn:>9}")
+        for size_factor, culling, downsample, lod in configs:
+            renderer.size_factor = size_factor
+            configure(renderer, culling, culling, downsample, lod)
+            ms = render_ms(app, 6)
+            rmse = float(np.sqrt(((gpu.read_pixels() / 255.0 - ref) ** 2).mean()))
+            rows.append((group, size_factor, culling, downsample, lod, ms, rmse, renderer.stats.sprites))
+            print(f"{group:>6} {size_factor:>5} {'on' if culling else 'off':>8} {downsample:>10} "
+                  f"{lod or '-':>7} {ms:>8.1f} {rmse:>8.4f} {renderer.stats.sprites:>8}")
         app.close()
     gpu.release()
     return rows
@@ -138,18 +160,30 @@ def plot(rows) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(7, 4.5))
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(12, 4.5))
+    full = [r for r in rows if r[3] == 1 and r[4] is None]
     for group, marker in ((8, "o"), (16, "s"), (32, "^")):
         for culling, fill in ((False, "none"), (True, "full")):
-            sel = [r for r in rows if r[0] == group and r[2] == culling]
-            ax.plot([r[3] for r in sel], [r[4] for r in sel], marker=marker, fillstyle=fill, linestyle="-",
+            sel = [r for r in full if r[0] == group and r[2] == culling]
+            ax.plot([r[5] for r in sel], [r[6] for r in sel], marker=marker, fillstyle=fill, linestyle="-",
                     label=f"group {group}, culling {'on' if culling else 'off'}")
             for r in sel:
-                ax.annotate(f"{r[1]:g}", (r[3], r[4]), fontsize=7, xytext=(3, 3), textcoords="offset points")
-    ax.set_xlabel("frame time (ms, render graph)")
-    ax.set_ylabel("RMSE vs ray-marched reference")
-    ax.set_title("point-sprite clouds: error vs run time (labels: sprite size factor)")
-    ax.legend(fontsize=7)
+                ax.annotate(f"{r[1]:g}", (r[5], r[6]), fontsize=7, xytext=(3, 3), textcoords="offset points")
+    ax.set_title("full resolution (labels: sprite size factor)")
+    for downsample, marker in ((1, "s"), (2, "D"), (4, "v")):
+        sel = [r for r in rows if r[0] == 16 and r[1] == 3.0 and r[2] and r[3] == downsample]
+        sel.sort(key=lambda r: r[4] or 0)
+        bx.plot([r[5] for r in sel], [r[6] for r in sel], marker=marker, linestyle="-",
+                label=f"downsample {downsample}")
+        for r in sel:
+            bx.annotate(f"LOD {r[4]:g}" if r[4] else "no LOD", (r[5], r[6]), fontsize=7, xytext=(3, 3),
+                        textcoords="offset points")
+    bx.set_title("group 16, size 3, culling on: off-screen resolution and levels of detail")
+    for a in (ax, bx):
+        a.set_xlabel("frame time (ms, render graph)")
+        a.set_ylabel("RMSE vs ray-marched reference")
+        a.legend(fontsize=7)
+    fig.suptitle("point-sprite clouds: error vs run time")
     OUT.parent.mkdir(exist_ok=True)
     fig.tight_layout()
     fig.savefig(OUT, dpi=120)

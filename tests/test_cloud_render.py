@@ -263,7 +263,7 @@ def test_cloud_images_show_clouds_near_the_reference_and_move(gpu, ctx, view):
 
 
 def test_levels_of_detail_look_like_full_detail(gpu, ctx):
-    app, renderer = scene(gpu, warmup=20)
+    app, renderer = scene(gpu, warmup=20, downsample=1)
     look(app, *BELOW)
     full = frame(app, gpu)
     sprites = renderer.stats.sprites

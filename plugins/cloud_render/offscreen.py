@@ -62,8 +62,7 @@ class OffscreenClouds:
         return fbo
 
     def end(self, frame: PassContext, factor: int, near: float, far: float) -> None:
-        """Blend the low-res clouds onto "color" (premultiplied, ONE, ONE_MINUS_SRC_ALPHA)."""
-        ctx = frame.gpu.ctx
+        """Blend the low-res clouds onto "color" (premultiplied, :meth:`PassContext.blend_over`)."""
         frame.framebuffer(color=[COLOR]).use()
         for unit, name in enumerate((CLOUD_COLOR, CLOUD_DEPTH, DEPTH)):
             frame.texture(name).use(unit)
@@ -71,6 +70,5 @@ class OffscreenClouds:
         p["factor"].value = factor
         p["inv_near_far"].value = (1.0 / near, 1.0 / far)
         p["edge"].value = EDGE
-        ctx.enable(moderngl.BLEND)
-        ctx.blend_func = moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA
+        frame.blend_over()
         frame.fullscreen(p)

@@ -63,7 +63,7 @@ class CloudRenderPlugin(Plugin):
 
     def __init__(self, base_altitude: float | None = None, size_factor: float = 3.0, sigma: float | None = None,
                  frustum_culling: bool = True, empty_space_skipping: bool = True,
-                 max_point_size: float | None = None, downsample: int = 1, lod_pixels: float | None = None):
+                 max_point_size: float | None = None, downsample: int = 2, lod_pixels: float | None = None):
         if base_altitude is not None and (not isinstance(base_altitude, (int, float)) or isinstance(base_altitude, bool)
                                           or not math.isfinite(base_altitude)):
             raise ValueError(f"CloudRenderPlugin.base_altitude must be a finite number (world y of the "
@@ -213,9 +213,9 @@ class CloudSpritePass(RenderPass):
         for name, value in uniforms.items():
             p[name].value = value
         fbo.depth_mask = False
-        ctx.enable(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.PROGRAM_POINT_SIZE)
+        frame.blend_over()
+        ctx.enable(moderngl.DEPTH_TEST | moderngl.PROGRAM_POINT_SIZE)
         ctx.depth_func = "<="          # a tiny near plane rounds far depths to 1.0: still in front of the sky
-        ctx.blend_func = moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA
         bind_volume(p, sim, self.sampler, app.get_resource(Sun))
         self.particle.use(4)
         try:
@@ -224,8 +224,7 @@ class CloudSpritePass(RenderPass):
             unbind_volume(self.sampler)
             fbo.depth_mask = True
             ctx.depth_func = "<"
-            ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.PROGRAM_POINT_SIZE)
-            ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
+            ctx.disable(moderngl.DEPTH_TEST | moderngl.PROGRAM_POINT_SIZE)   # blending: the graph resets it
         if factor > 1:
             self.offscreen.end(frame, factor, camera.near, camera.far)
 

@@ -7,7 +7,6 @@ two with their ``enabled`` flags. Pass "clouds_reference": reads "depth", blends
 """
 from __future__ import annotations
 
-import moderngl
 import numpy as np
 
 from atmos.camera import Camera, set_camera_uniforms
@@ -60,10 +59,7 @@ class CloudMarchPass(RenderPass):
         renderer = self.plugin.renderer
         layout = renderer.layout(sim)
         frame.framebuffer(color=[COLOR]).use()
-        ctx = gpu.ctx
-        ctx.disable(moderngl.DEPTH_TEST)
-        ctx.enable(moderngl.BLEND)
-        ctx.blend_func = moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA
+        frame.blend_over()
         set_camera_uniforms(p, app.resource(Camera), gpu.size[0] / gpu.size[1])
         for name, value in (("layer_min", layout.lo), ("layer_max", layout.hi), ("cell_size", layout.cell)):
             p[name].value = tuple(float(v) for v in value)
@@ -74,8 +70,6 @@ class CloudMarchPass(RenderPass):
             frame.fullscreen(p)
         finally:
             unbind_volume(self.sampler)
-            ctx.disable(moderngl.BLEND)
-            ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
 
     def release(self) -> None:
         if self.sampler is not None:
