@@ -178,7 +178,7 @@ def plot(rows) -> None:
         for r in sel:
             bx.annotate(f"LOD {r[4]:g}" if r[4] else "no LOD", (r[5], r[6]), fontsize=7, xytext=(3, 3),
                         textcoords="offset points")
-    bx.set_title("group 16, size 3, culling on: off-screen resolution and levels of detail")
+    bx.set_title("group 16, size 3, culled: downsample x levels of detail")
     for a in (ax, bx):
         a.set_xlabel("frame time (ms, render graph)")
         a.set_ylabel("RMSE vs ray-marched reference")
