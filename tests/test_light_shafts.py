@@ -19,6 +19,7 @@ from atmos.plugins.terrain import TerrainPlugin
 from atmos.plugins.test_volume import TestVolumePlugin, VolumeBox
 from atmos.render_core import COLOR, CapturePass
 from test_cloud_shadows import FillPass, pass_plugin, save_png
+from fullscreen_probe import run_fullscreen
 
 
 def random_params(rng, **fixed) -> LightShaftParams:
@@ -30,26 +31,11 @@ def random_params(rng, **fixed) -> LightShaftParams:
 
 
 def gpu_blur(gpu, mask: np.ndarray, sun_uv, params, strength=1.0) -> np.ndarray:
-    """The blur shader alone on an (h, w, 3) mask; the output (float32) starts as NaN everywhere."""
-    ctx = gpu.ctx
+    """The blur shader alone on an (h, w, 3) mask (float16 RGBA texture, linear filtering)."""
     h, w = mask.shape[:2]
     rgba = np.concatenate([mask, np.zeros((h, w, 1))], -1).astype(np.float16)
-    src = ctx.texture((w, h), 4, rgba.tobytes(), dtype="f2")
-    dst = ctx.texture((w, h), 4, np.full((h, w, 4), np.nan, np.float32).tobytes(), dtype="f4")
-    fbo = ctx.framebuffer([dst])
-    program = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="light_shafts/blur.frag")
-    vao = ctx.vertex_array(program, [])
-    try:
-        fbo.use()
-        ctx.disable(ctx.BLEND | ctx.DEPTH_TEST)
-        src.use(0)
-        blur_uniforms(program, sun_uv, params, strength)
-        vao.render(vertices=3)
-        return np.frombuffer(dst.read(), np.float32).reshape(h, w, 4).astype(np.float64)
-    finally:
-        gpu.target.use()
-        for obj in (vao, fbo, dst, src):
-            obj.release()
+    return run_fullscreen(gpu, "light_shafts/blur.frag", (w, h), [rgba],
+                          lambda program: blur_uniforms(program, sun_uv, params, strength))
 
 
 @pytest.mark.parametrize("where", ["random", "centre", "pixel_centre", "edge", "outside", "far_outside"])

@@ -12,7 +12,6 @@ from atmos.camera import Camera
 from atmos.cli import main
 from atmos.defaults import DefaultPlugins
 from atmos.gpu import create_headless
-from atmos.gpu.context import release_gl
 from atmos.lighting import Sun
 from atmos.plugins.daylight import solar_direction
 from atmos.plugins.ground import GroundPlugin
@@ -20,6 +19,7 @@ from atmos.plugins.shading.scattering import sky_light
 from atmos.plugins.sky import SkyParams, SkyPlugin, evaluate_sky, sky_color, sky_radiance
 from atmos.plugins.sky.preetham import preetham_rgb
 from atmos.plugins.sky.shader import set_sky_uniforms, set_view_basis, sky_defines, view_basis
+from fullscreen_probe import run_fullscreen
 
 OUT = os.path.join(os.path.dirname(__file__), "..", "out", "sky")
 
@@ -92,26 +92,13 @@ def test_stars_on_the_gpu_are_the_reference_stars(gpu, ctx, rng):
 
 
 def render_sky(gpu, camera: Camera, size, params: SkyParams, sun, sun_color, time=0.0):
-    """(h, w, 3) float32 sky.frag output (row 0 at the bottom) into a NaN-prefilled float target."""
-    ctx = gpu.ctx
+    """(h, w, 4) sky.frag output (row 0 at the bottom)."""
     w, h = size
-    prog = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="sky/sky.frag", defines=sky_defines())
-    tex = ctx.texture(size, 4, dtype="f4")
-    tex.write(np.full((h, w, 4), np.nan, np.float32).tobytes())
-    fbo = ctx.framebuffer([tex])
-    try:
-        fbo.use()
-        ctx.disable(ctx.BLEND | ctx.DEPTH_TEST)
+
+    def uniforms(prog):
         set_view_basis(prog, camera, w / h)
         set_sky_uniforms(prog, params, sun, sun_color, time, camera.fov_y / h)
-        vao = ctx.vertex_array(prog, [])
-        vao.render(ctx.TRIANGLES, vertices=3)
-        vao.release()
-        return np.frombuffer(tex.read(), np.float32).reshape(h, w, 4)
-    finally:
-        release_gl(fbo)
-        tex.release()
-        gpu.target.use()
+    return run_fullscreen(gpu, "sky/sky.frag", size, (), uniforms, defines=sky_defines())
 
 
 def pixel_centres(size):

@@ -9,7 +9,6 @@ from atmos.app import App
 from atmos.camera import Camera, set_camera_uniforms, view_basis
 from atmos.defaults import DefaultPlugins
 from atmos.gpu import create_headless
-from atmos.gpu.context import release_gl
 from atmos.lighting import Sun
 from atmos.plugins.ground import GroundPlugin
 from atmos.plugins.light_shafts import LightShaftsPlugin
@@ -18,6 +17,7 @@ from atmos.plugins.sky_layer import SkyLayerPlugin
 from atmos.plugins.test_volume import TestVolumePlugin, VolumeBox
 from atmos.plugins.volumetric_fog import VolumetricFogPlugin
 from atmos.render_core import CapturePass
+from fullscreen_probe import run_fullscreen
 
 NONE = -7.0        # what the shader returns where nothing was drawn (depth 1)
 
@@ -45,30 +45,14 @@ def reference_rays(camera: Camera, size) -> np.ndarray:
 
 
 def render_view_rays(gpu, camera: Camera, depth: np.ndarray) -> np.ndarray:
-    """(h, w, 4) float32 output of shaders/test/view_ray.frag (unit direction, distance) into a
-    NaN-prefilled target, the camera's uniforms set by set_camera_uniforms."""
-    ctx = gpu.ctx
+    """(h, w, 4) output of shaders/test/view_ray.frag (unit direction, distance), the camera's
+    uniforms set by set_camera_uniforms."""
     h, w = depth.shape
-    src = ctx.texture((w, h), 1, np.ascontiguousarray(depth, np.float32).tobytes(), dtype="f4")
-    src.filter = (ctx.NEAREST, ctx.NEAREST)
-    dst = ctx.texture((w, h), 4, np.full((h, w, 4), np.nan, np.float32).tobytes(), dtype="f4")
-    fbo = ctx.framebuffer([dst])
-    prog = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="test/view_ray.frag")
-    vao = ctx.vertex_array(prog, [])
-    try:
-        fbo.use()
-        ctx.disable(ctx.BLEND | ctx.DEPTH_TEST)
-        src.use(0)
+
+    def uniforms(prog):
         set_camera_uniforms(prog, camera, w / h)
         prog["none"].value = NONE
-        vao.render(vertices=3)
-        return np.frombuffer(dst.read(), np.float32).reshape(h, w, 4).astype(np.float64)
-    finally:
-        gpu.target.use()
-        vao.release()
-        release_gl(fbo)
-        dst.release()
-        src.release()
+    return run_fullscreen(gpu, "test/view_ray.frag", (w, h), [depth.astype(np.float32)], uniforms, nearest=True)
 
 
 @pytest.mark.parametrize("near, far", [(0.1, 1e10), (0.1, 2000.0), (1e-3, 1e12)])
