@@ -6,6 +6,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from atmos.camera import Camera, set_camera_uniforms
+
 
 @dataclass(slots=True)
 class Sun:
@@ -40,6 +42,13 @@ def set_sun_uniforms(program, sun: Sun) -> None:
     for name, value in (("sun_dir", sun.direction), ("sun_color", sun.color)):
         if name in program:
             program[name].value = tuple(float(v) for v in value)
+
+
+def set_scene_uniforms(program, app, aspect: float) -> None:
+    """The App's camera (:func:`atmos.camera.set_camera_uniforms`) and sun (:func:`set_sun_uniforms`)
+    uniforms: what a pass drawing the lit scene writes each frame."""
+    set_camera_uniforms(program, app.resource(Camera), aspect)
+    set_sun_uniforms(program, scene_sun(app))
 
 
 _DEFAULT_SUN = Sun()

@@ -1,9 +1,8 @@
 """A large ground plane at height 0 with a procedural checker, lit by the sun, faded into the distance."""
 import numpy as np
 
-from atmos.camera import Camera, set_camera_uniforms
 from atmos.graph import PassBuilder, PassContext, RenderPass
-from atmos.lighting import scene_sun, set_sun_uniforms
+from atmos.lighting import set_scene_uniforms
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
 
@@ -30,8 +29,7 @@ class GroundPass(RenderPass):
         app, gpu = frame.data["app"], frame.gpu
         frame.framebuffer(color=[COLOR], depth=DEPTH).use()
         gpu.ctx.enable(gpu.ctx.DEPTH_TEST)
-        set_camera_uniforms(self.program, app.resource(Camera), gpu.size[0] / gpu.size[1])
-        set_sun_uniforms(self.program, scene_sun(app))
+        set_scene_uniforms(self.program, app, gpu.size[0] / gpu.size[1])
         self.program["albedo"].value = self.plugin.albedo
         self.program["tile"].value = self.plugin.tile
         self.vao.render(gpu.ctx.TRIANGLE_STRIP)

@@ -20,6 +20,8 @@ clamped to the edge value in the outer half cell, and zero outside the box.
 """
 from __future__ import annotations
 
+import itertools
+
 import math
 import numbers
 
@@ -142,37 +144,23 @@ def exit_fraction(q, v: float, n: int):
 
 
 # -- interpolation ---------------------------------------------------------------------------------
-def trilinear(volume: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """Clamp-to-edge trilinear samples of ``volume`` at index-space ``points`` (..., 3)."""
-    n = np.array(volume.shape)
+def multilinear(grid: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Clamp-to-edge multilinear samples of an n-d ``grid`` at index-space ``points`` (..., n)."""
+    n = np.array(grid.shape)
     p = np.clip(points, 0, n - 1)
     i0 = np.floor(p).astype(np.int64)
     fr = p - i0
     i1 = np.minimum(i0 + 1, n - 1)
     out = np.zeros(p.shape[:-1])
-    for cx in (0, 1):
-        wx = fr[..., 0] if cx else 1 - fr[..., 0]
-        ix = i1[..., 0] if cx else i0[..., 0]
-        for cy in (0, 1):
-            wy = fr[..., 1] if cy else 1 - fr[..., 1]
-            iy = i1[..., 1] if cy else i0[..., 1]
-            for cz in (0, 1):
-                wz = fr[..., 2] if cz else 1 - fr[..., 2]
-                iz = i1[..., 2] if cz else i0[..., 2]
-                out += wx * wy * wz * volume[ix, iy, iz]
+    for corner in itertools.product((0, 1), repeat=grid.ndim):
+        weight = np.ones(p.shape[:-1])
+        for axis, c in enumerate(corner):
+            weight = weight * (fr[..., axis] if c else 1 - fr[..., axis])
+        out += weight * grid[tuple((i1 if c else i0)[..., axis] for axis, c in enumerate(corner))]
     return out
 
 
-def bilinear(plane: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Clamp-to-edge bilinear samples of ``plane`` at (..., 2) positions."""
-    n = np.array(plane.shape)
-    p = np.clip(y, 0, n - 1)
-    i0 = np.floor(p).astype(np.int64)
-    fr = p - i0
-    i1 = np.minimum(i0 + 1, n - 1)
-    a = plane[i0[..., 0], i0[..., 1]] * (1 - fr[..., 1]) + plane[i0[..., 0], i1[..., 1]] * fr[..., 1]
-    b = plane[i1[..., 0], i0[..., 1]] * (1 - fr[..., 1]) + plane[i1[..., 0], i1[..., 1]] * fr[..., 1]
-    return a * (1 - fr[..., 0]) + b * fr[..., 0]
+trilinear = bilinear = multilinear      # the names the 3D and 2D callers use
 
 
 def catmull_rom(t: np.ndarray) -> tuple:

@@ -1,7 +1,6 @@
 """A cheap analytic sky: horizon-to-zenith gradient, a sun disc and glow. Draws the whole background."""
-from atmos.camera import Camera, set_camera_uniforms
 from atmos.graph import FullscreenPass, PassContext
-from atmos.lighting import scene_sun, set_sun_uniforms
+from atmos.lighting import set_scene_uniforms
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR
 
@@ -13,8 +12,7 @@ class SkyGradientPass(FullscreenPass):
     def execute(self, frame: PassContext) -> None:
         app, gpu = frame.data["app"], frame.gpu
         frame.framebuffer(color=[COLOR]).use()
-        set_camera_uniforms(self.program, app.resource(Camera), gpu.size[0] / gpu.size[1])
-        set_sun_uniforms(self.program, scene_sun(app))
+        set_scene_uniforms(self.program, app, gpu.size[0] / gpu.size[1])
         self.program["zenith"].value = self.plugin.zenith
         self.program["horizon"].value = self.plugin.horizon
         self.program["ground"].value = self.plugin.ground

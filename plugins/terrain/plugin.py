@@ -1,9 +1,8 @@
 """TerrainPlugin and its pass: draws the heightfield into ``color`` and ``depth``."""
 from __future__ import annotations
 
-from atmos.camera import Camera, set_camera_uniforms
 from atmos.graph import PassBuilder, PassContext, RenderPass
-from atmos.lighting import scene_sun, set_sun_uniforms
+from atmos.lighting import set_scene_uniforms
 from atmos.plugin import Plugin
 from atmos.plugins.terrain.heightfield import heightfield, triangle_count
 from atmos.render_core import COLOR, DEPTH
@@ -33,8 +32,7 @@ class TerrainPass(RenderPass):
         app, gpu = frame.data["app"], frame.gpu
         frame.framebuffer(color=[COLOR], depth=DEPTH).use()
         gpu.ctx.enable(gpu.ctx.DEPTH_TEST)
-        set_camera_uniforms(self.program, app.resource(Camera), gpu.size[0] / gpu.size[1])
-        set_sun_uniforms(self.program, scene_sun(app))
+        set_scene_uniforms(self.program, app, gpu.size[0] / gpu.size[1])
         self.program["relief"].value = self.plugin.relief
         self.vao.render(gpu.ctx.TRIANGLES)
 

@@ -4,10 +4,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from atmos.camera import Camera, set_camera_uniforms
 from atmos.frames import SlicedJob, SliceStage, TripleSet
 from atmos.graph import FullscreenPass, PassContext, TextureDesc
-from atmos.lighting import scene_sun, set_sun_uniforms
+from atmos.lighting import set_scene_uniforms
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
 
@@ -84,8 +83,7 @@ class TestVolumePass(FullscreenPass):
         a["density"].use(0)
         b["density"].use(1)
         frame.texture(DEPTH).use(2)
-        set_camera_uniforms(p, app.resource(Camera), gpu.size[0] / gpu.size[1])
-        set_sun_uniforms(p, scene_sun(app))
+        set_scene_uniforms(p, app, gpu.size[0] / gpu.size[1])
         p["t"].value = t
         box = self.plugin.box
         p["box_min"].value = tuple(c - s / 2 for c, s in zip(box.center, box.size))
