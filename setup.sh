@@ -24,5 +24,5 @@ fi
 python3 -m venv .venv
 .venv/bin/python -m pip install -q --upgrade pip
 .venv/bin/python -m pip install -q -e '.[dev]'
-.venv/bin/atmos info | head -3
+.venv/bin/atmos info > .venv/gl-info.txt && head -3 .venv/gl-info.txt
 echo "setup: done. Run a demo with .venv/bin/atmos demo, the tests with .venv/bin/python -m pytest"

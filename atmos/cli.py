@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 from atmos.demo_registry import DEFAULT_DEMO, DemoSettings, list_demos, load_demo
@@ -119,18 +120,23 @@ def main(argv: list[str] | None = None) -> int:
     from atmos.gpu import GpuError, ShaderError
     top = parser()
     args = top.parse_args(argv)
+    commands = {"info": lambda: cmd_info(args), "demo": lambda: cmd_demo(args, top),
+                "graph": lambda: cmd_graph(args, top)}
+    if args.command not in commands:
+        top.print_help()
+        return 2
     try:
-        if args.command == "info":
-            return cmd_info(args)
-        if args.command == "demo":
-            return cmd_demo(args, top)
-        if args.command == "graph":
-            return cmd_graph(args, top)
+        status = commands[args.command]()
+        sys.stdout.flush()
+        return status
     except (GpuError, ShaderError) as error:
         print(f"atmos: {error}", file=sys.stderr)
         return 1
-    top.print_help()
-    return 2
+    except BrokenPipeError:
+        # The reader closed early (`atmos info | head -3`): that is its choice, not our failure.
+        # Point stdout at devnull so the interpreter's final flush does not raise again.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
 
 
 if __name__ == "__main__":

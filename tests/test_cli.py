@@ -1,4 +1,8 @@
 """The atmos command: demos render headless and are not blank; bad arguments get clear messages."""
+import os
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 from PIL import Image
@@ -20,6 +24,17 @@ def test_demo_list(capsys):
 def test_info(capsys):
     code, out, _ = run(capsys, "info")
     assert code == 0 and "GL_RENDERER" in out and "GL_VERSION" in out
+
+
+def test_info_into_a_closed_pipe_is_not_an_error():
+    """`atmos info | head -3` under pipefail (setup.sh did this): a reader that stops early is fine."""
+    read_end, write_end = os.pipe()
+    os.close(read_end)
+    done = subprocess.run([sys.executable, "-c", "import sys; from atmos.cli import main; sys.exit(main(['info']))"],
+                          stdout=write_end, stderr=subprocess.PIPE, text=True, timeout=120)
+    os.close(write_end)
+    assert done.returncode == 0, done.stderr
+    assert "Traceback" not in done.stderr
 
 
 def test_graph_text_and_dot(capsys):
