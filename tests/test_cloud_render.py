@@ -65,6 +65,22 @@ def frame(app, gpu):
 
 
 # -- the vertex stage against numpy ----------------------------------------------------------------
+@pytest.mark.parametrize("group, level", [((16, 16), 0), ((32, 8), 0), ((32, 32), 2)])
+def test_a_group_draws_every_block_once_and_the_farther_of_two_neighbours_first(rng, group, level):
+    s = 1 << level
+    for camera in [*rng.uniform(-40, 70, (40, 2)), (0.0, 0.0), (group[0] / 2, group[1] / 2), (1e9, -1e9)]:
+        cells = group_cells(group, level, camera)
+        blocks = {(int(x), int(z)) for x, z in cells}
+        assert len(blocks) == len(cells) == (group[0] // s) * (group[1] // s)
+        place = {block: i for i, block in enumerate(map(tuple, cells.tolist()))}
+        for (x, z), i in place.items():
+            for neighbour in ((x + s, z), (x, z + s)):
+                if neighbour in place:
+                    far = lambda b: np.hypot(b[0] + s / 2 - camera[0], b[1] + s / 2 - camera[1])   # noqa: E731
+                    first, second = sorted([(x, z), neighbour], key=lambda b: place[b])
+                    assert far(first) >= far(second) - 1e-3 * s, (camera, first, second)
+
+
 @pytest.mark.parametrize("shading_scale, level", [(1, 0), (2, 0), (1, 1), (2, 2)])
 def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale, level):
     app, renderer = scene(gpu, shading_scale=shading_scale, seed=int(rng.integers(1000)))
@@ -89,7 +105,7 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale,
     sampler = clamp_sampler(ctx)
     inst = ctx.buffer(segments.tobytes())
     vao = ctx.vertex_array(prog, [(inst, "4i/i", "in_segment")])
-    blocks = len(group_cells(layout.group, level))
+    blocks = (layout.group[0] >> level) * (layout.group[1] >> level)
     n = len(segments) * blocks
     out = ctx.buffer(np.full(n * 10, np.nan, np.float32).tobytes())
     try:

@@ -1,19 +1,21 @@
 """CloudRenderPlugin: the CloudSimulation's clouds as point sprites (thesis ch. 6, 7.2).
 
-Drawing: one static vertex buffer holds the ``gx × gz`` local cells of a sprite group (the density
-maps' ``group_size``); the segments a frame draws go, back to front, into an instance buffer of
-``(gi, j, gk)`` and the whole layer is ONE instanced draw (instances are rasterized in order, so
-the order holds; per-draw uniforms would cost a Python call per segment). The vertex shader fetches
+Drawing: the segments a frame draws (group x, slice or block y, group z, level) go, back to front,
+into an instance buffer, and the whole layer is ONE multi-draw with no vertex buffer: gl_VertexID is
+a block's place in its group, walked farther neighbour first from where the camera stands (blending
+is in vertex order, so the back-to-front order holds inside a group too). The vertex shader fetches
 density and transmittance as mix(A, B, t), throws empty cells out of the view volume, sizes the
 sprite from distance and density, and colours it sun × T + ambient; the fragment shader applies
 the soft particle. Blending is premultiplied (ONE, ONE_MINUS_SRC_ALPHA), so "color"'s alpha stays
 in [0, 1]; the depth test runs against the scene's "depth" with depth writes off.
 
-Opacity: a sprite of world diameter D = ``size_factor × max(cx, cz) × (0.5 + 0.5 min(density, 1))``
+Opacity: a sprite of world diameter D = ``size_factor × max(cx, cz) × (0.75 + 0.25 min(density, 1))``
 has centre optical depth ``tau = sigma × density × V / l / (pi D² / 12)`` (V the cell volume, l its
 cube-root length, sigma per cell length), so its optical depth summed over the screen equals the
-cell's — what the reference ray marcher integrates (exact for cubic cells). Sprites under a pixel
-are drawn 1 pixel wide with their opacity scaled by their area in pixels.
+cell's — what the reference ray marcher integrates (exact for cubic cells). All but empty cells keep
+3/4 of the size, so neighbouring sprites still overlap (at 1/2, thin cloud bottoms fell apart into
+streaks along the columns). Sprites under a pixel are drawn 1 pixel wide with their opacity scaled
+by their area in pixels.
 """
 from __future__ import annotations
 
@@ -127,6 +129,7 @@ def sprite_uniforms(plugin, sim, layout: CloudLayout, camera: Camera, aspect: fl
     limit = point_limit if plugin.max_point_size is None else min(point_limit, plugin.max_point_size)
     return {"volume_shape": tuple(int(n) for n in layout.shape), "group_size": tuple(layout.group),
             "layer_min": tuple(float(v) for v in layout.lo), "cell_size": tuple(float(c) for c in cell),
+            "camera_cell": tuple(float(v) for v in (np.asarray(camera.position, np.float64) - layout.lo) / cell),
             "base_diameter": float(plugin.size_factor * max(cell[0], cell[2])),
             "pixel_scale": float(height) / 2.0 * float(camera.projection(aspect)[1, 1]),
             "max_point_size": float(limit), "tau_scale": float(tau_scale)}

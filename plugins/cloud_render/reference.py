@@ -14,12 +14,34 @@ from atmos.plugins.shading.reference import trilinear
 CULLED = np.array([0.0, 0.0, 2.0, 1.0])
 
 
-def group_cells(group, level: int = 0) -> np.ndarray:
-    """The block origins (in cells) of one group at ``level``, x-major like gl_VertexID, (n, 2) int32."""
-    gx, gz = group
-    step = 1 << level
-    return np.stack(np.meshgrid(np.arange(0, gx, step), np.arange(0, gz, step), indexing="ij"),
-                    -1).reshape(-1, 2).astype(np.int32)
+SMALLEST = 0.75     # an all but empty block's sprite diameter relative to a dense one's
+
+
+def toward(k, n: int, c: float, s: int):
+    """Block index drawn k-th of ``n`` (size ``s``) along an axis, the camera ``c`` cells from its start:
+    each side of the camera walked toward it, the side whose innermost block is farther first."""
+    x = np.float32(c) / np.float32(s)
+    before = int(np.clip(np.ceil(x - np.float32(0.5)), 0, n))
+    after = n - before
+    if x >= before:
+        return np.where(k < before, k, n - 1 - (k - before))
+    return np.where(k < after, n - 1 - k, k - after)
+
+
+def group_cells(group, level: int, camera) -> np.ndarray:
+    """Block origins (in cells, relative to the group) of one group at ``level`` in gl_VertexID order,
+    ``camera`` the camera's (x, z) in cells from the group's origin; (n, 2) int32. The outer axis is the
+    one the camera is farther off along."""
+    s = 1 << level
+    nx, nz = group[0] // s, group[1] // s
+    cam = np.asarray(camera, np.float32)
+    off = np.abs(cam - np.float32(0.5) * np.asarray(group, np.float32))
+    k = np.arange(nx * nz)
+    if off[0] >= off[1]:
+        bx, bz = toward(k // nz, nx, cam[0], s), toward(k % nz, nz, cam[1], s)
+    else:
+        bx, bz = toward(k % nx, nx, cam[0], s), toward(k // nx, nz, cam[1], s)
+    return (np.stack([bx, bz], -1) * s).astype(np.int32)
 
 
 def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, uniforms: dict, view_proj,
@@ -34,9 +56,10 @@ def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, 
     d_full = np.asarray(density_a, np.float64) * (1.0 - t) + np.asarray(density_b, np.float64) * t
     padded = np.pad(d_full, [(0, 1 << int(seg[:, 3].max(initial=0)))] * 3)   # cells past the edge are empty
     cells, sums, spans = [], [], []
+    camera = np.asarray(u["camera_cell"], np.float32)
     for gi, j, gk, level in seg:
         s = 1 << level
-        local = group_cells((gx, gz), level)
+        local = group_cells((gx, gz), level, camera[[0, 2]] - np.float32([gi * gx, gk * gz]))
         origin = np.stack([gi * gx + local[:, 0], np.full(len(local), j * s), gk * gz + local[:, 1]], -1)
         offsets = np.stack(np.meshgrid(*[np.arange(s)] * 3, indexing="ij"), -1).reshape(-1, 3)
         idx = np.minimum(origin[:, None, :] + offsets[None], np.array(padded.shape) - 1)
@@ -58,7 +81,7 @@ def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, 
             trilinear(np.asarray(trans_b, np.float64), points) * t
     world = np.asarray(u["layer_min"]) + center * np.asarray(u["cell_size"])
     clip = np.concatenate([world, np.ones((len(c), 1))], 1) @ np.asarray(view_proj, np.float64).T
-    diameter = s * u["base_diameter"] * (0.5 + 0.5 * np.minimum(d, 1.0))
+    diameter = s * u["base_diameter"] * (SMALLEST + (1.0 - SMALLEST) * np.minimum(d, 1.0))
     px = diameter * u["pixel_scale"] / np.maximum(clip[:, 3], 1e-6)
     return {"position": np.where(visible[:, None], clip, CULLED),
             "size": np.where(visible, np.clip(px, 1.0, u["max_point_size"]), 1.0),

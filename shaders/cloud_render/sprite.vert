@@ -1,7 +1,9 @@
 #version 430
 // One cloud particle per cell of a sprite group (thesis 6.2), or per block of s³ cells at level of
 // detail L (s = 2^L): each instance is one segment (group x, slice or block y, group z, L), its
-// gl_VertexID the block's place in the group, x-major. Density is the block's mean of mix(A, B, t)
+// gl_VertexID the block's place in the group's drawing order: rows along the axis the camera is
+// farther off, each axis walked from both ends toward the camera, so of two neighbouring sprites the
+// farther is always drawn first (blending is in vertex order). Density is the block's mean of mix(A, B, t)
 // (cells past the volume's edge count as empty); empty blocks and blocks past the edge are thrown
 // out of the view volume.
 #include "cloud_render/volume.glsl"
@@ -10,6 +12,7 @@ uniform ivec3 volume_shape;
 uniform ivec2 group_size;
 uniform vec3 layer_min;        // world corner of cell (0, 0, 0)
 uniform vec3 cell_size;
+uniform vec3 camera_cell;      // the camera in cells from the volume's corner
 uniform mat4 view_proj;
 uniform float base_diameter;   // world sprite diameter of one cell at density 1: size factor × max(cx, cz)
 uniform float pixel_scale;     // pixel diameter = world diameter × pixel_scale / clip.w
@@ -20,12 +23,29 @@ flat out float v_tau;
 flat out float v_coverage;     // < 1 for sprites smaller than a pixel: their area in pixels
 
 const vec4 CULLED = vec4(0.0, 0.0, 2.0, 1.0);   // z > w: outside the clip volume
+const float SMALLEST = 0.75;   // an all but empty block's sprite, relative to a dense one's: neighbours overlap
+
+// The block drawn k-th of n (size s) along an axis with the camera c cells from the group's start:
+// each side of the camera walked toward it, the side whose innermost block is farther first.
+int toward(int k, int n, float c, int s) {
+    float x = c / float(s);
+    int before = int(clamp(ceil(x - 0.5), 0.0, float(n)));     // blocks whose centre is before c
+    int after = n - before;
+    if (x >= float(before))                                     // c in block `before`: its left neighbour is farther
+        return k < before ? k : n - 1 - (k - before);
+    return k < after ? n - 1 - k : k - after;
+}
 
 void main() {
     int s = 1 << in_segment.w;
-    int across = group_size.y / s;
-    ivec3 cell = ivec3(in_segment.x * group_size.x + (gl_VertexID / across) * s, in_segment.y * s,
-                       in_segment.z * group_size.y + (gl_VertexID % across) * s);
+    ivec2 n = group_size / s;
+    ivec2 origin = in_segment.xz * group_size;
+    vec2 cam = camera_cell.xz - vec2(origin);
+    vec2 off = abs(cam - 0.5 * vec2(group_size));
+    ivec2 block = off.x >= off.y
+        ? ivec2(toward(gl_VertexID / n.y, n.x, cam.x, s), toward(gl_VertexID % n.y, n.y, cam.y, s))
+        : ivec2(toward(gl_VertexID % n.x, n.x, cam.x, s), toward(gl_VertexID / n.x, n.y, cam.y, s));
+    ivec3 cell = ivec3(origin.x + block.x * s, in_segment.y * s, origin.y + block.y * s);
     v_light = vec3(0.0);
     v_tau = 0.0;
     v_coverage = 0.0;
@@ -44,7 +64,7 @@ void main() {
     float d = sum / float(s * s * s);
     vec3 center = vec3(cell) + 0.5 * float(s);
     vec4 clip = view_proj * vec4(layer_min + center * cell_size, 1.0);
-    float diameter = float(s) * base_diameter * (0.5 + 0.5 * min(d, 1.0));
+    float diameter = float(s) * base_diameter * mix(SMALLEST, 1.0, min(d, 1.0));
     float px = diameter * pixel_scale / max(clip.w, 1e-6);
     float c = clamp(px, 0.0, 1.0);
     v_coverage = c * c;
