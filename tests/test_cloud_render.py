@@ -138,9 +138,9 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale,
 
 
 # -- frustum culling and empty-space skipping ------------------------------------------------------
-def frustum_reference(layout, view_proj):
+def frustum_reference(layout, view_proj, pad_scale=1.0):
     """Independent test: a box is outside when all 8 corners, in clip space, fail one clip inequality."""
-    lo, hi = layout.column_boxes()
+    lo, hi = layout.column_boxes(pad_scale)
     corners = np.stack([np.stack([(hi if bx else lo)[..., 0], (hi if by else lo)[..., 1], (hi if bz else lo)[..., 2]], -1)
                         for bx in (0, 1) for by in (0, 1) for bz in (0, 1)], -2)            # (gx, gz, 8, 3)
     clip = np.concatenate([corners, np.ones(corners.shape[:-1] + (1,))], -1) @ view_proj.T
@@ -151,7 +151,7 @@ def frustum_reference(layout, view_proj):
 
 def test_frustum_culling_equals_an_independent_cpu_test(rng):
     layout = CloudLayout((256, 32, 256), (20.0, 10.0, 20.0), tuple(rng.uniform(-50, 50, 2)), 500.0, (16, 16), pad=30.0)
-    checked = 0
+    checked = lod_checked = 0
     for _ in range(300):
         cam = Camera(position=rng.uniform([-3000, -200, -3000], [8000, 2000, 8000]), yaw=rng.uniform(-np.pi, np.pi),
                      pitch=rng.uniform(-1.5, 1.5), fov_y=rng.uniform(0.2, 2.5),
@@ -165,7 +165,19 @@ def test_frustum_culling_equals_an_independent_cpu_test(rng):
         assert stats.columns_frustum_culled == outside.sum()
         assert stats.segments_drawn == (~outside).sum() * 32
         checked += outside.any() and not outside.all()
+        # with levels of detail a column's box is padded by its blocks' sprite radius
+        lod, scale = rng.uniform(1, 16), rng.uniform(50, 1000)
+        segments, stats = select_segments(layout, cam.position, vp, lod_pixels=lod, pixel_scale=scale)
+        lo, hi = layout.column_boxes(0.0)
+        levels = column_levels(np.linalg.norm((lo + hi) / 2 - cam.position, axis=-1), 20.0 * scale, lod, 2)
+        outside = frustum_reference(layout, vp, 1 << levels)
+        drawn = np.zeros(layout.grid, bool)
+        drawn[segments[:, 0], segments[:, 2]] = True
+        np.testing.assert_array_equal(drawn, ~outside)
+        assert stats.columns_frustum_culled == outside.sum()
+        lod_checked += (levels > 0).any() and (outside != frustum_reference(layout, vp, 4.0)).any()
     assert checked > 50, "enough cameras with a partly culled layer"
+    assert lod_checked > 5, "enough cameras where the finer levels' smaller padding culls more"
 
 
 @pytest.mark.parametrize("cloud_density", [15, 60])

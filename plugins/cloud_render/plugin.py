@@ -32,7 +32,7 @@ from atmos.plugins.cloud_render.binding import bind_volume, clamp_sampler, unbin
 from atmos.plugins.cloud_render.offscreen import MAX_DOWNSAMPLE, OffscreenClouds, low_size
 from atmos.plugins.clouds.layout import CloudLayout
 from atmos.plugins.cloud_render.particle import PROFILE_AREA, particle_texture
-from atmos.plugins.cloud_render.segments import MAX_LEVEL, SegmentStats, max_level, select_segments
+from atmos.plugins.cloud_render.segments import MAX_LEVEL, SegmentStats, select_segments
 from atmos.plugins.clouds.simulation import CloudSimulation
 from atmos.render_core import COLOR, DEPTH
 
@@ -109,10 +109,10 @@ class CloudRenderPlugin(Plugin):
 
     # -- shared with the reference ray marcher --------------------------------------------------
     def layout(self, sim: CloudSimulation) -> CloudLayout:
-        """The volume's world placement now, column boxes padded by the largest sprite radius."""
-        cell, group = sim.settings.cell_size, sim.settings.group_size
-        blocks = 1 if self.lod_pixels is None else 1 << max_level(group, sim.shape[1], MAX_LEVEL)
-        return sim.layout(self.base_altitude, pad=0.5 * self.size_factor * max(cell[0], cell[2]) * blocks)
+        """The volume's world placement now, column boxes padded by one cell's largest sprite radius
+        (:func:`select_segments` scales it by a column's block size)."""
+        cell = sim.settings.cell_size
+        return sim.layout(self.base_altitude, pad=0.5 * self.size_factor * max(cell[0], cell[2]))
 
     def extinction(self, sim: CloudSimulation) -> float:
         return float(sim.settings.sigma if self.sigma is None else self.sigma)

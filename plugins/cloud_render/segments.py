@@ -9,8 +9,8 @@ column's centre distance (a cell of ``max(cx, cz)`` spans ``max(cx, cz) · pixel
 so far columns draw up to 8^L fewer sprites; off (level 0 everywhere) with ``lod_pixels=None``.
 Culling:
 
-* frustum (7.2.1): a column's padded box (all height slices together) outside one of the 6
-  frustum planes culls the whole column;
+* frustum (7.2.1): a column's box (all height slices together), padded by the layout's sprite
+  radius × 2^level (its blocks' sprites), outside one of the 6 frustum planes culls the column;
 * empty space (7.2.2): ``max_maps`` from :meth:`CloudSimulation.max_maps` (already the max of the
   two interpolated steps): a column whose map [0] is 0 is skipped; otherwise slice ``j`` is skipped
   where its band's map ``[1 + j // band_height]`` is 0.
@@ -81,12 +81,14 @@ def select_segments(layout: CloudLayout, camera_pos, view_proj=None, max_maps=No
     ny = layout.shape[1]
     cam = np.asarray(camera_pos, np.float64)
     stats = SegmentStats(columns=gx * gz, segments=gx * gz * ny)
+    lo, hi = layout.column_boxes(0.0)
+    distance = np.linalg.norm((lo + hi) / 2 - cam, axis=-1)                  # (gx, gz)
+    top = 0 if lod_pixels is None else min(top_level, max_level(layout.group, ny))
+    levels = column_levels(distance, max(layout.cell[0], layout.cell[2]) * pixel_scale, lod_pixels, top)
     keep = np.ones((gx, gz), bool)
-    lo, hi = layout.column_boxes()
     if view_proj is not None:
-        outside = boxes_outside(frustum_planes(view_proj), lo, hi)
-        keep &= ~outside
-        stats.columns_frustum_culled = int(outside.sum())
+        keep &= ~boxes_outside(frustum_planes(view_proj), *layout.column_boxes(1 << levels))
+        stats.columns_frustum_culled = int((~keep).sum())
         stats.segments_frustum_culled = stats.columns_frustum_culled * ny
     slice_ok = np.ones((gx, gz, ny), bool)
     if max_maps is not None:
@@ -100,12 +102,9 @@ def select_segments(layout: CloudLayout, camera_pos, view_proj=None, max_maps=No
         slice_ok = maps[1 + np.arange(ny) // band_height].transpose(1, 2, 0) > 0
         stats.segments_empty = stats.columns_empty * ny + int((keep[..., None] & ~slice_ok).sum())
     cols = np.argwhere(keep)                                       # (C, 2) as (gi, gk)
-    centers = (lo[cols[:, 0], cols[:, 1]] + hi[cols[:, 0], cols[:, 1]]) / 2
-    distance = np.linalg.norm(centers - cam, axis=1)
-    order = np.argsort(-distance, kind="stable")
-    cols, distance = cols[order], distance[order]
-    top = min(top_level, max_level(layout.group, ny))
-    levels = column_levels(distance, max(layout.cell[0], layout.cell[2]) * pixel_scale, lod_pixels, top)
+    order = np.argsort(-distance[keep], kind="stable")
+    cols = cols[order]
+    levels = levels[cols[:, 0], cols[:, 1]]
     stats.columns_by_level = tuple(int((levels == L).sum()) for L in range(top + 1))
     parts = []
     for level in range(top, -1, -1):                               # levels fall along the order

@@ -46,8 +46,9 @@ class CloudLayout:
         """World y of every height slice's cell centres, (ny,)."""
         return self.base + (np.arange(self.shape[1]) + 0.5) * self.cell[1]
 
-    def column_boxes(self) -> tuple[np.ndarray, np.ndarray]:
-        """(lo, hi) world boxes of every column, each (gx, gz, 3), padded by ``pad``."""
+    def column_boxes(self, pad_scale=1.0) -> tuple[np.ndarray, np.ndarray]:
+        """(lo, hi) world boxes of every column, each (gx, gz, 3), padded by ``pad × pad_scale``
+        (a number, or one per column as (gx, gz))."""
         gx, gz = self.grid
         cell = np.asarray(self.cell, float)
         i = np.arange(gx)[:, None]
@@ -56,4 +57,5 @@ class CloudLayout:
         hi_cells = np.stack(np.broadcast_arrays(np.minimum((i + 1) * self.group[0], self.shape[0]),
                                                 0 * i * k + self.shape[1],
                                                 np.minimum((k + 1) * self.group[1], self.shape[2])), -1)
-        return self.lo + lo_cells * cell - self.pad, self.lo + hi_cells * cell + self.pad
+        pad = self.pad * np.asarray(pad_scale, float)[..., None]
+        return self.lo + lo_cells * cell - pad, self.lo + hi_cells * cell + pad
