@@ -12,6 +12,8 @@ A plain script (``python benchmarks/bench_cloud_render.py [--quick]``):
 2. 96×16×96 cells at 480×360: RMSE (display values 0..1) of the sprite image against a
    1024-sample ray march of the same volume against frame time, per group size × sprite size
    factor × culling, and per downsample × level of detail; a table and ``out/bench_cloud_render.png``.
+3. The same volume seen from the side, from below and edge-on (the defaults: group 16, size 3,
+   culled, 1/2 resolution): RMSE per view; the images beside their references in ``out/``.
 
 On llvmpipe (no GPU) only the ratios measured side by side in this run mean anything.
 """
@@ -120,9 +122,36 @@ def culling_table(quick: bool) -> None:
     gpu.release()
 
 
+ERROR_SHAPE, ERROR_SIZE, ERROR_CELL = (96, 16, 96), (480, 360), (20.0, 15.0, 20.0)
+VIEWS = {"side": ((200.0, BASE - 150.0, 1700.0), (960.0, BASE + 120.0, 700.0)),
+         "below": ((900.0, BASE - 60.0, 900.0), (1400.0, BASE + 200.0, 1300.0)),
+         "edge-on": ((-300.0, BASE + 100.0, 960.0), (960.0, BASE + 100.0, 960.0))}
+
+
+def error_app(gpu, group):
+    app, renderer, reference = make_app(gpu, ERROR_SHAPE, 80, (group, group), ERROR_CELL, reference_steps=1024,
+                                        warmup=20)
+    look_from(app, *VIEWS["side"])
+    return app, renderer, reference
+
+
+def look_from(app, position, target) -> None:
+    cam = app.resource(Camera)
+    cam.position = np.array(position)
+    cam.look_at(target)
+    cam.far = 8000.0
+
+
+def reference_image(app, renderer, reference) -> np.ndarray:
+    renderer.enabled, reference.enabled = False, True
+    app.graph.execute(app=app)
+    renderer.enabled, reference.enabled = True, False
+    return app.gpu.read_pixels() / 255.0
+
+
 def error_table():
     """Rows (group, size factor, culling, downsample, lod_pixels, ms, RMSE, sprites)."""
-    shape, size, cell = (96, 16, 96), (480, 360), (20.0, 15.0, 20.0)
+    shape, size = ERROR_SHAPE, ERROR_SIZE
     gpu = create_headless(size)
     print(f"\n2) error vs run time, {shape[0]}x{shape[1]}x{shape[2]} cells, {size[0]}x{size[1]}, "
           "RMSE of display values (0..1) against a 1024-sample ray march")
@@ -134,15 +163,8 @@ def error_table():
               32: [(f, c, 1, None) for f in (1.5, 2.0, 3.0, 4.0) for c in (False, True)]}
     rows = []
     for group, configs in sweeps.items():
-        app, renderer, reference = make_app(gpu, shape, 80, (group, group), cell, reference_steps=1024, warmup=20)
-        cam = app.resource(Camera)
-        cam.position = np.array([200.0, BASE - 150.0, 1700.0])
-        cam.look_at((960.0, BASE + 120.0, 700.0))
-        cam.far = 8000.0
-        renderer.enabled, reference.enabled = False, True
-        app.graph.execute(app=app)
-        ref = gpu.read_pixels() / 255.0
-        renderer.enabled, reference.enabled = True, False
+        app, renderer, reference = error_app(gpu, group)
+        ref = reference_image(app, renderer, reference)
         for size_factor, culling, downsample, lod in configs:
             renderer.size_factor = size_factor
             configure(renderer, culling, culling, downsample, lod)
@@ -154,6 +176,24 @@ def error_table():
         app.close()
     gpu.release()
     return rows
+
+
+def view_table() -> None:
+    from PIL import Image
+    gpu = create_headless(ERROR_SIZE)
+    app, renderer, reference = error_app(gpu, 16)
+    renderer.size_factor = 3.0
+    print("\n3) RMSE by view, group 16, size 3, culled, 1/2 resolution")
+    for name, (position, target) in VIEWS.items():
+        look_from(app, position, target)
+        ref = reference_image(app, renderer, reference)
+        app.graph.execute(app=app)
+        img = gpu.read_pixels() / 255.0
+        path = OUT.with_name(f"bench_cloud_render_{name}.png")
+        Image.fromarray((np.concatenate([img, ref], 1) * 255).round().astype(np.uint8)).save(path)
+        print(f"{name:>8}: RMSE {np.sqrt(((img - ref) ** 2).mean()):.4f}   (sprites | reference: {path.name})")
+    app.close()
+    gpu.release()
 
 
 def plot(rows) -> None:
@@ -195,6 +235,7 @@ def main() -> None:
     start = time.perf_counter()
     culling_table(quick)
     plot(error_table())
+    view_table()
     print(f"total {time.perf_counter() - start:.0f} s")
 
 
