@@ -17,7 +17,8 @@ from atmos.plugins.cloud_render import (CloudLayout, CloudReferencePlugin, Cloud
 from atmos.plugins.cloud_render.binding import bind_volume, clamp_sampler, unbind_volume
 from atmos.plugins.cloud_render.example import example_weather
 from atmos.plugins.cloud_render.plugin import sprite_uniforms
-from atmos.plugins.cloud_render.segments import column_levels, max_level
+from atmos.plugins.cloud_render.segments import (column_levels, draw_units, max_level, pack, segment_columns,
+                                                 unpack)
 from atmos.plugins.cloud_render.reference import group_cells, sprite_vertices
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin, read_volume
 from atmos.plugins.ground import GroundPlugin
@@ -96,6 +97,10 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale,
     segments = np.stack(np.meshgrid(np.arange(gx), np.arange(SHAPE[1] >> level), np.arange(gz), [level],
                                     indexing="ij"), -1)
     segments = rng.permutation(segments.reshape(-1, 4)).astype(np.int32)
+    span_x = np.where(segments[:, 0] < gx - 1, rng.integers(1, 3, len(segments)), 1)     # merged units too
+    span_z = np.where(segments[:, 2] < gz - 1, rng.integers(1, 3, len(segments)), 1)
+    segments[:, 3] = pack(level, span_x, span_z)
+    segments = segments[np.argsort(segments[:, 3], kind="stable")]              # one transform per unit size
     uniforms = sprite_uniforms(renderer, sim, layout, cam, aspect, height, 255.0)
     vp = cam.view_projection(aspect)
 
@@ -103,23 +108,31 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale,
     names = ["gl_Position", "gl_PointSize", "v_light", "v_tau", "v_coverage"]
     prog = ctx.program(vertex_shader=src, varyings=names)
     sampler = clamp_sampler(ctx)
-    inst = ctx.buffer(segments.tobytes())
-    vao = ctx.vertex_array(prog, [(inst, "4i/i", "in_segment")])
-    blocks = (layout.group[0] >> level) * (layout.group[1] >> level)
-    n = len(segments) * blocks
-    out = ctx.buffer(np.full(n * 10, np.nan, np.float32).tobytes())
+    sun = app.resource(Sun)
+    parts = []
     try:
         prog["view_proj"].write(np.asarray(vp, np.float32).T.tobytes())
         for name, value in uniforms.items():
             prog[name].value = value
-        sun = app.resource(Sun)
         bind_volume(prog, sim, sampler, sun)
-        vao.transform(out, moderngl.POINTS, vertices=blocks, instances=len(segments))
+        for code in np.unique(segments[:, 3]):
+            mine = segments[segments[:, 3] == code]
+            _, sx, sz = unpack(code)
+            blocks = (layout.group[0] * sx >> level) * (layout.group[1] * sz >> level)
+            inst = ctx.buffer(mine.tobytes())
+            vao = ctx.vertex_array(prog, [(inst, "4i/i", "in_segment")])
+            out = ctx.buffer(np.full(len(mine) * blocks * 10, np.nan, np.float32).tobytes())
+            vao.transform(out, moderngl.POINTS, vertices=blocks, instances=len(mine))
+            parts.append(np.frombuffer(out.read(), np.float32).reshape(-1, 10).astype(np.float64))
+            for obj in (vao, out, inst):
+                obj.release()
         unbind_volume(sampler)
-        got = np.frombuffer(out.read(), np.float32).reshape(n, 10).astype(np.float64)
     finally:
-        for obj in (vao, out, inst, sampler, prog):
+        for obj in (sampler, prog):
             obj.release()
+    got = np.concatenate(parts)
+    n = len(got)
+    assert len(np.unique(segments[:, 3])) == 4, "units of every size"
     assert np.isfinite(got).all(), "every output element written"
     color, ambient = sun_light(sun)
     trans = [read_volume(s["transmittance"]) for s in (a, b)]
@@ -160,7 +173,7 @@ def test_frustum_culling_equals_an_independent_cpu_test(rng):
         segments, stats = select_segments(layout, cam.position, vp)
         outside = frustum_reference(layout, vp)
         drawn = np.zeros(layout.grid, bool)
-        drawn[segments[:, 0], segments[:, 2]] = True
+        drawn[tuple(segment_columns(segments)[:, [0, 2]].T)] = True
         np.testing.assert_array_equal(drawn, ~outside)
         assert stats.columns_frustum_culled == outside.sum()
         assert stats.segments_drawn == (~outside).sum() * 32
@@ -172,7 +185,7 @@ def test_frustum_culling_equals_an_independent_cpu_test(rng):
         levels = column_levels(np.linalg.norm((lo + hi) / 2 - cam.position, axis=-1), 20.0 * scale, lod, 2)
         outside = frustum_reference(layout, vp, 1 << levels)
         drawn = np.zeros(layout.grid, bool)
-        drawn[segments[:, 0], segments[:, 2]] = True
+        drawn[tuple(segment_columns(segments)[:, [0, 2]].T)] = True
         np.testing.assert_array_equal(drawn, ~outside)
         assert stats.columns_frustum_culled == outside.sum()
         lod_checked += (levels > 0).any() and (outside != frustum_reference(layout, vp, 4.0)).any()
@@ -201,7 +214,7 @@ def test_empty_space_skipping_never_skips_density_in_a_or_b(gpu, ctx, cloud_dens
                     full[gi, j, gk] = (col[:, (j // bh) * bh:(j // bh + 1) * bh] > 0).any()
         segments, stats = select_segments(layout, app.resource(Camera).position, None, sim.max_maps(), bh)
         drawn = np.zeros_like(full)
-        drawn[segments[:, 0], segments[:, 1], segments[:, 2]] = True
+        drawn[tuple(segment_columns(segments)[:, :3].T)] = True
         np.testing.assert_array_equal(drawn, full)
         has_density = np.zeros_like(full)
         for j in range(SHAPE[1]):
@@ -213,7 +226,7 @@ def test_empty_space_skipping_never_skips_density_in_a_or_b(gpu, ctx, cloud_dens
                                           lod_pixels=20.0, pixel_scale=400.0)
         assert sum(n > 0 for n in stats.columns_by_level) >= 2, "the test needs several levels"
         covered = np.zeros_like(full)
-        for gi, j, gk, level in segments:
+        for gi, j, gk, level in segment_columns(segments):
             covered[gi, j << level:(j + 1) << level, gk] = True
         assert not (has_density & ~covered).any()
     app.close()
@@ -230,12 +243,39 @@ def test_levels_of_detail_follow_pixel_size_and_fall_along_the_draw_order(rng):
         cam = rng.uniform([-3000, 0, -3000], [5000, 1500, 5000])
         segments, stats = select_segments(layout, cam, lod_pixels=float(rng.uniform(1, 16)),
                                           pixel_scale=float(rng.uniform(100, 1000)))
-        assert (np.diff(segments[:, 3]) <= 0).all(), "coarser levels first"
+        assert (np.diff(unpack(segments[:, 3])[0]) <= 0).all(), "coarser levels first"
         assert sum(stats.columns_by_level) == 64
-        per_level = [(segments[:, 3] == L).sum() // (16 >> L) for L in range(3)]
+        columns = segment_columns(segments)
+        per_level = [(columns[:, 3] == L).sum() // (16 >> L) for L in range(3)]
         assert per_level == [c for c in stats.columns_by_level] + [0] * (3 - len(stats.columns_by_level))
-        blocks = (16 >> segments[:, 3]) ** 2
+        blocks = (16 >> columns[:, 3]) ** 2
         assert stats.sprites == blocks.sum()
+
+
+def test_columns_beside_a_boundary_the_camera_stands_on_are_drawn_as_one_unit(rng):
+    """Within one sprite diameter of a column boundary, the columns on its two sides form one unit
+    (2x2 at a corner); every kept column is drawn exactly once, culled columns never join a unit."""
+    layout = CloudLayout((128, 8, 96), (10.0, 10.0, 10.0), (0.0, 0.0), 100.0, (16, 16), pad=15.0)   # 160 m groups
+    keep = np.ones(layout.grid, bool)
+    units = draw_units(layout, (320.0 + 10.0, 140.0, 50.0), keep, 30.0)          # on the x = 320 boundary
+    wide = units[units[:, 2] == 2]
+    assert len(wide) == 6 and (wide[:, 0] == 1).all() and (wide[:, 3] == 1).all()
+    units = draw_units(layout, (320.0 - 5.0, 900.0, 480.0 + 20.0), keep, 30.0)   # on a corner, above the layer
+    assert [tuple(u) for u in units if u[2] * u[3] == 4] == [(1, 2, 2, 2)]
+    assert draw_units(layout, (320.0 + 40.0, 140.0, 50.0), keep, 30.0)[:, 2:].max() == 1, "too far: no merge"
+    assert draw_units(layout, (-5.0, 140.0, -5.0), keep, 30.0)[:, 2:].max() == 1, "the layer's edge is no seam"
+    for _ in range(50):
+        keep = rng.random(layout.grid) < 0.7
+        camera = rng.uniform([-100, 0, -100], [1380, 300, 1060])
+        units = draw_units(layout, camera, keep, float(rng.uniform(0, 100)))
+        count = np.zeros(layout.grid, int)
+        for i, k, sx, sz in units:
+            count[i:i + sx, k:k + sz] += 1
+        np.testing.assert_array_equal(count, keep.astype(int))
+        segments, stats = select_segments(layout, camera, lod_pixels=4.0, pixel_scale=300.0)
+        cols = segment_columns(segments)
+        assert len(np.unique(cols, axis=0)) == len(cols) == stats.segments_drawn
+        assert (np.diff(unpack(segments[:, 3])[0]) <= 0).all(), "levels still fall along the order"
 
 
 def test_draw_order_is_back_to_front():

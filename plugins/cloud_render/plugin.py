@@ -1,9 +1,10 @@
 """CloudRenderPlugin: the CloudSimulation's clouds as point sprites (thesis ch. 6, 7.2).
 
-Drawing: the segments a frame draws (group x, slice or block y, group z, level) go, back to front,
-into an instance buffer, and the whole layer is ONE multi-draw with no vertex buffer: gl_VertexID is
-a block's place in its group, walked farther neighbour first from where the camera stands (blending
-is in vertex order, so the back-to-front order holds inside a group too). The vertex shader fetches
+Drawing: the segments a frame draws (group x, slice or block y, group z, level and span; see
+``segments``) go, back to front, into an instance buffer, and the whole layer is ONE multi-draw with
+no vertex buffer: gl_VertexID is a block's place in its unit (a group, or 2 beside a boundary the
+camera stands on), walked farther neighbour first from where the camera stands (blending is in
+vertex order, so the back-to-front order holds inside a unit too). The vertex shader fetches
 density and transmittance as mix(A, B, t), throws empty cells out of the view volume, sizes the
 sprite from distance and density, and colours it sun × T + ambient; the fragment shader applies
 the soft particle. Blending is premultiplied (ONE, ONE_MINUS_SRC_ALPHA), so "color"'s alpha stays
@@ -32,7 +33,7 @@ from atmos.plugins.cloud_render.binding import bind_volume, clamp_sampler, unbin
 from atmos.plugins.cloud_render.offscreen import MAX_DOWNSAMPLE, OffscreenClouds, low_size
 from atmos.plugins.clouds.layout import CloudLayout
 from atmos.plugins.cloud_render.particle import PROFILE_AREA, particle_texture
-from atmos.plugins.cloud_render.segments import MAX_LEVEL, SegmentStats, select_segments
+from atmos.plugins.cloud_render.segments import MAX_LEVEL, SegmentStats, select_segments, unpack
 from atmos.plugins.clouds.simulation import CloudSimulation
 from atmos.render_core import COLOR, DEPTH
 
@@ -161,27 +162,30 @@ class CloudSpritePass(RenderPass):
         self.point_limit = float(limit)
 
     def _buffers(self, gpu, group, shape) -> None:
-        """An instance buffer for every segment and one draw command per level (made once per group size)."""
+        """An instance buffer for every segment (made once per group size and volume shape)."""
         if self._group == (group, shape):
             return
         self._release_buffers()
         gx, gz = group
         grid = (-(-shape[0] // gx)) * (-(-shape[2] // gz)) * shape[1]
         self.instances = gpu.ctx.buffer(reserve=16 * grid)
-        self.commands = gpu.ctx.buffer(reserve=COMMAND_BYTES * (MAX_LEVEL + 1))
+        self.commands = gpu.ctx.buffer(reserve=COMMAND_BYTES * 16)
         self.vao = gpu.ctx.vertex_array(self.program, [(self.instances, "4i/i", "in_segment")])
         self._group = (group, shape)
 
     def _draw(self, segments: np.ndarray, group) -> None:
-        """Every level's run of segments as one instanced draw of its blocks, all in one multi-draw:
-        commands (blocks per group, segments, first vertex 0, first instance), farthest level first.
-        moderngl strides array commands by 20 bytes (the indexed layout), hence the zero pad."""
-        levels = segments[:, 3]
-        starts = np.flatnonzero(np.r_[True, levels[1:] != levels[:-1]])
-        counts = np.diff(np.r_[starts, len(levels)])
-        blocks = (group[0] >> levels[starts]) * (group[1] >> levels[starts])
+        """Every run of segments with one level and span as one instanced draw of its blocks, all in one
+        multi-draw: commands (blocks per unit, segments, first vertex 0, first instance). moderngl
+        strides array commands by 20 bytes (the indexed layout), hence the zero pad."""
+        code = segments[:, 3]
+        starts = np.flatnonzero(np.r_[True, code[1:] != code[:-1]])
+        counts = np.diff(np.r_[starts, len(code)])
+        level, sx, sz = unpack(code[starts])
+        blocks = (group[0] * sx >> level) * (group[1] * sz >> level)
         zero = np.zeros_like(counts)
         commands = np.stack([blocks, counts, zero, starts, zero], -1).astype(np.uint32)
+        if commands.nbytes > self.commands.size:
+            self.commands.orphan(commands.nbytes)
         self.commands.write(commands.tobytes())
         self.vao.render_indirect(self.commands, moderngl.POINTS, count=len(commands))
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from atmos.plugins.cloud_render.segments import unpack
 from atmos.plugins.shading.reference import trilinear
 
 CULLED = np.array([0.0, 0.0, 2.0, 1.0])
@@ -46,7 +47,7 @@ def group_cells(group, level: int, camera) -> np.ndarray:
 
 def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, uniforms: dict, view_proj,
                     sun_color, ambient) -> dict:
-    """Arrays over the vertices of every segment (gi, j, gk, level), in order: ``position`` (n, 4),
+    """Arrays over the vertices of every segment (gi, j, gk, packed level and span), in order: ``position`` (n, 4),
     ``size``, ``light`` (n, 3), ``tau``, ``coverage``, ``visible``. ``trans_a``/``trans_b`` None: no
     shading (T = 1)."""
     u = uniforms
@@ -54,12 +55,13 @@ def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, 
     gx, gz = u["group_size"]
     seg = np.asarray(segments, np.int64)
     d_full = np.asarray(density_a, np.float64) * (1.0 - t) + np.asarray(density_b, np.float64) * t
-    padded = np.pad(d_full, [(0, 1 << int(seg[:, 3].max(initial=0)))] * 3)   # cells past the edge are empty
+    levels, spans_x, spans_z = unpack(seg[:, 3])
+    padded = np.pad(d_full, [(0, 1 << int(levels.max(initial=0)))] * 3)   # cells past the edge are empty
     cells, sums, spans = [], [], []
     camera = np.asarray(u["camera_cell"], np.float32)
-    for gi, j, gk, level in seg:
+    for (gi, j, gk, _), level, sx, sz in zip(seg, levels, spans_x, spans_z):
         s = 1 << level
-        local = group_cells((gx, gz), level, camera[[0, 2]] - np.float32([gi * gx, gk * gz]))
+        local = group_cells((gx * sx, gz * sz), level, camera[[0, 2]] - np.float32([gi * gx, gk * gz]))
         origin = np.stack([gi * gx + local[:, 0], np.full(len(local), j * s), gk * gz + local[:, 1]], -1)
         offsets = np.stack(np.meshgrid(*[np.arange(s)] * 3, indexing="ij"), -1).reshape(-1, 3)
         idx = np.minimum(origin[:, None, :] + offsets[None], np.array(padded.shape) - 1)

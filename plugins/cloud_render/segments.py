@@ -20,6 +20,13 @@ levels never rise along the order); inside a column, slices (blocks) by ``|centr
 height|``, farthest first — bottom-up for a camera above the layer, top-down below it, and from
 both ends toward the camera's height inside it. A level-``L`` block is skipped as empty only if
 all its slices are.
+
+Seams: a column boundary plane that (nearly) holds the camera is seen edge-on, and the sprites of
+the two columns beside it overlap across it at every depth — drawn one column after the other they
+leave a line on screen. So within one sprite diameter of such a boundary the two columns on either
+side are drawn as one unit, 2 groups wide (2×2 at a corner), whose blocks the vertex shader walks
+toward the camera like any group's. The segment's 4th component packs the level and the unit's
+span: :func:`pack`, :func:`unpack`.
 """
 from __future__ import annotations
 
@@ -43,12 +50,58 @@ class SegmentStats:
     segments: int = 0
     segments_frustum_culled: int = 0
     segments_empty: int = 0
-    segments_drawn: int = 0
+    segments_drawn: int = 0   # group-slices (group-blocks at a level) drawn; a merged unit counts each column
     sprites: int = 0          # vertices submitted: Σ segments_drawn × sprites per group at its level
     columns_by_level: tuple = (0,)   # columns drawn (not culled) at level 0, 1, ...
 
     def as_dict(self) -> dict:
         return {f.name: getattr(self, f.name) for f in fields(self)}
+
+
+def pack(level, span_x=1, span_z=1):
+    """A segment's 4th component: level (0..3) | (span x − 1) << 2 | (span z − 1) << 3."""
+    return np.asarray(level) | (np.asarray(span_x) - 1) << 2 | (np.asarray(span_z) - 1) << 3
+
+
+def unpack(code):
+    """(level, span x, span z) of a segment's 4th component(s)."""
+    code = np.asarray(code)
+    return code & 3, 1 + (code >> 2 & 1), 1 + (code >> 3 & 1)
+
+
+def segment_columns(segments) -> np.ndarray:
+    """One row (gi, j, gk, level) per column each segment covers, (m, 4) int."""
+    level, sx, sz = unpack(segments[:, 3])
+    rows = [np.stack([segments[:, 0] + dx, segments[:, 1], segments[:, 2] + dz, level], -1)[(dx < sx) & (dz < sz)]
+            for dx in (0, 1) for dz in (0, 1)]
+    return np.concatenate(rows)
+
+
+def draw_units(layout: CloudLayout, camera, keep, margin: float) -> np.ndarray:
+    """(U, 4) int (gi, gk, span x, span z): kept columns, merged in pairs (2×2 at a corner) across a
+    column boundary the camera is within ``margin`` of; merged columns must all be kept."""
+    gx, gz = layout.grid
+    near = []
+    for axis, count, size in ((0, gx, layout.group[0] * layout.cell[0]), (2, gz, layout.group[1] * layout.cell[2])):
+        t = (camera[axis] - layout.lo[axis]) / size
+        b = int(np.clip(np.round(t), 0, count))
+        near.append(b if 0 < b < count and abs(t - b) * size < margin else None)
+    taken = ~keep
+    units = []
+
+    def claim(i, k, sx, sz):
+        if not taken[i:i + sx, k:k + sz].any():
+            taken[i:i + sx, k:k + sz] = True
+            units.append((i, k, sx, sz))
+    bx, bz = near
+    if bx is not None and bz is not None:
+        claim(bx - 1, bz - 1, 2, 2)
+    for k in range(gz) if bx is not None else ():
+        claim(bx - 1, k, 2, 1)
+    for i in range(gx) if bz is not None else ():
+        claim(i, bz - 1, 1, 2)
+    units += [(i, k, 1, 1) for i, k in np.argwhere(~taken)]
+    return np.array(units, np.int64).reshape(-1, 4)
 
 
 def max_level(group, shape_y: int, limit: int = MAX_LEVEL) -> int:
@@ -73,7 +126,7 @@ def column_levels(distance, cell_px: float, lod_pixels: float | None, top: int) 
 def select_segments(layout: CloudLayout, camera_pos, view_proj=None, max_maps=None, band_height: int = 1,
                     lod_pixels: float | None = None, pixel_scale: float = 0.0,
                     top_level: int = MAX_LEVEL) -> tuple[np.ndarray, SegmentStats]:
-    """(segments int32 (n, 4) as (gi, j, gk, level) in draw order, stats). ``view_proj=None``: no
+    """(segments int32 (n, 4) as (gi, j, gk, :func:`pack` (level, span)) in draw order, stats). ``view_proj=None``: no
     frustum culling; ``max_maps=None``: no empty-space skipping; ``lod_pixels=None``: level 0 only
     (else ``pixel_scale`` is the target's pixels per world unit at distance 1, and levels go up to
     ``min(top_level, max_level(group, ny))``)."""
@@ -101,23 +154,31 @@ def select_segments(layout: CloudLayout, camera_pos, view_proj=None, max_maps=No
         keep &= ~empty
         slice_ok = maps[1 + np.arange(ny) // band_height].transpose(1, 2, 0) > 0
         stats.segments_empty = stats.columns_empty * ny + int((keep[..., None] & ~slice_ok).sum())
-    cols = np.argwhere(keep)                                       # (C, 2) as (gi, gk)
-    order = np.argsort(-distance[keep], kind="stable")
-    cols = cols[order]
-    levels = levels[cols[:, 0], cols[:, 1]]
-    stats.columns_by_level = tuple(int((levels == L).sum()) for L in range(top + 1))
+    units = draw_units(layout, cam, keep, 2.0 * layout.pad * (1 << top))
+    lo_u = lo[units[:, 0], units[:, 1]]
+    hi_u = hi[units[:, 0] + units[:, 2] - 1, units[:, 1] + units[:, 3] - 1]
+    unit_distance = np.linalg.norm((lo_u + hi_u) / 2 - cam, axis=-1)
+    order = np.argsort(-unit_distance, kind="stable")
+    units, unit_distance = units[order], unit_distance[order]
+    levels = column_levels(unit_distance, max(layout.cell[0], layout.cell[2]) * pixel_scale, lod_pixels, top)
+    area = units[:, 2] * units[:, 3]
+    stats.columns_by_level = tuple(int(area[levels == L].sum()) for L in range(top + 1))
+    unit_ok = np.zeros((len(units), ny), bool)
+    for dx in (0, 1):
+        for dz in (0, 1):
+            member = (dx < units[:, 2]) & (dz < units[:, 3])
+            unit_ok[member] |= slice_ok[units[member, 0] + dx, units[member, 1] + dz]
     parts = []
     for level in range(top, -1, -1):                               # levels fall along the order
-        mine = cols[levels == level]
-        s = 1 << level
+        mine, s = levels == level, 1 << level
         blocks = -(-ny // s)
-        ok = slice_ok[mine[:, 0], mine[:, 1]]
-        ok = np.pad(ok, ((0, 0), (0, blocks * s - ny))).reshape(len(mine), blocks, s).any(-1)
+        ok = np.pad(unit_ok[mine], ((0, 0), (0, blocks * s - ny))).reshape(-1, blocks, s).any(-1)
         heights = layout.base + (np.arange(blocks) * s + 0.5 * s) * layout.cell[1]
         slices = np.argsort(-np.abs(heights - cam[1]), kind="stable")
         ci, si = np.nonzero(ok[:, slices])
-        parts.append(np.stack([mine[ci, 0], slices[si], mine[ci, 1], np.full(len(ci), level)], -1))
-        stats.sprites += len(ci) * (layout.group[0] // s) * (layout.group[1] // s)
+        u = units[mine][ci]
+        parts.append(np.stack([u[:, 0], slices[si], u[:, 1], pack(level, u[:, 2], u[:, 3])], -1))
+        stats.sprites += int((u[:, 2] * u[:, 3]).sum()) * (layout.group[0] // s) * (layout.group[1] // s)
+        stats.segments_drawn += int((u[:, 2] * u[:, 3]).sum())
     segments = np.concatenate(parts).astype(np.int32)
-    stats.segments_drawn = len(segments)
     return segments, stats

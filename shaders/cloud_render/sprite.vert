@@ -1,11 +1,12 @@
 #version 430
 // One cloud particle per cell of a sprite group (thesis 6.2), or per block of s³ cells at level of
-// detail L (s = 2^L): each instance is one segment (group x, slice or block y, group z, L), its
-// gl_VertexID the block's place in the group's drawing order: rows along the axis the camera is
-// farther off, each axis walked from both ends toward the camera, so of two neighbouring sprites the
-// farther is always drawn first (blending is in vertex order). Density is the block's mean of mix(A, B, t)
-// (cells past the volume's edge count as empty); empty blocks and blocks past the edge are thrown
-// out of the view volume.
+// detail L (s = 2^L). Each instance is one segment (group x, slice or block y, group z, code): code
+// packs L | (span x − 1) << 2 | (span z − 1) << 3, a unit of 1 or 2 groups per side (columns merged
+// across a boundary the camera stands on, see segments.py). gl_VertexID is a block's place in the
+// unit's drawing order: rows along the axis the camera is farther off, each axis walked toward the
+// camera, so of two neighbouring sprites the farther is always drawn first (blending is in vertex
+// order). Density is the block's mean of mix(A, B, t) (cells past the volume's edge count as empty);
+// empty blocks and blocks past the edge are thrown out of the view volume.
 #include "cloud_render/volume.glsl"
 layout(location = 0) in ivec4 in_segment;
 uniform ivec3 volume_shape;
@@ -37,11 +38,12 @@ int toward(int k, int n, float c, int s) {
 }
 
 void main() {
-    int s = 1 << in_segment.w;
-    ivec2 n = group_size / s;
+    int s = 1 << (in_segment.w & 3);
+    ivec2 extent = group_size * (1 + ((ivec2(in_segment.w) >> ivec2(2, 3)) & 1));
+    ivec2 n = extent / s;
     ivec2 origin = in_segment.xz * group_size;
     vec2 cam = camera_cell.xz - vec2(origin);
-    vec2 off = abs(cam - 0.5 * vec2(group_size));
+    vec2 off = abs(cam - 0.5 * vec2(extent));
     ivec2 block = off.x >= off.y
         ? ivec2(toward(gl_VertexID / n.y, n.x, cam.x, s), toward(gl_VertexID % n.y, n.y, cam.y, s))
         : ivec2(toward(gl_VertexID % n.x, n.x, cam.x, s), toward(gl_VertexID / n.x, n.y, cam.y, s));
