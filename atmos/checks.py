@@ -4,6 +4,7 @@ Shared by parameter classes of the plugins (volumetric fog, sky layer, ...).
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import operator
 
@@ -56,3 +57,21 @@ def check_known(owner: str, changes: dict, known) -> None:
     unknown = sorted(set(changes) - set(known))
     if unknown:
         raise ValueError(f"unknown {owner} setting(s) {', '.join(unknown)}; known: {', '.join(sorted(known))}")
+
+
+class CheckedParams:
+    """Base of the plugins' frozen settings dataclasses (their ``__post_init__`` checks every field)."""
+
+    def replace(self, **changes):
+        """A checked copy with ``changes``; unknown names and bad values raise ValueError."""
+        check_known(type(self).__name__, changes, [f.name for f in dataclasses.fields(self)])
+        return dataclasses.replace(self, **changes)
+
+
+def plugin_params(plugin: str, cls, params, settings: dict):
+    """A plugin's settings: ``params`` (a ``cls``, or None for the defaults) with keyword ``settings``
+    applied on top, all checked before anything is kept."""
+    if params is not None and not isinstance(params, cls):
+        raise ValueError(f"{plugin} params must be a {cls.__name__}, got {type(params).__name__}")
+    base = params if params is not None else cls()
+    return base.replace(**settings) if settings else base

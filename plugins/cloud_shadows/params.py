@@ -1,15 +1,15 @@
 """CloudShadowParams: the settings of the ground shadows, checked as a whole before any is used."""
 from __future__ import annotations
 
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass
 
-from atmos.checks import check_known, check_num, check_vec
+from atmos.checks import CheckedParams, check_num, check_vec
 
 _OWNER = "CloudShadowParams"
 
 
 @dataclass(frozen=True)
-class CloudShadowParams:
+class CloudShadowParams(CheckedParams):
     """Where the cloud layer is and how dark its shadow is (world units are metres, y is up).
 
     ``base_altitude``: world height of the bottom of the simulation volume (None: the simulation's
@@ -44,8 +44,3 @@ class CloudShadowParams:
         )
         for name, value in checked.items():
             object.__setattr__(self, name, value)
-
-    def replace(self, **changes) -> "CloudShadowParams":
-        """A checked copy with ``changes``; unknown names and bad values raise ValueError."""
-        check_known(_OWNER, changes, [f.name for f in fields(self)])
-        return replace(self, **changes)

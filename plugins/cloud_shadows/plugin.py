@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from atmos.camera import Camera, set_camera_uniforms
+from atmos.checks import plugin_params
 from atmos.graph import FullscreenPass, PassContext
 from atmos.lighting import scene_sun
 from atmos.plugin import Plugin
@@ -61,9 +62,7 @@ class CloudShadowsPlugin(Plugin):
     def __init__(self, params: CloudShadowParams | None = None, **fields):
         if params is not None and fields:
             raise ValueError("give CloudShadowsPlugin either a CloudShadowParams or its fields as keywords, not both")
-        self.params = params if params is not None else CloudShadowParams(**fields)
-        if not isinstance(self.params, CloudShadowParams):
-            raise ValueError(f"CloudShadowsPlugin params must be a CloudShadowParams, got {type(self.params).__name__}")
+        self.params = plugin_params("CloudShadowsPlugin", CloudShadowParams, params, fields)
 
     def build(self, app) -> None:
         if app.graph is None:

@@ -1,9 +1,9 @@
 """LightShaftParams: the settings of the light shafts, checked as a whole before any is used."""
 from __future__ import annotations
 
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass
 
-from atmos.checks import check_int, check_known, check_num
+from atmos.checks import CheckedParams, check_int, check_num
 
 MAX_SAMPLES = 256
 MAX_DOWNSAMPLE = 8
@@ -11,7 +11,7 @@ _OWNER = "LightShaftParams"
 
 
 @dataclass(frozen=True)
-class LightShaftParams:
+class LightShaftParams(CheckedParams):
     """Occlusion mask, radial blur toward the sun (GPU Gems 3, ch. 13) and when the effect shows.
 
     Mask: sky pixels (depth 1) whose luminance exceeds ``threshold`` (linear HDR) keep the excess,
@@ -62,8 +62,3 @@ class LightShaftParams:
         )
         for name, value in checked.items():
             object.__setattr__(self, name, value)
-
-    def replace(self, **changes) -> "LightShaftParams":
-        """A checked copy with ``changes``; unknown names and bad values raise ValueError."""
-        check_known(_OWNER, changes, [f.name for f in fields(self)])
-        return replace(self, **changes)

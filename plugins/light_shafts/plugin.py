@@ -4,6 +4,7 @@ from __future__ import annotations
 import math
 
 from atmos.camera import Camera
+from atmos.checks import plugin_params
 from atmos.graph import PassBuilder, PassContext, RenderPass, TextureDesc
 from atmos.lighting import scene_sun
 from atmos.plugin import Plugin
@@ -94,9 +95,7 @@ class LightShaftsPlugin(Plugin):
     def __init__(self, params: LightShaftParams | None = None, **fields):
         if params is not None and fields:
             raise ValueError("give LightShaftsPlugin either a LightShaftParams or its fields as keywords, not both")
-        self.params = params if params is not None else LightShaftParams(**fields)
-        if not isinstance(self.params, LightShaftParams):
-            raise ValueError(f"LightShaftsPlugin params must be a LightShaftParams, got {type(self.params).__name__}")
+        self.params = plugin_params("LightShaftsPlugin", LightShaftParams, params, fields)
         self.gpu = None
 
     def build(self, app) -> None:

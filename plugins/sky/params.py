@@ -1,9 +1,9 @@
 """SkyParams: every setting of the Preetham sky, checked as a whole before any of it is used."""
 from __future__ import annotations
 
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass
 
-from atmos.checks import check_known, check_num, check_vec
+from atmos.checks import CheckedParams, check_num, check_vec
 from atmos.plugins.shading.scattering import NIGHT_SKY
 from atmos.plugins.sky.preetham import TURBIDITY_RANGE, check_turbidity
 
@@ -11,7 +11,7 @@ _OWNER = "SkyParams"
 
 
 @dataclass(frozen=True)
-class SkyParams:
+class SkyParams(CheckedParams):
     """Look of the sky: haze, brightness in the HDR pipeline, sun disc, night and stars.
 
     ``scale``: HDR units per kcd/m² of Preetham luminance (0.03 puts a clear noon zenith near 0.25,
@@ -52,8 +52,3 @@ class SkyParams:
         )
         for name, value in checked.items():
             object.__setattr__(self, name, value)
-
-    def replace(self, **changes) -> "SkyParams":
-        """A checked copy with ``changes``; unknown names and bad values raise ValueError."""
-        check_known(_OWNER, changes, [f.name for f in fields(self)])
-        return replace(self, **changes)

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from atmos.camera import Camera, set_camera_uniforms
+from atmos.checks import plugin_params
 from atmos.graph import FullscreenPass, PassContext
 from atmos.lighting import scene_sun, sun_and_day
 from atmos.plugin import Plugin
@@ -37,10 +38,7 @@ class SkyPlugin(Plugin):
     """
 
     def __init__(self, params: SkyParams | None = None, **settings):
-        if params is not None and not isinstance(params, SkyParams):
-            raise ValueError(f"params must be a SkyParams, got {type(params).__name__}")
-        base = params if params is not None else SkyParams()
-        self.params = base.replace(**settings) if settings else base
+        self.params = plugin_params("SkyPlugin", SkyParams, params, settings)
 
     def configure(self, **changes) -> SkyParams:
         self.params = self.params.replace(**changes)

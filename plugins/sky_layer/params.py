@@ -1,9 +1,9 @@
 """SkyLayerParams: every setting of the 2D cloud layer, checked as a whole before any of it is used."""
 from __future__ import annotations
 
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass
 
-from atmos.checks import check_int, check_known, check_num, check_vec
+from atmos.checks import CheckedParams, check_int, check_num, check_vec
 
 _OWNER = "SkyLayerParams"
 MIN_GAP = 1e-3          # sharpness − emptiness must be at least this (the remap divides by it)
@@ -13,7 +13,7 @@ TEXTURE_SETTINGS = ("size", "base_frequency", "seed", "light_step")   # changing
 
 
 @dataclass(frozen=True)
-class SkyLayerParams:
+class SkyLayerParams(CheckedParams):
     """Look (emptiness, sharpness, thickness, colours), placement (altitude, tile_size) and motion (wind).
 
     Octave k has ``base_frequency · 2^k`` noise cells across one tile of ``tile_size`` metres.
@@ -61,11 +61,6 @@ class SkyLayerParams:
                              f"(got emptiness={self.emptiness!r}, sharpness={self.sharpness!r})")
         for name, value in checked.items():
             object.__setattr__(self, name, value)
-
-    def replace(self, **changes) -> "SkyLayerParams":
-        """A checked copy with ``changes``; unknown names and bad values raise ValueError."""
-        check_known(_OWNER, changes, [f.name for f in fields(self)])
-        return replace(self, **changes)
 
     def texture_key(self) -> tuple:
         """The settings the baked octave textures depend on."""

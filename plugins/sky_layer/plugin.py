@@ -4,6 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from atmos.camera import Camera, set_camera_uniforms
+from atmos.checks import plugin_params
 from atmos.graph import FullscreenPass, PassContext
 from atmos.lighting import Sun, scene_sun, sun_and_day
 from atmos.plugin import Plugin
@@ -68,10 +69,7 @@ class SkyLayerPlugin(Plugin):
 
     def __init__(self, params: SkyLayerParams | None = None, animate: bool = True,
                  rebake_tolerance: float = 0.05, **settings):
-        if params is not None and not isinstance(params, SkyLayerParams):
-            raise ValueError(f"params must be a SkyLayerParams, got {type(params).__name__}")
-        base = params if params is not None else SkyLayerParams()
-        self.params = base.replace(**settings) if settings else base
+        self.params = plugin_params("SkyLayerPlugin", SkyLayerParams, params, settings)
         if not (isinstance(rebake_tolerance, (int, float)) and 0 <= rebake_tolerance <= 1):
             raise ValueError(f"rebake_tolerance must be a number in 0..1 (fraction of a light step), "
                              f"got {rebake_tolerance!r}")

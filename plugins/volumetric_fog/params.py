@@ -1,9 +1,9 @@
 """FogParams: every setting of the volumetric fog, checked as a whole before any of it is used."""
 from __future__ import annotations
 
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass
 
-from atmos.checks import check_int, check_known, check_num, check_vec
+from atmos.checks import CheckedParams, check_int, check_num, check_vec
 
 MAX_OCTAVES = 16
 MAX_STEPS = 1024
@@ -12,7 +12,7 @@ _OWNER = "FogParams"
 
 
 @dataclass(frozen=True)
-class FogParams:
+class FogParams(CheckedParams):
     """The FBM medium, the march and the colours (world units are metres, y is up).
 
     density(p) = bias − falloff·‖(p − center)/scale‖ + fbm(frequency·(p − center − wind·t), octaves);
@@ -56,8 +56,3 @@ class FogParams:
         )
         for name, value in checked.items():
             object.__setattr__(self, name, value)
-
-    def replace(self, **changes) -> "FogParams":
-        """A checked copy with ``changes``; unknown names and bad values raise ValueError."""
-        check_known(_OWNER, changes, [f.name for f in fields(self)])
-        return replace(self, **changes)

@@ -4,6 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from atmos.camera import Camera, set_camera_uniforms
+from atmos.checks import plugin_params
 from atmos.graph import FullscreenPass, PassContext
 from atmos.lighting import Sun, scene_sun, sun_and_day
 from atmos.plugin import Plugin
@@ -58,10 +59,7 @@ class VolumetricFogPlugin(Plugin):
     """
 
     def __init__(self, params: FogParams | None = None, animate: bool = True, **settings):
-        base = params if params is not None else FogParams()
-        if params is not None and not isinstance(params, FogParams):
-            raise ValueError(f"params must be a FogParams, got {type(params).__name__}")
-        self.params = base.replace(**settings) if settings else base
+        self.params = plugin_params("VolumetricFogPlugin", FogParams, params, settings)
         self.animate = bool(animate)
 
     def configure(self, **changes) -> FogParams:
