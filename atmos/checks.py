@@ -6,7 +6,10 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import numbers
 import operator
+
+import numpy as np
 
 
 def check_vec(owner: str, name: str, value, n: int, kind: str = "finite") -> tuple:
@@ -50,6 +53,22 @@ def check_int(owner: str, name: str, value, lo: int, hi: int) -> int:
     if v is None or not lo <= v <= hi:
         raise ValueError(f"{owner}.{name} must be a whole number {lo}..{hi}, got {value!r}")
     return v
+
+
+def is_int(value) -> bool:
+    """True for Python and numpy integers, not bools."""
+    return isinstance(value, (numbers.Integral, np.integer)) and not isinstance(value, (bool, np.bool_))
+
+
+def check_shape(shape, name: str = "shape") -> tuple[int, int, int]:
+    """``(nx, ny, nz)`` as ints; ValueError naming ``name`` unless three positive ints."""
+    try:
+        values = tuple(shape)
+    except TypeError:
+        values = None
+    if values is None or len(values) != 3 or not all(is_int(n) and n >= 1 for n in values):
+        raise ValueError(f"{name} must be three positive ints (nx, ny, nz), got {shape!r}")
+    return tuple(int(n) for n in values)
 
 
 def check_known(owner: str, changes: dict, known) -> None:

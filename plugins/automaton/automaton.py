@@ -46,6 +46,7 @@ import numbers
 import moderngl
 import numpy as np
 
+from atmos.checks import check_shape, is_int
 from atmos.gpu.shaders import build_program
 from atmos.hashing import stream_key
 
@@ -58,10 +59,6 @@ _ONE = 1 << PRECISION_BITS
 
 _RULE_IDS = np.repeat(np.arange(3, dtype=np.uint32), PRECISION_BITS)
 _PLANE_IDS = np.tile(np.arange(PRECISION_BITS, dtype=np.uint32), 3)
-
-
-def _is_int(value) -> bool:
-    return isinstance(value, (numbers.Integral, np.integer)) and not isinstance(value, (bool, np.bool_))
 
 
 def _mb(n: int) -> str:
@@ -81,15 +78,9 @@ class CloudAutomaton:
             raise ValueError(f"ctx must be a moderngl.Context, got {type(ctx).__name__}")
         if layout not in LAYOUTS:
             raise ValueError(f"layout must be one of {LAYOUTS}, got {layout!r}")
-        if not _is_int(seed) or not 0 <= int(seed) < 2**32:
+        if not is_int(seed) or not 0 <= int(seed) < 2**32:
             raise ValueError(f"seed must be an int in [0, 2**32), got {seed!r}")
-        try:
-            shape = tuple(shape)
-        except TypeError:
-            shape = None
-        if shape is None or len(shape) != 3 or not all(_is_int(n) and n >= 1 for n in shape):
-            raise ValueError(f"shape must be three positive ints (nx, ny, nz), got {shape!r}")
-        shape = tuple(int(n) for n in shape)
+        shape = check_shape(shape)
         nx, ny, nz = shape
         nwx = -(-nx // 32)
         words = nwx * ny * nz

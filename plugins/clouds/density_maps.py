@@ -24,8 +24,9 @@ import math
 import moderngl
 import numpy as np
 
+from atmos.checks import check_shape, is_int
 from atmos.gpu.shaders import build_program
-from atmos.plugins.clouds.reference import check_shape, group_grid, is_int
+from atmos.plugins.clouds.reference import group_grid
 from atmos.plugins.clouds.smoothing import as_context, check_texture_limit, check_volume_texture, check_z_range
 
 

@@ -17,29 +17,13 @@ strictly positive and stays so after rounding to the texture format.
 """
 from __future__ import annotations
 
-import numbers
-
 import numpy as np
+
+from atmos.checks import is_int
 
 WEIGHTS = ("tent", "box")
 MAX_RADIUS = 8
 F16_MIN_NORMAL = 2.0 ** -14   # smallest normal half float: survives r16f storage and flush-to-zero
-
-
-def is_int(value) -> bool:
-    """True for Python/numpy integers, not bools."""
-    return isinstance(value, (numbers.Integral, np.integer)) and not isinstance(value, (bool, np.bool_))
-
-
-def check_shape(shape) -> tuple[int, int, int]:
-    """``(nx, ny, nz)`` as ints; ValueError unless three positive ints."""
-    try:
-        shape = tuple(shape)
-    except TypeError:
-        shape = None
-    if shape is None or len(shape) != 3 or not all(is_int(n) and n >= 1 for n in shape):
-        raise ValueError(f"shape must be three positive ints (nx, ny, nz), got {shape!r}")
-    return tuple(int(n) for n in shape)
 
 
 def check_radius(radius) -> tuple[int, int, int]:

@@ -22,10 +22,10 @@ import math
 import moderngl
 import numpy as np
 
+from atmos.checks import check_shape, is_int
 from atmos.gpu.shaders import build_program
 from atmos.plugins.automaton import LAYOUTS
-from atmos.plugins.clouds.reference import (F16_MIN_NORMAL, axis_weights, check_radius,
-                                            check_shape, check_weights, is_int)
+from atmos.plugins.clouds.reference import F16_MIN_NORMAL, axis_weights, check_radius, check_weights
 
 FORMATS = {"f2": "r16f", "f4": "r32f"}       # texture dtype -> image format
 MIN_DENSITY = {"f2": F16_MIN_NORMAL, "f4": 0.0}

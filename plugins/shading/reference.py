@@ -90,17 +90,6 @@ def check_scale(scale) -> int:
     return int(scale)
 
 
-def check_shape(shape) -> tuple[int, int, int]:
-    try:
-        shape = tuple(shape)
-    except TypeError:
-        shape = None
-    if shape is None or len(shape) != 3 or not all(isinstance(n, numbers.Integral) and not isinstance(n, bool)
-                                                 and n >= 1 for n in shape):
-        raise ValueError(f"shape must be three ints >= 1 (nx, ny, nz); got {shape!r}")
-    return tuple(int(n) for n in shape)
-
-
 # -- geometry --------------------------------------------------------------------------------------
 def shading_shape(shape, scale: int) -> tuple[int, int, int]:
     """Shading grid for ``scale``: ceil(n / scale) per axis (the same box, coarser cells)."""

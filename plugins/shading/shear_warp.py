@@ -22,6 +22,7 @@ import weakref
 import moderngl
 import numpy as np
 
+from atmos.checks import check_shape
 from atmos.frames import SliceStage
 from atmos.gpu.shaders import build_program
 from atmos.plugins.shading import reference as ref
@@ -83,7 +84,7 @@ class ShearWarpShader:
 
     def __init__(self, ctx, shape, scale: int = 1, model: str = "true-path", levels: int = 0):
         self.ctx = context_of(ctx)
-        self.shape = ref.check_shape(shape)
+        self.shape = check_shape(shape)
         self.scale = ref.check_scale(scale)
         if model not in ("true-path", "fixed-ratio"):
             raise ValueError(f"model must be 'true-path' or 'fixed-ratio'; got {model!r}")

@@ -12,12 +12,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from atmos.checks import check_shape, is_int
+
 #: Upper bound of ``cloud_density`` (ellipsoids are ECS entities; the rules run in Python).
 MAX_CLOUD_DENSITY = 100_000
-
-
-def _is_int(value) -> bool:
-    return isinstance(value, (numbers.Integral, np.integer)) and not isinstance(value, (bool, np.bool_))
 
 
 def _is_real(value) -> bool:
@@ -100,7 +98,7 @@ class WeatherParams:
 
         def integer(name, lo, hi):
             value = getattr(self, name)
-            if not _is_int(value) or not lo <= int(value) <= hi:
+            if not is_int(value) or not lo <= int(value) <= hi:
                 raise ValueError(f"WeatherParams.{name} must be an int in [{lo}, {hi}], got {value!r}")
             object.__setattr__(self, name, int(value))
 
@@ -121,15 +119,7 @@ class WeatherParams:
                              f"so that every lifetime is positive, got {self.lifetime_variance!r}")
         real("shrink_time", 0.0)
         real("region_margin", 0.0)
-        shape = self.volume_shape
-        try:
-            shape = tuple(shape)
-        except TypeError:
-            shape = None
-        if shape is None or len(shape) != 3 or not all(_is_int(n) and n >= 1 for n in shape):
-            raise ValueError(f"WeatherParams.volume_shape must be three positive ints (nx, ny, nz), "
-                             f"got {self.volume_shape!r}")
-        object.__setattr__(self, "volume_shape", tuple(int(n) for n in shape))
+        object.__setattr__(self, "volume_shape", check_shape(self.volume_shape, "WeatherParams.volume_shape"))
         wind = self.wind
         try:
             wind = tuple(wind)
