@@ -15,5 +15,5 @@ def mapped_packages():
 setup(
     packages=mapped_packages(),
     package_dir={"atmos": "atmos", **MAPPED},
-    package_data={"": ["*.glsl", "*.vert", "*.frag", "*.comp", "*.geom"]},
+    package_data={"": ["*.glsl", "*.vert", "*.frag", "*.comp", "*.geom"], "atmos": ["py.typed"]},
 )

@@ -1,1 +1,53 @@
-"""atmos: real-time atmospheric effects for Python games and demo scenes."""
+"""atmos: real-time atmospheric effects for Python games and demo scenes.
+
+What a game or plugin author needs is importable from here::
+
+    from atmos import App, DefaultPlugins, create_headless
+    from atmos.plugins.sky import SkyPlugin
+
+Names load on first use, so ``import atmos`` stays cheap.
+"""
+from __future__ import annotations
+
+from importlib import import_module
+
+_EXPORTS = {
+    # the App and plugins
+    "App": "atmos.app", "Plugin": "atmos.plugin", "PluginGroup": "atmos.plugin",
+    "DefaultPlugins": "atmos.defaults", "discover_plugins": "atmos.plugin",
+    # plugin settings (the convention: atmos.checks)
+    "CheckedSettings": "atmos.checks", "check_num": "atmos.checks", "check_int": "atmos.checks",
+    "check_vec": "atmos.checks", "check_bool": "atmos.checks", "check_choice": "atmos.checks",
+    "RenderCoreSettings": "atmos.render_core",
+    # render passes and the graph
+    "RenderPass": "atmos.graph", "FullscreenPass": "atmos.graph", "PassBuilder": "atmos.graph",
+    "PassContext": "atmos.graph", "RenderGraph": "atmos.graph", "TextureDesc": "atmos.graph",
+    "GraphError": "atmos.graph", "PHASES": "atmos.graph",
+    "COLOR": "atmos.render_core", "DEPTH": "atmos.render_core", "SCREEN": "atmos.render_core",
+    "CapturePass": "atmos.render_core", "RenderCorePlugin": "atmos.render_core",
+    # what passes see and write
+    "SceneView": "atmos.scene_view", "Camera": "atmos.camera", "Input": "atmos.camera",
+    "CameraPlugin": "atmos.camera", "set_camera_uniforms": "atmos.camera", "Sun": "atmos.lighting",
+    "set_sun_uniforms": "atmos.lighting", "set_scene_uniforms": "atmos.lighting", "FixedClock": "atmos.clock",
+    # GPU
+    "GpuContext": "atmos.gpu", "GpuError": "atmos.gpu", "ShaderError": "atmos.gpu",
+    "create_headless": "atmos.gpu", "from_current": "atmos.gpu", "add_shader_path": "atmos.gpu.shaders",
+    # work spread over frames
+    "TextureSet": "atmos.frames", "TripleSet": "atmos.frames", "SlicedJob": "atmos.frames",
+    "SliceStage": "atmos.frames", "FrameScheduler": "atmos.frames",
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str):
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'atmos' has no attribute {name!r}")
+    value = getattr(import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

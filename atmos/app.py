@@ -5,6 +5,7 @@ import time
 
 from atmos.clock import FixedClock
 from atmos.plugin import Plugin, PluginGroup
+from atmos.scene_view import SceneView
 from atmos.schedule import Schedule
 from atmos.world import World
 
@@ -29,11 +30,10 @@ class App:
         self.graph = RenderGraph(gpu) if gpu is not None else None
         self.frames = FrameScheduler()
         self.running = True
-        self._started = False
+        self._started = self._finished = False
         self.add_system(lambda app: app.frames.tick(), "render", label="frame_scheduler")
         if self.graph is not None:
-            self.add_system(lambda app: app.graph.execute(app=app), "render", label="render_graph",
-                            after="frame_scheduler")
+            self.add_system(App.render, "render", label="render_graph", after="frame_scheduler")
 
     # -- building --------------------------------------------------------------------------
     def add_plugins(self, *plugins: Plugin | PluginGroup) -> "App":
@@ -71,9 +71,10 @@ class App:
         return self.resources.get(kind, default)
 
     # -- running ---------------------------------------------------------------------------
-    def startup(self) -> None:
-        """Finish plugins, check the schedule (unknown labels and cycles fail here), run ``startup``."""
-        if self._started:
+    def finish(self) -> None:
+        """Finish building: plugins' ``finish``, the schedule checked (unknown labels and cycles fail
+        here), the render graph compiled. Runs no system: what ``atmos graph`` needs."""
+        if self._finished:
             return
         self._activate()
         for plugin in self.plugins:
@@ -81,11 +82,18 @@ class App:
         self.schedule.build()
         if self.graph is not None:
             self.graph.compile()
+        self._finished = True
+
+    def startup(self) -> None:
+        """:meth:`finish`, then run the ``startup`` stage once (simulations warm up there)."""
+        if self._started:
+            return
+        self.finish()
         self._started = True
         self.schedule.run("startup", self)
 
     def update(self, frame_dt: float | None = None) -> None:
-        """Run one frame: update, the due fixed ``simulate`` steps, render, cleanup."""
+        """Run one frame: update, the due fixed ``simulate`` steps, render, last."""
         if not self._started:
             self.startup()
         if frame_dt is None:
@@ -99,7 +107,12 @@ class App:
             self.schedule.run("simulate", self)
             self.clock.tick()
         self.schedule.run("render", self)
-        self.schedule.run("cleanup", self)
+        self.schedule.run("last", self)
+
+    def render(self) -> None:
+        """Run the render graph once with the scene as it is (what the render stage does each frame;
+        tests and tools call it to draw again without advancing time)."""
+        self.graph.execute(SceneView.of(self))
 
     def run_frames(self, n: int, dt: float = 1 / 60) -> None:
         for _ in range(n):

@@ -143,4 +143,4 @@ class CameraPlugin(Plugin):
         app.insert_resource(self.camera)
         app.insert_resource(Input())
         app.add_system(fly_camera, "update", label="fly_camera")
-        app.add_system(lambda app: app.resource(Input).end_frame(), "cleanup", label="input_end_frame")
+        app.add_system(lambda app: app.resource(Input).end_frame(), "last", label="input_end_frame")

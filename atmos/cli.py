@@ -107,7 +107,7 @@ def cmd_graph(args, top) -> int:
     except ValueError as error:
         top.error(str(error))
     gpu = create_headless((320, 180))
-    app = build_app(args.name, DemoSettings(size=gpu.size, headless=True), gpu)
+    app = build_app(args.name, DemoSettings(size=gpu.size, headless=True), gpu, start=False)
     try:
         print(app.graph.to_dot() if args.dot else app.graph.dump())
     finally:

@@ -1,4 +1,9 @@
-"""The sun as a resource: where it is and what colour its light has."""
+"""The sun as a resource: where it is and what colour its light has; the sun/sky light model.
+
+:func:`sky_light` gives the sun's colour (reddened near the horizon, zero at night) and the sky's
+ambient colour for a sun direction: what DaylightPlugin writes into :class:`Sun`, and what the sky
+(``NIGHT_SKY``) and the cloud light (:mod:`atmos.shading.scattering`) build on.
+"""
 from __future__ import annotations
 
 import math
@@ -6,7 +11,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from atmos.camera import Camera, set_camera_uniforms
+from atmos.camera import set_camera_uniforms
+from atmos.checks import check_sun_dir
+
+RAYLEIGH = np.array([0.03, 0.07, 0.16])      # extinction of sunlight per air mass (red, green, blue)
+DAY_SKY = np.array([0.35, 0.47, 0.65])
+TWILIGHT_SKY = np.array([0.30, 0.22, 0.25])
+NIGHT_SKY = np.array([0.012, 0.016, 0.03])
 
 
 @dataclass(slots=True)
@@ -23,6 +34,37 @@ class Sun:
         return cls(np.array([math.sin(a) * math.cos(e), math.sin(e), -math.cos(a) * math.cos(e)]), color)
 
 
+def unit_sun(direction) -> np.ndarray | None:
+    """The unit direction toward the sun, or None when it is not a finite non-zero vector."""
+    s = np.asarray(direction, np.float64).reshape(3)
+    norm = np.linalg.norm(s)
+    return s / norm if np.isfinite(norm) and norm > 1e-12 else None
+
+
+def _smoothstep(e0: float, e1: float, x: float) -> float:
+    t = min(max((x - e0) / (e1 - e0), 0.0), 1.0)
+    return t * t * (3 - 2 * t)
+
+
+def sky_light(sun_dir, ambient_scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """(sun colour, ambient colour) as float64 RGB for a sun in direction ``sun_dir`` (y up).
+
+    Sun: reddened by ``exp(-RAYLEIGH * air mass)`` (Kasten-Young air mass), faded out across the
+    horizon over the sun disc (-0.5 deg .. 0.5 deg), 0 below. Ambient: day blue, tinted at twilight,
+    dark blue at night (``NIGHT_SKY``), scaled by ``ambient_scale`` (a cloud
+    :class:`~atmos.shading.Scattering`'s ``ambient``). Continuous in the direction.
+    """
+    u = check_sun_dir(sun_dir)
+    e = math.degrees(math.asin(max(-1.0, min(1.0, u[1]))))
+    height = max(e, 0.0)
+    air_mass = 1.0 / (math.sin(math.radians(height)) + 0.50572 * (height + 6.07995) ** -1.6364)
+    sun = np.exp(-RAYLEIGH * air_mass) * _smoothstep(-0.5, 0.5, e)
+    day = _smoothstep(-6.0, 20.0, e)
+    twilight = _smoothstep(-8.0, 0.0, e) * (1.0 - _smoothstep(0.0, 15.0, e))
+    ambient = NIGHT_SKY + day * DAY_SKY + 0.5 * twilight * TWILIGHT_SKY
+    return sun, ambient * float(ambient_scale)
+
+
 def sun_and_day(sun: Sun) -> tuple[np.ndarray, float]:
     """(unit direction toward the sun, daylight 0..1 = smoothstep(-0.15, 0.1, sun height) like the sky)."""
     s = np.asarray(sun.direction, np.float64)
@@ -32,11 +74,6 @@ def sun_and_day(sun: Sun) -> tuple[np.ndarray, float]:
     return s, day * day * (3 - 2 * day)
 
 
-def scene_sun(app) -> Sun:
-    """The App's Sun resource, or the default sun for a scene that has none."""
-    return app.get_resource(Sun) or _DEFAULT_SUN
-
-
 def set_sun_uniforms(program, sun: Sun) -> None:
     """Write ``sun_dir`` and ``sun_color`` where the program has them."""
     for name, value in (("sun_dir", sun.direction), ("sun_color", sun.color)):
@@ -44,11 +81,8 @@ def set_sun_uniforms(program, sun: Sun) -> None:
             program[name].value = tuple(float(v) for v in value)
 
 
-def set_scene_uniforms(program, app, aspect: float) -> None:
-    """The App's camera (:func:`atmos.camera.set_camera_uniforms`) and sun (:func:`set_sun_uniforms`)
-    uniforms: what a pass drawing the lit scene writes each frame."""
-    set_camera_uniforms(program, app.resource(Camera), aspect)
-    set_sun_uniforms(program, scene_sun(app))
-
-
-_DEFAULT_SUN = Sun()
+def set_scene_uniforms(program, view) -> None:
+    """The camera (:func:`atmos.camera.set_camera_uniforms`) and sun (:func:`set_sun_uniforms`)
+    uniforms of a :class:`atmos.SceneView`: what a pass drawing the lit scene writes each frame."""
+    set_camera_uniforms(program, view.camera, view.aspect)
+    set_sun_uniforms(program, view.sun)

@@ -66,6 +66,7 @@ class FrameWriter:
 class EncodePass(RenderPass):
     """Reads the finished screen image back and hands it to the writer (a side effect)."""
     name = "encode"
+    phase = "readback"
 
     def __init__(self, writer: FrameWriter):
         self.writer = writer
@@ -85,7 +86,7 @@ class OutputPlugin(Plugin):
         self.writer = FrameWriter(path, fps)
 
     def build(self, app) -> None:
-        app.graph.import_texture(VIDEO, self.writer)
+        app.graph.import_resource(VIDEO, self.writer)
         app.graph.add_pass(EncodePass(self.writer))
 
     def cleanup(self, app) -> None:

@@ -2,20 +2,54 @@
 from __future__ import annotations
 
 from importlib.metadata import entry_points
+from typing import TYPE_CHECKING, Any
+
+from atmos.checks import configure_settings, plugin_settings
+
+if TYPE_CHECKING:
+    from atmos.app import App
 
 ENTRY_POINT_GROUP = "atmos.plugins"
 
 
 class Plugin:
-    """An effect or a piece of the engine. ``build`` registers; ``finish`` runs once all are built."""
+    """An effect or a piece of the engine. ``build`` registers; ``finish`` runs once all are built.
 
-    def build(self, app) -> None:
+    Settings (the convention, :mod:`atmos.checks`): a plugin with settings names its frozen, checked
+    ``<Thing>Settings`` dataclass in ``settings_class``; ``Plugin(settings=None, **fields)`` keeps
+    ``self.settings`` (``fields`` on top of ``settings`` or the defaults, all checked) and
+    :meth:`configure` changes them while running. Passes and systems read ``plugin.settings``
+    every frame, so a change shows on the next frame.
+    """
+
+    settings_class: type | None = None
+
+    def __init__(self, settings=None, **fields):
+        cls = type(self).settings_class
+        if cls is None:
+            if settings is not None or fields:
+                given = (["settings"] if settings is not None else []) + sorted(fields)
+                raise ValueError(f"{self.name} takes no settings, got {', '.join(given)}")
+            self.settings = None
+            return
+        self.settings = plugin_settings(self.name, cls, settings, fields)
+
+    def configure(self, **changes) -> Any:
+        """Change settings while running; returns the new settings. All ``changes`` are checked
+        together (unknown names, bad values, the ``FIXED`` fields that cannot change while running):
+        on any error a ValueError says why and nothing changes. Takes effect on the next frame."""
+        if getattr(self, "settings", None) is None:
+            raise ValueError(f"{self.name} has no settings to configure")
+        self.settings = configure_settings(self.name, self.settings, changes)
+        return self.settings
+
+    def build(self, app: App) -> None:
         """Add systems, resources and render passes to ``app``."""
 
-    def finish(self, app) -> None:
+    def finish(self, app: App) -> None:
         """Late setup, after every plugin's ``build`` (e.g. read other plugins' resources)."""
 
-    def cleanup(self, app) -> None:
+    def cleanup(self, app: App) -> None:
         """Release what ``build``/``finish`` created (GL objects above all); called by App.close()."""
 
     @property
@@ -52,6 +86,21 @@ class PluginGroup:
     def add(self, plugin: Plugin) -> "PluginGroup":
         self.plugins.append(plugin)
         return self
+
+    def set(self, plugin: Plugin) -> "PluginGroup":
+        """Replace the member of ``plugin``'s type with ``plugin`` (configured as you want it), as in
+        ``DefaultPlugins().set(RenderCorePlugin(exposure=1.5))``."""
+        self.plugins[self._index(type(plugin))] = plugin
+        return self
+
+    def configure(self, kind: type, **changes) -> "PluginGroup":
+        """Change settings of the member of type ``kind`` (checked like :meth:`Plugin.configure`)."""
+        self.plugins[self._index(kind)].configure(**changes)
+        return self
+
+    def get(self, kind: type) -> Plugin:
+        """The member of type ``kind``."""
+        return self.plugins[self._index(kind)]
 
     def __iter__(self):
         return iter(self.plugins)

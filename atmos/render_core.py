@@ -5,7 +5,7 @@ The ``color`` target's alpha: how much each pixel is occluded from the sky
 ``color.rgb`` is linear HDR radiance; ``color.a`` is how much of the pixel hides the sky behind it:
 **0 = open sky, 1 = opaque geometry or opaque cloud** (in between: partly covered, e.g. a cloud edge).
 Every pass that writes ``color`` keeps to it; the light shafts' occlusion mask reads it
-(:class:`atmos.plugins.light_shafts.LightShaftParams`), so bright sunlit clouds over the sky cut the
+(:class:`atmos.plugins.light_shafts.LightShaftSettings`), so bright sunlit clouds over the sky cut the
 shafts instead of casting them.
 
 - The clear pass clears alpha to 0 (nothing drawn is open sky); the sky passes (``sky``,
@@ -28,7 +28,11 @@ shafts instead of casting them.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
+
+from atmos.checks import CheckedSettings, check_num, check_vec
 
 from atmos.graph import FullscreenPass, PassBuilder, PassContext, RenderPass, TextureDesc
 from atmos.plugin import Plugin
@@ -48,12 +52,13 @@ def depth_desc(gpu) -> TextureDesc:
 
 class ClearPass(RenderPass):
     """Creates the scene's HDR ``color`` and ``depth`` textures and clears them: colour to
-    ``(*color, 0)`` (alpha 0: open sky, see the module docstring), depth to 1."""
+    ``(*clear_color, 0)`` (alpha 0: open sky, see the module docstring), depth to 1."""
     name = "clear"
+    phase = "clear"
 
-    def __init__(self, gpu, color=(0.0, 0.0, 0.0)):
+    def __init__(self, gpu, plugin: "RenderCorePlugin"):
         self.gpu = gpu
-        self.color = color
+        self.plugin = plugin
 
     def setup(self, builder: PassBuilder) -> None:
         builder.create(COLOR, color_desc(self.gpu))
@@ -62,21 +67,22 @@ class ClearPass(RenderPass):
     def execute(self, frame: PassContext) -> None:
         fbo = frame.framebuffer(color=[COLOR], depth=DEPTH)
         fbo.use()
-        fbo.clear(*self.color, 0.0, depth=1.0)
+        fbo.clear(*self.plugin.settings.clear_color, 0.0, depth=1.0)
 
 
 class PresentPass(FullscreenPass):
     """Tone-maps the HDR ``color`` into the screen (window or offscreen target), with sRGB gamma;
     the screen's alpha is 1 (``color.a``, the sky occlusion, is not shown)."""
     name = "present"
+    phase = "present"
     fragment = "core/present.frag"
     reads = (COLOR,)
     writes = (SCREEN,)
 
     def execute(self, frame: PassContext) -> None:
-        frame.texture(SCREEN).use()
-        frame.texture(COLOR).use(0)
-        self.program["exposure"].value = self.plugin.exposure
+        frame.resource(SCREEN).use()
+        frame.resource(COLOR).use(0)
+        self.program["exposure"].value = self.plugin.settings.exposure
         frame.fullscreen(self.program)
 
 
@@ -84,6 +90,7 @@ class CapturePass(RenderPass):
     """Copies the final HDR ``color`` (float, (h, w, 4)) and ``depth`` ((h, w)) to numpy each frame,
     rows bottom-up as OpenGL stores them. For tests, tools and HDR screenshots; a side effect."""
     name = "capture"
+    phase = "readback"
 
     def __init__(self):
         self.color = self.depth = None
@@ -95,20 +102,33 @@ class CapturePass(RenderPass):
 
     def execute(self, frame: PassContext) -> None:
         w, h = frame.gpu.size
-        self.color = np.frombuffer(frame.texture(COLOR).read(), np.float16).reshape(h, w, 4).astype(np.float64)
-        self.depth = np.frombuffer(frame.texture(DEPTH).read(), np.float32).reshape(h, w).astype(np.float64)
+        self.color = np.frombuffer(frame.resource(COLOR).read(), np.float16).reshape(h, w, 4).astype(np.float64)
+        self.depth = np.frombuffer(frame.resource(DEPTH).read(), np.float32).reshape(h, w).astype(np.float64)
+
+
+@dataclass(frozen=True)
+class RenderCoreSettings(CheckedSettings):
+    """``clear_color``: linear HDR colour ``color`` starts each frame with (non-negative);
+    ``exposure``: HDR scale before tone mapping (> 0). All live."""
+    clear_color: tuple = (0.0, 0.0, 0.0)
+    exposure: float = 1.0
+
+    def __post_init__(self):
+        o = "RenderCoreSettings"
+        self.store(dict(clear_color=check_vec(o, "clear_color", self.clear_color, 3, "non-negative"),
+                        exposure=check_num(o, "exposure", self.exposure, 0.0, 1e6, lo_open=True)))
 
 
 class RenderCorePlugin(Plugin):
-    """Imports the screen into the render graph and adds the clear and present passes."""
+    """Imports the screen into the render graph and adds the clear and present passes:
+    ``RenderCorePlugin(settings=None, **fields)`` with :class:`RenderCoreSettings`;
+    ``configure(**changes)`` changes any of them live (next frame)."""
 
-    def __init__(self, clear_color=(0.0, 0.0, 0.0), exposure: float = 1.0):
-        self.clear_color = clear_color
-        self.exposure = exposure
+    settings_class = RenderCoreSettings
 
     def build(self, app) -> None:
         if app.graph is None:
             return
-        app.graph.import_texture(SCREEN, lambda: app.gpu.target)
-        app.graph.add_pass(ClearPass(app.gpu, self.clear_color))
+        app.graph.import_resource(SCREEN, lambda: app.gpu.target)
+        app.graph.add_pass(ClearPass(app.gpu, self))
         app.graph.add_pass(PresentPass(self))

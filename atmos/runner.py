@@ -13,15 +13,16 @@ def has_display() -> bool:
     return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")) or sys.platform in ("win32", "darwin")
 
 
-def build_app(name: str, settings: DemoSettings, gpu, *extra_plugins) -> App:
-    """A started App for demo ``name`` on ``gpu``, with ``extra_plugins`` added after the demo's."""
+def build_app(name: str, settings: DemoSettings, gpu, *extra_plugins, start: bool = True) -> App:
+    """A started App for demo ``name`` on ``gpu``, with ``extra_plugins`` added after the demo's
+    (``start=False``: built and finished, but no system has run — no simulation warm-up)."""
     demo = load_demo(name)
     app = App(gpu)
     app.insert_resource(settings)           # demos read it (headless runs script their camera)
     try:
         demo.build(app, settings)
         app.add_plugins(*extra_plugins)
-        app.startup()
+        app.startup() if start else app.finish()
     except Exception:
         app.close()
         raise
@@ -67,7 +68,7 @@ def run_window(name: str, settings: DemoSettings) -> None:
     from pyglet.window import key
 
     from atmos.camera import Input
-    from atmos.plugins.overlay import FrameTimes
+    from atmos.plugins.overlay import FrameTimes, OverlayPlugin
 
     config = pyglet.gl.Config(major_version=4, minor_version=3, forward_compatible=True,
                               depth_size=24, double_buffer=True)
@@ -89,7 +90,6 @@ def run_window(name: str, settings: DemoSettings) -> None:
     @window.event
     def on_resize(width, height):
         gpu.resize(window.get_framebuffer_size())
-        app.graph.invalidate()
 
     @window.event
     def on_key_press(symbol, modifiers):
@@ -97,8 +97,9 @@ def run_window(name: str, settings: DemoSettings) -> None:
         name_ = key.symbol_string(symbol).lower()
         inp.keys.add(name_)
         inp.pressed.add(name_)
-        if symbol == key.F1 and app.get_resource(FrameTimes) is not None:
-            app.resource(FrameTimes).visible ^= True
+        overlay = next((p for p in app.plugins if isinstance(p, OverlayPlugin)), None)
+        if symbol == key.F1 and overlay is not None:
+            overlay.configure(visible=not overlay.settings.visible)
 
     @window.event
     def on_key_release(symbol, modifiers):

@@ -7,8 +7,9 @@ from typing import Callable
 from atmos.toposort import CycleError, stable_toposort
 
 #: Stages in the order one frame runs them. ``startup`` runs once before the first frame;
-#: ``simulate`` runs zero or more times a frame, once per fixed simulation step (see FixedClock).
-STAGES = ("startup", "update", "simulate", "render", "cleanup")
+#: ``simulate`` runs zero or more times a frame, once per fixed simulation step (see FixedClock);
+#: ``last`` ends the frame (per-frame input is cleared there).
+STAGES = ("startup", "update", "simulate", "render", "last")
 
 
 class ScheduleError(ValueError):

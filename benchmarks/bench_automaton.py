@@ -12,7 +12,7 @@ import time
 import numpy as np
 
 from atmos.gpu import create_headless
-from atmos.plugins.automaton import CloudAutomaton, reference
+from atmos.automaton import CloudAutomaton, reference
 
 THESIS_STEP_MS = 12.5   # Table 8.1, "Simulation step update", GeForce 8700M GT, 256x32x256
 
@@ -24,8 +24,9 @@ def initial_state(rng, shape):
     return hum, act, cld
 
 
-def time_gpu(ctx, layout, shape, state, kwargs, steps):
-    ca = CloudAutomaton(ctx, shape, seed=1, layout=layout)
+def time_gpu(gpu, layout, shape, state, kwargs, steps):
+    ctx = gpu.ctx
+    ca = CloudAutomaton(gpu, shape, seed=1, layout=layout)
     ca.upload(*state)
     ca.step(**kwargs)             # warm-up: compiles, uploads and packs the probability arrays
     ctx.finish()
@@ -69,8 +70,8 @@ def main() -> None:
     print(head)
     print("-" * len(head))
     for (name, kwargs), goal in zip(cases.items(), (15, 5)):
-        packed = time_gpu(ctx, "packed", shape, state, kwargs, args.steps)
-        cell = time_gpu(ctx, "cell", shape, state, kwargs, args.steps)
+        packed = time_gpu(gpu, "packed", shape, state, kwargs, args.steps)
+        cell = time_gpu(gpu, "cell", shape, state, kwargs, args.steps)
         ref = time_numpy(shape, state, kwargs, args.numpy_steps)
         print(f"{name:30s} {packed:10.2f} {cell:10.2f} {ref:10.1f} {cell / packed:11.1f}x {goal:5d}x "
               f"{THESIS_STEP_MS:10.1f}")

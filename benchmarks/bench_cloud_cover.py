@@ -15,7 +15,7 @@ import numpy as np
 from atmos.app import App
 from atmos.gpu import create_headless
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
-from atmos.plugins.weather import Ellipsoid, WeatherParams
+from atmos.plugins.weather import Ellipsoid, WeatherSettings
 
 OUT = Path(__file__).resolve().parents[1] / "out" / "bench_cloud_cover.png"
 SCHEDULE = [(0, 80), (1000, 160), (1300, 40)]      # (step, cloud_density)
@@ -23,12 +23,12 @@ STEPS = 1600
 
 
 def run(gpu, adaption: int):
-    params = WeatherParams(volume_shape=(64, 8, 64), cloud_density=SCHEDULE[0][1], density_adaption=adaption,
+    params = WeatherSettings(volume_shape=(64, 8, 64), cloud_density=SCHEDULE[0][1], density_adaption=adaption,
                            cloud_size=4.0, cloud_size_variance=1.5, region_margin=6.0, lifetime=400.0,
                            lifetime_variance=50.0, hum_scale=0.2, act_scale=0.01, ext_scale=0.1,
                            vertical_scale=0.5, altitude_variance=0.1, wind=(0.5, 0.0, 0.25))
     app = App(gpu)
-    plugin = CloudsPlugin(params, CloudSettings(smoothing_slices=2, group_size=(16, 16)), seed=7)
+    plugin = CloudsPlugin(CloudSettings(weather=params, smoothing_slices=2, group_size=(16, 16)), seed=7)
     app.add_plugins(plugin)
     app.startup()
     sim = plugin.simulation

@@ -18,16 +18,16 @@ from atmos.defaults import DefaultPlugins
 from atmos.gpu import create_headless
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin, CloudSimulation
 from atmos.plugins.clouds.top_view import CloudTopViewPlugin
-from atmos.plugins.weather import WeatherParams
+from atmos.plugins.weather import WeatherSettings
 
 
 def scene(gpu, shape, mode: str) -> App:
     nx, ny, nz = shape
-    params = WeatherParams(volume_shape=shape, cloud_density=int(nx * nz / 400), density_adaption=8,
+    params = WeatherSettings(volume_shape=shape, cloud_density=int(nx * nz / 400), density_adaption=8,
                            cloud_size=nx / 20, cloud_size_variance=nx / 60, region_margin=nx / 16,
                            lifetime=300.0, lifetime_variance=50.0, hum_scale=0.2, act_scale=0.01, ext_scale=0.1)
     settings = CloudSettings(smoothing_slices=max(1, nz // 8), group_size=(32, 32))
-    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(params, settings, warmup_steps=20),
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(settings, weather=params, warmup_steps=20),
                                CloudTopViewPlugin())
     app.frames.mode = "naive" if mode == "naive" else "sliced"
     if mode == "paused":

@@ -30,7 +30,7 @@ from atmos.camera import Camera
 from atmos.defaults import DefaultPlugins
 from atmos.gpu import create_headless
 from atmos.lighting import Sun
-from atmos.plugins.cloud_render import CloudReferencePlugin, CloudRenderPlugin
+from atmos.plugins.cloud_render import CloudMarchPlugin, CloudRenderPlugin
 from atmos.plugins.cloud_render.example import example_weather
 from atmos.plugins.clouds import CloudSettings, CloudSimulation, CloudsPlugin
 from atmos.plugins.ground import GroundPlugin
@@ -50,8 +50,8 @@ def make_app(gpu, shape, cloud_density, group, cell, size_factor=3.0, reference_
     weather = example_weather(shape, cloud_density, density_adaption=max(4, cloud_density // 10))
     renderer = CloudRenderPlugin(base_altitude=BASE, size_factor=size_factor)
     plugins = [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(),
-               CloudsPlugin(weather, settings, seed=1, warmup_steps=warmup), renderer]
-    reference = CloudReferencePlugin(renderer, steps=reference_steps, enabled=False) if reference_steps else None
+               CloudsPlugin(settings, weather=weather, seed=1, warmup_steps=warmup), renderer]
+    reference = CloudMarchPlugin(renderer, steps=reference_steps, enabled=False) if reference_steps else None
     app.add_plugins(*plugins, *([reference] if reference else []))
     app.startup()
     app.update(1 / 60)
@@ -72,7 +72,7 @@ def render_ms(app, frames=20) -> float:
     for _ in range(frames + 2):
         ctx.finish()
         start = time.perf_counter()
-        app.graph.execute(app=app)
+        app.render()
         ctx.finish()
         times.append(time.perf_counter() - start)
     return float(np.median(times[2:]) * 1e3)
@@ -90,8 +90,8 @@ CONFIGS = {   # label: (frustum, ESS, downsample, lod_pixels)
 
 
 def configure(renderer, frustum, ess, downsample, lod_pixels) -> None:
-    renderer.frustum_culling, renderer.empty_space_skipping = frustum, ess
-    renderer.downsample, renderer.lod_pixels = downsample, lod_pixels
+    renderer.configure(frustum_culling=frustum, empty_space_skipping=ess, downsample=downsample,
+                       lod_pixels=lod_pixels)
 
 
 def culling_table(quick: bool) -> None:
@@ -143,9 +143,11 @@ def look_from(app, position, target) -> None:
 
 
 def reference_image(app, renderer, reference) -> np.ndarray:
-    renderer.enabled, reference.enabled = False, True
-    app.graph.execute(app=app)
-    renderer.enabled, reference.enabled = True, False
+    renderer.configure(enabled=False)
+    reference.configure(enabled=True)
+    app.render()
+    renderer.configure(enabled=True)
+    reference.configure(enabled=False)
     return app.gpu.read_pixels() / 255.0
 
 
@@ -166,7 +168,7 @@ def error_table():
         app, renderer, reference = error_app(gpu, group)
         ref = reference_image(app, renderer, reference)
         for size_factor, culling, downsample, lod in configs:
-            renderer.size_factor = size_factor
+            renderer.configure(size_factor=size_factor)
             configure(renderer, culling, culling, downsample, lod)
             ms = render_ms(app, 6)
             rmse = float(np.sqrt(((gpu.read_pixels() / 255.0 - ref) ** 2).mean()))
@@ -182,12 +184,12 @@ def view_table() -> None:
     from PIL import Image
     gpu = create_headless(ERROR_SIZE)
     app, renderer, reference = error_app(gpu, 16)
-    renderer.size_factor = 3.0
+    renderer.configure(size_factor=3.0)
     print("\n3) RMSE by view, group 16, size 3, culled, 1/2 resolution")
     for name, (position, target) in VIEWS.items():
         look_from(app, position, target)
         ref = reference_image(app, renderer, reference)
-        app.graph.execute(app=app)
+        app.render()
         img = gpu.read_pixels() / 255.0
         path = OUT.with_name(f"bench_cloud_render_{name}.png")
         Image.fromarray((np.concatenate([img, ref], 1) * 255).round().astype(np.uint8)).save(path)

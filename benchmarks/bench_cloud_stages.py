@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from atmos.gpu import create_headless
-from atmos.plugins.automaton import CloudAutomaton
+from atmos.automaton import CloudAutomaton
 from atmos.plugins.clouds import DensityMaps, Smoother, read_volume, reference, slice_range
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -48,10 +48,10 @@ def median_ms(ctx, run, runs: int) -> float:
 
 def region_volume_ms(gpu, shape, runs: int) -> dict[int, float]:
     """ms to render the region volume (and its probabilities) from n random weather ellipsoids."""
-    from atmos.plugins.weather import RegionVolume, WeatherParams
+    from atmos.plugins.weather import RegionVolume, WeatherSettings
     rng = np.random.default_rng(1)
     region = RegionVolume(gpu, shape)
-    params = WeatherParams(volume_shape=shape)
+    params = WeatherSettings(volume_shape=shape)
     result = {}
     for n in (100, 1000):
         e = np.zeros((n, 8), np.float32)
@@ -108,10 +108,10 @@ def main() -> None:
     shape = tuple(args.shape)
     gpu = create_headless((16, 16))
     ctx = gpu.ctx
-    ca = CloudAutomaton(ctx, shape, layout="packed")
+    ca = CloudAutomaton(gpu, shape, layout="packed")
     cld = cloud_field(np.random.default_rng(0), shape)
     ca.upload(np.zeros(shape, bool), np.zeros(shape, bool), cld)
-    maps = DensityMaps(ctx, shape, band_height=4, group_size=(32, 32))
+    maps = DensityMaps(gpu, shape, band_height=4, group_size=(32, 32))
     print(f"cloud stages, {shape[0]}x{shape[1]}x{shape[2]} cells, {cld.mean():.1%} cld, "
           f"{ctx.info['GL_RENDERER']}, median of {args.runs} runs")
     head = (f"{'stage':34s} {'whole ms':>9s} {f'1/{args.slices} slice ms':>16s} {'thesis ms':>10s} "
@@ -120,7 +120,7 @@ def main() -> None:
     print("-" * len(head))
     density = None
     for layout, dtype in (("packed", "f2"), ("packed", "f4"), ("cell", "f2")):
-        state = ca if layout == "packed" else CloudAutomaton(ctx, shape, layout="cell")
+        state = ca if layout == "packed" else CloudAutomaton(gpu, shape, layout="cell")
         if state is not ca:
             state.upload(np.zeros(shape, bool), np.zeros(shape, bool), cld)
         smoother = Smoother.for_automaton(state)

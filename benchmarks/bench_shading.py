@@ -17,9 +17,9 @@ import time
 import numpy as np
 
 from atmos.gpu import create_headless
-from atmos.plugins.automaton import CloudAutomaton
-from atmos.plugins.shading import ShearWarpShader, raymarch, reference
-from atmos.plugins.shading.shear_warp import read_volume, upload_volume
+from atmos.automaton import CloudAutomaton
+from atmos.shading import ShearWarpShader, raymarch, reference
+from atmos.shading.shear_warp import read_volume, upload_volume
 
 THESIS_MS = 8.696          # sec. 8.2: full-resolution shading, 256x32x256, GeForce 8700M GT
 ELEVATIONS = (90, 60, 45, 30, 10, 1)
@@ -59,9 +59,9 @@ def smooth_volume(shape, rng) -> np.ndarray:
     return (out / out.max()).astype(np.float32)
 
 
-def automaton_volume(ctx, shape, steps: int = 40) -> np.ndarray:
+def automaton_volume(gpu, shape, steps: int = 40) -> np.ndarray:
     rng = np.random.default_rng(7)
-    ca = CloudAutomaton(ctx, shape, seed=3)
+    ca = CloudAutomaton(gpu, shape, seed=3)
     y = np.arange(shape[1])[None, :, None] / shape[1]
     band = np.exp(-((y - 0.45) / 0.2) ** 2) * np.ones(shape)
     ca.upload(rng.random(shape) < 0.3 * band, rng.random(shape) < 0.02 * band, np.zeros(shape, bool))
@@ -87,18 +87,18 @@ def timed(ctx, run, repeats: int) -> tuple[float, object]:
 def run_methods(gpu, density, sun, repeats):
     """{method: (ms, transmittance on the full grid)}; upsampling of coarse results is not timed."""
     ctx = gpu.ctx
-    texture = upload_volume(ctx, density)
+    texture = upload_volume(gpu, density)
     results = {}
     for name, scale, model in (("shear-warp x1", 1, "true-path"), ("shear-warp x2", 2, "true-path"),
                                ("shear-warp x4", 4, "true-path"), ("thesis fixed-ratio", 1, "fixed-ratio")):
-        shader = ShearWarpShader(ctx, density.shape, scale=scale, model=model, levels=255 if model != "true-path" else 0)
+        shader = ShearWarpShader(gpu, density.shape, scale=scale, model=model, levels=255 if model != "true-path" else 0)
         sigma = SIGMA
         ms, _ = timed(ctx, lambda: (shader.begin(texture, sun, sigma), shader.run_all()), repeats)
         coarse = read_volume(shader.result).astype(np.float64)
         results[name] = (ms, reference.upsample(coarse, density.shape) if scale > 1 else coarse)
         shader.release()
     target = ctx.texture3d(density.shape, 1, dtype="f4")
-    ms, _ = timed(ctx, lambda: raymarch(ctx, texture, sun, SIGMA, target), max(1, repeats // 2))
+    ms, _ = timed(ctx, lambda: raymarch(gpu, texture, sun, SIGMA, target), max(1, repeats // 2))
     results["raymarch"] = (ms, read_volume(target).astype(np.float64))
     target.release()
     texture.release()
@@ -108,10 +108,10 @@ def run_methods(gpu, density, sun, repeats):
 def thesis_size_ms(gpu, repeats):
     shape = (256, 32, 256)
     density = smooth_volume(shape, np.random.default_rng(1))
-    texture = upload_volume(gpu.ctx, density)
+    texture = upload_volume(gpu, density)
     out = {}
     for scale in (1, 2):
-        shader = ShearWarpShader(gpu.ctx, shape, scale=scale)
+        shader = ShearWarpShader(gpu, shape, scale=scale)
         out[scale], _ = timed(gpu.ctx, lambda: (shader.begin(texture, (0.2, 1, 0.1), SIGMA), shader.run_all()),
                               repeats)
         shader.release()
@@ -171,7 +171,7 @@ def main() -> None:
     args = parser.parse_args()
     shape = tuple(args.shape)
     gpu = create_headless((16, 16))
-    volumes = {"smooth": smooth_volume(shape, np.random.default_rng(0)), "automaton": automaton_volume(gpu.ctx, shape)}
+    volumes = {"smooth": smooth_volume(shape, np.random.default_rng(0)), "automaton": automaton_volume(gpu, shape)}
     print(f"cloud shading, {shape[0]}x{shape[1]}x{shape[2]} voxels, sigma {SIGMA}/cell, azimuth {AZIMUTH} deg, "
           f"{gpu.ctx.info['GL_RENDERER']}")
     head = (f"{'volume':10s} {'elev':>5s} {'method':20s} {'mean err':>9s} {'max err':>9s} {'ms/pass':>9s} "

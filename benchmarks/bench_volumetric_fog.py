@@ -32,6 +32,7 @@ REFERENCE_STEPS = 1024
 class ReadColor(RenderPass):
     """Reads the HDR colour back each frame (which also waits for the GPU to finish the frame)."""
     name = "read_color"
+    phase = "readback"
 
     def setup(self, builder):
         builder.read(COLOR)
@@ -39,7 +40,7 @@ class ReadColor(RenderPass):
 
     def execute(self, frame):
         w, h = frame.gpu.size
-        self.image = np.frombuffer(frame.texture(COLOR).read(), np.float16).reshape(h, w, 4)[..., :3].astype(float)
+        self.image = np.frombuffer(frame.resource(COLOR).read(), np.float16).reshape(h, w, 4)[..., :3].astype(float)
 
 
 def measure(app, plugin, reader, steps: int, frames: int):

@@ -29,16 +29,18 @@ BASE_ALTITUDE = 900.0
 
 def build_cloudscape(app, settings, *, hours: float, speed: float = 0.0, cloud_density: int = 140,
                      warmup_steps: int = 30, slices_per_frame: int = 3, wind=(0.6, 0.0, 0.25)):
-    """Add the whole scene to ``app``; returns the weather parameters (change cloud_density live)."""
+    """Add the whole scene to ``app``; returns the CloudsPlugin (``configure(weather={"cloud_density": n})``
+    changes the cover live)."""
     weather = example_weather(SHAPE, cloud_density=cloud_density, wind=wind)
     clouds = CloudSettings(cell_size=CELL, base_altitude=BASE_ALTITUDE, smoothing_slices=8, group_size=(32, 32),
                            sigma=0.8)
+    cloud_plugin = CloudsPlugin(clouds, weather=weather, seed=settings.seed, warmup_steps=warmup_steps)
     app.insert_resource(VolumeOrigin(-SHAPE[0] / 2, 0.0, -SHAPE[2] / 2))
     app.add_plugins(DefaultPlugins(overlay=not settings.headless),
                     DaylightPlugin(hours=hours, speed=speed),
                     SkyPlugin(),
                     TerrainPlugin(size=40000.0, cells=71, relief=500.0),
-                    CloudsPlugin(weather, clouds, seed=settings.seed, warmup_steps=warmup_steps),
+                    cloud_plugin,
                     CloudShadowsPlugin(),
                     CloudRenderPlugin(size_factor=4.0),
                     LightShaftsPlugin())
@@ -46,7 +48,7 @@ def build_cloudscape(app, settings, *, hours: float, speed: float = 0.0, cloud_d
     cam = app.resource(Camera)
     cam.near, cam.far = 1.0, 20000.0
     cam.position = np.array([0.0, 250.0, 0.0])
-    return weather
+    return cloud_plugin
 
 
 def follow_camera(app) -> None:

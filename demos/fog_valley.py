@@ -11,7 +11,7 @@ from atmos.camera import Camera, Input
 from atmos.defaults import DefaultPlugins
 from atmos.demo_registry import DemoSettings
 from atmos.lighting import Sun
-from atmos.plugins.fog import FogPlugin, FogSettings
+from atmos.plugins.fog import FogPlugin
 from atmos.plugins.fog.settings import PAPER_RESOLUTIONS
 from atmos.plugins.sky_gradient import SkyGradientPlugin
 from atmos.plugins.terrain import TerrainPlugin
@@ -19,12 +19,12 @@ from atmos.plugins.terrain import TerrainPlugin
 TITLE = "heterogeneous Perlin-turbulence fog over a 10,000-triangle valley (Zdrojewska 2004)"
 DEFAULT_FRAMES = 60
 
-PRESETS = {  # the paper's figures: eq. (7) = hetero_exp2, eq. (6) = hetero_exp
-    "fig6": FogSettings(mode="hetero_exp2", density=0.044, resolutions=PAPER_RESOLUTIONS["fine"]),
-    "fig7": FogSettings(mode="hetero_exp", density=0.044, resolutions=PAPER_RESOLUTIONS["fine"]),
-    "fig8": FogSettings(mode="hetero_exp2", density=0.044, resolutions=PAPER_RESOLUTIONS["coarse"]),
-    "fig9": FogSettings(mode="hetero_exp", density=0.044, resolutions=PAPER_RESOLUTIONS["coarse"]),
-    "fig10": FogSettings(mode="hetero_exp", density=0.06, resolutions=PAPER_RESOLUTIONS["coarse"]),
+PRESETS = {  # the paper's figures (FogSettings fields): eq. (7) = hetero_exp2, eq. (6) = hetero_exp
+    "fig6": dict(mode="hetero_exp2", density=0.044, resolutions=PAPER_RESOLUTIONS["fine"]),
+    "fig7": dict(mode="hetero_exp", density=0.044, resolutions=PAPER_RESOLUTIONS["fine"]),
+    "fig8": dict(mode="hetero_exp2", density=0.044, resolutions=PAPER_RESOLUTIONS["coarse"]),
+    "fig9": dict(mode="hetero_exp", density=0.044, resolutions=PAPER_RESOLUTIONS["coarse"]),
+    "fig10": dict(mode="hetero_exp", density=0.06, resolutions=PAPER_RESOLUTIONS["coarse"]),
 }
 TERRAIN_SIZE = 112.0
 NOISE_TILE = 112.0  # metres per noise tile: the lowest octave's 16 cells are 7 m
@@ -32,7 +32,8 @@ CAMERA_POS = np.array([-3.0, 4.5, 44.0])
 CAMERA_TARGET = (4.0, 2.5, 0.0)
 
 
-def preset(name: str) -> FogSettings:
+def preset(name: str) -> dict:
+    """The FogSettings fields of a preset."""
     if name not in PRESETS:
         raise ValueError(f"unknown fog preset {name!r}; allowed: {', '.join(PRESETS)}")
     return PRESETS[name]
@@ -50,7 +51,7 @@ def place_camera(app) -> None:
 
 def build(app, settings, fog_preset: str | None = None) -> FogPlugin:
     name = fog_preset or os.environ.get("ATMOS_FOG_PRESET", "fig6")
-    fog = FogPlugin(preset(name), sky="fog", tile_size=NOISE_TILE)
+    fog = FogPlugin(sky="fog", tile_size=NOISE_TILE, **preset(name))
     app.insert_resource(Sun.from_angles(elevation_deg=30.0, azimuth_deg=-30.0))
     app.add_plugins(DefaultPlugins(overlay=not settings.headless), SkyGradientPlugin(), TerrainPlugin(size=TERRAIN_SIZE, relief=10.0), fog)
     cam = app.resource(Camera)
@@ -62,7 +63,7 @@ def build(app, settings, fog_preset: str | None = None) -> FogPlugin:
         keys = app.resource(Input).pressed
         for key, name in zip("12345", PRESETS):
             if key in keys or f"_{key}" in keys:
-                fog.configure(PRESETS[name], sky=fog.settings.sky, tile_size=NOISE_TILE)
+                fog.configure(**PRESETS[name])
 
     app.add_system(place_camera, "update", label="fog_valley_camera", after="fly_camera")
     app.add_system(switch_preset, "update", label="fog_valley_presets")

@@ -7,7 +7,7 @@ from atmos.camera import Camera
 from atmos.defaults import DefaultPlugins
 from atmos.demo_registry import DemoSettings
 from atmos.lighting import Sun
-from atmos.plugins.daylight import DaylightPlugin, TimeOfDay
+from atmos.plugins.daylight import DaylightPlugin
 from atmos.plugins.ground import GroundPlugin
 from atmos.plugins.sky import SkyPlugin
 
@@ -16,11 +16,13 @@ DEFAULT_FRAMES = 360
 HOURS_PER_SECOND = 2.5       # in full daylight or deep night; 5x slower with the sun near the horizon
 
 
-def pace_time(app) -> None:
-    """Time runs slower while the sun is near the horizon, so twilight lasts long enough to watch."""
-    sun = app.get_resource(Sun)
-    height = abs(float(sun.direction[1])) if sun is not None else 1.0
-    app.resource(TimeOfDay).speed = HOURS_PER_SECOND * (0.2 + 0.8 * min(1.0, height / 0.3))
+def pacer(daylight: DaylightPlugin):
+    """A system: time runs slower while the sun is near the horizon, so twilight lasts long enough to watch."""
+    def pace_time(app) -> None:
+        sun = app.get_resource(Sun)
+        height = abs(float(sun.direction[1])) if sun is not None else 1.0
+        daylight.configure(speed=HOURS_PER_SECOND * (0.2 + 0.8 * min(1.0, height / 0.3)))
+    return pace_time
 
 
 def face_the_sun(app) -> None:
@@ -34,11 +36,10 @@ def face_the_sun(app) -> None:
 
 
 def build(app, settings) -> None:
-    app.add_plugins(DefaultPlugins(overlay=not settings.headless),
-                    DaylightPlugin(hours=17.0, speed=HOURS_PER_SECOND, latitude=45.0, day_of_year=172.0),
-                    SkyPlugin(), GroundPlugin())
+    daylight = DaylightPlugin(hours=17.0, speed=HOURS_PER_SECOND, latitude=45.0, day_of_year=172.0)
+    app.add_plugins(DefaultPlugins(overlay=not settings.headless), daylight, SkyPlugin(), GroundPlugin())
     cam = app.resource(Camera)
     cam.position = np.array([0.0, 2.0, 0.0])
     cam.fov_y = math.radians(70.0)
-    app.add_system(pace_time, "update", label="pace_time", before="daylight")
+    app.add_system(pacer(daylight), "update", label="pace_time", before="daylight")
     app.add_system(face_the_sun, "update", label="face_the_sun", after="daylight")

@@ -6,7 +6,7 @@ import numpy as np
 from atmos.camera import Camera
 from atmos.demo_registry import DemoSettings
 from atmos.demos._cloudscape import build_cloudscape
-from atmos.plugins.weather import WeatherParams
+from atmos.plugins.clouds import CloudsPlugin
 
 TITLE = "sunny to overcast and back: the cloud density target rises and falls over time"
 DEFAULT_FRAMES = 360
@@ -14,9 +14,14 @@ SUNNY, OVERCAST = 20, 700      # ellipsoids
 PERIOD = 24.0                  # seconds for sunny → overcast → sunny
 
 
-def change_weather(app) -> None:
-    phase = 0.5 - 0.5 * math.cos(2 * math.pi * app.clock.frame_time / PERIOD)
-    app.resource(WeatherParams).cloud_density = int(round(SUNNY + (OVERCAST - SUNNY) * phase))
+def weather_changer(clouds: CloudsPlugin):
+    """A system: the cloud density target follows a slow cosine from sunny to overcast and back."""
+    def change_weather(app) -> None:
+        phase = 0.5 - 0.5 * math.cos(2 * math.pi * app.clock.frame_time / PERIOD)
+        density = int(round(SUNNY + (OVERCAST - SUNNY) * phase))
+        if density != clouds.settings.weather.cloud_density:
+            clouds.configure(weather={"cloud_density": density})
+    return change_weather
 
 
 def look_up(app) -> None:
@@ -26,8 +31,8 @@ def look_up(app) -> None:
 
 
 def build(app, settings) -> None:
-    build_cloudscape(app, settings, hours=13.0, cloud_density=SUNNY, warmup_steps=10)
-    app.resource(WeatherParams).density_adaption = 40
+    clouds = build_cloudscape(app, settings, hours=13.0, cloud_density=SUNNY, warmup_steps=10)
+    clouds.configure(weather={"density_adaption": 40})
     app.resource(Camera).position = np.array([0.0, 200.0, 0.0])
-    app.add_system(change_weather, "update", label="change_weather")
+    app.add_system(weather_changer(clouds), "update", label="change_weather")
     app.add_system(look_up, "update", label="look_up", after="fly_camera")

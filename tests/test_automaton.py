@@ -2,19 +2,18 @@
 import numpy as np
 import pytest
 
-from atmos.gpu.shaders import build_program
 from atmos.hashing import hash4, hash_counter, lowbias32, stream_key
-from atmos.plugins.automaton import CloudAutomaton, reference
+from atmos.automaton import CloudAutomaton, reference
 
 LAYOUTS = ("packed", "cell")
 
 
 @pytest.fixture
-def make(ctx):
+def make(gpu, ctx):
     made = []
 
     def factory(shape, seed=0, layout="packed"):
-        ca = CloudAutomaton(ctx, shape, seed=seed, layout=layout)
+        ca = CloudAutomaton(gpu, shape, seed=seed, layout=layout)
         made.append(ca)
         return ca
 
@@ -48,13 +47,13 @@ def run_both(make, rng, shape, steps, kwargs_for_step, layouts=LAYOUTS, state=No
 
 
 # -- hash ------------------------------------------------------------------------------------------
-def test_hash_glsl_matches_numpy(ctx, rng):
+def test_hash_glsl_matches_numpy(gpu, ctx, rng):
     n = 4096
     inputs = rng.integers(0, 2**32, size=(n, 4), dtype=np.uint64).astype(np.uint32)
     inputs[:16] = 0
     inputs[16:32, 0] = 0xFFFFFFFF
     inputs[:, 3] &= np.uint32(0xFFFF)
-    prog = build_program(ctx, {"compute_shader": "automaton/hash_check.comp"})
+    prog = gpu.program(compute_shader="automaton/hash_check.comp")
     src = ctx.buffer(inputs.astype("<u4").tobytes())
     dst = ctx.buffer(reserve=8 * n)
     try:
@@ -67,7 +66,6 @@ def test_hash_glsl_matches_numpy(ctx, rng):
     finally:
         src.release()
         dst.release()
-        prog.release()
     c, seed, step, stream = inputs.T
     assert np.array_equal(out[:, 0], lowbias32(c))
     assert np.array_equal(out[:, 1], hash4(c, seed, step, stream))
@@ -195,6 +193,31 @@ def test_mixed_everything_packed_equals_cell(make, rng):
     def kwargs(i):
         return {"p_ext": p_ext, "p_hum": 0.15, "p_act": 0.01, "shift": per_layer if i % 2 else (i, -1)}
     run_both(make, rng, shape, 8, kwargs)
+
+
+@pytest.mark.parametrize("layout", LAYOUTS)
+def test_automata_of_different_shapes_share_the_context_programs(gpu, make, rng, layout):
+    """Programs come from gpu.program (one per file): automata of other shapes stepped in between
+    (their size uniforms on the same program) change nothing; release leaves the programs cached."""
+    shapes = [(70, 9, 11), (5, 3, 40), (33, 5, 7)]
+    autos = [make(shape, seed=7 + i, layout=layout) for i, shape in enumerate(shapes)]
+    expected = [random_state(rng, shape) for shape in shapes]
+    probs = [(rng.random(shape) * 0.3).astype(np.float32) for shape in shapes]
+    for ca, state in zip(autos, expected):
+        ca.upload(*state)
+    for step in range(3):
+        for i, ca in enumerate(autos):
+            kwargs = {"p_ext": probs[i], "p_hum": 0.1, "p_act": 0.02, "shift": (step + 1, -1)}
+            expected[i] = reference.step(*expected[i], seed=7 + i, step=step, **kwargs)
+            ca.step(**kwargs)
+    for ca, e in zip(autos, expected):
+        assert all(np.array_equal(g, x) for g, x in zip(ca.download(), e))
+    prefix = "automaton/packed_" if layout == "packed" else "automaton/cell_"
+    assert {prefix + "step.comp", prefix + "advect.comp"} <= gpu.compiled_files
+    programs = len(gpu._programs)
+    autos[0].release()
+    again = make(shapes[0], layout=layout)
+    assert len(gpu._programs) == programs and again._prog_step is autos[1]._prog_step
 
 
 @pytest.mark.parametrize("shift", [(1, 0), (0, 1), (-1, -1), (5, -3), (31, 2), (32, 0), (-33, 4),
@@ -326,7 +349,7 @@ def test_bad_step_inputs(make, rng, kwargs, words):
     assert all(np.array_equal(g, e) for g, e in zip(ca.download(), state))
 
 
-def test_bad_upload_and_constructor_inputs(ctx, make):
+def test_bad_upload_and_constructor_inputs(gpu, make):
     shape = (4, 3, 4)
     ca = make(shape)
     good = np.zeros(shape, bool)
@@ -337,25 +360,27 @@ def test_bad_upload_and_constructor_inputs(ctx, make):
     with pytest.raises(ValueError, match="act.*bool"):
         ca.upload(hum=good, act=[[[True]]], cld=good)
     with pytest.raises(ValueError, match="layout"):
-        CloudAutomaton(ctx, shape, layout="texture")
+        CloudAutomaton(gpu, shape, layout="texture")
     with pytest.raises(ValueError, match="seed"):
-        CloudAutomaton(ctx, shape, seed=-1)
+        CloudAutomaton(gpu, shape, seed=-1)
     with pytest.raises(ValueError, match="seed"):
-        CloudAutomaton(ctx, shape, seed=2**32)
+        CloudAutomaton(gpu, shape, seed=2**32)
     for bad in [(4, 3), (0, 3, 4), (4.0, 3, 4), (4, -1, 4), None, (True, 3, 4)]:
         with pytest.raises(ValueError, match="shape"):
-            CloudAutomaton(ctx, bad)
-    with pytest.raises(ValueError, match="ctx"):
+            CloudAutomaton(gpu, bad)
+    with pytest.raises(ValueError, match="gpu"):
         CloudAutomaton(None, shape)
+    with pytest.raises(ValueError, match="GpuContext"):
+        CloudAutomaton(gpu.ctx, shape)
 
 
 @pytest.mark.parametrize("layout", LAYOUTS)
-def test_shape_too_big_for_gpu(ctx, layout):
+def test_shape_too_big_for_gpu(gpu, ctx, layout):
     limit = int(ctx.info["GL_MAX_SHADER_STORAGE_BLOCK_SIZE"])
     side = int(np.ceil((limit / 4) ** (1 / 3))) + 64
     for shape in [(side, side, side), (2**20, 2**12, 2**12)]:
         with pytest.raises(ValueError, match="too big.*GL_MAX_SHADER_STORAGE_BLOCK_SIZE"):
-            CloudAutomaton(ctx, shape, layout=layout)
+            CloudAutomaton(gpu, shape, layout=layout)
 
 
 def test_release(make):
@@ -367,21 +392,21 @@ def test_release(make):
 
 
 @pytest.mark.parametrize("layout", ["packed", "cell"])
-def test_step_with_region_texture_equals_step_with_arrays(ctx, rng, layout):
+def test_step_with_region_texture_equals_step_with_arrays(gpu, ctx, rng, layout):
     """The weather region's probability texture drives a step on the GPU exactly like float32 arrays."""
-    from atmos.plugins.weather import RegionVolume, WeatherParams
+    from atmos.plugins.weather import RegionVolume, WeatherSettings
     shape = (37, 6, 11)
-    params = WeatherParams(hum_scale=0.3, act_scale=0.05, ext_scale=0.2, volume_shape=shape)
+    params = WeatherSettings(hum_scale=0.3, act_scale=0.05, ext_scale=0.2, volume_shape=shape)
     ellipsoids = np.zeros((6, 8), np.float32)
     ellipsoids[:, :3] = rng.uniform(0, 1, (6, 3)) * shape
     ellipsoids[:, 3] = rng.uniform(0, 6.28, 6)
     ellipsoids[:, 4:7] = rng.uniform(2, 8, (6, 3))
-    region = RegionVolume(ctx, shape)
+    region = RegionVolume(gpu, shape)
     region.render(ellipsoids)
     texture = region.probabilities(params)
     p_hum, p_act, p_ext = region.download_probabilities()
     state = [rng.random(shape) < 0.3 for _ in range(3)]
-    a, b = CloudAutomaton(ctx, shape, seed=5, layout=layout), CloudAutomaton(ctx, shape, seed=5, layout=layout)
+    a, b = CloudAutomaton(gpu, shape, seed=5, layout=layout), CloudAutomaton(gpu, shape, seed=5, layout=layout)
     for ca in (a, b):
         ca.upload(*state)
     for _ in range(3):

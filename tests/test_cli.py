@@ -44,6 +44,19 @@ def test_graph_text_and_dot(capsys):
     assert code == 0 and out.lstrip().startswith("digraph")
 
 
+def test_graph_of_the_cloud_demo_runs_no_simulation(capsys, monkeypatch):
+    from atmos.frames import SlicedJob
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("atmos graph ran a simulation slice")
+    monkeypatch.setattr(SlicedJob, "_run_one", refuse)
+    code, out, _ = run(capsys, "graph", "sunset")
+    assert code == 0
+    for phase in ("[sky]", "[opaque]", "[shadows]", "[translucent]", "[post]", "[present]"):
+        assert phase in out
+    assert "cloud_sets@0" in out and "(plugins/cloud_render/plugin.py:" in out
+
+
 def test_headless_demo_frames_are_not_blank_and_move(tmp_path, capsys):
     code, out, _ = run(capsys, "demo", "testbed", "--headless", "--frames", "24", "--size", "160x90",
                        "--out", str(tmp_path), "--quiet")

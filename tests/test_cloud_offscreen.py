@@ -27,6 +27,7 @@ def random_depth(rng, size):
 class OffscreenProbe(RenderPass):
     """Runs OffscreenClouds.begin, fills the low-res colour with given clouds, then end; keeps the low depth."""
     name = "probe"
+    phase = "translucent"
 
     def __init__(self, size, factor, clouds):
         self.size, self.factor, self.clouds = size, factor, clouds
@@ -34,6 +35,7 @@ class OffscreenProbe(RenderPass):
 
     def setup(self, builder: PassBuilder) -> None:
         builder.read(DEPTH)
+        builder.read(COLOR)
         builder.write(COLOR)
         OffscreenClouds.declare(builder, self.size, self.factor)
 
@@ -42,9 +44,9 @@ class OffscreenProbe(RenderPass):
 
     def execute(self, frame) -> None:
         self.offscreen.begin(frame, self.factor)
-        depth = frame.texture(CLOUD_DEPTH)
+        depth = frame.resource(CLOUD_DEPTH)
         self.low_depth = np.frombuffer(depth.read(), np.float32).reshape(depth.size[1], depth.size[0])
-        frame.texture(CLOUD_COLOR).write(self.clouds.astype(np.float16).tobytes())
+        frame.resource(CLOUD_COLOR).write(self.clouds.astype(np.float16).tobytes())
         self.offscreen.end(frame, self.factor, NEAR, FAR)
 
 
@@ -62,8 +64,8 @@ def test_depth_and_composite_match_the_references(fresh_gpu, rng, size, factor):
     depth_texture.compare_func = ""
     gpu.resize(size)
     graph = RenderGraph(gpu)
-    graph.import_texture(COLOR, color)
-    graph.import_texture(DEPTH, depth_texture)
+    graph.import_resource(COLOR, color)
+    graph.import_resource(DEPTH, depth_texture)
     probe = graph.add_pass(OffscreenProbe(size, factor, clouds))
     graph.execute()
     depth = np.frombuffer(depth_texture.read(), np.float32).reshape(h, w)      # as stored (24-bit)
@@ -94,10 +96,10 @@ def test_downsampled_clouds_match_full_resolution(gpu, ctx):
     look(app, *BELOW)
     images = {}
     for factor in (1, 2, 4):
-        renderer.downsample = factor
+        renderer.configure(downsample=factor)
         images[factor] = frame(app, gpu)
         save(images[factor], f"cloud_offscreen_{factor}.png")
-    renderer.enabled = False
+    renderer.configure(enabled=False)
     empty = frame(app, gpu)
     app.close()
     signal = np.sqrt(((images[1] - empty) ** 2).mean())
@@ -116,7 +118,7 @@ def test_downsample_allocates_only_when_used(fresh_gpu):
     app, renderer = scene(gpu, warmup=2, downsample=1)
     app.update(1 / 60)
     assert CLOUD_COLOR not in app.graph.dump()
-    renderer.downsample = 2
+    renderer.configure(downsample=2)
     app.update(1 / 60)
     assert CLOUD_COLOR in app.graph.dump() and CLOUD_DEPTH in app.graph.dump()
     app.close()
@@ -124,9 +126,9 @@ def test_downsample_allocates_only_when_used(fresh_gpu):
 
 @pytest.mark.parametrize("value", [0, 9, 1.5, True, "2"])
 def test_bad_downsample_is_refused(value):
-    with pytest.raises(ValueError, match=r"downsample must be an int in 1\.\.8"):
+    with pytest.raises(ValueError, match=r"CloudRenderSettings\.downsample must be a whole number 1\.\.8"):
         CloudRenderPlugin(downsample=value)
     plugin = CloudRenderPlugin(downsample=2)
     with pytest.raises(ValueError, match="downsample"):
-        plugin.downsample = value
-    assert plugin.downsample == 2
+        plugin.configure(downsample=value)
+    assert plugin.settings.downsample == 2

@@ -12,7 +12,7 @@ from atmos.camera import Camera
 from atmos.defaults import DefaultPlugins
 from atmos.gpu.shaders import load_source
 from atmos.lighting import Sun
-from atmos.plugins.cloud_render import (CloudLayout, CloudReferencePlugin, CloudRenderPlugin, select_segments,
+from atmos.plugins.cloud_render import (CloudLayout, CloudMarchPlugin, CloudRenderPlugin, select_segments,
                                         sun_light)
 from atmos.plugins.cloud_render.binding import bind_volume, clamp_sampler, unbind_volume
 from atmos.plugins.cloud_render.example import example_weather
@@ -37,9 +37,9 @@ def scene(gpu, cloud_density=60, shading_scale=1, warmup=25, seed=3, sun=(25.0, 
     app.insert_resource(Sun.from_angles(*sun))
     renderer = CloudRenderPlugin(base_altitude=BASE, **render)
     plugins = [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(),
-               CloudsPlugin(example_weather(SHAPE, cloud_density, density_adaption=adaption), settings, seed=seed, warmup_steps=warmup), renderer]
+               CloudsPlugin(settings, weather=example_weather(SHAPE, cloud_density, density_adaption=adaption), seed=seed, warmup_steps=warmup), renderer]
     if reference:
-        plugins.append(CloudReferencePlugin(renderer, steps=192, enabled=False))
+        plugins.append(CloudMarchPlugin(renderer, steps=192, enabled=False))
     app.add_plugins(*plugins)
     app.startup()
     return app, renderer
@@ -196,7 +196,7 @@ def test_frustum_culling_equals_an_independent_cpu_test(rng):
 @pytest.mark.parametrize("cloud_density", [15, 60])
 def test_empty_space_skipping_never_skips_density_in_a_or_b(gpu, ctx, cloud_density):
     app, renderer = scene(gpu, cloud_density=cloud_density, warmup=12)
-    renderer.frustum_culling = False
+    renderer.configure(frustum_culling=False)
     from atmos.plugins.clouds import CloudSimulation
     sim = app.resource(CloudSimulation)
     for _ in range(6):
@@ -304,18 +304,19 @@ def test_cloud_images_show_clouds_near_the_reference_and_move(gpu, ctx, view):
     gpu.resize((320, 180))
     try:
         app, renderer = scene(gpu, reference=True)
-        ref_plugin = next(p for p in app.plugins if isinstance(p, CloudReferencePlugin))
+        ref_plugin = next(p for p in app.plugins if isinstance(p, CloudMarchPlugin))
         look(app, *(BELOW if view == "below" else ABOVE))
         img = frame(app, gpu)
         save(img, f"cloud_render_{view}.png")
-        renderer.enabled = False
-        app.graph.execute(app=app)
+        renderer.configure(enabled=False)
+        app.render()
         empty = gpu.read_pixels().astype(float)
-        ref_plugin.enabled = True
-        app.graph.execute(app=app)
+        ref_plugin.configure(enabled=True)
+        app.render()
         ref = gpu.read_pixels().astype(float)
         save(ref, f"cloud_render_{view}_reference.png")
-        renderer.enabled, ref_plugin.enabled = True, False
+        renderer.configure(enabled=True)
+        ref_plugin.configure(enabled=False)
         assert img.std() > 3, "not blank"
         diff = np.abs(img - empty).sum(-1)
         assert diff.mean() > 1.5 and (diff > 20).mean() > 0.05, "the clouds show against the empty sky"
@@ -335,12 +336,12 @@ def test_levels_of_detail_look_like_full_detail(gpu, ctx):
     look(app, *BELOW)
     full = frame(app, gpu)
     sprites = renderer.stats.sprites
-    renderer.lod_pixels = 6.0
+    renderer.configure(lod_pixels=6.0)
     lod = frame(app, gpu)
     save(lod, "cloud_render_lod.png")
     assert sum(n > 0 for n in renderer.stats.columns_by_level) >= 2, "the test needs several levels in one draw"
     assert renderer.stats.sprites < 0.6 * sprites
-    renderer.enabled = False
+    renderer.configure(enabled=False)
     empty = frame(app, gpu)
     app.close()
     signal = np.sqrt(((full - empty) ** 2).mean())
@@ -378,7 +379,6 @@ def test_tiny_and_minimized_targets(gpu, ctx, size):
     look(app, *BELOW)
     app.run_frames(1)
     gpu.resize(size)
-    app.graph.invalidate()
     try:
         img = frame(app, gpu)
         assert img.shape[:2] == (max(1, size[1]), max(1, size[0]))
@@ -430,7 +430,10 @@ def test_bad_parameters_are_refused(kwargs, message):
 
 
 def test_needs_the_cloud_simulation(gpu):
-    with pytest.raises(ValueError, match="add CloudsPlugin before it"):
-        App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudRenderPlugin())
-    with pytest.raises(ValueError, match="steps must be an int in 1..65536"):
-        CloudReferencePlugin(CloudRenderPlugin(), steps=0)
+    from atmos.graph import GraphError
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudRenderPlugin())
+    with pytest.raises(GraphError, match=r"'cloud_render' reads 'cloud_sets'.*is the plugin that provides it added"):
+        app.update(1 / 60)
+    app.close()
+    with pytest.raises(ValueError, match=r"CloudMarchSettings\.steps must be a whole number 1\.\.65536"):
+        CloudMarchPlugin(CloudRenderPlugin(), steps=0)

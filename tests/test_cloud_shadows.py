@@ -13,11 +13,11 @@ from atmos.graph import PassBuilder, RenderPass
 from atmos.lighting import Sun
 from atmos.plugin import Plugin
 from atmos.plugins.clouds.layout import CloudLayout
-from atmos.plugins.cloud_shadows import CloudShadowParams, CloudShadowsPlugin, cloud_layout, reference
+from atmos.plugins.cloud_shadows import CloudShadowSettings, CloudShadowsPlugin, cloud_layout, reference
 from atmos.plugins.clouds import CloudSettings, CloudSimulation, CloudsPlugin
 from atmos.plugins.ground import GroundPlugin
 from atmos.plugins.sky_gradient import SkyGradientPlugin
-from atmos.plugins.weather import VolumeOrigin, WeatherParams
+from atmos.plugins.weather import VolumeOrigin, WeatherSettings
 from atmos.render_core import COLOR, DEPTH, CapturePass
 
 OUT = os.path.join(os.path.dirname(__file__), "..", "out")
@@ -27,6 +27,7 @@ OUT = os.path.join(os.path.dirname(__file__), "..", "out")
 class FillPass(RenderPass):
     """Writes given arrays (GL row order: row 0 at the bottom) into "color" (h, w, 4) and "depth" (h, w)."""
     name = "test_fill"
+    phase = "opaque"
 
     def __init__(self):
         self.color = self.depth = None
@@ -37,9 +38,9 @@ class FillPass(RenderPass):
 
     def execute(self, frame) -> None:
         if self.color is not None:
-            frame.texture(COLOR).write(np.ascontiguousarray(self.color, np.float16).tobytes())
+            frame.resource(COLOR).write(np.ascontiguousarray(self.color, np.float16).tobytes())
         if self.depth is not None:
-            frame.texture(DEPTH).write(np.ascontiguousarray(self.depth, np.float32).tobytes())
+            frame.resource(DEPTH).write(np.ascontiguousarray(self.depth, np.float32).tobytes())
 
 
 class _PassPlugin(Plugin):
@@ -89,10 +90,10 @@ def weather(shape=(16, 8, 16), **kw):
                 region_margin=6.0, lifetime=60.0, lifetime_variance=10.0, hum_scale=0.2, act_scale=0.01,
                 ext_scale=0.1, altitude=0.5, altitude_variance=0.1, vertical_scale=0.5, wind=(0.5, 0.0, 0.25))
     base.update(kw)
-    return WeatherParams(**base)
+    return WeatherSettings(**base)
 
 
-def shadow_app(gpu, params: CloudShadowParams, wp=None, cell_size=(1.0, 1.0, 1.0), warmup=0, scene=False,
+def shadow_app(gpu, params: CloudShadowSettings, wp=None, cell_size=(1.0, 1.0, 1.0), warmup=0, scene=False,
                origin=(0.0, 0.0)):
     """Clouds (volume at ``origin`` x, z cells), then (scene) sky + ground or (else) the fill pass,
     then the shadows, then the probe."""
@@ -100,7 +101,7 @@ def shadow_app(gpu, params: CloudShadowParams, wp=None, cell_size=(1.0, 1.0, 1.0
     settings = CloudSettings(smoothing_slices=2, group_size=(8, 8), shading=False, cell_size=cell_size)
     drawn = [SkyGradientPlugin(), GroundPlugin()] if scene else [pass_plugin(fill)]
     app = App(gpu).insert_resource(VolumeOrigin(origin[0], 0.0, origin[1]))
-    app.add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(wp or weather(), settings, seed=5,
+    app.add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(settings, weather=wp or weather(), seed=5,
                                                                            warmup_steps=warmup),
                                *drawn, CloudShadowsPlugin(params), pass_plugin(probe))
     app.startup()
@@ -115,7 +116,7 @@ def write_sums(sim, texture_set, sums: np.ndarray) -> None:
 def test_gpu_matches_reference_on_random_scenes(gpu, ctx, rng):
     size = gpu.size
     cell = tuple(rng.uniform([3.0, 1.0, 3.0], [8.0, 3.0, 8.0]))
-    params = CloudShadowParams(base_altitude=rng.uniform(20, 80), cell_size=cell, sigma=rng.uniform(0.2, 1.0),
+    params = CloudShadowSettings(base_altitude=rng.uniform(20, 80), cell_size=cell, sigma=rng.uniform(0.2, 1.0),
                                strength=rng.uniform(0.5, 2.0), direct_fraction=rng.uniform(0.5, 1.0))
     app, sim, fill, probe = shadow_app(gpu, params)
     for _ in range(2):
@@ -148,7 +149,7 @@ def test_gpu_matches_reference_on_random_scenes(gpu, ctx, rng):
     depth[rng.random((h, w)) < 0.1] = 1.0       # sky pixels stay as they are
     color = rng.uniform(0.5, 2.0, (h, w, 4))
     fill.color, fill.depth = color, depth
-    app.graph.execute(app=app)                  # render only: the sets stay as written
+    app.render()                  # render only: the sets stay as written
     assert np.isfinite(probe.color).all()
     weight = reference.direct_weight(sun.direction, sun.color, params)
     expected = reference.shadow_factor(world_points(cam, size, probe.depth), sums[0][0], sums[1][0], t,
@@ -179,7 +180,7 @@ def test_reference_projects_along_the_sun_onto_the_layer():
 
 
 def test_sun_weight_extremes():
-    p = CloudShadowParams(direct_fraction=0.8, horizon_fade=0.1)
+    p = CloudShadowSettings(direct_fraction=0.8, horizon_fade=0.1)
     assert reference.direct_weight((0, 1, 0), (1, 1, 1), p) == pytest.approx(0.8)
     assert reference.direct_weight((1, 0, 0), (1, 1, 1), p) == 0.0               # on the horizon
     assert reference.direct_weight((1, -0.2, 0), (1, 1, 1), p) == 0.0            # below it
@@ -190,7 +191,7 @@ def test_sun_weight_extremes():
                 dict(cell_size=(1, 0, 1)), dict(base_altitude="high")):
         name = next(iter(bad))
         with pytest.raises(ValueError, match=name):
-            CloudShadowParams(**bad)
+            CloudShadowSettings(**bad)
     with pytest.raises(ValueError, match="unknown"):
         p.replace(strenght=2.0)
     assert p.replace(strength=2.0).strength == 2.0 and p.strength == 1.0
@@ -210,7 +211,7 @@ def scene_colour(gpu, app, sun: Sun, sums=None):
         for s in sim.view()[:2]:
             write_sums(sim, s, sums)
     app.insert_resource(sun)
-    app.graph.execute(app=app)
+    app.render()
     probe = next(p for p in app.graph.passes if isinstance(p, CapturePass))
     return probe.color.copy(), gpu.read_pixels()
 
@@ -219,7 +220,7 @@ def scene_colour(gpu, app, sun: Sun, sums=None):
 def test_extremes_no_nan_and_the_right_darkening(scene_gpu, case):
     gpu = scene_gpu
     gpu.make_current()
-    params = CloudShadowParams(base_altitude=60.0, cell_size=(6.0, 3.0, 6.0))
+    params = CloudShadowSettings(base_altitude=60.0, cell_size=(6.0, 3.0, 6.0))
     wp = weather((32, 8, 32), cloud_density=0 if case == "empty" else 30)
     app, sim, _, _ = shadow_app(gpu, params, wp, cell_size=(6.0, 3.0, 6.0), warmup=12, scene=True)
     cam = app.resource(Camera)
@@ -231,9 +232,9 @@ def test_extremes_no_nan_and_the_right_darkening(scene_gpu, case):
     layers = 1 + sim.maps_of(sim.view()[0]).bands
     sums = np.full((layers, 32, 32), 1e6, np.float32) if case == "full" else None
     plugin = next(p for p in app.plugins if isinstance(p, CloudShadowsPlugin))
-    plugin.params = params.replace(strength=0.0)
+    plugin.configure(strength=0.0)
     base, _ = scene_colour(gpu, app, sun, sums)
-    plugin.params = params
+    plugin.configure(strength=params.strength)
     shaded, pixels = scene_colour(gpu, app, sun, sums)
     assert gpu.ctx.error == "GL_NO_ERROR"
     assert np.isfinite(shaded).all() and np.isfinite(base).all()
@@ -258,7 +259,7 @@ def test_shadows_on_the_ground_look_right_and_move_with_the_clouds():
     """A camera above the layer looking down at an angle: blotches on the ground, drifting with the wind."""
     gpu = create_headless((480, 270))
     cell = (6.0, 3.0, 6.0)
-    params = CloudShadowParams(base_altitude=120.0, cell_size=cell, strength=1.5)
+    params = CloudShadowSettings(base_altitude=120.0, cell_size=cell, strength=1.5)
     wp = weather((64, 16, 64), cloud_density=25, cloud_size=9.0, cloud_size_variance=3.0, region_margin=10.0,
                  wind=(1.5, 0.0, 0.5))
     app, sim, _, _ = shadow_app(gpu, params, wp, cell_size=cell, warmup=30, scene=True, origin=(-32, -32))
@@ -273,8 +274,8 @@ def test_shadows_on_the_ground_look_right_and_move_with_the_clouds():
         frames.append(gpu.read_pixels())
         save_png(f"cloud_shadows_ground_{len(frames)}.png", frames[-1])
     plugin = next(p for p in app.plugins if isinstance(p, CloudShadowsPlugin))
-    plugin.params = params.replace(strength=0.0)
-    app.graph.execute(app=app)
+    plugin.configure(strength=0.0)
+    app.render()
     plain = gpu.read_pixels()
     save_png("cloud_shadows_ground_without.png", plain)
     assert gpu.ctx.error == "GL_NO_ERROR"

@@ -4,7 +4,7 @@ import pytest
 
 from atmos.app import App
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin, read_volume, reference
-from atmos.plugins.weather import Ellipsoid, VolumeOrigin, WeatherParams
+from atmos.plugins.weather import Ellipsoid, VolumeOrigin, WeatherSettings
 
 
 def params(shape=(32, 8, 32), **kw):
@@ -12,12 +12,12 @@ def params(shape=(32, 8, 32), **kw):
                 region_margin=6.0, lifetime=40.0, lifetime_variance=10.0, hum_scale=0.2, act_scale=0.01,
                 ext_scale=0.1, altitude=0.5, altitude_variance=0.1, vertical_scale=0.5, wind=(0.5, 0.0, 0.25))
     base.update(kw)
-    return WeatherParams(**base)
+    return WeatherSettings(**base)
 
 
 def clouds_app(gpu, p, settings=None, seed=3, **kw):
     app = App(gpu)
-    plugin = CloudsPlugin(p, settings or CloudSettings(smoothing_slices=2, group_size=(8, 8)), seed=seed, **kw)
+    plugin = CloudsPlugin(settings or CloudSettings(smoothing_slices=2, group_size=(8, 8)), weather=p, seed=seed, **kw)
     app.add_plugins(plugin)
     app.startup()
     return app, plugin.simulation
@@ -83,7 +83,7 @@ def rise_steps(gpu, adaption):
         sim.job.run_step()
         lows.append(sim.cover())
     low = np.mean(lows[-10:])
-    p.cloud_density = 120
+    next(q for q in app.plugins if isinstance(q, CloudsPlugin)).configure(weather={"cloud_density": 120})
     covers = []
     for _ in range(180):
         sim.job.run_step()
@@ -159,15 +159,31 @@ def test_strong_wind_and_shift_larger_than_the_volume(gpu, ctx):
     app.close()
 
 
-@pytest.mark.parametrize("settings, message", [
-    (CloudSettings(step_seconds=0.0), "step_seconds"),
-    (CloudSettings(smoothing_slices=0), "smoothing_slices must be an int in 1..32"),
-    (CloudSettings(cover_threshold=float("nan")), "cover_threshold"),
+@pytest.mark.parametrize("fields, message", [
+    (dict(step_seconds=0.0), "CloudSettings.step_seconds must be a finite number > 0.0"),
+    (dict(smoothing_slices=0), r"CloudSettings.smoothing_slices must be a whole number 1\.\.32"),
+    (dict(smoothing_slices=33), r"1\.\.32, got 33"),
+    (dict(cover_threshold=float("nan")), "CloudSettings.cover_threshold"),
+    (dict(layout="dense"), "CloudSettings.layout must be one of 'packed', 'cell'"),
+    (dict(shading_scale=3), "CloudSettings.shading_scale must be 1, 2 or 4"),
+    (dict(cell_size=(1.0, 0.0, 1.0)), "CloudSettings.cell_size must be 3 positive numbers"),
+    (dict(weather={"cloud_size": -1.0}), "WeatherSettings.cloud_size"),
 ])
-def test_bad_settings(gpu, ctx, settings, message):
-    app = App(gpu)
+def test_bad_settings(fields, message):
     with pytest.raises(ValueError, match=message):
-        app.add_plugins(CloudsPlugin(params(), settings))
+        CloudsPlugin(weather=params(), **fields) if "weather" not in fields else CloudsPlugin(**fields)
+
+
+def test_live_and_fixed_settings(gpu, ctx):
+    app, sim = clouds_app(gpu, params())
+    plugin = next(p for p in app.plugins if isinstance(p, CloudsPlugin))
+    plugin.configure(weather={"cloud_density": 3}, step_seconds=2.0)
+    assert sim.settings is plugin.settings and sim.settings.weather.cloud_density == 3
+    before = plugin.settings
+    with pytest.raises(ValueError, match=r"CloudSettings\.weather\.volume_shape, CloudSettings\.smoothing_slices "
+                                         r"cannot change"):
+        plugin.configure(weather={"volume_shape": (16, 8, 16)}, smoothing_slices=4)
+    assert plugin.settings is before and sim.settings is before
     app.close()
 
 
@@ -175,7 +191,7 @@ def test_shading_stage_lights_each_step_with_the_sun_of_its_start(gpu, ctx):
     """Transmittance in a completed set = one-shot shading of that set's density with the sun as it
     was when the step began, however much the sun moved while the step was sliced over frames."""
     from atmos.lighting import Sun
-    from atmos.plugins.shading import compute_transmittance
+    from atmos.shading import compute_transmittance
     settings = CloudSettings(smoothing_slices=2, group_size=(8, 8), sigma=0.8, cell_size=(2.0, 1.0, 2.0),
                              shading_slices_per_run=4)
     app, sim = clouds_app(gpu, params(), settings)
@@ -193,7 +209,7 @@ def test_shading_stage_lights_each_step_with_the_sun_of_its_start(gpu, ctx):
     assert frames > 5
     _, b, _ = sim.view()
     density = read_volume(b["density"])
-    expected = compute_transmittance(gpu.ctx, density, start_sun, 0.8)
+    expected = compute_transmittance(gpu, density, start_sun, 0.8)
     got = read_volume(b["transmittance"])
     assert density.max() > 0.5 and got.min() < 0.9, "clouds cast light shadows"
     assert np.abs(got - expected).max() < 2e-3        # f2 storage
@@ -203,5 +219,5 @@ def test_shading_stage_lights_each_step_with_the_sun_of_its_start(gpu, ctx):
 def test_volume_larger_than_the_gpu_allows_is_a_clear_error(gpu, ctx):
     app = App(gpu)
     with pytest.raises(ValueError, match="too big for this GPU"):
-        app.add_plugins(CloudsPlugin(params((8192, 64, 8192))))
+        app.add_plugins(CloudsPlugin(weather=params((8192, 64, 8192))))
     app.close()

@@ -46,7 +46,7 @@ def test_plugin_drives_the_sun_through_a_day():
 
 
 @pytest.mark.parametrize("fields, message", [
-    ({"hours": 25.0}, "hours must be a number in"),
+    ({"hours": 25.0}, r"DaylightSettings.hours must be a finite number >= 0.0 and <= 24.0, got 25.0"),
     ({"latitude": float("nan")}, "latitude"),
     ({"speed": float("inf")}, "speed must be a finite number"),
 ])

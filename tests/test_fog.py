@@ -39,7 +39,7 @@ def reference_volumes(settings):
 @pytest.mark.parametrize("tpc", [1, 3])
 def test_gpu_noise_volumes_match_reference_and_fill_every_texel(gpu, ctx, rng, tpc):
     settings = FogSettings(mode="hetero_exp", resolutions=(4, 8, 16, 24), texels_per_cell=tpc,
-                           seed=int(rng.integers(2**32))).validated()
+                           seed=int(rng.integers(2**32)))
     volumes = NoiseVolumes(gpu, settings, fill=np.nan)
     got = volumes.read()
     volumes.release()
@@ -96,14 +96,14 @@ def test_reference_factor_extremes_stay_in_unit_interval(mode):
     ("hetero_exp", {"noise": "texture"}, TEX_TOL), ("hetero_exp2", {"noise": "texture", "texels_per_cell": 2}, TEX_TOL),
     ("hetero_exp2", {"noise": "procedural", "octaves": 2, "amplitude": 0.5, "sky": "keep"}, TOL),
 ])
-def test_apply_fog_matches_reference(ctx, rng, mode, extra, tol):
+def test_apply_fog_matches_reference(gpu, ctx, rng, mode, extra, tol):
     color, distance, positions = random_inputs(rng)
     kw = dict(extra)
     if mode.startswith("hetero"):
         kw.update(resolutions=SMALL, seed=int(rng.integers(2**32)), tile_size=float(rng.uniform(40, 300)))
     time = float(rng.uniform(0, 100))
-    out = apply_fog(ctx, color, distance, mode=mode, positions=positions, time=time, **kw)
-    settings = FogSettings(mode=mode, **kw).validated()
+    out = apply_fog(gpu, color, distance, mode=mode, positions=positions, time=time, **kw)
+    settings = FogSettings(mode=mode, **kw)
     volumes = reference_volumes(settings) if settings.heterogeneous and settings.noise == "texture" else None
     ref = apply_fog_ref(color, distance, settings, positions, time, volumes=volumes)
     assert out.dtype == np.float32 and out.shape == color.shape and np.isfinite(out).all()
@@ -112,22 +112,22 @@ def test_apply_fog_matches_reference(ctx, rng, mode, extra, tol):
 
 
 @pytest.mark.parametrize("sky", ["fog", "keep"])
-def test_apply_fog_writes_every_pixel(ctx, rng, sky):
+def test_apply_fog_writes_every_pixel(gpu, ctx, rng, sky):
     color = rng.random((17, 40, 3), dtype=np.float32)
     distance = np.full((17, 40), np.inf, np.float32)
-    out = apply_fog(ctx, color, distance, mode="exp", density=0.1, fog_color=(0.2, 0.5, 0.7), sky=sky)
+    out = apply_fog(gpu, color, distance, mode="exp", density=0.1, fog_color=(0.2, 0.5, 0.7), sky=sky)
     expected = np.broadcast_to([0.2, 0.5, 0.7], color.shape) if sky == "fog" else color
     np.testing.assert_allclose(out, expected, atol=1e-6)
 
 
 @pytest.mark.parametrize("mode", ["exp", "exp2", "hetero_exp", "hetero_exp2", "linear"])
 @pytest.mark.parametrize("density", [0.0, 1e-30, 1e30])
-def test_apply_fog_extremes_never_nan(ctx, rng, mode, density):
+def test_apply_fog_extremes_never_nan(gpu, ctx, rng, mode, density):
     color = rng.random((4, 5, 3), dtype=np.float32)
     distance = np.array([[0, 1e-30, 1, 1e6, np.inf]] * 4, np.float32)
     positions = (rng.random((4, 5, 3)) * 1e4).astype(np.float32)
     kw = {"resolutions": SMALL, "noise": "procedural"} if mode.startswith("hetero") else {}
-    out = apply_fog(ctx, color, distance, mode=mode, density=density, positions=positions, far=np.inf, **kw)
+    out = apply_fog(gpu, color, distance, mode=mode, density=density, positions=positions, far=np.inf, **kw)
     assert np.isfinite(out).all() and (out >= 0).all() and (out <= 1).all()
     if mode != "linear":
         np.testing.assert_allclose(out[:, 0], color[:, 0], atol=1e-6)           # distance 0: untouched
@@ -136,33 +136,33 @@ def test_apply_fog_extremes_never_nan(ctx, rng, mode, density):
 
 
 @pytest.mark.parametrize("kwargs,message", [
-    ({"mode": "fast"}, "unknown fog mode 'fast'; allowed: linear, exp, exp2, hetero_exp, hetero_exp2"),
-    ({"density": -0.1}, "fog density must be >= 0"),
-    ({"density": float("nan")}, "density must be a finite number"),
-    ({"mode": "linear", "start": 50.0, "end": 50.0}, "linear fog needs start < end"),
+    ({"mode": "fast"}, "FogSettings.mode must be one of linear, exp, exp2, hetero_exp, hetero_exp2"),
+    ({"density": -0.1}, "FogSettings.density must be a finite number >= 0"),
+    ({"density": float("nan")}, "FogSettings.density must be a finite number"),
+    ({"mode": "linear", "start": 50.0, "end": 50.0}, "FogSettings.start must be < end for linear fog"),
     ({"color": np.zeros((3, 4, 4), np.float32)}, "color must be float32 (H, W, 3) = (3, 4, 3)"),
     ({"distance": np.zeros((3,), np.float32)}, "distance must be float32 (H, W)"),
     ({"distance": np.full((3, 4), -1.0, np.float32)}, "distance must be >= 0 metres or +inf"),
     ({"mode": "hetero_exp"}, "needs positions=(H, W, 3)"),
     ({"mode": "hetero_exp", "positions": np.zeros((3, 4, 2))}, "positions must be float32 (H, W, 3)"),
-    ({"mode": "hetero_exp", "positions": np.zeros((3, 4, 3)), "octaves": 5}, "octaves must be an int in 1..4"),
-    ({"mode": "hetero_exp", "positions": np.zeros((3, 4, 3)), "noise": "cubic"}, "noise must be one of texture, procedural"),
-    ({"mode": "hetero_exp", "positions": np.zeros((3, 4, 3)), "resolutions": (512,)}, "resolutions needs 4 to 4"),
-    ({"mode": "hetero_exp", "positions": np.zeros((3, 4, 3)), "resolutions": (8, 16, 32, 512)}, "each resolution must be an int in 2..256"),
-    ({"sky": "paint"}, "sky must be one of fog, keep"),
+    ({"mode": "hetero_exp", "positions": np.zeros((3, 4, 3)), "octaves": 5}, "FogSettings.octaves must be a whole number 1..4"),
+    ({"mode": "hetero_exp", "positions": np.zeros((3, 4, 3)), "noise": "cubic"}, "FogSettings.noise must be one of 'texture', 'procedural'"),
+    ({"mode": "hetero_exp", "positions": np.zeros((3, 4, 3)), "resolutions": (512,)}, "FogSettings.resolutions must be 4 to 4 whole numbers"),
+    ({"mode": "hetero_exp", "positions": np.zeros((3, 4, 3)), "resolutions": (8, 16, 32, 512)}, "FogSettings.resolutions[3] must be a whole number 2..256"),
+    ({"sky": "paint"}, "FogSettings.sky must be one of 'fog', 'keep'"),
     ({"wobble": 1}, "unknown keyword(s) wobble"),
 ])
-def test_bad_input_is_a_value_error_naming_what_is_allowed(ctx, kwargs, message):
+def test_bad_input_is_a_value_error_naming_what_is_allowed(gpu, ctx, kwargs, message):
     args = {"color": np.zeros((3, 4, 3), np.float32), "distance": np.ones((3, 4), np.float32)}
     args.update(kwargs)
     with pytest.raises(ValueError) as error:
-        apply_fog(ctx, **args)
+        apply_fog(gpu, **args)
     assert message in str(error.value)
 
 
 def test_plugin_configure_is_all_or_nothing():
     plugin = FogPlugin(mode="hetero_exp", density=0.06)
-    with pytest.raises(ValueError, match="amplitude must be in"):
+    with pytest.raises(ValueError, match="FogSettings.amplitude must be a finite number >= 0.0 and <= 1.0"):
         plugin.configure(density=0.01, amplitude=2.0)
     assert plugin.settings.density == 0.06 and plugin.settings.mode == "hetero_exp"
     assert FogPlugin(mode="heterogeneous_exp2").settings.mode == "hetero_exp2"
@@ -172,6 +172,7 @@ def test_plugin_configure_is_all_or_nothing():
 class KnownScene(RenderPass):
     """Writes given colour and depth values into the scene's textures."""
     name = "known_scene"
+    phase = "opaque"
 
     def __init__(self, color, depth):
         self.color, self.depth = color, depth
@@ -181,15 +182,15 @@ class KnownScene(RenderPass):
         builder.write(DEPTH)
 
     def execute(self, frame):
-        frame.texture(COLOR).write(self.color.astype(np.float16).tobytes())
-        frame.texture(DEPTH).write(self.depth.astype(np.float32).tobytes())
+        frame.resource(COLOR).write(self.color.astype(np.float16).tobytes())
+        frame.resource(DEPTH).write(self.depth.astype(np.float32).tobytes())
 
 
 @pytest.mark.parametrize("mode,noise,sky,planes", [("exp", "texture", "fog", (0.5, 200.0)),
                                                    ("hetero_exp2", "procedural", "keep", (0.5, 200.0)),
                                                    ("hetero_exp", "texture", "fog", (0.5, 200.0)),
                                                    ("hetero_exp", "procedural", "fog", (0.1, 1e10))])
-def test_fog_pass_on_a_known_depth_buffer_matches_reference(rng, mode, noise, sky, planes):
+def test_fog_pass_on_a_known_depth_buffer_matches_reference(gpu, rng, mode, noise, sky, planes):
     w, h = 48, 27
     gpu = create_headless((w, h))
     try:
@@ -202,7 +203,7 @@ def test_fog_pass_on_a_known_depth_buffer_matches_reference(rng, mode, noise, sk
         depth = ndc_z * 0.5 + 0.5
         depth[:3, :] = 1.0                                   # sky rows
         settings = FogSettings(mode=mode, density=0.03, noise=noise, sky=sky, resolutions=SMALL,
-                               tile_size=64.0, seed=int(rng.integers(2**32))).validated()
+                               tile_size=64.0, seed=int(rng.integers(2**32)))
         probe = CapturePass()
         app = App(gpu).add_plugins(DefaultPlugins(overlay=False))
         app.graph.add_pass(KnownScene(color, depth))
@@ -230,7 +231,7 @@ def test_fog_pass_on_a_known_depth_buffer_matches_reference(rng, mode, noise, sk
         gpu.release()
 
 
-def test_scene_without_fog_runs_and_compiles_none_of_it():
+def test_scene_without_fog_runs_and_compiles_none_of_it(gpu):
     gpu = create_headless((64, 36))
     try:
         app = App(gpu).add_plugins(DefaultPlugins(overlay=False), SkyGradientPlugin(), TerrainPlugin())

@@ -11,23 +11,23 @@ from atmos.gpu import create_headless
 from atmos.lighting import Sun
 from atmos.graph import PassBuilder, RenderPass
 from atmos.plugins.ground import GroundPlugin
-from atmos.plugins.light_shafts import LightShaftParams, LightShaftsPlugin, blur_uniforms, reference, screen_sun
+from atmos.plugins.light_shafts import LightShaftSettings, LightShaftsPlugin, blur_uniforms, reference, screen_sun
 from atmos.plugins.light_shafts.plugin import MASK
 from atmos.plugins.sky import SkyPlugin
 from atmos.plugins.sky_gradient import SkyGradientPlugin
 from atmos.plugins.terrain import TerrainPlugin
 from atmos.plugins.test_volume import TestVolumePlugin, VolumeBox
-from atmos.render_core import COLOR, CapturePass
+from atmos.render_core import COLOR, DEPTH, CapturePass
 from test_cloud_shadows import FillPass, pass_plugin, save_png
 from fullscreen_probe import run_fullscreen
 
 
-def random_params(rng, **fixed) -> LightShaftParams:
+def random_params(rng, **fixed) -> LightShaftSettings:
     values = dict(samples=int(rng.integers(1, 65)), density=rng.uniform(0.2, 1.0), decay=rng.uniform(0.8, 1.0),
                   weight=rng.uniform(0.01, 0.2), exposure=rng.uniform(0.2, 2.0), threshold=rng.uniform(0.0, 1.0), ceiling=rng.uniform(0.1, 3.0),
                   radius=rng.uniform(0.1, 1.0))
     values.update(fixed)
-    return LightShaftParams(**values)
+    return LightShaftSettings(**values)
 
 
 def gpu_blur(gpu, mask: np.ndarray, sun_uv, params, strength=1.0) -> np.ndarray:
@@ -59,7 +59,7 @@ def test_blur_reference_by_hand():
     """One bright texel: the shaft runs from it away from the sun, falling off by decay per tap."""
     mask = np.zeros((1, 9, 1))
     mask[0, 2] = 1.0                                    # x centre uv = 2.5 / 9
-    p = LightShaftParams(samples=4, density=1.0, decay=0.5, weight=1.0, exposure=1.0)
+    p = LightShaftSettings(samples=4, density=1.0, decay=0.5, weight=1.0, exposure=1.0)
     out = reference.radial_blur(mask, (0.5 / 9, 0.5), p)[0, :, 0]   # sun at pixel 0's centre
     # pixel x takes taps at x - i·x/4 (i = 1..4), tap i weighing 0.5^(i-1): pixel 4 hits 2 with tap 2,
     # pixel 8 with tap 3, pixel 6 half-hits it (at 1.5) with tap 3, pixel 2 itself with tap 1 (at 1.5)
@@ -101,7 +101,7 @@ def test_pass_matches_reference_on_random_frames(gpu, ctx, rng):
     color[..., 3] = np.where(pick < 0.3, 0.0, np.where(pick < 0.45, 1.0, rng.uniform(-0.3, 1.3, (h, w))))
     depth = np.where(rng.random((h, w)) < 0.5, 1.0, rng.uniform(0.5, 0.99, (h, w)))
     fill.color, fill.depth = color, depth
-    app.graph.execute(app=app)
+    app.render()
     assert ctx.error == "GL_NO_ERROR"
     where = screen_sun(cam, w / h, app.resource(Sun).direction, params)
     assert np.allclose(where.uv, sun_uv, atol=1e-9) and where.strength > 0
@@ -120,12 +120,14 @@ class BrightLayerPass(RenderPass):
     """Premultiplied (rgb·a, a) over screen rectangles, blended like the cloud sprites (ONE,
     ONE_MINUS_SRC_ALPHA on colour and alpha), no depth: a sunlit cloud drawn over the sky."""
     name = "test_bright_layer"
+    phase = "translucent"
 
     def __init__(self, rects):
         self.rects = rects              # [((x, y, w, h) in pixels, rgb, alpha)]
         self.program = None
 
     def setup(self, builder: PassBuilder) -> None:
+        builder.read(COLOR)
         builder.write(COLOR)
 
     def prepare(self, gpu) -> None:
@@ -146,17 +148,21 @@ class BrightLayerPass(RenderPass):
 
 
 class CaptureBefore(CapturePass):
-    """The capture, declared a writer of "color" too, so it keeps its place before the shafts."""
+    """The capture of "color" as the media phase left it (a versioned read): it runs in phase post
+    before the shafts write the next version."""
     name = "capture_before_shafts"
+    phase = "post"
 
     def setup(self, builder: PassBuilder) -> None:
-        super().setup(builder)
-        builder.write(COLOR)
+        builder.read(COLOR, at="media")
+        builder.read(DEPTH)
+        builder.side_effect()
 
 
 class MaskProbe(RenderPass):
     """Copies the light shafts' occlusion mask (h, w, 4) to numpy."""
     name = "test_mask_probe"
+    phase = "post"
 
     def __init__(self):
         self.mask = None
@@ -166,7 +172,7 @@ class MaskProbe(RenderPass):
         builder.side_effect()
 
     def execute(self, frame) -> None:
-        tex = frame.texture(MASK)
+        tex = frame.resource(MASK)
         w, h = tex.size
         self.mask = np.frombuffer(tex.read(), np.float16).reshape(h, w, 4).astype(np.float64)
 
@@ -176,7 +182,7 @@ def test_bright_cloud_over_the_sky_cuts_the_mask_through_alpha(gpu, ctx):
     sky pixels are sky) kept it in the mask; with color.a (sky occlusion) it is cut, partly where
     it is partly transparent, and the open sky around it still casts."""
     w, h = gpu.size
-    params = LightShaftParams(downsample=1, threshold=0.6, ceiling=3.0, radius=0.6)
+    params = LightShaftSettings(downsample=1, threshold=0.6, ceiling=3.0, radius=0.6)
     opaque = ((int(0.55 * w), int(0.45 * h), int(0.15 * w), int(0.25 * h)), (6.0, 5.5, 5.0), 1.0)
     half = ((int(0.25 * w), int(0.45 * h), int(0.15 * w), int(0.25 * h)), (6.0, 5.5, 5.0), 0.5)
     before, probe = CaptureBefore(), MaskProbe()
@@ -189,7 +195,7 @@ def test_bright_cloud_over_the_sky_cuts_the_mask_through_alpha(gpu, ctx):
     cam.yaw, cam.pitch = 0.3, 0.25
     sun_uv = (0.5, 0.55)
     app.insert_resource(Sun(sun_toward(cam, gpu.size, sun_uv)))
-    app.graph.execute(app=app)
+    app.render()
     assert ctx.error == "GL_NO_ERROR"
     color, depth = before.color, before.depth
     where = screen_sun(cam, w / h, app.resource(Sun).direction, params)
@@ -238,7 +244,7 @@ def test_colour_alpha_is_the_sky_occlusion_and_the_screen_alpha_is_one(gpu, ctx,
     cam.position = np.array([0.0, 30.0, 0.0])
     cam.yaw, cam.pitch = 0.4, -0.05
     app.insert_resource(Sun(np.array([0.3, 0.4, -1.0])))
-    app.graph.execute(app=app)
+    app.render()
     sky = probe.depth >= 1.0
     assert np.all(probe.color[sky, 3] == 0.0) and np.all(probe.color[~sky, 3] == 1.0)
     if scene != "clear":
@@ -252,7 +258,7 @@ def test_colour_alpha_is_the_sky_occlusion_and_the_screen_alpha_is_one(gpu, ctx,
 def test_screen_sun_fades():
     cam = Camera(position=np.array([0.0, 0.0, 0.0]))
     cam.look_at((0.0, 0.3, -1.0))
-    p = LightShaftParams()
+    p = LightShaftSettings()
     ahead = screen_sun(cam, 16 / 9, cam.forward(), p)
     assert ahead.uv == pytest.approx((0.5, 0.5)) and ahead.strength == pytest.approx(1.0)
     assert screen_sun(cam, 16 / 9, -cam.forward(), p).strength == 0.0               # behind the camera
@@ -268,14 +274,14 @@ def test_screen_sun_fades():
     for bad in (dict(samples=0), dict(samples=1000), dict(decay=1.5), dict(downsample=0), dict(radius=0.0),
                 dict(exposure=-1.0), dict(density=math.inf)):
         with pytest.raises(ValueError, match=next(iter(bad))):
-            LightShaftParams(**bad)
+            LightShaftSettings(**bad)
 
 
 @pytest.mark.parametrize("case", ["behind", "below", "edge", "centre", "far_outside", "tiny", "minimized"])
 def test_extremes_no_nan_no_gl_error(case):
     size = {"tiny": (1, 1), "minimized": (0, 0)}.get(case, (96, 54))
     gpu = create_headless(size)
-    app, plugin, _, probe = shafts_app(gpu, LightShaftParams(), scene=True)
+    app, plugin, _, probe = shafts_app(gpu, LightShaftSettings(), scene=True)
     cam = app.resource(Camera)
     cam.position = np.array([0.0, 5.0, 0.0])
     cam.look_at((0.0, 8.0, -20.0))
@@ -286,11 +292,11 @@ def test_extremes_no_nan_no_gl_error(case):
     elif case == "below":
         sun = np.array([0.0, -0.1, -1.0])
     app.insert_resource(Sun(sun))
-    plugin.params = plugin.params.replace(exposure=0.0)
-    app.graph.execute(app=app)
+    plugin.configure(exposure=0.0)
+    app.render()
     base = probe.color.copy()
-    plugin.params = plugin.params.replace(exposure=0.5)
-    app.graph.execute(app=app)
+    plugin.configure(exposure=0.5)
+    app.render()
     assert gpu.ctx.error == "GL_NO_ERROR"
     assert np.isfinite(probe.color).all() and np.isfinite(gpu.read_pixels()).all()
     added = probe.color - base
@@ -307,7 +313,7 @@ def test_shafts_around_clouds_at_sunset_look_right():
     """A low orange sun just above drifting cloud blobs: a glow streaked by the clouds' shadows."""
     gpu = create_headless((480, 270))
     box = VolumeBox(center=(0.0, 16.0, -40.0), size=(70.0, 14.0, 30.0))
-    params = LightShaftParams(exposure=1.0, threshold=0.3)
+    params = LightShaftSettings(exposure=1.0, threshold=0.3)
     probe = CapturePass()
     plugin = LightShaftsPlugin(params)
     app = App(gpu).add_plugins(DefaultPlugins(overlay=False),
@@ -324,8 +330,8 @@ def test_shafts_around_clouds_at_sunset_look_right():
         shots.append(gpu.read_pixels())
         save_png(f"light_shafts_{n + 1}.png", shots[-1])
     with_shafts = probe.color.copy()
-    plugin.params = params.replace(exposure=0.0)
-    app.graph.execute(app=app)
+    plugin.configure(exposure=0.0)
+    app.render()
     save_png("light_shafts_without.png", gpu.read_pixels())
     added = (with_shafts - probe.color)[..., :3].max(-1)
     assert gpu.ctx.error == "GL_NO_ERROR" and np.isfinite(with_shafts).all()

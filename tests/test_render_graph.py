@@ -12,10 +12,10 @@ class P(RenderPass):
     """A configurable test pass that records what the graph does with it."""
 
     def __init__(self, name, creates=None, reads=(), writes=(), side=False, before=(), after=(),
-                 shader=None, run=None):
-        self.name, self.before, self.after = name, tuple(before), tuple(after)
+                 shader=None, run=None, phase="post", at=None):
+        self.name, self.phase, self.before, self.after = name, phase, tuple(before), tuple(after)
         self.creates, self.reads, self.writes, self.side = dict(creates or {}), reads, writes, side
-        self.shader, self.run = shader, run
+        self.shader, self.run, self.at = shader, run, dict(at or {})
         self.setups = self.prepared = self.executed = self.released = 0
         self.program = None
         self.seen = {}
@@ -25,7 +25,7 @@ class P(RenderPass):
         for name, desc in self.creates.items():
             builder.create(name, desc)
         for name in self.reads:
-            builder.read(name)
+            builder.read(name, at=self.at.get(name))
         for name in self.writes:
             builder.write(name)
         if self.side:
@@ -38,7 +38,7 @@ class P(RenderPass):
 
     def execute(self, frame):
         self.executed += 1
-        self.seen = {n: frame.texture(n) for n in [*self.creates, *self.reads, *self.writes]}
+        self.seen = {n: frame.resource(n) for n in [*self.creates, *self.reads, *self.writes]}
         if self.run:
             self.run(self, frame)
 
@@ -66,59 +66,115 @@ def names(compiled):
 
 
 # -- ordering ----------------------------------------------------------------------------------
-def test_order_follows_dependencies_with_registration_tie_break(graph):
-    graph.import_texture("screen", object())
-    graph.add_pass(P("present", reads=["b"], writes=["screen"]))
-    graph.add_pass(P("second", reads=["a"], creates={"b": SMALL}))
-    graph.add_pass(P("first", creates={"a": SMALL}))
-    graph.add_pass(P("hud", writes=["screen"], after=["present"]))
-    graph.add_pass(P("independent1", side=True))
-    graph.add_pass(P("independent2", side=True))
-    assert names(graph.compile()) == ["first", "second", "present", "hud", "independent1", "independent2"]
+def test_order_follows_phases_then_data_then_names(graph):
+    graph.import_resource("screen", object())
+    graph.add_pass(P("present", reads=["b"], writes=["screen"], phase="present"))
+    graph.add_pass(P("second", reads=["a"], creates={"b": SMALL}, phase="sky"))
+    graph.add_pass(P("first", creates={"a": SMALL}, phase="sky"))
+    graph.add_pass(P("hud", reads=["screen"], writes=["screen"], phase="overlay"))
+    graph.add_pass(P("zeta", side=True, phase="clear"))
+    graph.add_pass(P("alpha", side=True, phase="clear"))
+    assert names(graph.compile()) == ["alpha", "zeta", "first", "second", "present", "hud"]
 
 
-def test_writers_precede_pure_readers_and_hints_order_writers(graph):
+def test_overwriters_then_modifiers_then_readers_inside_a_phase(graph):
+    graph.add_pass(P("make", creates={"x": SMALL}, phase="clear"))
     graph.add_pass(P("reader", reads=["x"], side=True))
-    graph.add_pass(P("w1", writes=["x"]))
-    graph.add_pass(P("w2", reads=["x"], writes=["x"]))  # read-modify-write
-    graph.add_pass(P("make", creates={"x": SMALL}))
-    assert names(graph.compile()) == ["make", "w1", "w2", "reader"]
-
-    graph.remove_pass("w1")
-    w1 = P("w1", writes=["x"], after=["w2"])
-    graph.add_pass(w1)
-    assert names(graph.compile()) == ["make", "w2", "w1", "reader"]
+    graph.add_pass(P("blend", reads=["x"], writes=["x"]))     # modifies: reads and writes
+    graph.add_pass(P("paint", writes=["x"]))                  # overwrites
+    compiled = graph.compile()
+    assert names(compiled) == ["make", "paint", "blend", "reader"]
+    assert compiled.reads["blend"] == {"x": 2} and compiled.writes["blend"] == {"x": 3}
+    assert compiled.reads["reader"] == {"x": 3}
+    assert compiled.resources["x"].versions == ["make", "paint", "blend"]
 
 
-def test_compile_is_idempotent(graph):
-    a = graph.add_pass(P("a", side=True))
-    first = graph.compile()
-    assert graph.compile() is first and a.setups == 1
-    graph.add_pass(P("b", side=True))
-    assert graph.compile() is not first and a.setups == 2
+def test_two_unordered_writers_in_one_phase_are_an_error_naming_both(graph):
+    graph.add_pass(P("make", creates={"x": SMALL}, phase="clear"))
+    graph.add_pass(P("fog", reads=["x"], writes=["x"], side=True, phase="media"))
+    graph.add_pass(P("haze", reads=["x"], writes=["x"], side=True, phase="media"))
+    with pytest.raises(GraphError, match=r"passes 'fog' and 'haze' both modify 'x' in phase 'media'.*after=") :
+        graph.compile()
+    graph.remove_pass("haze")
+    graph.add_pass(P("haze", reads=["x"], writes=["x"], side=True, phase="media", after=["fog"]))
+    assert names(graph.compile()) == ["make", "fog", "haze"]
+    graph.add_pass(P("sky1", writes=["x"], side=True, phase="sky"))
+    graph.add_pass(P("sky2", writes=["x"], side=True, phase="sky"))
+    with pytest.raises(GraphError, match=r"'sky1' and 'sky2' both overwrite 'x' in phase 'sky'"):
+        graph.compile()
 
 
-def test_resize_and_invalidate_recompile(gpu, graph):
+def test_opaque_writers_commute_in_name_order(graph):
+    graph.add_pass(P("make", creates={"x": SMALL}, phase="clear"))
+    graph.add_pass(P("terrain", reads=["x"], writes=["x"], side=True, phase="opaque"))
+    graph.add_pass(P("ground", reads=["x"], writes=["x"], side=True, phase="opaque"))
+    assert names(graph.compile()) == ["make", "ground", "terrain"]
+
+
+def test_order_never_depends_on_registration(gpu, rng):
+    specs = [("make", dict(creates={"x": SMALL}, phase="clear")), ("sky", dict(writes=["x"], phase="sky")),
+             ("layer", dict(reads=["x"], writes=["x"], phase="sky")),
+             ("b_mesh", dict(writes=["x"], phase="opaque")), ("a_mesh", dict(writes=["x"], phase="opaque")),
+             ("fog", dict(reads=["x"], writes=["x"], phase="media")), ("show", dict(reads=["x"], side=True))]
+    orders = set()
+    for perm in [specs, specs[::-1]] + [[specs[i] for i in rng.permutation(len(specs))] for _ in range(60)]:
+        g = RenderGraph(gpu)
+        for name, kw in perm:
+            g.add_pass(P(name, **kw))
+        orders.add(tuple(g.compile().kept))
+    assert orders == {("make", "sky", "layer", "a_mesh", "b_mesh", "fog", "show")}
+
+
+def test_versioned_read_of_an_earlier_phase(graph):
+    graph.add_pass(P("make", creates={"x": SMALL}, phase="clear"))
+    graph.add_pass(P("cloud", reads=["x"], writes=["x"], side=True, phase="translucent"))
+    graph.add_pass(P("mask", reads=["x"], side=True, phase="translucent", at={"x": "opaque"}))
+    compiled = graph.compile()
+    assert names(compiled) == ["make", "mask", "cloud"]       # the read of version 1 runs before version 2
+    assert compiled.reads["mask"] == {"x": 1}
+    graph.add_pass(P("fog", reads=["x"], writes=["x"], phase="media"))
+    graph.add_pass(P("late", reads=["x"], side=True, phase="post", at={"x": "translucent"}))
+    with pytest.raises(GraphError, match=r"'late' \(phase 'post'\) reads 'x' as of phase 'translucent', "
+                                         r"but 'fog' writes it in between"):
+        graph.compile()
+    graph.remove_pass("late")
+    graph.add_pass(P("early", reads=["x"], side=True, phase="sky", at={"x": "post"}))
+    with pytest.raises(GraphError, match="later phase 'post'"):
+        graph.compile()
+
+
+def test_phase_is_required_and_checked(graph):
+    with pytest.raises(GraphError, match=r"pass 'nophase' .* has phase ''.*one of: clear, sky"):
+        graph.add_pass(P("nophase", phase=""))
+    with pytest.raises(GraphError, match="has phase 'later'"):
+        graph.add_pass(P("bad", phase="later"))
+
+
+def test_hints_across_phases_must_agree_with_them(graph):
+    graph.add_pass(P("sky", side=True, phase="sky", after=["fog"]))
+    graph.add_pass(P("fog", side=True, phase="media"))
+    with pytest.raises(GraphError, match=r"'sky' has after='fog'.*phases run in the order"):
+        graph.compile()
+
+
+def test_setup_runs_every_frame_and_recompiles_only_on_change(gpu, graph):
     sizes = []
+    wanted = [(8, 8)]
 
     class Sized(P):
         def setup(self, builder):
-            builder.create("c", TextureDesc(gpu.size))
+            self.setups += 1
+            builder.create("c", TextureDesc(wanted[0]))
             builder.side_effect()
 
-    graph.add_pass(Sized("sized", run=lambda p, f: sizes.append(f.texture("c").size)))
+    sized = graph.add_pass(Sized("sized", run=lambda p, f: sizes.append(f.resource("c").size)))
     first = graph.compile()
-    assert graph.compile() is first
-    graph.invalidate()
-    second = graph.compile()
-    assert second is not first
-    old = gpu.size
-    try:
-        gpu.resize((old[0] // 2, old[1] // 2))
-        graph.execute()
-        assert graph.compile() is not second and sizes == [gpu.size]
-    finally:
-        gpu.resize(old)
+    assert graph.compile() is first and sized.setups == 2 and graph.compiles == 1
+    wanted[0] = (4, 4)
+    graph.execute()
+    assert graph.compile() is not first and graph.compiles == 2 and sizes == [(4, 4)]
+    graph.add_pass(P("b", side=True))
+    assert graph.compiles == 2 and graph.compile() and graph.compiles == 3
 
 
 def test_cycle_names_the_passes(graph):
@@ -136,7 +192,7 @@ def test_cycle_names_the_passes(graph):
 def test_hint_cycle_and_unknown_hint(graph):
     graph.add_pass(P("a", side=True, before=["b"]))
     graph.add_pass(P("b", side=True, before=["a"]))
-    with pytest.raises(GraphError, match=r"cycle between passes '(a|b)', '(a|b)'"):
+    with pytest.raises(GraphError, match=r"cycle in phase 'post' between passes '(a|b)', '(a|b)'"):
         graph.compile()
     graph.remove_pass("b")
     graph.add_pass(P("b", side=True, after=["ghost"]))
@@ -165,7 +221,7 @@ def test_two_creators_is_an_error(graph):
 
 
 def test_creating_an_imported_name_is_an_error(graph):
-    graph.import_texture("screen", object())
+    graph.import_resource("screen", object())
     graph.add_pass(P("sky", creates={"screen": SMALL}))
     with pytest.raises(GraphError, match=r"'sky' creates 'screen'.*imported"):
         graph.compile()
@@ -203,7 +259,7 @@ def test_texture_desc_validation():
 
 # -- culling ------------------------------------------------------------------------------------
 def test_unread_chain_is_culled_wholly(graph, screen):
-    graph.import_texture("screen", screen)
+    graph.import_resource("screen", screen)
     graph.add_pass(P("noise", creates={"noise": SMALL}))
     graph.add_pass(P("fog", reads=["noise"], creates={"fog_color": SMALL}))
     graph.add_pass(P("sky", writes=["screen"]))
@@ -215,7 +271,7 @@ def test_unread_chain_is_culled_wholly(graph, screen):
 
 
 def test_chain_feeding_a_kept_pass_is_kept(graph, screen):
-    graph.import_texture("screen", screen)
+    graph.import_resource("screen", screen)
     graph.add_pass(P("noise", creates={"noise": SMALL}))
     graph.add_pass(P("fog", reads=["noise"], creates={"fog_color": SMALL}))
     graph.add_pass(P("unused", reads=["noise"], creates={"junk": SMALL}))
@@ -227,19 +283,19 @@ def test_chain_feeding_a_kept_pass_is_kept(graph, screen):
 
 
 def test_writing_an_import_or_side_effect_keeps_a_pass(graph, screen):
-    graph.import_texture("screen", screen)
-    graph.import_texture("history", screen)
+    graph.import_resource("screen", screen)
+    graph.import_resource("history", screen)
     graph.add_pass(P("to_screen", writes=["screen"]))
     graph.add_pass(P("reads_import_only", reads=["history"]))
     graph.add_pass(P("debug", side=True))
     compiled = graph.compile()
-    assert names(compiled) == ["to_screen", "debug"]
+    assert names(compiled) == ["debug", "to_screen"]
     assert compiled.culled == {"reads_import_only": "declares no outputs and no side effect"}
 
 
 def test_culled_passes_compile_no_shaders_and_allocate_no_textures(gpu, graph, screen):
     odd = TextureDesc((3, 5), 2, "f4")  # a desc no kept pass uses
-    graph.import_texture("screen", screen)
+    graph.import_resource("screen", screen)
     culled = graph.add_pass(P("culled", creates={"fog_color": odd}, shader="test/graph_culled.frag"))
     kept = graph.add_pass(P("kept", creates={"tmp": SMALL}, shader="test/graph_gradient.frag"))
     graph.add_pass(P("present", reads=["tmp"], writes=["screen"]))
@@ -279,7 +335,7 @@ def test_pool_reuses_equal_descs(gpu, ctx):
 
 
 def test_steady_frames_allocate_nothing(graph, screen):
-    graph.import_texture("screen", screen)
+    graph.import_resource("screen", screen)
     graph.add_pass(P("a", creates={"x": SMALL}))
     graph.add_pass(P("b", reads=["x"], creates={"y": SMALL}))
     graph.add_pass(P("c", reads=["x", "y"], writes=["screen"]))
@@ -294,7 +350,7 @@ def test_steady_frames_allocate_nothing(graph, screen):
 
 def test_textures_with_disjoint_lifetimes_alias(graph, screen):
     other = TextureDesc((8, 8), 1, "f4")
-    graph.import_texture("screen", screen)
+    graph.import_resource("screen", screen)
     p1 = graph.add_pass(P("p1", creates={"a": SMALL}))
     p2 = graph.add_pass(P("p2", reads=["a"], creates={"mid": other}))
     p3 = graph.add_pass(P("p3", reads=["mid"], creates={"b": SMALL}))
@@ -310,9 +366,9 @@ def test_textures_with_disjoint_lifetimes_alias(graph, screen):
 
 def test_undeclared_texture_is_an_error(graph, screen):
     def peek(p, frame):
-        frame.texture("screen")
+        frame.resource("screen")
     graph.add_pass(P("sneaky", side=True, run=peek))
-    graph.import_texture("screen", screen)
+    graph.import_resource("screen", screen)
     with pytest.raises(GraphError, match="'sneaky' uses 'screen' but did not declare it"):
         graph.execute()
 
@@ -324,7 +380,7 @@ def _fill(p, frame):
 
 
 def _swizzle(p, frame):
-    frame.texture("color").use(location=0)
+    frame.resource("color").use(location=0)
     p.program["src"].value = 0
     frame.framebuffer(color=["target"]).use()
     frame.fullscreen(p.program)
@@ -332,7 +388,7 @@ def _swizzle(p, frame):
 
 def test_two_pass_frame_renders_expected_pixels(gpu, graph):
     w, h = gpu.size
-    graph.import_texture("target", lambda: gpu.target)
+    graph.import_resource("target", lambda: gpu.target)
     graph.add_pass(P("gradient", creates={"color": TextureDesc((w, h))},
                      shader="test/graph_gradient.frag", run=_fill))
     graph.add_pass(P("swizzle", reads=["color"], writes=["target"],
@@ -360,8 +416,8 @@ def test_callable_import_is_resolved_every_frame(gpu, graph, ctx):
         fbo = frame.framebuffer(color=["out"])
         ctx.copy_framebuffer(fbo, frame.framebuffer(color=["src"]))
 
-    graph.import_texture("src", lambda: current[0])
-    graph.import_texture("out", out)
+    graph.import_resource("src", lambda: current[0])
+    graph.import_resource("out", out)
     copier = graph.add_pass(P("copy", reads=["src"], writes=["out"], run=copy))
     compiled = graph.compile()
     graph.execute()
@@ -369,9 +425,9 @@ def test_callable_import_is_resolved_every_frame(gpu, graph, ctx):
     assert np.frombuffer(out.read(), np.uint8)[:4].tolist() == [255, 0, 0, 255]
     current[0] = green
     graph.execute()
-    assert copier.seen["src"] is green and graph.compile() is compiled and copier.setups == 1
+    assert copier.seen["src"] is green and graph.compile() is compiled and graph.compiles == 1
     assert np.frombuffer(out.read(), np.uint8)[:4].tolist() == [0, 255, 0, 255]
-    graph.import_texture("src", red)  # replacing a known import's source does not recompile either
+    graph.import_resource("src", red)  # replacing a known import's source does not recompile either
     graph.execute()
     assert copier.seen["src"] is red and graph.compile() is compiled
     graph.release()
@@ -379,21 +435,21 @@ def test_callable_import_is_resolved_every_frame(gpu, graph, ctx):
         texture.release()
 
 
-def test_execute_data_reaches_passes(graph):
+def test_the_scene_view_reaches_passes(graph):
     got = {}
 
     def grab(p, frame):
         assert isinstance(frame, PassContext)
-        got.update(frame.data, name=frame.pass_name, gpu=frame.gpu)
+        got.update(view=frame.view, name=frame.pass_name, gpu=frame.gpu)
 
     graph.add_pass(P("grab", side=True, run=grab))
-    graph.execute(app="the app", dt=0.5)
-    assert got == {"app": "the app", "dt": 0.5, "name": "grab", "gpu": graph.gpu}
+    graph.execute("the view")
+    assert got == {"view": "the view", "name": "grab", "gpu": graph.gpu}
 
 
 def test_framebuffers_are_cached(graph, screen):
     fbos = []
-    graph.import_texture("screen", screen)
+    graph.import_resource("screen", screen)
     graph.add_pass(P("draw", creates={"c": SMALL, "d": TextureDesc((8, 8), depth=True)}, writes=["screen"],
                      run=lambda p, f: fbos.append((f.framebuffer(["c"], depth="d"), f.framebuffer(["screen"])))))
     for _ in range(4):
@@ -404,7 +460,7 @@ def test_framebuffers_are_cached(graph, screen):
 
 # -- timings, dumps, lifetime --------------------------------------------------------------------
 def test_timings_cover_kept_passes_only(graph, screen):
-    graph.import_texture("screen", screen)
+    graph.import_resource("screen", screen)
     graph.add_pass(P("a", creates={"x": SMALL}))
     graph.add_pass(P("b", reads=["x"], writes=["screen"]))
     graph.add_pass(P("culled", creates={"y": SMALL}))
@@ -425,27 +481,31 @@ def test_timings_cover_kept_passes_only(graph, screen):
 
 
 def test_dump_and_dot_show_kept_and_culled(graph, screen):
-    graph.import_texture("screen", screen)
+    graph.import_resource("screen", screen)
     graph.add_pass(P("sky", creates={"sky_color": TextureDesc((64, 32))}))
     graph.add_pass(P("fog", reads=["sky_color"], creates={"fog_color": SMALL}))
     graph.add_pass(P("present", reads=["sky_color"], writes=["screen"]))
     text = graph.dump()
-    assert "1. sky" in text and "2. present" in text
+    assert "[post]" in text and "1. sky" in text and "2. present" in text
+    assert "creates sky_color@1" in text and "reads sky_color@1; writes screen@1 [side effect]" in text
+    assert "(tests/test_render_graph.py:" in text          # each pass leads to its file
+    assert "versions @0 (imported), @1 present" in text
     assert "culled:" in text and "fog" in text and "nothing reads texture 'fog_color'" in text
     assert "64x32 4xf2 linear" in text and "imported" in text and "never allocated" in text
     dot = graph.to_dot()
     assert dot.startswith("digraph") and dot.rstrip().endswith("}")
     assert '"pass:sky" [shape=box' in dot and 'label="1. sky"' in dot
     assert '"pass:fog" [shape=box, style="dashed,filled"' in dot
-    assert "peripheries=2" in dot and '"res:sky_color" [shape=ellipse' in dot
-    assert '"pass:sky" -> "res:sky_color" [label="create"]' in dot
-    assert '"res:sky_color" -> "pass:present" [label="read"]' in dot
-    assert '"pass:present" -> "res:screen" [label="write"]' in dot
+    assert 'subgraph "cluster_post" { label="post"' in dot
+    assert "peripheries=2" in dot and '"res:sky_color@1" [shape=ellipse' in dot
+    assert '"pass:sky" -> "res:sky_color@1" [label="create"]' in dot
+    assert '"res:sky_color@1" -> "pass:present" [label="read"]' in dot
+    assert '"pass:present" -> "res:screen@1" [label="write"]' in dot
 
 
 def test_release_frees_everything(gpu, ctx, screen):
     graph = RenderGraph(gpu)
-    graph.import_texture("screen", screen)
+    graph.import_resource("screen", screen)
     fbos = []
     a = graph.add_pass(P("a", creates={"x": SMALL}, shader="test/graph_gradient.frag",
                          run=lambda p, f: (fbos.append(f.framebuffer(["x"])), f.framebuffer(["x"]).use(),
@@ -470,3 +530,38 @@ def test_remove_pass_releases_it(graph):
     graph.execute()
     graph.remove_pass("a")
     assert p.released == 1 and graph.compile().kept == []
+
+
+def test_every_pass_starts_from_the_same_gl_state(gpu, graph, ctx):
+    """A pass that leaves blending, depth test, culling, point size, a small viewport, a scissor and
+    masked writes behind: the next pass still fills the whole target with exactly its colour."""
+    import moderngl
+    target = ctx.texture((16, 16), 4, dtype="f4")
+    depth = ctx.depth_texture((16, 16))
+    graph.import_resource("t", target)
+    graph.import_resource("d", depth)
+
+    def mess(p, frame):
+        fbo = frame.framebuffer(color=["t"], depth="d")
+        fbo.use()
+        ctx.enable(moderngl.BLEND | moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.PROGRAM_POINT_SIZE)
+        ctx.blend_func = moderngl.ZERO, moderngl.ZERO
+        ctx.blend_equation = moderngl.MIN
+        ctx.depth_func = "0"
+        fbo.depth_mask = False
+        fbo.color_mask = (False, False, False, False)
+        ctx.viewport = (0, 0, 2, 2)
+        ctx.scissor = (0, 0, 1, 1)
+
+    def fill(p, frame):
+        frame.framebuffer(color=["t"], depth="d").use()
+        p.program["color"].value = (0.25, 0.5, 0.75, 1.0)
+        frame.fullscreen(p.program)
+
+    graph.add_pass(P("a_mess", reads=["t"], writes=["t", "d"], run=mess, phase="sky"))
+    graph.add_pass(P("b_fill", reads=["t"], writes=["t", "d"], run=fill, phase="post", shader="test/solid.frag"))
+    graph.execute()
+    pixels = np.frombuffer(target.read(), np.float32).reshape(16, 16, 4)
+    np.testing.assert_array_equal(pixels, np.broadcast_to([0.25, 0.5, 0.75, 1.0], (16, 16, 4)))
+    target.release()
+    depth.release()

@@ -62,7 +62,6 @@ def test_resize_including_minimized_window(fresh_gpu, size):
     app = scene(fresh_gpu)
     app.run_frames(1)
     fresh_gpu.resize(size)
-    app.graph.invalidate()
     app.run_frames(2)
     img = fresh_gpu.read_pixels()
     assert img.shape[:2] == (max(1, size[1]), max(1, size[0])) and np.isfinite(img).all()

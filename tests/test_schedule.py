@@ -18,7 +18,7 @@ def test_stages_run_in_fixed_order():
         app.add_system(record(log, stage), stage)
     app.update(1 / 30)
     app.update(1 / 30)
-    assert log == ["startup", "update", "simulate", "render", "cleanup", "update", "simulate", "render", "cleanup"]
+    assert log == ["startup", "update", "simulate", "render", "last", "update", "simulate", "render", "last"]
     app.close()
 
 
@@ -71,7 +71,7 @@ def test_cross_stage_label_is_an_error():
 
 def test_unknown_stage_and_duplicate_label():
     s = Schedule()
-    with pytest.raises(ScheduleError, match="unknown stage 'physics'.*startup, update, simulate, render, cleanup"):
+    with pytest.raises(ScheduleError, match="unknown stage 'physics'.*startup, update, simulate, render, last"):
         s.add(record([], "a"), "physics")
     s.add(record([], "a"), "update")
     with pytest.raises(ScheduleError, match="labelled 'a'"):

@@ -6,11 +6,12 @@ import pytest
 
 from atmos.frames import SlicedJob, TripleSet
 from atmos.graph import TextureDesc
-from atmos.plugins.shading import (LightVolumeShader, Scattering, ShadingStage, ShearWarpShader,
-                                   compute_fixed_ratio, compute_transmittance, light_volume_reference,
-                                   reference as R, sky_light)
-from atmos.plugins.shading.scattering import harris_reference
-from atmos.plugins.shading.shear_warp import read_volume, upload_volume
+from atmos.lighting import sky_light
+from atmos.shading import (LightVolumeShader, Scattering, ShadingStage, ShearWarpShader,
+                           compute_fixed_ratio, compute_transmittance, light_volume_reference,
+                           reference as R)
+from atmos.shading.scattering import harris_reference
+from atmos.shading.shear_warp import read_volume, upload_volume
 
 SHAPE = (20, 12, 16)
 
@@ -41,22 +42,22 @@ def nan_prefilled(shader):
 
 # -- GPU against the float64 twin of its own algorithm ------------------------------------------------
 @pytest.mark.parametrize("scale", [1, 2, 4])
-def test_shear_warp_gpu_matches_numpy_scheme(ctx, rng, scale):
+def test_shear_warp_gpu_matches_numpy_scheme(gpu, ctx, rng, scale):
     density = smooth_field(rng) * np.float32(rng.uniform(0.2, 3))
     for _ in range(4):
         sun, sigma = random_direction(rng), rng.uniform(0.05, 1.0)
-        got = compute_transmittance(ctx, density, sun, sigma, scale=scale)
+        got = compute_transmittance(gpu, density, sun, sigma, scale=scale)
         want = R.shear_warp_scheme(density, sun, sigma, scale=scale)
         assert got.dtype == np.float32 and got.shape == SHAPE
         assert np.isfinite(got).all()
         np.testing.assert_allclose(got, want, atol=3e-5, err_msg=f"sun {sun}, sigma {sigma}")
 
 
-def test_every_voxel_written(ctx, rng):
+def test_every_voxel_written(gpu, ctx, rng):
     density = smooth_field(rng)
-    texture = upload_volume(ctx, density)
+    texture = upload_volume(gpu, density)
     for scale in (1, 2, 4):
-        shader = ShearWarpShader(ctx, SHAPE, scale=scale)
+        shader = ShearWarpShader(gpu, SHAPE, scale=scale)
         for sun in (random_direction(rng), (0, 1, 0), (1, 0, 0), (0, 0, -1)):
             nan_prefilled(shader)
             shader.begin(texture, sun, 0.5)
@@ -66,10 +67,10 @@ def test_every_voxel_written(ctx, rng):
     texture.release()
 
 
-def test_fixed_ratio_gpu_matches_numpy(ctx, rng):
+def test_fixed_ratio_gpu_matches_numpy(gpu, ctx, rng):
     density = smooth_field(rng)
     sun = random_direction(rng)
-    got = compute_fixed_ratio(ctx, density, sun, 0.3)
+    got = compute_fixed_ratio(gpu, density, sun, 0.3)
     want = R.shear_warp_scheme(density, sun, 0.3, fixed_ratio=True, levels=255)
     assert np.abs(got - want).max() <= 1 / 255 + 1e-6   # a rounding step may land the other way
     assert np.mean(np.abs(got - want) > 1e-5) < 0.01
@@ -87,11 +88,11 @@ def test_exact_reference_matches_fine_midpoint_march(rng):
     np.testing.assert_allclose(R.optical_depth_exact(density, sun), fine, rtol=1e-5, atol=1e-5)
 
 
-def test_raymarch_matches_exact_reference(ctx, rng):
+def test_raymarch_matches_exact_reference(gpu, ctx, rng):
     density = rng.random(SHAPE).astype(np.float32)      # rough on purpose: the march is exact for trilinear
     for sun in (random_direction(rng), random_direction(rng), (0, 1, 0), (1, 1, 0), (1, 0.0, 0.3)):
         sigma = rng.uniform(0.01, 0.5)
-        got = compute_transmittance(ctx, density, sun, sigma, method="raymarch")
+        got = compute_transmittance(gpu, density, sun, sigma, method="raymarch")
         np.testing.assert_allclose(got, R.transmittance_exact(density, sun, sigma), atol=2e-6, rtol=1e-5)
 
 
@@ -101,33 +102,33 @@ SMALL_VOLUME_MEAN_ERROR = 0.015
 
 
 @pytest.mark.parametrize("elevation", [90, 60, 45, 30, 10, 1, 0, -20, -90])
-def test_shear_warp_close_to_exact(ctx, rng, elevation):
+def test_shear_warp_close_to_exact(gpu, ctx, rng, elevation):
     density = smooth_field(rng, (28, 12, 24))
     sun = direction(elevation, rng.uniform(0, 360))
     exact = R.transmittance_exact(density, sun, 0.3)
-    errors = [np.abs(compute_transmittance(ctx, density, sun, 0.3, scale=s) - exact).mean() for s in (1, 2, 4)]
+    errors = [np.abs(compute_transmittance(gpu, density, sun, 0.3, scale=s) - exact).mean() for s in (1, 2, 4)]
     assert errors[0] < SMALL_VOLUME_MEAN_ERROR, errors
     assert errors[0] <= errors[1] + 1e-3 and errors[1] <= errors[2] + 1e-3, errors
 
 
-def test_true_path_beats_fixed_ratio_at_low_sun(ctx, rng):
+def test_true_path_beats_fixed_ratio_at_low_sun(gpu, ctx, rng):
     density = smooth_field(rng)
     sun = direction(20, 30)
     exact = R.transmittance_exact(density, sun, 0.3)
-    ours = np.abs(compute_transmittance(ctx, density, sun, 0.3) - exact).mean()
-    thesis = np.abs(compute_fixed_ratio(ctx, density, sun, 0.3) - exact).mean()
+    ours = np.abs(compute_transmittance(gpu, density, sun, 0.3) - exact).mean()
+    thesis = np.abs(compute_fixed_ratio(gpu, density, sun, 0.3) - exact).mean()
     assert ours * 5 < thesis, (ours, thesis)
 
 
 # -- extreme directions -------------------------------------------------------------------------------
-def test_straight_down_is_exact(ctx, rng):
+def test_straight_down_is_exact(gpu, ctx, rng):
     density = rng.random(SHAPE).astype(np.float32)
-    got = compute_transmittance(ctx, density, (0, 3, 0), 0.4)
+    got = compute_transmittance(gpu, density, (0, 3, 0), 0.4)
     np.testing.assert_allclose(got, R.transmittance_exact(density, (0, 1, 0), 0.4), atol=2e-6)
 
 
 @pytest.mark.parametrize("pair", [("y", "x"), ("x", "z"), ("y", "z")])
-def test_45_degrees_both_axes_agree(ctx, rng, pair):
+def test_45_degrees_both_axes_agree(gpu, ctx, rng, pair):
     """Exactly on the case switch the tie goes to a fixed axis; nudging either way gives nearly the same."""
     density = smooth_field(rng)
     axes = {"x": 0, "y": 1, "z": 2}
@@ -138,8 +139,8 @@ def test_45_degrees_both_axes_agree(ctx, rng, pair):
     nudge[axes[pair[0]]] = 1e-6
     results = {}
     for name, sun in (("tie", base), ("first", base + nudge), ("second", base - nudge)):
-        shader = ShearWarpShader(ctx, SHAPE)
-        texture = upload_volume(ctx, density)
+        shader = ShearWarpShader(gpu, SHAPE)
+        texture = upload_volume(gpu, density)
         shader.begin(texture, sun, 0.5)
         results[name] = (shader.axis, shader.run_all() or read_volume(shader.result))
         shader.release()
@@ -154,47 +155,47 @@ def test_45_degrees_both_axes_agree(ctx, rng, pair):
 
 @pytest.mark.parametrize("sun", [(1, 0, 0), (0.3, 0, -1), (1, 1e-6, 0.2), (0, -1, 0), (0.4, -0.3, 0.2),
                                  (0, 0, 1e-30), (1e-300, 1e-300, 0)])
-def test_extreme_directions(ctx, rng, sun):
+def test_extreme_directions(gpu, ctx, rng, sun):
     density = smooth_field(rng)
     exact = R.transmittance_exact(density, sun, 0.4)
     for method in ("shear-warp", "raymarch"):
-        got = compute_transmittance(ctx, density, sun, 0.4, method=method)
+        got = compute_transmittance(gpu, density, sun, 0.4, method=method)
         assert np.isfinite(got).all() and got.min() >= 0 and got.max() <= 1
         assert np.abs(got - exact).mean() < SMALL_VOLUME_MEAN_ERROR, method
 
 
-def test_sigma_extremes(ctx, rng):
+def test_sigma_extremes(gpu, ctx, rng):
     density = smooth_field(rng)
     density[3, 4, 5] = 3e38
     sun = random_direction(rng)
     for method in ("shear-warp", "raymarch"):
-        assert np.array_equal(compute_transmittance(ctx, density, sun, 0.0, method=method), np.ones(SHAPE))
+        assert np.array_equal(compute_transmittance(gpu, density, sun, 0.0, method=method), np.ones(SHAPE))
         for sigma in (1e30, 1e300):
-            got = compute_transmittance(ctx, density, sun, sigma, method=method)
+            got = compute_transmittance(gpu, density, sun, sigma, method=method)
             assert np.isfinite(got).all() and got.max() < 1e-30, method
     for scale in (2, 4):
-        assert np.array_equal(compute_transmittance(ctx, density, sun, 0.0, scale=scale), np.ones(SHAPE))
-        assert np.isfinite(compute_transmittance(ctx, density, sun, 1e300, scale=scale)).all()
+        assert np.array_equal(compute_transmittance(gpu, density, sun, 0.0, scale=scale), np.ones(SHAPE))
+        assert np.isfinite(compute_transmittance(gpu, density, sun, 1e300, scale=scale)).all()
 
 
-def test_empty_and_tiny_volumes(ctx, rng):
-    assert np.array_equal(compute_transmittance(ctx, np.zeros(SHAPE), (0.3, 1, 0), 5.0), np.ones(SHAPE))
+def test_empty_and_tiny_volumes(gpu, ctx, rng):
+    assert np.array_equal(compute_transmittance(gpu, np.zeros(SHAPE), (0.3, 1, 0), 5.0), np.ones(SHAPE))
     for shape in ((1, 1, 1), (1, 5, 1), (3, 1, 2)):
         density = rng.random(shape).astype(np.float32)
         for scale in (1, 2, 4):
-            got = compute_transmittance(ctx, density, random_direction(rng), 0.7, scale=scale)
+            got = compute_transmittance(gpu, density, random_direction(rng), 0.7, scale=scale)
             assert got.shape == shape and np.isfinite(got).all()
-        np.testing.assert_allclose(compute_transmittance(ctx, density, (0.2, 1, 0.1), 0.7, method="raymarch"),
+        np.testing.assert_allclose(compute_transmittance(gpu, density, (0.2, 1, 0.1), 0.7, method="raymarch"),
                                    R.transmittance_exact(density, (0.2, 1, 0.1), 0.7), atol=2e-6)
 
 
 # -- energy sanity --------------------------------------------------------------------------------------
-def test_transmittance_never_increases_along_the_light_path(ctx, rng):
+def test_transmittance_never_increases_along_the_light_path(gpu, ctx, rng):
     """Each voxel is at most as bright as the brightest of the four voxels one step toward the sun
     (no new maxima: the bicubic lookup is limited); exactly so where the step hits a voxel."""
     density = smooth_field(rng) * 3
     for sun in [random_direction(rng) for _ in range(4)] + [(0, 1, 0), (1, 1, 0), (0, -1, -1)]:
-        t = compute_transmittance(ctx, density, sun, 0.5)
+        t = compute_transmittance(gpu, density, sun, 0.5)
         assert t.min() >= 0 and t.max() <= 1
         plan = R.SlicePlan(SHAPE, R.check_sun_dir(sun))
         a, (b, c) = plan.axis, plan.lateral
@@ -212,11 +213,11 @@ def test_transmittance_never_increases_along_the_light_path(ctx, rng):
 
 
 # -- sliced (amortized) shading -------------------------------------------------------------------------
-def test_slices_in_chunks_equal_one_shot(ctx, rng):
+def test_slices_in_chunks_equal_one_shot(gpu, ctx, rng):
     density = smooth_field(rng)
     sun = random_direction(rng)
-    texture = upload_volume(ctx, density)
-    shader = ShearWarpShader(ctx, SHAPE)
+    texture = upload_volume(gpu, density)
+    shader = ShearWarpShader(gpu, SHAPE)
     shader.begin(texture, sun, 0.5)
     shader.run_all()
     one_shot = read_volume(shader.result)
@@ -285,17 +286,17 @@ def test_shading_stage_one_slice_per_frame_with_moving_sun(gpu, ctx, rng):
     ({"scale": 3}, "(1, 2, 4)"),
     ({"scale": 2, "method": "raymarch"}, "scale=1"),
 ])
-def test_bad_input(ctx, kwargs, words):
+def test_bad_input(gpu, ctx, kwargs, words):
     args = {"density": np.ones(SHAPE, np.float32), "sun_dir": (0, 1, 0), "sigma": 0.5, **kwargs}
     with pytest.raises(ValueError, match=None) as info:
-        compute_transmittance(ctx, **args)
+        compute_transmittance(gpu, **args)
     assert words in str(info.value)
 
 
-def test_bad_slicing_changes_nothing(ctx, rng):
+def test_bad_slicing_changes_nothing(gpu, ctx, rng):
     density = smooth_field(rng)
-    texture = upload_volume(ctx, density)
-    shader = ShearWarpShader(ctx, SHAPE)
+    texture = upload_volume(gpu, density)
+    shader = ShearWarpShader(gpu, SHAPE)
     with pytest.raises(ValueError, match="before begin"):
         shader.run_slices(0, 1)
     count = shader.begin(texture, (0, 1, 0), 0.5)
@@ -305,13 +306,13 @@ def test_bad_slicing_changes_nothing(ctx, rng):
             shader.run_slices(*args)
     with pytest.raises(ValueError, match="sun_dir"):
         shader.begin(texture, (0, 0, 0), 0.5)
-    wrong = upload_volume(ctx, np.zeros((4, 4, 4)))
+    wrong = upload_volume(gpu, np.zeros((4, 4, 4)))
     with pytest.raises(ValueError, match="density_texture must be"):
         shader.begin(wrong, (0, 1, 0), 0.5)
     assert shader.next_slice == 2 and shader.slice_count == count   # the pass in flight is untouched
     shader.run_all()
     with pytest.raises(ValueError, match="scale must be one of"):
-        ShearWarpShader(ctx, SHAPE, scale=0)
+        ShearWarpShader(gpu, SHAPE, scale=0)
     for obj in (texture, wrong):
         obj.release()
     shader.release()
@@ -328,17 +329,17 @@ def test_harris_recurrence_tends_to_reduced_extinction(rng):
     assert Scattering().extinction(0.8) == 0.8
 
 
-def test_light_volume_gpu_matches_reference(ctx, rng):
+def test_light_volume_gpu_matches_reference(gpu, ctx, rng):
     t = rng.random(SHAPE).astype(np.float32)
     sun_color, ambient = sky_light(direction(rng.uniform(-10, 90), 0))
-    src = upload_volume(ctx, t)
+    src = upload_volume(gpu, t)
     dst = ctx.texture3d(SHAPE, 4, dtype="f4")
     dst.write(np.full(SHAPE[::-1] + (4,), np.nan, np.float32).tobytes())
-    LightVolumeShader(ctx).run(src, dst, sun_color, ambient)
+    LightVolumeShader(gpu).run(src, dst, sun_color, ambient)
     got = np.frombuffer(dst.read(), np.float32).reshape(SHAPE[::-1] + (4,)).transpose(2, 1, 0, 3)
     np.testing.assert_allclose(got, light_volume_reference(t, sun_color, ambient), atol=1e-6)
     with pytest.raises(ValueError, match="sun_color"):
-        LightVolumeShader(ctx).run(src, dst, (1, -1, 0), ambient)
+        LightVolumeShader(gpu).run(src, dst, (1, -1, 0), ambient)
     src.release()
     dst.release()
 

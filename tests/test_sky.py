@@ -15,8 +15,8 @@ from atmos.gpu import create_headless
 from atmos.lighting import Sun
 from atmos.plugins.daylight import solar_direction
 from atmos.plugins.ground import GroundPlugin
-from atmos.plugins.shading.scattering import sky_light
-from atmos.plugins.sky import SkyParams, SkyPlugin, evaluate_sky, sky_color, sky_radiance
+from atmos.lighting import sky_light
+from atmos.plugins.sky import SkySettings, SkyPlugin, evaluate_sky, sky_color, sky_radiance
 from atmos.plugins.sky.preetham import preetham_rgb
 from atmos.plugins.sky.shader import set_sky_uniforms, set_view_basis, sky_defines, view_basis
 from fullscreen_probe import run_fullscreen
@@ -56,7 +56,7 @@ def random_params(rng, **fixed):
                     night=tuple(rng.uniform(0.0, 0.05, 3)), stars=True, star_density=rng.uniform(0.05, 0.6),
                     star_brightness=rng.uniform(0.5, 8.0), twinkle=rng.uniform(0.0, 1.0))
     settings.update(fixed)
-    return SkyParams(**settings)
+    return SkySettings(**settings)
 
 
 # -- GPU against the float64 reference ------------------------------------------------------------
@@ -82,7 +82,7 @@ def test_stars_on_the_gpu_are_the_reference_stars(gpu, ctx, rng):
     sun = Sun.from_angles(-30.0, 0.0).direction
     dirs = random_dirs(rng, 20000)
     dirs = dirs[dirs[:, 1] > 0.2]
-    dark = SkyParams(stars=False, night=params.night, turbidity=params.turbidity)
+    dark = SkySettings(stars=False, night=params.night, turbidity=params.turbidity)
     time = rng.uniform(0.0, 100.0)
     got = evaluate_sky(gpu, dirs, sun, (0, 0, 0), params, time) - evaluate_sky(gpu, dirs, sun, (0, 0, 0), dark)
     want = sky_color(dirs, sun, (0, 0, 0), params, time) - sky_color(dirs, sun, (0, 0, 0), dark)
@@ -91,7 +91,7 @@ def test_stars_on_the_gpu_are_the_reference_stars(gpu, ctx, rng):
     assert near(got, want, 5e-3, 1e-4) <= 0
 
 
-def render_sky(gpu, camera: Camera, size, params: SkyParams, sun, sun_color, time=0.0):
+def render_sky(gpu, camera: Camera, size, params: SkySettings, sun, sun_color, time=0.0):
     """(h, w, 4) sky.frag output (row 0 at the bottom)."""
     w, h = size
 
@@ -151,7 +151,7 @@ def test_extreme_suns_and_views_are_finite_on_gpu_and_reference(gpu, ctx, turbid
     views = unit(np.array(EXTREME_VIEWS + EXTREME_SUNS, np.float64))
     for s in EXTREME_SUNS:
         for stars in (False, True):
-            params = SkyParams(turbidity=turbidity, stars=stars, star_density=1.0)
+            params = SkySettings(turbidity=turbidity, stars=stars, star_density=1.0)
             want = sky_color(views, s, (1, 1, 1), params, time=1e4, pixel_angle=1.0)
             got = evaluate_sky(gpu, views, s, (1, 1, 1), params, time=1e4, pixel_angle=1.0)
             assert np.isfinite(want).all() and np.isfinite(got).all() and (got >= 0).all(), s
@@ -162,7 +162,7 @@ def test_extreme_suns_and_views_are_finite_on_gpu_and_reference(gpu, ctx, turbid
 @pytest.mark.parametrize("near_far", [(1e-4, 1e7), (0.1, 0.2), (10.0, 2000.0)])
 def test_camera_straight_up_or_down_and_extreme_planes_render_finite(gpu, ctx, pitch, near_far):
     cam = Camera(position=np.array([0.0, 1.0, 0.0]), yaw=0.3, pitch=pitch, near=near_far[0], far=near_far[1])
-    img = render_sky(gpu, cam, (16, 16), SkyParams(), Sun.from_angles(20, 0).direction, (1, 1, 1), 3.0)
+    img = render_sky(gpu, cam, (16, 16), SkySettings(), Sun.from_angles(20, 0).direction, (1, 1, 1), 3.0)
     assert np.isfinite(img).all() and (img[..., :3] >= 0).all()
     sky = img[..., :3].mean()
     assert (sky > 0.05) if pitch > 0 else (sky < 0.2), "looking up sees the sky, down the dimmed horizon"
@@ -174,16 +174,16 @@ def test_bad_inputs_raise_clear_errors_and_change_nothing():
                           ({"night": (1, 2)}, "night"), ({"stars": "yes"}, "True or False"),
                           ({"star_density": 2}, "star_density"), ({"twinkle": math.nan}, "twinkle")]:
         with pytest.raises(ValueError, match=words.replace("[", r"\[").replace("]", r"\]")):
-            SkyParams(**kwargs)
+            SkySettings(**kwargs)
         with pytest.raises(ValueError):
             SkyPlugin(**kwargs)
     plugin = SkyPlugin(turbidity=3.0)
-    before = plugin.params
+    before = plugin.settings
     with pytest.raises(ValueError, match="scale"):
         plugin.configure(turbidity=5.0, scale=-1.0)
-    with pytest.raises(ValueError, match="unknown SkyParams setting"):
+    with pytest.raises(ValueError, match="unknown SkySettings setting"):
         plugin.configure(turbidity=5.0, nosuch=1)
-    assert plugin.params is before
+    assert plugin.settings is before
     assert plugin.configure(turbidity=5.0).turbidity == 5.0
     with pytest.raises(ValueError, match="view_dir"):
         sky_radiance((0, 0, 0), (0, 1, 0))
@@ -211,7 +211,7 @@ def test_preetham_reference_properties():
 
 
 def test_sky_changes_colour_through_a_day_and_is_reddish_near_sunset(gpu, ctx):
-    params = SkyParams(stars=False)
+    params = SkySettings(stars=False)
     rows = []
     for hours in np.arange(0.0, 24.0, 0.25):
         s = solar_direction(hours)
@@ -233,7 +233,7 @@ def test_sky_changes_colour_through_a_day_and_is_reddish_near_sunset(gpu, ctx):
 
 def test_stars_only_at_night_above_the_horizon_and_twinkle(gpu, ctx, rng):
     dirs = random_dirs(rng, 20000)
-    on, off = SkyParams(star_density=0.3, twinkle=0.8), SkyParams(stars=False)
+    on, off = SkySettings(star_density=0.3, twinkle=0.8), SkySettings(stars=False)
     for elevation in (45.0, 2.0, -1.0):
         s = Sun.from_angles(elevation, 30.0).direction
         assert np.array_equal(evaluate_sky(gpu, dirs, s, (1, 1, 1), on, 5.0),
@@ -294,7 +294,6 @@ def test_resized_and_minimized_window(size):
         app = sky_scene(gpu, -5.0)
         app.run_frames(1)
         gpu.resize(size)
-        app.graph.invalidate()
         app.run_frames(2)
         img = gpu.read_pixels()
         assert img.shape[:2] == (max(1, size[1]), max(1, size[0]))

@@ -7,10 +7,9 @@ import pytest
 from atmos.app import App
 from atmos.camera import Camera
 from atmos.defaults import DefaultPlugins
-from atmos.gpu.shaders import build_program
 from atmos.lighting import Sun
 from atmos.plugins.ground import GroundPlugin
-from atmos.plugins.sky_layer import SkyLayerParams, SkyLayerPlugin, reference
+from atmos.plugins.sky_layer import SkyLayerSettings, SkyLayerPlugin, reference
 from atmos.plugins.sky_layer.octaves import OctaveTextures
 from atmos.plugins.sky_layer.plugin import layer_light, scroll_offsets
 from atmos.render_core import CapturePass
@@ -18,7 +17,7 @@ from atmos.render_core import CapturePass
 
 # -- octave textures ---------------------------------------------------------------------------------
 def test_gpu_octaves_match_reference_and_every_texel_is_written(gpu, ctx, rng):
-    params = SkyLayerParams(size=48, base_frequency=int(rng.integers(3, 8)), seed=int(rng.integers(0, 2**32)),
+    params = SkyLayerSettings(size=48, base_frequency=int(rng.integers(3, 8)), seed=int(rng.integers(0, 2**32)),
                             light_step=float(rng.uniform(0.005, 0.05)))
     sun = Sun.from_angles(float(rng.uniform(5, 80)), float(rng.uniform(0, 360))).direction
     octaves = OctaveTextures(gpu)
@@ -63,8 +62,9 @@ def test_light_march_channels_are_the_noise_shifted_toward_the_sun(rng):
 
 
 # -- remap and shading --------------------------------------------------------------------------------
-def gpu_shade(ctx, fbm, fade, params, light):
-    prog = build_program(ctx, {"compute_shader": "sky_layer/shade_points.comp"})
+def gpu_shade(gpu, fbm, fade, params, light):
+    ctx = gpu.ctx
+    prog = gpu.program(compute_shader="sky_layer/shade_points.comp")
     n = len(fbm)
     data = np.zeros((n, 8), np.float32)
     data[:, :4], data[:, 4] = fbm, fade
@@ -81,14 +81,14 @@ def gpu_shade(ctx, fbm, fade, params, light):
         ctx.memory_barrier()
         return np.frombuffer(dst.read(), np.float32).reshape(n, 4).astype(np.float64)
     finally:
-        src.release(), dst.release(), prog.release()
+        src.release(), dst.release()
 
 
 @pytest.mark.parametrize("look", [
     dict(), dict(emptiness=0.0, sharpness=1.0), dict(emptiness=0.5, sharpness=0.501), dict(thickness=0.0),
     dict(thickness=1e6), dict(emptiness=0.999, sharpness=1.0), dict(color=(0, 0, 0), lit_color=(5, 5, 5))])
-def test_gpu_shading_matches_float64_reference(ctx, rng, look):
-    params = SkyLayerParams(**look)
+def test_gpu_shading_matches_float64_reference(gpu, ctx, rng, look):
+    params = SkyLayerSettings(**look)
     n = 2048
     fbm = rng.uniform(-0.2, 1.2, (n, 4))
     fbm[:8] = [[0, 0, 0, 0], [1, 1, 1, 1], [params.emptiness] * 4, [params.sharpness] * 4,
@@ -97,7 +97,7 @@ def test_gpu_shading_matches_float64_reference(ctx, rng, look):
     fade = rng.uniform(0, 1, n)
     fade[:4] = [0, 1, 0, 1]
     light = rng.uniform(0, 2, 3)
-    got = gpu_shade(ctx, fbm, fade, params, light)
+    got = gpu_shade(gpu, fbm, fade, params, light)
     want = reference.shade(fbm, params, light, fade)
     assert np.isfinite(got).all() and (got[:, 3] >= 0).all() and (got[:, 3] <= 1).all()
     # a remap with a 1e-3 gap amplifies float32 input rounding by 1/gap
@@ -141,7 +141,7 @@ def bilinear(tex, uv):
 
 
 def test_pass_draws_the_reference_layer_on_the_sky_only(fresh_gpu, tmp_path):
-    params = SkyLayerParams(size=32, base_frequency=12, tile_size=40000.0, altitude=1200.0,
+    params = SkyLayerSettings(size=32, base_frequency=12, tile_size=40000.0, altitude=1200.0,
                             wind=((0.11, 0.0), (0.0, 0.37), (0.0, -0.2), (-0.9, 0.0)))
     plugin = SkyLayerPlugin(params, animate=False)
     app0, bg, cam = render(fresh_gpu)
@@ -210,7 +210,7 @@ def test_layer_scrolls_with_time_and_rebakes_only_when_the_sun_turns(fresh_gpu):
 
 
 def test_octaves_scroll_at_different_speeds_and_directions():
-    wind = np.asarray(SkyLayerParams().wind)
+    wind = np.asarray(SkyLayerSettings().wind)
     speeds = np.linalg.norm(wind, axis=1)
     assert np.allclose(speeds / speeds[0], [1, 1.5, 2, 2.5])
     assert len({tuple(np.sign(w)) for w in wind}) == 4
@@ -227,20 +227,20 @@ def test_camera_above_the_layer_and_looking_down_draws_nothing(fresh_gpu):
 
 
 @pytest.mark.parametrize("change, message", [
-    (dict(emptiness=-0.1), "SkyLayerParams.emptiness must be a finite number >= 0.0 and <= 1.0"),
+    (dict(emptiness=-0.1), "SkyLayerSettings.emptiness must be a finite number >= 0.0 and <= 1.0"),
     (dict(sharpness=1.5), "sharpness"), (dict(emptiness=0.6, sharpness=0.6), "sharpness must exceed emptiness"),
-    (dict(thickness=-1), "thickness"), (dict(color=(1, 1)), "SkyLayerParams.color must be 3 non-negative"),
+    (dict(thickness=-1), "thickness"), (dict(color=(1, 1)), "SkyLayerSettings.color must be 3 non-negative"),
     (dict(tile_size=0), "tile_size must be a finite number > 0"), (dict(size=8), "size must be a whole number 16..2048"),
     (dict(wind=((1, 0),) * 3), "wind must be 4"), (dict(wind=((1, 0), (0, 1), (0, math.nan), (1, 1))), r"wind\[2\]"),
     (dict(base_frequency=0), "1..64"), (dict(light_step=0.5), "light_step"), (dict(horizon_fade=0), "horizon_fade"),
-    (dict(altitude=math.inf), "altitude"), (dict(cover=0.5), "unknown SkyLayerParams setting"),
+    (dict(altitude=math.inf), "altitude"), (dict(cover=0.5), "unknown SkyLayerSettings setting"),
 ])
 def test_bad_settings_are_refused_and_nothing_is_applied(change, message):
     plugin = SkyLayerPlugin()
-    before = plugin.params
+    before = plugin.settings
     with pytest.raises(ValueError, match=message):
         plugin.configure(**{"thickness": 2.0, **change})
-    assert plugin.params is before
+    assert plugin.settings is before
     with pytest.raises(ValueError):
         SkyLayerPlugin(**change)
 

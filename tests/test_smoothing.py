@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from atmos.plugins.automaton import CloudAutomaton
+from atmos.automaton import CloudAutomaton
 from atmos.plugins.clouds import DensityMaps, Smoother, read_volume, reference, slice_range
 
 LAYOUTS = ("packed", "cell")
@@ -19,8 +19,8 @@ def made(ctx):
         obj.release()
 
 
-def automaton(ctx, made, shape, cld, layout):
-    ca = CloudAutomaton(ctx, shape, layout=layout)
+def automaton(gpu, made, shape, cld, layout):
+    ca = CloudAutomaton(gpu, shape, layout=layout)
     made.append(ca)
     ca.upload(np.zeros(shape, bool), np.zeros(shape, bool), cld)
     return ca
@@ -33,9 +33,9 @@ def nan_texture(smoother, made, dtype):
     return texture
 
 
-def smooth_gpu(ctx, made, cld, layout="packed", dtype="f2", radius=(1, 1, 1), weights="tent", slices=None):
+def smooth_gpu(gpu, made, cld, layout="packed", dtype="f2", radius=(1, 1, 1), weights="tent", slices=None):
     """Smooth ``cld`` on the GPU (whole, or in the given (z0, z1) slices) into a NaN-prefilled texture."""
-    ca = automaton(ctx, made, cld.shape, cld, layout)
+    ca = automaton(gpu, made, cld.shape, cld, layout)
     smoother = Smoother.for_automaton(ca, radius, weights)
     made.append(smoother)
     texture = nan_texture(smoother, made, dtype)
@@ -60,20 +60,20 @@ def random_cld(rng, shape):
 @pytest.mark.parametrize("layout", LAYOUTS)
 @pytest.mark.parametrize("dtype", ["f2", "f4"])
 @pytest.mark.parametrize("shape", [(37, 6, 19), (1, 1, 1), (64, 3, 5), (33, 4, 2)])
-def test_smoothing_matches_reference(ctx, made, rng, layout, dtype, shape):
+def test_smoothing_matches_reference(gpu, ctx, made, rng, layout, dtype, shape):
     cld = random_cld(rng, shape)
     radius = tuple(int(r) for r in rng.integers(0, 4, size=3))
     weights = str(rng.choice(reference.WEIGHTS))
     print("radius", radius, "weights", weights)
-    got, _, smoother = smooth_gpu(ctx, made, cld, layout, dtype, radius, weights)
+    got, _, smoother = smooth_gpu(gpu, made, cld, layout, dtype, radius, weights)
     assert_matches(got, reference.smooth(cld, radius, weights, smoother.min_density(dtype)), dtype)
 
 
 @pytest.mark.parametrize("layout", LAYOUTS)
-def test_smoothing_after_automaton_steps(ctx, made, rng, layout):
+def test_smoothing_after_automaton_steps(gpu, ctx, made, rng, layout):
     """The state buffer the automaton leaves after real steps (buffers swap) is read correctly."""
     shape = (45, 5, 11)
-    ca = CloudAutomaton(ctx, shape, seed=int(rng.integers(0, 2**32)), layout=layout)
+    ca = CloudAutomaton(gpu, shape, seed=int(rng.integers(0, 2**32)), layout=layout)
     made.append(ca)
     ca.upload(*(rng.random(shape) < p for p in (0.5, 0.1, 0.3)))
     smoother = Smoother.for_automaton(ca)
@@ -88,11 +88,11 @@ def test_smoothing_after_automaton_steps(ctx, made, rng, layout):
 
 @pytest.mark.parametrize("layout", LAYOUTS)
 @pytest.mark.parametrize("weights", reference.WEIGHTS)
-def test_empty_and_full_volumes(ctx, made, layout, weights):
+def test_empty_and_full_volumes(gpu, ctx, made, layout, weights):
     shape = (37, 6, 19)
-    empty, _, _ = smooth_gpu(ctx, made, np.zeros(shape, bool), layout, "f4", weights=weights)
+    empty, _, _ = smooth_gpu(gpu, made, np.zeros(shape, bool), layout, "f4", weights=weights)
     assert (empty == 0).all()
-    full, _, _ = smooth_gpu(ctx, made, np.ones(shape, bool), layout, "f2", radius=(2, 1, 1), weights=weights)
+    full, _, _ = smooth_gpu(gpu, made, np.ones(shape, bool), layout, "f2", radius=(2, 1, 1), weights=weights)
     assert (full[2:-2, 1:-1, 1:-1] == 1.0).all(), "a full neighbourhood must give exactly 1.0"
     # no renormalization at the borders: outside cells count as 0
     assert (full[0] < 1).all() and (full[:, 0] < 1).all() and (full[:, :, -1] < 1).all()
@@ -100,40 +100,40 @@ def test_empty_and_full_volumes(ctx, made, layout, weights):
 
 
 @pytest.mark.parametrize("layout", LAYOUTS)
-def test_tiny_densities_stay_positive_in_r16f(ctx, made, rng, layout):
+def test_tiny_densities_stay_positive_in_r16f(gpu, ctx, made, rng, layout):
     """Radius 8 tent: a lone cell's far corner weighs 1/81**3, below half precision; it is floored."""
     shape = (40, 17, 18)
     cld = rng.random(shape) < 0.0005
     cld[int(rng.integers(0, 40)), 8, 9] = True
-    got, _, smoother = smooth_gpu(ctx, made, cld, layout, "f2", radius=8)
+    got, _, smoother = smooth_gpu(gpu, made, cld, layout, "f2", radius=8)
     expected = reference.smooth(cld, 8, "tent", smoother.min_density("f2"))
     assert_matches(got, expected, "f2")
     assert got[got > 0].min() >= 2.0 ** -14
     assert (reference.smooth(cld, 8) > 0).sum() == (got > 0).sum()
 
 
-def test_radius_zero_is_the_cld_field(ctx, made, rng):
+def test_radius_zero_is_the_cld_field(gpu, ctx, made, rng):
     cld = random_cld(rng, (37, 6, 19))
-    got, _, _ = smooth_gpu(ctx, made, cld, "packed", "f2", radius=0)
+    got, _, _ = smooth_gpu(gpu, made, cld, "packed", "f2", radius=0)
     assert np.array_equal(got, cld.astype(np.float32))
 
 
 @pytest.mark.parametrize("layout", LAYOUTS)
-def test_sliced_smoothing_equals_whole(ctx, made, rng, layout):
+def test_sliced_smoothing_equals_whole(gpu, ctx, made, rng, layout):
     shape = (37, 6, 19)
     cld = random_cld(rng, shape)
-    whole, _, _ = smooth_gpu(ctx, made, cld, layout)
+    whole, _, _ = smooth_gpu(gpu, made, cld, layout)
     cuts = np.sort(rng.choice(np.arange(1, 19), size=4, replace=False))
     slices = list(zip([0, *cuts], [*cuts, 19])) + [(5, 5)]
-    sliced, _, _ = smooth_gpu(ctx, made, cld, layout, slices=slices)
+    sliced, _, _ = smooth_gpu(gpu, made, cld, layout, slices=slices)
     assert np.array_equal(sliced, whole)
-    one_layer, _, _ = smooth_gpu(ctx, made, cld, layout, slices=[slice_range(19, i, 19) for i in range(19)])
+    one_layer, _, _ = smooth_gpu(gpu, made, cld, layout, slices=[slice_range(19, i, 19) for i in range(19)])
     assert np.array_equal(one_layer, whole)
 
 
-def test_slice_writes_only_its_layers(ctx, made, rng):
+def test_slice_writes_only_its_layers(gpu, ctx, made, rng):
     cld = random_cld(rng, (20, 3, 9))
-    got, _, _ = smooth_gpu(ctx, made, cld, slices=[(2, 5)])
+    got, _, _ = smooth_gpu(gpu, made, cld, slices=[(2, 5)])
     assert not np.isnan(got[:, :, 2:5]).any()
     assert np.isnan(got[:, :, :2]).all() and np.isnan(got[:, :, 5:]).all()
 
@@ -147,21 +147,23 @@ def test_slice_range_covers_everything():
         slice_range(10, 3, 3)
 
 
-def test_smoother_rejects_bad_parameters(ctx):
+def test_smoother_rejects_bad_parameters(gpu, ctx):
     for kwargs, match in [({"shape": (0, 1, 1)}, "shape"), ({"shape": (2, 2)}, "shape"),
                           ({"radius": 9}, r"radius .*\[0, 8\]"), ({"radius": (1, -1, 1)}, "radius"),
                           ({"radius": 1.5}, "radius"), ({"weights": "gauss"}, "weights .*tent"),
                           ({"layout": "bits"}, "layout .*packed"), ({"shape": (4096, 1, 1)}, "too big")]:
         args = {"shape": (4, 4, 4), **kwargs}
         with pytest.raises(ValueError, match=match):
-            Smoother(ctx, **args)
-    with pytest.raises(ValueError, match="moderngl.Context"):
+            Smoother(gpu, **args)
+    with pytest.raises(ValueError, match="GpuContext"):
         Smoother(object(), (4, 4, 4))
+    with pytest.raises(ValueError, match="GpuContext"):
+        DensityMaps(gpu.ctx, (4, 4, 4))
 
 
-def test_run_rejects_bad_input_and_changes_nothing(ctx, made, rng):
+def test_run_rejects_bad_input_and_changes_nothing(gpu, ctx, made, rng):
     shape = (37, 6, 19)
-    ca = automaton(ctx, made, shape, random_cld(rng, shape), "packed")
+    ca = automaton(gpu, made, shape, random_cld(rng, shape), "packed")
     smoother = Smoother.for_automaton(ca)
     made.append(smoother)
     texture = nan_texture(smoother, made, "f2")
@@ -184,8 +186,8 @@ def test_run_rejects_bad_input_and_changes_nothing(ctx, made, rng):
 
 
 # -- density maps ----------------------------------------------------------------------------------
-def nan_maps(ctx, made, shape, band_height, group_size):
-    maps = DensityMaps(ctx, shape, band_height, group_size)
+def nan_maps(gpu, made, shape, band_height, group_size):
+    maps = DensityMaps(gpu, shape, band_height, group_size)
     made.append(maps)
     for texture in (maps.sums, maps.max_maps):
         texture.write(np.full(texture.size[::-1], np.nan, np.float32).tobytes())
@@ -210,37 +212,37 @@ def assert_maps(maps, density_gpu, density_ref):
 @pytest.mark.parametrize("shape,band_height,group_size", [
     ((37, 6, 19), 4, (5, 7)), ((37, 6, 19), 4, (32, 32)), ((1, 1, 1), 4, (32, 32)),
     ((70, 9, 33), 2, (3, 32)), ((37, 6, 19), 1, 1), ((37, 6, 19), 7, (37, 19))])
-def test_density_maps_match_reference(ctx, made, rng, layout, shape, band_height, group_size):
+def test_density_maps_match_reference(gpu, ctx, made, rng, layout, shape, band_height, group_size):
     cld = rng.random(shape) < rng.uniform(0.0005, 0.05)   # sparse: many empty segments
-    density, texture, smoother = smooth_gpu(ctx, made, cld, layout, str(rng.choice(["f2", "f4"])))
-    maps = nan_maps(ctx, made, shape, band_height, group_size)
+    density, texture, smoother = smooth_gpu(gpu, made, cld, layout, str(rng.choice(["f2", "f4"])))
+    maps = nan_maps(gpu, made, shape, band_height, group_size)
     maps.run(texture)
     assert_maps(maps, density, reference.smooth(cld))
 
 
 @pytest.mark.parametrize("fill", [False, True])
-def test_density_maps_of_empty_and_full_volumes(ctx, made, fill):
+def test_density_maps_of_empty_and_full_volumes(gpu, ctx, made, fill):
     shape = (37, 6, 19)
     cld = np.full(shape, fill)
-    density, texture, _ = smooth_gpu(ctx, made, cld)
-    maps = nan_maps(ctx, made, shape, 4, (8, 8))
+    density, texture, _ = smooth_gpu(gpu, made, cld)
+    maps = nan_maps(gpu, made, shape, 4, (8, 8))
     maps.run(texture)
     assert_maps(maps, density, reference.smooth(cld))
     assert (maps.read_max_maps() > 0).all() == fill and (maps.read_max_maps() == 0).all() != fill
 
 
-def test_sliced_pipeline_equals_whole(ctx, made, rng):
+def test_sliced_pipeline_equals_whole(gpu, ctx, made, rng):
     """Smoothing and density maps interleaved slice by slice, as a frame scheduler runs them."""
     shape = (37, 6, 19)
     cld = rng.random(shape) < 0.02
-    density, texture, _ = smooth_gpu(ctx, made, cld)
-    whole = nan_maps(ctx, made, shape, 4, (5, 7))
+    density, texture, _ = smooth_gpu(gpu, made, cld)
+    whole = nan_maps(gpu, made, shape, 4, (5, 7))
     whole.run(texture)
-    ca = automaton(ctx, made, shape, cld, "packed")
+    ca = automaton(gpu, made, shape, cld, "packed")
     smoother = Smoother.for_automaton(ca)
     made.append(smoother)
     sliced_tex = nan_texture(smoother, made, "f2")
-    sliced = nan_maps(ctx, made, shape, 4, (5, 7))
+    sliced = nan_maps(gpu, made, shape, 4, (5, 7))
     count = int(rng.integers(2, 20))
     for i in range(count):
         z0, z1 = slice_range(shape[2], i, count)
@@ -252,14 +254,14 @@ def test_sliced_pipeline_equals_whole(ctx, made, rng):
     assert_maps(sliced, density, reference.smooth(cld))
 
 
-def test_density_maps_reject_bad_input(ctx, made):
+def test_density_maps_reject_bad_input(gpu, ctx, made):
     for kwargs, match in [({"band_height": 0}, "band_height"), ({"band_height": 2.0}, "band_height"),
                           ({"group_size": (0, 3)}, "group_size"), ({"group_size": (1, 2, 3)}, "group_size"),
                           ({"shape": (3, 0, 3)}, "shape"), ({"shape": (32, 9000, 32), "band_height": 1}, "too big"),
                           ({"shape": (40000, 1, 1)}, "too big")]:
         with pytest.raises(ValueError, match=match):
-            DensityMaps(ctx, **{"shape": (8, 4, 8), **kwargs})
-    maps = nan_maps(ctx, made, (8, 4, 8), 4, 4)
+            DensityMaps(gpu, **{"shape": (8, 4, 8), **kwargs})
+    maps = nan_maps(gpu, made, (8, 4, 8), 4, 4)
     wrong = ctx.texture3d((8, 4, 7), 1, dtype="f2")
     made.append(wrong)
     with pytest.raises(ValueError, match=r"density must be .*\(8, 4, 8\)"):
@@ -269,3 +271,26 @@ def test_density_maps_reject_bad_input(ctx, made):
     with pytest.raises(ValueError, match="z range"):
         maps.run(good, 0, 9)
     assert np.isnan(maps.read_sums()).all() and np.isnan(maps.read_max_maps()).all()
+
+
+def test_smoothers_and_maps_of_other_shapes_share_the_context_programs(gpu, ctx, made, rng):
+    """Two pipelines of different shapes and radii, run slice by slice in turn: each writes its own
+    uniforms on the shared gpu.program programs, so each still equals its reference."""
+    runs = []
+    for shape, radius, groups in (((37, 6, 19), (1, 2, 1), (5, 7)), ((20, 9, 33), (3, 0, 2), (32, 4))):
+        cld = random_cld(rng, shape)
+        ca = automaton(gpu, made, shape, cld, "packed")
+        smoother = Smoother.for_automaton(ca, radius)
+        made.append(smoother)
+        texture, maps = nan_texture(smoother, made, "f4"), nan_maps(gpu, made, shape, 2, groups)
+        runs.append((cld, radius, ca, smoother, texture, maps))
+    for i in range(4):
+        for cld, radius, ca, smoother, texture, maps in runs:
+            z0, z1 = slice_range(cld.shape[2], i, 4)
+            smoother.run(ca.state_buffer, texture, z0, z1)
+            maps.run(texture, z0, z1)
+    for cld, radius, ca, smoother, texture, maps in runs:
+        expected = reference.smooth(cld, radius, "tent", smoother.min_density("f4"))
+        assert_matches(read_volume(texture), expected, "f4")
+        assert_maps(maps, read_volume(texture), expected)
+    assert {"clouds/smooth.comp", "clouds/density_sums.comp", "clouds/density_max.comp"} <= gpu.compiled_files

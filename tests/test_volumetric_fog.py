@@ -7,10 +7,9 @@ import pytest
 from atmos.app import App
 from atmos.camera import Camera
 from atmos.defaults import DefaultPlugins
-from atmos.gpu.shaders import build_program
 from atmos.lighting import Sun
 from atmos.plugins.ground import GroundPlugin
-from atmos.plugins.volumetric_fog import FogParams, VolumetricFogPlugin
+from atmos.plugins.volumetric_fog import VolumetricFogSettings, VolumetricFogPlugin
 from atmos import value_noise as noise
 from atmos.plugins.volumetric_fog import reference
 from atmos.plugins.volumetric_fog.plugin import set_medium_uniforms, sun_terms
@@ -20,8 +19,9 @@ EPS32 = 2.0 ** -24
 
 
 # -- GPU helpers -----------------------------------------------------------------------------------
-def gpu_fbm(ctx, points, octaves, seed):
-    prog = build_program(ctx, {"compute_shader": "volumetric_fog/fbm_points.comp"})
+def gpu_fbm(gpu, points, octaves, seed):
+    ctx = gpu.ctx
+    prog = gpu.program(compute_shader="volumetric_fog/fbm_points.comp")
     n = len(points)
     pts = np.zeros((n, 4), np.float32)
     pts[:, :3] = points
@@ -35,11 +35,12 @@ def gpu_fbm(ctx, points, octaves, seed):
         ctx.memory_barrier()
         return np.frombuffer(dst.read(), np.float32).astype(np.float64)
     finally:
-        src.release(), dst.release(), prog.release()
+        src.release(), dst.release()
 
 
-def gpu_march(ctx, origins, dirs, limits, params, sun, time=0.0):
-    prog = build_program(ctx, {"compute_shader": "volumetric_fog/march_rays.comp"})
+def gpu_march(gpu, origins, dirs, limits, params, sun, time=0.0):
+    ctx = gpu.ctx
+    prog = gpu.program(compute_shader="volumetric_fog/march_rays.comp")
     n = len(origins)
     rays = np.zeros((n, 8), np.float32)
     rays[:, :3], rays[:, 3], rays[:, 4:7] = origins, limits, dirs
@@ -54,7 +55,7 @@ def gpu_march(ctx, origins, dirs, limits, params, sun, time=0.0):
         ctx.memory_barrier()
         return np.frombuffer(dst.read(), np.float32).reshape(n, 4).astype(np.float64)
     finally:
-        src.release(), dst.release(), prog.release()
+        src.release(), dst.release()
 
 
 def ref_march(origins, dirs, limits, params, sun, time=0.0):
@@ -76,12 +77,12 @@ def fbm_tolerance(points, octaves):
 
 # -- FBM ---------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("octaves", [1, 3, 8, 16])
-def test_gpu_fbm_matches_float64_reference(ctx, rng, octaves):
+def test_gpu_fbm_matches_float64_reference(gpu, ctx, rng, octaves):
     n = 4096
     points = rng.uniform(-60, 60, (n, 3)) * rng.choice([0.01, 0.1, 1.0], (n, 1))
     points = points.astype(np.float32).astype(np.float64)        # the GPU sees float32 inputs
     seed = int(rng.integers(0, 2**32))
-    got = gpu_fbm(ctx, points, octaves, seed)
+    got = gpu_fbm(gpu, points, octaves, seed)
     want = noise.fbm(points, octaves, seed)
     assert np.isfinite(got).all(), "every output written"
     err = np.abs(got - want)
@@ -91,10 +92,10 @@ def test_gpu_fbm_matches_float64_reference(ctx, rng, octaves):
     assert (want >= 0).all() and (want < 1 - 2.0 ** -octaves).all()
 
 
-def test_noise_at_lattice_points_equals_hash_exactly(ctx, rng):
+def test_noise_at_lattice_points_equals_hash_exactly(gpu, ctx, rng):
     cells = rng.integers(-10**6, 10**6, (1024, 3)).astype(np.float64)
     seed = int(rng.integers(0, 2**32))
-    got = gpu_fbm(ctx, cells, 1, seed)
+    got = gpu_fbm(gpu, cells, 1, seed)
     assert np.array_equal(got, 0.5 * noise.lattice(cells.astype(np.int64), noise.key(seed)))
 
 
@@ -110,11 +111,11 @@ def test_value_noise_is_smooth_and_in_range(rng):
         assert np.abs(noise.value_noise(x + dx, k) - v).max() <= 1.5 * h * 1.0001
 
 
-def test_fbm_extreme_inputs_stay_finite_and_in_range(ctx):
+def test_fbm_extreme_inputs_stay_finite_and_in_range(gpu, ctx):
     points = np.array([[0, 0, 0], [1e6, -1e6, 1e6], [-3e7, 2e7, 1e7], [1e9, 1e9, -1e9],
                        [3.4e38, -3.4e38, 1.0], [1e-30, -1e-30, 0]], np.float64)
     for octaves in (1, 16):
-        got = gpu_fbm(ctx, points, octaves, 123)
+        got = gpu_fbm(gpu, points, octaves, 123)
         assert np.isfinite(got).all() and (got >= 0).all() and (got < 1).all(), got
     ref = noise.fbm(points, 16, 123)
     assert np.isfinite(ref).all() and (ref >= 0).all() and (ref < 1).all()
@@ -136,14 +137,14 @@ def random_rays(rng, n, params, spread=1.5):
             limits.astype(np.float32).astype(np.float64))
 
 
-def test_gpu_march_matches_float64_reference(ctx, rng):
-    params = FogParams(center=tuple(rng.uniform(-5, 5, 3)), scale=(1.5, 0.6, 1.2), bias=0.1, falloff=0.05,
+def test_gpu_march_matches_float64_reference(gpu, ctx, rng):
+    params = VolumetricFogSettings(center=tuple(rng.uniform(-5, 5, 3)), scale=(1.5, 0.6, 1.2), bias=0.1, falloff=0.05,
                        frequency=float(rng.uniform(0.1, 0.3)), octaves=5, seed=int(rng.integers(0, 2**32)),
                        wind=(1.0, 0.0, -0.5), absorption=float(rng.uniform(0.1, 0.4)), steps=40,
                        light_steps=4, light_step=2.5, max_distance=150.0)
     sun = Sun.from_angles(float(rng.uniform(10, 70)), float(rng.uniform(0, 360)))
     origins, dirs, limits = random_rays(rng, 256, params)
-    got = gpu_march(ctx, origins, dirs, limits, params, sun, time=1.25)
+    got = gpu_march(gpu, origins, dirs, limits, params, sun, time=1.25)
     want = ref_march(origins, dirs, limits, params, sun, time=1.25)
     assert np.isfinite(got).all(), "every ray written"
     assert (want[:, 3] < 0.9).sum() > 20 and (want[:, 3] > 0.999).sum() > 5, "rays both through and past the fog"
@@ -155,7 +156,7 @@ def test_gpu_march_matches_float64_reference(ctx, rng):
 
 
 def test_march_converges_with_steps_and_exits_early():
-    params = FogParams(center=(0, 0, 0), scale=(1, 1, 1), octaves=4, absorption=0.2, light_steps=2)
+    params = VolumetricFogSettings(center=(0, 0, 0), scale=(1, 1, 1), octaves=4, absorption=0.2, light_steps=2)
     sun = Sun.from_angles(40)
     o, d, lim = np.array([[0.0, 0.0, -40.0]]), np.array([[0.0, 0.0, 1.0]]), np.array([1e30])
     ref = ref_march(o, d, lim, params.replace(steps=1024), sun)
@@ -169,13 +170,13 @@ def test_march_converges_with_steps_and_exits_early():
     dict(absorption=0.0), dict(absorption=1e4), dict(steps=1), dict(steps=1024, octaves=2),
     dict(light_steps=0), dict(falloff=0.0, max_distance=60.0), dict(bias=-5.0), dict(octaves=16, steps=8),
     dict(frequency=1e3), dict(max_distance=1e-3)])
-def test_march_extremes_finite_and_as_reference(ctx, rng, change):
-    params = FogParams(center=(0, 0, 0), scale=(1, 1, 1), octaves=3, steps=16, light_steps=3).replace(**change)
+def test_march_extremes_finite_and_as_reference(gpu, ctx, rng, change):
+    params = VolumetricFogSettings(center=(0, 0, 0), scale=(1, 1, 1), octaves=3, steps=16, light_steps=3).replace(**change)
     origins = np.array([[0.0, 0.0, 0.0], [0.0, 5.0, -60.0], [1e3, 0, 0], [0.0, 0.0, -25.0]])
     dirs = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [-1.0, 0, 0], [0.0, 0.0, 1.0]])
     limits = np.array([1e30, 1e30, 2e3, 0.0])
     for sun in (Sun.from_angles(45), Sun.from_angles(-60), Sun(np.zeros(3))):
-        got = gpu_march(ctx, origins, dirs, limits, params, sun)
+        got = gpu_march(gpu, origins, dirs, limits, params, sun)
         want = ref_march(origins, dirs, limits, params, sun)
         assert np.isfinite(got).all() and (got >= 0).all() and (got[:, 3] <= 1).all()
         assert np.allclose(got[3], [0, 0, 0, 1]), "zero-length ray: no fog"
@@ -187,21 +188,21 @@ def test_march_extremes_finite_and_as_reference(ctx, rng, change):
 
 # -- parameters ----------------------------------------------------------------------------------------
 @pytest.mark.parametrize("change, message", [
-    (dict(octaves=0), "FogParams.octaves must be a whole number 1..16, got 0"),
+    (dict(octaves=0), "VolumetricFogSettings.octaves must be a whole number 1..16, got 0"),
     (dict(octaves=17), "1..16"), (dict(octaves=2.5), "whole number"), (dict(octaves=True), "whole number"),
-    (dict(steps=0), "FogParams.steps must be a whole number 1..1024"), (dict(steps=2000), "1..1024"),
-    (dict(light_steps=-1), "0..32"), (dict(light_step=0), "light_step must be a finite number > 0"), (dict(absorption=-1), "FogParams.absorption must be a finite number >= 0"),
+    (dict(steps=0), "VolumetricFogSettings.steps must be a whole number 1..1024"), (dict(steps=2000), "1..1024"),
+    (dict(light_steps=-1), "0..32"), (dict(light_step=0), "light_step must be a finite number > 0"), (dict(absorption=-1), "VolumetricFogSettings.absorption must be a finite number >= 0"),
     (dict(absorption=math.nan), "absorption"), (dict(frequency=0), "frequency must be a finite number > 0"),
-    (dict(scale=(1, 0, 1)), "FogParams.scale must be 3 positive numbers"), (dict(center=(1, 2)), "center"),
+    (dict(scale=(1, 0, 1)), "VolumetricFogSettings.scale must be 3 positive numbers"), (dict(center=(1, 2)), "center"),
     (dict(ambient=(-1, 0, 0)), "non-negative"), (dict(max_distance=math.inf), "max_distance"),
-    (dict(seed=-1), "0..4294967295"), (dict(colour=(1, 1, 1)), "unknown FogParams setting(s) colour; known:"),
+    (dict(seed=-1), "0..4294967295"), (dict(colour=(1, 1, 1)), "unknown VolumetricFogSettings setting(s) colour; known:"),
 ])
 def test_bad_settings_are_refused_and_nothing_is_applied(change, message):
     plugin = VolumetricFogPlugin(steps=20)
-    before = plugin.params
+    before = plugin.settings
     with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(")", r"\)").replace(".", r"\.")):
         plugin.configure(**{"light_step": 0.5, **change})
-    assert plugin.params is before
+    assert plugin.settings is before
     with pytest.raises(ValueError):
         VolumetricFogPlugin(**change)
 
@@ -220,7 +221,7 @@ def render(gpu, *plugins, camera_at=(0.0, 6.0, 45.0), target=(0.0, 2.0, 0.0)):
 
 
 def test_pass_blends_the_reference_march_over_the_scene_stopping_at_depth(fresh_gpu, tmp_path):
-    params = FogParams(octaves=4, steps=24, light_steps=3, absorption=0.15)
+    params = VolumetricFogSettings(octaves=4, steps=24, light_steps=3, absorption=0.15)
     bg, cam = render(fresh_gpu)
     fog, _ = render(fresh_gpu, VolumetricFogPlugin(params, animate=False))
     assert np.isfinite(fog.color).all()

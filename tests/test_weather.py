@@ -1,4 +1,5 @@
 """Weather ellipsoids (thesis sec. 4.3.3.4-4.3.3.5) and the region volume on the GPU."""
+import dataclasses
 import math
 
 import numpy as np
@@ -6,7 +7,7 @@ import pytest
 
 from atmos.app import App
 from atmos.world import World
-from atmos.plugins.weather import (MAX_CLOUD_DENSITY, Ellipsoid, RegionVolume, VolumeOrigin, WeatherParams,
+from atmos.plugins.weather import (MAX_CLOUD_DENSITY, Ellipsoid, RegionVolume, VolumeOrigin, WeatherSettings,
                                    WeatherPlugin, ellipsoid_array, probabilities, region_volume,
                                    step_weather, wind_field_at)
 
@@ -26,7 +27,7 @@ def params(**kw):
                 lifetime=1e6, lifetime_variance=0.0, shrink_time=0.0, region_margin=16.0,
                 volume_shape=(32, 8, 32), wind=(0.0, 0.0, 0.0), wind_variance=0.0)
     base.update(kw)
-    return WeatherParams(**base)
+    return WeatherSettings(**base)
 
 
 def ellipsoids(world):
@@ -59,9 +60,9 @@ def dense_reference(a, shape):
     return out.reshape(shape)
 
 
-def render_checked(ctx, a, shape, dtype="f4"):
+def render_checked(gpu, a, shape, dtype="f4"):
     """Render ``a`` with every cell pre-filled with NaN; assert every cell was written."""
-    rv = RegionVolume(ctx, shape, dtype=dtype)
+    rv = RegionVolume(gpu, shape, dtype=dtype)
     try:
         nx, ny, nz = shape
         fill = np.full((nz, ny, nx), np.nan, np.float32 if dtype == "f4" else np.float16)
@@ -81,10 +82,10 @@ def test_count_converges_at_adaption_pace(world, rng):
     p = params(cloud_density=40, density_adaption=2)
     counts = [step_weather(world, p, rng).count for _ in range(25)]
     assert counts == [2 * i for i in range(1, 21)] + [40] * 5   # never faster than 2 per step
-    p.cloud_density = 31
+    p = p.replace(cloud_density=31)
     counts = [step_weather(world, p, rng).count for _ in range(6)]
     assert counts == [38, 36, 34, 32, 31, 31]
-    p.cloud_density, p.density_adaption = 100, 1000
+    p = p.replace(cloud_density=100, density_adaption=1000)
     report = step_weather(world, p, rng)
     assert report.created == 69 and report.count == 100
 
@@ -101,24 +102,24 @@ def test_removal_prefers_ellipsoids_out_of_view(world, rng):
     assert far not in left and near not in left and old not in left
 
 
-def test_density_zero_means_no_clouds(world, rng, ctx):
+def test_density_zero_means_no_clouds(gpu, world, rng, ctx):
     p = params(cloud_density=0)
     for _ in range(5):
         assert step_weather(world, p, rng).count == 0
     a = ellipsoid_array(world)
     assert a.shape == (0, 8)
-    got = render_checked(ctx, a, (8, 4, 6))
+    got = render_checked(gpu, a, (8, 4, 6))
     assert (got == 0).all()
     p_hum, p_act, p_ext = probabilities(got, p)
     assert (p_hum == 0).all() and (p_act == 0).all() and (p_ext == 1).all()
 
 
-def test_maximal_density(world, rng, ctx):
+def test_maximal_density(gpu, world, rng, ctx):
     p = params(cloud_density=MAX_CLOUD_DENSITY, density_adaption=MAX_CLOUD_DENSITY,
                volume_shape=(6, 3, 5), region_margin=2.0, cloud_size=1.5, cloud_size_variance=1.0)
     assert step_weather(world, p, rng).count == MAX_CLOUD_DENSITY
     a = ellipsoid_array(world)
-    got = render_checked(ctx, a, p.volume_shape)
+    got = render_checked(gpu, a, p.volume_shape)
     want = dense_reference(a, p.volume_shape)
     assert np.abs(got - np.maximum(want, 0)).max() < TOLERANCE["f4"]
     assert (got > 0.3).all()    # 100,000 ellipsoids in a 10×7×9 region cover every cell
@@ -212,7 +213,7 @@ def test_ellipsoid_leaving_the_region_is_removed_and_replaced(world, rng):
     assert lo[0] <= e.x <= hi[0] and lo[2] <= e.z <= hi[2]
     # ellipsoids out of view but inside the boundings are kept
     kept = world.create_entity(Ellipsoid(x=-6.0, y=4, z=-7.0, lifetime=1e6))
-    p.wind, p.cloud_density = (0.0, 0.0, 0.0), 2
+    p = p.replace(wind=(0.0, 0.0, 0.0), cloud_density=2)
     step_weather(world, p, rng)
     assert kept in {e for e, _ in ellipsoids(world)}
 
@@ -270,18 +271,18 @@ def test_rules_are_deterministic_for_a_seed():
     assert len(arrays[0]) >= 20 and np.array_equal(arrays[0], arrays[1])
 
 
-def test_one_cell_volume(world, rng, ctx):
+def test_one_cell_volume(gpu, world, rng, ctx):
     p = params(cloud_density=7, density_adaption=7, volume_shape=(1, 1, 1), region_margin=0.0,
                cloud_size=0.8, cloud_size_variance=0.1)
     assert step_weather(world, p, rng).count == 7
     lo, hi = p.region_bounds()
     assert all(lo[0] <= c.x <= hi[0] and lo[2] <= c.z <= hi[2] for _, c in ellipsoids(world))
     a = ellipsoid_array(world)
-    got = render_checked(ctx, a, (1, 1, 1))
+    got = render_checked(gpu, a, (1, 1, 1))
     assert abs(got[0, 0, 0] - region_volume(a, (1, 1, 1))[0, 0, 0]) < TOLERANCE["f4"]
     one = np.array([[0.5, 0.5, 0.5, 0.3, 1, 1, 1, 0], [0.5, 0.5, 1.0, 0, 1, 1, 1, 0]], np.float32)
-    assert render_checked(ctx, one[:1], (1, 1, 1))[0, 0, 0] == pytest.approx(1.0)
-    assert render_checked(ctx, one[1:], (1, 1, 1))[0, 0, 0] == pytest.approx(0.5)
+    assert render_checked(gpu, one[:1], (1, 1, 1))[0, 0, 0] == pytest.approx(1.0)
+    assert render_checked(gpu, one[1:], (1, 1, 1))[0, 0, 0] == pytest.approx(0.5)
 
 
 # -- parameters ----------------------------------------------------------------------------------
@@ -296,16 +297,17 @@ def test_one_cell_volume(world, rng, ctx):
     ("wind_field", np.zeros((8, 8))), ("wind_field", np.full((8, 8, 2), np.inf)),
     ("hum_scale", 1.5), ("ext_scale", -0.1), ("vanish_threshold", float("nan")),
 ])
-def test_bad_params_name_the_field(field, value):
+def test_bad_settings_name_the_field(field, value):
     with pytest.raises(ValueError, match=field):
-        WeatherParams(**{field: value})
+        WeatherSettings(**{field: value})
 
 
-def test_params_revalidated_each_step(world, rng):
+def test_settings_are_frozen_and_changed_by_a_checked_replace(world, rng):
     p = params()
-    p.cloud_size_variance = 10.0
-    with pytest.raises(ValueError, match="cloud_size_variance"):
-        step_weather(world, p, rng)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        p.cloud_size_variance = 10.0
+    with pytest.raises(ValueError, match="WeatherSettings.cloud_size_variance must be >= 0 and < cloud_size"):
+        p.replace(cloud_size_variance=10.0)
     with pytest.raises(ValueError, match="dt"):
         step_weather(world, params(), rng, dt=float("nan"))
 
@@ -313,10 +315,10 @@ def test_params_revalidated_each_step(world, rng):
 # -- region volume on the GPU ---------------------------------------------------------------------
 @pytest.mark.parametrize("dtype", ["f4", "f2"])
 @pytest.mark.parametrize("shape", [(16, 8, 16), (13, 7, 5), (1, 9, 2)])
-def test_region_volume_matches_reference(ctx, rng, shape, dtype):
+def test_region_volume_matches_reference(gpu, ctx, rng, shape, dtype):
     a = random_ellipsoids(rng, int(rng.integers(1, 60)), shape)
     a[::7, 4 + int(rng.integers(0, 3))] = 0.0          # fully shrunk: contributes nothing
-    got = render_checked(ctx, a, shape, dtype)
+    got = render_checked(gpu, a, shape, dtype)
     want = region_volume(a, shape)
     assert np.abs(got - want).max() <= TOLERANCE[dtype]
     dense = dense_reference(a, shape)                   # unclipped: < 0 outside every ellipsoid
@@ -325,10 +327,10 @@ def test_region_volume_matches_reference(ctx, rng, shape, dtype):
     assert got.min() >= 0 and got.max() <= 1
 
 
-def test_region_volume_falloff_is_linear(ctx):
+def test_region_volume_falloff_is_linear(gpu, ctx):
     shape = (21, 11, 21)
     a = np.array([[10.5, 5.5, 10.5, 0.0, 8.0, 4.0, 6.0, 0.0]], np.float32)
-    got = render_checked(ctx, a, shape)
+    got = render_checked(gpu, a, shape)
     assert got[10, 5, 10] == pytest.approx(1.0)
     assert got[14, 5, 10] == pytest.approx(0.5, abs=1e-6)        # 4 of 8 cells along x
     assert got[10, 7, 10] == pytest.approx(0.5, abs=1e-6)        # 2 of 4 along y
@@ -336,24 +338,24 @@ def test_region_volume_falloff_is_linear(ctx):
     assert got[18, 5, 10] == 0 and got[10, 10, 10] == 0 and got[0, 0, 0] == 0
     # yaw: a quarter turn swaps the x and z radii
     a[0, 3] = math.pi / 2
-    turned = render_checked(ctx, a, shape)
+    turned = render_checked(gpu, a, shape)
     assert turned[10, 5, 16] == pytest.approx(1 - 6 / 8, abs=1e-5)
     assert turned[16, 5, 10] == pytest.approx(0.0, abs=1e-5)
 
 
-def test_region_volume_zero_and_ten_thousand_ellipsoids(ctx, rng, world):
+def test_region_volume_zero_and_ten_thousand_ellipsoids(gpu, ctx, rng, world):
     shape = (12, 6, 10)
-    assert (render_checked(ctx, np.zeros((0, 8), np.float32), shape) == 0).all()
+    assert (render_checked(gpu, np.zeros((0, 8), np.float32), shape) == 0).all()
     p = params(cloud_density=10_000, density_adaption=10_000, volume_shape=shape, region_margin=6.0,
                cloud_size=2.0, cloud_size_variance=1.5)
     assert step_weather(world, p, rng).count == 10_000
     a = ellipsoid_array(world)
-    got = render_checked(ctx, a, shape)
+    got = render_checked(gpu, a, shape)
     assert np.abs(got - region_volume(a, shape)).max() <= TOLERANCE["f4"]
     # ellipsoids far outside the volume render nothing, at no cost
     far = a.copy()
     far[:, 0] += 1000
-    rv = RegionVolume(ctx, shape)
+    rv = RegionVolume(gpu, shape)
     rv.render(far)
     assert rv.work_items == 0 and (rv.download() == 0).all()
     rv.release()
@@ -374,16 +376,16 @@ def test_region_volume_re_renders_and_rejects_bad_input(ctx, gpu, rng):
     with pytest.raises(RuntimeError):
         rv.render(np.zeros((0, 8)))
     with pytest.raises(ValueError, match="shape"):
-        RegionVolume(ctx, (4, 0, 4))
+        RegionVolume(gpu, (4, 0, 4))
     with pytest.raises(ValueError, match="dtype"):
-        RegionVolume(ctx, (4, 4, 4), dtype="f8")
+        RegionVolume(gpu, (4, 4, 4), dtype="f8")
 
 
 @pytest.mark.parametrize("dtype", ["f4", "f2"])
-def test_probabilities_gpu_and_reference(ctx, rng, dtype):
+def test_probabilities_gpu_and_reference(gpu, ctx, rng, dtype):
     shape = (11, 6, 9)
-    p = WeatherParams(hum_scale=0.2, act_scale=0.01, ext_scale=0.3, vanish_threshold=0.05)
-    rv = RegionVolume(ctx, shape, dtype=dtype)
+    p = WeatherSettings(hum_scale=0.2, act_scale=0.01, ext_scale=0.3, vanish_threshold=0.05)
+    rv = RegionVolume(gpu, shape, dtype=dtype)
     rv.render(random_ellipsoids(rng, 12, shape))
     region = rv.download()
     rv.probabilities(p)

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 from atmos.frames.texture_sets import TextureSet, TripleSet
+from atmos.gpu.queries import query_pool
 
 Measure = Callable[[Callable[[], None]], float]
 """Runs the given callable (one slice) and returns how long it took in milliseconds."""
@@ -43,22 +44,32 @@ def timer_query_measure(ctx) -> Measure:
     """A measure from an OpenGL timer query around the slice: the GPU's own time for its commands.
 
     Reading the result waits for the slice to finish on the GPU, which the budget needs anyway.
+    Each call borrows a query from the context's :func:`~atmos.gpu.queries.query_pool` and gives
+    it back once read, so measures hold no query between slices and make none in steady state.
     """
-    query = ctx.query(time=True)
+    pool = query_pool(ctx)
 
     def measure(run: Callable[[], None]) -> float:
-        with query:
-            run()
-        return query.elapsed / 1e6
+        query = pool.acquire(time=True)
+        try:
+            with query:
+                run()
+            return query.elapsed / 1e6
+        finally:
+            pool.release(query)
     return measure
+
+
+def is_software(ctx) -> bool:
+    """True on a software rasterizer (llvmpipe, softpipe, swrast), whose timer queries mean nothing."""
+    renderer = ctx.info.get("GL_RENDERER", "").lower()
+    return any(name in renderer for name in ("llvmpipe", "softpipe", "swrast"))
 
 
 def gpu_measure(ctx) -> Measure:
     """The best GPU-cost measure for ``ctx``: timer queries on a real GPU, synced wall time on a
     software rasterizer (llvmpipe reports meaningless timer-query results)."""
-    renderer = ctx.info.get("GL_RENDERER", "").lower()
-    software = any(name in renderer for name in ("llvmpipe", "softpipe", "swrast"))
-    return synced_measure(ctx) if software else timer_query_measure(ctx)
+    return synced_measure(ctx) if is_software(ctx) else timer_query_measure(ctx)
 
 
 @dataclass

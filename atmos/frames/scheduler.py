@@ -11,6 +11,7 @@ Modes:
 """
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 
 from atmos.frames.job import Measure, SlicedJob, gpu_measure, perf_measure
@@ -62,6 +63,7 @@ class FrameScheduler:
         self.slices_last_frame = 0
         self.ms_last_frame = 0.0
         self._next = 0  # round-robin start
+        self._gpu_measures: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()  # ctx -> Measure
 
     # -- jobs -------------------------------------------------------------------------------
     def add(self, job: SlicedJob) -> SlicedJob:
@@ -90,7 +92,13 @@ class FrameScheduler:
     def _measure_for(self, job: SlicedJob) -> Measure:
         if self.measure is not None:
             return self.measure
-        return gpu_measure(job.triple.gpu.ctx) if self.sync else perf_measure
+        if not self.sync:
+            return perf_measure
+        ctx = job.triple.gpu.ctx  # one measure per context, made once: no query or GL_RENDERER read per slice
+        measure = self._gpu_measures.get(ctx)
+        if measure is None:
+            measure = self._gpu_measures[ctx] = gpu_measure(ctx)
+        return measure
 
     def tick(self) -> None:
         """Run one frame's worth of slices."""

@@ -1,7 +1,8 @@
-"""GPU access: one context type for windows and headless EGL, and GLSL loading with readable errors."""
+"""GPU access: one context type for windows and headless EGL, and GLSL loading (a shader search path
+that plugins add their own directories to, ``#include``, errors naming the real file and line)."""
 from atmos.gpu.context import (GpuContext, GpuError, MIN_GL_VERSION, create_headless, from_current,
-                               release_gl)
-from atmos.gpu.shaders import ShaderError, load_source
+                               release_gl, require_gpu)
+from atmos.gpu.shaders import ShaderError, add_shader_path, load_source, remove_shader_path, shader_paths
 
 __all__ = ["GpuContext", "GpuError", "MIN_GL_VERSION", "create_headless", "from_current", "release_gl",
-           "ShaderError", "load_source"]
+           "require_gpu", "ShaderError", "load_source", "add_shader_path", "remove_shader_path", "shader_paths"]

@@ -6,6 +6,7 @@ import weakref
 import moderngl
 import numpy as np
 
+from atmos.gpu.queries import QueryPool, query_pool
 from atmos.gpu.shaders import build_program
 
 MIN_GL_VERSION = 430  # compute shaders
@@ -63,6 +64,16 @@ def from_current(size: tuple[int, int]) -> "GpuContext":
     return GpuContext(ctx, size, headless=False)
 
 
+def require_gpu(gpu, what: str = "gpu") -> "GpuContext":
+    """``gpu`` itself when it is a :class:`GpuContext`; a ValueError naming ``what`` otherwise (the
+    libraries take the GpuContext, never a bare moderngl context, so every program comes from
+    :meth:`GpuContext.program`)."""
+    if not isinstance(gpu, GpuContext):
+        raise ValueError(f"{what} must be an atmos GpuContext (atmos.gpu.create_headless or from_current), "
+                         f"got {type(gpu).__name__}")
+    return gpu
+
+
 class GpuContext:
     """A moderngl context, the framebuffer frames are drawn into, and a cache of compiled programs.
 
@@ -76,6 +87,7 @@ class GpuContext:
         self._programs: dict[tuple, object] = {}
         self._tracked: "weakref.WeakSet" = weakref.WeakSet()
         self._offscreen: list = []
+        self.queries: QueryPool = query_pool(ctx)  # query objects shared by every App on this context
         self.target: moderngl.Framebuffer = ctx.screen
         self.resize(size)
 
@@ -112,7 +124,9 @@ class GpuContext:
 
     # -- programs and lifetime ---------------------------------------------------------------
     def program(self, defines: dict | None = None, **stages: str):
-        """A compiled program from ``shaders/`` files, compiled once per (files, defines).
+        """A compiled program from shader files on the search path (atmos's ``shaders/``, then the
+        directories of :func:`atmos.gpu.add_shader_path`), compiled once per (files, defines).
+        The context owns it: it is released by :meth:`release`, never by its users.
 
         ``gpu.program(vertex_shader="sky.vert", fragment_shader="sky.frag")`` or
         ``gpu.program(compute_shader="volume.comp", defines={"N": 4})``.
@@ -144,6 +158,7 @@ class GpuContext:
             release_gl(obj)
         self._programs.clear()
         self._offscreen.clear()
+        self.queries.clear()
         if self.headless:
             self.ctx.release()
 

@@ -1,4 +1,5 @@
-"""PassContext: what a pass's ``execute`` sees — its textures, cached framebuffers, a fullscreen draw."""
+"""PassContext: what a pass's ``execute`` sees — the scene view, its resources, cached framebuffers,
+a fullscreen draw — and the one place that resets GL state before every pass."""
 from __future__ import annotations
 
 from collections import OrderedDict
@@ -9,37 +10,43 @@ from atmos.gpu.context import release_gl
 from atmos.graph.errors import GraphError
 
 FRAMEBUFFER_CACHE = 64  # framebuffers kept per graph, least recently used dropped first
+STATE_FLAGS = moderngl.BLEND | moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.PROGRAM_POINT_SIZE
 
 
 class PassContext:
     """Handed to :meth:`RenderPass.execute`; one object per graph, reused every frame.
 
-    ``gpu`` is the GpuContext, ``data`` the keyword arguments of ``RenderGraph.execute`` and
-    ``pass_name`` the pass now running. Framebuffers and the fullscreen VAO are cached, so a
-    steady frame allocates no GL objects.
+    ``view`` is this frame's :class:`atmos.SceneView` (camera, sun, clock, size), ``gpu`` the
+    GpuContext and ``pass_name`` the pass now running. Every pass starts from the same GL state
+    (:meth:`reset_state`): no blending, no depth test (depth function ``<``), no culling, no
+    program point size, and each framebuffer it takes starts with depth and colour writes on, the
+    full viewport and no scissor — so no pass restores state by hand. Framebuffers and the fullscreen VAO are cached,
+    so a steady frame allocates no GL objects.
     """
 
     def __init__(self, gpu):
         self.gpu = gpu
-        self.data: dict = {}
+        self.view = None
         self.pass_name = ""
-        self._textures: dict[str, object] = {}   # this frame's resolved resources
+        self._resources: dict[str, object] = {}   # this frame's resolved resources
         self._declared: frozenset[str] = frozenset()
         self._framebuffers: OrderedDict = OrderedDict()
         self._vaos: dict[int, tuple[object, object]] = {}
+        self._fresh: set[int] = set()             # framebuffers already reset in this pass
 
-    def texture(self, name: str):
-        """The texture behind ``name`` this frame: a pooled transient or the resolved import.
-
-        An imported framebuffer is returned as that framebuffer.
-        """
+    def resource(self, name: str):
+        """The resource behind ``name`` this frame: a pooled transient texture or the resolved import
+        (a texture, a framebuffer such as the screen, or any imported object)."""
         if name not in self._declared:
             raise GraphError(f"pass '{self.pass_name}' uses '{name}' but did not declare it in setup() "
                              "(declare it with builder.create/read/write)")
         try:
-            return self._textures[name]
+            value = self._resources[name]
         except KeyError:
             raise GraphError(f"pass '{self.pass_name}': resource '{name}' is not available this frame") from None
+        if isinstance(value, moderngl.Framebuffer):
+            self._reset_framebuffer(value)
+        return value
 
     def framebuffer(self, color=(), depth: str | None = None):
         """A framebuffer over the named textures, cached by texture identity.
@@ -48,8 +55,8 @@ class PassContext:
         named alone as ``color`` is returned as it is.
         """
         names = [color] if isinstance(color, str) else list(color)
-        attachments = [self.texture(n) for n in names]
-        depth_attachment = self.texture(depth) if depth is not None else None
+        attachments = [self.resource(n) for n in names]
+        depth_attachment = self.resource(depth) if depth is not None else None
         if any(isinstance(a, moderngl.Framebuffer) for a in attachments + [depth_attachment]):
             if len(attachments) == 1 and depth_attachment is None:
                 return attachments[0]
@@ -61,7 +68,7 @@ class PassContext:
         entry = self._framebuffers.get(key)
         if entry is not None and all(_alive(a) for a in entry[1]):
             self._framebuffers.move_to_end(key)
-            return entry[0]
+            return self._reset_framebuffer(entry[0])
         if entry is not None:
             self._drop(key)
         fbo = self.gpu.ctx.framebuffer(attachments, depth_attachment)
@@ -69,6 +76,7 @@ class PassContext:
         self._framebuffers[key] = (fbo, attachments + ([depth_attachment] if depth_attachment else []))
         while len(self._framebuffers) > FRAMEBUFFER_CACHE:
             self._drop(next(iter(self._framebuffers)))
+        self._fresh.add(id(fbo))
         return fbo
 
     def fullscreen(self, program) -> None:
@@ -77,22 +85,6 @@ class PassContext:
         if entry is None or entry[1] is not program:
             entry = self._vaos[id(program)] = (self.gpu.ctx.vertex_array(program, []), program)
         entry[0].render(moderngl.TRIANGLES, vertices=3)
-
-    def _drop(self, key) -> None:
-        fbo, _ = self._framebuffers.pop(key)
-        release_gl(fbo)
-
-    def _begin_frame(self, data: dict, textures: dict) -> None:
-        self.data = data
-        self._textures = textures
-
-    def _begin_pass(self, name: str, declared: frozenset[str]) -> None:
-        self.pass_name = name
-        self._declared = declared
-        ctx = self.gpu.ctx                # every pass starts from the same GL state
-        ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST | moderngl.CULL_FACE)
-        ctx.blend_func = moderngl.DEFAULT_BLENDING
-        ctx.blend_equation = moderngl.FUNC_ADD
 
     def blend_transmittance(self) -> None:
         """Blend a participating medium's (in-scattered light, transmittance T) over the colour:
@@ -111,10 +103,59 @@ class PassContext:
         ctx.enable(moderngl.BLEND)
         ctx.blend_func = (moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA, moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA)
 
+    def reset_state(self) -> None:
+        """The GL state every pass starts from (and a frame ends with)."""
+        ctx = self.gpu.ctx
+        ctx.disable(STATE_FLAGS)
+        ctx.blend_func = moderngl.DEFAULT_BLENDING
+        ctx.blend_equation = moderngl.FUNC_ADD
+        ctx.depth_func = "<"
+        self._fresh.clear()
+
+    def _reset_framebuffer(self, fbo):
+        """Depth and colour writes on, the full viewport, no scissor: the first time a pass takes ``fbo``."""
+        if id(fbo) not in self._fresh:
+            self._fresh.add(id(fbo))
+            fbo.depth_mask = True
+            if fbo.color_attachments:
+                fbo.color_mask = (True, True, True, True)
+            fbo.viewport = (0, 0, *fbo.size)
+            fbo.scissor = None
+        return fbo
+
+    def _drop(self, key) -> None:
+        fbo, _ = self._framebuffers.pop(key)
+        self._fresh.discard(id(fbo))
+        release_gl(fbo)
+
+    def _begin_frame(self, view, resources: dict) -> None:
+        self.view = view
+        self._resources = resources
+
+    def _begin_pass(self, name: str, declared: frozenset[str]) -> None:
+        self.pass_name = name
+        self._declared = declared
+        self.reset_state()
+
     def _end_frame(self) -> None:
+        self.reset_state()
         self.pass_name = ""
         self._declared = frozenset()
-        self._textures = {}
+        self._resources = {}
+
+    def drop_released(self) -> int:
+        """Release cached framebuffers over textures that were released (evicted by the pool): a GL
+        framebuffer keeps a deleted texture's storage alive. Returns how many were dropped."""
+        dead = [key for key, (_, attachments) in self._framebuffers.items()
+                if not all(_alive(a) for a in attachments)]
+        for key in dead:
+            self._drop(key)
+        return len(dead)
+
+    @property
+    def cached_framebuffers(self) -> int:
+        """Framebuffers held by the cache now (tests count GL objects with it)."""
+        return len(self._framebuffers)
 
     def release(self) -> None:
         """Release the cached framebuffers and vertex arrays."""

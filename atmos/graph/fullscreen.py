@@ -5,16 +5,21 @@ from atmos.graph.passes import PassBuilder, RenderPass
 
 
 class FullscreenPass(RenderPass):
-    """Subclass with ``name``, ``fragment`` (a file under ``shaders/``), ``reads`` and ``writes``
+    """Subclass with ``name``, ``phase``, ``fragment`` (a shader file), ``reads`` and ``writes``
     (resource names) and, if needed, :meth:`defines`; ``execute`` binds a target and calls
-    ``frame.fullscreen(self.program)``. ``plugin`` is the plugin that made the pass (its settings)."""
+    ``frame.fullscreen(self.program)``. ``plugin`` is the plugin that made the pass (its settings).
+
+    ``program`` comes from the GPU context's program cache each time it is asked for, with the
+    current :meth:`defines`, so a setting that changes a define takes effect on the next frame.
+    A pass that blends onto ``color`` lists it in ``reads`` and ``writes``.
+    """
     fragment: str = ""
     reads: tuple[str, ...] = ()
     writes: tuple[str, ...] = ("color",)
 
     def __init__(self, plugin=None):
         self.plugin = plugin
-        self.program = None
+        self.gpu = None
 
     def defines(self) -> dict:
         """Compile-time constants of the fragment shader (``#define`` name value)."""
@@ -27,5 +32,9 @@ class FullscreenPass(RenderPass):
             builder.write(name)
 
     def prepare(self, gpu) -> None:
-        self.program = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader=self.fragment,
-                                   defines=self.defines())
+        self.gpu = gpu
+
+    @property
+    def program(self):
+        return self.gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader=self.fragment,
+                                defines=self.defines())

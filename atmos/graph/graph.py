@@ -1,11 +1,14 @@
-"""RenderGraph: register passes and imported resources, compile once, execute every frame."""
+"""RenderGraph: register passes and imported resources; every frame, declare, (re)compile if the
+declarations changed, execute."""
 from __future__ import annotations
+
+from typing import Any, Callable
 
 from atmos.graph.compiler import CompiledGraph, compile_graph
 from atmos.graph.dump import dump_text, dump_dot
 from atmos.graph.errors import GraphError
 from atmos.graph.frame import PassContext
-from atmos.graph.passes import RenderPass
+from atmos.graph.passes import PassBuilder, RenderPass, check_pass
 from atmos.graph.resources import TexturePool
 from atmos.graph.timing import PassTimers
 
@@ -13,19 +16,22 @@ from atmos.graph.timing import PassTimers
 class RenderGraph:
     """A Frostbite-style frame graph.
 
-    Passes declare resources in ``setup``; :meth:`compile` orders them, culls those whose outputs
-    nothing needs (writing an imported resource is a side effect) and plans when each transient
-    texture is taken from and given back to :attr:`pool`, so textures alias across the frame.
+    Passes declare resources and a phase in ``setup``, which runs every frame; :meth:`compile`
+    recompiles only when the declarations (or the set of passes and imports) changed: it orders the
+    passes by phase and data, versions every write, culls those whose outputs nothing needs
+    (writing an imported resource is a side effect) and plans when each transient texture is taken
+    from and given back to :attr:`pool`, so textures alias across the frame.
     """
 
     def __init__(self, gpu):
         self.gpu = gpu
         self.pool = TexturePool(gpu)
         self.timings_enabled = True
+        self.compiles = 0                       # how often the declarations changed (tests, benchmarks)
         self._passes: dict[str, RenderPass] = {}
         self._imports: dict[str, object] = {}
         self._compiled: CompiledGraph | None = None
-        self._compiled_size = None
+        self._key: tuple | None = None
         self._prepared: dict[str, RenderPass] = {}
         self._timers = PassTimers(gpu.ctx)
         self._frame = PassContext(gpu)
@@ -33,20 +39,16 @@ class RenderGraph:
     # -- building ---------------------------------------------------------------------------
     @property
     def passes(self) -> tuple[RenderPass, ...]:
-        """Every registered pass, in registration order."""
+        """Every registered pass (in no meaningful order: the compiled order is by phase and data)."""
         return tuple(self._passes.values())
 
     def add_pass(self, p: RenderPass) -> RenderPass:
-        """Register ``p``; its name must be unique in this graph."""
-        if not isinstance(p, RenderPass):
-            raise GraphError(f"add_pass needs a RenderPass, got {type(p).__name__}")
-        if not isinstance(p.name, str) or not p.name:
-            raise GraphError(f"pass of type {type(p).__name__} has no name; set RenderPass.name to a unique string")
+        """Register ``p``; its name must be unique in this graph and its phase one of PHASES."""
+        check_pass(p)
         if p.name in self._passes:
             raise GraphError(f"the graph already has a pass named '{p.name}' "
                              f"({type(self._passes[p.name]).__name__}); pass names must be unique")
         self._passes[p.name] = p
-        self.invalidate()
         return p
 
     def remove_pass(self, name: str) -> None:
@@ -58,47 +60,59 @@ class RenderGraph:
             del self._prepared[name]
             p.release()
         self._timers.forget(name)
-        self.invalidate()
 
-    def import_texture(self, name: str, source) -> None:
-        """A persistent resource: a moderngl texture/framebuffer, or a zero-argument callable returning
+    def import_resource(self, name: str, source: Any | Callable[[], Any]) -> None:
+        """A persistent resource made outside the graph: a moderngl texture or framebuffer, any other
+        object passes read (the cloud simulation's texture sets), or a zero-argument callable returning
         the current one (resolved once per frame). Replacing the source of a known name does not recompile."""
         if not isinstance(name, str) or not name:
             raise GraphError(f"imported resource names must be non-empty strings, got {name!r}")
         if source is None:
-            raise GraphError(f"import_texture('{name}', None): give a texture, a framebuffer or a callable")
-        if name not in self._imports:
-            self.invalidate()
+            raise GraphError(f"import_resource('{name}', None): give a texture, a framebuffer, an object or "
+                             "a callable returning one")
         self._imports[name] = source
 
-    def invalidate(self) -> None:
-        """Force the next :meth:`compile` to call every pass's ``setup`` again (after a pass changed
-        what it declares)."""
-        self._compiled = None
+    def remove_import(self, name: str) -> None:
+        """Forget the imported resource ``name`` (a plugin that made it is going away)."""
+        if self._imports.pop(name, None) is None:
+            raise GraphError(f"the graph imports no resource '{name}' (imports: {', '.join(self._imports) or 'none'})")
 
     # -- compiling and running ---------------------------------------------------------------
+    def declare(self) -> dict[str, PassBuilder]:
+        """Run every pass's ``setup``: this frame's declarations."""
+        builders = {}
+        for p in self._passes.values():
+            builder = builders[p.name] = PassBuilder(p.name)
+            p.setup(builder)
+        return builders
+
     def compile(self) -> CompiledGraph:
-        """Order, validate and cull; cached until passes, imports or ``gpu.size`` change
-        (descs often depend on the frame size), or :meth:`invalidate` is called."""
-        if self._compiled is None or self._compiled_size != self.gpu.size:
-            self._compiled = compile_graph(list(self._passes.values()), self._imports)
-            self._compiled_size = self.gpu.size
-            self._timers.keep_only(set(self._compiled.kept))
+        """This frame's compiled graph: every pass's ``setup`` runs; the graph is compiled again only
+        when a declaration, a phase, a pass or an import changed."""
+        builders = self.declare()
+        key = (tuple((p.name, p.phase, p.before, p.after, builders[p.name].key()) for p in self._passes.values()),
+               tuple(self._imports))
+        if key != self._key:
+            compiled = compile_graph(list(self._passes.values()), builders, self._imports)
+            self._compiled, self._key = compiled, key
+            self.compiles += 1
+            self._timers.keep_only(set(compiled.kept))
         return self._compiled
 
-    def execute(self, **data) -> None:
-        """Run one frame: kept passes in order; ``data`` is available as ``PassContext.data``."""
+    def execute(self, view=None) -> None:
+        """Run one frame: kept passes in order; ``view`` (an :class:`atmos.SceneView`: camera, sun,
+        clock, size) is what passes see as ``frame.view``."""
         compiled = self.compile()
-        textures: dict[str, object] = {}
+        resources: dict[str, object] = {}
         for name in compiled.imports_used:
-            textures[name] = self._resolve(name)
+            resources[name] = self._resolve(name)
         transient: dict[str, object] = {}
         frame = self._frame
-        frame._begin_frame(data, textures)
+        frame._begin_frame(view, resources)
         try:
             for i, p in enumerate(compiled.order):
                 for r in compiled.acquire[i]:
-                    textures[r] = transient[r] = self.pool.acquire(compiled.resources[r].desc)
+                    resources[r] = transient[r] = self.pool.acquire(compiled.resources[r].desc)
                 if self._prepared.get(p.name) is not p:
                     p.prepare(self.gpu)
                     self._prepared[p.name] = p
@@ -109,12 +123,14 @@ class RenderGraph:
                 else:
                     p.execute(frame)
                 for r in compiled.release[i]:
-                    del textures[r]
+                    del resources[r]
                     self.pool.release(transient.pop(r))
         finally:
             for texture in transient.values():  # only after an exception
                 self.pool.release(texture)
             frame._end_frame()
+            if self.pool.end_frame():  # evicted textures: drop the cached framebuffers over them
+                frame.drop_released()
 
     def _resolve(self, name: str):
         source = self._imports[name]
@@ -130,7 +146,7 @@ class RenderGraph:
 
     # -- inspection and cleanup ----------------------------------------------------------------
     def dump(self) -> str:
-        """The compiled graph as text: execution order, culled passes and why, resources."""
+        """The compiled graph as text: phases, execution order with versions, culled passes and why, resources."""
         return dump_text(self.compile())
 
     def to_dot(self) -> str:

@@ -1,46 +1,68 @@
 """RenderPass, the base class of every pass, and PassBuilder, through which a pass declares its resources."""
 from __future__ import annotations
 
+from atmos.gpu.context import GpuContext
 from atmos.graph.errors import GraphError
+from atmos.graph.frame import PassContext
+from atmos.graph.phases import PHASE_INDEX, PHASES
 from atmos.graph.resources import TextureDesc
 
 
 class RenderPass:
-    """One step of a frame. Subclass it and override what you need.
+    """One step of a frame. Subclass it, set ``name`` and ``phase``, override what you need.
 
-    ``setup`` declares resources (called by ``RenderGraph.compile``); ``prepare`` is called once,
-    lazily, for passes that survive culling, before their first ``execute`` — compile shaders and
-    make buffers there, never in ``__init__`` or ``setup``; ``release`` frees what ``prepare`` made.
-    ``before``/``after`` name passes this one must run before/after.
+    ``phase`` is one of :data:`atmos.graph.PHASES`; inside a phase the order follows the data the
+    passes declare. ``setup`` declares resources and runs every frame (keep it cheap: read settings,
+    declare; the graph recompiles only when the declarations change). ``prepare`` is called once,
+    lazily, for passes that survive culling, before their first ``execute`` — make buffers there,
+    never in ``__init__`` or ``setup``; ``release`` frees what ``prepare`` made. ``before``/``after``
+    name passes of the same phase this one must run before/after (rarely needed: prefer data).
     """
 
     name: str = ""
+    phase: str = ""
     before: tuple[str, ...] = ()
     after: tuple[str, ...] = ()
 
-    def setup(self, builder: "PassBuilder") -> None:
-        """Declare the resources this pass creates, reads and writes."""
+    def setup(self, builder: PassBuilder) -> None:
+        """Declare the resources this pass creates, reads and writes (every frame)."""
 
-    def prepare(self, gpu) -> None:
-        """Make GL objects (programs, buffers); called once before the first execute."""
+    def prepare(self, gpu: GpuContext) -> None:
+        """Make GL objects (buffers, textures); called once before the first execute."""
 
-    def execute(self, frame) -> None:
-        """Record this pass's GPU work; ``frame`` is the graph's PassContext."""
+    def execute(self, frame: PassContext) -> None:
+        """Record this pass's GPU work; ``frame`` is the graph's PassContext (``frame.view``: camera, sun, clock)."""
 
     def release(self) -> None:
         """Free what ``prepare`` made; ``prepare`` runs again if the pass executes later."""
 
     def __repr__(self) -> str:
-        return f"<{type(self).__name__} {self.name!r}>"
+        return f"<{type(self).__name__} {self.name!r} [{self.phase}]>"
+
+
+def check_pass(p) -> None:
+    """A GraphError unless ``p`` is a RenderPass with a name and a known phase."""
+    if not isinstance(p, RenderPass):
+        raise GraphError(f"add_pass needs a RenderPass, got {type(p).__name__}")
+    if not isinstance(p.name, str) or not p.name:
+        raise GraphError(f"pass of type {type(p).__name__} has no name; set RenderPass.name to a unique string")
+    if p.phase not in PHASE_INDEX:
+        raise GraphError(f"pass '{p.name}' ({type(p).__name__}) has phase {p.phase!r}; set RenderPass.phase "
+                         f"to one of: {', '.join(PHASES)}")
 
 
 class PassBuilder:
-    """Collects one pass's declarations during ``setup``."""
+    """Collects one pass's declarations during ``setup``.
+
+    ``read(name)`` reads the version of ``name`` current when the pass runs; ``read(name, at=phase)``
+    names the version left at the end of an earlier phase (the compiler checks that nothing writes
+    it in between). A pass that blends onto a resource reads and writes it.
+    """
 
     def __init__(self, pass_name: str):
         self.pass_name = pass_name
         self.creates: dict[str, TextureDesc] = {}
-        self.reads: list[str] = []
+        self.reads: dict[str, str | None] = {}      # name -> the phase whose version is read (None: current)
         self.writes: list[str] = []
         self.has_side_effect = False
 
@@ -53,11 +75,13 @@ class PassBuilder:
             raise GraphError(f"pass '{self.pass_name}' creates '{name}' twice")
         self.creates[name] = desc
 
-    def read(self, name: str) -> None:
-        """This pass samples ``name``."""
+    def read(self, name: str, at: str | None = None) -> None:
+        """This pass samples (or blends onto) ``name``; ``at``: the phase whose final version it needs."""
         self._check(name)
-        if name not in self.reads:
-            self.reads.append(name)
+        if at is not None and at not in PHASE_INDEX:
+            raise GraphError(f"pass '{self.pass_name}' reads '{name}' at phase {at!r}; "
+                             f"allowed: {', '.join(PHASES)}")
+        self.reads[name] = at
 
     def write(self, name: str) -> None:
         """This pass modifies an existing resource (read-modify-write passes also call ``read``)."""
@@ -73,6 +97,10 @@ class PassBuilder:
     def names(self) -> frozenset[str]:
         """Every resource name this pass declared."""
         return frozenset(self.creates) | frozenset(self.reads) | frozenset(self.writes)
+
+    def key(self) -> tuple:
+        """The declarations as a comparable value: the graph recompiles when a pass's key changes."""
+        return (tuple(self.creates.items()), tuple(self.reads.items()), tuple(self.writes), self.has_side_effect)
 
     def uses(self, name: str) -> str:
         """How this pass uses ``name``: 'create', 'read', 'write', 'read/write' or ''."""

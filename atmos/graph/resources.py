@@ -69,20 +69,34 @@ class TextureDesc:
 
 
 class TexturePool:
-    """Textures keyed by :class:`TextureDesc`: ``acquire`` reuses a free one of an equal desc, else creates one."""
+    """Textures keyed by :class:`TextureDesc`: ``acquire`` reuses a free one of an equal desc, else creates one.
 
-    def __init__(self, gpu):
+    :meth:`end_frame` (the graph calls it after each frame) releases the GL memory of free textures
+    that no frame acquired or released during the last ``keep_frames`` frames, so descs that stop
+    being used (old window sizes, a changed setting) do not pile up. In-use textures are never evicted.
+    """
+
+    def __init__(self, gpu, keep_frames: int = 3):
+        if isinstance(keep_frames, bool) or not isinstance(keep_frames, int) or keep_frames < 1:
+            raise ValueError(f"TexturePool keep_frames={keep_frames!r}: allowed is an int >= 1 (frames a free "
+                             "texture is kept after its last use before its GL memory is released)")
         self.gpu = gpu
+        self.keep_frames = keep_frames
+        self.frame = 0        # frames ended so far (end_frame calls)
         self.allocations = 0  # textures ever created
+        self.evictions = 0    # textures released by end_frame
         self._free: dict[TextureDesc, list] = {}
         self._desc: dict[int, tuple[TextureDesc, object]] = {}  # id(texture) -> (desc, texture), all pooled
         self._in_use: set[int] = set()
+        self._used: dict[int, int] = {}  # id(texture) -> frame it was last acquired or released
 
     def acquire(self, desc: TextureDesc):
         """A texture matching ``desc``, free until :meth:`release` gives it back."""
         free = self._free.get(desc)
         texture = free.pop() if free else self._create(desc)
-        self._in_use.add(id(texture))
+        key = id(texture)
+        self._in_use.add(key)
+        self._used[key] = self.frame
         return texture
 
     def release(self, texture) -> None:
@@ -93,7 +107,28 @@ class TexturePool:
         if key not in self._in_use:
             raise ValueError("TexturePool.release: this texture was already released")
         self._in_use.discard(key)
+        self._used[key] = self.frame
         self._free.setdefault(self._desc[key][0], []).append(texture)
+
+    def end_frame(self) -> int:
+        """End a frame: release every free texture not acquired (or released) during the last
+        ``keep_frames`` frames, counting this one. Returns how many were released."""
+        evicted = 0
+        stale = self.frame - self.keep_frames  # last used at or before this frame: evict
+        used = self._used
+        for desc, free in list(self._free.items()):
+            if all(used[id(t)] > stale for t in free):
+                continue
+            for texture in [t for t in free if used[id(t)] <= stale]:
+                del self._desc[id(texture)], used[id(texture)]
+                texture.release()
+                evicted += 1
+            free[:] = [t for t in free if id(t) in used]
+            if not free:
+                del self._free[desc]
+        self.frame += 1
+        self.evictions += evicted
+        return evicted
 
     @property
     def textures(self) -> int:
@@ -105,6 +140,17 @@ class TexturePool:
         """Textures acquired and not yet released."""
         return len(self._in_use)
 
+    @property
+    def bytes(self) -> int:
+        """GL memory of the textures the pool holds now (free and in use), in bytes (approximate for depth)."""
+        total = 0
+        for desc, _ in self._desc.values():
+            texels = 1
+            for s in desc.size:
+                texels *= s
+            total += texels * (4 if desc.depth else desc.components * int(desc.dtype[1]))
+        return total
+
     def release_all(self) -> None:
         """Free the GL memory of every pooled texture, free or in use; the pool starts empty again."""
         for _, texture in self._desc.values():
@@ -112,6 +158,7 @@ class TexturePool:
         self._free.clear()
         self._desc.clear()
         self._in_use.clear()
+        self._used.clear()
 
     def _create(self, desc: TextureDesc):
         texture = desc.create(self.gpu.ctx)

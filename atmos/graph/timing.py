@@ -4,6 +4,8 @@ from __future__ import annotations
 import time
 from contextlib import contextmanager
 
+from atmos.gpu.queries import QueryPool, query_pool
+
 RING = 3  # queries per pass; the one read back was issued RING - 1 frames ago
 
 
@@ -23,13 +25,17 @@ class PassTimers:
     ``results`` maps pass name -> (gpu_ms, cpu_ms) of the latest measurement whose GPU result has
     been read back; a frame's query is read ``RING - 1`` frames later, so results lag a little.
     GL time queries cannot nest: a pass must not run its own time query while timed.
+
+    Queries come from the context's :class:`~atmos.gpu.queries.QueryPool` (``queries``; by default
+    :func:`~atmos.gpu.queries.query_pool` of ``ctx``) and go back to it when a pass is forgotten or
+    the timers released: moderngl 5.13 cannot release a Query, so graphs on one context share them.
     """
 
-    def __init__(self, ctx):
+    def __init__(self, ctx, queries: QueryPool | None = None):
         self.ctx = ctx
+        self.queries = queries if queries is not None else query_pool(ctx)
         self.results: dict[str, tuple[float, float]] = {}
         self._rings: dict[str, _Ring] = {}
-        self._spare: list = []  # moderngl 5.13 cannot release a Query: recycle them instead
 
     @contextmanager
     def measure(self, name: str):
@@ -45,7 +51,7 @@ class PassTimers:
             self._collect(name, ring, slot)
         query = ring.queries[slot]
         if query is None:
-            query = ring.queries[slot] = self._spare.pop() if self._spare else self.ctx.query(time=True)
+            query = ring.queries[slot] = self.queries.acquire(time=True)
         start = time.perf_counter()
         with query:
             yield
@@ -62,7 +68,9 @@ class PassTimers:
         ring = self._rings.pop(name, None)
         self.results.pop(name, None)
         if ring:
-            self._spare += [query for query in ring.queries if query is not None]
+            for query in ring.queries:
+                if query is not None:
+                    self.queries.release(query)
 
     def keep_only(self, names) -> None:
         """Forget every pass not in ``names``."""
@@ -71,12 +79,7 @@ class PassTimers:
                 self.forget(name)
 
     def release(self) -> None:
-        """Release every query (where moderngl can; else they go with the context) and clear the results."""
+        """Give every query back to the context's pool and clear the results."""
         for name in list(self._rings):
             self.forget(name)
-        for query in self._spare:
-            release = getattr(query, "release", None)
-            if release:
-                release()
-        self._spare.clear()
         self.results.clear()

@@ -15,8 +15,9 @@ def clamp_sampler(ctx: moderngl.Context):
 
 
 def bind_volume(program, sim, sampler, sun: Sun | None) -> float:
-    """Bind mix(A, B, t)'s textures to units 0..3 with ``sampler`` and set ``t``, ``has_shading``,
-    ``sun_color``, ``ambient``; returns t. Call :func:`unbind_volume` when the draw is done."""
+    """Bind mix(A, B, t)'s textures (``sim``: the frame's CloudSets, or the CloudSimulation) to units
+    0..3 with ``sampler`` and set ``t``, ``has_shading``, ``sun_color``, ``ambient``; returns t. Call
+    :func:`unbind_volume` when the draw is done."""
     a, b, t = sim.view()
     shading = "transmittance" in a
     a["density"].use(0)

@@ -46,15 +46,11 @@ class OffscreenClouds:
         """Write the low-res depth, clear the low-res colour; returns the framebuffer to draw sprites into."""
         ctx = frame.gpu.ctx
         frame.framebuffer(depth=CLOUD_DEPTH).use()
-        frame.texture(DEPTH).use(0)
+        frame.resource(DEPTH).use(0)
         self.far_depth["factor"].value = factor
         ctx.enable(moderngl.DEPTH_TEST)
-        ctx.depth_func = "1"
-        try:
-            frame.fullscreen(self.far_depth)
-        finally:
-            ctx.depth_func = "<"
-            ctx.disable(moderngl.DEPTH_TEST)
+        ctx.depth_func = "1"                # always: the shader writes the block's farthest depth
+        frame.fullscreen(self.far_depth)
         fbo = frame.framebuffer(color=[CLOUD_COLOR], depth=CLOUD_DEPTH)
         fbo.depth_mask = False              # clear the colour only: the sprites test the depth just written
         fbo.clear(0.0, 0.0, 0.0, 0.0)
@@ -63,9 +59,10 @@ class OffscreenClouds:
 
     def end(self, frame: PassContext, factor: int, near: float, far: float) -> None:
         """Blend the low-res clouds onto "color" (premultiplied, :meth:`PassContext.blend_over`)."""
+        frame.reset_state()                 # the sprites' depth test and point size are done
         frame.framebuffer(color=[COLOR]).use()
         for unit, name in enumerate((CLOUD_COLOR, CLOUD_DEPTH, DEPTH)):
-            frame.texture(name).use(unit)
+            frame.resource(name).use(unit)
         p = self.composite
         p["factor"].value = factor
         p["inv_near_far"].value = (1.0 / near, 1.0 / far)

@@ -20,37 +20,27 @@ by their area in pixels.
 """
 from __future__ import annotations
 
-import math
+from dataclasses import dataclass
 
 import moderngl
 import numpy as np
 
 from atmos.camera import Camera
+from atmos.checks import CheckedSettings, check_bool, check_int, check_num
 from atmos.graph import PassBuilder, PassContext, RenderPass
-from atmos.lighting import Sun
 from atmos.plugin import Plugin
 from atmos.plugins.cloud_render.binding import bind_volume, clamp_sampler, unbind_volume
 from atmos.plugins.cloud_render.offscreen import MAX_DOWNSAMPLE, OffscreenClouds, low_size
 from atmos.plugins.clouds.layout import CloudLayout
 from atmos.plugins.cloud_render.particle import PROFILE_AREA, particle_texture
 from atmos.plugins.cloud_render.segments import MAX_LEVEL, SegmentStats, select_segments, unpack
-from atmos.plugins.clouds.simulation import CloudSimulation
+from atmos.plugins.clouds.sets import CLOUD_SETS, CloudSets
 from atmos.render_core import COLOR, DEPTH
 
 
-def _number(name: str, value, lo: float, lo_open: bool = True, none_ok: bool = False):
-    if value is None and none_ok:
-        return None
-    ok = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
-    ok = ok and math.isfinite(float(value)) and (float(value) > lo if lo_open else float(value) >= lo)
-    if not ok:
-        raise ValueError(f"CloudRenderPlugin.{name} must be a finite number {'>' if lo_open else '>='} {lo}"
-                         f"{' or None' if none_ok else ''}, got {value!r}")
-    return None if value is None else float(value)
-
-
-class CloudRenderPlugin(Plugin):
-    """Point-sprite clouds; add it after CloudsPlugin.
+@dataclass(frozen=True)
+class CloudRenderSettings(CheckedSettings):
+    """How the sprites are drawn (all live: a change shows on the next frame).
 
     ``base_altitude``: world y of the layer's bottom (None: ``CloudSettings.base_altitude``; placement:
     :mod:`atmos.plugins.clouds.layout`). ``size_factor``:
@@ -58,65 +48,67 @@ class CloudRenderPlugin(Plugin):
     per cell length at density 1 (None: the simulation's ``CloudSettings.sigma``). ``frustum_culling``
     and ``empty_space_skipping`` switch the two culling tests; ``max_point_size`` caps sprite pixels
     (None: the GL limit). ``downsample`` (1..8): draw the sprites off screen at 1/downsample of the
-    frame size and upsample them (:mod:`.offscreen`; 2 fills a quarter of the pixels).
+    frame size and upsample them (:mod:`.offscreen`; 2 fills a quarter of the pixels; read by the
+    pass's ``setup`` every frame, so a change resizes the off-screen targets on the next frame).
     ``lod_pixels``: level of detail — columns where a block of 2^L cells spans at most this many
     target pixels are drawn one sprite per block (L ≤ 2, :mod:`.segments`); None: every cell.
-    ``enabled`` False skips drawing. After each frame ``stats`` holds the :class:`SegmentStats` counters.
+    ``enabled`` False skips drawing.
+    """
+    base_altitude: float | None = None
+    size_factor: float = 3.0
+    sigma: float | None = None
+    frustum_culling: bool = True
+    empty_space_skipping: bool = True
+    max_point_size: float | None = None
+    downsample: int = 2
+    lod_pixels: float | None = None
+    enabled: bool = True
+
+    def __post_init__(self):
+        o = "CloudRenderSettings"
+        self.store(dict(
+            base_altitude=check_num(o, "base_altitude", self.base_altitude, optional=True),
+            size_factor=check_num(o, "size_factor", self.size_factor, 0.0, lo_open=True),
+            sigma=check_num(o, "sigma", self.sigma, 0.0, optional=True),
+            frustum_culling=check_bool(o, "frustum_culling", self.frustum_culling),
+            empty_space_skipping=check_bool(o, "empty_space_skipping", self.empty_space_skipping),
+            max_point_size=check_num(o, "max_point_size", self.max_point_size, 1.0, optional=True),
+            downsample=check_int(o, "downsample", self.downsample, 1, MAX_DOWNSAMPLE),
+            lod_pixels=check_num(o, "lod_pixels", self.lod_pixels, 0.0, lo_open=True, optional=True),
+            enabled=check_bool(o, "enabled", self.enabled),
+        ))
+
+
+class CloudRenderPlugin(Plugin):
+    """Point-sprite clouds of the CloudsPlugin's simulation (its imported "cloud_sets"):
+    ``CloudRenderPlugin(settings=None, **fields)`` with :class:`CloudRenderSettings`;
+    ``configure(**changes)`` changes any of them live (next frame). After each frame ``stats``
+    holds the :class:`SegmentStats` counters.
     """
 
-    def __init__(self, base_altitude: float | None = None, size_factor: float = 3.0, sigma: float | None = None,
-                 frustum_culling: bool = True, empty_space_skipping: bool = True,
-                 max_point_size: float | None = None, downsample: int = 2, lod_pixels: float | None = None):
-        if base_altitude is not None and (not isinstance(base_altitude, (int, float)) or isinstance(base_altitude, bool)
-                                          or not math.isfinite(base_altitude)):
-            raise ValueError(f"CloudRenderPlugin.base_altitude must be a finite number (world y of the "
-                             f"layer's bottom), got {base_altitude!r}")
-        for name, flag in (("frustum_culling", frustum_culling), ("empty_space_skipping", empty_space_skipping)):
-            if not isinstance(flag, bool):
-                raise ValueError(f"CloudRenderPlugin.{name} must be True or False, got {flag!r}")
-        size_factor = _number("size_factor", size_factor, 0.0)
-        sigma = _number("sigma", sigma, 0.0, lo_open=False, none_ok=True)
-        max_point_size = _number("max_point_size", max_point_size, 1.0, lo_open=False, none_ok=True)
-        self.lod_pixels = _number("lod_pixels", lod_pixels, 0.0, none_ok=True)
-        self.base_altitude = None if base_altitude is None else float(base_altitude)
-        self.size_factor, self.sigma, self.max_point_size = size_factor, sigma, max_point_size
-        self.frustum_culling, self.empty_space_skipping = frustum_culling, empty_space_skipping
-        self.enabled = True
+    settings_class = CloudRenderSettings
+
+    def __init__(self, settings: CloudRenderSettings | None = None, **fields):
+        super().__init__(settings, **fields)
         self.stats = SegmentStats()
-        self.gpu = self._graph = None
-        self.downsample = downsample
-
-    @property
-    def downsample(self) -> int:
-        return self._downsample
-
-    @downsample.setter
-    def downsample(self, value: int) -> None:
-        """Checked; a running App's render graph recompiles for the new target size."""
-        if not isinstance(value, (int, np.integer)) or isinstance(value, bool) or not 1 <= value <= MAX_DOWNSAMPLE:
-            raise ValueError(f"CloudRenderPlugin.downsample must be an int in 1..{MAX_DOWNSAMPLE} "
-                             f"(1: sprites drawn at full resolution), got {value!r}")
-        self._downsample = int(value)
-        if self._graph is not None:
-            self._graph.invalidate()
+        self.gpu = None
 
     def build(self, app) -> None:
         if app.graph is None:
             raise ValueError("CloudRenderPlugin needs an App with a GPU context (App(gpu))")
-        if app.get_resource(CloudSimulation) is None:
-            raise ValueError("CloudRenderPlugin draws the CloudSimulation: add CloudsPlugin before it")
-        self.gpu, self._graph = app.gpu, app.graph
+        self.gpu = app.gpu
         app.graph.add_pass(CloudSpritePass(self))
 
     # -- shared with the reference ray marcher --------------------------------------------------
-    def layout(self, sim: CloudSimulation) -> CloudLayout:
+    def layout(self, sim: CloudSets) -> CloudLayout:
         """The volume's world placement now, column boxes padded by one cell's largest sprite radius
         (:func:`select_segments` scales it by a column's block size)."""
-        cell = sim.settings.cell_size
-        return sim.layout(self.base_altitude, pad=0.5 * self.size_factor * max(cell[0], cell[2]))
+        cell, s = sim.settings.cell_size, self.settings
+        return sim.layout(s.base_altitude, pad=0.5 * s.size_factor * max(cell[0], cell[2]))
 
-    def extinction(self, sim: CloudSimulation) -> float:
-        return float(sim.settings.sigma if self.sigma is None else self.sigma)
+    def extinction(self, sim: CloudSets) -> float:
+        sigma = self.settings.sigma
+        return float(sim.settings.sigma if sigma is None else sigma)
 
 
 COMMAND_BYTES = 20
@@ -127,19 +119,21 @@ def sprite_uniforms(plugin, sim, layout: CloudLayout, camera: Camera, aspect: fl
     """The uniforms of ``cloud_render/sprite.vert`` but view_proj and the volume's (:func:`bind_volume`)."""
     cell = np.asarray(layout.cell, np.float64)
     tau_scale = plugin.extinction(sim) * cell.prod() / np.cbrt(cell.prod()) / (PROFILE_AREA / 4.0)
-    limit = point_limit if plugin.max_point_size is None else min(point_limit, plugin.max_point_size)
+    settings = plugin.settings
+    limit = point_limit if settings.max_point_size is None else min(point_limit, settings.max_point_size)
     return {"volume_shape": tuple(int(n) for n in layout.shape), "group_size": tuple(layout.group),
             "layer_min": tuple(float(v) for v in layout.lo), "cell_size": tuple(float(c) for c in cell),
             "camera_cell": tuple(float(v) for v in (np.asarray(camera.position, np.float64) - layout.lo) / cell),
-            "base_diameter": float(plugin.size_factor * max(cell[0], cell[2])),
+            "base_diameter": float(settings.size_factor * max(cell[0], cell[2])),
             "pixel_scale": float(height) / 2.0 * float(camera.projection(aspect)[1, 1]),
             "max_point_size": float(limit), "tau_scale": float(tau_scale)}
 
 
 class CloudSpritePass(RenderPass):
-    """Pass "clouds": reads "depth", blends the sprites into "color" (with ``downsample`` > 1 through
-    the low-res "cloud_color"/"cloud_depth" it creates)."""
-    name = "clouds"
+    """Pass "cloud_render" (phase translucent): reads "depth" and "cloud_sets", blends the sprites
+    onto "color" (with ``downsample`` > 1 through the low-res "cloud_color"/"cloud_depth" it creates)."""
+    name = "cloud_render"
+    phase = "translucent"
 
     def __init__(self, plugin: CloudRenderPlugin):
         self.plugin = plugin
@@ -149,9 +143,12 @@ class CloudSpritePass(RenderPass):
 
     def setup(self, builder: PassBuilder) -> None:
         builder.read(DEPTH)
+        builder.read(CLOUD_SETS)
+        builder.read(COLOR)                 # blends onto it
         builder.write(COLOR)
-        if self.plugin.downsample > 1:
-            OffscreenClouds.declare(builder, self.plugin.gpu.size, self.plugin.downsample)
+        downsample = self.plugin.settings.downsample
+        if downsample > 1:
+            OffscreenClouds.declare(builder, self.plugin.gpu.size, downsample)
 
     def prepare(self, gpu) -> None:
         self.program = gpu.program(vertex_shader="cloud_render/sprite.vert", fragment_shader="cloud_render/sprite.frag")
@@ -191,22 +188,23 @@ class CloudSpritePass(RenderPass):
 
     def execute(self, frame: PassContext) -> None:
         plugin = self.plugin
-        app, gpu = frame.data["app"], frame.gpu
-        sim: CloudSimulation = app.resource(CloudSimulation)
-        camera: Camera = app.resource(Camera)
-        if not plugin.enabled:
+        settings = plugin.settings
+        if not settings.enabled:
             return
-        aspect = gpu.size[0] / gpu.size[1]
+        view, gpu = frame.view, frame.gpu
+        sim: CloudSets = frame.resource(CLOUD_SETS)
+        camera = view.camera
+        aspect = view.aspect
         layout = plugin.layout(sim)
         view_proj = camera.view_projection(aspect)
         maps = sim.maps_of(sim.view()[0])
-        ctx, p, factor = gpu.ctx, self.program, plugin.downsample
+        ctx, p, factor = gpu.ctx, self.program, settings.downsample
         uniforms = sprite_uniforms(plugin, sim, layout, camera, aspect, low_size(gpu.size, factor)[1],
                                    self.point_limit)
         segments, plugin.stats = select_segments(
-            layout, camera.position, view_proj if plugin.frustum_culling else None,
-            sim.max_maps() if plugin.empty_space_skipping else None, maps.band_height,
-            plugin.lod_pixels, uniforms["pixel_scale"], MAX_LEVEL)
+            layout, camera.position, view_proj if settings.frustum_culling else None,
+            sim.max_maps() if settings.empty_space_skipping else None, maps.band_height,
+            settings.lod_pixels, uniforms["pixel_scale"], MAX_LEVEL)
         if not len(segments):
             return
         self._buffers(gpu, layout.group, layout.shape)
@@ -223,15 +221,12 @@ class CloudSpritePass(RenderPass):
         frame.blend_over()
         ctx.enable(moderngl.DEPTH_TEST | moderngl.PROGRAM_POINT_SIZE)
         ctx.depth_func = "<="          # a tiny near plane rounds far depths to 1.0: still in front of the sky
-        bind_volume(p, sim, self.sampler, app.get_resource(Sun))
+        bind_volume(p, sim, self.sampler, view.sun)
         self.particle.use(4)
         try:
             self._draw(segments, layout.group)
         finally:
             unbind_volume(self.sampler)
-            fbo.depth_mask = True
-            ctx.depth_func = "<"
-            ctx.disable(moderngl.DEPTH_TEST | moderngl.PROGRAM_POINT_SIZE)   # blending: the graph resets it
         if factor > 1:
             self.offscreen.end(frame, factor, camera.near, camera.far)
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from atmos.plugins.cloud_render.segments import unpack
-from atmos.plugins.shading.reference import trilinear
+from atmos.shading.reference import trilinear
 
 CULLED = np.array([0.0, 0.0, 2.0, 1.0])
 

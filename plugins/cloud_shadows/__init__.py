@@ -1,12 +1,12 @@
 """Cloud shadows on the ground (thesis 7.3.1): the top-view density map projected along the light.
 
 ``CloudShadowsPlugin`` adds the "cloud_shadows" pass (reads "depth", multiplies "color");
-``CloudShadowParams`` its settings; ``cloud_layout`` the volume's world placement (the sprite
+``CloudShadowSettings`` its settings; ``cloud_layout`` the volume's world placement (the sprite
 renderer's :class:`~atmos.plugins.clouds.layout.CloudLayout`);
 ``reference`` the numpy float64 shadow factor the GPU is tested against.
 """
 from atmos.plugins.cloud_shadows import reference
-from atmos.plugins.cloud_shadows.params import CloudShadowParams
+from atmos.plugins.cloud_shadows.settings import CloudShadowSettings
 from atmos.plugins.cloud_shadows.plugin import CloudShadowsPass, CloudShadowsPlugin, cloud_layout
 
-__all__ = ["CloudShadowParams", "CloudShadowsPass", "CloudShadowsPlugin", "cloud_layout", "reference"]
+__all__ = ["CloudShadowSettings", "CloudShadowsPass", "CloudShadowsPlugin", "cloud_layout", "reference"]

@@ -1,38 +1,49 @@
 """CloudShadowsPlugin: darkens the scene's surfaces where the cloud layer blocks the sun (thesis 7.3.1)."""
 from __future__ import annotations
 
-from atmos.camera import Camera, set_camera_uniforms
-from atmos.checks import plugin_params
+import numpy as np
+
+from atmos.camera import set_camera_uniforms
 from atmos.graph import FullscreenPass, PassContext
-from atmos.lighting import scene_sun
+from atmos.lighting import unit_sun
 from atmos.plugin import Plugin
 from atmos.plugins.clouds.layout import CloudLayout
-from atmos.plugins.cloud_shadows.params import CloudShadowParams
-from atmos.plugins.cloud_shadows.reference import direct_weight, unit_sun
-from atmos.plugins.clouds.simulation import CloudSimulation
+from atmos.plugins.cloud_shadows.settings import CloudShadowSettings
+from atmos.plugins.clouds.sets import CLOUD_SETS, CloudSets
 from atmos.render_core import COLOR, DEPTH
 
 
-def cloud_layout(sim: CloudSimulation, params: CloudShadowParams) -> CloudLayout:
-    """The volume's world placement (:meth:`CloudSimulation.layout`), with ``params.base_altitude``
-    and ``params.cell_size`` where they are set."""
-    return sim.layout(params.base_altitude, params.cell_size)
+def direct_weight(sun_direction, sun_color, settings) -> float:
+    """How much of the light shadows can take away: ``direct_fraction`` × smoothstep(0,
+    ``horizon_fade``, sun height), and 0 when the sun has no colour (night) or no direction."""
+    s = unit_sun(sun_direction)
+    if s is None or not max(float(c) for c in sun_color) > 0.0:
+        return 0.0
+    x = float(np.clip(s[1] / settings.horizon_fade, 0.0, 1.0))
+    return settings.direct_fraction * x * x * (3.0 - 2.0 * x)
+
+
+def cloud_layout(sim, settings: CloudShadowSettings) -> CloudLayout:
+    """The volume's world placement (``layout()`` of CloudSets or the CloudSimulation), with ``settings.base_altitude``
+    and ``settings.cell_size`` where they are set."""
+    return sim.layout(settings.base_altitude, settings.cell_size)
 
 
 class CloudShadowsPass(FullscreenPass):
     """Multiplies "color" by the shadow factor where "depth" has geometry (blend ZERO, SRC_COLOR)."""
     name = "cloud_shadows"
+    phase = "shadows"
     fragment = "cloud_shadows/shadow.frag"
-    reads = (DEPTH,)
+    reads = (COLOR, DEPTH, CLOUD_SETS)
 
     def execute(self, frame: PassContext) -> None:
-        app, gpu, p = frame.data["app"], frame.gpu, self.program
-        params = self.plugin.params
-        sun = scene_sun(app)
+        view, gpu, p = frame.view, frame.gpu, self.program
+        params = self.plugin.settings
+        sun = view.sun
         weight = direct_weight(sun.direction, sun.color, params)
         if weight <= 0.0 or params.strength == 0.0:
             return                                  # no direct light to take away: nothing to draw
-        sim = app.resource(CloudSimulation)
+        sim: CloudSets = frame.resource(CLOUD_SETS)
         layout = cloud_layout(sim, params)
         sigma = sim.settings.sigma if params.sigma is None else params.sigma
         a, b, t = sim.view()
@@ -42,8 +53,8 @@ class CloudShadowsPass(FullscreenPass):
         ctx.blend_func = ctx.ZERO, ctx.SRC_COLOR, ctx.ZERO, ctx.ONE    # alpha (sky occlusion) kept
         sim.maps_of(a).sums.use(0)
         sim.maps_of(b).sums.use(1)
-        frame.texture(DEPTH).use(2)
-        set_camera_uniforms(p, app.resource(Camera), gpu.size[0] / gpu.size[1])
+        frame.resource(DEPTH).use(2)
+        set_camera_uniforms(p, view.camera, view.aspect)
         p["sun_dir"].value = tuple(unit_sun(sun.direction))
         p["weight"].value = weight
         p["extinction"].value = sigma * params.strength
@@ -55,14 +66,11 @@ class CloudShadowsPass(FullscreenPass):
 
 
 class CloudShadowsPlugin(Plugin):
-    """Ground shadows of the clouds of a CloudsPlugin (add it after the passes that draw the ground
-    or terrain, before the clouds themselves); ``params``: :class:`CloudShadowParams`, or its fields
-    as keywords. Set ``plugin.params = plugin.params.replace(...)`` to change them while running."""
+    """Ground shadows of the clouds of a CloudsPlugin (phase shadows: over the ground and terrain,
+    under the clouds themselves): ``CloudShadowsPlugin(settings=None, **fields)`` with
+    :class:`CloudShadowSettings`; ``configure(**changes)`` changes any of them live (next frame)."""
 
-    def __init__(self, params: CloudShadowParams | None = None, **fields):
-        if params is not None and fields:
-            raise ValueError("give CloudShadowsPlugin either a CloudShadowParams or its fields as keywords, not both")
-        self.params = plugin_params("CloudShadowsPlugin", CloudShadowParams, params, fields)
+    settings_class = CloudShadowSettings
 
     def build(self, app) -> None:
         if app.graph is None:

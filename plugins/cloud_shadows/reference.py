@@ -12,26 +12,11 @@ from __future__ import annotations
 import numpy as np
 
 from atmos.plugins.clouds.layout import CloudLayout
-from atmos.plugins.shading.reference import bilinear
+from atmos.shading.reference import bilinear
+from atmos.lighting import unit_sun
+from atmos.plugins.cloud_shadows.plugin import direct_weight  # noqa: F401  (the pass's own)
 
 MIN_SUN_HEIGHT = 1e-4   # the projection's divisor never gets smaller (weight is 0 there anyway)
-
-
-def unit_sun(direction) -> np.ndarray | None:
-    """The unit direction toward the sun, or None when it is not a finite non-zero vector."""
-    s = np.asarray(direction, np.float64).reshape(3)
-    norm = np.linalg.norm(s)
-    return s / norm if np.isfinite(norm) and norm > 1e-12 else None
-
-
-def direct_weight(sun_direction, sun_color, params) -> float:
-    """How much of the light shadows can take away: ``direct_fraction`` × smoothstep(0,
-    ``horizon_fade``, sun height), and 0 when the sun has no colour (night) or no direction."""
-    s = unit_sun(sun_direction)
-    if s is None or not max(float(c) for c in sun_color) > 0.0:
-        return 0.0
-    x = float(np.clip(s[1] / params.horizon_fade, 0.0, 1.0))
-    return params.direct_fraction * x * x * (3.0 - 2.0 * x)
 
 
 def zero_border_bilinear(plane: np.ndarray, p: np.ndarray) -> np.ndarray:

@@ -9,8 +9,9 @@ references of smoothing and density maps.
 from atmos.plugins.clouds import reference
 from atmos.plugins.clouds.density_maps import DensityMaps
 from atmos.plugins.clouds.plugin import CloudsPlugin
+from atmos.plugins.clouds.sets import CLOUD_SETS, CloudSets
 from atmos.plugins.clouds.simulation import CloudSettings, CloudSimulation
 from atmos.plugins.clouds.smoothing import FORMATS, Smoother, read_volume, slice_range
 
-__all__ = ["CloudSettings", "CloudSimulation", "CloudsPlugin", "DensityMaps", "FORMATS", "Smoother",
+__all__ = ["CLOUD_SETS", "CloudSets", "CloudSettings", "CloudSimulation", "CloudsPlugin", "DensityMaps", "FORMATS", "Smoother",
            "read_volume", "reference", "slice_range"]

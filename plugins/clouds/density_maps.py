@@ -25,9 +25,13 @@ import moderngl
 import numpy as np
 
 from atmos.checks import check_shape, is_int
-from atmos.gpu.shaders import build_program
-from atmos.plugins.clouds.reference import group_grid
-from atmos.plugins.clouds.smoothing import as_context, check_texture_limit, check_volume_texture, check_z_range
+from atmos.gpu.context import GpuContext, require_gpu
+from atmos.plugins.clouds.smoothing import check_texture_limit, check_volume_texture, check_z_range
+
+
+def group_grid(nx: int, nz: int, group_size) -> tuple[int, int]:
+    """Segments per axis: ``ceil(nx / group_x), ceil(nz / group_z)`` (the last ones clamped)."""
+    return -(-nx // group_size[0]), -(-nz // group_size[1])
 
 
 def _check_group_size(group_size) -> tuple[int, int]:
@@ -54,23 +58,25 @@ class DensityMaps:
     """Top-view density maps of a ``shape = (nx, ny, nz)`` volume; see the module docstring.
 
     ``band_height``: height slices per band (an int >= 1); ``group_size``: cells per sprite-group
-    segment along x and z (an int or two ints >= 1).
+    segment along x and z (an int or two ints >= 1). The programs come from ``gpu.program``.
     """
 
-    def __init__(self, ctx, shape, band_height: int = 4, group_size=(32, 32)):
-        ctx = as_context(ctx)
+    def __init__(self, gpu: GpuContext, shape, band_height: int = 4, group_size=(32, 32)):
+        ctx = require_gpu(gpu).ctx
         shape = check_shape(shape)
         if not is_int(band_height) or band_height < 1:
             raise ValueError(f"band_height must be an int >= 1 (height slices per band), got {band_height!r}")
         group_size = _check_group_size(group_size)
         nx, ny, nz = shape
-        self.ctx, self.shape, self.band_height, self.group_size = ctx, shape, int(band_height), group_size
+        self.gpu, self.ctx = gpu, ctx
+        self.shape, self.band_height, self.group_size = shape, int(band_height), group_size
         self.bands = -(-ny // self.band_height)
         self.grid = group_grid(nx, nz, group_size)
         layers = 1 + self.bands
         check_texture_limit(ctx, (nx, nz), "GL_MAX_TEXTURE_SIZE", "the density map size (nx, nz)")
         check_texture_limit(ctx, (layers,), "GL_MAX_ARRAY_TEXTURE_LAYERS", "the number of maps (1 + bands)")
-        self._sum_prog = self._max_prog = None
+        self._sum_prog = gpu.program(compute_shader="clouds/density_sums.comp")
+        self._max_prog = gpu.program(compute_shader="clouds/density_max.comp")
         self.sums = self.max_maps = None
         try:
             self.sums = ctx.texture_array((nx, nz, layers), 1, dtype="f4")
@@ -78,13 +84,9 @@ class DensityMaps:
             for texture in (self.sums, self.max_maps):
                 texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
                 texture.write(bytes(4 * math.prod(texture.size)))
-            self._sum_prog = build_program(ctx, {"compute_shader": "clouds/density_sums.comp"})
-            self._max_prog = build_program(ctx, {"compute_shader": "clouds/density_max.comp"})
         except Exception:
             self.release()
             raise
-        self._set(self._sum_prog, u_size=shape, u_band_height=self.band_height, u_density=0)
-        self._set(self._max_prog, u_extent=(nx, nz), u_group=group_size, u_grid=self.grid, u_sums=0)
         self._released = False
 
     def run(self, density, z0: int = 0, z1: int | None = None) -> None:
@@ -99,6 +101,8 @@ class DensityMaps:
             return
         density.use(0)
         self.sums.bind_to_image(0, read=False, write=True)
+        # the programs are shared with other DensityMaps on the GpuContext: this one's uniforms each run
+        self._set(self._sum_prog, u_size=self.shape, u_band_height=self.band_height, u_density=0)
         self._sum_prog["u_z0"].value = z0
         self._sum_prog.run(-(-nx // 64), z1 - z0, 1)
         self.ctx.memory_barrier()
@@ -107,6 +111,7 @@ class DensityMaps:
         if gz1 > gz0:
             self.sums.use(0)
             self.max_maps.bind_to_image(0, read=False, write=True)
+            self._set(self._max_prog, u_extent=(nx, nz), u_group=self.group_size, u_grid=self.grid, u_sums=0)
             self._max_prog["u_gz0"].value = gz0
             self._max_prog.run(-(-self.grid[0] // 8), -(-(gz1 - gz0) // 8), 1 + self.bands)
             self.ctx.memory_barrier()
@@ -120,12 +125,12 @@ class DensityMaps:
         return _read_array(self.sums)
 
     def release(self) -> None:
-        """Free the textures and programs; the maps cannot be used afterwards."""
+        """Free the textures (the programs are the GpuContext's); the maps cannot be used afterwards."""
         self._released = True
-        for obj in (self._sum_prog, self._max_prog, self.sums, self.max_maps):
+        for obj in (self.sums, self.max_maps):
             if obj is not None:
                 obj.release()
-        self._sum_prog = self._max_prog = self.sums = self.max_maps = None
+        self.sums = self.max_maps = None
 
     def __repr__(self) -> str:
         return (f"DensityMaps(shape={self.shape}, band_height={self.band_height}, "

@@ -3,29 +3,38 @@ from __future__ import annotations
 
 from atmos.lighting import Sun
 from atmos.plugin import Plugin
+from atmos.plugins.clouds.sets import CLOUD_SETS
 from atmos.plugins.clouds.simulation import CloudSettings, CloudSimulation
-from atmos.plugins.weather import VolumeOrigin, WeatherParams
+from atmos.checks import check_int
+from atmos.plugins.weather import VolumeOrigin
 
 
 class CloudsPlugin(Plugin):
     """Weather ellipsoids → region volume → automaton → smoothing → density maps, sliced over frames.
 
+    ``CloudsPlugin(settings=None, *, seed=0, warmup_steps=0, **fields)`` with :class:`CloudSettings`
+    (its ``weather`` field the :class:`~atmos.plugins.weather.WeatherSettings`);
+    ``configure(**changes)`` changes the live ones (``configure(weather={"cloud_density": 300})``
+    moves the cover from the next step on). ``seed`` (the random streams) and ``warmup_steps``
+    (whole steps run at start-up, so a scene can open on formed clouds) are how it starts, not settings.
     The shading stage reads the ``Sun`` resource's direction when a step starts (DaylightPlugin
-    moves it). Resources it adds: ``WeatherParams`` (change ``cloud_density`` at run time to move the cover),
-    ``VolumeOrigin`` (move it with the viewer; one already present is used) and the
-    :class:`CloudSimulation` (readers take ``view()`` and ``max_maps()`` from it).
-    ``warmup_steps`` whole steps run at start-up, so a scene can open on formed clouds.
+    moves it). Resources it adds: ``VolumeOrigin`` (move it with the viewer; one already present is
+    used) and the :class:`CloudSimulation` (readers take ``view()`` and ``max_maps()`` from it).
     """
 
-    def __init__(self, params: WeatherParams | None = None, settings: CloudSettings | None = None,
-                 seed: int = 0, warmup_steps: int = 0):
-        if not isinstance(warmup_steps, int) or warmup_steps < 0:
-            raise ValueError(f"warmup_steps must be an int >= 0, got {warmup_steps!r}")
-        self.params = params or WeatherParams()
-        self.settings = settings
-        self.seed = seed
-        self.warmup_steps = warmup_steps
+    settings_class = CloudSettings
+
+    def __init__(self, settings: CloudSettings | None = None, *, seed: int = 0, warmup_steps: int = 0, **fields):
+        super().__init__(settings, **fields)
+        self.seed = check_int("CloudsPlugin", "seed", seed, 0, 2**32 - 1)
+        self.warmup_steps = check_int("CloudsPlugin", "warmup_steps", warmup_steps, 0, 10**6)
         self.simulation: CloudSimulation | None = None
+
+    def configure(self, **changes) -> CloudSettings:
+        settings = super().configure(**changes)
+        if self.simulation is not None:
+            self.simulation.settings = settings       # what its next step (and frame) reads
+        return settings
 
     def build(self, app) -> None:
         if app.gpu is None:
@@ -35,17 +44,23 @@ class CloudsPlugin(Plugin):
 
         def sun():
             return (app.get_resource(Sun) or default_sun).direction
-        self.simulation = CloudSimulation(app.gpu, app.world, self.params, self.settings, self.seed, origin, sun)
-        app.insert_resource(self.params)
+        self.simulation = CloudSimulation(app.gpu, app.world, self.settings, self.seed, origin, sun)
         app.insert_resource(origin)
         app.insert_resource(self.simulation)
+        app.graph.import_resource(CLOUD_SETS, self.simulation.sets)
+        app.add_system(self._warm_up, "startup", label="clouds_warm_up")
+        app.frames.add(self.simulation.job)
+
+    def _warm_up(self, app) -> None:
+        """Fill sets A and B (and ``warmup_steps`` more steps) before the first frame; at start-up,
+        not in ``build``, so building a scene (``atmos graph``) runs no simulation."""
         self.simulation.job.prime()
         for _ in range(self.warmup_steps):
             self.simulation.job.run_step()
-        app.frames.add(self.simulation.job)
 
     def cleanup(self, app) -> None:
         if self.simulation is not None:
+            app.graph.remove_import(CLOUD_SETS)
             if self.simulation.job in app.frames:      # a scene may have paused the simulation
                 app.frames.remove(self.simulation.job)
             self.simulation.release()

@@ -1,7 +1,7 @@
 """numpy float64 references of cloud field smoothing (eq. 2.11 over space) and density maps (7.2.2).
 
-They define what the GPU versions in :mod:`.smoothing` and :mod:`.density_maps` compute, and hold
-the parameter checks both share. Arrays are indexed ``[x, y, z]``, y is height.
+They define what the GPU versions in :mod:`.smoothing` and :mod:`.density_maps` compute (the
+parameter checks both share live in those modules). Arrays are indexed ``[x, y, z]``, y is height.
 
 Smoothing: ``q(x, y, z) = sum_d w(d) cld(x + d) / sum_d w(d)`` over the box ``|d_a| <= r_a``, with
 separable integer weights ``w(d) = wx(dx) * wy(dy) * wz(dz)``:
@@ -19,36 +19,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.checks import is_int
-
-WEIGHTS = ("tent", "box")
-MAX_RADIUS = 8
-F16_MIN_NORMAL = 2.0 ** -14   # smallest normal half float: survives r16f storage and flush-to-zero
-
-
-def check_radius(radius) -> tuple[int, int, int]:
-    """``(rx, ry, rz)`` from an int or three ints in [0, MAX_RADIUS]; ValueError otherwise."""
-    allowed = f"an int or three ints (rx, ry, rz), each in [0, {MAX_RADIUS}]"
-    values = (radius,) * 3 if is_int(radius) else radius
-    try:
-        values = tuple(values)
-    except TypeError:
-        values = None
-    if values is None or len(values) != 3 or not all(is_int(r) and 0 <= r <= MAX_RADIUS for r in values):
-        raise ValueError(f"radius must be {allowed}, got {radius!r}")
-    return tuple(int(r) for r in values)
-
-
-def check_weights(weights) -> str:
-    if weights not in WEIGHTS:
-        raise ValueError(f"weights must be one of {WEIGHTS}, got {weights!r}")
-    return weights
-
-
-def axis_weights(kind: str, r: int) -> np.ndarray:
-    """Integer weights of offsets ``-r..r`` along one axis (int64, length ``2r + 1``)."""
-    d = np.abs(np.arange(-r, r + 1, dtype=np.int64))
-    return r + 1 - d if check_weights(kind) == "tent" else np.ones_like(d)
+# the parameter checks and weights are the GPU side's own; kept here by name
+from atmos.plugins.clouds.density_maps import group_grid
+from atmos.plugins.clouds.smoothing import (F16_MIN_NORMAL, MAX_RADIUS, WEIGHTS,  # noqa: F401
+                                            axis_weights, check_radius, check_weights)
 
 
 def smooth(cld, radius=(1, 1, 1), weights: str = "tent", min_density: float = 0.0) -> np.ndarray:
@@ -69,11 +43,6 @@ def smooth(cld, radius=(1, 1, 1), weights: str = "tent", min_density: float = 0.
         acc = sum(int(w[i]) * np.take(padded, np.arange(i, i + n), axis=axis) for i in range(2 * r + 1))
     q = acc / float(total)
     return np.where(acc > 0, np.maximum(q, min_density), 0.0)
-
-
-def group_grid(nx: int, nz: int, group_size) -> tuple[int, int]:
-    """Segments per axis: ``ceil(nx / group_x), ceil(nz / group_z)`` (the last ones clamped)."""
-    return -(-nx // group_size[0]), -(-nz // group_size[1])
 
 
 def density_maps(density, band_height: int = 4, group_size=(32, 32)):

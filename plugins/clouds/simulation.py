@@ -10,40 +10,51 @@ the max maps comes back to the CPU.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from atmos.checks import (CheckedSettings, check_bool, check_choice, check_int, check_num, check_vec,
+                          is_int)
+
 from atmos.frames import SlicedJob, SliceStage, TripleSet
 from atmos.graph import TextureDesc
-from atmos.plugins.automaton import CloudAutomaton
+from atmos.automaton import CloudAutomaton
 from atmos.plugins.clouds.density_maps import DensityMaps
 from atmos.plugins.clouds.layout import CloudLayout
-from atmos.plugins.clouds.smoothing import Smoother, slice_range
-from atmos.plugins.shading.reference import check_scale, check_sigma, shading_shape
-from atmos.plugins.shading.scattering import Scattering
-from atmos.plugins.shading.shear_warp import ShadingStage, ShearWarpShader
-from atmos.plugins.weather import RegionVolume, VolumeOrigin, WeatherParams, ellipsoid_array, step_weather
+from atmos.plugins.clouds.sets import CloudSets
+from atmos.plugins.clouds.smoothing import FORMATS, WEIGHTS, Smoother, slice_range
+from atmos.shading.grid import check_scale, shading_shape
+from atmos.shading.scattering import Scattering
+from atmos.shading.shear_warp import ShadingStage, ShearWarpShader
+from atmos.plugins.weather import RegionVolume, VolumeOrigin, WeatherSettings, ellipsoid_array, step_weather
 
 
-@dataclass
-class CloudSettings:
-    """How the cloud chain is computed (the weather itself is :class:`WeatherParams`).
+@dataclass(frozen=True)
+class CloudSettings(CheckedSettings):
+    """How the cloud chain is computed, and the weather it is computed from.
 
-    ``step_seconds``: weather time one simulation step represents. ``layout``: automaton layout
-    ("packed" or "cell"). ``density_dtype``: "f2" or "f4" smoothed density. ``radius`` and
-    ``weights``: smoothing neighbourhood (eq. 2.11). ``band_height`` and ``group_size``: density
-    maps per height band and the sprite-group grid they are max-downsampled to.
-    ``smoothing_slices``: z ranges the smoothing and density maps are split into.
+    ``weather``: the :class:`WeatherSettings` (ellipsoids and probabilities; ``configure(weather=
+    {"cloud_density": 200})`` changes single fields of it). ``step_seconds``: weather time one
+    simulation step represents. ``layout``: automaton layout ("packed" or "cell").
+    ``density_dtype``: "f2" or "f4" smoothed density. ``radius`` (an int or three, 0..8) and
+    ``weights`` ("tent" or "box"): smoothing neighbourhood (eq. 2.11). ``band_height`` and
+    ``group_size``: density maps per height band and the sprite-group grid they are max-downsampled
+    to. ``smoothing_slices``: z ranges the smoothing and density maps are split into.
     ``cover_threshold``: a column counts as covered when its summed density exceeds this (cells).
     ``base_altitude``: world y of the volume's bottom (see :mod:`atmos.plugins.clouds.layout`).
     Shading (thesis ch. 5): ``shading`` on or off; ``sigma`` extinction per cell length at density
-    1; ``scattering`` single or Harris multiple forward scattering (:class:`Scattering`);
+    1; ``scattering`` single or Harris multiple forward scattering (:class:`Scattering`, None: single);
     ``shading_scale`` 1, 2 or 4 (full, half, quarter resolution); ``shading_slices_per_run``
     light-space slices per job slice; ``cell_size`` the world size of a cell (x, y, z), so the sun
     direction is taken into cell units (cells need not be cubes).
+
+    Live (the next step, or the next frame for placement): ``weather`` (but its ``volume_shape``),
+    ``step_seconds``, ``cover_threshold``, ``sigma``, ``scattering``, ``cell_size``,
+    ``base_altitude``. FIXED (they size the automaton, the textures, the maps and the job's
+    slices): the others.
     """
+    weather: WeatherSettings = WeatherSettings()
     step_seconds: float = 1.0
     layout: str = "packed"
     density_dtype: str = "f2"
@@ -61,21 +72,53 @@ class CloudSettings:
     cell_size: tuple = (1.0, 1.0, 1.0)
     base_altitude: float = 100.0
 
-    def validate(self, shape) -> "CloudSettings":
-        if not (math.isfinite(self.step_seconds) and self.step_seconds > 0):
-            raise ValueError(f"CloudSettings.step_seconds must be a finite number > 0, got {self.step_seconds!r}")
-        if not isinstance(self.smoothing_slices, int) or not 1 <= self.smoothing_slices <= shape[2]:
-            raise ValueError(f"CloudSettings.smoothing_slices must be an int in 1..{shape[2]} (the volume depth), "
-                             f"got {self.smoothing_slices!r}")
-        if not (math.isfinite(self.cover_threshold) and self.cover_threshold >= 0):
-            raise ValueError(f"CloudSettings.cover_threshold must be a finite number >= 0, got {self.cover_threshold!r}")
-        if not math.isfinite(self.base_altitude):
-            raise ValueError(f"CloudSettings.base_altitude must be a finite number (metres), got {self.base_altitude!r}")
-        if len(self.cell_size) != 3 or not all(math.isfinite(c) and c > 0 for c in self.cell_size):
-            raise ValueError(f"CloudSettings.cell_size must be three finite numbers > 0 (x, y, z), got {self.cell_size!r}")
-        check_sigma(self.sigma)
-        check_scale(self.shading_scale)
-        return self
+    FIXED = ("layout", "density_dtype", "radius", "weights", "band_height", "group_size", "smoothing_slices",
+             "shading", "shading_scale", "shading_slices_per_run")
+
+    def __post_init__(self):
+        o = "CloudSettings"
+        if not isinstance(self.weather, WeatherSettings):
+            raise ValueError(f"{o}.weather must be a WeatherSettings, got {type(self.weather).__name__}")
+        nz = self.weather.volume_shape[2]
+        radius = (self.radius,) * 3 if is_int(self.radius) else self.radius
+        group = (self.group_size,) * 2 if is_int(self.group_size) else self.group_size
+        try:
+            radius, group = tuple(radius), tuple(group)
+        except TypeError:
+            radius = group = ()
+        if len(radius) != 3:
+            raise ValueError(f"{o}.radius must be an int or three ints (rx, ry, rz), each 0..8, got {self.radius!r}")
+        if len(group) != 2:
+            raise ValueError(f"{o}.group_size must be an int or two ints (group_x, group_z), got {self.group_size!r}")
+        if self.scattering is not None and not isinstance(self.scattering, Scattering):
+            raise ValueError(f"{o}.scattering must be None or a Scattering, got {self.scattering!r}")
+        try:
+            shading_scale = check_scale(self.shading_scale)
+        except ValueError:
+            raise ValueError(f"{o}.shading_scale must be 1, 2 or 4 (full, half, quarter resolution), "
+                             f"got {self.shading_scale!r}") from None
+        self.store(dict(
+            step_seconds=check_num(o, "step_seconds", self.step_seconds, 0.0, lo_open=True),
+            layout=check_choice(o, "layout", self.layout, ("packed", "cell")),
+            density_dtype=check_choice(o, "density_dtype", self.density_dtype, tuple(FORMATS)),
+            radius=tuple(check_int(o, f"radius[{i}]", r, 0, 8) for i, r in enumerate(radius)),
+            weights=check_choice(o, "weights", self.weights, WEIGHTS),
+            band_height=check_int(o, "band_height", self.band_height, 1, 4096),
+            group_size=tuple(check_int(o, f"group_size[{i}]", g, 1, 4096) for i, g in enumerate(group)),
+            smoothing_slices=check_int(o, "smoothing_slices", self.smoothing_slices, 1, nz),
+            cover_threshold=check_num(o, "cover_threshold", self.cover_threshold, 0.0),
+            shading=check_bool(o, "shading", self.shading),
+            sigma=check_num(o, "sigma", self.sigma, 0.0),
+            shading_scale=shading_scale,
+            shading_slices_per_run=check_int(o, "shading_slices_per_run", self.shading_slices_per_run, 1, 4096),
+            cell_size=check_vec(o, "cell_size", self.cell_size, 3, "positive"),
+            base_altitude=check_num(o, "base_altitude", self.base_altitude),
+        ))
+
+    @property
+    def extinction(self) -> float:
+        """The shading's extinction per cell length at density 1 (sigma, with the scattering model's)."""
+        return (self.scattering or Scattering()).extinction(self.sigma)
 
 
 class CloudSimulation:
@@ -89,11 +132,12 @@ class CloudSimulation:
     and ``maps_of(set).sums`` the top-view sums (layer 0 all heights, then one per height band).
     """
 
-    def __init__(self, gpu, world, params: WeatherParams, settings: CloudSettings | None = None,
-                 seed: int = 0, origin: VolumeOrigin | None = None, sun=None):
-        self.params = params.validate()
-        shape = tuple(params.volume_shape)
-        self.settings = (settings or CloudSettings()).validate(shape)
+    def __init__(self, gpu, world, settings: CloudSettings | None = None, seed: int = 0,
+                 origin: VolumeOrigin | None = None, sun=None):
+        if settings is not None and not isinstance(settings, CloudSettings):
+            raise ValueError(f"CloudSimulation settings must be a CloudSettings, got {type(settings).__name__}")
+        self.settings = settings or CloudSettings()      # read live: CloudsPlugin.configure replaces it
+        shape = self.settings.weather.volume_shape
         self.shape = shape
         self.world = world
         self.origin = origin or VolumeOrigin()
@@ -106,24 +150,25 @@ class CloudSimulation:
         try:
             self.region = RegionVolume(gpu, shape)
             made.append(self.region)
-            self.automaton = CloudAutomaton(gpu.ctx, shape, seed=seed, layout=s.layout)
+            self.automaton = CloudAutomaton(gpu, shape, seed=seed, layout=s.layout)
             made.append(self.automaton)
             self.smoother = Smoother.for_automaton(self.automaton, s.radius, s.weights)
             made.append(self.smoother)
             descs = {"density": TextureDesc(shape, 1, s.density_dtype)}
             if s.shading:
                 descs["transmittance"] = TextureDesc(shading_shape(shape, s.shading_scale), 1, "f2")
-                self.shader = ShearWarpShader(gpu.ctx, shape, s.shading_scale)
+                self.shader = ShearWarpShader(gpu, shape, s.shading_scale)
                 made.append(self.shader)
             self.triple = TripleSet(gpu, descs)
             made.append(self.triple)
-            self._maps = {id(t): DensityMaps(gpu.ctx, shape, s.band_height, s.group_size) for t in self.triple.sets}
+            self._maps = {id(t): DensityMaps(gpu, shape, s.band_height, s.group_size) for t in self.triple.sets}
             made += list(self._maps.values())
         except Exception:
             for obj in made:
                 obj.release()
             raise
         self._max_maps = {key: np.zeros((1 + m.bands, *m.grid), np.float32) for key, m in self._maps.items()}
+        self._placement: dict[int, tuple] = {}    # id(texture set) -> VolumeOrigin its step began at
         self._drift = np.zeros(2)          # sub-cell wind displacement not yet applied
         self._last_origin = np.array(self.origin.as_tuple())
         n = s.smoothing_slices
@@ -133,18 +178,19 @@ class CloudSimulation:
             SliceStage("smoothing", n, self._smoothing_slice),
             SliceStage("density_maps", n, self._maps_slice),
         ]
-        if s.shading:
-            extinction = (s.scattering or Scattering()).extinction(s.sigma)
-            stages.append(ShadingStage(self.shader, self.sun_in_cells, extinction,
+        if s.shading:                  # sigma and scattering read when each step's shading begins
+            stages.append(ShadingStage(self.shader, self.sun_in_cells, lambda: self.settings.extinction,
                                        slices_per_run=s.shading_slices_per_run))
         self.job = SlicedJob("clouds", stages, self.triple)
 
     # -- stages ------------------------------------------------------------------------------
     def _region_slice(self, index: int, job) -> None:
         origin = self.origin.as_tuple()
-        step_weather(self.world, self.params, self.rng, self.settings.step_seconds, origin)
+        self._placement[id(job.target)] = origin
+        s = self.settings
+        step_weather(self.world, s.weather, self.rng, s.step_seconds, origin)
         self.region.render(ellipsoid_array(self.world, origin))
-        self.region.probabilities(self.params)
+        self.region.probabilities(s.weather)
 
     def _automaton_slice(self, index: int, job) -> None:
         self.automaton.step_with_texture(self.region.prob_texture, shift=self._next_shift())
@@ -165,7 +211,7 @@ class CloudSimulation:
         origin = np.array(self.origin.as_tuple())
         moved = origin - self._last_origin
         self._last_origin = origin
-        wind = np.asarray(self.params.wind, float)
+        wind = np.asarray(self.settings.weather.wind, float)
         self._drift += wind[[0, 2]] * self.settings.step_seconds - moved[[0, 2]]
         shift = np.trunc(self._drift)
         self._drift -= shift
@@ -176,11 +222,15 @@ class CloudSimulation:
         """Where the volume is in the world now (the VolumeOrigin moves it): the placement the
         renderer, the ground shadows and the light shafts share. ``base_altitude`` and ``cell_size``
         default to the settings'; ``pad`` widens the column boxes (the sprite radius)."""
-        s = self.settings
-        cell = tuple(float(c) for c in (s.cell_size if cell_size is None else cell_size))
-        base = float(s.base_altitude if base_altitude is None else base_altitude)
-        return CloudLayout(tuple(self.shape), cell, (float(self.origin.x), float(self.origin.z)), base,
-                           tuple(s.group_size), pad)
+        return self.sets().layout(base_altitude, cell_size, pad)
+
+    def sets(self) -> CloudSets:
+        """This frame's :class:`CloudSets` (the render graph's imported ``"cloud_sets"``)."""
+        a, b, t = self.view()
+        here = self.origin.as_tuple()
+        return CloudSets(a, b, float(t), self._maps[id(a)], self._maps[id(b)], self._max_maps[id(a)],
+                         self._max_maps[id(b)], self._placement.get(id(a), here), self._placement.get(id(b), here),
+                         here, self.settings, tuple(self.shape))
 
     def sun_in_cells(self) -> np.ndarray:
         """The sun direction in cell units (what the shear-warp needs when cells are not cubes)."""

@@ -23,22 +23,43 @@ import moderngl
 import numpy as np
 
 from atmos.checks import check_shape, is_int
-from atmos.gpu.shaders import build_program
-from atmos.plugins.automaton import LAYOUTS
-from atmos.plugins.clouds.reference import F16_MIN_NORMAL, axis_weights, check_radius, check_weights
+from atmos.gpu.context import GpuContext, require_gpu
+from atmos.automaton import LAYOUTS
+
+WEIGHTS = ("tent", "box")
+MAX_RADIUS = 8
+F16_MIN_NORMAL = 2.0 ** -14   # smallest normal half float: survives r16f storage and flush-to-zero
+
+
+def check_radius(radius) -> tuple[int, int, int]:
+    """``(rx, ry, rz)`` from an int or three ints in [0, MAX_RADIUS]; ValueError otherwise."""
+    allowed = f"an int or three ints (rx, ry, rz), each in [0, {MAX_RADIUS}]"
+    values = (radius,) * 3 if is_int(radius) else radius
+    try:
+        values = tuple(values)
+    except TypeError:
+        values = None
+    if values is None or len(values) != 3 or not all(is_int(r) and 0 <= r <= MAX_RADIUS for r in values):
+        raise ValueError(f"radius must be {allowed}, got {radius!r}")
+    return tuple(int(r) for r in values)
+
+
+def check_weights(weights) -> str:
+    if weights not in WEIGHTS:
+        raise ValueError(f"weights must be one of {WEIGHTS}, got {weights!r}")
+    return weights
+
+
+def axis_weights(kind: str, r: int) -> np.ndarray:
+    """Integer weights of offsets ``-r..r`` along one axis (int64, length ``2r + 1``)."""
+    d = np.abs(np.arange(-r, r + 1, dtype=np.int64))
+    return r + 1 - d if check_weights(kind) == "tent" else np.ones_like(d)
+
 
 FORMATS = {"f2": "r16f", "f4": "r32f"}       # texture dtype -> image format
 MIN_DENSITY = {"f2": F16_MIN_NORMAL, "f4": 0.0}
 _LOCAL = (16, 4, 1)
 _NUMPY = {"f2": np.float16, "f4": np.float32}
-
-
-def as_context(ctx) -> moderngl.Context:
-    """A moderngl.Context from itself or from an atmos GpuContext; ValueError otherwise."""
-    ctx = getattr(ctx, "ctx", ctx)
-    if not isinstance(ctx, moderngl.Context):
-        raise ValueError(f"ctx must be a moderngl.Context or an atmos GpuContext, got {type(ctx).__name__}")
-    return ctx
 
 
 def check_texture_limit(ctx, size, limit_name: str, what: str) -> None:
@@ -90,10 +111,11 @@ class Smoother:
 
     ``radius``: an int or ``(rx, ry, rz)``, each in [0, 8]; ``weights``: ``"tent"`` or ``"box"``;
     ``layout``: the automaton's layout, ``"packed"`` or ``"cell"``. See the module docstring.
+    The program comes from ``gpu.program`` (shared, released by the GpuContext).
     """
 
-    def __init__(self, ctx, shape, radius=(1, 1, 1), weights: str = "tent", layout: str = "packed"):
-        ctx = as_context(ctx)
+    def __init__(self, gpu: GpuContext, shape, radius=(1, 1, 1), weights: str = "tent", layout: str = "packed"):
+        ctx = require_gpu(gpu).ctx
         shape = check_shape(shape)
         radius = check_radius(radius)
         check_weights(weights)
@@ -101,7 +123,8 @@ class Smoother:
             raise ValueError(f"layout must be one of {LAYOUTS}, got {layout!r}")
         check_texture_limit(ctx, shape, "GL_MAX_3D_TEXTURE_SIZE", "shape")
         nx, ny, nz = shape
-        self.ctx, self.shape, self.radius, self.weights, self.layout = ctx, shape, radius, weights, layout
+        self.gpu, self.ctx = gpu, ctx
+        self.shape, self.radius, self.weights, self.layout = shape, radius, weights, layout
         self.words_x = -(-nx // 32)
         words = self.words_x * ny * nz if layout == "packed" else nx * ny * nz
         self.state_bytes = 4 * (3 * words if layout == "packed" else words)
@@ -112,13 +135,12 @@ class Smoother:
         windows = [((1 << (2 * k + 1)) - 1) << (rx - k) for k in range(rx + 1)]
         self._arrays = {"u_cx": steps, "u_window": windows, "u_wy": taps[1], "u_wz": taps[2]}
         self.total = math.prod(int(w.sum()) for w in taps)
-        self._programs: dict[str, object] = {}
         self._released = False
 
     @classmethod
     def for_automaton(cls, automaton, radius=(1, 1, 1), weights: str = "tent") -> "Smoother":
-        """A Smoother matching ``automaton``'s context, shape and layout."""
-        return cls(automaton.ctx, automaton.shape, radius, weights, automaton.layout)
+        """A Smoother matching ``automaton``'s GpuContext, shape and layout."""
+        return cls(automaton.gpu, automaton.shape, radius, weights, automaton.layout)
 
     def min_density(self, dtype: str = "f2") -> float:
         """The smallest density above 0 written to a texture of ``dtype`` ("f2" or "f4")."""
@@ -156,33 +178,29 @@ class Smoother:
         self.ctx.memory_barrier()
 
     def release(self) -> None:
-        """Free the compiled programs; the Smoother cannot be used afterwards."""
+        """The Smoother cannot be used afterwards (it owns no GL objects: its program is the GpuContext's)."""
         self._released = True
-        for program in self._programs.values():
-            program.release()
-        self._programs.clear()
 
     def __repr__(self) -> str:
         return (f"Smoother(shape={self.shape}, radius={self.radius}, weights={self.weights!r}, "
                 f"layout={self.layout!r})")
 
     def _program(self, dtype: str):
-        program = self._programs.get(dtype)
-        if program is None:
-            defines = {"FORMAT": FORMATS[dtype], "LAYOUT_PACKED": int(self.layout == "packed")}
-            program = build_program(self.ctx, {"compute_shader": "clouds/smooth.comp"}, defines)
-            values = {"u_size": self.shape, "u_radius": self.radius, "u_nwx": self.words_x,
-                      "u_cld_offset": self._cld_offset, "u_total": self.total,
-                      "u_min_density": MIN_DENSITY[dtype]}
-            for name, value in values.items():
-                member = program.get(name, None)
-                if member is not None:
-                    member.value = value
-            for name, values in self._arrays.items():
-                member = program.get(name, None)
-                if member is not None:
-                    data = np.zeros(member.array_length, "<u4")
-                    data[:len(values)] = values
-                    member.write(data.tobytes())
-            self._programs[dtype] = program
+        """The shared program for ``dtype`` with this Smoother's uniforms written (other Smoothers on
+        the GpuContext use the same program, so they are written before every run)."""
+        defines = {"FORMAT": FORMATS[dtype], "LAYOUT_PACKED": int(self.layout == "packed")}
+        program = self.gpu.program(compute_shader="clouds/smooth.comp", defines=defines)
+        values = {"u_size": self.shape, "u_radius": self.radius, "u_nwx": self.words_x,
+                  "u_cld_offset": self._cld_offset, "u_total": self.total,
+                  "u_min_density": MIN_DENSITY[dtype]}
+        for name, value in values.items():
+            member = program.get(name, None)
+            if member is not None:
+                member.value = value
+        for name, values in self._arrays.items():
+            member = program.get(name, None)
+            if member is not None:
+                data = np.zeros(member.array_length, "<u4")
+                data[:len(values)] = values
+                member.write(data.tobytes())
         return program

@@ -5,33 +5,48 @@ the clouds in 3D.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
+from atmos.checks import CheckedSettings, check_num
 from atmos.graph import FullscreenPass, PassContext
 from atmos.plugin import Plugin
-from atmos.plugins.clouds.simulation import CloudSimulation
+from atmos.plugins.clouds.sets import CLOUD_SETS, CloudSets
 from atmos.render_core import COLOR
 
 
 class CloudTopViewPass(FullscreenPass):
     name = "cloud_top_view"
+    phase = "opaque"
     fragment = "clouds/top_view.frag"
+    reads = (CLOUD_SETS,)
 
     def execute(self, frame: PassContext) -> None:
-        sim = frame.data["app"].resource(CloudSimulation)
+        sim: CloudSets = frame.resource(CLOUD_SETS)
         a, b, t = sim.view()
         frame.framebuffer(color=[COLOR]).use()
         sim.maps_of(a).sums.use(0)
         sim.maps_of(b).sums.use(1)
         self.program["t"].value = t
-        self.program["full"].value = self.plugin.full_column
-        self.program["aspect"].value = frame.gpu.size[0] / frame.gpu.size[1]
+        self.program["full"].value = self.plugin.settings.full_column
+        self.program["aspect"].value = frame.view.aspect
         frame.fullscreen(self.program)
 
 
-class CloudTopViewPlugin(Plugin):
-    """Draws the cloud field seen from above; ``full_column``: summed density drawn fully white."""
+@dataclass(frozen=True)
+class CloudTopViewSettings(CheckedSettings):
+    """``full_column``: the summed density (cells) drawn fully white, > 0. Live."""
+    full_column: float = 4.0
 
-    def __init__(self, full_column: float = 4.0):
-        self.full_column = full_column
+    def __post_init__(self):
+        self.store(dict(full_column=check_num("CloudTopViewSettings", "full_column", self.full_column, 0.0,
+                                              lo_open=True)))
+
+
+class CloudTopViewPlugin(Plugin):
+    """Draws the cloud field seen from above: ``CloudTopViewPlugin(settings=None, **fields)`` with
+    :class:`CloudTopViewSettings`; ``configure(full_column=...)`` changes it on the next frame."""
+
+    settings_class = CloudTopViewSettings
 
     def build(self, app) -> None:
         app.graph.add_pass(CloudTopViewPass(self))

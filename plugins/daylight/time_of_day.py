@@ -6,7 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from atmos.lighting import Sun
+from atmos.checks import CheckedSettings, check_num
+from atmos.lighting import Sun, sky_light
 from atmos.plugin import Plugin
 
 
@@ -28,50 +29,67 @@ def solar_direction(hours: float, latitude: float = 45.0, day_of_year: float = 1
     return v / np.linalg.norm(v)
 
 
-@dataclass
-class TimeOfDay:
-    """``hours``: local solar time in [0, 24); ``speed``: in-game hours per real second (0 stops
-    the clock); ``latitude`` in degrees (−90..90); ``day_of_year`` 1..365."""
+@dataclass(frozen=True)
+class DaylightSettings(CheckedSettings):
+    """``hours``: local solar time in [0, 24] the clock starts at (``configure(hours=...)`` sets the
+    clock to it); ``speed``: in-game hours per real second (0 stops the clock); ``latitude`` in
+    degrees (−90..90); ``day_of_year`` 1..366. All live (next frame)."""
     hours: float = 10.0
     speed: float = 0.0
     latitude: float = 45.0
     day_of_year: float = 172.0
 
-    def validate(self) -> "TimeOfDay":
-        for name, lo, hi in (("hours", 0.0, 24.0), ("latitude", -90.0, 90.0), ("day_of_year", 1.0, 366.0)):
-            value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and lo <= value <= hi):
-                raise ValueError(f"TimeOfDay.{name} must be a number in [{lo}, {hi}], got {value!r}")
-        if not (isinstance(self.speed, (int, float)) and math.isfinite(self.speed)):
-            raise ValueError(f"TimeOfDay.speed must be a finite number of in-game hours per second, got {self.speed!r}")
-        return self
-
-    @property
-    def sun_direction(self) -> np.ndarray:
-        return solar_direction(self.hours, self.latitude, self.day_of_year)
+    def __post_init__(self):
+        o = "DaylightSettings"
+        self.store(dict(hours=check_num(o, "hours", self.hours, 0.0, 24.0),
+                        speed=check_num(o, "speed", self.speed),
+                        latitude=check_num(o, "latitude", self.latitude, -90.0, 90.0),
+                        day_of_year=check_num(o, "day_of_year", self.day_of_year, 1.0, 366.0)))
 
 
-def advance_daylight(app) -> None:
-    """System: advance the clock by ``speed × dt`` and write the Sun's direction, colour and ambient."""
-    from atmos.plugins.shading.scattering import sky_light
-    tod: TimeOfDay = app.resource(TimeOfDay)
-    tod.hours = (tod.hours + tod.speed * app.clock.dt) % 24.0
-    sun = app.get_resource(Sun)
-    if sun is None:
-        sun = Sun()
-        app.insert_resource(sun)
-    sun.direction = tod.sun_direction
-    color, ambient = sky_light(sun.direction)
-    sun.color, sun.ambient = tuple(color), tuple(ambient)
+@dataclass(slots=True)
+class TimeOfDay:
+    """The running clock (a resource the daylight system advances every frame): ``hours``, local
+    solar time in [0, 24)."""
+    hours: float = 10.0
 
 
 class DaylightPlugin(Plugin):
-    """The day–night cycle: a TimeOfDay resource driving the Sun resource (update stage, "daylight")."""
+    """The day–night cycle: ``DaylightPlugin(settings=None, **fields)`` with :class:`DaylightSettings`;
+    a TimeOfDay resource driving the Sun resource (update stage, "daylight").
+    ``configure(**changes)`` changes any setting live; ``hours`` also sets the clock."""
 
-    def __init__(self, time_of_day: TimeOfDay | None = None, **fields):
-        self.time_of_day = (time_of_day or TimeOfDay(**fields)).validate()
+    settings_class = DaylightSettings
+
+    def __init__(self, settings: DaylightSettings | None = None, **fields):
+        super().__init__(settings, **fields)
+        self.time_of_day = TimeOfDay(self.settings.hours)
+
+    def configure(self, **changes) -> DaylightSettings:
+        settings = super().configure(**changes)
+        if "hours" in changes:
+            self.time_of_day.hours = settings.hours % 24.0
+        return settings
+
+    def sun_direction(self) -> np.ndarray:
+        """Unit vector toward the sun at the clock's time."""
+        s = self.settings
+        return solar_direction(self.time_of_day.hours, s.latitude, s.day_of_year)
+
+    def advance(self, app) -> None:
+        """System: advance the clock by ``speed × dt`` and write the Sun's direction, colour and ambient."""
+        tod = self.time_of_day
+        tod.hours = (tod.hours + self.settings.speed * app.clock.dt) % 24.0
+        sun = app.get_resource(Sun)
+        if sun is None:
+            sun = Sun()
+            app.insert_resource(sun)
+        sun.direction = self.sun_direction()
+        color, ambient = sky_light(sun.direction)
+        sun.color, sun.ambient = tuple(color), tuple(ambient)
 
     def build(self, app) -> None:
         app.insert_resource(self.time_of_day)
-        app.add_system(advance_daylight, "update", label="daylight")
-        app.add_system(advance_daylight, "startup", label="daylight_start")
+        self.advance(app)        # the Sun is right from the start, whatever runs first at start-up
+        app.add_system(self.advance, "update", label="daylight")
+        app.add_system(self.advance, "startup", label="daylight_start")

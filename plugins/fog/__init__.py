@@ -7,34 +7,27 @@ Modes: ``linear`` (eq. 2), ``exp`` (eq. 3), ``exp2`` (eq. 4), ``hetero_exp`` (eq
 """
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 
-from atmos.gpu.context import release_gl
+from atmos.gpu.context import release_gl, require_gpu
 from atmos.plugin import Plugin
 from atmos.plugins.fog.noise import NoiseVolumes
 from atmos.plugins.fog.post import FogPass, draw_state, fog_program, restore_state, set_fog_uniforms
-from atmos.plugins.fog.programs import gl_context
 from atmos.plugins.fog.settings import MODES, FogSettings
 
 __all__ = ["FogPlugin", "FogSettings", "FogPass", "apply_fog", "MODES"]
 
 
 class FogPlugin(Plugin):
-    """Adds the ``fog`` pass. ``FogPlugin(settings)`` or ``FogPlugin(mode="hetero_exp2", density=0.044,
-    ...)`` with :class:`FogSettings` fields; ``time_offset`` shifts the noise animation clock."""
+    """Adds the ``fog`` pass. ``FogPlugin(settings=None, **fields)`` with :class:`FogSettings`, e.g.
+    ``FogPlugin(mode="hetero_exp2", density=0.044)``; ``configure(**changes)`` changes any of them
+    live (all or nothing; the pass adapts on the next frame)."""
 
-    def __init__(self, settings: FogSettings | None = None, *, time_offset: float = 0.0, **fields):
-        base = settings if settings is not None else FogSettings()
-        self.settings = replace(base, **fields).validated()
-        self.time_offset = float(time_offset)
+    settings_class = FogSettings
+
+    def __init__(self, settings: FogSettings | None = None, **fields):
+        super().__init__(settings, **fields)
         self.fog_pass: FogPass | None = None
-
-    def configure(self, settings: FogSettings | None = None, **fields) -> FogSettings:
-        """Validate, then swap in new settings (all or nothing); the pass adapts next frame."""
-        self.settings = replace(settings or self.settings, **fields).validated()
-        return self.settings
 
     def build(self, app) -> None:
         self.fog_pass = FogPass(self)
@@ -45,7 +38,7 @@ class FogPlugin(Plugin):
             self.fog_pass.release()
 
 
-def apply_fog(ctx, color, distance, mode: str = "exp2", density: float = 0.044, fog_color=(0.8, 0.8, 0.8),
+def apply_fog(gpu, color, distance, mode: str = "exp2", density: float = 0.044, fog_color=(0.8, 0.8, 0.8),
               start: float = 0.0, end: float = 100.0, *, positions=None, time: float = 0.0,
               far: float = np.inf, **noise) -> np.ndarray:
     """Fog ``color`` (float32 (H, W, 3)) at ``distance`` (float32 (H, W), +inf = sky) on the GPU with
@@ -55,21 +48,22 @@ def apply_fog(ctx, color, distance, mode: str = "exp2", density: float = 0.044, 
     settings of :class:`FogSettings` (``octaves``, ``resolutions``, ``winds``, ``tile_size``,
     ``amplitude``, ``noise``, ``texels_per_cell``, ``seed``) as keywords, plus ``time`` (s);
     ``sky="keep"`` leaves sky pixels alone, else they are fogged at distance ``far``.
-    ``ctx`` is a moderngl context or a GpuContext.
+    ``gpu`` is a GpuContext (the program comes from its cache).
     """
-    unknown = set(noise) - set(FogSettings.__dataclass_fields__)
+    allowed = [f for f in FogSettings.__dataclass_fields__
+               if f not in ("mode", "density", "fog_color", "start", "end", "time_offset")]
+    unknown = set(noise) - set(allowed)
     if unknown:
         raise ValueError(f"apply_fog got unknown keyword(s) {', '.join(sorted(unknown))}; allowed: "
-                         f"{', '.join(f for f in FogSettings.__dataclass_fields__ if f not in ('mode', 'density', 'fog_color', 'start', 'end'))}, positions, time, far")
-    settings = FogSettings(mode=mode, density=density, fog_color=fog_color, start=start, end=end,
-                           **noise).validated()
+                         f"{', '.join(allowed)}, positions, time, far")
+    settings = FogSettings(mode=mode, density=density, fog_color=fog_color, start=start, end=end, **noise)
     color, distance, positions = _check_inputs(color, distance, positions, settings)
     far = float(far)
     if np.isnan(far) or far < 0:
         raise ValueError(f"far must be >= 0 or +inf, got {far!r}")
     h, w = distance.shape
-    gl = gl_context(ctx)
-    prog = fog_program(ctx, settings, from_depth=False)
+    gl = require_gpu(gpu).ctx
+    prog = fog_program(gpu, settings, from_depth=False)
     made, volumes = [], None
     try:
         target = gl.texture((w, h), 4, np.dstack([color, np.ones((h, w), np.float32)]).tobytes(), dtype="f4")
@@ -85,7 +79,7 @@ def apply_fog(ctx, color, distance, mode: str = "exp2", density: float = 0.044, 
         vao = gl.vertex_array(prog, [])
         made.append(vao)
         if settings.heterogeneous and settings.noise == "texture":
-            volumes = NoiseVolumes(ctx, settings)
+            volumes = NoiseVolumes(gpu, settings)
             volumes.use(3)
         dist_tex.use(0)
         pos_tex.use(1)

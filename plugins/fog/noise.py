@@ -13,8 +13,8 @@ import math
 
 import numpy as np
 
+from atmos.gpu.context import GpuContext, require_gpu
 from atmos.hashing import hash_counter, stream_key
-from atmos.plugins.fog.programs import gl_context, program
 
 FOG_RULE = 0xF06  # stream id of the fog gradients: stream_key(seed, 0, FOG_RULE, octave)
 GRADIENTS = np.array([(1, 1, 0), (-1, 1, 0), (1, -1, 0), (-1, -1, 0), (1, 0, 1), (-1, 0, 1),
@@ -101,9 +101,9 @@ class NoiseVolumes:
 
     ``fill`` prefills every texel first (tests pass NaN to prove each texel is written)."""
 
-    def __init__(self, target, settings, fill: float | None = None):
-        ctx = gl_context(target)
-        shader = program(target, compute_shader="fog/noise.comp")
+    def __init__(self, gpu: GpuContext, settings, fill: float | None = None):
+        ctx = require_gpu(gpu).ctx
+        shader = gpu.program(compute_shader="fog/noise.comp")
         self.key = (settings.seed, settings.resolutions[:settings.octaves], settings.texels_per_cell)
         self.textures = []
         try:

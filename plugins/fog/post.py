@@ -3,10 +3,9 @@ from __future__ import annotations
 
 import math
 
-from atmos.camera import Camera, set_camera_uniforms
+from atmos.camera import set_camera_uniforms
 from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.plugins.fog.noise import NoiseVolumes, octave_key
-from atmos.plugins.fog.programs import program
 from atmos.plugins.fog.settings import MODES
 from atmos.render_core import COLOR, DEPTH
 
@@ -14,11 +13,12 @@ FRAGMENT = "fog/fog.frag"
 VERTEX = "lib/fullscreen.vert"
 
 
-def fog_program(target, settings, from_depth: bool):
-    """The fog program for ``settings`` (one compiled variant per mode, octave count and noise kind)."""
+def fog_program(gpu, settings, from_depth: bool):
+    """The fog program for ``settings`` from ``gpu``'s cache (one variant per mode, octave count and
+    noise kind)."""
     defines = {"FOG_MODE": MODES[settings.mode], "FOG_OCTAVES": settings.octaves,
                "FOG_PROCEDURAL": int(settings.noise == "procedural"), "FOG_FROM_DEPTH": int(from_depth)}
-    return program(target, defines, vertex_shader=VERTEX, fragment_shader=FRAGMENT)
+    return gpu.program(defines, vertex_shader=VERTEX, fragment_shader=FRAGMENT)
 
 
 def _set(prog, name, values) -> None:
@@ -69,6 +69,7 @@ def restore_state(ctx) -> None:
 class FogPass(RenderPass):
     """Fullscreen fog over the scene: distance from depth via the inverse view-projection."""
     name = "fog"
+    phase = "media"
 
     def __init__(self, plugin):
         self.plugin = plugin
@@ -77,6 +78,7 @@ class FogPass(RenderPass):
 
     def setup(self, builder: PassBuilder) -> None:
         builder.read(DEPTH)
+        builder.read(COLOR)                 # blends onto it
         builder.write(COLOR)
 
     def prepare(self, gpu) -> None:
@@ -95,18 +97,17 @@ class FogPass(RenderPass):
         return prog
 
     def execute(self, frame: PassContext) -> None:
-        app, gpu = frame.data["app"], frame.gpu
+        view, gpu = frame.view, frame.gpu
         settings = self.plugin.settings
         prog = self._sync(settings)
         frame.framebuffer(color=[COLOR]).use()
-        draw_state(gpu.ctx)
-        frame.texture(DEPTH).use(0)
+        frame.blend_transmittance()
+        frame.resource(DEPTH).use(0)
         if self.volumes is not None:
             self.volumes.use(3)
-        set_camera_uniforms(prog, app.resource(Camera), gpu.size[0] / gpu.size[1])
-        set_fog_uniforms(prog, settings, app.clock.frame_time + self.plugin.time_offset)
+        set_camera_uniforms(prog, view.camera, view.aspect)
+        set_fog_uniforms(prog, settings, view.time + settings.time_offset)
         frame.fullscreen(prog)
-        restore_state(gpu.ctx)
 
     def release(self) -> None:
         if self.volumes is not None:

@@ -1,8 +1,10 @@
-"""FogSettings: every knob of the fog post-process, validated in one place (errors name what is allowed)."""
+"""FogSettings: every knob of the fog post-process, checked as a whole before any of it is used (all live)."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
+
+from atmos.checks import CheckedSettings, check_choice, check_int, check_num, check_vec
 
 MODES = {"linear": 0, "exp": 1, "exp2": 2, "hetero_exp": 3, "hetero_exp2": 4}
 ALIASES = {"exponential": "exp", "exp_squared": "exp2", "squared_exponential": "exp2",
@@ -13,10 +15,11 @@ MAX_TEXELS = 256          # largest noise volume edge (resolution * texels_per_c
 PAPER_RESOLUTIONS = {"fine": (16, 32, 64, 128), "coarse": (8, 16, 32, 64)}
 DEFAULT_WINDS = ((1.5, 0.0, 0.5), (-1.0, 0.1, 1.2), (0.8, -0.05, -1.6), (-2.0, 0.0, -0.7))
 GOLDEN_ANGLE = math.pi * (3.0 - math.sqrt(5.0))
+_OWNER = "FogSettings"
 
 
 @dataclass(frozen=True)
-class FogSettings:
+class FogSettings(CheckedSettings):
     """Fog factor mode (``linear``, ``exp``, ``exp2``, ``hetero_exp`` = eq. 6, ``hetero_exp2`` = eq. 7),
     density g, linear ``start``/``end``, ``fog_color`` (linear RGB) and sky handling (``fog``: sky
     pixels are fogged as at the far distance; ``keep``: left to the sky).
@@ -25,7 +28,9 @@ class FogSettings:
     lattice cells per ``tile_size`` metres, displaced by ``winds[i]`` m/s and turned about y by i golden
     angles; ``noise`` is ``texture`` (GPU-made tileable 3D textures of resolution * texels_per_cell
     texels, trilinear) or ``procedural`` (the same noise evaluated per pixel); ``amplitude`` in [0, 1]
-    is the grey-scale range of an octave; ``seed`` picks the lattice gradients.
+    is the grey-scale range of an octave; ``seed`` picks the lattice gradients. ``time_offset``
+    (seconds) shifts the noise animation clock. Every field is live: ``FogPlugin.configure`` changes
+    it on the next frame (the pass fetches the program variant and noise volumes it needs).
     """
 
     mode: str = "exp2"
@@ -42,6 +47,7 @@ class FogSettings:
     noise: str = "texture"
     texels_per_cell: int = 1
     seed: int = 0
+    time_offset: float = 0.0
 
     @property
     def heterogeneous(self) -> bool:
@@ -52,75 +58,43 @@ class FogSettings:
         """The octaves' turn angles about y (radians)."""
         return tuple(i * GOLDEN_ANGLE for i in range(4))
 
-    def validated(self) -> "FogSettings":
-        """A copy with the mode alias resolved and tuples normalised; ValueError naming the allowed values."""
+    def __post_init__(self):
+        """Check every field (ValueError naming ``FogSettings.field``, the value and what is allowed);
+        keeps the mode alias resolved and the tuples normalised."""
+        o = _OWNER
         mode = ALIASES.get(self.mode, self.mode) if isinstance(self.mode, str) else self.mode
         if mode not in MODES:
-            raise ValueError(f"unknown fog mode {self.mode!r}; allowed: {', '.join(MODES)} "
-                             f"(aliases: {', '.join(ALIASES)})")
-        density = _number("density", self.density)
-        if density < 0:
-            raise ValueError(f"fog density must be >= 0 (a finite number), got {self.density!r}")
-        start, end = _number("start", self.start), _number("end", self.end)
+            raise ValueError(f"{o}.mode must be one of {', '.join(MODES)} (aliases: {', '.join(ALIASES)}), "
+                             f"got {self.mode!r}")
+        start, end = check_num(o, "start", self.start), check_num(o, "end", self.end)
         if mode == "linear" and not start < end:
-            raise ValueError(f"linear fog needs start < end, got start={self.start!r}, end={self.end!r}")
-        color = _vector("fog_color", self.fog_color, 3)
-        if self.sky not in SKIES:
-            raise ValueError(f"sky must be one of {', '.join(SKIES)}, got {self.sky!r}")
-        if self.noise not in NOISES:
-            raise ValueError(f"noise must be one of {', '.join(NOISES)}, got {self.noise!r}")
-        octaves = _integer("octaves", self.octaves, 1, 4)
-        tpc = _integer("texels_per_cell", self.texels_per_cell, 1, MAX_TEXELS)
+            raise ValueError(f"{o}.start must be < end for linear fog, got start={self.start!r}, end={self.end!r}")
+        octaves = check_int(o, "octaves", self.octaves, 1, 4)
+        tpc = check_int(o, "texels_per_cell", self.texels_per_cell, 1, MAX_TEXELS)
         try:
-            resolutions = tuple(self.resolutions)
+            resolutions = () if isinstance(self.resolutions, str) else tuple(self.resolutions)
         except TypeError:
-            raise ValueError(f"resolutions must be a sequence of 1-4 ints, got {self.resolutions!r}") from None
+            resolutions = ()
         if not octaves <= len(resolutions) <= 4:
-            raise ValueError(f"resolutions needs {octaves} to 4 entries (one per octave), got {len(resolutions)}")
-        resolutions = tuple(_integer("each resolution", r, 2, MAX_TEXELS // tpc) for r in resolutions)
+            raise ValueError(f"{o}.resolutions must be {octaves} to 4 whole numbers (one per octave; octaves="
+                             f"{octaves}), got {self.resolutions!r}")
         try:
-            winds = tuple(self.winds)
+            winds = () if isinstance(self.winds, str) else tuple(self.winds)
         except TypeError:
-            raise ValueError(f"winds must be 4 (x, y, z) velocities in m/s, got {self.winds!r}") from None
+            winds = ()
         if len(winds) != 4:
-            raise ValueError(f"winds must be 4 (x, y, z) velocities in m/s (one per octave), got {len(winds)}")
-        winds = tuple(_vector("each wind", w, 3) for w in winds)
-        tile = _number("tile_size", self.tile_size)
-        if not tile > 0:
-            raise ValueError(f"tile_size must be > 0 metres, got {self.tile_size!r}")
-        amplitude = _number("amplitude", self.amplitude)
-        if not 0 <= amplitude <= 1:
-            raise ValueError(f"amplitude must be in [0, 1], got {self.amplitude!r}")
-        seed = _integer("seed", self.seed, 0, 2**32 - 1)
-        return replace(self, mode=mode, density=density, fog_color=color, start=start, end=end,
-                       octaves=octaves, resolutions=resolutions, winds=winds, tile_size=tile,
-                       amplitude=amplitude, texels_per_cell=tpc, seed=seed)
-
-
-def _number(name, value) -> float:
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a finite number, got {value!r}") from None
-    if not math.isfinite(x):
-        raise ValueError(f"{name} must be a finite number, got {value!r}")
-    return x
-
-
-def _integer(name, value, low, high) -> int:
-    if isinstance(value, bool) or not isinstance(value, int) and not (hasattr(value, "__index__")):
-        raise ValueError(f"{name} must be an int in {low}..{high}, got {value!r}")
-    value = int(value)
-    if not low <= value <= high:
-        raise ValueError(f"{name} must be an int in {low}..{high}, got {value}")
-    return value
-
-
-def _vector(name, value, n) -> tuple:
-    try:
-        items = tuple(value)
-    except TypeError:
-        raise ValueError(f"{name} must be {n} finite numbers, got {value!r}") from None
-    if len(items) != n:
-        raise ValueError(f"{name} must be {n} finite numbers, got {value!r}")
-    return tuple(_number(name, v) for v in items)
+            raise ValueError(f"{o}.winds must be 4 (x, y, z) velocities in m/s (one per octave), got {self.winds!r}")
+        self.store(dict(
+            mode=mode, start=start, end=end, octaves=octaves, texels_per_cell=tpc,
+            density=check_num(o, "density", self.density, 0.0),
+            fog_color=check_vec(o, "fog_color", self.fog_color, 3),
+            sky=check_choice(o, "sky", self.sky, SKIES),
+            noise=check_choice(o, "noise", self.noise, NOISES),
+            resolutions=tuple(check_int(o, f"resolutions[{i}]", r, 2, MAX_TEXELS // tpc)
+                              for i, r in enumerate(resolutions)),
+            winds=tuple(check_vec(o, f"winds[{i}]", w, 3) for i, w in enumerate(winds)),
+            tile_size=check_num(o, "tile_size", self.tile_size, 0.0, lo_open=True),
+            amplitude=check_num(o, "amplitude", self.amplitude, 0.0, 1.0),
+            seed=check_int(o, "seed", self.seed, 0, 2**32 - 1),
+            time_offset=check_num(o, "time_offset", self.time_offset),
+        ))

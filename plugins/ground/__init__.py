@@ -1,5 +1,9 @@
 """A large ground plane at height 0 with a procedural checker, lit by the sun, faded into the distance."""
+from dataclasses import dataclass
+
 import numpy as np
+
+from atmos.checks import CheckedSettings, check_num, check_vec
 
 from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.lighting import set_scene_uniforms
@@ -7,8 +11,30 @@ from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
 
 
+@dataclass(frozen=True)
+class GroundSettings(CheckedSettings):
+    """``half_size``: the plane reaches this many metres each way from the origin; ``tile``: checker
+    tiles of this many metres; ``albedo``: linear RGB reflectance in [0, 1]. All live."""
+    half_size: float = 4000.0
+    tile: float = 4.0
+    albedo: tuple = (0.28, 0.36, 0.2)
+
+    def __post_init__(self):
+        o = "GroundSettings"
+        self.store(dict(half_size=check_num(o, "half_size", self.half_size, 0.0, lo_open=True),
+                        tile=check_num(o, "tile", self.tile, 0.0, lo_open=True),
+                        albedo=check_vec(o, "albedo", self.albedo, 3, "non-negative")))
+
+
+def ground_quad(half_size: float) -> bytes:
+    """The plane's four (x, z) corners as a triangle strip."""
+    h = half_size
+    return np.array([[-h, -h], [h, -h], [-h, h], [h, h]], np.float32).tobytes()
+
+
 class GroundPass(RenderPass):
     name = "ground"
+    phase = "opaque"
 
     def __init__(self, plugin: "GroundPlugin"):
         self.plugin = plugin
@@ -16,22 +42,26 @@ class GroundPass(RenderPass):
 
     def setup(self, builder: PassBuilder) -> None:
         builder.write(COLOR)
+        builder.read(DEPTH)                 # depth-tested
         builder.write(DEPTH)
 
     def prepare(self, gpu) -> None:
         self.program = gpu.program(vertex_shader="ground/ground.vert", fragment_shader="ground/ground.frag")
-        h = self.plugin.half_size
-        quad = np.array([[-h, -h], [h, -h], [-h, h], [h, h]], np.float32)
-        self.vbo = gpu.track(gpu.ctx.buffer(quad.tobytes()))
+        self.half_size = self.plugin.settings.half_size
+        self.vbo = gpu.track(gpu.ctx.buffer(ground_quad(self.half_size)))
         self.vao = gpu.track(gpu.ctx.vertex_array(self.program, [(self.vbo, "2f", "in_xz")]))
 
     def execute(self, frame: PassContext) -> None:
-        app, gpu = frame.data["app"], frame.gpu
+        gpu = frame.gpu
         frame.framebuffer(color=[COLOR], depth=DEPTH).use()
         gpu.ctx.enable(gpu.ctx.DEPTH_TEST)
-        set_scene_uniforms(self.program, app, gpu.size[0] / gpu.size[1])
-        self.program["albedo"].value = self.plugin.albedo
-        self.program["tile"].value = self.plugin.tile
+        set_scene_uniforms(self.program, frame.view)
+        settings = self.plugin.settings
+        if settings.half_size != self.half_size:           # a live change: the same 4 corners, moved
+            self.half_size = settings.half_size
+            self.vbo.write(ground_quad(self.half_size))
+        self.program["albedo"].value = settings.albedo
+        self.program["tile"].value = settings.tile
         self.vao.render(gpu.ctx.TRIANGLE_STRIP)
 
     def release(self) -> None:
@@ -41,10 +71,10 @@ class GroundPass(RenderPass):
 
 
 class GroundPlugin(Plugin):
-    """Ground plane of ``half_size`` metres each way; checker tiles of ``tile`` metres in ``albedo``."""
+    """Ground plane: ``GroundPlugin(settings=None, **fields)`` with :class:`GroundSettings`;
+    ``configure(**changes)`` changes any of them live (next frame)."""
 
-    def __init__(self, half_size: float = 4000.0, tile: float = 4.0, albedo=(0.28, 0.36, 0.2)):
-        self.half_size, self.tile, self.albedo = half_size, tile, albedo
+    settings_class = GroundSettings
 
     def build(self, app) -> None:
         app.graph.add_pass(GroundPass(self))

@@ -3,12 +3,9 @@ from __future__ import annotations
 
 import math
 
-from atmos.camera import Camera
-from atmos.checks import plugin_params
 from atmos.graph import PassBuilder, PassContext, RenderPass, TextureDesc
-from atmos.lighting import scene_sun
 from atmos.plugin import Plugin
-from atmos.plugins.light_shafts.params import LightShaftParams
+from atmos.plugins.light_shafts.settings import LightShaftSettings
 from atmos.plugins.light_shafts.screen_sun import screen_sun
 from atmos.render_core import COLOR, DEPTH
 
@@ -16,14 +13,14 @@ MASK = "light_shafts_mask"
 BLUR = "light_shafts_blur"
 
 
-def blur_uniforms(program, sun_uv, params: LightShaftParams, strength: float) -> None:
+def blur_uniforms(program, sun_uv, settings: LightShaftSettings, strength: float) -> None:
     """Set the radial blur's uniforms (shaders/light_shafts/blur.frag)."""
     program["sun_uv"].value = tuple(sun_uv)
-    program["samples"].value = params.samples
-    program["density"].value = params.density
-    program["decay"].value = params.decay
-    program["weight"].value = params.weight
-    program["scale"].value = params.exposure * strength
+    program["samples"].value = settings.samples
+    program["density"].value = settings.density
+    program["decay"].value = settings.decay
+    program["weight"].value = settings.weight
+    program["scale"].value = settings.exposure * strength
 
 
 class LightShaftsPass(RenderPass):
@@ -34,6 +31,7 @@ class LightShaftsPass(RenderPass):
     while the mask is drawn and only written by the last draw, so it is never read and written at once.
     """
     name = "light_shafts"
+    phase = "post"
 
     def __init__(self, plugin: "LightShaftsPlugin"):
         self.plugin = plugin
@@ -41,7 +39,7 @@ class LightShaftsPass(RenderPass):
 
     def setup(self, builder: PassBuilder) -> None:
         w, h = self.plugin.gpu.size
-        d = self.plugin.params.downsample
+        d = self.plugin.settings.downsample
         desc = TextureDesc((math.ceil(w / d), math.ceil(h / d)), components=4, dtype="f2")
         builder.create(MASK, desc)
         builder.create(BLUR, desc)
@@ -56,17 +54,16 @@ class LightShaftsPass(RenderPass):
         self.composite = gpu.program(vertex_shader=fullscreen, fragment_shader="light_shafts/composite.frag")
 
     def execute(self, frame: PassContext) -> None:
-        app, gpu, params = frame.data["app"], frame.gpu, self.plugin.params
-        w, h = gpu.size
-        sun = scene_sun(app)
-        where = screen_sun(app.resource(Camera), w / h, sun.direction, params)
+        view, gpu, params = frame.view, frame.gpu, self.plugin.settings
+        w, h = view.size
+        where = screen_sun(view.camera, view.aspect, view.sun.direction, params)
         if where.strength <= 0.0 or params.exposure == 0.0 or params.weight == 0.0:
             return                                      # sun behind, below or far off-screen
         ctx = gpu.ctx
-        mask = frame.texture(MASK)
+        mask = frame.resource(MASK)
         frame.framebuffer(color=[MASK]).use()
-        frame.texture(COLOR).use(0)
-        frame.texture(DEPTH).use(1)
+        frame.resource(COLOR).use(0)
+        frame.resource(DEPTH).use(1)
         self.mask["mask_size"].value = mask.size
         self.mask["sun_uv"].value = where.uv
         self.mask["threshold"].value = params.threshold
@@ -81,21 +78,21 @@ class LightShaftsPass(RenderPass):
         frame.fullscreen(self.blur)
 
         frame.framebuffer(color=[COLOR]).use()
-        frame.texture(BLUR).use(0)
+        frame.resource(BLUR).use(0)
         ctx.enable(ctx.BLEND)
         ctx.blend_func = ctx.ONE, ctx.ONE
         frame.fullscreen(self.composite)
 
 
 class LightShaftsPlugin(Plugin):
-    """Screen-space light shafts around the sun; add it after everything that draws the sky, the
-    clouds and the scene. ``params``: :class:`LightShaftParams`, or its fields as keywords; set
-    ``plugin.params = plugin.params.replace(...)`` to change them while running."""
+    """Screen-space light shafts around the sun (phase post: after the sky, the scene, the clouds
+    and the fog). ``LightShaftsPlugin(settings=None, **fields)`` with :class:`LightShaftSettings`;
+    ``configure(**changes)`` changes any of them live (next frame; ``downsample`` resizes the mask)."""
 
-    def __init__(self, params: LightShaftParams | None = None, **fields):
-        if params is not None and fields:
-            raise ValueError("give LightShaftsPlugin either a LightShaftParams or its fields as keywords, not both")
-        self.params = plugin_params("LightShaftsPlugin", LightShaftParams, params, fields)
+    settings_class = LightShaftSettings
+
+    def __init__(self, settings: LightShaftSettings | None = None, **fields):
+        super().__init__(settings, **fields)
         self.gpu = None
 
     def build(self, app) -> None:

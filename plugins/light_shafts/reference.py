@@ -17,7 +17,7 @@ def pixel_uv(w: int, h: int) -> np.ndarray:
     return np.stack([x, y], axis=-1)
 
 
-def occlusion_mask(color, depth, sun_uv, params) -> np.ndarray:
+def occlusion_mask(color, depth, sun_uv, settings) -> np.ndarray:
     """(h, w, 3): the sky (depth >= 1) brighter than ``threshold``, by its excess luminance (at most
     ``ceiling``) times how open to the sky it is, ``1 − clip(color.a, 0, 1)`` (``color.a``: the sky
     occlusion of :mod:`atmos.render_core`), near the sun. ``color``: (h, w, 4) RGBA."""
@@ -27,26 +27,26 @@ def occlusion_mask(color, depth, sun_uv, params) -> np.ndarray:
     c = np.maximum(color[..., :3], 0.0)
     h, w = c.shape[:2]
     lum = c @ LUMA
-    excess = np.clip(lum - params.threshold, 0.0, params.ceiling) * (1.0 - np.clip(color[..., 3], 0.0, 1.0))
+    excess = np.clip(lum - settings.threshold, 0.0, settings.ceiling) * (1.0 - np.clip(color[..., 3], 0.0, 1.0))
     bright = c * (excess / np.maximum(lum, 1e-4))[..., None]
     r = np.linalg.norm((pixel_uv(w, h) - np.asarray(sun_uv)) * np.array([w / h, 1.0]), axis=-1)
-    near = np.exp(-(r / params.radius) ** 2)
+    near = np.exp(-(r / settings.radius) ** 2)
     return np.where((np.asarray(depth) >= 1.0)[..., None], bright * near[..., None], 0.0)
 
 
-def radial_blur(mask, sun_uv, params, strength: float = 1.0) -> np.ndarray:
+def radial_blur(mask, sun_uv, settings, strength: float = 1.0) -> np.ndarray:
     """(h, w, c): per pixel, ``samples`` bilinear taps (zero outside the mask) stepping toward the sun,
     tap i weighing ``weight·decay^(i−1)``, summed and scaled by ``exposure·strength``."""
     mask = np.asarray(mask, np.float64)
     h, w, channels = mask.shape
     uv = pixel_uv(w, h)
-    step = (uv - np.asarray(sun_uv)) * (params.density / params.samples)
+    step = (uv - np.asarray(sun_uv)) * (settings.density / settings.samples)
     out = np.zeros_like(mask)
     falloff = 1.0
-    for i in range(1, params.samples + 1):
+    for i in range(1, settings.samples + 1):
         texel = (uv - i * step) * np.array([w, h]) - 0.5          # (h, w, 2) as (x, y)
         p = texel[..., ::-1]                                        # index order of mask: (row, column)
         for ch in range(channels):
-            out[..., ch] += zero_border_bilinear(mask[..., ch], p) * (params.weight * falloff)
-        falloff *= params.decay
-    return out * (params.exposure * strength)
+            out[..., ch] += zero_border_bilinear(mask[..., ch], p) * (settings.weight * falloff)
+        falloff *= settings.decay
+    return out * (settings.exposure * strength)

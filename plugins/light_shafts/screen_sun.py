@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from atmos.plugins.cloud_shadows.reference import unit_sun
+from atmos.lighting import unit_sun
 
 UV_LIMIT = 64.0     # a sun further off-screen is faded out; its uv is clamped to keep the blur finite
 
@@ -23,17 +23,17 @@ class ScreenSun:
     strength: float
 
 
-def screen_sun(camera, aspect: float, sun_direction, params) -> ScreenSun:
+def screen_sun(camera, aspect: float, sun_direction, settings) -> ScreenSun:
     """Project the direction toward the sun (a point at infinity) with ``camera``'s view-projection."""
     s = unit_sun(sun_direction)
     if s is None:
         return ScreenSun((0.5, 0.5), 0.0)
     facing = float(np.dot(camera.forward(), s))
-    strength = _smoothstep(0.0, params.horizon_fade, s[1]) * _smoothstep(0.0, params.front_fade, facing)
+    strength = _smoothstep(0.0, settings.horizon_fade, s[1]) * _smoothstep(0.0, settings.front_fade, facing)
     if strength <= 0.0:
         return ScreenSun((0.5, 0.5), 0.0)
     clip = camera.view_projection(aspect) @ np.append(s, 0.0)
     uv = np.clip(0.5 * clip[:2] / clip[3] + 0.5, -UV_LIMIT, UV_LIMIT)
     outside = float(np.max(np.maximum(np.maximum(-uv, uv - 1.0), 0.0)))
-    strength *= 1.0 - _smoothstep(0.0, params.edge_fade, outside)
+    strength *= 1.0 - _smoothstep(0.0, settings.edge_fade, outside)
     return ScreenSun((float(uv[0]), float(uv[1])), strength)

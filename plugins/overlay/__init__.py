@@ -1,15 +1,18 @@
 """Frame-time overlay: a bar graph of recent frame times (green < 16.7 ms, yellow < 33.3 ms, red above).
 
-Toggle with F1 in a window (``FrameTimes.visible``). The numbers are kept even when hidden, for
-the window caption and for benchmarks; per-pass timings come from the render graph's timer queries.
+Toggle with F1 in a window (``OverlayPlugin.configure(visible=...)``). The numbers are kept even
+when hidden, for the window caption and for benchmarks; per-pass timings come from the render
+graph's timer queries.
 """
 from __future__ import annotations
 
 import time
 from collections import deque
+from dataclasses import dataclass
 
 import numpy as np
 
+from atmos.checks import CheckedSettings, check_bool, check_int
 from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.plugin import Plugin
 from atmos.render_core import SCREEN
@@ -17,11 +20,28 @@ from atmos.render_core import SCREEN
 HISTORY = 128
 
 
+@dataclass(frozen=True)
+class OverlaySettings(CheckedSettings):
+    """``visible``: draw the bars (the times are recorded either way); ``size``: (width, height) of
+    the graph in pixels, 1..4096 each (cut to the screen). All live."""
+    visible: bool = True
+    size: tuple = (256, 64)
+
+    def __post_init__(self):
+        o = "OverlaySettings"
+        try:
+            size = tuple(check_int(o, f"size[{i}]", n, 1, 4096) for i, n in enumerate(self.size))
+        except TypeError:
+            size = ()
+        if len(size) != 2:
+            raise ValueError(f"{o}.size must be (width, height) in pixels, got {self.size!r}")
+        self.store(dict(visible=check_bool(o, "visible", self.visible), size=size))
+
+
 class FrameTimes:
     """Wall-clock milliseconds of the last HISTORY frames."""
 
-    def __init__(self, visible: bool = True):
-        self.visible = visible
+    def __init__(self):
         self.ms: deque = deque([0.0] * HISTORY, maxlen=HISTORY)
         self._last: float | None = None
 
@@ -44,13 +64,17 @@ def record_frame_time(app) -> None:
 
 class OverlayPass(RenderPass):
     name = "overlay"
+    phase = "overlay"
 
-    def __init__(self, times: FrameTimes, size=(256, 64)):
-        self.times = times
-        self.size = size
+    def __init__(self, plugin: "OverlayPlugin"):
+        self.plugin = plugin
+        self.times = plugin.times
         self.program = self.data = None
 
     def setup(self, builder: PassBuilder) -> None:
+        if not self.plugin.settings.visible:
+            return                          # declares nothing: culled until it is shown again
+        builder.read(SCREEN)                # blends onto it
         builder.write(SCREEN)
 
     def prepare(self, gpu) -> None:
@@ -59,20 +83,17 @@ class OverlayPass(RenderPass):
         self.data.filter = (gpu.ctx.NEAREST, gpu.ctx.NEAREST)
 
     def execute(self, frame: PassContext) -> None:
-        if not self.times.visible:
-            return
+        settings = self.plugin.settings
         gpu = frame.gpu
-        frame.texture(SCREEN).use()
-        w, h = min(self.size[0], gpu.size[0]), min(self.size[1], gpu.size[1])
+        frame.resource(SCREEN).use()
+        w, h = min(settings.size[0], gpu.size[0]), min(settings.size[1], gpu.size[1])
         self.data.write(np.asarray(self.times.ms, np.float32).tobytes())
         self.data.use(0)
-        gpu.ctx.viewport = (4, 4, w, h) if gpu.size[0] > w + 8 else (0, 0, w, h)
+        gpu.ctx.viewport = (4, 4, w, h) if gpu.size[0] > w + 8 else (0, 0, w, h)   # the graph resets it
         gpu.ctx.enable(gpu.ctx.BLEND)
         # over the screen; its alpha stays what present wrote (1)
         gpu.ctx.blend_func = gpu.ctx.SRC_ALPHA, gpu.ctx.ONE_MINUS_SRC_ALPHA, gpu.ctx.ZERO, gpu.ctx.ONE
         frame.fullscreen(self.program)
-        gpu.ctx.disable(gpu.ctx.BLEND)
-        gpu.ctx.viewport = (0, 0, *gpu.size)
 
     def release(self) -> None:
         if self.data is not None:
@@ -80,11 +101,17 @@ class OverlayPass(RenderPass):
 
 
 class OverlayPlugin(Plugin):
-    def __init__(self, visible: bool = True):
-        self.times = FrameTimes(visible)
+    """The frame-time bars: ``OverlayPlugin(settings=None, **fields)`` with :class:`OverlaySettings`;
+    ``configure(visible=...)`` shows or hides them on the next frame. Adds the FrameTimes resource."""
+
+    settings_class = OverlaySettings
+
+    def __init__(self, settings: OverlaySettings | None = None, **fields):
+        super().__init__(settings, **fields)
+        self.times = FrameTimes()
 
     def build(self, app) -> None:
         app.insert_resource(self.times)
         app.add_system(record_frame_time, "update", label="record_frame_time")
         if app.graph is not None:
-            app.graph.add_pass(OverlayPass(self.times))
+            app.graph.add_pass(OverlayPass(self))

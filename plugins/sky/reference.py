@@ -14,15 +14,12 @@ import math
 
 import numpy as np
 
-from atmos.plugins.shading.scattering import NIGHT_SKY
-from atmos.plugins.sky.params import SkyParams
+from atmos.lighting import NIGHT_SKY
+from atmos.plugins.sky.settings import SkySettings
 from atmos.plugins.sky.preetham import check_turbidity, preetham_rgb, unit_vectors
 from atmos.plugins.sky.stars import smoothstep, star_field
-
-DAY_FADE = (-0.2, 0.02)      # sun height (sin elevation): night below the first, full Preetham day above the second
-GROUND_DIM = 0.3
-BELOW_FADE = 0.1
-DISC_EDGE = 0.25
+# the model's constants are the GLSL's (handed over as defines by .shader); kept here by name
+from atmos.plugins.sky.shader import BELOW_FADE, DAY_FADE, DISC_EDGE, GROUND_DIM, disc_chords  # noqa: F401
 
 
 def daylight(sun_y) -> np.ndarray:
@@ -35,7 +32,7 @@ def below_horizon(view_y) -> np.ndarray:
     return 1.0 + (GROUND_DIM - 1.0) * smoothstep(0.0, -BELOW_FADE, view_y)
 
 
-def sky_radiance(view_dir, sun_dir, turbidity: float = SkyParams.turbidity, scale: float = SkyParams.scale,
+def sky_radiance(view_dir, sun_dir, turbidity: float = SkySettings.turbidity, scale: float = SkySettings.scale,
                  night=tuple(NIGHT_SKY)) -> np.ndarray:
     """(..., 3) linear HDR sky colour (no sun disc, no stars) for view directions ``view_dir`` (..., 3)
     and the direction toward the sun ``sun_dir`` (3,); any direction, sun above or below the horizon."""
@@ -47,22 +44,16 @@ def sky_radiance(view_dir, sun_dir, turbidity: float = SkyParams.turbidity, scal
     return rgb * below_horizon(v[..., 1])[..., None]
 
 
-def disc_chords(size_deg: float) -> tuple[float, float]:
-    """Chord lengths |v − s| where the disc's soft edge starts and ends."""
-    r = math.radians(size_deg)
-    return 2.0 * math.sin(0.5 * r * (1.0 - DISC_EDGE)), 2.0 * math.sin(0.5 * r)
-
-
 def sun_disc(view_dir, sun_dir, sun_color, size_deg: float, gain: float) -> np.ndarray:
     """(..., 3) the sun disc's radiance: ``gain · sun_color`` inside, soft edge (unit directions)."""
     inside = 1.0 - smoothstep(*disc_chords(size_deg), np.linalg.norm(view_dir - sun_dir, axis=-1))
     return gain * inside[..., None] * np.asarray(sun_color, np.float64)
 
 
-def sky_color(view_dir, sun_dir, sun_color, params: SkyParams | None = None, time: float = 0.0,
+def sky_color(view_dir, sun_dir, sun_color, settings: SkySettings | None = None, time: float = 0.0,
               pixel_angle: float = 0.0) -> np.ndarray:
-    """(..., 3) what the sky pass writes: sky radiance, sun disc and (if ``params.stars``) stars."""
-    p = params or SkyParams()
+    """(..., 3) what the sky pass writes: sky radiance, sun disc and (if ``settings.stars``) stars."""
+    p = settings or SkySettings()
     v = unit_vectors(view_dir, "view_dir")
     s = unit_vectors(sun_dir, "sun_dir").reshape(3)
     extra = sun_disc(v, s, sun_color, p.sun_size_deg, p.sun_gain)

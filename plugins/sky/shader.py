@@ -6,15 +6,26 @@ import math
 import numpy as np
 
 from atmos.camera import gl_matrix3, view_basis
-from atmos.plugins.sky import reference as ref, stars
-from atmos.plugins.sky.params import SkyParams
+from atmos.plugins.sky import stars
+from atmos.plugins.sky.settings import SkySettings
 from atmos.plugins.sky.preetham import COS_FLOOR, unit_vectors
+
+DAY_FADE = (-0.2, 0.02)      # sun height (sin elevation): night below the first, full Preetham day above the second
+GROUND_DIM = 0.3
+BELOW_FADE = 0.1
+DISC_EDGE = 0.25
+
+
+def disc_chords(size_deg: float) -> tuple[float, float]:
+    """Chord lengths |v − s| where the disc's soft edge starts and ends."""
+    r = math.radians(size_deg)
+    return 2.0 * math.sin(0.5 * r * (1.0 - DISC_EDGE)), 2.0 * math.sin(0.5 * r)
 
 
 def sky_defines() -> dict:
     """The constants of the float64 reference, handed to the GLSL as defines (one source of truth)."""
-    return {"SKY_COS_FLOOR": repr(COS_FLOOR), "DAY_LO": repr(ref.DAY_FADE[0]), "DAY_HI": repr(ref.DAY_FADE[1]),
-            "GROUND_DIM": repr(ref.GROUND_DIM), "BELOW_FADE": repr(ref.BELOW_FADE),
+    return {"SKY_COS_FLOOR": repr(COS_FLOOR), "DAY_LO": repr(DAY_FADE[0]), "DAY_HI": repr(DAY_FADE[1]),
+            "GROUND_DIM": repr(GROUND_DIM), "BELOW_FADE": repr(BELOW_FADE),
             "STAR_GRID": stars.STAR_GRID, "STAR_KEY_A": f"{stars.STAR_KEY[0]}u", "STAR_KEY_B": f"{stars.STAR_KEY[1]}u",
             "STAR_SIGMA": repr(stars.STAR_SIGMA), "STAR_SIGMA_MAX": repr(stars.STAR_SIGMA_MAX),
             "STAR_CUT_LO": repr(stars.STAR_CUT[0]), "STAR_CUT_HI": repr(stars.STAR_CUT[1]),
@@ -29,23 +40,23 @@ def set_view_basis(program, camera, aspect: float) -> None:
     program["view_basis"].write(gl_matrix3(view_basis(camera, aspect)))
 
 
-def set_sky_uniforms(program, params: SkyParams, sun_dir, sun_color, time: float = 0.0,
+def set_sky_uniforms(program, settings: SkySettings, sun_dir, sun_color, time: float = 0.0,
                      pixel_angle: float = 0.0) -> None:
     """Write every uniform of ``sky/sky.glsl`` (``sun_dir`` is normalised here)."""
     s = unit_vectors(sun_dir, "sun_dir").reshape(3)
     values = {"sky_sun_dir": tuple(s), "sky_sun_color": tuple(float(c) for c in sun_color),
-              "turbidity": params.turbidity, "sky_scale": params.scale,
-              "sun_chords": ref.disc_chords(params.sun_size_deg), "sun_gain": params.sun_gain,
-              "night_color": params.night,
-              "star_threshold": stars.star_threshold(params.star_density) if params.stars else 0,
-              "star_brightness": params.star_brightness, "twinkle": params.twinkle,
+              "turbidity": settings.turbidity, "sky_scale": settings.scale,
+              "sun_chords": disc_chords(settings.sun_size_deg), "sun_gain": settings.sun_gain,
+              "night_color": settings.night,
+              "star_threshold": stars.star_threshold(settings.star_density) if settings.stars else 0,
+              "star_brightness": settings.star_brightness, "twinkle": settings.twinkle,
               "sky_time": float(time) % stars.TWINKLE_PERIOD, "pixel_angle": float(pixel_angle)}
     for name, value in values.items():
         if name in program:
             program[name].value = value
 
 
-def evaluate_sky(gpu, view_dirs, sun_dir, sun_color, params: SkyParams | None = None, time: float = 0.0,
+def evaluate_sky(gpu, view_dirs, sun_dir, sun_color, settings: SkySettings | None = None, time: float = 0.0,
                  pixel_angle: float = 0.0) -> np.ndarray:
     """(n, 3) float32 sky colours computed on the GPU for ``view_dirs`` (n, 3): what
     :func:`atmos.plugins.sky.reference.sky_color` computes in float64. ``gpu``: a GpuContext."""
@@ -54,7 +65,7 @@ def evaluate_sky(gpu, view_dirs, sun_dir, sun_color, params: SkyParams | None = 
     if n == 0:
         return np.zeros((0, 3), np.float32)
     prog = gpu.program(compute_shader="sky/eval.comp", defines=sky_defines())
-    set_sky_uniforms(prog, params or SkyParams(), sun_dir, sun_color, time, pixel_angle)
+    set_sky_uniforms(prog, settings or SkySettings(), sun_dir, sun_color, time, pixel_angle)
     prog["count"].value = n
     data = np.zeros((n, 4), np.float32)
     data[:, :3] = dirs

@@ -2,7 +2,7 @@
 on two circles) scrolling at different speeds, fbm weights 1/2..1/16, emptiness/sharpness remap, four
 light-march samples toward the sun packed in RGBA. A scene without :class:`SkyLayerPlugin` runs none of it.
 """
-from atmos.plugins.sky_layer.params import SkyLayerParams
+from atmos.plugins.sky_layer.settings import SkyLayerSettings
 from atmos.plugins.sky_layer.plugin import SkyLayerPass, SkyLayerPlugin
 
-__all__ = ["SkyLayerParams", "SkyLayerPlugin", "SkyLayerPass"]
+__all__ = ["SkyLayerSettings", "SkyLayerPlugin", "SkyLayerPass"]

@@ -6,8 +6,21 @@ import math
 import moderngl
 import numpy as np
 
-from atmos.plugins.sky_layer.params import SkyLayerParams
-from atmos.plugins.sky_layer.reference import light_shift, octave_key
+from atmos.plugins.sky_layer.settings import SkyLayerSettings
+from atmos.value_noise import key
+
+
+def octave_key(seed: int, octave: int) -> int:
+    """The lattice key of octave ``octave`` (a different noise per octave)."""
+    return int(key((seed + 0x9E3779B1 * octave) % 2**32))
+
+
+def light_shift(sun_dir, light_step: float) -> np.ndarray:
+    """uv step toward the sun: light_step along the sun's horizontal direction (0 with the sun overhead)."""
+    xz = np.array([sun_dir[0], sun_dir[2]], np.float64)
+    n = np.linalg.norm(xz)
+    return xz / n * light_step if n > 1e-6 else np.zeros(2)
+
 
 OCTAVES = 4
 
@@ -23,24 +36,24 @@ class OctaveTextures:
         self.baked_for: tuple | None = None    # (texture settings, light shift) of the last bake
         self._program = None
 
-    def bake(self, params: SkyLayerParams, sun_dir) -> None:
-        """Fill the textures for ``params`` and the sun direction (re-allocating on a size change)."""
+    def bake(self, settings: SkyLayerSettings, sun_dir) -> None:
+        """Fill the textures for ``settings`` and the sun direction (re-allocating on a size change)."""
         ctx = self.gpu.ctx
         if self._program is None:
             self._program = self.gpu.program(compute_shader="sky_layer/octave.comp")
-        if not self.textures or self.textures[0].size != (params.size, params.size):
+        if not self.textures or self.textures[0].size != (settings.size, settings.size):
             self.release()
             for _ in range(OCTAVES):
-                tex = self.gpu.track(ctx.texture((params.size, params.size), 4, dtype="f4"))
+                tex = self.gpu.track(ctx.texture((settings.size, settings.size), 4, dtype="f4"))
                 tex.repeat_x = tex.repeat_y = True
                 self.textures.append(tex)
-        shift = light_shift(sun_dir, params.light_step)
+        shift = light_shift(sun_dir, settings.light_step)
         prog = self._program
         prog["light_shift"].value = tuple(shift)
-        groups = math.ceil(params.size / 8)
+        groups = math.ceil(settings.size / 8)
         for k, tex in enumerate(self.textures):
-            prog["frequency"].value = float(params.base_frequency * 2 ** k)
-            prog["key"].value = octave_key(params.seed, k)
+            prog["frequency"].value = float(settings.base_frequency * 2 ** k)
+            prog["key"].value = octave_key(settings.seed, k)
             tex.bind_to_image(0, read=False, write=True)
             prog.run(groups, groups)
         ctx.memory_barrier()
@@ -48,15 +61,15 @@ class OctaveTextures:
             tex.build_mipmaps()
             tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
         self.bakes += 1
-        self.baked_for = (params.texture_key(), tuple(shift))
+        self.baked_for = (settings.texture_key(), tuple(shift))
 
-    def needs_bake(self, params: SkyLayerParams, sun_dir, tolerance: float) -> bool:
+    def needs_bake(self, settings: SkyLayerSettings, sun_dir, tolerance: float) -> bool:
         """True before the first bake, after a texture setting changed, or once the light shift moved by
         more than ``tolerance`` of a light step (the sun turned)."""
-        if self.baked_for is None or self.baked_for[0] != params.texture_key():
+        if self.baked_for is None or self.baked_for[0] != settings.texture_key():
             return True
-        moved = np.linalg.norm(light_shift(sun_dir, params.light_step) - self.baked_for[1])
-        return moved > tolerance * params.light_step
+        moved = np.linalg.norm(light_shift(sun_dir, settings.light_step) - self.baked_for[1])
+        return moved > tolerance * settings.light_step
 
     def download(self, k: int) -> np.ndarray:
         """Octave ``k`` as float64 (size, size, 4) indexed [x, y, channel]."""

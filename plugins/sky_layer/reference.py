@@ -3,15 +3,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.value_noise import key, value_noise
+from atmos.plugins.sky_layer.octaves import light_shift, octave_key  # noqa: F401  (the GPU side's own)
+from atmos.value_noise import value_noise
 
 WEIGHTS = np.array([0.5, 0.25, 0.125, 0.0625])
 RAY = np.array([0.0, 0.2, 0.4, 0.6])
-
-
-def octave_key(seed: int, octave: int) -> int:
-    """The lattice key of octave ``octave`` (a different noise per octave)."""
-    return int(key((seed + 0x9E3779B1 * octave) % 2**32))
 
 
 def tile_noise(uv: np.ndarray, frequency: float, k) -> np.ndarray:
@@ -28,13 +24,6 @@ def octave_texture(size: int, frequency: float, k, light_shift) -> np.ndarray:
     uv = np.stack(np.meshgrid(i, i, indexing="ij"), axis=-1)
     shift = np.asarray(light_shift, np.float64)
     return np.stack([tile_noise(uv + c * shift, frequency, k) for c in range(4)], axis=-1)
-
-
-def light_shift(sun_dir, light_step: float) -> np.ndarray:
-    """uv step toward the sun: light_step along the sun's horizontal direction (0 with the sun overhead)."""
-    xz = np.array([sun_dir[0], sun_dir[2]], np.float64)
-    n = np.linalg.norm(xz)
-    return xz / n * light_step if n > 1e-6 else np.zeros(2)
 
 
 def fbm(samples) -> np.ndarray:

@@ -1,6 +1,9 @@
 """TerrainPlugin and its pass: draws the heightfield into ``color`` and ``depth``."""
 from __future__ import annotations
 
+from dataclasses import dataclass
+
+from atmos.checks import CheckedSettings, check_int, check_num
 from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.lighting import set_scene_uniforms
 from atmos.plugin import Plugin
@@ -8,51 +11,83 @@ from atmos.plugins.terrain.heightfield import heightfield, triangle_count
 from atmos.render_core import COLOR, DEPTH
 
 
+@dataclass(frozen=True)
+class TerrainSettings(CheckedSettings):
+    """A ``size`` metre square of ``cells``² quads (2 triangles each; 71 → 10,082) with ``relief``
+    metre hills. All live: a change re-makes the mesh on the next frame."""
+    size: float = 256.0
+    cells: int = 71
+    relief: float = 30.0
+
+    def __post_init__(self):
+        o = "TerrainSettings"
+        self.store(dict(size=check_num(o, "size", self.size, 0.0, lo_open=True),
+                        cells=check_int(o, "cells", self.cells, 1, 1024),
+                        relief=check_num(o, "relief", self.relief)))
+
+    def mesh_key(self) -> tuple:
+        return self.size, self.cells, self.relief
+
+
 class TerrainPass(RenderPass):
     name = "terrain"
+    phase = "opaque"
 
     def __init__(self, plugin: "TerrainPlugin"):
         self.plugin = plugin
         self.program = self.vao = self.vbo = self.ibo = None
+        self.mesh_key = None
 
     def setup(self, builder: PassBuilder) -> None:
         builder.write(COLOR)
+        builder.read(DEPTH)                 # depth-tested
         builder.write(DEPTH)
 
     def prepare(self, gpu) -> None:
-        p = self.plugin
         self.program = gpu.program(vertex_shader="terrain/terrain.vert", fragment_shader="terrain/terrain.frag")
-        vertices, indices = heightfield(p.size, p.cells, p.relief)
+        self.make_mesh(gpu)
+
+    def make_mesh(self, gpu) -> None:
+        """(Re)make the mesh for the plugin's current settings."""
+        self._release_mesh()
+        s = self.plugin.settings
+        vertices, indices = heightfield(s.size, s.cells, s.relief)
+        self.mesh_key = s.mesh_key()
         self.vbo = gpu.track(gpu.ctx.buffer(vertices.tobytes()))
         self.ibo = gpu.track(gpu.ctx.buffer(indices.tobytes()))
         self.vao = gpu.track(gpu.ctx.vertex_array(self.program, [(self.vbo, "3f 3f", "in_position", "in_normal")],
                                                   index_buffer=self.ibo, index_element_size=4))
 
     def execute(self, frame: PassContext) -> None:
-        app, gpu = frame.data["app"], frame.gpu
+        gpu = frame.gpu
         frame.framebuffer(color=[COLOR], depth=DEPTH).use()
         gpu.ctx.enable(gpu.ctx.DEPTH_TEST)
-        set_scene_uniforms(self.program, app, gpu.size[0] / gpu.size[1])
-        self.program["relief"].value = self.plugin.relief
+        set_scene_uniforms(self.program, frame.view)
+        if self.plugin.settings.mesh_key() != self.mesh_key:
+            self.make_mesh(gpu)
+        self.program["relief"].value = self.plugin.settings.relief
         self.vao.render(gpu.ctx.TRIANGLES)
 
-    def release(self) -> None:
+    def _release_mesh(self) -> None:
         for obj in (self.vao, self.vbo, self.ibo):
             if obj is not None:
                 obj.release()
         self.vao = self.vbo = self.ibo = None
+        self.mesh_key = None
+
+    def release(self) -> None:
+        self._release_mesh()
 
 
 class TerrainPlugin(Plugin):
-    """A ``size`` metre square of ``cells``² quads (2 triangles each; 71 → 10,082) with ``relief`` metre hills."""
+    """The heightfield terrain: ``TerrainPlugin(settings=None, **fields)`` with :class:`TerrainSettings`;
+    ``configure(**changes)`` changes any of them live (the mesh is re-made on the next frame)."""
 
-    def __init__(self, size: float = 256.0, cells: int = 71, relief: float = 30.0):
-        heightfield(size, cells, relief)  # validates before anything is kept
-        self.size, self.cells, self.relief = float(size), cells, float(relief)
+    settings_class = TerrainSettings
 
     @property
     def triangles(self) -> int:
-        return triangle_count(self.cells)
+        return triangle_count(self.settings.cells)
 
     def build(self, app) -> None:
         app.graph.add_pass(TerrainPass(self))

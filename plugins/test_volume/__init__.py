@@ -5,6 +5,6 @@ slices handed out by the frame scheduler into the C set of a triple-buffered tex
 ray-march pass draws A and B interpolated by C's progress. It is the template an expensive effect
 follows (the cloud simulation does the same with its stage chain).
 """
-from atmos.plugins.test_volume.plugin import TestVolumePlugin, VolumeBox
+from atmos.plugins.test_volume.plugin import TestVolumePlugin, TestVolumeSettings, VolumeBox
 
-__all__ = ["TestVolumePlugin", "VolumeBox"]
+__all__ = ["TestVolumePlugin", "TestVolumeSettings", "VolumeBox"]

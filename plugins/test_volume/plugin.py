@@ -4,54 +4,84 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from atmos.checks import CheckedSettings, check_int, check_num, check_shape, check_vec
 from atmos.frames import SlicedJob, SliceStage, TripleSet
 from atmos.graph import FullscreenPass, PassContext, TextureDesc
 from atmos.lighting import set_scene_uniforms
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
 
+TEST_VOLUME_SETS = "test_volume_sets"     # the imported (A, B, t) of the test volume's texture sets
 
-@dataclass(slots=True)
-class VolumeBox:
+
+@dataclass(frozen=True)
+class VolumeBox(CheckedSettings):
     """Where the volume sits in the world: centre and full size in metres (y is up)."""
     center: tuple = (0.0, 7.0, 0.0)
     size: tuple = (28.0, 8.0, 28.0)
 
+    def __post_init__(self):
+        self.store(dict(center=check_vec("VolumeBox", "center", self.center, 3),
+                        size=check_vec("VolumeBox", "size", self.size, 3, "positive")))
+
+
+@dataclass(frozen=True)
+class TestVolumeSettings(CheckedSettings):
+    """``resolution`` cells (x, y, z) and ``slices`` slices per step (a divisor of z) size the texture
+    sets and the sliced job: FIXED (``configure`` refuses them). Live: ``step_seconds`` animation
+    time per step, ``box`` (a :class:`VolumeBox`) where it is drawn, ``march_steps`` (1..1024, a
+    shader define: the pass fetches that program variant on the next frame)."""
+    __test__ = False  # not a pytest test class despite the name
+    FIXED = ("resolution", "slices")
+
+    resolution: tuple = (64, 32, 64)
+    slices: int = 8
+    step_seconds: float = 0.25
+    box: VolumeBox = VolumeBox()
+    march_steps: int = 48
+
+    def __post_init__(self):
+        o = "TestVolumeSettings"
+        resolution = check_shape(self.resolution, f"{o}.resolution")
+        slices = check_int(o, "slices", self.slices, 1, resolution[2])
+        if resolution[2] % slices:
+            raise ValueError(f"{o}.slices must divide the z resolution {resolution[2]}, got {self.slices!r}")
+        if not isinstance(self.box, VolumeBox):
+            raise ValueError(f"{o}.box must be a VolumeBox, got {self.box!r}")
+        self.store(dict(resolution=resolution, slices=slices,
+                        step_seconds=check_num(o, "step_seconds", self.step_seconds, 0.0, lo_open=True),
+                        march_steps=check_int(o, "march_steps", self.march_steps, 1, 1024)))
+
 
 class TestVolumePlugin(Plugin):
-    """``resolution`` cells (x, y, z); ``slices`` slices per step; ``step_seconds`` animation time per step."""
+    """``TestVolumePlugin(settings=None, **fields)`` with :class:`TestVolumeSettings`;
+    ``configure(**changes)`` changes the live ones on the next frame."""
     __test__ = False  # not a pytest test class despite the name
+    settings_class = TestVolumeSettings
 
-    def __init__(self, resolution=(64, 32, 64), slices: int = 8, step_seconds: float = 0.25,
-                 box: VolumeBox | None = None, march_steps: int = 48):
-        nz = resolution[2]
-        if slices < 1 or nz % slices:
-            raise ValueError(f"slices must be a positive divisor of the z resolution {nz} (got {slices})")
-        self.resolution = tuple(int(n) for n in resolution)
-        self.slices = slices
-        self.step_seconds = step_seconds
-        self.box = box or VolumeBox()
-        self.march_steps = march_steps
+    def __init__(self, settings: TestVolumeSettings | None = None, **fields):
+        super().__init__(settings, **fields)
         self.triple = self.job = None
         self._time = 0.0
 
     def build(self, app) -> None:
-        app.insert_resource(self.box)
-        desc = TextureDesc(self.resolution, components=1, dtype="f2")
+        s = self.settings
+        desc = TextureDesc(s.resolution, components=1, dtype="f2")
         self.triple = TripleSet(app.gpu, {"density": desc})
         self.program = app.gpu.program(compute_shader="test_volume/density.comp")
-        self.job = SlicedJob("test_volume", [SliceStage("density", self.slices, self._fill_slice)],
+        self.job = SlicedJob("test_volume", [SliceStage("density", s.slices, self._fill_slice)],
                              self.triple, begin=self._begin_step)
-        self.job.prime()
+        app.add_system(lambda app: self.job.prime(), "startup", label="test_volume_prime")
         app.frames.add(self.job)
+        app.graph.import_resource(TEST_VOLUME_SETS, self.job.view)
         app.graph.add_pass(TestVolumePass(self))
 
     def _begin_step(self, step: int) -> None:
-        self._time = step * self.step_seconds
+        self._time = step * self.settings.step_seconds
 
     def _fill_slice(self, index: int, job) -> None:
-        nx, ny, nz = self.resolution
-        layers = nz // self.slices
+        nx, ny, nz = self.settings.resolution
+        layers = nz // self.settings.slices
         job.target["density"].bind_to_image(0, read=False, write=True)
         self.program["time"].value = self._time
         self.program["z0"].value = index * layers
@@ -60,7 +90,8 @@ class TestVolumePlugin(Plugin):
 
     def cleanup(self, app) -> None:
         if self.triple is not None:
-            app.frames.remove(self.job)
+            if self.job in app.frames:              # a scene may have paused the job
+                app.frames.remove(self.job)
             self.triple.release()
             self.triple = None
 
@@ -69,23 +100,24 @@ class TestVolumePass(FullscreenPass):
     """Ray-marches mix(A, B, t) inside the box, occluded by scene depth, blended over the colour
     premultiplied (:meth:`PassContext.blend_over`): it covers the sky like a cloud."""
     name = "test_volume"
+    phase = "translucent"
     fragment = "test_volume/march.frag"
-    reads = (DEPTH,)
+    reads = (COLOR, DEPTH, TEST_VOLUME_SETS)
 
     def defines(self) -> dict:
-        return {"MARCH_STEPS": self.plugin.march_steps}
+        return {"MARCH_STEPS": self.plugin.settings.march_steps}
 
     def execute(self, frame: PassContext) -> None:
-        app, gpu, p = frame.data["app"], frame.gpu, self.program
-        a, b, t = self.plugin.job.view()
+        p = self.program
+        a, b, t = frame.resource(TEST_VOLUME_SETS)
         frame.framebuffer(color=[COLOR]).use()
         frame.blend_over()
         a["density"].use(0)
         b["density"].use(1)
-        frame.texture(DEPTH).use(2)
-        set_scene_uniforms(p, app, gpu.size[0] / gpu.size[1])
+        frame.resource(DEPTH).use(2)
+        set_scene_uniforms(p, frame.view)
         p["t"].value = t
-        box = self.plugin.box
+        box = self.plugin.settings.box
         p["box_min"].value = tuple(c - s / 2 for c, s in zip(box.center, box.size))
         p["box_max"].value = tuple(c + s / 2 for c, s in zip(box.center, box.size))
         frame.fullscreen(p)

@@ -2,7 +2,7 @@
 Beer-Lambert absorption and early exit, an inner light march toward the sun, ambient + scattered light.
 A scene that does not add :class:`VolumetricFogPlugin` runs and compiles none of it.
 """
-from atmos.plugins.volumetric_fog.params import FogParams
+from atmos.plugins.volumetric_fog.settings import VolumetricFogSettings
 from atmos.plugins.volumetric_fog.plugin import VolumetricFogPlugin, VolumetricFogPass
 
-__all__ = ["FogParams", "VolumetricFogPlugin", "VolumetricFogPass"]
+__all__ = ["VolumetricFogSettings", "VolumetricFogPlugin", "VolumetricFogPass"]

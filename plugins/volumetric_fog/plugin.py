@@ -3,31 +3,30 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.camera import Camera, set_camera_uniforms
-from atmos.checks import plugin_params
+from atmos.camera import set_camera_uniforms
 from atmos.graph import FullscreenPass, PassContext
-from atmos.lighting import Sun, scene_sun, sun_and_day
+from atmos.lighting import Sun, sun_and_day
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
-from atmos.plugins.volumetric_fog.params import FogParams
+from atmos.plugins.volumetric_fog.settings import VolumetricFogSettings
 
 
-def sun_terms(sun: Sun, params: FogParams):
+def sun_terms(sun: Sun, settings: VolumetricFogSettings):
     """(unit direction toward the sun, sun_light, ambient_light): the sun fades out below the horizon."""
     s, day = sun_and_day(sun)
-    sun_light = np.asarray(sun.color, np.float64) * params.scattering * day
-    ambient_light = np.asarray(params.ambient) * (0.1 + 0.9 * day)
+    sun_light = np.asarray(sun.color, np.float64) * settings.scattering * day
+    ambient_light = np.asarray(settings.ambient) * (0.1 + 0.9 * day)
     return s, sun_light, ambient_light
 
 
-def set_medium_uniforms(program, params: FogParams, sun: Sun, time: float) -> None:
+def set_medium_uniforms(program, settings: VolumetricFogSettings, sun: Sun, time: float) -> None:
     """Write every uniform of ``volumetric_fog/medium.glsl``."""
-    s, sun_light, ambient_light = sun_terms(sun, params)
-    values = {"center": params.center, "scale": params.scale, "bias": params.bias, "falloff": params.falloff,
-              "frequency": params.frequency, "wind": params.wind, "time": float(time),
-              "octaves": params.octaves, "seed": params.seed, "absorption": params.absorption,
-              "steps": params.steps, "light_steps": params.light_steps, "light_step": params.light_step,
-              "max_distance": params.max_distance, "sun_dir": tuple(s), "sun_light": tuple(sun_light),
+    s, sun_light, ambient_light = sun_terms(sun, settings)
+    values = {"center": settings.center, "scale": settings.scale, "bias": settings.bias, "falloff": settings.falloff,
+              "frequency": settings.frequency, "wind": settings.wind, "time": float(time),
+              "octaves": settings.octaves, "seed": settings.seed, "absorption": settings.absorption,
+              "steps": settings.steps, "light_steps": settings.light_steps, "light_step": settings.light_step,
+              "max_distance": settings.max_distance, "sun_dir": tuple(s), "sun_light": tuple(sun_light),
               "ambient_light": tuple(ambient_light)}
     for name, value in values.items():
         if name in program:          # the compiler drops uniforms it proves unused
@@ -38,37 +37,31 @@ class VolumetricFogPass(FullscreenPass):
     """Reads ``depth``, blends (in-scattered light, transmittance) over ``color`` with ONE, SRC_ALPHA;
     alpha (the sky occlusion of :mod:`atmos.render_core`) kept: the medium tints the sky, it does not hide it."""
     name = "volumetric_fog"
+    phase = "media"
     fragment = "volumetric_fog/fog.frag"
-    reads = (DEPTH,)
+    reads = (COLOR, DEPTH)
 
     def execute(self, frame: PassContext) -> None:
-        app, gpu, p = frame.data["app"], frame.gpu, self.program
+        view, p = frame.view, self.program
         frame.framebuffer(color=[COLOR]).use()
         frame.blend_transmittance()
-        frame.texture(DEPTH).use(0)
-        set_camera_uniforms(p, app.resource(Camera), gpu.size[0] / gpu.size[1])
-        set_medium_uniforms(p, self.plugin.params, scene_sun(app), self.plugin.time(app))
+        frame.resource(DEPTH).use(0)
+        set_camera_uniforms(p, view.camera, view.aspect)
+        set_medium_uniforms(p, self.plugin.settings, view.sun, self.plugin.time(view))
         frame.fullscreen(p)
 
 
 class VolumetricFogPlugin(Plugin):
-    """Ray-marched FBM fog; ``FogParams`` fields as keyword arguments (or ``params=``).
-
-    ``configure(**changes)`` changes settings at run time: all are checked before any is applied.
+    """Ray-marched FBM fog: ``VolumetricFogPlugin(settings=None, **fields)`` with
+    :class:`VolumetricFogSettings`; ``configure(**changes)`` changes any of them live (next frame).
     The noise drifts with the App's clock (``clock.frame_time``) unless ``animate=False``.
     """
 
-    def __init__(self, params: FogParams | None = None, animate: bool = True, **settings):
-        self.params = plugin_params("VolumetricFogPlugin", FogParams, params, settings)
-        self.animate = bool(animate)
+    settings_class = VolumetricFogSettings
 
-    def configure(self, **changes) -> FogParams:
-        """Replace settings at once (checked together; on error nothing changes); returns the new params."""
-        self.params = self.params.replace(**changes)
-        return self.params
-
-    def time(self, app) -> float:
-        return float(app.clock.frame_time) if self.animate else 0.0
+    def time(self, view) -> float:
+        """Seconds the noise has drifted for: the view's frame time (0 unless ``animate``)."""
+        return float(view.time) if self.settings.animate else 0.0
 
     def build(self, app) -> None:
         app.graph.add_pass(VolumetricFogPass(self))

@@ -4,27 +4,27 @@ from __future__ import annotations
 import numpy as np
 
 from atmos.value_noise import fbm
-from atmos.plugins.volumetric_fog.params import FogParams
+from atmos.plugins.volumetric_fog.settings import VolumetricFogSettings
 
 
-def density(points: np.ndarray, params: FogParams, time: float = 0.0) -> np.ndarray:
+def density(points: np.ndarray, settings: VolumetricFogSettings, time: float = 0.0) -> np.ndarray:
     """bias − falloff·‖(p − center)/scale‖ + fbm(frequency·(p − center − wind·time)); points (..., 3)."""
-    q = np.asarray(points, np.float64) - params.center
-    envelope = params.bias - params.falloff * np.linalg.norm(q / params.scale, axis=-1)
-    return envelope + fbm(params.frequency * (q - np.multiply(params.wind, time)), params.octaves, params.seed)
+    q = np.asarray(points, np.float64) - settings.center
+    envelope = settings.bias - settings.falloff * np.linalg.norm(q / settings.scale, axis=-1)
+    return envelope + fbm(settings.frequency * (q - np.multiply(settings.wind, time)), settings.octaves, settings.seed)
 
 
-def march_range(origins, dirs, limits, params: FogParams):
+def march_range(origins, dirs, limits, settings: VolumetricFogSettings):
     """(enter, leave) per ray: the bounding ellipsoid of positive density, clipped to [0, limit]."""
-    limits = np.minimum(limits, params.max_distance)
+    limits = np.minimum(limits, settings.max_distance)
     n = len(origins)
-    if params.falloff <= 0:
+    if settings.falloff <= 0:
         return np.zeros(n), limits
-    radius = (params.bias + 1.0 - 2.0 ** -params.octaves) / params.falloff
+    radius = (settings.bias + 1.0 - 2.0 ** -settings.octaves) / settings.falloff
     if radius <= 0:
         return np.zeros(n), -np.ones(n)
-    o = (origins - params.center) / params.scale
-    d = dirs / params.scale
+    o = (origins - settings.center) / settings.scale
+    d = dirs / settings.scale
     a, b = (d * d).sum(-1), (o * d).sum(-1)
     c = (o * o).sum(-1) - radius * radius
     disc = b * b - a * c
@@ -34,7 +34,7 @@ def march_range(origins, dirs, limits, params: FogParams):
     return np.where(disc > 0, enter, 0.0), np.where(disc > 0, leave, -1.0)
 
 
-def march(origins, dirs, limits, params: FogParams, sun_dir, sun_light, ambient_light, time: float = 0.0):
+def march(origins, dirs, limits, settings: VolumetricFogSettings, sun_dir, sun_light, ambient_light, time: float = 0.0):
     """(N, 4): in-scattered light rgb and transmittance of N rays, exactly the GLSL march in float64.
 
     ``dirs`` are normalized here; ``sun_dir`` is the unit vector toward the sun.
@@ -45,27 +45,27 @@ def march(origins, dirs, limits, params: FogParams, sun_dir, sun_light, ambient_
     limits = np.broadcast_to(np.asarray(limits, np.float64), (len(origins),))
     sun_dir = np.asarray(sun_dir, np.float64)
     sun_light, ambient_light = np.asarray(sun_light, np.float64), np.asarray(ambient_light, np.float64)
-    enter, leave = march_range(origins, dirs, limits, params)
-    dt = (leave - enter) / params.steps
+    enter, leave = march_range(origins, dirs, limits, settings)
+    dt = (leave - enter) / settings.steps
     light = np.zeros((len(origins), 3))
     trans = np.ones(len(origins))
     active = leave > enter
-    sigma = params.absorption
-    for i in range(params.steps):
+    sigma = settings.absorption
+    for i in range(settings.steps):
         if not active.any():
             break
         idx = np.flatnonzero(active)
         p = origins[idx] + dirs[idx] * (enter[idx] + (i + 0.5) * dt[idx])[:, None]
-        d = density(p, params, time)
+        d = density(p, settings, time)
         inside = d > 0
         idx, p, d = idx[inside], p[inside], d[inside]
         step_t = np.exp(-sigma * d * dt[idx])
         tl = np.ones(len(idx))
         lit = np.ones(len(idx), bool)       # still marching toward the sun
-        for j in range(params.light_steps):
-            dl = density(p + sun_dir * (j * params.light_step), params, time)
+        for j in range(settings.light_steps):
+            dl = density(p + sun_dir * (j * settings.light_step), settings, time)
             hit = lit & (dl > 0)
-            tl = np.where(hit, tl * np.exp(-sigma * np.maximum(dl, 0) * params.light_step), tl)
+            tl = np.where(hit, tl * np.exp(-sigma * np.maximum(dl, 0) * settings.light_step), tl)
             lit &= ~(hit & (tl <= 0.01))
         light[idx] += (trans[idx] * (1 - step_t))[:, None] * (ambient_light + sun_light * tl[:, None])
         trans[idx] *= step_t

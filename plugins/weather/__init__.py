@@ -1,6 +1,6 @@
 """Weather ellipsoids and the region volume (thesis sec. 4.3.2-4.3.3).
 
-* :class:`WeatherParams` — the parameters of sec. 4.3.3.4, validated.
+* :class:`WeatherSettings` — the parameters of sec. 4.3.3.4, validated.
 * :class:`Ellipsoid` — the ECS component of one weather ellipsoid; :class:`VolumeOrigin` — where
   the simulation volume (the viewer) is.
 * :func:`step_weather` — the five rules of sec. 4.3.3.5 for one step.
@@ -10,13 +10,13 @@
 * :class:`WeatherPlugin` — the rules as the App ``simulate`` system ``"weather"``.
 """
 from atmos.plugins.weather import reference
-from atmos.plugins.weather.components import Ellipsoid, VolumeOrigin
-from atmos.plugins.weather.params import MAX_CLOUD_DENSITY, WeatherParams
-from atmos.plugins.weather.reference import COLUMNS, probabilities, region_volume
+from atmos.plugins.weather.components import COLUMNS, Ellipsoid, VolumeOrigin
+from atmos.plugins.weather.settings import MAX_CLOUD_DENSITY, WeatherSettings
+from atmos.plugins.weather.reference import probabilities, region_volume
 from atmos.plugins.weather.region import RegionVolume
 from atmos.plugins.weather.system import (StepReport, WeatherPlugin, ellipsoid_array, step_weather,
                                           wind_field_at)
 
 __all__ = ["COLUMNS", "Ellipsoid", "MAX_CLOUD_DENSITY", "RegionVolume", "StepReport", "VolumeOrigin",
-           "WeatherParams", "WeatherPlugin", "ellipsoid_array", "probabilities", "reference",
+           "WeatherSettings", "WeatherPlugin", "ellipsoid_array", "probabilities", "reference",
            "region_volume", "step_weather", "wind_field_at"]

@@ -8,6 +8,24 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
+#: Columns of an ellipsoid array handed to :class:`RegionVolume.render` and :func:`region_volume`.
+COLUMNS = ("x", "y", "z", "yaw", "rx", "ry", "rz", "pad")
+NCOLS = len(COLUMNS)
+
+
+def check_ellipsoid_array(ellipsoids) -> np.ndarray:
+    """The array as float32 (n, 8); ValueError naming what is allowed."""
+    a = np.asarray(ellipsoids, dtype=np.float32)
+    if a.size == 0:
+        return np.zeros((0, NCOLS), np.float32)
+    if a.ndim != 2 or a.shape[1] != NCOLS:
+        raise ValueError(f"ellipsoids must be an (n, {NCOLS}) array with columns {COLUMNS}; got shape {a.shape}")
+    if not np.isfinite(a).all():
+        raise ValueError("ellipsoids must hold finite numbers; the array holds NaN or inf")
+    return np.ascontiguousarray(a)
+
 
 @dataclass(slots=True)
 class Ellipsoid:

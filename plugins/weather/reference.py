@@ -16,22 +16,7 @@ origin, yaw (radians, around y), the radii already multiplied by the shrink scal
 from __future__ import annotations
 
 import numpy as np
-
-#: Columns of an ellipsoid array handed to :class:`RegionVolume.render` and :func:`region_volume`.
-COLUMNS = ("x", "y", "z", "yaw", "rx", "ry", "rz", "pad")
-NCOLS = len(COLUMNS)
-
-
-def check_ellipsoid_array(ellipsoids) -> np.ndarray:
-    """The array as float32 (n, 8); ValueError naming what is allowed."""
-    a = np.asarray(ellipsoids, dtype=np.float32)
-    if a.size == 0:
-        return np.zeros((0, NCOLS), np.float32)
-    if a.ndim != 2 or a.shape[1] != NCOLS:
-        raise ValueError(f"ellipsoids must be an (n, {NCOLS}) array with columns {COLUMNS}; got shape {a.shape}")
-    if not np.isfinite(a).all():
-        raise ValueError("ellipsoids must hold finite numbers; the array holds NaN or inf")
-    return np.ascontiguousarray(a)
+from atmos.plugins.weather.components import COLUMNS, NCOLS, check_ellipsoid_array
 
 
 def region_volume(ellipsoids, shape) -> np.ndarray:
@@ -67,7 +52,7 @@ def probabilities(region, hum_scale=0.1, act_scale=0.001, ext_scale=0.1, vanish_
     ``p_hum = hum_scale·R``, ``p_act = act_scale·R``, ``p_ext = ext_scale·(1 − R)``, and
     ``p_ext = 1`` where ``R <= vanish_threshold``: cells outside every ellipsoid lose their cloud
     (the thesis's "remove cloud particles outside of the defined ellipsoids").
-    Pass a :class:`WeatherParams` as ``hum_scale`` to take all four scales from it.
+    Pass a :class:`WeatherSettings` as ``hum_scale`` to take all four scales from it.
     """
     if hasattr(hum_scale, "hum_scale"):
         p = hum_scale

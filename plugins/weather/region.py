@@ -20,28 +20,20 @@ import math
 import moderngl
 import numpy as np
 
-from atmos.gpu.shaders import build_program
-from atmos.plugins.weather.reference import check_ellipsoid_array
+from atmos.gpu.context import GpuContext, require_gpu
+from atmos.plugins.weather.components import check_ellipsoid_array
 
 CHUNK = 256
 _FORMATS = {"f4": ("r32f", "rgba32f", np.float32), "f2": ("r16f", "rgba16f", np.float16)}
 
 
 class RegionVolume:
-    """Region volume of ``shape = (nx, ny, nz)`` cells (y is height) on ``ctx_or_gpu``.
-
-    ``ctx_or_gpu`` is an :class:`atmos.gpu.GpuContext` (programs come from its cache) or a
-    ``moderngl.Context``; ``dtype`` is ``"f4"`` (r32f, default) or ``"f2"`` (r16f).
+    """Region volume of ``shape = (nx, ny, nz)`` cells (y is height) on the GpuContext ``gpu``
+    (programs come from its cache); ``dtype`` is ``"f4"`` (r32f, default) or ``"f2"`` (r16f).
     """
 
-    def __init__(self, ctx_or_gpu, shape, dtype: str = "f4"):
-        if isinstance(ctx_or_gpu, moderngl.Context):
-            self.ctx, self._gpu = ctx_or_gpu, None
-        elif isinstance(getattr(ctx_or_gpu, "ctx", None), moderngl.Context):
-            self.ctx, self._gpu = ctx_or_gpu.ctx, ctx_or_gpu
-        else:
-            raise ValueError(f"ctx_or_gpu must be a moderngl.Context or an atmos GpuContext, "
-                             f"got {type(ctx_or_gpu).__name__}")
+    def __init__(self, gpu: GpuContext, shape, dtype: str = "f4"):
+        self.gpu, self.ctx = require_gpu(gpu), gpu.ctx
         try:
             shape = tuple(shape)
         except TypeError:
@@ -60,7 +52,6 @@ class RegionVolume:
             raise ValueError(f"shape {self.shape} is too big for this GPU (at most {max_3d} cells per axis "
                              f"and {limit // 4} cells in all); use a smaller shape")
         fmt, prob_fmt, self._np_dtype = _FORMATS[dtype]
-        self._programs = []
         self._scatter = self._program("weather/region_scatter.comp", {"CHUNK": CHUNK})
         self._resolve = self._program("weather/region_resolve.comp", {"FORMAT": fmt})
         self._probs = self._program("weather/probabilities.comp", {"FORMAT": prob_fmt})
@@ -74,13 +65,12 @@ class RegionVolume:
         self.count = 0          # ellipsoids in the last render
         self.work_items = 0     # chunks dispatched in the last render
         self._released = False
-        if self._gpu is not None:
-            for obj in (self.texture, self._cells):
-                self._gpu.track(obj)
+        for obj in (self.texture, self._cells):
+            gpu.track(obj)
 
     # -- public --------------------------------------------------------------------------
     def render(self, ellipsoids) -> moderngl.Texture3D:
-        """Render an (n, 8) ellipsoid array (columns :data:`reference.COLUMNS`, volume-local cells)
+        """Render an (n, 8) ellipsoid array (columns :data:`.components.COLUMNS`, volume-local cells)
         into :attr:`texture`; every cell is written. Returns the texture."""
         self._check_alive()
         a = check_ellipsoid_array(ellipsoids)
@@ -117,19 +107,18 @@ class RegionVolume:
         data = np.frombuffer(self.texture.read(alignment=1), self._np_dtype)
         return np.ascontiguousarray(data.reshape(nz, ny, nx).transpose(2, 1, 0)).astype(np.float32)
 
-    def probabilities(self, params=None, *, hum_scale=0.1, act_scale=0.001, ext_scale=0.1,
+    def probabilities(self, settings=None, *, hum_scale=0.1, act_scale=0.001, ext_scale=0.1,
                       vanish_threshold=0.001) -> moderngl.Texture3D:
         """Fill :attr:`prob_texture` (rgba, same float format) with (p_hum, p_act, p_ext, 0) per cell
-        from the current region volume; ``params`` (a WeatherParams) overrides the scales."""
+        from the current region volume; ``settings`` (a WeatherSettings) overrides the scales."""
         self._check_alive()
-        if params is not None:
-            hum_scale, act_scale = params.hum_scale, params.act_scale
-            ext_scale, vanish_threshold = params.ext_scale, params.vanish_threshold
+        if settings is not None:
+            hum_scale, act_scale = settings.hum_scale, settings.act_scale
+            ext_scale, vanish_threshold = settings.ext_scale, settings.vanish_threshold
         if self.prob_texture is None:
             self.prob_texture = self.ctx.texture3d(self.shape, 4, dtype=self.dtype)
             self.prob_texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
-            if self._gpu is not None:
-                self._gpu.track(self.prob_texture)
+            self.gpu.track(self.prob_texture)
         nx, ny, nz = self.shape
         self.texture.use(0)
         self.prob_texture.bind_to_image(0, read=False, write=True)
@@ -151,26 +140,21 @@ class RegionVolume:
         return tuple(np.ascontiguousarray(data[..., i]) for i in range(3))
 
     def release(self) -> None:
-        """Release the textures, buffers and (for a bare moderngl context) the programs."""
+        """Release the textures and buffers (the programs belong to the GpuContext)."""
         if self._released:
             return
         self._released = True
-        for obj in [self.texture, self._cells, self.prob_texture, *self._buffers.values(), *self._programs]:
+        for obj in [self.texture, self._cells, self.prob_texture, *self._buffers.values()]:
             if obj is not None:
                 obj.release()
         self._buffers.clear()
-        self._programs.clear()
 
     def __repr__(self) -> str:
         return f"RegionVolume(shape={self.shape}, dtype={self.dtype!r}, count={self.count})"
 
     # -- internals -----------------------------------------------------------------------
     def _program(self, name, defines):
-        if self._gpu is not None:
-            return self._gpu.program(compute_shader=name, defines=defines)
-        program = build_program(self.ctx, {"compute_shader": name}, defines)
-        self._programs.append(program)
-        return program
+        return self.gpu.program(compute_shader=name, defines=defines)
 
     @staticmethod
     def _set(program, name, value) -> None:
@@ -188,8 +172,7 @@ class RegionVolume:
             if buf is not None:
                 buf.release()
             buf = self._buffers[name] = self.ctx.buffer(reserve=max(len(raw), 256) * 2)
-            if self._gpu is not None:
-                self._gpu.track(buf)
+            self.gpu.track(buf)
         buf.write(raw)
 
     def _prepare(self, a: np.ndarray) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""The weather rules (thesis sec. 4.3.3.5) as a function of (world, params, rng, dt), and the App plugin.
+"""The weather rules (thesis sec. 4.3.3.5) as a function of (world, settings, rng, dt), and the App plugin.
 
 One call of :func:`step_weather` applies, in this order:
 
@@ -23,10 +23,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from atmos.checks import check_choice, check_int
 from atmos.plugin import Plugin
-from atmos.plugins.weather.components import Ellipsoid, VolumeOrigin
-from atmos.plugins.weather.params import WeatherParams
-from atmos.plugins.weather.reference import NCOLS
+from atmos.plugins.weather.components import NCOLS, Ellipsoid, VolumeOrigin
+from atmos.plugins.weather.settings import WeatherSettings
 
 
 @dataclass(slots=True)
@@ -69,7 +69,7 @@ def _shrink(e: Ellipsoid, shrink_time: float) -> None:
     e.scale = 1.0 if shrink_time <= 0 else min(1.0, max(0.0, (e.lifetime - e.age) / shrink_time))
 
 
-def step_weather(world, params: WeatherParams, rng: np.random.Generator, dt: float = 1.0,
+def step_weather(world, settings: WeatherSettings, rng: np.random.Generator, dt: float = 1.0,
                  origin=(0.0, 0.0, 0.0)) -> StepReport:
     """Apply the five rules once to the :class:`Ellipsoid` entities of ``world``.
 
@@ -77,14 +77,15 @@ def step_weather(world, params: WeatherParams, rng: np.random.Generator, dt: flo
     rules are per step). ``origin``: world position (cells) of the simulation volume's cell
     (0, 0, 0), i.e. where the viewer's volume is now; the region boundings are around it.
     """
-    params.validate()
+    if not isinstance(settings, WeatherSettings):
+        raise ValueError(f"step_weather needs a WeatherSettings, got {type(settings).__name__}")
     if not (isinstance(dt, (int, float, np.floating)) and math.isfinite(dt) and dt >= 0):
         raise ValueError(f"dt must be a finite number >= 0 (seconds), got {dt!r}")
     origin = np.asarray(origin, dtype=np.float64)
     if origin.shape != (3,) or not np.isfinite(origin).all():
         raise ValueError(f"origin must be three finite numbers (x, y, z) in cells, got {origin!r}")
     report = StepReport()
-    lo, hi = params.region_bounds(origin)
+    lo, hi = settings.region_bounds(origin)
     pairs = _sorted_ellipsoids(world)
     doomed = []
 
@@ -100,11 +101,11 @@ def step_weather(world, params: WeatherParams, rng: np.random.Generator, dt: flo
 
     # rule 4: move by the wind (+ the 8×8 field) and the ellipsoid's personal offset
     if alive:
-        wx, wy, wz = params.wind
-        if params.wind_field is not None:
+        wx, wy, wz = settings.wind
+        if settings.wind_field is not None:
             xs = np.fromiter((e.x for _, e in alive), np.float64, len(alive))
             zs = np.fromiter((e.z for _, e in alive), np.float64, len(alive))
-            local = wind_field_at(params.wind_field, (lo[0], lo[2]), (hi[0], hi[2]), xs, zs).tolist()
+            local = wind_field_at(settings.wind_field, (lo[0], lo[2]), (hi[0], hi[2]), xs, zs).tolist()
         else:
             local = None
         lx, ly, lz = lo.tolist()
@@ -129,20 +130,20 @@ def step_weather(world, params: WeatherParams, rng: np.random.Generator, dt: flo
     for entity in doomed:
         world.delete_entity(entity, immediate=True)
 
-    target = params.cloud_density
+    target = settings.cloud_density
     count = len(alive)
     if count < target:
         # rule 1: add at most density_adaption new random ellipsoids
-        k = min(params.density_adaption, target - count)
-        for e in _random_ellipsoids(params, rng, k, lo, hi, origin):
+        k = min(settings.density_adaption, target - count)
+        for e in _random_ellipsoids(settings, rng, k, lo, hi, origin):
             world.create_entity(e)
         report.created = k
     elif count > target:
         # rule 2: remove at most density_adaption, chosen by position (outside the view first) and age
-        k = min(params.density_adaption, count - target)
+        k = min(settings.density_adaption, count - target)
         ids = np.array([entity for entity, _ in alive])
         vlo = origin
-        vhi = origin + np.asarray(params.volume_shape, np.float64)
+        vhi = origin + np.asarray(settings.volume_shape, np.float64)
         pos = np.array([(e.x, e.z) for _, e in alive])
         outside = np.hypot(np.maximum(0, np.maximum(vlo[0] - pos[:, 0], pos[:, 0] - vhi[0])),
                            np.maximum(0, np.maximum(vlo[2] - pos[:, 1], pos[:, 1] - vhi[2])))
@@ -154,34 +155,34 @@ def step_weather(world, params: WeatherParams, rng: np.random.Generator, dt: flo
 
     # shrink shortly before the lifetime ends
     for _, e in world.get_component(Ellipsoid):
-        _shrink(e, params.shrink_time)
+        _shrink(e, settings.shrink_time)
     report.count = len(world.get_component(Ellipsoid))
     return report
 
 
-def _random_ellipsoids(params: WeatherParams, rng: np.random.Generator, k: int, lo, hi, origin) -> list:
+def _random_ellipsoids(settings: WeatherSettings, rng: np.random.Generator, k: int, lo, hi, origin) -> list:
     """``k`` new ellipsoids, uniformly inside the region boundings (rule 1); one rng call."""
     if k <= 0:
         return []
     u = rng.random((k, 10))
     s = lambda col: 2.0 * u[:, col] - 1.0  # uniform in [-1, 1)
-    ny = params.volume_shape[1]
+    ny = settings.volume_shape[1]
     x = lo[0] + u[:, 0] * (hi[0] - lo[0])
     z = lo[2] + u[:, 1] * (hi[2] - lo[2])
-    y = origin[1] + (params.altitude + params.altitude_variance * s(2)) * ny
-    rx = params.cloud_size + params.cloud_size_variance * s(3)
-    rz = params.cloud_size + params.cloud_size_variance * s(4)
-    ry = params.vertical_scale * 0.5 * (rx + rz)
+    y = origin[1] + (settings.altitude + settings.altitude_variance * s(2)) * ny
+    rx = settings.cloud_size + settings.cloud_size_variance * s(3)
+    rz = settings.cloud_size + settings.cloud_size_variance * s(4)
+    ry = settings.vertical_scale * 0.5 * (rx + rz)
     yaw = u[:, 5] * (2.0 * math.pi)
-    life = params.lifetime + params.lifetime_variance * s(6)
-    dx = params.wind_variance * s(7)
-    dz = params.wind_variance * s(8)
+    life = settings.lifetime + settings.lifetime_variance * s(6)
+    dx = settings.wind_variance * s(7)
+    dz = settings.wind_variance * s(8)
     out = []
     for i in range(k):
         e = Ellipsoid(x=float(x[i]), y=float(y[i]), z=float(z[i]), rx=float(rx[i]), ry=float(ry[i]),
                       rz=float(rz[i]), yaw=float(yaw[i]), age=0.0, lifetime=float(life[i]),
                       drift_x=float(dx[i]), drift_z=float(dz[i]))
-        _shrink(e, params.shrink_time)
+        _shrink(e, settings.shrink_time)
         out.append(e)
     return out
 
@@ -204,33 +205,37 @@ class WeatherPlugin(Plugin):
     """Weather ellipsoids for an App: the rules as the ``simulate`` system ``"weather"`` and, with a
     GPU, the region volume re-rendered after them by the ``simulate`` system ``"weather_region"``.
 
-    Resources: ``WeatherParams`` (``params``), ``VolumeOrigin`` (move it with the viewer; one
+    ``WeatherPlugin(settings=None, *, seed=0, dtype="f4", **fields)`` with :class:`WeatherSettings`;
+    ``configure(**changes)`` changes them live (the next step reads them; ``volume_shape`` is fixed).
+    ``seed`` (the rules' random generator) and ``dtype`` (the region volume's texture format) are
+    how the plugin starts, not settings. Resources: ``VolumeOrigin`` (move it with the viewer; one
     already inserted is kept) and, with a GPU, the ``RegionVolume`` (its ``.texture`` is what the
     automaton stage reads; order it ``after="weather_region"``).
     """
 
-    def __init__(self, params: WeatherParams | None = None, seed: int = 0, dtype: str = "f4"):
-        self.params = (params or WeatherParams()).validate()
-        self.rng = np.random.default_rng(seed)
-        self.dtype = dtype
+    settings_class = WeatherSettings
+
+    def __init__(self, settings: WeatherSettings | None = None, *, seed: int = 0, dtype: str = "f4", **fields):
+        super().__init__(settings, **fields)
+        self.rng = np.random.default_rng(check_int("WeatherPlugin", "seed", seed, 0, 2**63 - 1))
+        self.dtype = check_choice("WeatherPlugin", "dtype", dtype, ("f4", "f2"))
         self.region = None
         self.last_report = StepReport()
 
     def build(self, app) -> None:
         from atmos.plugins.weather.region import RegionVolume
 
-        app.insert_resource(self.params)
         if app.get_resource(VolumeOrigin) is None:
             app.insert_resource(VolumeOrigin())
         app.add_system(self._step, "simulate", label="weather")
         if app.gpu is not None:
-            self.region = RegionVolume(app.gpu, self.params.volume_shape, dtype=self.dtype)
+            self.region = RegionVolume(app.gpu, self.settings.volume_shape, dtype=self.dtype)
             app.insert_resource(self.region)
             app.add_system(self._render_region, "simulate", label="weather_region", after="weather")
 
     def _step(self, app) -> None:
         origin = app.resource(VolumeOrigin).as_tuple()
-        self.last_report = step_weather(app.world, self.params, self.rng, app.clock.step, origin)
+        self.last_report = step_weather(app.world, self.settings, self.rng, app.clock.step, origin)
 
     def _render_region(self, app) -> None:
         origin = app.resource(VolumeOrigin).as_tuple()

@@ -1,15 +1,15 @@
-"""CloudShadowParams: the settings of the ground shadows, checked as a whole before any is used."""
+"""CloudShadowSettings: the settings of the ground shadows, checked as a whole before any is used (all live)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from atmos.checks import CheckedParams, check_num, check_vec
+from atmos.checks import CheckedSettings, check_num, check_vec
 
-_OWNER = "CloudShadowParams"
+_OWNER = "CloudShadowSettings"
 
 
 @dataclass(frozen=True)
-class CloudShadowParams(CheckedParams):
+class CloudShadowSettings(CheckedSettings):
     """Where the cloud layer is and how dark its shadow is (world units are metres, y is up).
 
     ``base_altitude``: world height of the bottom of the simulation volume (None: the simulation's
@@ -35,12 +35,11 @@ class CloudShadowParams(CheckedParams):
     def __post_init__(self):
         o = _OWNER
         checked = dict(
-            base_altitude=None if self.base_altitude is None else check_num(o, "base_altitude", self.base_altitude),
-            cell_size=None if self.cell_size is None else check_vec(o, "cell_size", self.cell_size, 3, "positive"),
-            sigma=None if self.sigma is None else check_num(o, "sigma", self.sigma, 0.0),
+            base_altitude=check_num(o, "base_altitude", self.base_altitude, optional=True),
+            cell_size=check_vec(o, "cell_size", self.cell_size, 3, "positive", optional=True),
+            sigma=check_num(o, "sigma", self.sigma, 0.0, optional=True),
             strength=check_num(o, "strength", self.strength, 0.0),
             direct_fraction=check_num(o, "direct_fraction", self.direct_fraction, 0.0, 1.0),
             horizon_fade=check_num(o, "horizon_fade", self.horizon_fade, 0.0, 1.0, lo_open=True),
         )
-        for name, value in checked.items():
-            object.__setattr__(self, name, value)
+        self.store(checked)

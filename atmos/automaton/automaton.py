@@ -47,7 +47,7 @@ import moderngl
 import numpy as np
 
 from atmos.checks import check_shape, is_int
-from atmos.gpu.shaders import build_program
+from atmos.gpu.context import GpuContext, require_gpu
 from atmos.hashing import stream_key
 
 PRECISION_BITS = 16
@@ -66,16 +66,17 @@ def _mb(n: int) -> str:
 
 
 class CloudAutomaton:
-    """Cloud cellular automaton of ``shape = (nx, ny, nz)`` cells (y is height) on a moderngl context.
+    """Cloud cellular automaton of ``shape = (nx, ny, nz)`` cells (y is height) on a GpuContext ``gpu``.
 
     ``seed`` (an int in [0, 2**32)) selects the random streams; ``layout`` is ``"packed"`` (32
     cells per uint32 word, the fast one) or ``"cell"`` (one uint per cell, the thesis's layout).
-    Both give bit-identical results, equal to :func:`atmos.plugins.automaton.reference.step`.
+    Both give bit-identical results, equal to :func:`atmos.automaton.reference.step`. The programs
+    come from ``gpu.program`` (shared by every automaton on the context, released by the context);
+    :meth:`release` frees the buffers.
     """
 
-    def __init__(self, ctx: moderngl.Context, shape, seed: int = 0, layout: str = "packed"):
-        if not isinstance(ctx, moderngl.Context):
-            raise ValueError(f"ctx must be a moderngl.Context, got {type(ctx).__name__}")
+    def __init__(self, gpu: GpuContext, shape, seed: int = 0, layout: str = "packed"):
+        ctx = require_gpu(gpu).ctx
         if layout not in LAYOUTS:
             raise ValueError(f"layout must be one of {LAYOUTS}, got {layout!r}")
         if not is_int(seed) or not 0 <= int(seed) < 2**32:
@@ -108,6 +109,7 @@ class CloudAutomaton:
             raise ValueError(f"shape {shape} has too many cells for one compute dispatch on this GPU; "
                              f"use a smaller shape")
 
+        self.gpu = gpu
         self.ctx = ctx
         self.shape = shape
         self.layout = layout
@@ -120,17 +122,13 @@ class CloudAutomaton:
         self._released = False
         self._last_mask = (1 << (nx - 32 * (nwx - 1))) - 1 if nx % 32 else 0xFFFFFFFF
 
+        prefix = "automaton/packed_" if layout == "packed" else "automaton/cell_"
+        self._prog_step = gpu.program(compute_shader=prefix + "step.comp")
+        self._prog_advect = gpu.program(compute_shader=prefix + "advect.comp")
+        self._prog_pack = (gpu.program(compute_shader="automaton/pack_thresholds.comp")
+                           if layout == "packed" else None)
         objects = []
         try:
-            prefix = "automaton/packed_" if layout == "packed" else "automaton/cell_"
-            self._prog_step = build_program(ctx, {"compute_shader": prefix + "step.comp"})
-            objects.append(self._prog_step)
-            self._prog_advect = build_program(ctx, {"compute_shader": prefix + "advect.comp"})
-            objects.append(self._prog_advect)
-            self._prog_pack = None
-            if layout == "packed":
-                self._prog_pack = build_program(ctx, {"compute_shader": "automaton/pack_thresholds.comp"})
-                objects.append(self._prog_pack)
             state_bytes = needs["the packed state" if layout == "packed" else "the cell state"]
             self._state = [ctx.buffer(reserve=state_bytes), ctx.buffer(reserve=state_bytes)]
             objects += self._state
@@ -153,14 +151,7 @@ class CloudAutomaton:
         self._staging = None
         self._prob_cache: list = [None, None, None]   # the array last uploaded per rule (identity)
         self._prog_texture = None                      # made on the first step_with_texture
-        for prog in (self._prog_step, self._prog_advect, self._prog_pack):
-            if prog is not None:
-                self._set(prog, "u_size", shape)
-                self._set(prog, "u_nwx", nwx)
-                self._set(prog, "u_count", count)
-                self._set(prog, "u_last_mask", self._last_mask)
-        if self._prog_pack is not None:
-            self._set(self._prog_pack, "u_count", words)
+        self._words = words
 
     # -- public API ----------------------------------------------------------------------------
     @property
@@ -229,6 +220,7 @@ class CloudAutomaton:
         keys = np.stack([ka, kb], axis=-1).astype("<u4").tobytes()
 
         ctx, prog = self.ctx, self._prog_step
+        self._set_grid(prog)
         self._set(prog, "u_mode", tuple(modes))
         self._set(prog, "u_threshold", tuple(thresholds))
         member = prog.get("u_keys", None)
@@ -253,6 +245,7 @@ class CloudAutomaton:
             src.bind_to_storage_buffer(0)
             dst.bind_to_storage_buffer(1)
             self._shifts.bind_to_storage_buffer(5)
+            self._set_grid(self._prog_advect)
             self._prog_advect.run(*self._grid)
             self._current = 1 - self._current
         ctx.memory_barrier(moderngl.ALL_BARRIER_BITS)
@@ -267,8 +260,7 @@ class CloudAutomaton:
         if self._released:
             return
         self._released = True
-        objects = [self._prog_step, self._prog_advect, self._prog_pack, self._prog_texture, self._shifts, self._dummy,
-                   self._staging, *self._state, *self._prob_buffers]
+        objects = [self._shifts, self._dummy, self._staging, *self._state, *self._prob_buffers]
         for obj in objects:
             if obj is not None:
                 obj.release()
@@ -284,6 +276,13 @@ class CloudAutomaton:
         member = prog.get(name, None)
         if member is not None:
             member.value = value
+
+    def _set_grid(self, prog, count: int | None = None) -> None:
+        """This automaton's size uniforms (the programs are shared with other automata: set before each run)."""
+        self._set(prog, "u_size", self.shape)
+        self._set(prog, "u_nwx", self.words_x)
+        self._set(prog, "u_count", self._count if count is None else count)
+        self._set(prog, "u_last_mask", self._last_mask)
 
     def _check_alive(self) -> None:
         if self._released:
@@ -373,6 +372,7 @@ class CloudAutomaton:
         fill(self._staging)
         self._staging.bind_to_storage_buffer(6)
         self._prob_buffers[rule].bind_to_storage_buffer(7)
+        self._set_grid(self._prog_pack, count=self._words)
         self._prog_pack.run(*self._grid)
         self.ctx.memory_barrier(moderngl.SHADER_STORAGE_BARRIER_BIT)
 
@@ -388,8 +388,7 @@ class CloudAutomaton:
                              f"(p_hum, p_act, p_ext[, ·]); got {probabilities!r}")
         shifts = self._check_shift(shift)
         if self._prog_texture is None:
-            self._prog_texture = build_program(self.ctx, {"compute_shader": "automaton/from_texture.comp"})
-            self._set(self._prog_texture, "u_size", self.shape)
+            self._prog_texture = self.gpu.program(compute_shader="automaton/from_texture.comp")
         cells = self._prog_texture
         groups = -(-self._cells // _GROUP)
         grid = (min(groups, 65535), -(-groups // 65535), 1)
@@ -398,6 +397,7 @@ class CloudAutomaton:
             def fill(buffer):
                 probabilities.use(0)
                 buffer.bind_to_storage_buffer(6)
+                self._set(cells, "u_size", self.shape)
                 self._set(cells, "u_channel", channel)
                 cells.run(*grid)
                 self.ctx.memory_barrier(moderngl.SHADER_STORAGE_BARRIER_BIT)

@@ -3,7 +3,7 @@
 ``CloudAutomaton`` runs the automaton in compute shaders (layouts "packed" and "cell");
 ``reference`` holds the numpy reference that reproduces it bit for bit.
 """
-from atmos.plugins.automaton.automaton import LAYOUTS, PRECISION_BITS, CloudAutomaton
-from atmos.plugins.automaton import reference
+from atmos.automaton.automaton import LAYOUTS, PRECISION_BITS, CloudAutomaton
+from atmos.automaton import reference
 
 __all__ = ["CloudAutomaton", "LAYOUTS", "PRECISION_BITS", "reference"]

@@ -1,4 +1,6 @@
-"""Float64 numpy side of cloud shading: input checks, slice geometry, the exact reference, and the scheme.
+"""Float64 numpy references of cloud shading: the exact transmittance and the shear-warp scheme.
+
+The input checks and the slice plan they share with the GPU are in :mod:`atmos.shading.grid`.
 
 The quantity (index space, voxel ``i`` centred at integer ``i``, the volume is the box
 ``[-0.5, n-0.5]`` per axis)::
@@ -21,107 +23,17 @@ clamped to the edge value in the outer half cell, and zero outside the box.
 from __future__ import annotations
 
 import itertools
-
 import math
-import numbers
 
 import numpy as np
 
-SCALES = (1, 2, 4)
-MAJOR_ORDER = (1, 0, 2)          # ties for the slicing axis go to y, then x, then z
-LATERAL = {0: (1, 2), 1: (0, 2), 2: (0, 1)}
-TAU_MAX = 1e30                   # optical depth is clamped here: exp(-TAU_MAX) == 0, never inf - inf
-SIGMA_MAX = 3.0e38               # largest sigma handed to float32 shaders
-
-
-# -- input checks ----------------------------------------------------------------------------------
-def check_density(density) -> np.ndarray:
-    """``density`` as a float32 (nx, ny, nz) array, or a ValueError saying what is allowed."""
-    try:
-        array = np.asarray(density)
-    except Exception:
-        array = None
-    if array is None or array.dtype.kind not in "fiu" or array.ndim != 3 or min(array.shape, default=0) < 1:
-        what = "not an array" if array is None else f"dtype {array.dtype}, shape {array.shape}"
-        raise ValueError(f"density must be a real-valued array of shape (nx, ny, nz), each >= 1 "
-                         f"(y is height); got {what}")
-    with np.errstate(over="ignore", invalid="ignore"):
-        out = np.ascontiguousarray(array, dtype=np.float32)
-    bad = ~np.isfinite(out)
-    if bad.any():
-        raise ValueError(f"density must be finite (and within float32 range); {int(bad.sum())} value(s) are not, "
-                         f"first at index {tuple(int(i) for i in np.argwhere(bad)[0])}")
-    if (out < 0).any():
-        raise ValueError(f"density must be >= 0; {int((out < 0).sum())} value(s) are negative "
-                         f"(min {float(out.min())!r})")
-    return out
-
-
-def check_sun_dir(sun_dir) -> np.ndarray:
-    """The unit float64 direction toward the sun, or a ValueError (allowed: a finite 3-vector, length > 0)."""
-    try:
-        d = np.asarray(sun_dir, dtype=np.float64)
-    except (TypeError, ValueError):
-        d = None
-    if d is None or d.shape != (3,):
-        raise ValueError(f"sun_dir must be a 3-vector (x, y, z) pointing toward the sun; got {sun_dir!r}")
-    if not np.isfinite(d).all():
-        raise ValueError(f"sun_dir must be finite; got {tuple(d)}")
-    big = np.abs(d).max()
-    if big == 0:
-        raise ValueError("sun_dir must have a length > 0; got the zero vector")
-    d = d / big
-    return d / np.linalg.norm(d)
-
-
-def check_sigma(sigma) -> float:
-    """``sigma`` as a float, or a ValueError (allowed: a finite real number >= 0)."""
-    if isinstance(sigma, (bool, np.bool_)) or not isinstance(sigma, numbers.Real):
-        raise ValueError(f"sigma must be a real number >= 0 (extinction per cell length at density 1); got {sigma!r}")
-    value = float(sigma)
-    if not math.isfinite(value) or value < 0:
-        raise ValueError(f"sigma must be finite and >= 0 (extinction per cell length at density 1); got {sigma!r}")
-    return value
-
-
-def check_scale(scale) -> int:
-    if isinstance(scale, (bool, np.bool_)) or not isinstance(scale, numbers.Integral) or int(scale) not in SCALES:
-        raise ValueError(f"scale must be one of {SCALES} (full, half, quarter resolution); got {scale!r}")
-    return int(scale)
+from atmos.checks import check_sun_dir
+# the input checks and the slice geometry are the GPU side's own (atmos.shading.grid); kept here by name
+from atmos.shading.grid import (LATERAL, MAJOR_ORDER, SCALES, SIGMA_MAX, TAU_MAX, SlicePlan,  # noqa: F401
+                                check_density, check_scale, check_sigma, shading_shape)
 
 
 # -- geometry --------------------------------------------------------------------------------------
-def shading_shape(shape, scale: int) -> tuple[int, int, int]:
-    """Shading grid for ``scale``: ceil(n / scale) per axis (the same box, coarser cells)."""
-    return tuple(-(-int(n) // scale) for n in shape)
-
-
-class SlicePlan:
-    """How the shear-warp walks a grid of ``shape`` cells of size ``spacing`` (fine cells) for unit ``u``.
-
-    ``axis`` slicing axis (largest |u/spacing|, ties y, x, z), ``lateral`` the other two,
-    ``sign`` +1 when the sun is toward +axis, ``step`` the index-space step toward the sun
-    (``step[axis] == sign``), ``length`` its length in fine cells, ``order`` the slices in order.
-    """
-
-    def __init__(self, shape, u: np.ndarray, spacing=(1.0, 1.0, 1.0)):
-        self.shape = tuple(int(n) for n in shape)
-        spacing = np.asarray(spacing, dtype=np.float64)
-        w = u / spacing
-        self.axis = max(MAJOR_ORDER, key=lambda a: (abs(w[a]), -MAJOR_ORDER.index(a)))
-        self.lateral = LATERAL[self.axis]
-        self.sign = 1 if w[self.axis] > 0 else -1
-        self.step = w / abs(w[self.axis])
-        self.step[self.axis] = float(self.sign)
-        self.length = float(np.linalg.norm(spacing * self.step))
-        n = self.shape[self.axis]
-        self.order = list(range(n - 1, -1, -1)) if self.sign > 0 else list(range(n))
-
-    @property
-    def count(self) -> int:
-        return len(self.order)
-
-
 def exit_fraction(q, v: float, n: int):
     """Fraction of one step ``v`` (one lateral axis) before a ray from integer ``q`` leaves [-0.5, n-0.5]."""
     q = np.asarray(q, dtype=np.float64)

@@ -7,21 +7,22 @@ Gauss-Legendre. Cost grows with the path length; the shear-warp is the fast path
 """
 from __future__ import annotations
 
-from atmos.plugins.shading import reference as ref
-from atmos.plugins.shading.shear_warp import (_RESULT_FORMATS, check_volume_texture, context_of, groups,
-                                              program)
+from atmos.checks import check_sun_dir
+from atmos.shading import grid
+from atmos.gpu.context import GpuContext, require_gpu
+from atmos.shading.shear_warp import _RESULT_FORMATS, check_volume_texture, groups, program
 
 
-def raymarch(ctx, density_texture, sun_dir, sigma, target) -> None:
+def raymarch(gpu: GpuContext, density_texture, sun_dir, sigma, target) -> None:
     """Write ``exp(-sigma * optical depth)`` of every voxel of ``density_texture`` into ``target``
     (a 1-component ``f2``/``f4`` 3D texture of the same size)."""
-    ctx = context_of(ctx)
+    ctx = require_gpu(gpu).ctx
     shape = tuple(density_texture.size)
     check_volume_texture(density_texture, shape, "density_texture")
     check_volume_texture(target, shape, "target", dtypes=tuple(_RESULT_FORMATS))
-    u = ref.check_sun_dir(sun_dir)
-    sigma = min(ref.check_sigma(sigma), ref.SIGMA_MAX)
-    prog = program(ctx, "raymarch", RESULT_FORMAT=_RESULT_FORMATS[target.dtype])
+    u = check_sun_dir(sun_dir)
+    sigma = min(grid.check_sigma(sigma), grid.SIGMA_MAX)
+    prog = program(gpu, "raymarch", RESULT_FORMAT=_RESULT_FORMATS[target.dtype])
     density_texture.use(0)
     prog["density"].value = 0
     prog["sun_dir"].value = tuple(float(x) for x in u)

@@ -1,11 +1,11 @@
-"""SkyLayerParams: every setting of the 2D cloud layer, checked as a whole before any of it is used."""
+"""SkyLayerSettings: every setting of the 2D cloud layer, checked as a whole before any of it is used (all live)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from atmos.checks import CheckedParams, check_int, check_num, check_vec
+from atmos.checks import CheckedSettings, check_bool, check_int, check_num, check_vec
 
-_OWNER = "SkyLayerParams"
+_OWNER = "SkyLayerSettings"
 MIN_GAP = 1e-3          # sharpness − emptiness must be at least this (the remap divides by it)
 # scroll of octaves 0..3 in tiles per second: speeds 1, 1.5, 2, 2.5 along +x, +z, −z, −x (the article's)
 DEFAULT_WIND = ((0.002, 0.0), (0.0, 0.003), (0.0, -0.004), (-0.005, 0.0))
@@ -13,7 +13,7 @@ TEXTURE_SETTINGS = ("size", "base_frequency", "seed", "light_step")   # changing
 
 
 @dataclass(frozen=True)
-class SkyLayerParams(CheckedParams):
+class SkyLayerSettings(CheckedSettings):
     """Look (emptiness, sharpness, thickness, colours), placement (altitude, tile_size) and motion (wind).
 
     Octave k has ``base_frequency · 2^k`` noise cells across one tile of ``tile_size`` metres.
@@ -32,6 +32,8 @@ class SkyLayerParams(CheckedParams):
     base_frequency: int = 4           # noise cells across a tile at octave 0, 1..64
     seed: int = 0
     light_step: float = 0.01          # tiles between the four light-march samples toward the sun
+    rebake_tolerance: float = 0.05    # re-bake when the sun moved the light step by this fraction, 0..1
+    animate: bool = True              # scroll with the App clock (False: frozen at time 0)
 
     def __post_init__(self):
         o = _OWNER
@@ -55,12 +57,13 @@ class SkyLayerParams(CheckedParams):
             base_frequency=check_int(o, "base_frequency", self.base_frequency, 1, 64),
             seed=check_int(o, "seed", self.seed, 0, 2**32 - 1),
             light_step=check_num(o, "light_step", self.light_step, 0.0, 0.25),
+            rebake_tolerance=check_num(o, "rebake_tolerance", self.rebake_tolerance, 0.0, 1.0),
+            animate=check_bool(o, "animate", self.animate),
         )
         if checked["sharpness"] - checked["emptiness"] < MIN_GAP:
             raise ValueError(f"{o}.sharpness must exceed emptiness by at least {MIN_GAP} "
                              f"(got emptiness={self.emptiness!r}, sharpness={self.sharpness!r})")
-        for name, value in checked.items():
-            object.__setattr__(self, name, value)
+        self.store(checked)
 
     def texture_key(self) -> tuple:
         """The settings the baked octave textures depend on."""

@@ -1,17 +1,17 @@
-"""SkyParams: every setting of the Preetham sky, checked as a whole before any of it is used."""
+"""SkySettings: every setting of the Preetham sky, checked as a whole before any of it is used (all live)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from atmos.checks import CheckedParams, check_num, check_vec
-from atmos.plugins.shading.scattering import NIGHT_SKY
+from atmos.checks import CheckedSettings, check_bool, check_num, check_vec
+from atmos.lighting import NIGHT_SKY
 from atmos.plugins.sky.preetham import TURBIDITY_RANGE, check_turbidity
 
-_OWNER = "SkyParams"
+_OWNER = "SkySettings"
 
 
 @dataclass(frozen=True)
-class SkyParams(CheckedParams):
+class SkySettings(CheckedSettings):
     """Look of the sky: haze, brightness in the HDR pipeline, sun disc, night and stars.
 
     ``scale``: HDR units per kcd/m² of Preetham luminance (0.03 puts a clear noon zenith near 0.25,
@@ -33,8 +33,6 @@ class SkyParams(CheckedParams):
 
     def __post_init__(self):
         o = _OWNER
-        if not isinstance(self.stars, bool):
-            raise ValueError(f"{o}.stars must be True or False, got {self.stars!r}")
         try:
             turbidity = check_turbidity(self.turbidity)
         except ValueError:
@@ -42,6 +40,7 @@ class SkyParams(CheckedParams):
                              f"(2 clear .. 10 hazy), got {self.turbidity!r}") from None
         checked = dict(
             turbidity=turbidity,
+            stars=check_bool(o, "stars", self.stars),
             scale=check_num(o, "scale", self.scale, 0.0, 1e3, lo_open=True),
             sun_size_deg=check_num(o, "sun_size_deg", self.sun_size_deg, 0.0, 5.0, lo_open=True),
             sun_gain=check_num(o, "sun_gain", self.sun_gain, 0.0, 1e4),
@@ -50,5 +49,4 @@ class SkyParams(CheckedParams):
             star_brightness=check_num(o, "star_brightness", self.star_brightness, 0.0, 1e4),
             twinkle=check_num(o, "twinkle", self.twinkle, 0.0, 1.0),
         )
-        for name, value in checked.items():
-            object.__setattr__(self, name, value)
+        self.store(checked)

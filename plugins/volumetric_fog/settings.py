@@ -1,18 +1,18 @@
-"""FogParams: every setting of the volumetric fog, checked as a whole before any of it is used."""
+"""VolumetricFogSettings: every setting of the volumetric fog, checked as a whole before any of it is used (all live)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from atmos.checks import CheckedParams, check_int, check_num, check_vec
+from atmos.checks import CheckedSettings, check_bool, check_int, check_num, check_vec
 
 MAX_OCTAVES = 16
 MAX_STEPS = 1024
 MAX_LIGHT_STEPS = 32
-_OWNER = "FogParams"
+_OWNER = "VolumetricFogSettings"
 
 
 @dataclass(frozen=True)
-class FogParams(CheckedParams):
+class VolumetricFogSettings(CheckedSettings):
     """The FBM medium, the march and the colours (world units are metres, y is up).
 
     density(p) = bias − falloff·‖(p − center)/scale‖ + fbm(frequency·(p − center − wind·t), octaves);
@@ -34,6 +34,7 @@ class FogParams(CheckedParams):
     max_distance: float = 400.0
     ambient: tuple = (0.45, 0.52, 0.62)        # ambient radiance the fog scatters
     scattering: tuple = (1.0, 0.7, 0.4)        # colour of scattered sunlight (times the sun colour)
+    animate: bool = True                       # drift with the App clock (False: frozen at time 0)
 
     def __post_init__(self):
         o = _OWNER
@@ -53,6 +54,6 @@ class FogParams(CheckedParams):
             steps=check_int(o, "steps", self.steps, 1, MAX_STEPS),
             light_steps=check_int(o, "light_steps", self.light_steps, 0, MAX_LIGHT_STEPS),
             seed=check_int(o, "seed", self.seed, 0, 2**32 - 1),
+            animate=check_bool(o, "animate", self.animate),
         )
-        for name, value in checked.items():
-            object.__setattr__(self, name, value)
+        self.store(checked)

@@ -1,17 +1,17 @@
-"""LightShaftParams: the settings of the light shafts, checked as a whole before any is used."""
+"""LightShaftSettings: the settings of the light shafts, checked as a whole before any is used (all live)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from atmos.checks import CheckedParams, check_int, check_num
+from atmos.checks import CheckedSettings, check_int, check_num
 
 MAX_SAMPLES = 256
 MAX_DOWNSAMPLE = 8
-_OWNER = "LightShaftParams"
+_OWNER = "LightShaftSettings"
 
 
 @dataclass(frozen=True)
-class LightShaftParams(CheckedParams):
+class LightShaftSettings(CheckedSettings):
     """Occlusion mask, radial blur toward the sun (GPU Gems 3, ch. 13) and when the effect shows.
 
     Mask: sky pixels (depth 1) whose luminance exceeds ``threshold`` (linear HDR) keep the excess,
@@ -23,8 +23,8 @@ class LightShaftParams(CheckedParams):
     the sky cut the shafts however brightly the sun lights them; fog tints the sky but keeps it sky.
     Blur, per pixel: ``samples`` taps on the way to the sun covering ``density`` of it; tap i
     (1-based) weighs ``weight · decay^(i−1)``; the sum times ``exposure`` is added to the colour.
-    ``downsample``: mask and blur at 1/downsample of the frame size (read when the render graph
-    compiles, i.e. at start-up and on resize).
+    ``downsample``: mask and blur at 1/downsample of the frame size (read by the pass's ``setup``
+    every frame: a change resizes them on the next frame).
     Fades (1 → 0): ``horizon_fade``: the sun's height (y of its unit direction) from this down to 0;
     ``front_fade``: the cosine between the view direction and the sun from this down to 0 (behind
     the camera: none); ``edge_fade``: the sun's screen position from the screen edge to this far
@@ -60,5 +60,4 @@ class LightShaftParams(CheckedParams):
             front_fade=check_num(o, "front_fade", self.front_fade, 0.0, 1.0, lo_open=True),
             edge_fade=check_num(o, "edge_fade", self.edge_fade, 0.0, lo_open=True),
         )
-        for name, value in checked.items():
-            object.__setattr__(self, name, value)
+        self.store(checked)

@@ -10,8 +10,8 @@ per-particle recurrence). :func:`harris_reference` is the discrete recurrence, f
 
 For the renderer: per voxel ``light.rgb = sun_color * T + ambient`` and ``light.a = T``, from
 :class:`LightVolumeShader` (GPU) or :func:`light_volume_reference` (numpy); colours from
-:func:`sky_light` (``sun_dir`` of the :class:`~atmos.lighting.Sun` resource). Below the horizon the sun
-colour is 0: ambient only (night).
+:func:`atmos.lighting.sky_light` (``sun_dir`` of the :class:`~atmos.lighting.Sun` resource, ambient
+scaled by :attr:`Scattering.ambient`). Below the horizon the sun colour is 0: ambient only (night).
 """
 from __future__ import annotations
 
@@ -21,14 +21,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from atmos.plugins.shading import reference as ref
-from atmos.plugins.shading.shear_warp import _RESULT_FORMATS, check_volume_texture, context_of, groups, program
+from atmos.shading import grid
+from atmos.gpu.context import GpuContext, require_gpu
+from atmos.shading.shear_warp import _RESULT_FORMATS, check_volume_texture, groups, program
 
 MODES = ("single", "multiple-forward")
-RAYLEIGH = np.array([0.03, 0.07, 0.16])      # extinction of sunlight per air mass (red, green, blue)
-DAY_SKY = np.array([0.35, 0.47, 0.65])
-TWILIGHT_SKY = np.array([0.30, 0.22, 0.25])
-NIGHT_SKY = np.array([0.012, 0.016, 0.03])
 
 
 def _fraction(name: str, value) -> float:
@@ -60,7 +57,7 @@ class Scattering:
 
     def extinction(self, sigma) -> float:
         """The sigma to shade with: ``sigma`` (single) or ``sigma * (1 - albedo * forward)`` (multiple forward)."""
-        sigma = ref.check_sigma(sigma)
+        sigma = grid.check_sigma(sigma)
         return sigma if self.mode == "single" else sigma * (1.0 - self.albedo * self.forward)
 
 
@@ -73,30 +70,6 @@ def harris_reference(rho, sigma: float, step: float, albedo: float, forward: flo
     return np.cumprod(t + albedo * forward * (1.0 - t))
 
 
-def _smoothstep(e0: float, e1: float, x: float) -> float:
-    t = min(max((x - e0) / (e1 - e0), 0.0), 1.0)
-    return t * t * (3 - 2 * t)
-
-
-def sky_light(sun_dir, scattering: Scattering | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """(sun colour, ambient colour) as float64 RGB for a sun in direction ``sun_dir`` (y up).
-
-    Sun: reddened by ``exp(-RAYLEIGH * air mass)`` (Kasten-Young air mass), faded out across the
-    horizon over the sun disc (-0.5 deg .. 0.5 deg), 0 below. Ambient: day blue, tinted at twilight,
-    dark blue at night, scaled by ``scattering.ambient``. Continuous in the direction.
-    """
-    u = ref.check_sun_dir(sun_dir)
-    scattering = scattering or Scattering()
-    e = math.degrees(math.asin(max(-1.0, min(1.0, u[1]))))
-    height = max(e, 0.0)
-    air_mass = 1.0 / (math.sin(math.radians(height)) + 0.50572 * (height + 6.07995) ** -1.6364)
-    sun = np.exp(-RAYLEIGH * air_mass) * _smoothstep(-0.5, 0.5, e)
-    day = _smoothstep(-6.0, 20.0, e)
-    twilight = _smoothstep(-8.0, 0.0, e) * (1.0 - _smoothstep(0.0, 15.0, e))
-    ambient = NIGHT_SKY + day * DAY_SKY + 0.5 * twilight * TWILIGHT_SKY
-    return sun, ambient * scattering.ambient
-
-
 def light_volume_reference(transmittance, sun_color, ambient) -> np.ndarray:
     """(nx, ny, nz, 4) float64: rgb = sun_color * T + ambient, a = T."""
     t = np.asarray(transmittance, dtype=np.float64)[..., None]
@@ -107,8 +80,9 @@ def light_volume_reference(transmittance, sun_color, ambient) -> np.ndarray:
 class LightVolumeShader:
     """GPU light volume: ``run(transmittance, target, sun_color, ambient)`` writes rgba (see module doc)."""
 
-    def __init__(self, ctx):
-        self.ctx = context_of(ctx)
+    def __init__(self, gpu: GpuContext):
+        self.gpu = require_gpu(gpu)
+        self.ctx = gpu.ctx
 
     def run(self, transmittance, target, sun_color, ambient) -> None:
         """``target``: a 4-component ``f2``/``f4`` 3D texture of the transmittance texture's size."""
@@ -124,7 +98,7 @@ class LightVolumeShader:
                 raise ValueError(f"{name} must be 3 finite numbers >= 0 (RGB); got {c!r}")
             colors.append(tuple(float(x) for x in c))
         fmt = {"f2": "rgba16f", "f4": "rgba32f"}[target.dtype]
-        prog = program(self.ctx, "light", RESULT_FORMAT=fmt)
+        prog = program(self.gpu, "light", RESULT_FORMAT=fmt)
         transmittance.use(0)
         prog["transmittance"].value = 0
         prog["sun_color"].value, prog["ambient"].value = colors

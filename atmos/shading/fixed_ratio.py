@@ -10,20 +10,22 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.plugins.shading.shear_warp import ShearWarpShader, context_of, read_volume, upload_volume
-from atmos.plugins.shading import reference as ref
+from atmos.checks import check_sun_dir
+from atmos.shading import grid
+from atmos.gpu.context import GpuContext, require_gpu
+from atmos.shading.shear_warp import ShearWarpShader, read_volume, upload_volume
 
 THESIS_LEVELS = 255
 
 
-def compute_fixed_ratio(ctx, density, sun_dir, sigma, levels: int = THESIS_LEVELS) -> np.ndarray:
+def compute_fixed_ratio(gpu: GpuContext, density, sun_dir, sigma, levels: int = THESIS_LEVELS) -> np.ndarray:
     """Transmittance by the thesis's fixed-ratio model (float32 (nx, ny, nz)); checks like compute_transmittance."""
-    ctx = context_of(ctx)
-    density = ref.check_density(density)
-    ref.check_sun_dir(sun_dir)
-    ref.check_sigma(sigma)
-    shader = ShearWarpShader(ctx, density.shape, model="fixed-ratio", levels=levels)
-    texture = upload_volume(ctx, density)
+    require_gpu(gpu)
+    density = grid.check_density(density)
+    check_sun_dir(sun_dir)
+    grid.check_sigma(sigma)
+    shader = ShearWarpShader(gpu, density.shape, model="fixed-ratio", levels=levels)
+    texture = upload_volume(gpu, density)
     try:
         shader.begin(texture, sun_dir, sigma)
         shader.run_all()

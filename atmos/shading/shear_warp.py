@@ -17,41 +17,27 @@ any ``[i0, i1)`` of the :attr:`slice_count` slices in order; :class:`ShadingStag
 from __future__ import annotations
 
 import math
-import weakref
 
 import moderngl
 import numpy as np
 
-from atmos.checks import check_shape
+from atmos.checks import check_shape, check_sun_dir
 from atmos.frames import SliceStage
-from atmos.gpu.shaders import build_program
-from atmos.plugins.shading import reference as ref
+from atmos.gpu.context import GpuContext, require_gpu
+from atmos.shading import grid
 
-_PROGRAMS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 _RESULT_FORMATS = {"f4": "r32f", "f2": "r16f"}
 
 
-def program(ctx: moderngl.Context, name: str, **defines):
-    """``shaders/shading/<name>.comp`` compiled once per context and defines."""
-    cache = _PROGRAMS.setdefault(ctx, {})
-    key = (name, tuple(sorted(defines.items())))
-    if key not in cache:
-        cache[key] = build_program(ctx, {"compute_shader": f"shading/{name}.comp"}, defines)
-    return cache[key]
+def program(gpu: GpuContext, name: str, **defines):
+    """``shaders/shading/<name>.comp`` with ``defines``, from the GpuContext's program cache."""
+    return gpu.program(compute_shader=f"shading/{name}.comp", defines=defines)
 
 
-def context_of(ctx) -> moderngl.Context:
-    """The moderngl context of a moderngl.Context or a GpuContext."""
-    inner = getattr(ctx, "ctx", ctx)
-    if not isinstance(inner, moderngl.Context):
-        raise ValueError(f"ctx must be a moderngl.Context or an atmos GpuContext; got {type(ctx).__name__}")
-    return inner
-
-
-def upload_volume(ctx: moderngl.Context, volume: np.ndarray):
-    """A 1-component float32 3D texture of size (nx, ny, nz) holding ``volume[x, y, z]``."""
+def upload_volume(gpu: GpuContext, volume: np.ndarray):
+    """A 1-component float32 3D texture of size (nx, ny, nz) holding ``volume[x, y, z]`` (caller releases it)."""
     data = np.ascontiguousarray(np.asarray(volume, dtype=np.float32).transpose(2, 1, 0))
-    texture = ctx.texture3d(volume.shape, 1, data.tobytes(), dtype="f4")
+    texture = require_gpu(gpu).ctx.texture3d(volume.shape, 1, data.tobytes(), dtype="f4")
     texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
     return texture
 
@@ -82,16 +68,17 @@ class ShearWarpShader:
     (``levels=255``: 8-bit rounding per slice), for comparison.
     """
 
-    def __init__(self, ctx, shape, scale: int = 1, model: str = "true-path", levels: int = 0):
-        self.ctx = context_of(ctx)
+    def __init__(self, gpu: GpuContext, shape, scale: int = 1, model: str = "true-path", levels: int = 0):
+        self.gpu = require_gpu(gpu)
+        self.ctx = gpu.ctx
         self.shape = check_shape(shape)
-        self.scale = ref.check_scale(scale)
+        self.scale = grid.check_scale(scale)
         if model not in ("true-path", "fixed-ratio"):
             raise ValueError(f"model must be 'true-path' or 'fixed-ratio'; got {model!r}")
         if isinstance(levels, bool) or not isinstance(levels, int) or not 0 <= levels <= 65535:
             raise ValueError(f"levels must be an int in [0, 65535] (0: no rounding); got {levels!r}")
         self.model, self.levels = model, levels
-        self.shading_shape = ref.shading_shape(self.shape, self.scale)
+        self.shading_shape = grid.shading_shape(self.shape, self.scale)
         side = max(self.shading_shape)
         self._objects = []
         self.result = self._track(self.ctx.texture3d(self.shading_shape, 1, dtype="f4"))
@@ -116,10 +103,10 @@ class ShearWarpShader:
         check_volume_texture(density_texture, self.shape, "density_texture")
         if target is not None:
             check_volume_texture(target, self.shading_shape, "target", dtypes=tuple(_RESULT_FORMATS))
-        u = ref.check_sun_dir(sun_dir)
-        sigma = min(ref.check_sigma(sigma), ref.SIGMA_MAX)
+        u = check_sun_dir(sun_dir)
+        sigma = min(grid.check_sigma(sigma), grid.SIGMA_MAX)
         if self._coarse is not None:
-            prog = program(self.ctx, "downsample", SCALE=self.scale)
+            prog = program(self.gpu, "downsample", SCALE=self.scale)
             density_texture.use(0)
             prog["fine"].value = 0
             prog["fine_size"].value = self.shape
@@ -128,7 +115,7 @@ class ShearWarpShader:
             self.ctx.memory_barrier()
             density_texture = self._coarse
         spacing = np.array(self.shape) / np.array(self.shading_shape)
-        self._plan = ref.SlicePlan(self.shading_shape, u, spacing)
+        self._plan = grid.SlicePlan(self.shading_shape, u, spacing)
         self._density, self._sigma = density_texture, sigma
         self._target = self.result if target is None else target
         self._next = 0
@@ -166,7 +153,7 @@ class ShearWarpShader:
         defines = {"RESULT_FORMAT": _RESULT_FORMATS[self._target.dtype]}
         if self.model == "fixed-ratio":
             defines.update(FIXED_RATIO=1, LEVELS=self.levels)
-        prog = program(self.ctx, "shear_warp", **defines)
+        prog = program(self.gpu, "shear_warp", **defines)
         basis = np.eye(3, dtype=int)
         a, (b, c) = plan.axis, plan.lateral
         prog["size"].value = self.shading_shape
@@ -225,9 +212,9 @@ class ShadingStage(SliceStage):
     def _count(self) -> int:
         sun = self.sun() if callable(self.sun) else self.sun
         sigma = self.sigma() if callable(self.sigma) else self.sigma
-        u, sigma = ref.check_sun_dir(sun), ref.check_sigma(sigma)
+        u, sigma = check_sun_dir(sun), grid.check_sigma(sigma)
         spacing = np.array(self.shader.shape) / np.array(self.shader.shading_shape)
-        slices = ref.SlicePlan(self.shader.shading_shape, u, spacing).count
+        slices = grid.SlicePlan(self.shader.shading_shape, u, spacing).count
         self._latched = (u, sigma)
         return math.ceil(slices / self.slices_per_run)
 

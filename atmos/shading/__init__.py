@@ -1,26 +1,28 @@
 """Cloud shading: transmittance toward the sun for every voxel of a density volume (thesis ch. 5).
 
 ``compute_transmittance`` is the one-shot entry point; ``ShearWarpShader`` / ``ShadingStage`` the
-sliced GPU path for the frame scheduler; ``raymarch`` the reference-quality GPU path; ``reference``
-the float64 numpy references; ``scattering`` the cloud light colour (sun x transmittance + ambient,
-multiple forward scattering option, time of day).
+sliced GPU path for the frame scheduler; ``raymarch`` the reference-quality GPU path; ``grid``
+the input checks and slice geometry; ``reference`` the float64 numpy references (test oracles);
+``scattering`` the cloud light colour (sun x transmittance + ambient, multiple forward scattering
+option; the sun and sky colours by time of day are :func:`atmos.lighting.sky_light`).
 """
 from __future__ import annotations
 
 import numpy as np
 
-from atmos.plugins.shading import reference
-from atmos.plugins.shading.fixed_ratio import compute_fixed_ratio
-from atmos.plugins.shading.raymarch import raymarch
-from atmos.plugins.shading.scattering import (LightVolumeShader, Scattering, light_volume_reference,
-                                              sky_light)
-from atmos.plugins.shading.shear_warp import (ShadingStage, ShearWarpShader, context_of, program,
-                                              read_volume, upload_volume, groups)
+from atmos.checks import check_sun_dir
+from atmos.shading import grid, reference
+from atmos.shading.fixed_ratio import compute_fixed_ratio
+from atmos.shading.raymarch import raymarch
+from atmos.shading.scattering import LightVolumeShader, Scattering, light_volume_reference
+from atmos.gpu.context import GpuContext, require_gpu
+from atmos.shading.shear_warp import ShadingStage, ShearWarpShader, groups, program, read_volume, upload_volume
 
 METHODS = ("shear-warp", "raymarch")
 
 
-def compute_transmittance(ctx, density, sun_dir, sigma, method: str = "shear-warp", scale: int = 1) -> np.ndarray:
+def compute_transmittance(gpu: GpuContext, density, sun_dir, sigma, method: str = "shear-warp",
+                          scale: int = 1) -> np.ndarray:
     """float32 (nx, ny, nz): exp(-sigma * integral of density) from each voxel centre toward the sun.
 
     ``density``: (nx, ny, nz) >= 0, y is height, trilinear between voxel centres, zero outside the
@@ -29,24 +31,24 @@ def compute_transmittance(ctx, density, sun_dir, sigma, method: str = "shear-war
     "raymarch" (exact per-voxel march, full resolution only). ``scale``: 1, 2 or 4 (full, half,
     quarter shading resolution; the result is interpolated back to the full grid).
     """
-    ctx = context_of(ctx)
+    ctx = require_gpu(gpu).ctx
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}; got {method!r}")
-    density = reference.check_density(density)
-    reference.check_sun_dir(sun_dir)
-    reference.check_sigma(sigma)
-    scale = reference.check_scale(scale)
+    density = grid.check_density(density)
+    check_sun_dir(sun_dir)
+    grid.check_sigma(sigma)
+    scale = grid.check_scale(scale)
     if method == "raymarch" and scale != 1:
         raise ValueError(f"method='raymarch' runs at full resolution only; allowed is scale=1, got scale={scale}")
-    texture = upload_volume(ctx, density)
+    texture = upload_volume(gpu, density)
     made = [texture]
     try:
         if method == "raymarch":
             out = ctx.texture3d(density.shape, 1, dtype="f4")
             made.append(out)
-            raymarch(ctx, texture, sun_dir, sigma, out)
+            raymarch(gpu, texture, sun_dir, sigma, out)
             return read_volume(out)
-        shader = ShearWarpShader(ctx, density.shape, scale=scale)
+        shader = ShearWarpShader(gpu, density.shape, scale=scale)
         made.append(shader)
         shader.begin(texture, sun_dir, sigma)
         shader.run_all()
@@ -54,7 +56,7 @@ def compute_transmittance(ctx, density, sun_dir, sigma, method: str = "shear-war
             return read_volume(shader.result)
         out = ctx.texture3d(density.shape, 1, dtype="f4")
         made.append(out)
-        prog = program(ctx, "upsample")
+        prog = program(gpu, "upsample")
         shader.result.use(0)
         prog["coarse"].value = 0
         prog["coarse_size"].value = shader.shading_shape
@@ -68,4 +70,4 @@ def compute_transmittance(ctx, density, sun_dir, sigma, method: str = "shear-war
 
 
 __all__ = ["compute_transmittance", "compute_fixed_ratio", "raymarch", "ShearWarpShader", "ShadingStage",
-           "Scattering", "LightVolumeShader", "light_volume_reference", "sky_light", "reference", "METHODS"]
+           "Scattering", "LightVolumeShader", "light_volume_reference", "grid", "reference", "METHODS"]

@@ -1,4 +1,4 @@
-"""WeatherParams: the user-facing parameters of the weather ellipsoids (thesis sec. 4.3.3.4).
+"""WeatherSettings: the user-facing settings of the weather ellipsoids (thesis sec. 4.3.3.4).
 
 Units: positions and sizes are in cells of the simulation volume; times are in seconds of
 simulation time (with ``dt = 1`` a "second" is one simulation step, as in the thesis, where the
@@ -6,25 +6,23 @@ lifetime is decreased by one per step); wind speeds are in cells per second.
 """
 from __future__ import annotations
 
-import math
-import numbers
 from dataclasses import dataclass
 
 import numpy as np
 
-from atmos.checks import check_shape, is_int
+from atmos.checks import CheckedSettings, check_int, check_num, check_shape, check_vec
 
 #: Upper bound of ``cloud_density`` (ellipsoids are ECS entities; the rules run in Python).
 MAX_CLOUD_DENSITY = 100_000
+_OWNER = "WeatherSettings"
 
 
-def _is_real(value) -> bool:
-    return isinstance(value, (numbers.Real, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
+@dataclass(frozen=True, eq=False)
+class WeatherSettings(CheckedSettings):
+    """Settings of the ellipsoid weather (sec. 4.3.3.4) and of the region-volume probabilities.
 
-
-@dataclass(slots=True, eq=False)
-class WeatherParams:
-    """Parameters of the ellipsoid weather (sec. 4.3.3.4) and of the region-volume probabilities.
+    Every field is live (read when the next step begins) but ``volume_shape``, which sizes the
+    GPU volumes: it is FIXED.
 
     Ellipsoids
         ``cloud_density``: target number of ellipsoids (in the whole region, not only in view).
@@ -78,77 +76,54 @@ class WeatherParams:
     ext_scale: float = 0.1
     vanish_threshold: float = 0.001
 
+    FIXED = ("volume_shape",)
+
     def __post_init__(self):
-        self.validate()
-
-    def validate(self) -> "WeatherParams":
-        """Check every field; raise ValueError naming the field and what is allowed. Returns self."""
-        def real(name, lo=None, hi=None, lo_open=False):
-            value = getattr(self, name)
-            if not _is_real(value) or not math.isfinite(float(value)):
-                raise ValueError(f"WeatherParams.{name} must be a finite number, got {value!r}")
-            value = float(value)
-            if lo is not None and (value < lo or (lo_open and value == lo)):
-                raise ValueError(f"WeatherParams.{name} must be {'>' if lo_open else '>='} {lo}"
-                                 + (f" and <= {hi}" if hi is not None else "") + f", got {value!r}")
-            if hi is not None and value > hi:
-                raise ValueError(f"WeatherParams.{name} must be <= {hi}, got {value!r}")
-            object.__setattr__(self, name, value)
-            return value
-
-        def integer(name, lo, hi):
-            value = getattr(self, name)
-            if not is_int(value) or not lo <= int(value) <= hi:
-                raise ValueError(f"WeatherParams.{name} must be an int in [{lo}, {hi}], got {value!r}")
-            object.__setattr__(self, name, int(value))
-
-        integer("cloud_density", 0, MAX_CLOUD_DENSITY)
-        integer("density_adaption", 1, MAX_CLOUD_DENSITY)
-        size = real("cloud_size", 0.0, lo_open=True)
-        real("cloud_size_variance", 0.0)
-        if self.cloud_size_variance >= size:
-            raise ValueError(f"WeatherParams.cloud_size_variance must be >= 0 and < cloud_size ({size}) "
+        """Check every field; a ValueError names ``WeatherSettings.field``, the value and what is allowed."""
+        o = _OWNER
+        size = check_num(o, "cloud_size", self.cloud_size, 0.0, lo_open=True)
+        variance = check_num(o, "cloud_size_variance", self.cloud_size_variance, 0.0)
+        if variance >= size:
+            raise ValueError(f"{o}.cloud_size_variance must be >= 0 and < cloud_size ({size}) "
                              f"so that no radius is 0 or negative, got {self.cloud_size_variance!r}")
-        real("vertical_scale", 0.0, lo_open=True)
-        real("altitude", 0.0, 1.0)
-        real("altitude_variance", 0.0, 1.0)
-        life = real("lifetime", 0.0, lo_open=True)
-        real("lifetime_variance", 0.0)
-        if self.lifetime_variance >= life:
-            raise ValueError(f"WeatherParams.lifetime_variance must be >= 0 and < lifetime ({life}) "
+        life = check_num(o, "lifetime", self.lifetime, 0.0, lo_open=True)
+        life_variance = check_num(o, "lifetime_variance", self.lifetime_variance, 0.0)
+        if life_variance >= life:
+            raise ValueError(f"{o}.lifetime_variance must be >= 0 and < lifetime ({life}) "
                              f"so that every lifetime is positive, got {self.lifetime_variance!r}")
-        real("shrink_time", 0.0)
-        real("region_margin", 0.0)
-        object.__setattr__(self, "volume_shape", check_shape(self.volume_shape, "WeatherParams.volume_shape"))
-        wind = self.wind
-        try:
-            wind = tuple(wind)
-        except TypeError:
-            wind = None
-        if (wind is None or len(wind) != 3 or not all(_is_real(w) for w in wind)
-                or not all(math.isfinite(float(w)) for w in wind)):
-            raise ValueError(f"WeatherParams.wind must be three finite numbers (wx, wy, wz) in cells "
-                             f"per second, got {self.wind!r}")
-        object.__setattr__(self, "wind", tuple(float(w) for w in wind))
-        real("wind_variance", 0.0)
-        if self.wind_field is not None:
+        wind_field = self.wind_field
+        if wind_field is not None:
             try:
-                f = np.array(self.wind_field, dtype=np.float64)
+                f = np.array(wind_field, dtype=np.float64)
             except (TypeError, ValueError):
-                raise ValueError(f"WeatherParams.wind_field must be None or a numeric array of shape "
-                                 f"(gx, gz, 2), e.g. (8, 8, 2); got {type(self.wind_field).__name__}") from None
+                raise ValueError(f"{o}.wind_field must be None or a numeric array of shape "
+                                 f"(gx, gz, 2), e.g. (8, 8, 2); got {type(wind_field).__name__}") from None
             if f.ndim != 3 or f.shape[2] != 2 or f.shape[0] < 1 or f.shape[1] < 1:
-                raise ValueError(f"WeatherParams.wind_field must be None or an array of shape (gx, gz, 2), "
+                raise ValueError(f"{o}.wind_field must be None or an array of shape (gx, gz, 2), "
                                  f"e.g. (8, 8, 2); got shape {f.shape}")
             if not np.isfinite(f).all():
-                raise ValueError("WeatherParams.wind_field must hold finite numbers; it holds NaN or inf")
+                raise ValueError(f"{o}.wind_field must hold finite numbers; it holds NaN or inf")
             f.setflags(write=False)
-            object.__setattr__(self, "wind_field", f)
-        real("hum_scale", 0.0, 1.0)
-        real("act_scale", 0.0, 1.0)
-        real("ext_scale", 0.0, 1.0)
-        real("vanish_threshold", 0.0, 1.0)
-        return self
+            wind_field = f
+        self.store(dict(
+            cloud_density=check_int(o, "cloud_density", self.cloud_density, 0, MAX_CLOUD_DENSITY),
+            density_adaption=check_int(o, "density_adaption", self.density_adaption, 1, MAX_CLOUD_DENSITY),
+            cloud_size=size, cloud_size_variance=variance,
+            vertical_scale=check_num(o, "vertical_scale", self.vertical_scale, 0.0, lo_open=True),
+            altitude=check_num(o, "altitude", self.altitude, 0.0, 1.0),
+            altitude_variance=check_num(o, "altitude_variance", self.altitude_variance, 0.0, 1.0),
+            lifetime=life, lifetime_variance=life_variance,
+            shrink_time=check_num(o, "shrink_time", self.shrink_time, 0.0),
+            region_margin=check_num(o, "region_margin", self.region_margin, 0.0),
+            volume_shape=check_shape(self.volume_shape, f"{o}.volume_shape"),
+            wind=check_vec(o, "wind", self.wind, 3),
+            wind_variance=check_num(o, "wind_variance", self.wind_variance, 0.0),
+            wind_field=wind_field,
+            hum_scale=check_num(o, "hum_scale", self.hum_scale, 0.0, 1.0),
+            act_scale=check_num(o, "act_scale", self.act_scale, 0.0, 1.0),
+            ext_scale=check_num(o, "ext_scale", self.ext_scale, 0.0, 1.0),
+            vanish_threshold=check_num(o, "vanish_threshold", self.vanish_threshold, 0.0, 1.0),
+        ))
 
     # -- derived -------------------------------------------------------------------------
     def region_bounds(self, origin=(0.0, 0.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:

@@ -1,0 +1,42 @@
+"""SceneView: what every render pass sees of the scene this frame (``frame.view``)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from atmos.camera import Camera
+from atmos.clock import FixedClock
+from atmos.lighting import Sun
+
+
+@dataclass(frozen=True, slots=True)
+class SceneView:
+    """This frame's camera, sun, clock and frame size, built by the App before the graph runs.
+
+    A scene without a ``Camera`` or ``Sun`` resource gets the defaults (``Camera()``,
+    ``Sun()``). Passes read the scene through it, never through the App; what a pass needs of the
+    simulation comes as an imported graph resource (for clouds: ``"cloud_sets"``).
+    """
+    camera: Camera
+    sun: Sun
+    clock: FixedClock
+    size: tuple[int, int]
+
+    @property
+    def aspect(self) -> float:
+        """Width / height of the frame."""
+        return self.size[0] / self.size[1]
+
+    @property
+    def time(self) -> float:
+        """Seconds of frame time so far (``clock.frame_time``): what animated effects follow."""
+        return self.clock.frame_time
+
+    @classmethod
+    def of(cls, app) -> "SceneView":
+        """The view of ``app`` now."""
+        return cls(app.get_resource(Camera) or _DEFAULT_CAMERA, app.get_resource(Sun) or _DEFAULT_SUN, app.clock,
+                   app.gpu.size)
+
+
+_DEFAULT_CAMERA = Camera()
+_DEFAULT_SUN = Sun()

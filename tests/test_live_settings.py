@@ -1,0 +1,515 @@
+"""Live settings: every documented live setting of every plugin takes effect on the next frame.
+
+The cases are generated from the settings dataclasses' fields: each plugin has a small headless
+scene (64×40) and, per live field (every field not in ``FIXED``), a new value; the test renders a
+frame, checks that an unchanged frame renders the same (the scenes are frozen: dt = 0, sliced jobs
+paused), ``configure``s the one field, renders one frame and asserts the frame's pixels (HDR colour
+and the screen) changed — or, for settings with no visible effect in that scene, the observable they
+drive (a texture size in the compiled graph, culling counters, the clock). A coverage test fails
+when a settings class gains a live field without a case here. Rejected changes (bad value, unknown
+name, a fixed field) raise a ValueError naming ``Class.field`` and leave the settings object, the
+plugin and the rendered pixels as they were.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+import pytest
+
+from atmos.app import App
+from atmos.camera import Camera
+from atmos.defaults import DefaultPlugins
+from atmos.gpu import create_headless
+from atmos.lighting import Sun
+from atmos.plugin import Plugin
+import atmos.plugins.clouds.simulation as cloud_simulation
+import atmos.plugins.weather.system as weather_system
+from atmos.checks import CheckedSettings
+from atmos.plugins.cloud_render import CloudMarchPlugin, CloudRenderPlugin
+from atmos.plugins.cloud_render.example import example_weather
+from atmos.plugins.cloud_render.offscreen import CLOUD_COLOR
+from atmos.plugins.cloud_shadows import CloudShadowsPlugin
+from atmos.plugins.clouds import CloudSettings, CloudsPlugin
+from atmos.plugins.clouds.top_view import CloudTopViewPlugin
+from atmos.plugins.daylight import DaylightPlugin, TimeOfDay
+from atmos.plugins.fog import FogPlugin
+from atmos.plugins.ground import GroundPlugin
+from atmos.plugins.light_shafts import LightShaftsPlugin
+from atmos.plugins.light_shafts.plugin import MASK
+from atmos.plugins.overlay import OverlayPlugin
+from atmos.plugins.sky import SkyPlugin
+from atmos.plugins.sky_gradient import SkyGradientPlugin
+from atmos.plugins.sky_layer import SkyLayerPlugin
+from atmos.plugins.terrain import TerrainPlugin
+from atmos.plugins.test_volume import TestVolumePlugin, VolumeBox
+from atmos.plugins.volumetric_fog import VolumetricFogPlugin
+from atmos.plugins.weather import WeatherPlugin
+from atmos.shading.scattering import Scattering
+from atmos.shading.shear_warp import ShadingStage
+from atmos.render_core import CapturePass, RenderCorePlugin
+
+SIZE = (64, 40)
+DAY = Sun.from_angles(30.0, 200.0)
+NIGHT = Sun.from_angles(-30.0, 200.0, color=(0.0, 0.0, 0.0))
+
+
+@pytest.fixture(scope="module")
+def small_gpu():
+    context = create_headless(SIZE)
+    yield context
+    context.release()
+
+
+# -- observables ------------------------------------------------------------------------------------
+def pixels(app, plugin):
+    """What the frame shows: the HDR colour (CapturePass) and the tone-mapped screen."""
+    capture = next(p for p in app.graph.passes if isinstance(p, CapturePass))
+    return capture.color.copy(), app.gpu.read_pixels()
+
+
+def resource_size(name):
+    def observe(app, plugin):
+        compiled = app.graph.compile()
+        return compiled.resources[name].desc.size if name in compiled.resources else None
+    return observe
+
+
+def culling_counters(app, plugin):
+    s = plugin.stats
+    return s.columns_frustum_culled, s.segments_frustum_culled, s.columns_empty, s.segments_empty, s.sprites
+
+
+STEPS: list = []        # (settings, dt) of every weather step, newest last (the scenes' step_weather records)
+
+
+def recording(step_weather):
+    def step(world, settings, rng, dt=1.0, origin=(0.0, 0.0, 0.0)):
+        STEPS.append((settings, dt))
+        return step_weather(world, settings, rng, dt, origin)
+    return step
+
+
+def next_step_reads(name):
+    """What the next simulation step reads: run it (a sliced job's whole step, or the App's own fixed
+    step) and return the field its weather rules got (``dt``: the step time)."""
+    def observe(app, plugin):
+        if isinstance(plugin, CloudsPlugin):
+            plugin.simulation.job.run_step()
+        settings, dt = STEPS[-1]
+        return dt if name == "dt" else getattr(settings, name)
+    return observe
+
+
+def shading_extinction(app, plugin):
+    """The extinction the next step's shading stage latches."""
+    stage = next(s for s in plugin.simulation.job.stages if isinstance(s, ShadingStage))
+    return stage.sigma()
+
+
+def same(a, b) -> bool:
+    if isinstance(a, tuple) and isinstance(b, tuple) and len(a) == len(b):
+        return all(same(x, y) for x, y in zip(a, b))
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        return np.array_equal(a, b)
+    return a == b
+
+
+def live_fields(plugin_or_class, nested: bool = False) -> list[str]:
+    """The settings class's fields not in FIXED; ``nested``: a field holding settings of their own
+    is listed as its live fields, ``outer.inner``."""
+    cls = getattr(plugin_or_class, "settings_class", plugin_or_class)
+    names = []
+    for f in dataclasses.fields(cls):
+        if f.name in cls.FIXED:
+            continue
+        inner = f.default if isinstance(f.default, CheckedSettings) else None
+        if nested and inner is not None and dataclasses.fields(inner):
+            names += [f"{f.name}.{sub}" for sub in live_fields(type(inner), nested=True)]
+        else:
+            names.append(f.name)
+    return names
+
+
+def nested_change(setting, value) -> dict:
+    """``configure`` keywords for ``setting`` (``outer.inner``: a dict of changes to the nested settings)."""
+    outer, _, inner = setting.partition(".")
+    return {outer: {inner: value}} if inner else {outer: value}
+
+
+def nested_value(settings, setting):
+    for name in setting.split("."):
+        settings = getattr(settings, name)
+    return settings
+
+
+# -- scenes -----------------------------------------------------------------------------------------
+def look(position, target=None, yaw=None, pitch=None, far=None):
+    def place(app):
+        cam = app.resource(Camera)
+        cam.position = np.array(position, float)
+        if target is not None:
+            cam.look_at(target)
+        if yaw is not None:
+            cam.yaw, cam.pitch = yaw, pitch
+        if far is not None:
+            cam.far = far
+    return place
+
+
+def sun_toward(cam: Camera, uv) -> np.ndarray:
+    """The direction toward a sun seen at screen ``uv`` (outside [0, 1]: off screen)."""
+    ndc = np.array([2 * uv[0] - 1, 2 * uv[1] - 1, 1.0, 1.0])
+    far = np.linalg.inv(cam.view_projection(SIZE[0] / SIZE[1])) @ ndc
+    d = far[:3] / far[3] - cam.position
+    return d / np.linalg.norm(d)
+
+
+def set_sun(sun: Sun):
+    def hook(app, plugin):
+        app.insert_resource(Sun(np.array(sun.direction), sun.color))
+    return hook
+
+
+def sun_at(uv, color=(1.0, 0.95, 0.85)):
+    def hook(app, plugin):
+        app.insert_resource(Sun(sun_toward(app.resource(Camera), uv), color))
+    return hook
+
+
+def freeze_frame_times(app, plugin):
+    """The bars show wall-clock frame times: hold them still."""
+    plugin.times.record = lambda: None
+
+
+def configure_first(**changes):
+    def hook(app, plugin):
+        plugin.configure(**changes)
+    return hook
+
+
+def clouds(shape=(32, 8, 32), cell=(20.0, 15.0, 20.0), cover=40, **settings):
+    weather = example_weather(shape, cover)
+    base = dict(smoothing_slices=2, group_size=(8, 8), cell_size=cell, base_altitude=300.0)
+    base.update(settings)
+    return CloudsPlugin(CloudSettings(weather=weather, **base), seed=3, warmup_steps=12)
+
+
+CLOUD_CENTER = (320.0, 360.0, 320.0)
+
+
+@dataclass
+class Spec:
+    """A plugin's scene and, per live field, the new value (``changes``); ``observe``: fields whose
+    effect is checked on something else than the pixels; ``before``: what a field's case does
+    before the first frame (e.g. put the sun where the setting matters); ``frame_dt``: the frame
+    time of a field's frames (0 elsewhere: a frozen scene)."""
+    make: Callable[[], list]
+    kind: type
+    camera: Callable
+    changes: dict
+    sun: Sun = field(default_factory=lambda: DAY)
+    observe: dict = field(default_factory=dict)
+    before: dict = field(default_factory=dict)
+    frame_dt: dict = field(default_factory=dict)
+    warm: float = 0.5                  # seconds of clock run before the scene is frozen (animation time > 0)
+
+
+SPECS = {
+    "render_core": Spec(
+        lambda: [DefaultPlugins(overlay=False), GroundPlugin()], RenderCorePlugin,
+        look((0.0, 3.0, 10.0), yaw=0.0, pitch=0.0),
+        dict(clear_color=(0.5, 0.2, 0.1), exposure=3.0)),
+    "overlay": Spec(
+        lambda: [DefaultPlugins(overlay=True), GroundPlugin()], OverlayPlugin,
+        look((0.0, 3.0, 10.0), yaw=0.0, pitch=0.0),
+        dict(visible=False, size=(20, 10)),
+        before={"__all__": freeze_frame_times}),
+    "ground": Spec(
+        lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin()], GroundPlugin,
+        look((0.0, 3.0, 10.0), yaw=0.0, pitch=-0.2),
+        dict(half_size=5.0, tile=1.0, albedo=(0.9, 0.1, 0.1))),
+    "sky_gradient": Spec(
+        lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin()], SkyGradientPlugin,
+        look((0.0, 3.0, 10.0), yaw=0.0, pitch=0.3),
+        dict(zenith=(0.9, 0.1, 0.1), horizon=(0.1, 0.9, 0.1), ground=(0.1, 0.1, 0.9))),
+    "terrain": Spec(
+        lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), TerrainPlugin(cells=24)], TerrainPlugin,
+        look((0.0, 50.0, 130.0), target=(0.0, 0.0, 0.0)),
+        dict(size=128.0, cells=12, relief=60.0)),
+    "sky": Spec(
+        lambda: [DefaultPlugins(overlay=False), SkyPlugin(star_density=0.5)], SkyPlugin,
+        look((0.0, 2.0, 0.0), yaw=math.radians(200.0), pitch=0.45),
+        dict(turbidity=8.0, scale=0.08, sun_size_deg=4.0, sun_gain=200.0, night=(0.2, 0.1, 0.3), stars=False,
+             star_density=0.9, star_brightness=40.0, twinkle=1.0),
+        before={"sun_gain": configure_first(sun_size_deg=4.0), "night": set_sun(NIGHT), "stars": set_sun(NIGHT), "star_density": set_sun(NIGHT),
+                "star_brightness": set_sun(NIGHT), "twinkle": set_sun(NIGHT)}),
+    "sky_layer": Spec(
+        lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), SkyLayerPlugin(size=32)], SkyLayerPlugin,
+        look((123.0, 3.0, -77.0), yaw=0.3, pitch=0.6),
+        dict(emptiness=0.1, sharpness=0.9, thickness=6.0, color=(0.9, 0.1, 0.1), lit_color=(0.1, 0.9, 0.1),
+             altitude=600.0, tile_size=1500.0, horizon_fade=0.9, wind=((0.02, 0.0),) * 4, size=16,
+             base_frequency=9, seed=7, light_step=0.2, rebake_tolerance=0.0, animate=False),
+        observe={"rebake_tolerance": lambda app, plugin: plugin.octaves.bakes},
+        # a sun turned by less than the default tolerance: only a tolerance of 0 re-bakes for it
+        before={"rebake_tolerance": lambda app, plugin: plugin.configure(rebake_tolerance=1.0)},
+        warm=2.0),
+    "volumetric_fog": Spec(
+        lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(),
+                 VolumetricFogPlugin(center=(0.0, 1.0, -10.0), scale=(8.0, 2.0, 8.0), falloff=0.5, bias=0.3,
+                                     absorption=0.3, steps=16, light_steps=2, max_distance=60.0, octaves=3)],
+        VolumetricFogPlugin,
+        look((0.0, 3.0, 10.0), yaw=0.0, pitch=-0.1),
+        dict(center=(3.0, 0.0, -12.0), scale=(4.0, 3.0, 4.0), bias=0.6, falloff=0.2, frequency=0.5, octaves=5,
+             seed=9, wind=(-4.0, 1.0, 3.0), absorption=0.05, steps=40, light_steps=6, light_step=0.5,
+             max_distance=12.0, ambient=(0.9, 0.1, 0.1), scattering=(0.1, 0.1, 0.9), animate=False)),
+    "fog": Spec(
+        lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(),
+                 FogPlugin(mode="hetero_exp2", density=0.06, resolutions=(4, 8, 8, 16), tile_size=32.0)],
+        FogPlugin,
+        look((0.0, 3.0, 10.0), yaw=0.0, pitch=-0.05),
+        dict(mode="exp", density=0.01, fog_color=(0.9, 0.1, 0.1), start=5.0, end=30.0, sky="keep", octaves=2,
+             resolutions=(2, 4, 8, 8), winds=((5.0, 0.0, 0.0),) * 4, tile_size=64.0, amplitude=0.3,
+             noise="procedural", texels_per_cell=2, seed=11, time_offset=3.0),
+        before={"start": configure_first(mode="linear"), "end": configure_first(mode="linear")}),
+    "light_shafts": Spec(
+        lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(), LightShaftsPlugin()],
+        LightShaftsPlugin,
+        look((0.0, 2.0, 10.0), yaw=0.0, pitch=0.05),
+        dict(samples=8, density=0.4, decay=0.7, weight=0.3, exposure=2.0, threshold=0.2, ceiling=0.05, radius=0.1,
+             downsample=4, horizon_fade=0.9, front_fade=1.0, edge_fade=2.0),
+        before={"__all__": sun_at((0.5, 0.55)), "edge_fade": sun_at((1.15, 0.55))},
+        observe={"downsample": resource_size(MASK)}),
+    "test_volume": Spec(
+        lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(),
+                 TestVolumePlugin(resolution=(16, 8, 16), slices=4, march_steps=24)], TestVolumePlugin,
+        look((0.0, 8.0, 30.0), target=(0.0, 7.0, 0.0)),
+        {"step_seconds": 1.0, "box.center": (4.0, 9.0, 2.0), "box.size": (10.0, 4.0, 20.0), "march_steps": 4},
+        # the sliced job is paused: step_seconds drives the animation time of the next step it begins
+        observe={"step_seconds": lambda app, plugin: (plugin._begin_step(3), plugin._time)[1]}),
+    "daylight": Spec(
+        lambda: [DefaultPlugins(overlay=False), DaylightPlugin(hours=15.0), SkyPlugin(stars=False), GroundPlugin()],
+        DaylightPlugin,
+        look((0.0, 2.0, 0.0), yaw=math.radians(240.0), pitch=0.2),
+        dict(hours=9.0, speed=20.0, latitude=-30.0, day_of_year=355.0),
+        frame_dt={"speed": 0.1}),
+    "cloud_shadows": Spec(
+        lambda: [DefaultPlugins(overlay=False), clouds(shading=False), SkyGradientPlugin(), GroundPlugin(),
+                 CloudShadowsPlugin()],
+        CloudShadowsPlugin,
+        look((320.0, 400.0, 900.0), target=(320.0, 0.0, 320.0), far=6000.0),
+        dict(base_altitude=900.0, cell_size=(10.0, 30.0, 10.0), sigma=5.0, strength=0.2, direct_fraction=0.3,
+             horizon_fade=0.95),
+        sun=Sun.from_angles(50.0, 30.0)),
+    "cloud_render": Spec(
+        lambda: [DefaultPlugins(overlay=False), clouds(cover=6), SkyGradientPlugin(), GroundPlugin(),
+                 CloudRenderPlugin()],
+        CloudRenderPlugin,
+        look((320.0, 60.0, 500.0), target=(320.0, 360.0, 100.0), far=6000.0),     # some columns out of view
+        dict(base_altitude=200.0, size_factor=6.0, sigma=0.05, frustum_culling=False, empty_space_skipping=False,
+             max_point_size=1.0, downsample=4, lod_pixels=40.0, enabled=False),
+        observe={"frustum_culling": culling_counters, "empty_space_skipping": culling_counters,
+                 "downsample": resource_size(CLOUD_COLOR)}),
+}
+
+
+def _clouds_spec():
+    weather = example_weather((32, 8, 32), 20)
+    changes = dict(step_seconds=3.0, cover_threshold=6.0, sigma=2.0, scattering=Scattering("multiple-forward"),
+                   cell_size=(10.0, 30.0, 10.0), base_altitude=150.0)
+    changes.update(weather_changes(weather))
+    observe = {"step_seconds": next_step_reads("dt"), "cover_threshold": lambda app, plugin: plugin.simulation.cover(),
+               "scattering": shading_extinction}
+    observe.update({f"weather.{name}": next_step_reads(name) for name in live_fields(WeatherPlugin)})
+    return Spec(lambda: [DefaultPlugins(overlay=False), clouds(cover=20), SkyGradientPlugin(), GroundPlugin(),
+                         CloudRenderPlugin()],
+                CloudsPlugin, look((320.0, 60.0, 1100.0), target=CLOUD_CENTER, far=6000.0), changes, observe=observe)
+
+
+def weather_changes(weather, prefix="weather."):
+    """A new value for every live WeatherSettings field, valid beside the others."""
+    return {f"{prefix}{k}": v for k, v in dict(
+        cloud_density=weather.cloud_density + 7, density_adaption=weather.density_adaption + 3,
+        cloud_size=weather.cloud_size + 1.0, cloud_size_variance=weather.cloud_size_variance / 2,
+        vertical_scale=weather.vertical_scale * 2, altitude=0.3, altitude_variance=0.05,
+        lifetime=weather.lifetime * 2, lifetime_variance=weather.lifetime_variance / 2,
+        shrink_time=weather.shrink_time + 2.0, region_margin=weather.region_margin + 3.0,
+        wind=(-1.0, 0.0, 2.0), wind_variance=weather.wind_variance + 0.3, wind_field=np.ones((2, 2, 2)),
+        hum_scale=0.5, act_scale=0.05, ext_scale=0.3, vanish_threshold=0.01).items()}
+
+
+def _weather_spec():
+    weather = example_weather((16, 8, 16), 10)
+    changes = weather_changes(weather, prefix="")
+    return Spec(lambda: [DefaultPlugins(overlay=False), GroundPlugin(), WeatherPlugin(weather, seed=1)],
+                WeatherPlugin, look((0.0, 3.0, 10.0), yaw=0.0, pitch=0.0), changes,
+                observe={name: next_step_reads(name) for name in changes},
+                frame_dt={name: 1 / 30 for name in changes})         # one fixed step per frame
+
+
+SPECS["clouds"] = _clouds_spec()
+SPECS["weather"] = _weather_spec()
+SPECS["cloud_top_view"] = Spec(
+    lambda: [DefaultPlugins(overlay=False), clouds(cover=20), CloudTopViewPlugin()], CloudTopViewPlugin,
+    look((0.0, 3.0, 10.0), yaw=0.0, pitch=0.0), dict(full_column=0.5))
+
+
+def _march_scene():
+    renderer = CloudRenderPlugin(enabled=False)
+    return [DefaultPlugins(overlay=False), clouds(), SkyGradientPlugin(), GroundPlugin(), renderer,
+            CloudMarchPlugin(renderer, steps=32)]
+
+
+SPECS["cloud_march"] = Spec(_march_scene, CloudMarchPlugin, look((320.0, 60.0, 1100.0), target=CLOUD_CENTER, far=6000.0),
+                            dict(steps=4, enabled=False))
+
+
+CASES = [(name, f) for name, spec in SPECS.items() for f in live_fields(spec.kind, nested=True)]
+
+
+# -- building and running the scenes ------------------------------------------------------------------
+_APPS: dict = {}
+
+
+@pytest.fixture(scope="module")
+def scenes(small_gpu):
+    with pytest.MonkeyPatch.context() as patch:         # the weather rules record what each step reads
+        for module in (weather_system, cloud_simulation):
+            patch.setattr(module, "step_weather", recording(module.step_weather))
+        yield lambda name: _scene(small_gpu, name)
+        for app, _, _ in _APPS.values():
+            app.close()
+        _APPS.clear()
+
+
+def _scene(gpu, name):
+    """(app, plugin under test, its original settings), built once per module and reset per test."""
+    spec = SPECS[name]
+    if name not in _APPS:
+        app = App(gpu).add_plugins(*spec.make())
+        app.graph.add_pass(CapturePass())
+        app.insert_resource(Sun(np.array(spec.sun.direction), spec.sun.color))
+        spec.camera(app)
+        plugin = next(p for p in app.plugins if isinstance(p, spec.kind))
+        app.run_frames(max(1, int(spec.warm / 0.25)), dt=0.25)   # start-up, then animation time > 0
+        for job in list(app.frames.jobs):
+            app.frames.remove(job)                          # a frozen scene: sliced jobs paused
+        _APPS[name] = (app, plugin, plugin.settings)
+    app, plugin, original = _APPS[name]
+    plugin.configure(**{f: getattr(original, f) for f in live_fields(plugin)})
+    if isinstance(plugin, DaylightPlugin):
+        app.resource(TimeOfDay).hours = original.hours
+    app.insert_resource(Sun(np.array(spec.sun.direction), spec.sun.color))
+    spec.camera(app)
+    return app, plugin, spec
+
+
+def render(app, dt=0.0):
+    app.update(dt)
+    assert app.gpu.ctx.error == "GL_NO_ERROR"
+
+
+# -- the tests ----------------------------------------------------------------------------------------
+def test_every_live_setting_of_every_plugin_has_a_case():
+    for name, spec in SPECS.items():
+        missing = set(live_fields(spec.kind, nested=True)) - set(spec.changes)
+        assert not missing, f"{spec.kind.__name__}: live settings without a case: {sorted(missing)}"
+        extra = set(spec.changes) - set(live_fields(spec.kind, nested=True))
+        assert not extra, f"{spec.kind.__name__}: cases for fields that are not live settings: {sorted(extra)}"
+
+
+def test_every_plugin_follows_the_convention():
+    """One frozen settings dataclass per plugin, made from keywords and from a settings object alike."""
+    for spec in SPECS.values():
+        cls = spec.kind.settings_class
+        assert cls.__name__.endswith("Settings") and dataclasses.is_dataclass(cls)
+        assert cls.__dataclass_params__.frozen, f"{cls.__name__} must be frozen"
+        default = cls()
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            setattr(default, dataclasses.fields(cls)[0].name, None)
+
+
+@pytest.mark.parametrize("name, setting", CASES, ids=[f"{n}.{f}" for n, f in CASES])
+def test_a_live_change_shows_on_the_next_frame(scenes, name, setting):
+    app, plugin, spec = scenes(name)
+    for hook in (spec.before.get("__all__"), spec.before.get(setting)):
+        if hook is not None:
+            hook(app, plugin)
+    observe = spec.observe.get(setting, pixels)
+    dt = spec.frame_dt.get(setting, 0.0)
+    render(app, dt)
+    before = observe(app, plugin)
+    render(app, dt)
+    assert same(observe(app, plugin), before), "the scene is not frozen: an unchanged frame differs"
+    new = spec.changes[setting]
+    if setting == "rebake_tolerance":
+        sun = app.resource(Sun)                                     # turned a little: within tolerance 1
+        sun.direction = Sun.from_angles(31.0, 201.0).direction
+        render(app, dt)
+        before = observe(app, plugin)
+    settings = plugin.configure(**nested_change(setting, new))
+    assert plugin.settings is settings and same(nested_value(settings, setting), new)
+    render(app, dt)
+    assert not same(observe(app, plugin), before), f"{type(settings).__name__}.{setting} = {new!r} changed nothing"
+
+
+REJECTED = [
+    ("sky", dict(turbidity=5.0, scale=-1.0), "SkySettings.scale"),
+    ("sky", dict(turbidity=5.0, nosuch=1), "unknown SkySettings setting(s) nosuch"),
+    ("ground", dict(albedo=(1, 1)), "GroundSettings.albedo must be 3 non-negative numbers"),
+    ("render_core", dict(exposure=0.0), "RenderCoreSettings.exposure must be a finite number > 0.0"),
+    ("light_shafts", dict(exposure=1.0, downsample=0), "LightShaftSettings.downsample must be a whole number 1..8"),
+    ("light_shafts", dict(downsample=3, colour=1), "unknown LightShaftSettings setting(s) colour"),
+    ("fog", dict(density=0.01, amplitude=2.0), "FogSettings.amplitude"),
+    ("terrain", dict(relief=5.0, cells=0), "TerrainSettings.cells must be a whole number 1..1024"),
+    ("overlay", dict(visible="yes"), "OverlaySettings.visible must be True or False"),
+    ("cloud_render", dict(size_factor=2.0, lod_pixels=0.0), "CloudRenderSettings.lod_pixels"),
+    ("daylight", dict(latitude=95.0), "DaylightSettings.latitude must be a finite number >= -90.0 and <= 90.0"),
+    ("test_volume", dict(march_steps=8, resolution=(32, 8, 16)), "TestVolumeSettings.resolution cannot change"),
+    ("test_volume", dict(slices=2), "TestVolumeSettings.slices cannot change"),
+]
+
+
+@pytest.mark.parametrize("name, changes, message", REJECTED, ids=[f"{n}-{'-'.join(c)}" for n, c, _ in REJECTED])
+def test_a_rejected_change_raises_and_leaves_everything_as_it_was(scenes, name, changes, message):
+    app, plugin, spec = scenes(name)
+    if spec.before.get("__all__") is not None:
+        spec.before["__all__"](app, plugin)
+    render(app)
+    shown = pixels(app, plugin)
+    settings = plugin.settings
+    compiled = app.graph.compile()
+    with pytest.raises(ValueError) as error:
+        plugin.configure(**changes)
+    assert message in str(error.value)
+    assert plugin.settings is settings
+    render(app)
+    assert app.graph.compile() is compiled, "the render graph recompiled"
+    assert same(pixels(app, plugin), shown), "a rejected change showed"
+
+
+def test_fixed_settings_are_documented_and_refused_by_name():
+    plugin = TestVolumePlugin(resolution=(16, 8, 16), slices=4)
+    assert type(plugin.settings).FIXED == ("resolution", "slices")
+    assert plugin.configure(resolution=(16, 8, 16)).resolution == (16, 8, 16)   # not a change
+    with pytest.raises(ValueError, match=r"TestVolumeSettings\.resolution, TestVolumeSettings\.slices cannot change"):
+        plugin.configure(resolution=(8, 8, 8), slices=2)
+
+
+def test_construction_takes_a_settings_object_and_keywords_on_top():
+    base = LightShaftsPlugin(samples=12).settings
+    plugin = LightShaftsPlugin(base, exposure=0.25)
+    assert (plugin.settings.samples, plugin.settings.exposure) == (12, 0.25)
+    with pytest.raises(ValueError, match="LightShaftsPlugin settings must be a LightShaftSettings, got SkySettings"):
+        LightShaftsPlugin(SkyPlugin().settings)
+
+    class Bare(Plugin):
+        pass
+    assert Bare().settings is None
+    with pytest.raises(ValueError, match="Bare takes no settings, got exposure"):
+        Bare(exposure=1.0)
+    with pytest.raises(ValueError, match="Bare has no settings to configure"):
+        Bare().configure(exposure=1.0)
