@@ -34,7 +34,7 @@ _EXPORTS = {
     "create_headless": "atmos.gpu", "from_current": "atmos.gpu", "add_shader_path": "atmos.gpu.shaders",
     # work spread over frames
     "TextureSet": "atmos.frames", "TripleSet": "atmos.frames", "SlicedJob": "atmos.frames",
-    "SliceStage": "atmos.frames", "FrameScheduler": "atmos.frames",
+    "SliceTask": "atmos.frames", "FrameScheduler": "atmos.frames",
 }
 
 __all__ = sorted(_EXPORTS)

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from atmos.frames import FrameScheduler, SlicedJob, SliceStage, TripleSet
+from atmos.frames import FrameScheduler, SlicedJob, SliceTask, TripleSet
 from atmos.gpu import create_headless
 
 from atmos.graph import TextureDesc
@@ -44,7 +44,7 @@ def heavy_job(gpu, iterations: int) -> SlicedJob:
         program["time"] = job_ctx.state["time"]
         program.run(VOLUME[0] // 8, VOLUME[1] // 8, layers)
 
-    job = SlicedJob("heavy", [SliceStage("simulate", SLICES, run)], triple, begin=begin)
+    job = SlicedJob("heavy", [SliceTask("simulate", SLICES, run)], triple, begin=begin)
     return job
 
 

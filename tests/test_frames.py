@@ -3,7 +3,7 @@ import moderngl
 import numpy as np
 import pytest
 
-from atmos.frames import FrameScheduler, SlicedJob, SliceStage, TextureSet, TripleSet, make_texture
+from atmos.frames import FrameScheduler, SlicedJob, SliceTask, TextureSet, TripleSet, make_texture
 from atmos.graph import TextureDesc as Desc
 
 
@@ -33,7 +33,7 @@ def fill_job(gpu, name="fill", size=SIZE, layers_per_slice=1, log=None):
         layers = min(layers_per_slice, size[2] - index * layers_per_slice)
         program.run(size[0] // 4, size[1] // 4, layers)
 
-    job = SlicedJob(name, [SliceStage("fill", slices, run)], triple, begin=begin)
+    job = SlicedJob(name, [SliceTask("fill", slices, run)], triple, begin=begin)
     return job
 
 
@@ -109,16 +109,16 @@ def test_progress_over_a_step(gpu, ctx):
     job.release()
 
 
-def test_stages_run_in_order_with_callable_counts(gpu, ctx):
+def test_tasks_run_in_order_with_callable_counts(gpu, ctx):
     triple = TripleSet(gpu, {"x": Desc((2, 2))})
     calls, counts = [], {"b": 3}
 
-    def stage(name):
+    def task(name):
         return lambda i, job_ctx: calls.append((job_ctx.step, name, i, job_ctx.slices,
                                                 job_ctx.target is triple.c, job_ctx.previous is triple.b))
 
-    job = SlicedJob("chain", [SliceStage("a", 2, stage("a")), SliceStage("empty", 0, stage("empty")),
-                              SliceStage("b", lambda: counts["b"], stage("b"))], triple)
+    job = SlicedJob("chain", [SliceTask("a", 2, task("a")), SliceTask("empty", 0, task("empty")),
+                              SliceTask("b", lambda: counts["b"], task("b"))], triple)
     job.run_step()
     assert calls == [(0, "a", 0, 2, True, True), (0, "a", 1, 2, True, True),
                      (0, "b", 0, 3, True, True), (0, "b", 1, 3, True, True), (0, "b", 2, 3, True, True)]
@@ -129,7 +129,7 @@ def test_stages_run_in_order_with_callable_counts(gpu, ctx):
     job.run_step()
     assert job.step == 2 and [c[1] for c in calls[5:]] == ["a", "a", "b"]
     assert job.stats.slices_total == 8 and job.stats.mean_slice_ms >= 0.0
-    assert set(job.stats.stage_ms) == {"a", "b"}
+    assert set(job.stats.task_ms) == {"a", "b"}
     triple.release()
 
 
@@ -328,19 +328,19 @@ def test_bad_scheduler_arguments(kwargs, message):
 def test_bad_job_arguments(gpu, ctx):
     triple = TripleSet(gpu, {"x": Desc((2, 2))})
     noop = lambda i, job_ctx: None  # noqa: E731
-    with pytest.raises(ValueError, match=r"stage 'a': slices must be an int >= 0.*got -1"):
-        SliceStage("a", -1, noop)
-    with pytest.raises(ValueError, match=r"stage 'a': run must be callable"):
-        SliceStage("a", 1, None)
-    with pytest.raises(ValueError, match=r"job 'j' needs at least one SliceStage"):
+    with pytest.raises(ValueError, match=r"task 'a': slices must be an int >= 0.*got -1"):
+        SliceTask("a", -1, noop)
+    with pytest.raises(ValueError, match=r"task 'a': run must be callable"):
+        SliceTask("a", 1, None)
+    with pytest.raises(ValueError, match=r"job 'j' needs at least one SliceTask"):
         SlicedJob("j", [], triple)
-    empty = SlicedJob("j", [SliceStage("a", lambda: 0, noop)], triple)
+    empty = SlicedJob("j", [SliceTask("a", lambda: 0, noop)], triple)
     with pytest.raises(ValueError, match=r"job 'j': step 0 has no slices"):
         empty.run_slices(1)
-    bad_count = SlicedJob("j", [SliceStage("a", lambda: "3", noop)], triple)
-    with pytest.raises(ValueError, match=r"stage 'a': slices must be an int"):
+    bad_count = SlicedJob("j", [SliceTask("a", lambda: "3", noop)], triple)
+    with pytest.raises(ValueError, match=r"task 'a': slices must be an int"):
         bad_count.run_step()
-    job = SlicedJob("j", [SliceStage("a", 2, noop)], triple)
+    job = SlicedJob("j", [SliceTask("a", 2, noop)], triple)
     with pytest.raises(ValueError, match=r"n must be an int >= 0; got -1"):
         job.run_slices(-1)
     assert job.run_slices(0) == 0
@@ -349,9 +349,9 @@ def test_bad_job_arguments(gpu, ctx):
     with pytest.raises(ValueError, match="already in this FrameScheduler"):
         scheduler.add(job)
     with pytest.raises(ValueError, match=r"a job named 'j' is already.*must be unique"):
-        scheduler.add(SlicedJob("j", [SliceStage("a", 2, noop)], triple))
+        scheduler.add(SlicedJob("j", [SliceTask("a", 2, noop)], triple))
     with pytest.raises(ValueError, match=r"job 'other' is not in this FrameScheduler; present: j"):
-        scheduler.remove(SlicedJob("other", [SliceStage("a", 2, noop)], triple))
+        scheduler.remove(SlicedJob("other", [SliceTask("a", 2, noop)], triple))
     triple.release()
 
 
@@ -364,7 +364,7 @@ def test_failed_slice_is_retried(gpu, ctx):
         if len(calls) == 2:
             raise RuntimeError("boom")
 
-    job = SlicedJob("j", [SliceStage("a", 3, run)], triple)
+    job = SlicedJob("j", [SliceTask("a", 3, run)], triple)
     job.run_slices(1)
     with pytest.raises(RuntimeError, match="boom"):
         job.run_slices(1)

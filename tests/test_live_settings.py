@@ -49,7 +49,7 @@ from atmos.plugins.test_volume import TestVolumePlugin, VolumeBox
 from atmos.plugins.volumetric_fog import VolumetricFogPlugin
 from atmos.plugins.weather import WeatherPlugin
 from atmos.shading.scattering import Scattering
-from atmos.shading.shear_warp import ShadingStage
+from atmos.shading.shear_warp import ShadingTask
 from atmos.render_core import CapturePass, RenderCorePlugin
 
 SIZE = (64, 40)
@@ -105,9 +105,9 @@ def next_step_reads(name):
 
 
 def shading_extinction(app, plugin):
-    """The extinction the next step's shading stage latches."""
-    stage = next(s for s in plugin.simulation.job.stages if isinstance(s, ShadingStage))
-    return stage.sigma()
+    """The extinction the next step's shading task latches."""
+    task = next(s for s in plugin.simulation.job.tasks if isinstance(s, ShadingTask))
+    return task.sigma()
 
 
 def same(a, b) -> bool:

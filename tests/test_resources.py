@@ -4,7 +4,7 @@ import pytest
 
 from atmos.app import App
 from atmos.defaults import DefaultPlugins
-from atmos.frames import FrameScheduler, SlicedJob, SliceStage, TripleSet, timer_query_measure
+from atmos.frames import FrameScheduler, SlicedJob, SliceTask, TripleSet, timer_query_measure
 from atmos.gpu import create_headless
 from atmos.gpu.queries import QueryPool, query_pool
 from atmos.graph import PassTimers, TextureDesc, TexturePool
@@ -190,7 +190,7 @@ def tiny_job(gpu):
 
     def run(index, job_ctx):
         job_ctx.target["v"].write(bytes(16), viewport=(0, index, 4, 1))
-    return SlicedJob("tiny", [SliceStage("rows", 4, run)], triple)
+    return SlicedJob("tiny", [SliceTask("rows", 4, run)], triple)
 
 
 def gl_objects(app, gpu, made):

@@ -7,7 +7,7 @@ import pytest
 from atmos.frames import SlicedJob, TripleSet
 from atmos.graph import TextureDesc
 from atmos.lighting import sky_light
-from atmos.shading import (LightVolumeShader, Scattering, ShadingStage, ShearWarpShader,
+from atmos.shading import (LightVolumeShader, Scattering, ShadingTask, ShearWarpShader,
                            compute_fixed_ratio, compute_transmittance, light_volume_reference,
                            reference as R)
 from atmos.shading.scattering import harris_reference
@@ -250,7 +250,7 @@ def test_shading_stage_one_slice_per_frame_with_moving_sun(gpu, ctx, rng):
         state["at_start"].append(d)
         return d
 
-    job = SlicedJob("clouds", [ShadingStage(shader, sun, 0.4)], triple)
+    job = SlicedJob("clouds", [ShadingTask(shader, sun, 0.4)], triple)
     ticks = 0
     while job.step < 3:
         job.run_slices(1)

@@ -1,7 +1,7 @@
 """A simulation chain split into slices, computed a few slices per frame into texture set C.
 
-A :class:`SlicedJob` is a list of :class:`SliceStage` (for clouds: region volume → automaton step
-→ smoothing → density maps → shading). One *step* runs every slice of every stage, in order,
+A :class:`SlicedJob` is a list of :class:`SliceTask` (for clouds: region volume → automaton step
+→ smoothing → density maps → shading). One *step* runs every slice of every task, in order,
 writing into ``triple.c`` and reading the previous result ``triple.b``. When the last slice of a
 step finishes the triple rotates, so readers, who only ever get ``(A, B, t)`` from :meth:`view`,
 never see a half-written set.
@@ -78,9 +78,9 @@ class SliceContext:
 
     job: "SlicedJob"
     step: int                 # index of the step being computed (0 for the first)
-    stage: "SliceStage"
-    slice: int                # index of this slice inside its stage
-    slices: int               # number of slices of this stage in this step
+    task: "SliceTask"
+    slice: int                # index of this slice inside its task
+    slices: int               # number of slices of this task in this step
     target: TextureSet        # triple.c, being written
     previous: TextureSet      # triple.b, the newest completed result (read only)
     state: dict               # the job's scratch space, kept across slices and steps
@@ -90,15 +90,15 @@ class SliceContext:
         return self.job.triple.gpu
 
 
-class SliceStage:
-    """One stage of a chain: ``slices`` pieces of work (an int, or a callable asked at the start of each step).
+class SliceTask:
+    """One task of a chain: ``slices`` pieces of work (an int, or a callable asked at the start of each step).
 
     ``run(slice_index, job_ctx)`` does one slice, writing into ``job_ctx.target``.
     """
 
     def __init__(self, name: str, slices: int | Callable[[], int], run: Callable[[int, SliceContext], None]):
         if not callable(run):
-            raise ValueError(f"stage {name!r}: run must be callable as run(slice_index, job_ctx); got {run!r}")
+            raise ValueError(f"task {name!r}: run must be callable as run(slice_index, job_ctx); got {run!r}")
         if not callable(slices):
             _check_count(name, slices)
         self.name = name
@@ -110,12 +110,12 @@ class SliceStage:
         return _check_count(self.name, self.slices() if callable(self.slices) else self.slices)
 
     def __repr__(self) -> str:
-        return f"SliceStage({self.name!r}, slices={self.slices!r})"
+        return f"SliceTask({self.name!r}, slices={self.slices!r})"
 
 
 def _check_count(name: str, value) -> int:
     if isinstance(value, bool) or not isinstance(value, int) or value < 0:
-        raise ValueError(f"stage {name!r}: slices must be an int >= 0 (or a callable returning one); got {value!r}")
+        raise ValueError(f"task {name!r}: slices must be an int >= 0 (or a callable returning one); got {value!r}")
     return value
 
 
@@ -128,7 +128,7 @@ class JobStats:
     steps: int = 0
     slices_total: int = 0
     ms_total: float = 0.0
-    stage_ms: dict = field(default_factory=dict)   # stage name → moving average of its slice cost (ms)
+    task_ms: dict = field(default_factory=dict)   # task name → moving average of its slice cost (ms)
 
     @property
     def mean_slice_ms(self) -> float:
@@ -136,39 +136,39 @@ class JobStats:
 
 
 class SlicedJob:
-    """A chain of sliced stages writing into ``triple.c``; see the module docstring.
+    """A chain of sliced tasks writing into ``triple.c``; see the module docstring.
 
     ``begin(step)`` is called before the first slice of each step, with the index of the step about
     to be computed (equal to the number of completed steps), to advance simulation parameters.
     """
 
-    EMA = 0.25  # weight of the newest sample in the per-stage cost estimate
+    EMA = 0.25  # weight of the newest sample in the per-task cost estimate
 
-    def __init__(self, name: str, stages: list[SliceStage], triple: TripleSet,
+    def __init__(self, name: str, tasks: list[SliceTask], triple: TripleSet,
                  begin: Callable[[int], None] | None = None):
-        if not stages:
-            raise ValueError(f"job {name!r} needs at least one SliceStage; got none")
-        for stage in stages:
-            if not isinstance(stage, SliceStage):
-                raise ValueError(f"job {name!r}: stages must be SliceStage objects; got {stage!r}")
+        if not tasks:
+            raise ValueError(f"job {name!r} needs at least one SliceTask; got none")
+        for task in tasks:
+            if not isinstance(task, SliceTask):
+                raise ValueError(f"job {name!r}: tasks must be SliceTask objects; got {task!r}")
         self.name = name
-        self.stages = list(stages)
+        self.tasks = list(tasks)
         self.triple = triple
         self.begin = begin
         self.step = 0
         self.state: dict = {}
         self.stats = JobStats()
-        self._plan: list[int] | None = None   # slices per stage of the current step, fixed when it begins
+        self._plan: list[int] | None = None   # slices per task of the current step, fixed when it begins
         self._total = 0
         self._done = 0
-        self._stage = 0                        # cursor: stage index and slice inside it
+        self._task = 0                        # cursor: task index and slice inside it
         self._slice = 0
 
     # -- progress ---------------------------------------------------------------------------
     @property
     def slices_in_step(self) -> int:
-        """Slices of the current step (fixed when it begins; the stages' current counts before that)."""
-        return self._total if self._plan is not None else sum(stage.count() for stage in self.stages)
+        """Slices of the current step (fixed when it begins; the tasks' current counts before that)."""
+        return self._total if self._plan is not None else sum(task.count() for task in self.tasks)
 
     @property
     def slices_done(self) -> int:
@@ -185,11 +185,11 @@ class SlicedJob:
         return self.step >= 2
 
     @property
-    def next_stage(self) -> SliceStage:
-        """The stage the next slice belongs to."""
+    def next_task(self) -> SliceTask:
+        """The task the next slice belongs to."""
         if self._plan is None:
-            return next((s for s in self.stages if s.count() > 0), self.stages[0])
-        return self.stages[self._stage]
+            return next((s for s in self.tasks if s.count() > 0), self.tasks[0])
+        return self.tasks[self._task]
 
     def view(self) -> tuple[TextureSet, TextureSet, float]:
         """(A, B, t) for readers: draw mix(A, B, t). Never returns C."""
@@ -199,25 +199,25 @@ class SlicedJob:
     def _begin_step(self) -> None:
         if self.begin is not None:
             self.begin(self.step)
-        plan = [stage.count() for stage in self.stages]
+        plan = [task.count() for task in self.tasks]
         total = sum(plan)
         if total == 0:
-            raise ValueError(f"job {self.name!r}: step {self.step} has no slices (every stage returned 0); "
+            raise ValueError(f"job {self.name!r}: step {self.step} has no slices (every task returned 0); "
                              "a step needs at least one slice to write texture set C")
         self._plan, self._total, self._done = plan, total, 0
-        self._stage, self._slice = 0, 0
-        while self._plan[self._stage] == 0:
-            self._stage += 1
+        self._task, self._slice = 0, 0
+        while self._plan[self._task] == 0:
+            self._task += 1
 
     def _run_one(self, measure: Measure) -> None:
         if self._plan is None:
             self._begin_step()
-        stage = self.stages[self._stage]
-        job_ctx = SliceContext(self, self.step, stage, self._slice, self._plan[self._stage],
+        task = self.tasks[self._task]
+        job_ctx = SliceContext(self, self.step, task, self._slice, self._plan[self._task],
                                self.triple.c, self.triple.b, self.state)
 
         def run() -> None:
-            stage.run(job_ctx.slice, job_ctx)
+            task.run(job_ctx.slice, job_ctx)
             # image writes must be visible to the next slice and, after rotation, to texture reads
             self.triple.gpu.ctx.memory_barrier()
 
@@ -227,13 +227,13 @@ class SlicedJob:
         stats.ms_last_frame += ms
         stats.slices_total += 1
         stats.ms_total += ms
-        previous = stats.stage_ms.get(stage.name)
-        stats.stage_ms[stage.name] = ms if previous is None else previous + self.EMA * (ms - previous)
+        previous = stats.task_ms.get(task.name)
+        stats.task_ms[task.name] = ms if previous is None else previous + self.EMA * (ms - previous)
 
         self._done += 1
         self._slice += 1
-        while self._stage < len(self._plan) and self._slice >= self._plan[self._stage]:
-            self._stage += 1
+        while self._task < len(self._plan) and self._slice >= self._plan[self._task]:
+            self._task += 1
             self._slice = 0
         if self._done >= self._total:
             self.triple.rotate()
@@ -241,7 +241,7 @@ class SlicedJob:
             self.stats.steps = self.step
             self._plan = None
             self._done = self._total = 0
-            self._stage = self._slice = 0
+            self._task = self._slice = 0
 
     def run_slices(self, n: int, *, measure: Measure | None = None) -> int:
         """Run ``n`` slices (crossing into the next step when one completes); returns the slices run.
@@ -269,8 +269,8 @@ class SlicedJob:
             self.run_step(measure=measure)
 
     def expected_slice_ms(self) -> float | None:
-        """Estimated cost of the next slice from its stage's measured costs (None before any measurement)."""
-        estimate = self.stats.stage_ms.get(self.next_stage.name)
+        """Estimated cost of the next slice from its task's measured costs (None before any measurement)."""
+        estimate = self.stats.task_ms.get(self.next_task.name)
         if estimate is None and self.stats.slices_total:
             estimate = self.stats.mean_slice_ms
         return estimate

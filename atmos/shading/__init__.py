@@ -1,6 +1,6 @@
 """Cloud shading: transmittance toward the sun for every voxel of a density volume (thesis ch. 5).
 
-``compute_transmittance`` is the one-shot entry point; ``ShearWarpShader`` / ``ShadingStage`` the
+``compute_transmittance`` is the one-shot entry point; ``ShearWarpShader`` / ``ShadingTask`` the
 sliced GPU path for the frame scheduler; ``raymarch`` the reference-quality GPU path; ``grid``
 the input checks and slice geometry; ``reference`` the float64 numpy references (test oracles);
 ``scattering`` the cloud light colour (sun x transmittance + ambient, multiple forward scattering
@@ -16,7 +16,7 @@ from atmos.shading.fixed_ratio import compute_fixed_ratio
 from atmos.shading.raymarch import raymarch
 from atmos.shading.scattering import LightVolumeShader, Scattering, light_volume_reference
 from atmos.gpu.context import GpuContext, require_gpu
-from atmos.shading.shear_warp import ShadingStage, ShearWarpShader, groups, program, read_volume, upload_volume
+from atmos.shading.shear_warp import ShadingTask, ShearWarpShader, groups, program, read_volume, upload_volume
 
 METHODS = ("shear-warp", "raymarch")
 
@@ -69,5 +69,5 @@ def compute_transmittance(gpu: GpuContext, density, sun_dir, sigma, method: str 
             obj.release()
 
 
-__all__ = ["compute_transmittance", "compute_fixed_ratio", "raymarch", "ShearWarpShader", "ShadingStage",
+__all__ = ["compute_transmittance", "compute_fixed_ratio", "raymarch", "ShearWarpShader", "ShadingTask",
            "Scattering", "LightVolumeShader", "light_volume_reference", "grid", "reference", "METHODS"]

@@ -17,7 +17,7 @@ class CloudsPlugin(Plugin):
     ``configure(**changes)`` changes the live ones (``configure(weather={"cloud_density": 300})``
     moves the cover from the next step on). ``seed`` (the random streams) and ``warmup_steps``
     (whole steps run at start-up, so a scene can open on formed clouds) are how it starts, not settings.
-    The shading stage reads the ``Sun`` resource's direction when a step starts (DaylightPlugin
+    The shading task reads the ``Sun`` resource's direction when a step starts (DaylightPlugin
     moves it). Resources it adds: ``VolumeOrigin`` (move it with the viewer; one already present is
     used) and the :class:`CloudSimulation` (readers take ``view()`` and ``max_maps()`` from it).
     """

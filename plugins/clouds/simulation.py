@@ -17,7 +17,7 @@ import numpy as np
 from atmos.checks import (CheckedSettings, check_bool, check_choice, check_int, check_num, check_vec,
                           is_int)
 
-from atmos.frames import SlicedJob, SliceStage, TripleSet
+from atmos.frames import SlicedJob, SliceTask, TripleSet
 from atmos.graph import TextureDesc
 from atmos.automaton import CloudAutomaton
 from atmos.plugins.clouds.density_maps import DensityMaps
@@ -26,7 +26,7 @@ from atmos.plugins.clouds.sets import CloudSets
 from atmos.plugins.clouds.smoothing import FORMATS, WEIGHTS, Smoother, slice_range
 from atmos.shading.grid import check_scale, shading_shape
 from atmos.shading.scattering import Scattering
-from atmos.shading.shear_warp import ShadingStage, ShearWarpShader
+from atmos.shading.shear_warp import ShadingTask, ShearWarpShader
 from atmos.plugins.weather import RegionVolume, VolumeOrigin, WeatherSettings, ellipsoid_array, step_weather
 
 
@@ -172,18 +172,18 @@ class CloudSimulation:
         self._drift = np.zeros(2)          # sub-cell wind displacement not yet applied
         self._last_origin = np.array(self.origin.as_tuple())
         n = s.smoothing_slices
-        stages = [
-            SliceStage("region", 1, self._region_slice),
-            SliceStage("automaton", 1, self._automaton_slice),
-            SliceStage("smoothing", n, self._smoothing_slice),
-            SliceStage("density_maps", n, self._maps_slice),
+        tasks = [
+            SliceTask("region", 1, self._region_slice),
+            SliceTask("automaton", 1, self._automaton_slice),
+            SliceTask("smoothing", n, self._smoothing_slice),
+            SliceTask("density_maps", n, self._maps_slice),
         ]
         if s.shading:                  # sigma and scattering read when each step's shading begins
-            stages.append(ShadingStage(self.shader, self.sun_in_cells, lambda: self.settings.extinction,
+            tasks.append(ShadingTask(self.shader, self.sun_in_cells, lambda: self.settings.extinction,
                                        slices_per_run=s.shading_slices_per_run))
-        self.job = SlicedJob("clouds", stages, self.triple)
+        self.job = SlicedJob("clouds", tasks, self.triple)
 
-    # -- stages ------------------------------------------------------------------------------
+    # -- tasks -------------------------------------------------------------------------------
     def _region_slice(self, index: int, job) -> None:
         origin = self.origin.as_tuple()
         self._placement[id(job.target)] = origin

@@ -5,7 +5,7 @@ import math
 from dataclasses import dataclass
 
 from atmos.checks import CheckedSettings, check_int, check_num, check_shape, check_vec
-from atmos.frames import SlicedJob, SliceStage, TripleSet
+from atmos.frames import SlicedJob, SliceTask, TripleSet
 from atmos.graph import FullscreenPass, PassContext, TextureDesc
 from atmos.lighting import set_scene_uniforms
 from atmos.plugin import Plugin
@@ -69,7 +69,7 @@ class TestVolumePlugin(Plugin):
         desc = TextureDesc(s.resolution, components=1, dtype="f2")
         self.triple = TripleSet(app.gpu, {"density": desc})
         self.program = app.gpu.program(compute_shader="test_volume/density.comp")
-        self.job = SlicedJob("test_volume", [SliceStage("density", s.slices, self._fill_slice)],
+        self.job = SlicedJob("test_volume", [SliceTask("density", s.slices, self._fill_slice)],
                              self.triple, begin=self._begin_step)
         app.add_system(lambda app: self.job.prime(), "startup", label="test_volume_prime")
         app.frames.add(self.job)

@@ -1,8 +1,8 @@
 """Cloud smoothing and density-map time at 256x32x256 beside the thesis's Table 8.1.
 
-A plain script (``python3 benchmarks/bench_cloud_stages.py [--runs N] [--shape NX NY NZ]``) that
+A plain script (``python3 benchmarks/bench_cloud_tasks.py [--runs N] [--shape NX NY NZ]``) that
 prints ms per stage (median of N runs, ctx.finish() before and after each) for the whole volume
-and per slice when split into ``--slices`` z slices, and writes ``out/bench_cloud_stages.png``:
+and per slice when split into ``--slices`` z slices, and writes ``out/bench_cloud_tasks.png``:
 the top-view density map, one height band, the max map over the sprite-group grid and a
 vertical cut through the smoothed volume.
 """
@@ -103,7 +103,7 @@ def main() -> None:
     parser.add_argument("--shape", type=int, nargs=3, default=(256, 32, 256))
     parser.add_argument("--runs", type=int, default=7, help="timed runs per case (median)")
     parser.add_argument("--slices", type=int, default=32, help="z slices for the sliced rows")
-    parser.add_argument("--out", type=Path, default=ROOT / "out" / "bench_cloud_stages.png")
+    parser.add_argument("--out", type=Path, default=ROOT / "out" / "bench_cloud_tasks.png")
     args = parser.parse_args()
     shape = tuple(args.shape)
     gpu = create_headless((16, 16))
