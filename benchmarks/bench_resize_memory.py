@@ -5,8 +5,8 @@ sizes 1280+7k × 720+5k (k = 0..29, two frames each, as a user dragging a window
 frames back at 1280×720. Prints host RSS (``/proc/self/statm``) and the textures and bytes the render
 graph's pool holds at the start, at the peak and at the end, and the growth in %. Raw RSS keeps what
 glibc's allocator holds on to after ``free`` (its mmap threshold rises after large frees), so RSS is
-also shown after ``malloc_trim(0)`` ("trimmed"); ``MALLOC_MMAP_THRESHOLD_=1048576`` in the
-environment keeps raw RSS flat too. Goal: trimmed RSS and pool bytes end within 5 % of the start:
+also shown after ``malloc_trim(0)`` ("trimmed"); on a software rasterizer atmos fixes glibc's mmap
+threshold itself (:mod:`atmos.gpu.host_memory`), so raw RSS stays flat too. Goal: trimmed RSS and pool bytes end within 5 % of the start:
 the pool evicts textures of sizes no frame uses any more (``TexturePool.end_frame``, ``keep_frames``).
 
     python benchmarks/bench_resize_memory.py [--sizes 30] [--frames-per-size 2] [--keep-frames 3]

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 from atmos.frames.texture_sets import TextureSet, TripleSet
+from atmos.gpu.host_memory import is_software
 from atmos.gpu.queries import query_pool
 
 Measure = Callable[[Callable[[], None]], float]
@@ -58,12 +59,6 @@ def timer_query_measure(ctx) -> Measure:
         finally:
             pool.release(query)
     return measure
-
-
-def is_software(ctx) -> bool:
-    """True on a software rasterizer (llvmpipe, softpipe, swrast), whose timer queries mean nothing."""
-    renderer = ctx.info.get("GL_RENDERER", "").lower()
-    return any(name in renderer for name in ("llvmpipe", "softpipe", "swrast"))
 
 
 def gpu_measure(ctx) -> Measure:

@@ -6,6 +6,7 @@ import weakref
 import moderngl
 import numpy as np
 
+from atmos.gpu.host_memory import is_software, return_freed_textures
 from atmos.gpu.queries import QueryPool, query_pool
 from atmos.gpu.shaders import build_program
 
@@ -88,6 +89,9 @@ class GpuContext:
         self._tracked: "weakref.WeakSet" = weakref.WeakSet()
         self._offscreen: list = []
         self.queries: QueryPool = query_pool(ctx)  # query objects shared by every App on this context
+        self.software = is_software(ctx)
+        if self.software:
+            return_freed_textures()
         self.target: moderngl.Framebuffer = ctx.screen
         self.resize(size)
 
