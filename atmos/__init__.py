@@ -13,11 +13,12 @@ from importlib import import_module
 
 _EXPORTS = {
     # the App and plugins
-    "App": "atmos.app", "Plugin": "atmos.plugin", "PluginGroup": "atmos.plugin",
+    "App": "atmos.app", "AppError": "atmos.app", "Plugin": "atmos.plugin", "PluginGroup": "atmos.plugin",
     "DefaultPlugins": "atmos.defaults", "discover_plugins": "atmos.plugin",
     # plugin settings (the convention: atmos.checks)
     "CheckedSettings": "atmos.checks", "check_num": "atmos.checks", "check_int": "atmos.checks",
     "check_vec": "atmos.checks", "check_bool": "atmos.checks", "check_choice": "atmos.checks",
+    "declared_rules": "atmos.checks", "Rule": "atmos.checks",
     "RenderCoreSettings": "atmos.render_core",
     # render passes and the graph
     "RenderPass": "atmos.graph", "FullscreenPass": "atmos.graph", "PassBuilder": "atmos.graph",
@@ -26,12 +27,19 @@ _EXPORTS = {
     "COLOR": "atmos.render_core", "DEPTH": "atmos.render_core", "SCREEN": "atmos.render_core",
     "CapturePass": "atmos.render_core", "RenderCorePlugin": "atmos.render_core",
     # what passes see and write
-    "SceneView": "atmos.scene_view", "Camera": "atmos.camera", "Input": "atmos.camera",
-    "CameraPlugin": "atmos.camera", "set_camera_uniforms": "atmos.camera", "Sun": "atmos.lighting",
+    "SceneView": "atmos.scene_view", "Camera": "atmos.camera", "CameraPlugin": "atmos.camera", "set_camera_uniforms": "atmos.camera", "Sun": "atmos.lighting",
     "set_sun_uniforms": "atmos.lighting", "set_scene_uniforms": "atmos.lighting", "FixedClock": "atmos.clock",
+    # games: running, input, moving things and the camera
+    "run": "atmos.runner", "DemoSettings": "atmos.demo_registry", "Input": "atmos.input",
+    "InputPlugin": "atmos.input", "key": "atmos.keys", "mouse": "atmos.keys", "Transform": "atmos.transform",
+    "Pose": "atmos.transform", "TransformPlugin": "atmos.transform", "FlyCameraPlugin": "atmos.camera_control",
+    "ChaseCameraPlugin": "atmos.camera_control", "HostFramePlugin": "atmos.host_frame",
     # GPU
     "GpuContext": "atmos.gpu", "GpuError": "atmos.gpu", "ShaderError": "atmos.gpu",
     "create_headless": "atmos.gpu", "from_current": "atmos.gpu", "add_shader_path": "atmos.gpu.shaders",
+    "GLMeter": "atmos.gpu.gl_meter", "GLCensus": "atmos.gpu.census", "camera_matrices": "atmos.camera", "CameraMatrices": "atmos.camera",
+    # writing frames to files
+    "OutputPlugin": "atmos.output", "FrameWriter": "atmos.output", "OutputError": "atmos.output",
     # work spread over frames
     "TextureSet": "atmos.frames", "TripleSet": "atmos.frames", "SlicedJob": "atmos.frames",
     "SliceTask": "atmos.frames", "FrameScheduler": "atmos.frames",

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import time
 
+from atmos.checks import check_int, check_num
 from atmos.clock import FixedClock
 from atmos.plugin import Plugin, PluginGroup
 from atmos.scene_view import SceneView
@@ -10,17 +11,28 @@ from atmos.schedule import Schedule
 from atmos.world import World
 
 
+class AppError(RuntimeError):
+    """The App cannot do this now: it was closed, or its start-up failed; the message says which."""
+
+
 class App:
     """A game or demo scene. Plugins fill it; :meth:`update` runs one frame.
 
     ``gpu`` is an :class:`atmos.gpu.GpuContext` (window or headless); without one the App runs its
     systems only (no render graph), which is what the framework-overhead benchmark and logic tests use.
+
+    Lifetime: :meth:`close` releases everything (``gpu.release()`` closes the Apps on it first); after
+    it every other method is an :class:`AppError`. A plugin whose ``build`` raises is taken out again
+    with what it registered; a start-up that raised leaves the App unable to run (AppError).
     """
 
     def __init__(self, gpu=None, *, fixed_step: float = 1 / 30, max_frame_dt: float = 0.1):
         from atmos.frames import FrameScheduler
         from atmos.graph import RenderGraph
+        from atmos.gpu.context import require_gpu
 
+        if gpu is not None:
+            require_gpu(gpu, "App gpu")._require_live()
         self.gpu = gpu
         self.world = World()
         self.schedule = Schedule()
@@ -30,14 +42,22 @@ class App:
         self.graph = RenderGraph(gpu) if gpu is not None else None
         self.frames = FrameScheduler()
         self.running = True
-        self._started = self._finished = False
+        self._started = self._finished = self._closed = False
+        self._finished_plugins: set[int] = set()     # id() of plugins whose finish ran
+        self._closed_by = "App.close"
+        self._startup_error: BaseException | None = None
+        if gpu is not None:
+            gpu._apps.add(self)
         self.add_system(lambda app: app.frames.tick(), "render", label="frame_scheduler")
         if self.graph is not None:
             self.add_system(App.render, "render", label="render_graph", after="frame_scheduler")
 
     # -- building --------------------------------------------------------------------------
     def add_plugins(self, *plugins: Plugin | PluginGroup) -> "App":
-        """Build plugins (and every plugin of a group) into this App, in order."""
+        """Build plugins (and every plugin of a group) into this App, in order. A plugin whose
+        ``build`` raises is taken out again, with the systems, passes, imports, resources, jobs and
+        plugins it added (and its ``cleanup`` run), so a corrected one can be added after."""
+        self._check_open("add_plugins")
         self._activate()
         for item in plugins:
             for plugin in (item if isinstance(item, PluginGroup) else [item]):
@@ -45,17 +65,53 @@ class App:
                     raise TypeError(f"add_plugins takes Plugin or PluginGroup instances, not {type(plugin).__name__}")
                 if any(type(p) is type(plugin) for p in self.plugins):
                     raise ValueError(f"{plugin.name} was added twice; each plugin type may be added once")
+                mark = self._mark()
                 self.plugins.append(plugin)
-                plugin.build(self)
+                try:
+                    plugin.build(self)
+                except BaseException as error:
+                    self._undo(mark, error)
+                    raise
         return self
+
+    def _mark(self) -> tuple:
+        """What :meth:`_undo` needs to take a failed build out again."""
+        graph = self.graph
+        return (len(self.plugins), len(self.schedule.systems), dict(self.resources), list(self.frames.jobs),
+                set(graph._passes) if graph else set(), dict(graph._imports) if graph else {})
+
+    def _undo(self, mark: tuple, error: BaseException) -> None:
+        """Remove the plugins (a failed one, and what its build added) and registrations made since ``mark``."""
+        plugins, systems, resources, jobs, passes, imports = mark
+        for plugin in reversed(self.plugins[plugins:]):
+            try:
+                plugin.cleanup(self)
+            except Exception as failure:   # a half-built plugin may not clean up; the build error matters
+                error.add_note(f"{plugin.name}.cleanup after the failed build also failed: {failure!r}")
+        del self.plugins[plugins:]
+        self.schedule.truncate(systems)
+        self.resources.clear()
+        self.resources.update(resources)
+        for job in [j for j in self.frames.jobs if not any(j is k for k in jobs)]:
+            self.frames.remove(job)
+        if self.graph is not None:
+            for name in set(self.graph._passes) - passes:
+                self.graph.remove_pass(name)
+            self.graph._imports.clear()
+            self.graph._imports.update(imports)
 
     def add_system(self, func, stage: str = "update", label: str | None = None, before=(), after=()) -> "App":
         """Run ``func(app)`` in ``stage`` every frame (``simulate``: every fixed step)."""
+        self._check_open("add_system")
         self.schedule.add(func, stage, label, before, after)
         return self
 
     def insert_resource(self, resource) -> "App":
         """Store one object per type, reachable with ``app.resource(Type)``."""
+        self._check_open("insert_resource")
+        if resource is None or isinstance(resource, type):
+            raise ValueError(f"insert_resource takes an object (one per type), got {resource!r}"
+                             + (f"; did you mean {resource.__name__}()?" if isinstance(resource, type) else ""))
         self.resources[type(resource)] = resource
         return self
 
@@ -76,25 +132,42 @@ class App:
         here), the render graph compiled. Runs no system: what ``atmos graph`` needs."""
         if self._finished:
             return
+        self._check_open("finish")
         self._activate()
         for plugin in self.plugins:
-            plugin.finish(self)
+            if id(plugin) not in self._finished_plugins:   # a retry after a failure runs each finish once
+                plugin.finish(self)
+                self._finished_plugins.add(id(plugin))
         self.schedule.build()
         if self.graph is not None:
             self.graph.compile()
         self._finished = True
 
     def startup(self) -> None:
-        """:meth:`finish`, then run the ``startup`` stage once (simulations warm up there)."""
+        """:meth:`finish`, then run the ``startup`` stage once (simulations warm up there). If a
+        start-up system raises, the App cannot run: this and every later frame raise AppError."""
+        self._check_open("startup")
+        if self._startup_error is not None:
+            raise AppError(f"this App's start-up failed ({type(self._startup_error).__name__}: "
+                           f"{self._startup_error}); close it and build a new App") from self._startup_error
         if self._started:
             return
         self.finish()
         self._started = True
-        self.schedule.run("startup", self)
+        try:
+            self.schedule.run("startup", self)
+        except BaseException as error:
+            self._startup_error = error
+            raise
 
     def update(self, frame_dt: float | None = None) -> None:
-        """Run one frame: update, the due fixed ``simulate`` steps, render, last."""
-        if not self._started:
+        """Run one frame: update, the due fixed ``simulate`` steps, render, last. ``frame_dt``:
+        seconds since the last frame (a finite number >= 0; the clock clamps it to ``max_frame_dt``),
+        or None to measure it."""
+        self._check_open("update")
+        if frame_dt is not None:
+            frame_dt = check_num("App.update", "frame_dt", frame_dt, 0.0, optional=True)
+        if not self._started or self._startup_error is not None:
             self.startup()
         if frame_dt is None:
             now = time.perf_counter()
@@ -102,21 +175,61 @@ class App:
             self._last = now
         self._activate()
         steps = self.clock.advance(frame_dt)
-        self.schedule.run("update", self)
+        self._run("update")
         for _ in range(steps):
-            self.schedule.run("simulate", self)
+            self._run("simulate")
             self.clock.tick()
-        self.schedule.run("render", self)
-        self.schedule.run("last", self)
+        self._run("render")
+        self._run("last")
+
+    def _run(self, stage: str) -> None:
+        """One stage, then the ECS world's deferred deletes: an entity deleted in a stage is gone
+        from every later stage's queries (and from the frame drawn after it)."""
+        self.schedule.run(stage, self)
+        self.world.clear_dead_entities()
 
     def render(self) -> None:
         """Run the render graph once with the scene as it is (what the render stage does each frame;
         tests and tools call it to draw again without advancing time)."""
+        self._check_open("render")
+        if self.graph is None:
+            raise AppError("App.render: this App has no GPU context (App(gpu)), so nothing to render")
         self.graph.execute(SceneView.of(self))
 
+    def read_linear(self):
+        """Render once (like :meth:`render`) and return the linear HDR ``color`` before exposure and
+        tone mapping: float32 (height, width, 4), first row at the top (alpha: sky occlusion)."""
+        import numpy as np
+
+        from atmos.render_core import LinearCapturePass
+        self._check_open("read_linear")
+        if self.graph is None:
+            raise AppError("App.read_linear: this App has no GPU context (App(gpu)), so nothing to render")
+        capture = next((p for p in self.graph.passes if isinstance(p, LinearCapturePass)), None)
+        if capture is None:                  # kept once added: reads back only when armed
+            capture = self.graph.add_pass(LinearCapturePass())
+        capture.armed = True
+        try:
+            self.graph.execute(SceneView.of(self))
+        finally:
+            capture.armed = False
+        return np.ascontiguousarray(capture.color[::-1], dtype=np.float32)
+
     def run_frames(self, n: int, dt: float = 1 / 60) -> None:
+        """:meth:`update` ``n`` times (a whole number >= 0) with frame time ``dt`` (finite, >= 0)."""
+        n = check_int("App.run_frames", "n", n, 0, 2**62)
+        dt = check_num("App.run_frames", "dt", dt, 0.0)
         for _ in range(n):
             self.update(dt)
+
+    @property
+    def closed(self) -> bool:
+        """True once :meth:`close` ran."""
+        return self._closed
+
+    def _check_open(self, what: str) -> None:
+        if self._closed:
+            raise AppError(f"App.{what}: this App was closed ({self._closed_by}); build a new App")
 
     def _activate(self) -> None:
         """Make this App's ECS world and GL context the current ones."""
@@ -125,10 +238,28 @@ class App:
             self.gpu.make_current()
 
     def close(self) -> None:
-        """Release every plugin's GL objects, the render graph and the ECS world."""
-        self._activate()
+        """Release every plugin's GL objects, the render graph and the ECS world: all of them even when
+        some fail; then one AppError lists the failures. Closing again does nothing."""
+        if self._closed:
+            return
+        self._closed = True
+        failures = []
+
+        def attempt(what, func, *args):
+            try:
+                func(*args)
+            except Exception as error:
+                failures.append((what, error))
+
+        attempt("making its context current", self._activate)
         for plugin in reversed(self.plugins):
-            plugin.cleanup(self)
+            attempt(f"{plugin.name}.cleanup", plugin.cleanup, self)
         if self.graph is not None:
-            self.graph.release()
-        self.world.close()
+            attempt("the render graph's release", self.graph.release)
+        attempt("the ECS world's close", self.world.close)
+        if self.gpu is not None:
+            self.gpu._apps.discard(self)
+        if failures:
+            listed = "; ".join(f"{what}: {type(error).__name__}: {error}" for what, error in failures)
+            raise AppError(f"App.close released everything else, but {len(failures)} step(s) failed: "
+                           f"{listed}") from failures[0][1]

@@ -1,4 +1,4 @@
-"""A perspective camera resource and a fly-camera controller driven by the Input resource."""
+"""The perspective camera resource, its matrices and the camera uniforms every pass writes."""
 from __future__ import annotations
 
 import math
@@ -6,30 +6,77 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from atmos.checks import check_num, check_vec
+from atmos.orientation import angles, basis
 from atmos.plugin import Plugin
+
+
+#: The smallest ``near`` (m): rasterised geometry keeps a depth below 1 out to about 1.6e7 × near
+#: (24-bit depth), 1.6 km at this limit; a smaller near loses the terrain behind a few centimetres.
+MIN_NEAR = 1e-4
+#: The largest far / near: view rays and distances from depth stay exact in float32 up to here.
+MAX_FAR_NEAR = 1e15
 
 
 @dataclass(slots=True)
 class Camera:
-    """World-space camera: y is up; yaw 0 looks along −z, pitch > 0 looks up (radians)."""
+    """World-space camera (y up), angles in radians (:mod:`atmos.orientation`): yaw 0 looks along −z,
+    pitch > 0 looks up (−π/2 … π/2), roll > 0 banks right. ``fov_y``: vertical field of view in
+    radians, in (0, π); ``near``, ``far``: the clip planes in metres, ``MIN_NEAR <= near < far``,
+    far / near at most ``MAX_FAR_NEAR``.
+
+    Every field is checked when it is set (a ValueError names the field, the value and what is
+    allowed); near < far is checked at construction and by :meth:`check`, which the App runs before
+    each frame (so ``cam.near, cam.far = 500, 1e5`` may pass through near > far in between).
+    """
     position: np.ndarray = field(default_factory=lambda: np.array([0.0, 2.0, 8.0]))
     yaw: float = 0.0
     pitch: float = 0.0
+    roll: float = 0.0
     fov_y: float = math.radians(60.0)
     near: float = 0.1
     far: float = 2000.0
 
+    def __setattr__(self, name: str, value) -> None:
+        object.__setattr__(self, name, _check_field(name, value))
+
+    def __post_init__(self):
+        self.check()
+
+    def check(self) -> "Camera":
+        """Raise a ValueError unless the fields fit together (near < far, far / near, a finite
+        position even after in-place edits); returns the camera."""
+        for name in ("position", "yaw", "pitch", "roll", "fov_y", "near", "far"):
+            _check_field(name, getattr(self, name))
+        if not self.far > self.near:
+            raise ValueError(f"Camera.far must be greater than Camera.near, got near={self.near!r}, far={self.far!r}")
+        if self.far / self.near > MAX_FAR_NEAR:
+            raise ValueError(f"Camera.far / Camera.near must be at most {MAX_FAR_NEAR:g} (depth and view rays lose "
+                             f"precision beyond), got near={self.near!r}, far={self.far!r}: raise near")
+        return self
+
+    def basis(self) -> np.ndarray:
+        """3×3 matrix with columns right, up, forward (:func:`atmos.orientation.basis`)."""
+        return basis(self.yaw, self.pitch, self.roll)
+
     def forward(self) -> np.ndarray:
-        cp = math.cos(self.pitch)
-        return np.array([math.sin(self.yaw) * cp, math.sin(self.pitch), -math.cos(self.yaw) * cp])
+        return self.basis()[:, 2]
 
     def right(self) -> np.ndarray:
-        return np.array([math.cos(self.yaw), 0.0, math.sin(self.yaw)])
+        return self.basis()[:, 0]
 
-    def look_at(self, target) -> "Camera":
+    def up(self) -> np.ndarray:
+        return self.basis()[:, 1]
+
+    def look_at(self, target, up=None) -> "Camera":
+        """Turn toward ``target`` (a point); ``up`` (a direction) sets the roll, else roll is kept."""
         d = np.asarray(target, float) - self.position
-        self.yaw = math.atan2(d[0], -d[2])
-        self.pitch = math.atan2(d[1], math.hypot(d[0], d[2]))
+        if not (d.shape == (3,) and np.isfinite(d).all() and d.any()):
+            raise ValueError(f"look_at needs a finite target other than the camera's position, got {target!r}")
+        yaw, pitch, roll = angles(d, up)
+        self.yaw, self.pitch = yaw, pitch
+        if up is not None:
+            self.roll = roll
         return self
 
     def orbit(self, target, radius: float, height: float, angle: float) -> "Camera":
@@ -39,9 +86,8 @@ class Camera:
         return self.look_at(target)
 
     def view(self) -> np.ndarray:
-        f = self.forward()
-        r = self.right()
-        u = np.cross(r, f)
+        """World → view matrix (view space: x right, y up, z backward)."""
+        r, u, f = self.basis().T
         m = np.identity(4)
         m[0, :3], m[1, :3], m[2, :3] = r, u, -f
         m[:3, 3] = -m[:3, :3] @ self.position
@@ -60,40 +106,30 @@ class Camera:
         return self.projection(aspect) @ self.view()
 
 
+def _check_field(name: str, value):
+    """The value of Camera field ``name`` as stored, or a ValueError naming it and what is allowed."""
+    if name == "position":
+        return np.array(check_vec("Camera", "position", value, 3), np.float64)
+    if name in ("yaw", "roll"):
+        return check_num("Camera", name, value)
+    if name == "pitch":
+        return check_num("Camera", name, value, -math.pi / 2, math.pi / 2)
+    if name == "fov_y":
+        v = check_num("Camera", name, value)
+        if not 0.0 < v < math.pi:
+            hint = f" (degrees? math.radians({v:g}) = {math.radians(v):.4g})" if math.pi <= v < 180 else ""
+            raise ValueError(f"Camera.fov_y must be radians in (0, pi), got {value!r}{hint}")
+        return v
+    if name == "near":
+        return check_num("Camera", name, value, MIN_NEAR)
+    if name == "far":
+        return check_num("Camera", name, value, MIN_NEAR, lo_open=True)
+    raise AttributeError(f"Camera has no field {name!r}")
+
+
 def gl_matrix(m: np.ndarray) -> bytes:
     """A 4×4 numpy matrix as the column-major float32 bytes a GLSL mat4 uniform expects."""
     return np.asarray(m, np.float32).T.tobytes()
-
-
-@dataclass
-class Input:
-    """What the window saw this frame: keys held (pyglet key names, lower case) and mouse motion."""
-    keys: set = field(default_factory=set)
-    pressed: set = field(default_factory=set)   # keys that went down this frame
-    mouse_dx: float = 0.0
-    mouse_dy: float = 0.0
-
-    def end_frame(self) -> None:
-        self.pressed.clear()
-        self.mouse_dx = self.mouse_dy = 0.0
-
-
-def fly_camera(app, speed: float = 20.0, turn: float = 0.004) -> None:
-    """System: WASD/QE move, arrow keys or mouse drag turn; shift moves 5× faster."""
-    inp: Input | None = app.get_resource(Input)
-    cam: Camera | None = app.get_resource(Camera)
-    if inp is None or cam is None:
-        return
-    dt = app.clock.dt
-    v = speed * (5.0 if {"lshift", "rshift"} & inp.keys else 1.0) * dt
-    move = {"w": cam.forward(), "s": -cam.forward(), "d": cam.right(), "a": -cam.right(),
-            "e": np.array([0, 1.0, 0]), "q": np.array([0, -1.0, 0])}
-    for key, direction in move.items():
-        if key in inp.keys:
-            cam.position = cam.position + v * direction
-    cam.yaw += inp.mouse_dx * turn + 1.5 * dt * (("right" in inp.keys) - ("left" in inp.keys))
-    cam.pitch += inp.mouse_dy * turn + 1.5 * dt * (("up" in inp.keys) - ("down" in inp.keys))
-    cam.pitch = float(np.clip(cam.pitch, -1.55, 1.55))
 
 
 def view_basis(camera: Camera, aspect: float) -> np.ndarray:
@@ -102,9 +138,9 @@ def view_basis(camera: Camera, aspect: float) -> np.ndarray:
     point at view depth z is ``camera.position + z · ray``). The same rays as unprojecting with the
     inverse view-projection, but independent of the near and far planes (unprojecting in float32
     breaks down at far/near ~ 1e11). The ``view_basis`` uniform of ``lib/view_ray.glsl``."""
-    f, r = camera.forward(), camera.right()
+    r, u, f = camera.basis().T
     ty = math.tan(0.5 * camera.fov_y)
-    return np.column_stack([r * ty * max(aspect, 1e-6), np.cross(r, f) * ty, f])
+    return np.column_stack([r * ty * max(aspect, 1e-6), u * ty, f])
 
 
 def gl_matrix3(m: np.ndarray) -> bytes:
@@ -112,35 +148,82 @@ def gl_matrix3(m: np.ndarray) -> bytes:
     return np.asarray(m, np.float32).T.tobytes()
 
 
+class CameraMatrices:
+    """What one camera state and aspect give a frame, computed once (:func:`camera_matrices`):
+    ``view``, ``projection``, ``view_proj`` and ``view_basis`` (:func:`view_basis`) as read-only
+    float64 arrays, exactly what the Camera's methods return; :meth:`gl` their uniform bytes."""
+    __slots__ = ("view", "projection", "view_proj", "view_basis", "camera_pos", "_gl")
+
+    def __init__(self, camera: Camera, aspect: float):
+        self.view, self.projection = camera.view(), camera.projection(aspect)
+        self.view_proj = self.projection @ self.view
+        self.view_basis = view_basis(camera, aspect)
+        for m in (self.view, self.projection, self.view_proj, self.view_basis):
+            m.flags.writeable = False
+        self.camera_pos = tuple(float(c) for c in camera.position)
+        self._gl: dict[str, bytes] = {}
+
+    def gl(self, name: str) -> bytes:
+        """The column-major float32 bytes of uniform ``view_proj``, ``inv_view_proj`` or ``view_basis``."""
+        data = self._gl.get(name)
+        if data is None:
+            if name == "view_proj":
+                data = gl_matrix(self.view_proj)
+            elif name == "inv_view_proj":
+                data = gl_matrix(np.linalg.inv(self.view_proj))
+            elif name == "view_basis":
+                data = gl_matrix3(self.view_basis)
+            else:
+                raise KeyError(f"CameraMatrices.gl: no uniform {name!r} (view_proj, inv_view_proj, view_basis)")
+            self._gl[name] = data
+        return data
+
+
+_MATRICES: dict = {}          # camera state + aspect -> CameraMatrices, a few kept
+_STATE = tuple(f for f in Camera.__dataclass_fields__ if f != "position")
+
+
+def camera_matrices(camera: Camera, aspect: float) -> CameraMatrices:
+    """The :class:`CameraMatrices` of ``camera`` as it is now, at ``aspect``: computed on the first
+    ask for this state (every field, the position by value) and shared by every pass of the frame."""
+    key = (float(aspect), camera.position.tobytes(), *[getattr(camera, name) for name in _STATE])
+    matrices = _MATRICES.get(key)
+    if matrices is None:
+        if len(_MATRICES) >= 8:
+            _MATRICES.clear()
+        matrices = _MATRICES[key] = CameraMatrices(camera, aspect)
+    return matrices
+
+
 def set_camera_uniforms(program, camera: Camera, aspect: float) -> None:
     """Write the camera uniforms ``program`` has (the compiler drops unused ones): ``view_proj``,
     ``inv_view_proj``, ``view_basis`` (:func:`view_basis`), ``camera_pos``, ``near``, ``far``.
 
     ``view_basis``, ``camera_pos``, ``near`` and ``far`` are what ``lib/view_ray.glsl`` needs for
-    view rays and distances from depth at any far/near ratio; prefer them to ``inv_view_proj``."""
-    if "view_proj" in program or "inv_view_proj" in program:
-        vp = camera.view_projection(aspect)
-        if "view_proj" in program:
-            program["view_proj"].write(gl_matrix(vp))
-        if "inv_view_proj" in program:
-            program["inv_view_proj"].write(gl_matrix(np.linalg.inv(vp)))
-    if "view_basis" in program:
-        program["view_basis"].write(gl_matrix3(view_basis(camera, aspect)))
-    for name, value in (("camera_pos", tuple(float(c) for c in camera.position)), ("near", float(camera.near)),
-                        ("far", float(camera.far))):
-        if name in program:
-            program[name].value = value
-
+    view rays and distances from depth at any far/near ratio; prefer them to ``inv_view_proj``.
+    The matrices come from :func:`camera_matrices`: computed once per frame, whatever the passes."""
+    matrices = camera_matrices(camera, aspect)
+    get = program.get
+    for name in ("view_proj", "inv_view_proj", "view_basis"):
+        member = get(name, None)
+        if member is not None:
+            member.write(matrices.gl(name))
+    for name, value in (("camera_pos", matrices.camera_pos), ("near", float(camera.near)), ("far", float(camera.far))):
+        member = get(name, None)
+        if member is not None:
+            member.value = value
 
 
 class CameraPlugin(Plugin):
-    """Adds the Camera and Input resources and the fly-camera system (update stage)."""
+    """Adds the :class:`Camera` resource (``CameraPlugin(camera)`` to start from your own). What moves
+    it is another plugin's: :class:`atmos.camera_control.FlyCameraPlugin` (in DefaultPlugins),
+    :class:`atmos.camera_control.ChaseCameraPlugin`, or your own system."""
 
     def __init__(self, camera: Camera | None = None):
+        super().__init__()
+        if camera is not None and not isinstance(camera, Camera):
+            raise ValueError(f"CameraPlugin takes an atmos Camera or None, got {type(camera).__name__}")
         self.camera = camera or Camera()
 
     def build(self, app) -> None:
         app.insert_resource(self.camera)
-        app.insert_resource(Input())
-        app.add_system(fly_camera, "update", label="fly_camera")
-        app.add_system(lambda app: app.resource(Input).end_frame(), "last", label="input_end_frame")

@@ -14,6 +14,10 @@ The convention
 * Fields listed in the settings class's ``FIXED`` size what the plugin makes once (GPU buffers,
   a sliced job): ``configure`` refuses to change them, naming them; give them when making the plugin.
 * Passes and systems read ``plugin.settings`` every frame, so a change shows on the next frame.
+
+:func:`declared_rules` lists the checks a settings class runs on its fields (the allowed values it
+declares): the bad-input tests generate their cases from them, so a new field is covered the day
+it is added.
 """
 from __future__ import annotations
 
@@ -21,13 +25,59 @@ import dataclasses
 import math
 import numbers
 import operator
+from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
 
 
-def check_vec(owner: str, name: str, value, n: int, kind: str = "finite", optional: bool = False) -> tuple | None:
-    """``n`` finite floats; ``kind`` 'positive' or 'non-negative' narrows them; ``optional``: None passes."""
+@dataclass(frozen=True)
+class Rule:
+    """One check as a settings class runs it: ``kind`` names the check (``num``, ``int``, ``vec``,
+    ``bool``, ``choice``, ``shape``), the other fields are its arguments (which values it allows)."""
+    owner: str
+    name: str                  # the field, or e.g. "resolutions[0]" for one item of it
+    kind: str
+    lo: float | None = None
+    hi: float | None = None
+    lo_open: bool = False      # num: lo itself is refused
+    optional: bool = False
+    n: int = 0                 # vec: how many numbers (each >= lo when lo is given)
+    vec_kind: str = "finite"   # vec: 'finite', 'positive' or 'non-negative'
+    choices: tuple = ()
+
+    @property
+    def field(self) -> str:
+        """The dataclass field the rule checks."""
+        return self.name.split("[", 1)[0]
+
+
+_recording: list | None = None
+
+
+def _declare(owner: str, name: str, kind: str, **args) -> None:
+    if _recording is not None:
+        _recording.append(Rule(owner, name, kind, **args))
+
+
+def declared_rules(cls) -> list[Rule]:
+    """The :class:`Rule` of every check ``cls()`` runs on its own fields (its ``__post_init__`` on the
+    defaults, recorded): what each field allows. Checks that run only for other values of other
+    fields are not seen; fields checked by hand have no rule. Not thread-safe."""
+    global _recording
+    saved, _recording = _recording, []
+    try:
+        cls()
+        return [rule for rule in _recording if rule.owner == cls.__name__]
+    finally:
+        _recording = saved
+
+
+def check_vec(owner: str, name: str, value, n: int, kind: str = "finite", optional: bool = False,
+              lo: float | None = None) -> tuple | None:
+    """``n`` finite floats; ``kind`` 'positive' or 'non-negative' narrows them, ``lo`` (each >= lo)
+    too; ``optional``: None passes."""
+    _declare(owner, name, "vec", n=n, vec_kind=kind, optional=optional, lo=lo)
     if optional and value is None:
         return None
     try:
@@ -39,8 +89,12 @@ def check_vec(owner: str, name: str, value, n: int, kind: str = "finite", option
         ok = min(v) > 0
     elif ok and kind == "non-negative":
         ok = min(v) >= 0
+    if ok and lo is not None:
+        ok = min(v) >= lo
     if not ok:
-        raise ValueError(f"{owner}.{name} must be {n} {kind} numbers{' or None' if optional else ''}, got {value!r}")
+        floor = f" >= {lo}" if lo is not None else ""
+        raise ValueError(f"{owner}.{name} must be {n} {kind} numbers{floor}{' or None' if optional else ''}, "
+                         f"got {value!r}")
     return v
 
 
@@ -57,6 +111,7 @@ def _real(value) -> float:
 def check_num(owner: str, name: str, value, lo: float | None = None, hi: float | None = None,
               lo_open: bool = False, optional: bool = False) -> float | None:
     """A finite float within [lo, hi] (``lo_open``: strictly above lo); ``optional``: None passes."""
+    _declare(owner, name, "num", lo=lo, hi=hi, lo_open=lo_open, optional=optional)
     if optional and value is None:
         return None
     v = _real(value)
@@ -71,6 +126,7 @@ def check_num(owner: str, name: str, value, lo: float | None = None, hi: float |
 
 def check_int(owner: str, name: str, value, lo: int, hi: int) -> int:
     """A whole number in lo..hi (bools are refused)."""
+    _declare(owner, name, "int", lo=lo, hi=hi)
     try:
         v = None if isinstance(value, (bool, np.bool_)) else operator.index(value)
     except TypeError:
@@ -82,6 +138,7 @@ def check_int(owner: str, name: str, value, lo: int, hi: int) -> int:
 
 def check_bool(owner: str, name: str, value) -> bool:
     """True or False (numpy bools too; not 0/1 or strings)."""
+    _declare(owner, name, "bool")
     if not isinstance(value, (bool, np.bool_)):
         raise ValueError(f"{owner}.{name} must be True or False, got {value!r}")
     return bool(value)
@@ -89,6 +146,7 @@ def check_bool(owner: str, name: str, value) -> bool:
 
 def check_choice(owner: str, name: str, value, choices) -> str:
     """One of the strings ``choices``."""
+    _declare(owner, name, "choice", choices=tuple(choices))
     if not isinstance(value, str) or value not in choices:
         raise ValueError(f"{owner}.{name} must be one of {', '.join(map(repr, choices))}, got {value!r}")
     return value
@@ -101,6 +159,8 @@ def is_int(value) -> bool:
 
 def check_shape(shape, name: str = "shape") -> tuple[int, int, int]:
     """``(nx, ny, nz)`` as ints; ValueError naming ``name`` unless three positive ints."""
+    owner, _, field = name.rpartition(".")
+    _declare(owner, field, "shape")
     try:
         values = tuple(shape)
     except TypeError:
@@ -110,19 +170,20 @@ def check_shape(shape, name: str = "shape") -> tuple[int, int, int]:
     return tuple(int(n) for n in values)
 
 
-def check_sun_dir(sun_dir) -> np.ndarray:
-    """The unit float64 direction toward the sun, or a ValueError (allowed: a finite 3-vector, length > 0)."""
+def check_sun_dir(sun_dir, name: str = "sun_dir") -> np.ndarray:
+    """The unit float64 direction toward the sun, or a ValueError naming ``name`` (allowed: a finite
+    3-vector, length > 0)."""
     try:
-        d = np.asarray(sun_dir, dtype=np.float64)
+        d = None if isinstance(sun_dir, (str, bytes)) else np.asarray(sun_dir, dtype=np.float64)
     except (TypeError, ValueError):
         d = None
     if d is None or d.shape != (3,):
-        raise ValueError(f"sun_dir must be a 3-vector (x, y, z) pointing toward the sun; got {sun_dir!r}")
+        raise ValueError(f"{name} must be a 3-vector (x, y, z) pointing toward the sun; got {sun_dir!r}")
     if not np.isfinite(d).all():
-        raise ValueError(f"sun_dir must be finite; got {tuple(d)}")
+        raise ValueError(f"{name} must be finite; got {tuple(d)}")
     big = np.abs(d).max()
     if big == 0:
-        raise ValueError("sun_dir must have a length > 0; got the zero vector")
+        raise ValueError(f"{name} must have a length > 0; got the zero vector")
     d = d / big
     return d / np.linalg.norm(d)
 

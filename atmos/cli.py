@@ -1,4 +1,4 @@
-"""The ``atmos`` command: info, demo, graph."""
+"""The ``atmos`` command: info, demo, run, graph."""
 from __future__ import annotations
 
 import argparse
@@ -43,28 +43,38 @@ def _out(text: str) -> str:
     try:
         output_kind(text)
     except ValueError as error:
-        raise argparse.ArgumentTypeError(str(error).removeprefix(f"--out {text}: ")) from None
+        message = str(error)
+        raise argparse.ArgumentTypeError(message.split(": ", 1)[1] if message.startswith("--out ") else message) from None
     return text
 
 
 def parser() -> argparse.ArgumentParser:
     top = argparse.ArgumentParser(prog="atmos", description="Real-time atmospheric effects: demos and tools.")
-    sub = top.add_subparsers(dest="command", metavar="{info,demo,graph}")
+    sub = top.add_subparsers(dest="command", metavar="{info,demo,run,graph}")
     sub.add_parser("info", help="OpenGL renderer, version and limits")
     demo = sub.add_parser("demo", help="run a demo scene (a window, or headless into a file)")
     demo.add_argument("name", nargs="?", default=DEFAULT_DEMO, help=f"demo name (default: {DEFAULT_DEMO})")
     demo.add_argument("--list", action="store_true", help="list the demos and exit")
+    _run_options(demo, "demo's")
+    game = sub.add_parser("run", help="run your game: a .py file that defines build(app, settings)")
+    game.add_argument("file", help="path to the game's Python file")
+    _run_options(game, "game's DEFAULT_FRAMES or 90")
+    graph = sub.add_parser("graph", help="print a demo's compiled render graph")
+    graph.add_argument("name", nargs="?", default=DEFAULT_DEMO)
+    graph.add_argument("--dot", action="store_true", help="Graphviz dot instead of text")
+    return top
+
+
+def _run_options(command, frames_default: str) -> None:
+    """The options ``atmos demo`` and ``atmos run`` share."""
+    demo = command
     demo.add_argument("--headless", action="store_true", help="render offscreen even when a display exists")
-    demo.add_argument("--frames", type=_positive, help="frames to render (headless default: the demo's)")
+    demo.add_argument("--frames", type=_positive, help=f"frames to render (headless default: the {frames_default})")
     demo.add_argument("--size", type=_size, default=(960, 540), help="WxH, default 960x540")
     demo.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
     demo.add_argument("--out", type=_out, help="FILE.mp4, FILE.gif, FILE.png (last frame) or a folder of PNGs; "
                                                "headless default: out/NAME.mp4")
     demo.add_argument("--quiet", action="store_true", help="no progress bar")
-    graph = sub.add_parser("graph", help="print a demo's compiled render graph")
-    graph.add_argument("name", nargs="?", default=DEFAULT_DEMO)
-    graph.add_argument("--dot", action="store_true", help="Graphviz dot instead of text")
-    return top
 
 
 def cmd_info(args) -> int:
@@ -79,7 +89,6 @@ def cmd_info(args) -> int:
 
 
 def cmd_demo(args, top) -> int:
-    from atmos.runner import has_display, run_headless, run_window
     if args.list:
         for name, title in list_demos().items():
             print(f"{name:16s} {title}")
@@ -88,14 +97,35 @@ def cmd_demo(args, top) -> int:
         load_demo(args.name)
     except ValueError as error:
         top.error(str(error))
+    return _play(args, args.name, args.name)
+
+
+def cmd_run(args, top) -> int:
+    from pathlib import Path
+
+    from atmos.runner import load_game_file
+    try:
+        load_game_file(args.file)
+    except ValueError as error:
+        top.error(str(error))
+    return _play(args, args.file, Path(args.file).stem)
+
+
+def _play(args, game, stem: str) -> int:
+    """A window, or headless into ``--out`` (default out/STEM.mp4) when asked, when ``--out`` is given
+    or when no display can be reached (a notice says why)."""
+    from atmos.runner import display_problem, run_headless, run_window
+    problem = None if args.headless else display_problem()
+    if problem is not None:
+        print(f"atmos: {problem}; rendering headless", file=sys.stderr)
     settings = DemoSettings(size=args.size, seed=args.seed, frames=args.frames,
-                            headless=args.headless or not has_display())
-    if settings.headless or args.out:
-        out = args.out or f"out/{args.name}.mp4"
-        result = run_headless(args.name, settings, out, progress=not args.quiet)
+                            headless=args.headless or problem is not None)
+    if settings.headless or args.out is not None:
+        out = args.out if args.out is not None else f"out/{stem}.mp4"
+        result = run_headless(game, settings, out, progress=not args.quiet)
         print(f"wrote {result['written']} frames to {result['out']}")
     else:
-        run_window(args.name, settings)
+        run_window(game, settings)
     return 0
 
 
@@ -117,10 +147,15 @@ def cmd_graph(args, top) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Exit status 0 on success, 2 for bad arguments, 1 when the run failed (no GPU, a shader, the
+    output cannot be written, a setting refused): a one-line message, no traceback (ATMOS_TRACEBACK=1
+    shows it)."""
+    from atmos.app import AppError
     from atmos.gpu import GpuError, ShaderError
+    from atmos.output import OutputError
     top = parser()
     args = top.parse_args(argv)
-    commands = {"info": lambda: cmd_info(args), "demo": lambda: cmd_demo(args, top),
+    commands = {"info": lambda: cmd_info(args), "demo": lambda: cmd_demo(args, top), "run": lambda: cmd_run(args, top),
                 "graph": lambda: cmd_graph(args, top)}
     if args.command not in commands:
         top.print_help()
@@ -129,9 +164,14 @@ def main(argv: list[str] | None = None) -> int:
         status = commands[args.command]()
         sys.stdout.flush()
         return status
-    except (GpuError, ShaderError) as error:
+    except (GpuError, ShaderError, OutputError, AppError, ValueError) as error:
+        if os.environ.get("ATMOS_TRACEBACK"):
+            raise
         print(f"atmos: {error}", file=sys.stderr)
         return 1
+    except KeyboardInterrupt:
+        print("atmos: interrupted; no output file was left half-written", file=sys.stderr)
+        return 130
     except BrokenPipeError:
         # The reader closed early (`atmos info | head -3`): that is its choice, not our failure.
         # Point stdout at devnull so the interpreter's final flush does not raise again.

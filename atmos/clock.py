@@ -1,6 +1,8 @@
 """Fixed-timestep clock: simulation advances in fixed steps; frame deltas are clamped."""
 from __future__ import annotations
 
+from atmos.checks import check_int, check_num
+
 
 class FixedClock:
     """Turns variable frame deltas into a whole number of fixed simulation steps.
@@ -10,12 +12,9 @@ class FixedClock:
     """
 
     def __init__(self, step: float = 1 / 30, max_frame_dt: float = 0.1, max_steps: int = 4):
-        if not (step > 0 and max_frame_dt > 0 and max_steps >= 1):
-            raise ValueError(f"FixedClock needs step > 0, max_frame_dt > 0 and max_steps >= 1 "
-                             f"(got step={step}, max_frame_dt={max_frame_dt}, max_steps={max_steps})")
-        self.step = float(step)
-        self.max_frame_dt = float(max_frame_dt)
-        self.max_steps = int(max_steps)
+        self.step = check_num("FixedClock", "step", step, 0.0, 3600.0, lo_open=True)
+        self.max_frame_dt = check_num("FixedClock", "max_frame_dt", max_frame_dt, 0.0, 3600.0, lo_open=True)
+        self.max_steps = check_int("FixedClock", "max_steps", max_steps, 1, 10_000)
         self.time = 0.0          # simulation time: fixed steps taken × step
         self.frame_time = 0.0    # sum of clamped frame deltas
         self.dt = 0.0            # this frame's clamped delta

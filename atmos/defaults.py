@@ -1,12 +1,21 @@
 """DefaultPlugins: what every rendered scene starts from."""
 from atmos.camera import CameraPlugin
+from atmos.checks import check_bool
+from atmos.camera_control import FlyCameraPlugin
+from atmos.input import InputPlugin
 from atmos.plugin import PluginGroup
 from atmos.plugins.overlay import OverlayPlugin
 from atmos.render_core import RenderCorePlugin
+from atmos.transform import TransformPlugin
 
 
 class DefaultPlugins(PluginGroup):
-    """RenderCorePlugin (clear + present), CameraPlugin (camera, input, fly camera), OverlayPlugin."""
+    """RenderCorePlugin (clear + present), InputPlugin, CameraPlugin, TransformPlugin (interpolation
+    between fixed steps), FlyCameraPlugin (WASD; ``fly_camera=False`` leaves it out) and OverlayPlugin
+    (the frame-time bars; ``overlay=False`` starts them hidden, F1 shows them)."""
 
-    def __init__(self, overlay: bool = True):
-        super().__init__(RenderCorePlugin(), CameraPlugin(), OverlayPlugin(visible=overlay))
+    def __init__(self, overlay: bool = True, fly_camera: bool = True):
+        overlay, fly_camera = check_bool("DefaultPlugins", "overlay", overlay), check_bool("DefaultPlugins", "fly_camera", fly_camera)
+        plugins = [RenderCorePlugin(), InputPlugin(), CameraPlugin(), TransformPlugin()]
+        plugins += [FlyCameraPlugin()] if fly_camera else []
+        super().__init__(*plugins, OverlayPlugin(visible=overlay))

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from atmos.camera import set_camera_uniforms
-from atmos.checks import check_sun_dir
+from atmos.checks import check_sun_dir, check_vec
 
 RAYLEIGH = np.array([0.03, 0.07, 0.16])      # extinction of sunlight per air mass (red, green, blue)
 DAY_SKY = np.array([0.35, 0.47, 0.65])
@@ -20,13 +20,31 @@ TWILIGHT_SKY = np.array([0.30, 0.22, 0.25])
 NIGHT_SKY = np.array([0.012, 0.016, 0.03])
 
 
+def _read_only(direction: np.ndarray) -> np.ndarray:
+    direction.setflags(write=False)        # changed by assigning a new one (checked), never in place
+    return direction
+
+
+_SUN_CHECKS = {
+    "direction": lambda v: _read_only(check_sun_dir(v, "Sun.direction")),
+    "color": lambda v: check_vec("Sun", "color", v, 3, "non-negative"),
+    "ambient": lambda v: check_vec("Sun", "ambient", v, 3, "non-negative"),
+}
+
+
 @dataclass(slots=True)
 class Sun:
-    """``direction`` points from the scene toward the sun (unit length); ``color`` is its radiance
-    (zero at night); ``ambient`` is the sky's diffuse light. DaylightPlugin drives all three."""
+    """``direction`` points from the scene toward the sun (kept at unit length, read-only: assign a
+    new one); ``color`` is its radiance (zero at night); ``ambient`` is the sky's diffuse light (linear
+    RGB, non-negative). Every assignment is checked (a ValueError names ``Sun.field``). DaylightPlugin
+    drives all three."""
     direction: np.ndarray = field(default_factory=lambda: np.array([0.3, 0.35, -0.88]))
     color: tuple = (1.0, 0.95, 0.85)
     ambient: tuple = (0.35, 0.47, 0.65)
+
+    def __setattr__(self, name: str, value) -> None:
+        check = _SUN_CHECKS.get(name)
+        object.__setattr__(self, name, check(value) if check is not None else value)
 
     @classmethod
     def from_angles(cls, elevation_deg: float, azimuth_deg: float = 0.0, color=(1.0, 0.95, 0.85)) -> "Sun":
@@ -37,8 +55,8 @@ class Sun:
 def unit_sun(direction) -> np.ndarray | None:
     """The unit direction toward the sun, or None when it is not a finite non-zero vector."""
     s = np.asarray(direction, np.float64).reshape(3)
-    norm = np.linalg.norm(s)
-    return s / norm if np.isfinite(norm) and norm > 1e-12 else None
+    norm = math.sqrt(s.dot(s))           # np.linalg.norm's own formula, without its overhead
+    return s / norm if math.isfinite(norm) and norm > 1e-12 else None
 
 
 def _smoothstep(e0: float, e1: float, x: float) -> float:
@@ -76,9 +94,11 @@ def sun_and_day(sun: Sun) -> tuple[np.ndarray, float]:
 
 def set_sun_uniforms(program, sun: Sun) -> None:
     """Write ``sun_dir`` and ``sun_color`` where the program has them."""
+    get = program.get
     for name, value in (("sun_dir", sun.direction), ("sun_color", sun.color)):
-        if name in program:
-            program[name].value = tuple(float(v) for v in value)
+        member = get(name, None)
+        if member is not None:
+            member.value = tuple(float(v) for v in value)
 
 
 def set_scene_uniforms(program, view) -> None:

@@ -1,9 +1,19 @@
-"""Writing rendered frames to PNG, GIF, MP4 or a folder of PNGs, as a render-graph side effect."""
+"""Writing rendered frames to PNG, GIF, MP4 or a folder of PNGs, as a render-graph side effect.
+
+Never half-written: the path is checked when the writer is made, before anything renders (its folder
+made, a probe file created there); frames go to a temporary file beside the target (``.NAME.*.partial.EXT``)
+that is renamed onto it only once complete; a failure (full disk, read-only folder, ffmpeg exiting
+with an error) deletes what this writer wrote and raises :class:`OutputError`.
+"""
 from __future__ import annotations
 
+import os
+import tempfile
 from pathlib import Path
 
 import numpy as np
+
+from atmos.checks import check_num
 
 from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.plugin import Plugin
@@ -13,10 +23,22 @@ VIDEO = "video"
 SUFFIXES = (".png", ".gif", ".mp4")
 
 
+class OutputError(RuntimeError):
+    """An output file cannot be written (or its writing failed); the message names the file and why.
+    Nothing half-written is left behind."""
+
+
 def output_kind(path: str | Path) -> str:
     """'png', 'gif', 'mp4' or 'dir' for an --out path; a ValueError names what is allowed."""
-    path = Path(path)
+    text = os.fspath(path) if isinstance(path, (str, Path)) else None
+    if not text:
+        raise ValueError(f"--out {path!r}: give FILE.mp4, FILE.gif, FILE.png (the last frame) or a folder "
+                         "(one PNG per frame), not an empty name")
+    path = Path(text)
     suffix = path.suffix.lower()
+    if suffix in SUFFIXES and text.endswith(("/", os.sep)):
+        raise ValueError(f"--out {text}: ends with '/' (a folder) but names a {suffix} file; "
+                         f"drop the '/' for the file, or name the folder without {suffix}")
     if suffix in SUFFIXES:
         return suffix[1:]
     if suffix == "" or path.is_dir():
@@ -25,42 +47,153 @@ def output_kind(path: str | Path) -> str:
                      "(the last frame) or a folder (one PNG per frame)")
 
 
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _reason(error: OSError) -> str:
+    where = error.filename if error.filename is not None else ""
+    return f"{error.strerror or error}" + (f" ({where})" if where else "")
+
+
+def check_output(path: str | Path) -> tuple[Path, str]:
+    """``(path, kind)`` once ``path`` is known to be writable: its folder made, a probe file created and
+    removed in it. :class:`OutputError` names the path and why not (a ValueError for a bad name)."""
+    kind = output_kind(path)
+    path = Path(path)
+    folder = path if kind == "dir" else path.parent
+    if kind == "dir" and path.exists() and not path.is_dir():
+        raise OutputError(f"cannot write frames into {path}: it is a file, not a folder; give a folder, "
+                          "or FILE.mp4, FILE.gif or FILE.png")
+    existing = next((p for p in (folder, *folder.parents) if p.exists()), None)
+    if existing is not None and not existing.is_dir():
+        raise OutputError(f"cannot write {path}: {existing} is a file, not a folder")
+    if kind != "dir" and path.is_dir():
+        raise OutputError(f"cannot write {path}: it is a folder; give a file name, or a folder name "
+                          f"without {path.suffix} for one PNG per frame")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise OutputError(f"cannot write {path}: {_reason(error)}") from None
+    try:
+        fd, probe = tempfile.mkstemp(dir=folder, prefix=".atmos-probe-")
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as error:
+        raise OutputError(f"cannot write {path}: {error.strerror or error} (in {folder})") from None
+    return path, kind
+
+
 class FrameWriter:
-    """Collects frames (uint8 RGB, top row first) into the file ``path`` names."""
+    """Collects frames (uint8 RGB, top row first) into the file ``path`` names, never half-written
+    (the module docstring): :meth:`close` completes the file, :meth:`abort` gives up and deletes what
+    was written. After either, writing is an OutputError."""
 
     def __init__(self, path: str | Path, fps: float = 30.0):
-        self.path = Path(path)
-        self.kind = output_kind(self.path)
-        self.fps = fps
+        folder = Path(path) if output_kind(path) == "dir" else Path(path).parent
+        self._new_folders = [f for f in (folder, *folder.parents) if not f.exists()]   # deepest first
+        self.path, self.kind = check_output(path)
+        self.fps = check_num("FrameWriter", "fps", fps, 0.0, 1000.0, lo_open=True)
         self.frames_written = 0
+        self.state = "open"                       # then "done" (close) or "failed" (abort, an error)
         self._last: np.ndarray | None = None
-        self._writer = None
-        target = self.path if self.kind == "dir" else self.path.parent
-        target.mkdir(parents=True, exist_ok=True)
+        self._encoder = None
+        self._temp: Path | None = None
+        self._made: list[Path] = []               # a folder's PNGs written by this writer
 
     def write(self, frame: np.ndarray) -> None:
-        import imageio.v2 as imageio
-        if self.kind == "dir":
-            imageio.imwrite(self.path / f"frame_{self.frames_written:05d}.png", frame)
-        elif self.kind == "png":
-            self._last = frame
-        else:
-            if self._writer is None:
-                if self.kind == "gif":
-                    self._writer = imageio.get_writer(self.path, mode="I", duration=1000.0 / self.fps, loop=0)
-                else:
-                    self._writer = imageio.get_writer(self.path, fps=self.fps, codec="libx264", quality=8,
-                                                      macro_block_size=2, ffmpeg_log_level="error")
-            self._writer.append_data(frame)
+        if self.state != "open":
+            raise OutputError(f"{self.path}: this writer is {self.state}; make a new FrameWriter")
+        try:
+            if self.kind == "dir":
+                name = self.path / f"frame_{self.frames_written:05d}.png"
+                self._complete(self._write_png(frame), name)
+                self._made.append(name)
+            elif self.kind == "png":
+                self._last = np.array(frame, copy=True)
+            else:
+                if self._encoder is None:
+                    self._encoder = self._open_encoder()
+                self._encoder.write(frame)
+        except Exception as error:
+            self._fail(error)
         self.frames_written += 1
 
     def close(self) -> None:
+        """Complete the file (rename it into place); OutputError if that fails. Again: nothing."""
+        if self.state != "open":
+            return
+        try:
+            if self.kind == "png" and self._last is not None:
+                self._complete(self._write_png(self._last), self.path)
+            elif self._encoder is not None:
+                self._encoder.close()
+                self._encoder = None
+                self._complete(self._temp, self.path)
+        except Exception as error:
+            self._fail(error)
+        self.state = "done"
+
+    def abort(self) -> None:
+        """Give up: stop the encoder, delete the temporary file and the PNGs this writer made."""
+        if self.state != "open":
+            return
+        self.state = "failed"
+        if self._encoder is not None:
+            try:
+                self._encoder.abort()
+            except Exception:                    # the file is deleted anyway
+                pass
+            self._encoder = None
+        for path in [self._temp, *self._made]:
+            if path is not None:
+                try:
+                    path.unlink(missing_ok=True)
+                except OSError:
+                    pass
+        self._temp = None
+        self._made.clear()
+        for folder in self._new_folders:          # the folders check_output made for this writer, if empty
+            try:
+                folder.rmdir()
+            except OSError:
+                break
+
+    # -- internals ---------------------------------------------------------------------------
+    def _fail(self, error: Exception):
+        self.abort()
+        reason = _reason(error) if isinstance(error, OSError) else f"{type(error).__name__}: {error}"
+        raise OutputError(f"writing {self.path} failed after {self.frames_written} frame(s): {reason}; "
+                          "nothing was left behind") from error
+
+    def _temporary(self) -> Path:
+        """A new empty temporary file beside the target, ending in the target's suffix."""
+        folder = self.path if self.kind == "dir" else self.path.parent
+        fd, name = tempfile.mkstemp(dir=folder, prefix=f".{self.path.name}.", suffix=f".partial.{self._suffix}")
+        os.close(fd)
+        os.chmod(name, 0o666 & ~_umask())          # mkstemp makes it private; the result is an ordinary file
+        self._temp = Path(name)
+        return self._temp
+
+    @property
+    def _suffix(self) -> str:
+        return "png" if self.kind in ("dir", "png") else self.kind
+
+    def _write_png(self, frame: np.ndarray) -> Path:
         import imageio.v2 as imageio
-        if self.kind == "png" and self._last is not None:
-            imageio.imwrite(self.path, self._last)
-        if self._writer is not None:
-            self._writer.close()
-            self._writer = None
+        temp = self._temporary()
+        imageio.imwrite(temp, frame, format="PNG")
+        return temp
+
+    def _complete(self, temp: Path, target: Path) -> None:
+        os.replace(temp, target)
+        self._temp = None
+
+    def _open_encoder(self):
+        from atmos.video import GifEncoder, Mp4Encoder
+        return (GifEncoder if self.kind == "gif" else Mp4Encoder)(self._temporary(), self.fps)
 
 
 class EncodePass(RenderPass):
@@ -80,9 +213,11 @@ class EncodePass(RenderPass):
 
 
 class OutputPlugin(Plugin):
-    """Records every rendered frame to ``path`` (see :func:`output_kind`)."""
+    """Records every rendered frame to ``path`` (see :func:`output_kind`), checked now (before anything
+    renders); ``App.close`` completes the file (a run that failed calls ``plugin.writer.abort()`` first)."""
 
     def __init__(self, path: str | Path, fps: float = 30.0):
+        super().__init__()
         self.writer = FrameWriter(path, fps)
 
     def build(self, app) -> None:

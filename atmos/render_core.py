@@ -9,7 +9,8 @@ Every pass that writes ``color`` keeps to it; the light shafts' occlusion mask r
 shafts instead of casting them.
 
 - The clear pass clears alpha to 0 (nothing drawn is open sky); the sky passes (``sky``,
-  ``sky_gradient``) write alpha 0.
+  ``sky_gradient``) write alpha 0, only where nothing was drawn (depth 1: :func:`where_nothing_was_drawn`),
+  so a frame the game drew first (:mod:`atmos.host_frame`) keeps its pixels.
 - Opaque geometry (``ground``, ``terrain``, the clouds' top view) writes alpha 1 (blending off).
 - Layers that cover the sky blend premultiplied ``(light, coverage a)`` with (ONE, ONE_MINUS_SRC_ALPHA)
   on colour *and* alpha (:meth:`PassContext.blend_over`): ``alpha = a + (1 − a) · alpha``. The cloud
@@ -30,9 +31,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import moderngl
 import numpy as np
 
-from atmos.checks import CheckedSettings, check_num, check_vec
+from atmos.checks import CheckedSettings, check_bool, check_num, check_vec
+from atmos.hashing import lowbias32
 
 from atmos.graph import FullscreenPass, PassBuilder, PassContext, RenderPass, TextureDesc
 from atmos.plugin import Plugin
@@ -70,9 +73,48 @@ class ClearPass(RenderPass):
         fbo.clear(*self.plugin.settings.clear_color, 0.0, depth=1.0)
 
 
+DITHER_STEP = 1.0 / 255.0     # one step of 8-bit output
+
+
+def tone_map(hdr, exposure: float = 1.0) -> np.ndarray:
+    """Display values in [0, 1] of linear HDR colours (float64 reference of ``core/present.frag``
+    before dithering): exposure, the ACES fit of Narkowicz, then gamma 1/2.2."""
+    x = np.maximum(np.asarray(hdr, np.float64) * exposure, 0.0)
+    return np.clip((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0) ** (1.0 / 2.2)
+
+
+def dither_offsets(width: int, height: int) -> np.ndarray:
+    """(height, width, 3) triangular dither in (−1, 1) that present adds (× ``DITHER_STEP``) to each
+    pixel, rows bottom-up like ``gl_FragCoord``: per pixel a hash, per channel the sum of two 16-bit
+    uniforms minus 1 (bit for bit the GLSL's hash)."""
+    y, x = np.mgrid[0:height, 0:width].astype(np.uint32)
+    with np.errstate(over="ignore"):
+        h = lowbias32((x * np.uint32(0x9E3779B9)) ^ lowbias32(y + np.uint32(0x2F6B4D5D)))
+    total = np.zeros((height, width, 3))
+    for i in range(2):
+        a, b = lowbias32(h + np.uint32(2 * i)), lowbias32(h + np.uint32(2 * i + 1))
+        total += np.stack([a & 0xFFFF, a >> 16, b & 0xFFFF], axis=-1) / 65536.0
+    return total - 1.0
+
+
+def where_nothing_was_drawn(frame: PassContext):
+    """Bind ``color`` over ``depth`` so a pass on the far plane (``vertex = "lib/fullscreen_far.vert"``)
+    draws only where the depth is still 1, where nothing was drawn: depth test ``<=``, depth writes
+    off. The skies draw so, behind whatever a game drew before them (a host frame, see
+    :mod:`atmos.host_frame`); such a pass reads ``depth``."""
+    fbo = frame.framebuffer(color=[COLOR], depth=DEPTH)
+    fbo.use()
+    fbo.depth_mask = False
+    frame.gpu.ctx.enable(moderngl.DEPTH_TEST)
+    frame.gpu.ctx.depth_func = "<="
+    return fbo
+
+
 class PresentPass(FullscreenPass):
-    """Tone-maps the HDR ``color`` into the screen (window or offscreen target), with sRGB gamma;
-    the screen's alpha is 1 (``color.a``, the sky occlusion, is not shown)."""
+    """Tone-maps the HDR ``color`` into the screen (window or offscreen target), with sRGB gamma
+    and (``RenderCoreSettings.dither``) a triangular dither of one 8-bit step against banding
+    (:func:`tone_map`, :func:`dither_offsets`); the screen's alpha is 1 (``color.a``, the sky
+    occlusion, is not shown)."""
     name = "present"
     phase = "present"
     fragment = "core/present.frag"
@@ -83,6 +125,7 @@ class PresentPass(FullscreenPass):
         frame.resource(SCREEN).use()
         frame.resource(COLOR).use(0)
         self.program["exposure"].value = self.plugin.settings.exposure
+        self.program["dither"].value = DITHER_STEP if self.plugin.settings.dither else 0.0
         frame.fullscreen(self.program)
 
 
@@ -106,17 +149,30 @@ class CapturePass(RenderPass):
         self.depth = np.frombuffer(frame.resource(DEPTH).read(), np.float32).reshape(h, w).astype(np.float64)
 
 
+class LinearCapturePass(CapturePass):
+    """:meth:`atmos.App.read_linear`'s pass: a CapturePass that reads back only while ``armed``."""
+    name = "read_linear"
+    armed = False
+
+    def execute(self, frame: PassContext) -> None:
+        if self.armed:
+            super().execute(frame)
+
+
 @dataclass(frozen=True)
 class RenderCoreSettings(CheckedSettings):
     """``clear_color``: linear HDR colour ``color`` starts each frame with (non-negative);
-    ``exposure``: HDR scale before tone mapping (> 0). All live."""
+    ``exposure``: HDR scale before tone mapping (> 0); ``dither``: add a triangular dither of ±1
+    step before 8-bit output (mean unchanged, no banding). All live."""
     clear_color: tuple = (0.0, 0.0, 0.0)
     exposure: float = 1.0
+    dither: bool = True
 
     def __post_init__(self):
         o = "RenderCoreSettings"
         self.store(dict(clear_color=check_vec(o, "clear_color", self.clear_color, 3, "non-negative"),
-                        exposure=check_num(o, "exposure", self.exposure, 0.0, 1e6, lo_open=True)))
+                        exposure=check_num(o, "exposure", self.exposure, 0.0, 1e6, lo_open=True),
+                        dither=check_bool(o, "dither", self.dither)))
 
 
 class RenderCorePlugin(Plugin):

@@ -1,4 +1,5 @@
-"""Running a demo: in a pyglet window when there is a display, else headless into a file."""
+"""Running a game or demo (``build(app, settings)``): in a pyglet window when a display can be reached,
+else headless into a file. ``atmos.run`` and the ``atmos run`` / ``atmos demo`` commands come here."""
 from __future__ import annotations
 
 import os
@@ -6,34 +7,125 @@ import sys
 
 from atmos.app import App
 from atmos.demo_registry import DemoSettings, load_demo
-from atmos.gpu import create_headless, from_current
+from atmos.gpu import create_headless
+
+_FILES: dict = {}      # game files loaded so far, by resolved path: each runs once per process
+
+
+def display_problem() -> str | None:
+    """None when a window can open here; else why not, in words (no DISPLAY, or a DISPLAY that no X
+    server answers: pyglet draws windows through X11 on Linux, Xwayland under Wayland)."""
+    if sys.platform in ("win32", "darwin"):
+        return None
+    name = os.environ.get("DISPLAY")
+    if not name:
+        if os.environ.get("WAYLAND_DISPLAY"):
+            return "WAYLAND_DISPLAY is set but DISPLAY is not (pyglet needs X11: start Xwayland)"
+        return "no display (DISPLAY is not set)"
+    import ctypes
+    import ctypes.util
+    library = ctypes.util.find_library("X11")
+    if library is None:
+        return f"DISPLAY={name} is set but libX11 is not installed"
+    x11 = ctypes.CDLL(library)
+    x11.XOpenDisplay.restype = ctypes.c_void_p
+    x11.XOpenDisplay.argtypes = [ctypes.c_char_p]
+    x11.XCloseDisplay.argtypes = [ctypes.c_void_p]
+    connection = x11.XOpenDisplay(name.encode())
+    if not connection:
+        return f"DISPLAY={name} is set but no X server answers there"
+    x11.XCloseDisplay(connection)
+    return None
 
 
 def has_display() -> bool:
-    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")) or sys.platform in ("win32", "darwin")
+    """True when a window can open here (:func:`display_problem` is None)."""
+    return display_problem() is None
 
 
-def build_app(name: str, settings: DemoSettings, gpu, *extra_plugins, start: bool = True) -> App:
-    """A started App for demo ``name`` on ``gpu``, with ``extra_plugins`` added after the demo's
-    (``start=False``: built and finished, but no system has run — no simulation warm-up)."""
-    demo = load_demo(name)
+def load_game(game):
+    """The module or object with ``build(app, settings)`` that ``game`` names: a demo name, a path to a
+    ``.py`` file (``atmos run game.py``), a module, or a ``build(app, settings)`` function itself."""
+    if callable(game) and not isinstance(game, type):
+        return _Built(game)
+    if isinstance(game, (str, os.PathLike)) and (str(game).endswith(".py") or os.sep in str(game)):
+        return load_game_file(os.fspath(game))
+    if isinstance(game, str):
+        return load_demo(game)
+    if callable(getattr(game, "build", None)):
+        return game
+    raise ValueError(f"expected a demo name, a path to a .py file, a module with build(app, settings) or such a "
+                     f"function, got {game!r}")
+
+
+class _Built:
+    """A bare ``build(app, settings)`` function seen as a game module."""
+
+    def __init__(self, build):
+        self.build = build
+        self.TITLE = getattr(build, "__doc__", None) or getattr(build, "__name__", "atmos")
+        self.__name__ = getattr(build, "__module__", "game")
+
+
+def load_game_file(path: str):
+    """Run the game file at ``path`` (once per process) and return it as a module; ValueError unless it
+    is a ``.py`` file that defines ``build(app, settings)``."""
+    import importlib.util
+    from pathlib import Path
+    file = Path(path)
+    if file.suffix != ".py" or not file.is_file():
+        raise ValueError(f"{path}: no such .py file (atmos run takes a Python file that defines build(app, settings))")
+    if file.resolve() in _FILES:
+        return _FILES[file.resolve()]
+    folder = str(file.resolve().parent)
+    if folder not in sys.path:
+        sys.path.insert(0, folder)          # the game may import its neighbours, as a script would
+    name = f"atmos_game_{file.stem}"       # never shadows a module of the same stem (random.py)
+    spec = importlib.util.spec_from_file_location(name, file)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module              # dataclasses in the game look their module up there
+    try:
+        spec.loader.exec_module(module)
+    except BaseException:
+        del sys.modules[name]
+        raise
+    if not callable(getattr(module, "build", None)):
+        raise ValueError(f"{path} defines no build(app, settings) function; atmos run needs one, as a demo has")
+    _FILES[file.resolve()] = module
+    return module
+
+
+def title_of(game) -> str:
+    module = load_game(game)
+    return getattr(module, "TITLE", None) or getattr(module, "__name__", "atmos")
+
+
+def build_app(name, settings: DemoSettings, gpu, *extra_plugins, start: bool = True) -> App:
+    """A started App for ``name`` (a demo, a game file or module, a build function: :func:`load_game`)
+    on ``gpu``, with ``extra_plugins`` added after the game's (``start=False``: built and finished,
+    but no system has run — no simulation warm-up)."""
+    demo = load_game(name)
     app = App(gpu)
     app.insert_resource(settings)           # demos read it (headless runs script their camera)
     try:
         demo.build(app, settings)
         app.add_plugins(*extra_plugins)
         app.startup() if start else app.finish()
-    except Exception:
-        app.close()
+    except Exception as error:
+        try:
+            app.close()
+        except Exception as failure:           # the build error is the one to show
+            error.add_note(f"closing the half-built App also failed: {failure}")
         raise
     return app
 
 
-def run_headless(name: str, settings: DemoSettings, out: str | None, progress: bool = True) -> dict:
-    """Render ``settings.frames`` frames at a fixed 1/30 s step; write them to ``out`` if given."""
+def run_headless(name, settings: DemoSettings, out: str | None, progress: bool = True) -> dict:
+    """Render ``settings.frames`` frames of ``name`` (:func:`load_game`) at a fixed 1/30 s step; write
+    them to ``out`` if given."""
     from atmos.output import OutputPlugin
-    frames = settings.frames or getattr(load_demo(name), "DEFAULT_FRAMES", 90)
-    output = OutputPlugin(out) if out else None
+    frames = settings.frames or getattr(load_game(name), "DEFAULT_FRAMES", 90)
+    output = OutputPlugin(out) if out is not None else None     # the path is checked here, before rendering
     gpu = create_headless(settings.size)
     try:
         app = build_app(name, settings, gpu, *([output] if output else []))
@@ -45,15 +137,27 @@ def run_headless(name: str, settings: DemoSettings, out: str | None, progress: b
         steps = range(frames)
         if progress:
             from tqdm import tqdm
-            steps = tqdm(steps, desc=f"atmos demo {name}", unit="frame", file=sys.stderr)
+            steps = tqdm(steps, desc=f"atmos {_label(name)}", unit="frame", file=sys.stderr)
         for _ in steps:
             app.update(1 / 30)
-        gpu.check(f"demo {name}")
+        gpu.check(_label(name))
+        if writer is not None:
+            writer.close()                            # completes the output file (OutputError if it cannot)
         return {"frames": frames, "out": str(writer.path) if writer else None,
                 "written": writer.frames_written if writer else 0}
+    except BaseException as error:
+        if writer is not None:
+            writer.abort()                            # a failed run leaves no file behind
+        try:
+            app.close()
+        except Exception as failure:                  # the run's error is the one to show
+            error.add_note(f"closing the App also failed: {failure}")
+        raise
     finally:
-        app.close()
-        gpu.release()
+        try:
+            app.close()
+        finally:
+            gpu.release()
 
 
 def slowest_passes(app, n: int = 3) -> str:
@@ -62,62 +166,47 @@ def slowest_passes(app, n: int = 3) -> str:
     return ", ".join(f"{name} {gpu_ms:.1f} ms" for name, (gpu_ms, _) in timings)
 
 
-def run_window(name: str, settings: DemoSettings) -> None:
-    """Open a window: ESC quits, F1 toggles the frame-time overlay, WASD/QE + mouse drag fly the camera."""
-    import pyglet
-    from pyglet.window import key
+def _label(game) -> str:
+    return f"demo {game}" if isinstance(game, str) and not game.endswith(".py") else str(getattr(game, "__name__", game))
 
-    from atmos.camera import Input
-    from atmos.plugins.overlay import FrameTimes, OverlayPlugin
 
-    config = pyglet.gl.Config(major_version=4, minor_version=3, forward_compatible=True,
-                              depth_size=24, double_buffer=True)
-    window = pyglet.window.Window(*settings.size, caption=f"atmos — {name}", resizable=True, config=config)
-    gpu = from_current(window.get_framebuffer_size())
-    app = build_app(name, settings, gpu)
-    frames = [0]
+def run_window(name, settings: DemoSettings, title: str | None = None) -> None:
+    """``name`` (:func:`load_game`) in a window (:mod:`atmos.window`: ESC quits, F1 the overlay);
+    the caption shows the frame times and the slowest passes."""
+    from atmos.plugins.overlay import FrameTimes
+    from atmos.window import run_window as window_loop
 
-    @window.event
-    def on_draw():
-        app.update()
-        frames[0] += 1
+    caption = title or f"atmos — {name}"
+
+    def show_times(app, window, frame):
         times = app.get_resource(FrameTimes)
-        if times is not None and frames[0] % 30 == 0:
-            window.set_caption(f"atmos — {name} — {times.summary()} — {slowest_passes(app)}")
-        if settings.frames and frames[0] >= settings.frames:
-            pyglet.app.exit()  # closing inside on_draw would disturb pyglet's window iteration
+        if times is not None and frame % 30 == 0:
+            window.set_caption(f"{caption} — {times.summary()} — {slowest_passes(app)}")
 
-    @window.event
-    def on_resize(width, height):
-        gpu.resize(window.get_framebuffer_size())
+    window_loop(lambda gpu: build_app(name, settings, gpu), settings.size, caption, settings.frames, show_times)
 
-    @window.event
-    def on_key_press(symbol, modifiers):
-        inp = app.resource(Input)
-        name_ = key.symbol_string(symbol).lower()
-        inp.keys.add(name_)
-        inp.pressed.add(name_)
-        overlay = next((p for p in app.plugins if isinstance(p, OverlayPlugin)), None)
-        if symbol == key.F1 and overlay is not None:
-            overlay.configure(visible=not overlay.settings.visible)
 
-    @window.event
-    def on_key_release(symbol, modifiers):
-        app.resource(Input).keys.discard(key.symbol_string(symbol).lower())
+def run(game, *, size: tuple[int, int] = (960, 540), title: str | None = None, headless: bool | None = None,
+        frames: int | None = None, out: str | None = None, seed: int = 0, progress: bool = False) -> dict | None:
+    """Run a game: ``game`` is ``build(app, settings)`` (a function, a module that defines it, a path
+    to a ``.py`` file, or a demo name). The App is made for you on a window's context (the window must
+    exist before the GL context, so atmos makes both), or on a headless one when ``headless`` is True,
+    when ``out`` is given, or when no display can be reached (a notice on stderr says why).
 
-    @window.event
-    def on_mouse_drag(x, y, dx, dy, buttons, modifiers):
-        inp = app.resource(Input)
-        inp.mouse_dx += dx
-        inp.mouse_dy += dy
-
-    @window.event
-    def on_close():
-        app.running = False
-
-    try:
-        pyglet.app.run(interval=0)
-    finally:
-        app.close()
-        gpu.release()
-        window.close()
+    ``settings`` (:class:`atmos.DemoSettings`) carries ``size``, ``seed``, ``frames`` and ``headless``.
+    Headless: ``frames`` frames (default the game's ``DEFAULT_FRAMES`` or 90) at 1/30 s, written to
+    ``out`` (``.mp4``, ``.gif``, ``.png`` or a folder) if given; returns what was written. Windowed:
+    until the window closes (or ``frames`` frames); returns None."""
+    from atmos.gpu.context import check_frame_size
+    load_game(game)                                   # a bad game fails here, before any window
+    size = check_frame_size(size, None, "atmos.run size")
+    if headless is None:
+        problem = display_problem()
+        headless = problem is not None or out is not None
+        if problem is not None:
+            print(f"atmos: {problem}; rendering headless" + (f" into {out}" if out else ""), file=sys.stderr)
+    settings = DemoSettings(size=size, seed=seed, frames=frames, headless=bool(headless))
+    if settings.headless or out is not None:
+        return run_headless(game, settings, out, progress=progress)
+    run_window(game, settings, title or title_of(game))
+    return None

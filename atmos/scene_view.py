@@ -33,8 +33,9 @@ class SceneView:
 
     @classmethod
     def of(cls, app) -> "SceneView":
-        """The view of ``app`` now."""
-        return cls(app.get_resource(Camera) or _DEFAULT_CAMERA, app.get_resource(Sun) or _DEFAULT_SUN, app.clock,
+        """The view of ``app`` now; the camera is checked (:meth:`Camera.check`) so a bad one fails here,
+        before the frame renders, naming the field."""
+        return cls((app.get_resource(Camera) or _DEFAULT_CAMERA).check(), app.get_resource(Sun) or _DEFAULT_SUN, app.clock,
                    app.gpu.size)
 
 

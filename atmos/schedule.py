@@ -36,15 +36,26 @@ class Schedule:
 
     def add(self, func: Callable, stage: str = "update", label: str | None = None,
             before=(), after=()) -> System:
+        if not callable(func):
+            raise ScheduleError(f"a system must be a callable func(app), got {type(func).__name__} {func!r}")
         if stage not in STAGES:
             raise ScheduleError(f"unknown stage {stage!r} for system {_name(func)}; stages are {', '.join(STAGES)}")
+        if label is not None and (not isinstance(label, str) or not label):
+            raise ScheduleError(f"system {_name(func)}: label must be a non-empty string or None, got {label!r}")
         label = label or _name(func)
         if any(s.label == label for s in self.systems):
             raise ScheduleError(f"two systems are labelled {label!r}; labels must be unique (pass label=...)")
-        system = System(func, stage, label, _labels(before), _labels(after), len(self.systems))
+        system = System(func, stage, label, _labels(label, "before", before), _labels(label, "after", after),
+                        len(self.systems))
         self.systems.append(system)
         self._order = None
         return system
+
+    def truncate(self, count: int) -> None:
+        """Forget every system added after the first ``count`` (undoing a failed plugin build)."""
+        if count < len(self.systems):
+            del self.systems[count:]
+            self._order = None
 
     def build(self) -> dict[str, list[System]]:
         """Order each stage; unknown labels, cross-stage labels and cycles raise ScheduleError."""
@@ -78,8 +89,16 @@ class Schedule:
             system.func(app)
 
 
-def _labels(value) -> tuple[str, ...]:
-    return (value,) if isinstance(value, str) else tuple(value)
+def _labels(system: str, name: str, value) -> tuple[str, ...]:
+    """``before``/``after``: one label or an iterable of labels (non-empty strings)."""
+    try:
+        labels = (value,) if isinstance(value, str) else tuple(value)
+    except TypeError:
+        labels = None
+    if labels is None or not all(isinstance(v, str) and v for v in labels):
+        raise ScheduleError(f"system {system!r}: {name} must be a label or a list of labels (non-empty "
+                            f"strings), got {value!r}")
+    return labels
 
 
 def _name(func: Callable) -> str:

@@ -29,7 +29,14 @@ class World:
         return esper.create_entity(*components)
 
     def delete_entity(self, entity: int, immediate: bool = False) -> None:
+        """Delete ``entity`` at the end of this stage (``immediate``: now; not while iterating a
+        query). Deleting one already deleted this stage does nothing; one that never existed or is
+        long gone is a ValueError."""
         self.activate()
+        if entity in esper._dead_entities and not immediate:
+            return
+        if entity not in esper._entities:
+            raise ValueError(f"entity {entity!r} does not exist in this world (deleted already, or never made)")
         esper.delete_entity(entity, immediate)
 
     def add_component(self, entity: int, component) -> None:
@@ -43,6 +50,16 @@ class World:
     def component_for_entity(self, entity: int, component_type: type):
         self.activate()
         return esper.component_for_entity(entity, component_type)
+
+    def has_entity(self, entity: int) -> bool:
+        """True while ``entity`` exists and is not deleted (deferred deletes count as deleted)."""
+        self.activate()
+        return esper.entity_exists(entity)
+
+    def try_component(self, entity: int, component_type: type):
+        """The entity's component of that type, or None."""
+        self.activate()
+        return esper.try_component(entity, component_type)
 
     def has_component(self, entity: int, component_type: type) -> bool:
         self.activate()
@@ -63,8 +80,12 @@ class World:
         return len(esper._entities)
 
     def clear_dead_entities(self) -> None:
+        """Carry out deferred deletes (the App does it after every stage, so an entity deleted in one
+        is gone from the next stage's queries). Nothing to do costs nothing: esper's query cache is
+        only cleared when something was deleted."""
         self.activate()
-        esper.clear_dead_entities()
+        if esper._dead_entities:
+            esper.clear_dead_entities()
 
     def close(self) -> None:
         """Delete this world and everything in it."""

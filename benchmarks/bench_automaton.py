@@ -47,6 +47,34 @@ def time_numpy(shape, state, kwargs, steps):
     return (time.perf_counter() - start) * 1e3 / steps
 
 
+GOALS = {"growth + advection": 15, "full step, per-cell p arrays": 5}   # packed speed-up over cell
+
+
+def cases(shape, seed: int = 0):
+    """(initial state, {case name: step keywords}) at ``shape``: growth + advection, and a full step
+    with stochastic rules driven by per-cell float32 probability arrays."""
+    rng = np.random.default_rng(seed)
+    state = initial_state(rng, shape)
+    ny = shape[1]
+    shifts = np.stack([np.arange(ny) % 3, (np.arange(ny) // 8) % 2], axis=1).astype(np.int32)
+    probs = {name: (rng.random(shape) * scale).astype(np.float32)
+             for name, scale in (("p_ext", 0.1), ("p_hum", 0.1), ("p_act", 0.002))}
+    return state, {"growth + advection": {"shift": shifts}, "full step, per-cell p arrays": {"shift": shifts, **probs}}
+
+
+def measure(gpu, shape, steps: int, numpy_steps: int = 0) -> list[dict]:
+    """One row per case: ms per step packed, cell (GPU, ``steps`` chained) and numpy (0: not run)."""
+    state, kinds = cases(shape)
+    rows = []
+    for name, kwargs in kinds.items():
+        packed = time_gpu(gpu, "packed", shape, state, kwargs, steps)
+        cell = time_gpu(gpu, "cell", shape, state, kwargs, steps)
+        ref = time_numpy(shape, state, kwargs, numpy_steps) if numpy_steps else None
+        rows.append({"case": name, "packed_ms": packed, "cell_ms": cell, "numpy_ms": ref,
+                     "speedup": cell / packed, "goal_speedup": GOALS[name], "thesis_ms": THESIS_STEP_MS})
+    return rows
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--shape", type=int, nargs=3, default=(256, 32, 256))
@@ -54,27 +82,15 @@ def main() -> None:
     parser.add_argument("--numpy-steps", type=int, default=2)
     args = parser.parse_args()
     shape = tuple(args.shape)
-    rng = np.random.default_rng(0)
-    state = initial_state(rng, shape)
-    ny = shape[1]
-    shifts = np.stack([np.arange(ny) % 3, (np.arange(ny) // 8) % 2], axis=1).astype(np.int32)
-    probs = {name: (rng.random(shape) * scale).astype(np.float32)
-             for name, scale in (("p_ext", 0.1), ("p_hum", 0.1), ("p_act", 0.002))}
-    cases = {"growth + advection": {"shift": shifts},
-             "full step, per-cell p arrays": {"shift": shifts, **probs}}
-
     gpu = create_headless((16, 16))
     ctx = gpu.ctx
     print(f"cloud automaton, {shape[0]}x{shape[1]}x{shape[2]} cells, {ctx.info['GL_RENDERER']}")
     head = f"{'case':30s} {'packed ms':>10s} {'cell ms':>10s} {'numpy ms':>10s} {'speed-up':>12s} {'goal':>6s} {'thesis ms':>10s}"
     print(head)
     print("-" * len(head))
-    for (name, kwargs), goal in zip(cases.items(), (15, 5)):
-        packed = time_gpu(gpu, "packed", shape, state, kwargs, args.steps)
-        cell = time_gpu(gpu, "cell", shape, state, kwargs, args.steps)
-        ref = time_numpy(shape, state, kwargs, args.numpy_steps)
-        print(f"{name:30s} {packed:10.2f} {cell:10.2f} {ref:10.1f} {cell / packed:11.1f}x {goal:5d}x "
-              f"{THESIS_STEP_MS:10.1f}")
+    for r in measure(gpu, shape, args.steps, args.numpy_steps):
+        print(f"{r['case']:30s} {r['packed_ms']:10.2f} {r['cell_ms']:10.2f} {r['numpy_ms']:10.1f} "
+              f"{r['speedup']:11.1f}x {r['goal_speedup']:5d}x {r['thesis_ms']:10.1f}")
     print(f"thesis Table 8.1: simulation step update {THESIS_STEP_MS} ms on a GeForce 8700M GT "
           f"(256x32x256, pixel shader, one RGBA8 texel per cell, noise texture, region-volume control)")
     ctx.error

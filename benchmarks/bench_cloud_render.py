@@ -94,16 +94,10 @@ def configure(renderer, frustum, ess, downsample, lod_pixels) -> None:
                        lod_pixels=lod_pixels)
 
 
-def culling_table(quick: bool) -> None:
-    shape, size = ((128, 16, 128), (512, 384)) if quick else ((256, 32, 256), (1024, 768))
-    cell = (20.0, 10.0, 20.0)
-    gpu = create_headless(size)
-    print(f"\n1) frame time, {shape[0]}x{shape[1]}x{shape[2]} cells, {size[0]}x{size[1]}, group 32x32, "
-          f"{gpu.ctx.info['GL_RENDERER']}" + ("  [--quick: SMALLER than the thesis's setup]" if quick else ""))
-    print("   thesis rows: full resolution, no LOD (Tables 8.2-8.4); ours add the off-screen 1/2-res target "
-          "and levels of detail")
-    print(f"{'cover':>6} {'actual':>6} | {'config':>25} {'ms':>7} {'fps':>6} {'sprites':>8} {'x none':>6} "
-          f"{'x same-res none':>15} | {'thesis fps':>10} {'thesis x':>8}")
+def culling_rows(gpu, shape, frames: int = 20, cell=(20.0, 10.0, 20.0)) -> list[dict]:
+    """Frame time per cover (``COVERS``, scaled by the volume's area) and config (``CONFIGS``) at the
+    size of ``gpu``: one dict per row, with the thesis's fps where it has one (the first three)."""
+    rows = []
     area = shape[0] * shape[2] / 256 ** 2
     for level, density in COVERS.items():
         app, renderer, _ = make_app(gpu, shape, max(1, round(density * area)), (32, 32), cell)
@@ -112,13 +106,33 @@ def culling_table(quick: bool) -> None:
         none_ms = {}
         for i, (label, config) in enumerate(CONFIGS.items()):
             configure(renderer, *config)
-            ms = render_ms(app, 8 if quick else 20)
+            ms = render_ms(app, frames)
             none_ms.setdefault(config[2], ms)                # the first row at each resolution is "none"
-            thesis = (f"{THESIS[level][i]:>10} {THESIS[level][i] / THESIS[level][0]:>7.1f}x" if i < 3 else "")
-            print(f"{level:>6} {cover:>6.0%} | {label:>25} {ms:>7.1f} {1e3 / ms:>6.1f} {renderer.stats.sprites:>8} "
-                  f"{none_ms[1] / ms:>5.1f}x {none_ms[config[2]] / ms:>14.1f}x | {thesis}")
-        print(f"{'':>6} {'':>6} | goal: culling speed-up >= thesis x{THESIS_SPEEDUP[level]}")
+            rows.append({"cover": level, "actual_cover": cover, "config": label, "ms": ms, "fps": 1e3 / ms,
+                         "sprites": renderer.stats.sprites, "x_none": none_ms[1] / ms,
+                         "x_same_res_none": none_ms[config[2]] / ms,
+                         "thesis_fps": THESIS[level][i] if i < 3 else None,
+                         "thesis_x": THESIS[level][i] / THESIS[level][0] if i < 3 else None})
         app.close()
+    return rows
+
+
+def culling_table(quick: bool) -> None:
+    shape, size = ((128, 16, 128), (512, 384)) if quick else ((256, 32, 256), (1024, 768))
+    gpu = create_headless(size)
+    print(f"\n1) frame time, {shape[0]}x{shape[1]}x{shape[2]} cells, {size[0]}x{size[1]}, group 32x32, "
+          f"{gpu.ctx.info['GL_RENDERER']}" + ("  [--quick: SMALLER than the thesis's setup]" if quick else ""))
+    print("   thesis rows: full resolution, no LOD (Tables 8.2-8.4); ours add the off-screen 1/2-res target "
+          "and levels of detail")
+    print(f"{'cover':>6} {'actual':>6} | {'config':>25} {'ms':>7} {'fps':>6} {'sprites':>8} {'x none':>6} "
+          f"{'x same-res none':>15} | {'thesis fps':>10} {'thesis x':>8}")
+    rows = culling_rows(gpu, shape, 8 if quick else 20)
+    for r in rows:
+        thesis = f"{r['thesis_fps']:>10} {r['thesis_x']:>7.1f}x" if r["thesis_fps"] else ""
+        print(f"{r['cover']:>6} {r['actual_cover']:>6.0%} | {r['config']:>25} {r['ms']:>7.1f} {r['fps']:>6.1f} "
+              f"{r['sprites']:>8} {r['x_none']:>5.1f}x {r['x_same_res_none']:>14.1f}x | {thesis}")
+        if r["config"] == list(CONFIGS)[-1]:
+            print(f"{'':>6} {'':>6} | goal: culling speed-up >= thesis x{THESIS_SPEEDUP[r['cover']]}")
     gpu.release()
 
 

@@ -98,6 +98,68 @@ def plot(maps: DensityMaps, density: np.ndarray, path: Path) -> None:
     fig.savefig(path, dpi=90)
 
 
+def measure(gpu, shape, runs: int, slices: int, references: bool = True, plot_to: Path | None = None) -> list[dict]:
+    """Rows (stage, whole_ms, slice_ms for 1/``slices`` of the volume, thesis_ms, numpy_ms) for the
+    smoothing (packed f2, packed f4, cell f2), the density maps and the region volume (100 and 1000
+    ellipsoids) at ``shape``; ``references``: time the numpy references too; ``plot_to``: write the
+    maps' picture there."""
+    ctx = gpu.ctx
+    ca = CloudAutomaton(gpu, shape, layout="packed")
+    cld = cloud_field(np.random.default_rng(0), shape)
+    ca.upload(np.zeros(shape, bool), np.zeros(shape, bool), cld)
+    maps = DensityMaps(gpu, shape, band_height=4, group_size=(32, 32))
+    rows, density = [], None
+    z0, z1 = slice_range(shape[2], 0, slices)
+    for layout, dtype in (("packed", "f2"), ("packed", "f4"), ("cell", "f2")):
+        state = ca if layout == "packed" else CloudAutomaton(gpu, shape, layout="cell")
+        if state is not ca:
+            state.upload(np.zeros(shape, bool), np.zeros(shape, bool), cld)
+        smoother = Smoother.for_automaton(state)
+        texture = smoother.create_texture(dtype)
+        smoother.run(state.state_buffer, texture)           # warm-up: compiles
+        whole = median_ms(ctx, lambda: smoother.run(state.state_buffer, texture), runs)
+        part = median_ms(ctx, lambda: smoother.run(state.state_buffer, texture, z0, z1), runs)
+        ref = None
+        if density is None:
+            if references:
+                start = time.perf_counter()
+                reference.smooth(cld, min_density=smoother.min_density(dtype))
+                ref = (time.perf_counter() - start) * 1e3
+            density = read_volume(texture)
+            maps.run(texture)
+            dm_whole = median_ms(ctx, lambda: maps.run(texture), runs)
+            dm_part = median_ms(ctx, lambda: maps.run(texture, z0, z1), runs)
+            dm_ref = None
+            if references:
+                start = time.perf_counter()
+                reference.density_maps(density, maps.band_height, maps.group_size)
+                dm_ref = (time.perf_counter() - start) * 1e3
+            dm_tex = texture
+        rows.append({"stage": f"smoothing r=1 tent, {layout}, {dtype}", "whole_ms": whole, "slice_ms": part,
+                     "thesis_ms": THESIS_MS["smoothing"], "numpy_ms": ref})
+        smoother.release()
+        if texture is not dm_tex:
+            texture.release()
+        if state is not ca:
+            state.release()
+    rows.append({"stage": f"density maps, {maps.bands} bands, {maps.grid[0]}x{maps.grid[1]}", "whole_ms": dm_whole,
+                 "slice_ms": dm_part, "thesis_ms": THESIS_MS["density maps"], "numpy_ms": dm_ref})
+    for n, ms in region_volume_ms(gpu, shape, runs).items():
+        rows.append({"stage": f"region volume, {n} ellipsoids", "whole_ms": ms, "slice_ms": None,
+                     "thesis_ms": THESIS_MS["region volume"], "numpy_ms": None})
+    maxes = maps.read_max_maps()
+    rows.append({"stage": "max maps read back (bytes)", "whole_ms": None, "slice_ms": None, "thesis_ms": None,
+                 "numpy_ms": None, "bytes": int(maxes.nbytes),
+                 "columns_drawn": f"{(maxes[0] > 0).sum()} of {maxes[0].size}",
+                 "band_segments_drawn": f"{(maxes[1:] > 0).sum()} of {maxes[1:].size}"})
+    if plot_to is not None:
+        plot(maps, density, plot_to)
+    dm_tex.release()
+    maps.release()
+    ca.release()
+    return rows
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--shape", type=int, nargs=3, default=(256, 32, 256))
@@ -107,63 +169,24 @@ def main() -> None:
     args = parser.parse_args()
     shape = tuple(args.shape)
     gpu = create_headless((16, 16))
-    ctx = gpu.ctx
-    ca = CloudAutomaton(gpu, shape, layout="packed")
-    cld = cloud_field(np.random.default_rng(0), shape)
-    ca.upload(np.zeros(shape, bool), np.zeros(shape, bool), cld)
-    maps = DensityMaps(gpu, shape, band_height=4, group_size=(32, 32))
-    print(f"cloud stages, {shape[0]}x{shape[1]}x{shape[2]} cells, {cld.mean():.1%} cld, "
-          f"{ctx.info['GL_RENDERER']}, median of {args.runs} runs")
+    print(f"cloud stages, {shape[0]}x{shape[1]}x{shape[2]} cells, {gpu.ctx.info['GL_RENDERER']}, "
+          f"median of {args.runs} runs")
     head = (f"{'stage':34s} {'whole ms':>9s} {f'1/{args.slices} slice ms':>16s} {'thesis ms':>10s} "
             f"{'numpy ms':>9s}")
     print(head)
     print("-" * len(head))
-    density = None
-    for layout, dtype in (("packed", "f2"), ("packed", "f4"), ("cell", "f2")):
-        state = ca if layout == "packed" else CloudAutomaton(gpu, shape, layout="cell")
-        if state is not ca:
-            state.upload(np.zeros(shape, bool), np.zeros(shape, bool), cld)
-        smoother = Smoother.for_automaton(state)
-        texture = smoother.create_texture(dtype)
-        smoother.run(state.state_buffer, texture)           # warm-up: compiles
-        whole = median_ms(ctx, lambda: smoother.run(state.state_buffer, texture), args.runs)
-        z0, z1 = slice_range(shape[2], 0, args.slices)
-        part = median_ms(ctx, lambda: smoother.run(state.state_buffer, texture, z0, z1), args.runs)
-        ref = ""
-        if density is None:
-            start = time.perf_counter()
-            reference.smooth(cld, min_density=smoother.min_density(dtype))
-            ref = f"{(time.perf_counter() - start) * 1e3:9.0f}"
-            density = read_volume(texture)
-            maps.run(texture)
-            dm_whole = median_ms(ctx, lambda: maps.run(texture), args.runs)
-            dm_part = median_ms(ctx, lambda: maps.run(texture, z0, z1), args.runs)
-            start = time.perf_counter()
-            reference.density_maps(density, maps.band_height, maps.group_size)
-            dm_ref = (time.perf_counter() - start) * 1e3
-            dm_tex = texture
-        print(f"{f'smoothing r=1 tent, {layout}, {dtype}':34s} {whole:9.2f} {part:16.3f} "
-              f"{THESIS_MS['smoothing']:10.3f} {ref:>9s}")
-        smoother.release()
-        if texture is not dm_tex:
-            texture.release()
-        if state is not ca:
-            state.release()
-    print(f"{f'density maps, {maps.bands} bands, {maps.grid[0]}x{maps.grid[1]}':34s} {dm_whole:9.2f} "
-          f"{dm_part:16.3f} {THESIS_MS['density maps']:10.3f} {dm_ref:9.0f}")
-    region_ms = region_volume_ms(gpu, shape, args.runs)
-    for n, ms in region_ms.items():
-        print(f"{f'region volume, {n} ellipsoids':34s} {ms:9.2f} {'':16s} {THESIS_MS['region volume']:10.3f}")
-    maxes = maps.read_max_maps()
-    print(f"max maps read back: {maxes.nbytes} bytes; segments to draw: {(maxes[0] > 0).sum()} of "
-          f"{maxes[0].size} columns, {(maxes[1:] > 0).sum()} of {maxes[1:].size} band segments")
+    rows = measure(gpu, shape, args.runs, args.slices, plot_to=args.out)
+    for r in rows:
+        if r["whole_ms"] is None:
+            print(f"max maps read back: {r['bytes']} bytes; segments to draw: {r['columns_drawn']} columns, "
+                  f"{r['band_segments_drawn']} band segments")
+            continue
+        part = "" if r["slice_ms"] is None else f"{r['slice_ms']:16.3f}"
+        ref = "" if r["numpy_ms"] is None else f"{r['numpy_ms']:9.0f}"
+        print(f"{r['stage']:34s} {r['whole_ms']:9.2f} {part:>16s} {r['thesis_ms']:10.3f} {ref:>9s}")
     print("thesis Table 8.1 (GeForce 8700M GT, pixel shaders, 256x32x256): volume smoothing "
           "6.024 ms, density map computation 0.588 ms, region volume 5.26 ms")
-    plot(maps, density, args.out)
     print(f"wrote {args.out}")
-    dm_tex.release()
-    maps.release()
-    ca.release()
     gpu.release()
 
 

@@ -33,7 +33,9 @@ PAPER = ("Zdrojewska 2004, GeForce FX 5200, ~10,000 triangles, 4 texture octaves
 def render(gpu, size, frames, preset="fig6", **fields):
     """(image float 0-1, fog pass GPU ms, frame wall ms) after warm-up, at a fixed scene time."""
     app = App(gpu)
-    fog = fog_valley.build(app, DemoSettings(size=size, headless=True), fog_preset=preset)
+    settings = DemoSettings(size=size, headless=True)
+    app.insert_resource(settings)           # the demo's systems read it, as under build_app
+    fog = fog_valley.build(app, settings, fog_preset=preset)
     fog.configure(**fields)
     app.run_frames(3, dt=0.0)           # compile, make noise volumes
     gpu.ctx.finish()

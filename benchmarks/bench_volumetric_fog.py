@@ -53,7 +53,20 @@ def measure(app, plugin, reader, steps: int, frames: int):
         app.update(1 / 60)
         wall.append((time.perf_counter() - start) * 1000)
     gpu_ms = app.graph.timings.get("volumetric_fog", (float("nan"),))[0]
-    return reader.image.copy(), float(np.median(wall)), gpu_ms
+    return (reader.image.copy() if reader else None), float(np.median(wall)), gpu_ms
+
+
+def make_scene(gpu, read_color: bool = True):
+    """(app, fog plugin, colour reader or None): sky gradient, ground and the demo's fog, seen from
+    the demo's viewpoint with a low sun."""
+    plugin = VolumetricFogPlugin(animate=False, **FOG)
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(), plugin)
+    app.insert_resource(Sun.from_angles(elevation_deg=18.0, azimuth_deg=120.0))
+    cam = app.resource(Camera)
+    cam.position = np.array([28.0, 14.0, 91.0])
+    cam.look_at((0.0, 4.0, 0.0))
+    reader = app.graph.add_pass(ReadColor()) if read_color else None
+    return app, plugin, reader
 
 
 def main() -> None:
@@ -63,13 +76,7 @@ def main() -> None:
     args = parser.parse_args()
     size = tuple(int(v) for v in args.size.split("x"))
     gpu = create_headless(size)
-    plugin = VolumetricFogPlugin(animate=False, **FOG)
-    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(), plugin)
-    app.insert_resource(Sun.from_angles(elevation_deg=18.0, azimuth_deg=120.0))
-    cam = app.resource(Camera)
-    cam.position = np.array([28.0, 14.0, 91.0])
-    cam.look_at((0.0, 4.0, 0.0))
-    reader = app.graph.add_pass(ReadColor())
+    app, plugin, reader = make_scene(gpu)
 
     reference, ref_wall, ref_gpu = measure(app, plugin, reader, REFERENCE_STEPS, max(1, args.frames // 2))
     signal = np.sqrt(np.mean(reference ** 2))

@@ -33,7 +33,7 @@ def build_cloudscape(app, settings, *, hours: float, speed: float = 0.0, cloud_d
     changes the cover live)."""
     weather = example_weather(SHAPE, cloud_density=cloud_density, wind=wind)
     clouds = CloudSettings(cell_size=CELL, base_altitude=BASE_ALTITUDE, smoothing_slices=8, group_size=(32, 32),
-                           sigma=0.8)
+                           sigma_t=0.02)
     cloud_plugin = CloudsPlugin(clouds, weather=weather, seed=settings.seed, warmup_steps=warmup_steps)
     app.insert_resource(VolumeOrigin(-SHAPE[0] / 2, 0.0, -SHAPE[2] / 2))
     app.add_plugins(DefaultPlugins(overlay=not settings.headless),

@@ -7,7 +7,9 @@ import os
 
 import numpy as np
 
-from atmos.camera import Camera, Input
+from atmos.camera import Camera
+from atmos.input import Input
+from atmos.keys import key
 from atmos.defaults import DefaultPlugins
 from atmos.demo_registry import DemoSettings
 from atmos.lighting import Sun
@@ -51,7 +53,7 @@ def place_camera(app) -> None:
 
 def build(app, settings, fog_preset: str | None = None) -> FogPlugin:
     name = fog_preset or os.environ.get("ATMOS_FOG_PRESET", "fig6")
-    fog = FogPlugin(sky="fog", tile_size=NOISE_TILE, **preset(name))
+    fog = FogPlugin(sky="fog", tile_size=NOISE_TILE, seed=settings.seed, **preset(name))   # --seed: the noise lattice
     app.insert_resource(Sun.from_angles(elevation_deg=30.0, azimuth_deg=-30.0))
     app.add_plugins(DefaultPlugins(overlay=not settings.headless), SkyGradientPlugin(), TerrainPlugin(size=TERRAIN_SIZE, relief=10.0), fog)
     cam = app.resource(Camera)
@@ -61,8 +63,8 @@ def build(app, settings, fog_preset: str | None = None) -> FogPlugin:
 
     def switch_preset(app) -> None:
         keys = app.resource(Input).pressed
-        for key, name in zip("12345", PRESETS):
-            if key in keys or f"_{key}" in keys:
+        for number, name in zip((key._1, key._2, key._3, key._4, key._5), PRESETS):
+            if number in keys:
                 fog.configure(**PRESETS[name])
 
     app.add_system(place_camera, "update", label="fog_valley_camera", after="fly_camera")

@@ -33,6 +33,14 @@ def test_bad_frame_delta_advances_nothing(dt):
     assert clock.advance(dt) == 0 and clock.dt == 0.0
 
 
-def test_bad_clock_parameters():
-    with pytest.raises(ValueError, match="step > 0"):
-        FixedClock(step=0)
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(step=0), r"FixedClock.step must be a finite number > 0.0 and <= 3600.0, got 0"),
+    (dict(step=float("inf")), r"FixedClock.step must be .*, got inf"),
+    (dict(step="fast"), r"FixedClock.step must be .*, got 'fast'"),
+    (dict(max_frame_dt=float("nan")), r"FixedClock.max_frame_dt must be .*, got nan"),
+    (dict(max_steps=1.5), r"FixedClock.max_steps must be a whole number 1..10000, got 1.5"),
+    (dict(max_steps=float("inf")), r"FixedClock.max_steps must be a whole number 1..10000, got inf"),
+])
+def test_bad_clock_parameters(kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        FixedClock(**kwargs)

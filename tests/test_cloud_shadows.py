@@ -128,12 +128,16 @@ def test_gpu_matches_reference_on_random_scenes(gpu, ctx, rng):
     sums = [rng.uniform(0, ny, (layers, nx, nz)) for _ in range(2)]
     write_sums(sim, a, sums[0])
     write_sums(sim, b, sums[1])
-    origin = app.resource(VolumeOrigin)
-    origin.x, origin.z = rng.uniform(-12, -4, 2)
+    # each set drawn where it was computed: B at its placement, A at another (sampled through a_shift)
+    place_b = (float(rng.integers(-12, -4)), 0.0, float(rng.integers(-12, -4)))
+    place_a = (place_b[0] - float(rng.integers(1, 4)), 0.0, place_b[2] + float(rng.integers(1, 4)))
+    sim._placement[id(a)], sim._placement[id(b)] = place_a, place_b
+    sets = sim.sets()
+    assert sets.a_shift[0] > 0 and sets.a_shift[2] < 0
     sun = Sun.from_angles(rng.uniform(20, 85), rng.uniform(0, 360), color=tuple(rng.uniform(0.2, 2, 3)))
     app.insert_resource(sun)
-    layout = cloud_layout(sim, params)
-    centre = (np.array([origin.x, 0.0, origin.z]) + np.array([nx, 0.0, nz]) / 2) * cell
+    layout = cloud_layout(sets, params)
+    centre = (np.array([place_b[0], 0.0, place_b[2]]) + np.array([nx, 0.0, nz]) / 2) * cell
     centre[1] = (layout.lo[1] + layout.hi[1]) / 2
     shadow = centre - sun.direction * centre[1] / sun.direction[1]      # where the layer's shadow falls
     cam = app.resource(Camera)
@@ -153,7 +157,8 @@ def test_gpu_matches_reference_on_random_scenes(gpu, ctx, rng):
     assert np.isfinite(probe.color).all()
     weight = reference.direct_weight(sun.direction, sun.color, params)
     expected = reference.shadow_factor(world_points(cam, size, probe.depth), sums[0][0], sums[1][0], t,
-                                       sun.direction, weight, params.sigma * params.strength, layout)
+                                       sun.direction, weight, params.sigma * params.strength, layout,
+                                       sets.a_shift)
     expected[probe.depth >= 1.0] = 1.0
     before = color.astype(np.float16).astype(np.float64)
     error = np.abs(probe.color[..., :3] / before[..., :3] - expected[..., None]).max(-1)

@@ -192,7 +192,7 @@ def test_shading_stage_lights_each_step_with_the_sun_of_its_start(gpu, ctx):
     was when the step began, however much the sun moved while the step was sliced over frames."""
     from atmos.lighting import Sun
     from atmos.shading import compute_transmittance
-    settings = CloudSettings(smoothing_slices=2, group_size=(8, 8), sigma=0.8, cell_size=(2.0, 1.0, 2.0),
+    settings = CloudSettings(smoothing_slices=2, group_size=(8, 8), sigma_t=0.5, cell_size=(2.0, 1.0, 2.0),
                              shading_slices_per_run=4)
     app, sim = clouds_app(gpu, params(), settings)
     sun = Sun.from_angles(30.0, 10.0)
@@ -209,7 +209,7 @@ def test_shading_stage_lights_each_step_with_the_sun_of_its_start(gpu, ctx):
     assert frames > 5
     _, b, _ = sim.view()
     density = read_volume(b["density"])
-    expected = compute_transmittance(gpu, density, start_sun, 0.8)
+    expected = compute_transmittance(gpu, density, start_sun, settings.shading_sigma(start_sun * (2.0, 1.0, 2.0)))
     got = read_volume(b["transmittance"])
     assert density.max() > 0.5 and got.min() < 0.9, "clouds cast light shadows"
     assert np.abs(got - expected).max() < 2e-3        # f2 storage

@@ -212,8 +212,8 @@ def test_naive_and_sliced_agree(gpu, ctx, slices_per_frame, layers_per_slice):
     while sliced_job.step < steps:
         sliced.tick()
         ticks += 1
-    per_step = -(-sliced_job.slices_in_step // slices_per_frame)
-    assert ticks == steps * per_step     # a job never rotates twice in one frame
+    # a frame that ends a step goes on into the next one: the slices run are spread evenly over frames
+    assert ticks == -(-steps * sliced_job.slices_in_step // slices_per_frame)
     assert naive_job.step == sliced_job.step == steps
     for name in "abc":
         np.testing.assert_array_equal(read(getattr(naive_job.triple, name)), read(getattr(sliced_job.triple, name)))
@@ -284,12 +284,12 @@ def test_time_budget_with_measure_hook(gpu, ctx):
     scheduler.tick()
     scheduler.tick()
     assert job.slices_done == 9
-    scheduler.tick()                      # 3 slices left fit, but a step ends: no second rotation this frame
+    scheduler.tick()                      # the last 3 slices: a rotation
     assert job.step == 1 and job.slices_done == 0
     big = FrameScheduler(time_budget_ms=1e6, measure=measure)
     big.add(job)
-    big.tick()
-    assert big.stats["fill"].slices_last_frame == 12 and job.step == 2
+    big.tick()                            # a whole step, then on into the next but for its rotating slice
+    assert big.stats["fill"].slices_last_frame == 23 and job.step == 2 and job.slices_done == 11
     job.release()
 
 
@@ -299,9 +299,25 @@ def test_time_budget_syncs_and_measures(gpu, ctx):
     assert scheduler.sync
     scheduler.add(job)
     scheduler.tick()
-    assert scheduler.stats["fill"].slices_last_frame == SIZE[2] and job.step == 1
+    assert scheduler.stats["fill"].slices_last_frame == 2 * SIZE[2] - 1 and job.step == 1   # never two rotations
     assert 0.0 < scheduler.stats["fill"].mean_slice_ms < 1000.0
     job.release()
+
+
+@pytest.mark.parametrize("budget", [None, 3.5])
+def test_interpolation_advances_evenly_across_rotations(gpu, ctx, budget):
+    """The shown time step + t rises by the same amount every frame, the frames that end a step too
+    (the scheduler used to stop a job after its rotation: one frame in a few barely moved)."""
+    job = fill_job(gpu, size=(8, 4, 10))
+    scheduler = FrameScheduler(slices_per_frame=3, time_budget_ms=budget, measure=lambda run: (run(), 1.0)[1])
+    scheduler.add(job)
+    shown = []
+    for _ in range(40):
+        scheduler.tick()
+        shown.append(job.step + job.progress)
+    increments = np.diff(shown)
+    assert job.step == 12
+    np.testing.assert_allclose(increments, 0.3, atol=1e-9)
 
 
 def test_no_jobs_ticks_fine(ctx):
@@ -312,17 +328,29 @@ def test_no_jobs_ticks_fine(ctx):
 
 
 @pytest.mark.parametrize("kwargs, message", [
-    ({"mode": "eager"}, r"mode 'eager': allowed are 'sliced', 'naive'"),
-    ({"slices_per_frame": 0}, r"slices_per_frame=0: allowed is an int >= 1"),
-    ({"slices_per_frame": 1.5}, r"slices_per_frame=1.5: allowed is an int >= 1"),
-    ({"time_budget_ms": 0}, r"time_budget_ms=0: allowed is a finite number of milliseconds > 0"),
-    ({"time_budget_ms": -2.0}, r"time_budget_ms=-2.0: allowed is"),
-    ({"time_budget_ms": float("nan")}, r"time_budget_ms=nan: allowed is"),
-    ({"measure": 3}, r"measure=3: allowed is None or a callable"),
+    ({"mode": "eager"}, r"FrameScheduler.mode must be one of 'sliced', 'naive', got 'eager'"),
+    ({"slices_per_frame": 0}, r"FrameScheduler.slices_per_frame must be a whole number 1..1000000, got 0"),
+    ({"slices_per_frame": 1.5}, r"FrameScheduler.slices_per_frame must be a whole number 1..1000000, got 1.5"),
+    ({"time_budget_ms": 0}, r"FrameScheduler.time_budget_ms must be a finite number > 0.0 or None, got 0"),
+    ({"time_budget_ms": -2.0}, r"FrameScheduler.time_budget_ms must be .*, got -2.0"),
+    ({"time_budget_ms": float("nan")}, r"FrameScheduler.time_budget_ms must be .*, got nan"),
+    ({"measure": 3}, r"FrameScheduler.measure must be None or a callable"),
+    ({"sync": "yes"}, r"FrameScheduler.sync must be True or False"),
 ])
 def test_bad_scheduler_arguments(kwargs, message):
     with pytest.raises(ValueError, match=message):
         FrameScheduler(**kwargs)
+
+
+@pytest.mark.parametrize("name, value", [("slices_per_frame", 0), ("slices_per_frame", -1), ("time_budget_ms", 0.0),
+                                         ("time_budget_ms", float("inf")), ("mode", "eager"), ("measure", 3)])
+def test_a_bad_scheduler_setting_assigned_while_running_is_refused_and_changes_nothing(name, value):
+    """``app.frames.slices_per_frame = 0`` used to stop every sliced job without a word."""
+    scheduler = FrameScheduler(slices_per_frame=2, time_budget_ms=None)
+    before = getattr(scheduler, name)
+    with pytest.raises(ValueError, match=f"FrameScheduler.{name} must be"):
+        setattr(scheduler, name, value)
+    assert getattr(scheduler, name) == before
 
 
 def test_bad_job_arguments(gpu, ctx):

@@ -222,7 +222,7 @@ SPECS = {
     "render_core": Spec(
         lambda: [DefaultPlugins(overlay=False), GroundPlugin()], RenderCorePlugin,
         look((0.0, 3.0, 10.0), yaw=0.0, pitch=0.0),
-        dict(clear_color=(0.5, 0.2, 0.1), exposure=3.0)),
+        dict(clear_color=(0.5, 0.2, 0.1), exposure=3.0, dither=False)),
     "overlay": Spec(
         lambda: [DefaultPlugins(overlay=True), GroundPlugin()], OverlayPlugin,
         look((0.0, 3.0, 10.0), yaw=0.0, pitch=0.0),
@@ -243,7 +243,7 @@ SPECS = {
     "sky": Spec(
         lambda: [DefaultPlugins(overlay=False), SkyPlugin(star_density=0.5)], SkyPlugin,
         look((0.0, 2.0, 0.0), yaw=math.radians(200.0), pitch=0.45),
-        dict(turbidity=8.0, scale=0.08, sun_size_deg=4.0, sun_gain=200.0, night=(0.2, 0.1, 0.3), stars=False,
+        dict(turbidity=8.0, scale=0.08, sun_size_deg=4.0, sun_gain=200.0, sun_glare=0.5, night=(0.2, 0.1, 0.3), stars=False,
              star_density=0.9, star_brightness=40.0, twinkle=1.0),
         before={"sun_gain": configure_first(sun_size_deg=4.0), "night": set_sun(NIGHT), "stars": set_sun(NIGHT), "star_density": set_sun(NIGHT),
                 "star_brightness": set_sun(NIGHT), "twinkle": set_sun(NIGHT)}),
@@ -294,7 +294,8 @@ SPECS = {
         lambda: [DefaultPlugins(overlay=False), DaylightPlugin(hours=15.0), SkyPlugin(stars=False), GroundPlugin()],
         DaylightPlugin,
         look((0.0, 2.0, 0.0), yaw=math.radians(240.0), pitch=0.2),
-        dict(hours=9.0, speed=20.0, latitude=-30.0, day_of_year=355.0),
+        dict(hours=9.0, speed=20.0, latitude=-30.0, day_of_year=355.0, year=1900, longitude=100.0, utc_offset=3.0),
+        before={"year": configure_first(day_of_year=80.0), "utc_offset": configure_first(longitude=0.0)},
         frame_dt={"speed": 0.1}),
     "cloud_shadows": Spec(
         lambda: [DefaultPlugins(overlay=False), clouds(shading=False), SkyGradientPlugin(), GroundPlugin(),
@@ -310,7 +311,8 @@ SPECS = {
         CloudRenderPlugin,
         look((320.0, 60.0, 500.0), target=(320.0, 360.0, 100.0), far=6000.0),     # some columns out of view
         dict(base_altitude=200.0, size_factor=6.0, sigma=0.05, frustum_culling=False, empty_space_skipping=False,
-             max_point_size=1.0, downsample=4, lod_pixels=40.0, enabled=False),
+             max_point_size=1.0, downsample=4, lod_pixels=40.0, ms_attenuation=0.1, ms_contribution=1.0,
+             ms_eccentricity=0.0, enabled=False),
         observe={"frustum_culling": culling_counters, "empty_space_skipping": culling_counters,
                  "downsample": resource_size(CLOUD_COLOR)}),
 }
@@ -318,7 +320,9 @@ SPECS = {
 
 def _clouds_spec():
     weather = example_weather((32, 8, 32), 20)
-    changes = dict(step_seconds=3.0, cover_threshold=6.0, sigma=2.0, scattering=Scattering("multiple-forward"),
+    changes = dict(step_seconds=3.0, cover_threshold=6.0, sigma_t=2.0, scattering=Scattering("multiple-forward"),
+                   albedo=0.5, phase_g=0.2, phase_g2=0.6, phase_w=0.7, sun_intensity=2.0, sky_intensity=4.0,
+                   ground_albedo=1.0,
                    cell_size=(10.0, 30.0, 10.0), base_altitude=150.0)
     changes.update(weather_changes(weather))
     observe = {"step_seconds": next_step_reads("dt"), "cover_threshold": lambda app, plugin: plugin.simulation.cover(),

@@ -175,7 +175,7 @@ def test_march_extremes_finite_and_as_reference(gpu, ctx, rng, change):
     origins = np.array([[0.0, 0.0, 0.0], [0.0, 5.0, -60.0], [1e3, 0, 0], [0.0, 0.0, -25.0]])
     dirs = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [-1.0, 0, 0], [0.0, 0.0, 1.0]])
     limits = np.array([1e30, 1e30, 2e3, 0.0])
-    for sun in (Sun.from_angles(45), Sun.from_angles(-60), Sun(np.zeros(3))):
+    for sun in (Sun.from_angles(45), Sun.from_angles(-60), Sun.from_angles(0.0)):   # (a zero Sun is refused)
         got = gpu_march(gpu, origins, dirs, limits, params, sun)
         want = ref_march(origins, dirs, limits, params, sun)
         assert np.isfinite(got).all() and (got >= 0).all() and (got[:, 3] <= 1).all()

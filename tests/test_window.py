@@ -53,3 +53,55 @@ def test_escape_quits_and_resize_is_safe(display):
     subprocess.run(["xdotool", "key", "Escape"], env=env, check=True)
     out, err = proc.communicate(timeout=60)
     assert proc.returncode == 0, err
+
+
+def test_a_resized_window_is_filled_and_atmos_leaves_no_gl_error(display, tmp_path):
+    """tests/window_probe.py grows and shrinks a window while running, reads each size's frame with
+    read_pixels and then draws a pyglet Label with pyglet's GL error checking on."""
+    import json
+    env = dict(os.environ, DISPLAY=display)
+    probe = os.path.join(os.path.dirname(__file__), "window_probe.py")
+    proc = subprocess.run([sys.executable, probe, str(tmp_path)], env=env, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    seen = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert [s["size"] for s in seen] == [[200, 120], [320, 240], [160, 200]]
+    for s in seen:
+        assert s["pixels"] == s["size"] and s["error"] == "GL_NO_ERROR", s
+        assert s["dark"] < 0.01, f"the frame at {s['size']} does not fill the window ({s['dark']:.0%} left dark)"
+
+
+GAME = '''
+from atmos import DefaultPlugins
+from atmos.plugins.sky_gradient import SkyGradientPlugin
+TITLE = "a tiny game"
+
+def build(app, settings):
+    app.add_plugins(DefaultPlugins(overlay=False), SkyGradientPlugin())
+'''
+
+
+def test_atmos_run_opens_a_game_file_in_a_window(display, tmp_path):
+    game = tmp_path / "tiny.py"
+    game.write_text(GAME)
+    env = dict(os.environ, DISPLAY=display)
+    proc = subprocess.run([sys.executable, "-m", "atmos", "run", str(game), "--size", "160x90", "--frames", "8"],
+                          env=env, capture_output=True, text=True, timeout=120, cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert "headless" not in proc.stderr and not (tmp_path / "out").exists(), "it ran headless, not in the window"
+
+
+def test_the_example_game_runs_in_a_window(display, tmp_path):
+    env = dict(os.environ, DISPLAY=display)
+    game = os.path.join(os.path.dirname(__file__), "..", "demos", "glider.py")
+    proc = subprocess.run([sys.executable, "-m", "atmos", "run", game, "--size", "160x90", "--frames", "6"],
+                          env=env, capture_output=True, text=True, timeout=180, cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert not (tmp_path / "out").exists(), "it ran headless, not in the window"
+
+
+def test_atmos_runs_inside_a_pyglet_window_the_game_owns(display):
+    env = dict(os.environ, DISPLAY=display)
+    example = os.path.join(os.path.dirname(__file__), "..", "examples", "pyglet_host.py")
+    proc = subprocess.run([sys.executable, example, "8"], env=env, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert "host drew 8 frames" in proc.stdout

@@ -92,6 +92,7 @@ class SliceTask:
     """
 
     def __init__(self, name: str, slices: int | Callable[[], int], run: Callable[[int, SliceContext], None]):
+        _check_name("task", name)
         if not callable(run):
             raise ValueError(f"task {name!r}: run must be callable as run(slice_index, job_ctx); got {run!r}")
         if not callable(slices):
@@ -106,6 +107,11 @@ class SliceTask:
 
     def __repr__(self) -> str:
         return f"SliceTask({self.name!r}, slices={self.slices!r})"
+
+
+def _check_name(what: str, name) -> None:
+    if not isinstance(name, str) or not name:
+        raise ValueError(f"a {what} name must be a non-empty string (it keys the stats), got {name!r}")
 
 
 def _check_count(name: str, value) -> int:
@@ -141,6 +147,9 @@ class SlicedJob:
 
     def __init__(self, name: str, tasks: list[SliceTask], triple: TripleSet,
                  begin: Callable[[int], None] | None = None):
+        _check_name("job", name)
+        if begin is not None and not callable(begin):
+            raise ValueError(f"job {name!r}: begin must be None or callable as begin(step); got {begin!r}")
         if not tasks:
             raise ValueError(f"job {name!r} needs at least one SliceTask; got none")
         for task in tasks:
@@ -164,6 +173,11 @@ class SlicedJob:
     def slices_in_step(self) -> int:
         """Slices of the current step (fixed when it begins; the tasks' current counts before that)."""
         return self._total if self._plan is not None else sum(task.count() for task in self.tasks)
+
+    @property
+    def slices_left(self) -> int:
+        """Slices until the current step completes (the last of them rotates the triple)."""
+        return self._total - self._done if self._plan is not None else self.slices_in_step
 
     @property
     def slices_done(self) -> int:

@@ -4,8 +4,10 @@ Modes:
 
 * ``"sliced"`` — each :meth:`FrameScheduler.tick` runs ``slices_per_frame`` slices, round robin over
   the jobs; or, with ``time_budget_ms``, as many slices as their measured cost allows (always at
-  least one per frame, so progress never stalls). A job completes at most one step per tick: a
-  second rotation in the same frame would throw away a result that was never shown.
+  least one per frame, so progress never stalls). A job completes at most one step per tick (a
+  second rotation in the same frame would throw away a result that was never shown), but after a
+  rotation it goes on into the next step, so a frame that crosses a step boundary runs as many
+  slices as any other and the interpolation factor t advances by the same amount every frame.
 * ``"naive"`` — each tick runs a whole step of every job (the frame pays for it: the reference for
   the benchmarks).
 """
@@ -14,6 +16,7 @@ from __future__ import annotations
 import weakref
 from dataclasses import dataclass
 
+from atmos.checks import check_bool, check_choice, check_int, check_num
 from atmos.frames.job import Measure, SlicedJob, gpu_measure, perf_measure
 
 MODES = ("sliced", "naive")
@@ -41,29 +44,55 @@ class FrameScheduler:
 
     def __init__(self, mode: str = "sliced", slices_per_frame: int = 1, time_budget_ms: float | None = None,
                  measure: Measure | None = None, sync: bool | None = None):
-        if mode not in MODES:
-            raise ValueError(f"FrameScheduler mode {mode!r}: allowed are {', '.join(repr(m) for m in MODES)}")
-        if isinstance(slices_per_frame, bool) or not isinstance(slices_per_frame, int) or slices_per_frame < 1:
-            raise ValueError(f"FrameScheduler slices_per_frame={slices_per_frame!r}: allowed is an int >= 1")
-        if time_budget_ms is not None:
-            if isinstance(time_budget_ms, bool) or not isinstance(time_budget_ms, (int, float)) \
-                    or not time_budget_ms > 0 or time_budget_ms == float("inf"):
-                raise ValueError(f"FrameScheduler time_budget_ms={time_budget_ms!r}: allowed is a finite "
-                                 "number of milliseconds > 0, or None for a fixed slices_per_frame")
-        if measure is not None and not callable(measure):
-            raise ValueError(f"FrameScheduler measure={measure!r}: allowed is None or a callable "
-                             "measure(run) -> milliseconds")
         self.mode = mode
         self.slices_per_frame = slices_per_frame
-        self.time_budget_ms = None if time_budget_ms is None else float(time_budget_ms)
+        self.time_budget_ms = time_budget_ms
         self.measure = measure
-        self.sync = (time_budget_ms is not None) if sync is None else bool(sync)
+        self.sync = (self.time_budget_ms is not None) if sync is None else check_bool("FrameScheduler", "sync", sync)
         self.jobs: list[SlicedJob] = []
         self.frame = 0
         self.slices_last_frame = 0
         self.ms_last_frame = 0.0
         self._next = 0  # round-robin start
         self._gpu_measures: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()  # ctx -> Measure
+
+    # -- settings (checked on every assignment, e.g. ``app.frames.slices_per_frame = 4``) ----------
+    @property
+    def mode(self) -> str:
+        return self._mode
+
+    @mode.setter
+    def mode(self, value: str) -> None:
+        self._mode = check_choice("FrameScheduler", "mode", value, MODES)
+
+    @property
+    def slices_per_frame(self) -> int:
+        """Slices run per frame without a time budget (>= 1: 0 would stop every sliced job)."""
+        return self._slices_per_frame
+
+    @slices_per_frame.setter
+    def slices_per_frame(self, value: int) -> None:
+        self._slices_per_frame = check_int("FrameScheduler", "slices_per_frame", value, 1, 1_000_000)
+
+    @property
+    def time_budget_ms(self) -> float | None:
+        """Milliseconds of slices per frame (always at least one slice), or None for ``slices_per_frame``."""
+        return self._time_budget_ms
+
+    @time_budget_ms.setter
+    def time_budget_ms(self, value: float | None) -> None:
+        self._time_budget_ms = check_num("FrameScheduler", "time_budget_ms", value, 0.0, lo_open=True, optional=True)
+
+    @property
+    def measure(self) -> Measure | None:
+        return self._measure
+
+    @measure.setter
+    def measure(self, value: Measure | None) -> None:
+        if value is not None and not callable(value):
+            raise ValueError(f"FrameScheduler.measure must be None or a callable measure(run) -> milliseconds, "
+                             f"got {value!r}")
+        self._measure = value
 
     # -- jobs -------------------------------------------------------------------------------
     def add(self, job: SlicedJob) -> SlicedJob:
@@ -125,6 +154,9 @@ class FrameScheduler:
         budget = self.time_budget_ms
         while active:
             for job in list(active):
+                if job.step != start_steps[id(job)] and job.slices_left == 1:
+                    active.remove(job)           # its next slice would be a second rotation this frame
+                    continue
                 if budget is None:
                     if ran >= self.slices_per_frame:
                         return
@@ -137,8 +169,6 @@ class FrameScheduler:
                 job.run_slices(1, measure=self._measure_for(job))
                 spent += job.stats.ms_last_frame - before
                 ran += 1
-                if job.step != start_steps[id(job)]:
-                    active.remove(job)       # at most one rotation per job per frame
 
     @property
     def stats(self) -> dict[str, FrameStats]:

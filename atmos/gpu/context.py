@@ -1,6 +1,7 @@
 """One GPU context type for a pyglet window and for headless EGL rendering into an offscreen framebuffer."""
 from __future__ import annotations
 
+import operator
 import weakref
 
 import moderngl
@@ -38,8 +39,36 @@ def release_gl(obj) -> None:
     obj.release()
 
 
+def check_frame_size(size, limit: int | None = None, what: str = "size") -> tuple[int, int]:
+    """``(width, height)`` as ints: two whole numbers >= 0 (0, a minimized window, becomes 1) and at
+    most ``limit`` (the context's largest render target); a ValueError naming ``what`` otherwise."""
+    try:
+        values = None if isinstance(size, (str, bytes)) else tuple(size)
+        w, h = (None if isinstance(v, (bool, np.bool_)) else operator.index(v) for v in values)
+    except (TypeError, ValueError):
+        w = h = None
+    if w is None or h is None or min(w, h) < 0 or (limit is not None and max(w, h) > limit):
+        top = f"0..{limit}" if limit is not None else ">= 0"
+        raise ValueError(f"{what} must be (width, height), two whole numbers {top} (0: a minimized window), "
+                         f"got {size!r}")
+    return max(1, int(w)), max(1, int(h))
+
+
+def window_framebuffer(ctx: moderngl.Context, size: tuple[int, int]) -> moderngl.Framebuffer:
+    """The window's framebuffer (GL name 0) at its current ``size``. moderngl keeps the size the window
+    had when the context was made (``ctx.screen.size``), and the render graph sets each pass's viewport
+    from a framebuffer's size, so after a resize frames would fill only the old rectangle."""
+    screen = ctx.detect_framebuffer(0)
+    screen._size = tuple(size)               # moderngl has no public setter for it
+    screen.viewport = (0, 0, *size)
+    return screen
+
+
 def create_headless(size: tuple[int, int] = (640, 360), backend: str = "egl") -> "GpuContext":
     """A standalone context (EGL by default) that renders into an offscreen framebuffer of ``size``."""
+    check_frame_size(size)
+    if not isinstance(backend, str) or not backend:
+        raise ValueError(f"backend must be a glcontext backend name such as 'egl', got {backend!r}")
     try:
         ctx = moderngl.create_standalone_context(backend=backend)
     except Exception as error:  # moderngl/glcontext raise plain Exceptions with the loader's message
@@ -49,10 +78,10 @@ def create_headless(size: tuple[int, int] = (640, 360), backend: str = "egl") ->
             "or a GPU driver with EGL.") from None
     try:
         _check_version(ctx)
-    except GpuError:
+        return GpuContext(ctx, size, headless=True)
+    except Exception:
         ctx.release()
         raise
-    return GpuContext(ctx, size, headless=True)
 
 
 def from_current(size: tuple[int, int]) -> "GpuContext":
@@ -78,7 +107,8 @@ def require_gpu(gpu, what: str = "gpu") -> "GpuContext":
 class GpuContext:
     """A moderngl context, the framebuffer frames are drawn into, and a cache of compiled programs.
 
-    Everything made through :meth:`track` or :meth:`program` is released by :meth:`release`.
+    Everything made through :meth:`track` or :meth:`program` is released by :meth:`release`; after
+    it, using the context is a :class:`GpuError` (a second ``release`` does nothing).
     """
 
     def __init__(self, ctx: moderngl.Context, size: tuple[int, int], headless: bool):
@@ -88,6 +118,8 @@ class GpuContext:
         self._programs: dict[tuple, object] = {}
         self._tracked: "weakref.WeakSet" = weakref.WeakSet()
         self._offscreen: list = []
+        self.released = False
+        self._apps: "weakref.WeakSet" = weakref.WeakSet()   # open Apps on this context (closed first by release)
         self.queries: QueryPool = query_pool(ctx)  # query objects shared by every App on this context
         self.software = is_software(ctx)
         if self.software:
@@ -99,12 +131,29 @@ class GpuContext:
         """Make this the thread's current OpenGL context. moderngl does not switch contexts by
         itself: with two contexts in one process (two headless Apps, a tool beside a game), GL
         calls go to whichever was made current last. App.update and the methods here call it."""
+        self._require_live()
         self.ctx.__enter__()
+
+    def _require_live(self) -> None:
+        if self.released:
+            raise GpuError("this GpuContext was released (GpuContext.release); create a new one "
+                           "(atmos.create_headless or atmos.from_current)")
+
+    @property
+    def max_size(self) -> int:
+        """The largest frame width or height this context can render (its texture, renderbuffer and
+        viewport limits)."""
+        info = self.ctx.info
+        viewport = info.get("GL_MAX_VIEWPORT_DIMS", (16384, 16384))
+        return int(min(info.get("GL_MAX_TEXTURE_SIZE", 16384), info.get("GL_MAX_RENDERBUFFER_SIZE", 16384),
+                       *viewport))
 
     # -- framebuffer -----------------------------------------------------------------------
     def resize(self, size: tuple[int, int]) -> None:
-        """Set the frame size; a minimized window (0 in either axis) keeps a 1×1 target."""
-        size = (max(1, int(size[0])), max(1, int(size[1])))
+        """Set the frame size; a minimized window (0 in either axis) keeps a 1×1 target. A size the
+        context cannot render (above :attr:`max_size`, negative, not whole numbers) is a ValueError."""
+        self._require_live()
+        size = check_frame_size(size, self.max_size, "GpuContext size")
         if size == self.size:
             return
         self.make_current()
@@ -117,13 +166,25 @@ class GpuContext:
             self.target = self.ctx.framebuffer([color], depth)
             self._offscreen = [self.target, color, depth]
         else:
-            self.target = self.ctx.screen
+            for obj in self._offscreen:          # the read_pixels copy of the old size
+                release_gl(obj)
+            self._offscreen = []
+            self.target = window_framebuffer(self.ctx, size)
 
     def read_pixels(self) -> np.ndarray:
-        """The current frame as uint8 RGB, shape (height, width, 3), first row at the top."""
+        """The current frame as uint8 RGB, shape (height, width, 3), first row at the top. In a window
+        the frame is copied to a texture first (moderngl's read of a window's framebuffer selects a
+        colour attachment it does not have: GL_INVALID_OPERATION), so no GL error is left behind."""
         self.make_current()
         w, h = self.size
-        data = self.target.read(viewport=(0, 0, w, h), components=3, alignment=1)
+        source = self.target
+        if not self.headless:
+            if not self._offscreen:
+                texture = self.ctx.texture((w, h), 3)
+                self._offscreen = [self.ctx.framebuffer([texture]), texture]
+            source = self._offscreen[0]
+            self.ctx.copy_framebuffer(source, self.target)
+        data = source.read(viewport=(0, 0, w, h), components=3, alignment=1)
         return np.frombuffer(data, np.uint8).reshape(h, w, 3)[::-1].copy()
 
     # -- programs and lifetime ---------------------------------------------------------------
@@ -135,6 +196,7 @@ class GpuContext:
         ``gpu.program(vertex_shader="sky.vert", fragment_shader="sky.frag")`` or
         ``gpu.program(compute_shader="volume.comp", defines={"N": 4})``.
         """
+        self._require_live()
         key = (tuple(sorted(stages.items())), tuple(sorted((defines or {}).items())))
         program = self._programs.get(key)
         if program is None:
@@ -148,12 +210,25 @@ class GpuContext:
 
     def track(self, obj):
         """Register a GL object to be released with this context; returns it."""
+        self._require_live()
         self._tracked.add(obj)
         return obj
 
     def release(self) -> None:
-        """Release every tracked object, program and offscreen target, then the context itself."""
+        """Release every tracked object, program and offscreen target, then the context itself
+        (a window's context stays its window's). Open Apps on it are closed first (App.close).
+        Releasing again does nothing."""
+        if self.released:
+            return
+        failures = []
+        for app in list(self._apps):
+            try:
+                app._closed_by = "by GpuContext.release"
+                app.close()
+            except Exception as error:         # the App released everything else; so does the context
+                failures.append(error)
         self.make_current()
+        self.released = True
         for obj in list(self._tracked):
             obj.release()
         for program in self._programs.values():
@@ -165,15 +240,19 @@ class GpuContext:
         self.queries.clear()
         if self.headless:
             self.ctx.release()
+        if failures:
+            raise failures[0]
 
     def check(self, where: str = "") -> None:
         """Raise if OpenGL has recorded an error (``GL_NO_ERROR`` otherwise)."""
+        self._require_live()
         error = self.ctx.error
         if error != "GL_NO_ERROR":
             raise GpuError(f"OpenGL error {error}" + (f" after {where}" if where else ""))
 
     def info(self) -> dict:
         """Renderer, version and the limits atmos cares about."""
+        self._require_live()
         info = self.ctx.info
         keys = ["GL_VENDOR", "GL_RENDERER", "GL_VERSION", "GL_MAX_TEXTURE_SIZE", "GL_MAX_3D_TEXTURE_SIZE",
                 "GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS", "GL_MAX_COMPUTE_WORK_GROUP_COUNT",

@@ -5,7 +5,8 @@ from atmos.graph.passes import PassBuilder, RenderPass
 
 
 class FullscreenPass(RenderPass):
-    """Subclass with ``name``, ``phase``, ``fragment`` (a shader file), ``reads`` and ``writes``
+    """Subclass with ``name``, ``phase``, ``fragment`` (a shader file; ``vertex``, the fullscreen
+    triangle, is ``lib/fullscreen_far.vert`` for a pass drawn behind everything), ``reads`` and ``writes``
     (resource names) and, if needed, :meth:`defines`; ``execute`` binds a target and calls
     ``frame.fullscreen(self.program)``. ``plugin`` is the plugin that made the pass (its settings).
 
@@ -14,6 +15,7 @@ class FullscreenPass(RenderPass):
     A pass that blends onto ``color`` lists it in ``reads`` and ``writes``.
     """
     fragment: str = ""
+    vertex: str = "lib/fullscreen.vert"     # lib/fullscreen_far.vert: on the far plane (skies)
     reads: tuple[str, ...] = ()
     writes: tuple[str, ...] = ("color",)
 
@@ -36,5 +38,5 @@ class FullscreenPass(RenderPass):
 
     @property
     def program(self):
-        return self.gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader=self.fragment,
+        return self.gpu.program(vertex_shader=self.vertex, fragment_shader=self.fragment,
                                 defines=self.defines())

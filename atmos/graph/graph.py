@@ -118,8 +118,11 @@ class RenderGraph:
                     self._prepared[p.name] = p
                 frame._begin_pass(p.name, compiled.declared[i])
                 if self.timings_enabled:
-                    with self._timers.measure(p.name):
+                    self._timers.begin(p.name)
+                    try:
                         p.execute(frame)
+                    finally:
+                        self._timers.end(p.name)
                 else:
                     p.execute(frame)
                 for r in compiled.release[i]:

@@ -10,13 +10,14 @@ RING = 3  # queries per pass; the one read back was issued RING - 1 frames ago
 
 
 class _Ring:
-    __slots__ = ("queries", "cpu_ms", "pending", "frame")
+    __slots__ = ("queries", "cpu_ms", "pending", "frame", "start")
 
     def __init__(self):
         self.queries: list = [None] * RING
         self.cpu_ms = [0.0] * RING
         self.pending = [False] * RING
         self.frame = 0
+        self.start = 0.0
 
 
 class PassTimers:
@@ -39,7 +40,15 @@ class PassTimers:
 
     @contextmanager
     def measure(self, name: str):
-        """Time the body as one frame of pass ``name``."""
+        """Time the body as one frame of pass ``name`` (:meth:`begin` and :meth:`end` around it)."""
+        self.begin(name)
+        try:
+            yield
+        finally:
+            self.end(name)
+
+    def begin(self, name: str) -> None:
+        """Start this frame's measurement of pass ``name`` (read back the one issued RING - 1 frames ago)."""
         ring = self._rings.get(name)
         if ring is None:
             ring = self._rings[name] = _Ring()
@@ -52,10 +61,15 @@ class PassTimers:
         query = ring.queries[slot]
         if query is None:
             query = ring.queries[slot] = self.queries.acquire(time=True)
-        start = time.perf_counter()
-        with query:
-            yield
-        ring.cpu_ms[slot] = (time.perf_counter() - start) * 1000.0
+        ring.start = time.perf_counter()
+        query.__enter__()
+
+    def end(self, name: str) -> None:
+        """End the measurement :meth:`begin` started."""
+        ring = self._rings[name]
+        slot = ring.frame % RING
+        ring.queries[slot].__exit__(None, None, None)
+        ring.cpu_ms[slot] = (time.perf_counter() - ring.start) * 1000.0
         ring.pending[slot] = True
         ring.frame += 1
 

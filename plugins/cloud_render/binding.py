@@ -4,7 +4,8 @@ from __future__ import annotations
 import moderngl
 
 from atmos.lighting import Sun
-from atmos.plugins.cloud_render.light import sun_light
+from atmos.plugins.cloud_render.light import DEFAULT_OCTAVES, light_uniforms
+from atmos.plugins.clouds.sets import CloudSets
 
 UNITS = (0, 1, 2, 3)        # density_a, density_b, trans_a, trans_b
 
@@ -14,9 +15,11 @@ def clamp_sampler(ctx: moderngl.Context):
     return ctx.sampler(filter=(moderngl.LINEAR, moderngl.LINEAR), repeat_x=False, repeat_y=False, repeat_z=False)
 
 
-def bind_volume(program, sim, sampler, sun: Sun | None) -> float:
+def bind_volume(program, sim, sampler, sun: Sun | None, octaves=DEFAULT_OCTAVES) -> float:
     """Bind mix(A, B, t)'s textures (``sim``: the frame's CloudSets, or the CloudSimulation) to units
-    0..3 with ``sampler`` and set ``t``, ``has_shading``, ``sun_color``, ``ambient``; returns t. Call
+    0..3 with ``sampler`` and set ``t``, ``a_shift`` (A drawn where it was computed), ``has_shading``
+    and the light (:func:`light_uniforms` of the simulation's medium, the sun and the
+    multiple-scattering ``octaves``); returns t. Call
     :func:`unbind_volume` when the draw is done."""
     a, b, t = sim.view()
     shading = "transmittance" in a
@@ -27,9 +30,11 @@ def bind_volume(program, sim, sampler, sun: Sun | None) -> float:
     b[light].use(3)
     for unit in UNITS:
         sampler.use(unit)
-    color, ambient = sun_light(sun)
     program["t"].value = float(t)
-    for name, value in (("has_shading", int(shading)), ("sun_color", color), ("ambient", ambient)):
+    if "a_shift" in program:
+        program["a_shift"].value = (sim if isinstance(sim, CloudSets) else sim.sets()).a_shift
+    values = {"has_shading": int(shading), **light_uniforms(sim.settings, sun, octaves)}
+    for name, value in values.items():
         if name in program:
             program[name].value = value
     return float(t)

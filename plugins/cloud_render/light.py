@@ -1,11 +1,14 @@
-"""The light model both cloud renderers share: colour = sun colour × transmittance + ambient."""
+"""The light both cloud renderers share (``cloud_render/volume.glsl``; the model is
+:mod:`atmos.shading.medium`): the sun's colour faded across the horizon, and the uniforms of J."""
 from __future__ import annotations
 
 import numpy as np
 
 from atmos.lighting import Sun
+from atmos.shading.medium import environment
 
 DEFAULT_AMBIENT = (0.35, 0.47, 0.65)
+DEFAULT_OCTAVES = (0.15, 0.55, 0.8)       # Wrenninge's a, b, c, fitted to the path tracer (bench_cloud_light --fit)
 
 
 def sun_light(sun: Sun | None) -> tuple[tuple, tuple]:
@@ -20,3 +23,25 @@ def sun_light(sun: Sun | None) -> tuple[tuple, tuple]:
     color = tuple(float(c) * fade for c in sun.color)
     ambient = tuple(float(c) for c in getattr(sun, "ambient", DEFAULT_AMBIENT))
     return color, ambient
+
+
+def unit_direction(sun: Sun | None) -> np.ndarray:
+    d = np.asarray((sun or Sun()).direction, np.float64)
+    n = np.linalg.norm(d)
+    return d / n if n > 0 and np.isfinite(n) else np.array([0.0, -1.0, 0.0])
+
+
+def light_uniforms(cloud_settings, sun: Sun | None, octaves=DEFAULT_OCTAVES) -> dict:
+    """The light uniforms of ``volume.glsl`` for a ``CloudSettings`` medium, the ``Sun`` and the
+    multiple-scattering octaves (a, b, c)."""
+    color, ambient = sun_light(sun)
+    direction = unit_direction(sun)
+    e, sky, ground = environment(cloud_settings, color, ambient, direction)
+    s = cloud_settings
+    return {"sun_source": tuple(float(v) for v in s.albedo * e),
+            "sky_source": tuple(float(v) for v in 0.5 * s.albedo * sky),
+            "ground_source": tuple(float(v) for v in 0.5 * s.albedo * ground),
+            "sun_dir": tuple(float(v) for v in direction),
+            "phase_lobes": (float(s.phase_g), float(s.phase_g2), float(s.phase_w)),
+            "ms_octaves": tuple(float(v) for v in octaves),
+            "column_tau": float(s.sigma_t * s.cell_size[1])}

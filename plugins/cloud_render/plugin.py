@@ -6,8 +6,9 @@ no vertex buffer: gl_VertexID is a block's place in its unit (a group, or 2 besi
 camera stands on), walked farther neighbour first from where the camera stands (blending is in
 vertex order, so the back-to-front order holds inside a unit too). The vertex shader fetches
 density and transmittance as mix(A, B, t), throws empty cells out of the view volume, sizes the
-sprite from distance and density, and colours it sun × T + ambient; the fragment shader applies
-the soft particle. Blending is premultiplied (ONE, ONE_MINUS_SRC_ALPHA), so "color"'s alpha stays
+sprite from distance and density, and lights it (the source J of :mod:`atmos.shading.medium`: octave
+weights of the sun's transmittance, sky and ground light dimmed by the columns above and below); the
+fragment shader applies the soft particle and the phase function at its own view ray. Blending is premultiplied (ONE, ONE_MINUS_SRC_ALPHA), so "color"'s alpha stays
 in [0, 1]; the depth test runs against the scene's "depth" with depth writes off.
 
 Opacity: a sprite of world diameter D = ``size_factor × max(cx, cz) × (0.75 + 0.25 min(density, 1))``
@@ -16,7 +17,8 @@ cube-root length, sigma per cell length), so its optical depth summed over the s
 cell's — what the reference ray marcher integrates (exact for cubic cells). All but empty cells keep
 3/4 of the size, so neighbouring sprites still overlap (at 1/2, thin cloud bottoms fell apart into
 streaks along the columns). Sprites under a pixel are drawn 1 pixel wide with their opacity scaled
-by their area in pixels.
+by their area in pixels; sprites within one diameter of the near plane fade out linearly, so the
+near plane never clips a visible sprite away (no pop).
 """
 from __future__ import annotations
 
@@ -25,11 +27,12 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
-from atmos.camera import Camera
+from atmos.camera import Camera, camera_matrices
 from atmos.checks import CheckedSettings, check_bool, check_int, check_num
 from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.plugin import Plugin
 from atmos.plugins.cloud_render.binding import bind_volume, clamp_sampler, unbind_volume
+from atmos.plugins.cloud_render.light import DEFAULT_OCTAVES
 from atmos.plugins.cloud_render.offscreen import MAX_DOWNSAMPLE, OffscreenClouds, low_size
 from atmos.plugins.clouds.layout import CloudLayout
 from atmos.plugins.cloud_render.particle import PROFILE_AREA, particle_texture
@@ -44,7 +47,7 @@ class CloudRenderSettings(CheckedSettings):
 
     ``base_altitude``: world y of the layer's bottom (None: ``CloudSettings.base_altitude``; placement:
     :mod:`atmos.plugins.clouds.layout`). ``size_factor``:
-    sprite diameter in cells at density 1 (≥ ~3 hides the grid; 2 shows stripes). ``sigma``: extinction
+    sprite diameter in cells at density 1 (>= 0.001; ≥ ~3 hides the grid; 2 shows stripes). ``sigma``: extinction
     per cell length at density 1 (None: the simulation's ``CloudSettings.sigma``). ``frustum_culling``
     and ``empty_space_skipping`` switch the two culling tests; ``max_point_size`` caps sprite pixels
     (None: the GL limit). ``downsample`` (1..8): draw the sprites off screen at 1/downsample of the
@@ -52,7 +55,10 @@ class CloudRenderSettings(CheckedSettings):
     pass's ``setup`` every frame, so a change resizes the off-screen targets on the next frame).
     ``lod_pixels``: level of detail — columns where a block of 2^L cells spans at most this many
     target pixels are drawn one sprite per block (L ≤ 2, :mod:`.segments`); None: every cell.
-    ``enabled`` False skips drawing.
+    ``ms_attenuation``, ``ms_contribution``, ``ms_eccentricity``: the multiple-scattering octaves
+    (Wrenninge's a, b, c in [0, 1]; a also dims the sky and ground light by the columns above and
+    below; the defaults are fitted to the path tracer, ``benchmarks/bench_cloud_light.py --fit``),
+    shared with the ray march. ``enabled`` False skips drawing.
     """
     base_altitude: float | None = None
     size_factor: float = 3.0
@@ -62,21 +68,31 @@ class CloudRenderSettings(CheckedSettings):
     max_point_size: float | None = None
     downsample: int = 2
     lod_pixels: float | None = None
+    ms_attenuation: float = DEFAULT_OCTAVES[0]     # fitted to the path tracer (light.DEFAULT_OCTAVES)
+    ms_contribution: float = DEFAULT_OCTAVES[1]
+    ms_eccentricity: float = DEFAULT_OCTAVES[2]
     enabled: bool = True
 
     def __post_init__(self):
         o = "CloudRenderSettings"
         self.store(dict(
             base_altitude=check_num(o, "base_altitude", self.base_altitude, optional=True),
-            size_factor=check_num(o, "size_factor", self.size_factor, 0.0, lo_open=True),
+            size_factor=check_num(o, "size_factor", self.size_factor, 1e-3),   # ~0 makes NaN sprites
             sigma=check_num(o, "sigma", self.sigma, 0.0, optional=True),
             frustum_culling=check_bool(o, "frustum_culling", self.frustum_culling),
             empty_space_skipping=check_bool(o, "empty_space_skipping", self.empty_space_skipping),
             max_point_size=check_num(o, "max_point_size", self.max_point_size, 1.0, optional=True),
             downsample=check_int(o, "downsample", self.downsample, 1, MAX_DOWNSAMPLE),
             lod_pixels=check_num(o, "lod_pixels", self.lod_pixels, 0.0, lo_open=True, optional=True),
+            ms_attenuation=check_num(o, "ms_attenuation", self.ms_attenuation, 0.0, 1.0),
+            ms_contribution=check_num(o, "ms_contribution", self.ms_contribution, 0.0, 1.0),
+            ms_eccentricity=check_num(o, "ms_eccentricity", self.ms_eccentricity, 0.0, 1.0),
             enabled=check_bool(o, "enabled", self.enabled),
         ))
+
+    @property
+    def octaves(self) -> tuple:
+        return self.ms_attenuation, self.ms_contribution, self.ms_eccentricity
 
 
 class CloudRenderPlugin(Plugin):
@@ -107,8 +123,13 @@ class CloudRenderPlugin(Plugin):
         return sim.layout(s.base_altitude, pad=0.5 * s.size_factor * max(cell[0], cell[2]))
 
     def extinction(self, sim: CloudSets) -> float:
+        """Extinction per cube-root cell length at density 1 (the thesis's sigma)."""
         sigma = self.settings.sigma
         return float(sim.settings.sigma if sigma is None else sigma)
+
+    def sigma_t(self, sim: CloudSets) -> float:
+        """Extinction in 1/m at density 1 (the medium's, or this plugin's ``sigma`` override)."""
+        return self.extinction(sim) / float(np.cbrt(np.prod(sim.settings.cell_size)))
 
 
 COMMAND_BYTES = 20
@@ -125,8 +146,11 @@ def sprite_uniforms(plugin, sim, layout: CloudLayout, camera: Camera, aspect: fl
             "layer_min": tuple(float(v) for v in layout.lo), "cell_size": tuple(float(c) for c in cell),
             "camera_cell": tuple(float(v) for v in (np.asarray(camera.position, np.float64) - layout.lo) / cell),
             "base_diameter": float(settings.size_factor * max(cell[0], cell[2])),
-            "pixel_scale": float(height) / 2.0 * float(camera.projection(aspect)[1, 1]),
-            "max_point_size": float(limit), "tau_scale": float(tau_scale)}
+            "pixel_scale": float(height) / 2.0 * float(camera_matrices(camera, aspect).projection[1, 1]),
+            "max_point_size": float(limit), "tau_scale": float(tau_scale), "near": float(camera.near),
+            "camera_pos": tuple(float(v) for v in camera.position),
+            "camera_right": tuple(float(v) for v in camera.right()),
+            "camera_up": tuple(float(v) for v in camera.up())}
 
 
 class CloudSpritePass(RenderPass):
@@ -139,7 +163,7 @@ class CloudSpritePass(RenderPass):
         self.plugin = plugin
         self.program = self.particle = self.sampler = self.offscreen = None
         self.instances = self.commands = self.vao = None
-        self._group = None
+        self._group = self._uploaded = None
 
     def setup(self, builder: PassBuilder) -> None:
         builder.read(DEPTH)
@@ -169,6 +193,7 @@ class CloudSpritePass(RenderPass):
         self.commands = gpu.ctx.buffer(reserve=COMMAND_BYTES * 16)
         self.vao = gpu.ctx.vertex_array(self.program, [(self.instances, "4i/i", "in_segment")])
         self._group = (group, shape)
+        self._uploaded = None
 
     def _draw(self, segments: np.ndarray, group) -> None:
         """Every run of segments with one level and span as one instanced draw of its blocks, all in one
@@ -196,7 +221,8 @@ class CloudSpritePass(RenderPass):
         camera = view.camera
         aspect = view.aspect
         layout = plugin.layout(sim)
-        view_proj = camera.view_projection(aspect)
+        matrices = camera_matrices(camera, aspect)
+        view_proj = matrices.view_proj
         maps = sim.maps_of(sim.view()[0])
         ctx, p, factor = gpu.ctx, self.program, settings.downsample
         uniforms = sprite_uniforms(plugin, sim, layout, camera, aspect, low_size(gpu.size, factor)[1],
@@ -208,20 +234,23 @@ class CloudSpritePass(RenderPass):
         if not len(segments):
             return
         self._buffers(gpu, layout.group, layout.shape)
-        self.instances.write(segments.tobytes())
+        if segments is not self._uploaded:          # select_segments hands back the same array when nothing moved
+            self.instances.write(segments.tobytes())
+            self._uploaded = segments
         if factor == 1:
             fbo = frame.framebuffer(color=[COLOR], depth=DEPTH)
             fbo.use()
         else:
             fbo = self.offscreen.begin(frame, factor)
-        p["view_proj"].write(np.asarray(view_proj, np.float32).T.tobytes())
+        p["view_proj"].write(matrices.gl("view_proj"))
         for name, value in uniforms.items():
-            p[name].value = value
+            if name in p:              # a compiler may drop a uniform a variant does not use
+                p[name].value = value
         fbo.depth_mask = False
         frame.blend_over()
         ctx.enable(moderngl.DEPTH_TEST | moderngl.PROGRAM_POINT_SIZE)
         ctx.depth_func = "<="          # a tiny near plane rounds far depths to 1.0: still in front of the sky
-        bind_volume(p, sim, self.sampler, view.sun)
+        bind_volume(p, sim, self.sampler, view.sun, settings.octaves)
         self.particle.use(4)
         try:
             self._draw(segments, layout.group)
@@ -235,7 +264,7 @@ class CloudSpritePass(RenderPass):
             if obj is not None:
                 obj.release()
         self.vao = self.instances = self.commands = None
-        self._group = None
+        self._group = self._uploaded = None
 
     def release(self) -> None:
         self._release_buffers()

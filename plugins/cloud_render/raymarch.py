@@ -88,8 +88,8 @@ class CloudMarchPass(RenderPass):
         set_camera_uniforms(p, view.camera, view.aspect)
         for name, value in (("layer_min", layout.lo), ("layer_max", layout.hi), ("cell_size", layout.cell)):
             p[name].value = tuple(float(v) for v in value)
-        p["sigma"].value = renderer.extinction(sim)
-        bind_volume(p, sim, self.sampler, view.sun)
+        p["sigma_t"].value = renderer.sigma_t(sim)
+        bind_volume(p, sim, self.sampler, view.sun, renderer.settings.octaves)
         frame.resource(DEPTH).use(5)
         try:
             frame.fullscreen(p)

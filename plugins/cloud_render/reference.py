@@ -3,13 +3,16 @@
 Given the densities and transmittances of sets A and B (``[x, y, z]`` arrays, the transmittance at
 its own shading resolution), the segments and the uniforms, it returns what every
 (instance, vertex) outputs, instance-major like the GPU: the clip position (``CULLED`` for empty
-blocks and blocks past the edge), point size, light colour, centre optical depth and coverage.
+blocks and blocks past the edge), point size, the light (octave weights of the sun's transmittance,
+the sky and ground light dimmed by the columns above and below: :mod:`atmos.shading.medium`), world
+centre and radius, centre optical depth and coverage.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from atmos.plugins.cloud_render.segments import unpack
+from atmos.shading.medium import ambient_shares, octave_weights
 from atmos.shading.reference import trilinear
 
 CULLED = np.array([0.0, 0.0, 2.0, 1.0])
@@ -45,16 +48,48 @@ def group_cells(group, level: int, camera) -> np.ndarray:
     return (np.stack([bx, bz], -1) * s).astype(np.int32)
 
 
+COLUMN_SAMPLES = 8
+
+
+def column_depth(density, uvw, direction: float, column_tau: float) -> np.ndarray:
+    """Optical depth from ``uvw`` (n, 3) straight up (1) or down (-1) to the volume's face: the
+    midpoint rule of ``volume.glsl`` on the clamp-to-edge trilinear density."""
+    shape = np.array(density.shape)
+    length = 1.0 - uvw[:, 1] if direction > 0 else uvw[:, 1]
+    total = np.zeros(len(uvw))
+    for i in range(COLUMN_SAMPLES):
+        q = uvw.copy()
+        q[:, 1] += direction * length * (i + 0.5) / COLUMN_SAMPLES
+        total += trilinear(density, q * shape - 0.5)
+    return column_tau * total * length * shape[1] / COLUMN_SAMPLES
+
+
+def shifted(volume: np.ndarray, shift) -> np.ndarray:
+    """``volume`` (nx, ny, nz) read at cell ``c + shift`` for every cell c, zero past its edge
+    (set A on set B's grid: :attr:`~atmos.plugins.clouds.CloudSets.a_shift`)."""
+    out = np.zeros_like(volume)
+    src, dst = [], []
+    for n, s in zip(volume.shape, shift):
+        src.append(slice(max(s, 0), min(n, n + s)))
+        dst.append(slice(max(-s, 0), min(n, n - s)))
+    out[tuple(dst)] = volume[tuple(src)]
+    return out
+
+
 def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, uniforms: dict, view_proj,
-                    sun_color, ambient) -> dict:
+                    light: dict, a_shift=(0, 0, 0)) -> dict:
     """Arrays over the vertices of every segment (gi, j, gk, packed level and span), in order: ``position`` (n, 4),
-    ``size``, ``light`` (n, 3), ``tau``, ``coverage``, ``visible``. ``trans_a``/``trans_b`` None: no
-    shading (T = 1)."""
+    ``size``, ``octaves`` (n, 4), ``ambient`` (n, 3), ``center`` (n, 3), ``radius``, ``tau``, ``coverage``,
+    ``visible``. ``trans_a``/``trans_b`` None: no shading (T = 1). ``light``: the light uniforms
+    (:func:`atmos.plugins.cloud_render.light.light_uniforms`). ``a_shift``: A's cell for B's cell c is
+    c + a_shift (zero past A's edge for the cell sums; clamp-to-edge for the sampled light, as the GPU)."""
     u = uniforms
     shape = np.array(u["volume_shape"])
     gx, gz = u["group_size"]
     seg = np.asarray(segments, np.int64)
-    d_full = np.asarray(density_a, np.float64) * (1.0 - t) + np.asarray(density_b, np.float64) * t
+    shift = np.array([int(v) for v in a_shift])
+    a64, b64 = np.asarray(density_a, np.float64), np.asarray(density_b, np.float64)
+    d_full = shifted(a64, shift) * (1.0 - t) + b64 * t
     levels, spans_x, spans_z = unpack(seg[:, 3])
     padded = np.pad(d_full, [(0, 1 << int(levels.max(initial=0)))] * 3)   # cells past the edge are empty
     cells, sums, spans = [], [], []
@@ -79,15 +114,30 @@ def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, 
         T = np.ones(len(c))
     else:
         points = center / shape * np.array(np.shape(trans_a)) - 0.5
-        T = trilinear(np.asarray(trans_a, np.float64), points) * (1 - t) + \
+        points_a = (center + shift) / shape * np.array(np.shape(trans_a)) - 0.5
+        T = trilinear(np.asarray(trans_a, np.float64), points_a) * (1 - t) + \
             trilinear(np.asarray(trans_b, np.float64), points) * t
+    a_ms, b_ms, _ = light["ms_octaves"]
+    uvw = center / shape
+    uvw_a = (center + shift) / shape
+    up, down = ((1.0 - t) * column_depth(a64, uvw_a, d, light["column_tau"]) +
+                t * column_depth(b64, uvw, d, light["column_tau"]) for d in (1.0, -1.0))
+    octaves = octave_weights(T, up + down, a_ms, b_ms)
     world = np.asarray(u["layer_min"]) + center * np.asarray(u["cell_size"])
+    ray = world - np.asarray(u["camera_pos"], np.float64)
+    sky_share, ground_share = ambient_shares(*light["phase_lobes"], ray[:, 1] / np.linalg.norm(ray, axis=1))
+    ambient = (sky_share * np.exp(-a_ms * up))[:, None] * np.asarray(light["sky_source"]) + \
+        (ground_share * np.exp(-a_ms * down))[:, None] * np.asarray(light["ground_source"])
     clip = np.concatenate([world, np.ones((len(c), 1))], 1) @ np.asarray(view_proj, np.float64).T
     diameter = s * u["base_diameter"] * (SMALLEST + (1.0 - SMALLEST) * np.minimum(d, 1.0))
     px = diameter * u["pixel_scale"] / np.maximum(clip[:, 3], 1e-6)
     return {"position": np.where(visible[:, None], clip, CULLED),
             "size": np.where(visible, np.clip(px, 1.0, u["max_point_size"]), 1.0),
-            "light": np.where(visible[:, None], np.outer(T, sun_color) + np.asarray(ambient), 0.0),
+            "octaves": np.where(visible[:, None], octaves, 0.0),
+            "ambient": np.where(visible[:, None], ambient, 0.0),
+            "center": np.where(visible[:, None], world, 0.0),
+            "radius": np.where(visible, 0.5 * diameter, 0.0),
             "tau": np.where(visible, u["tau_scale"] * total / np.maximum(diameter, 1e-30) ** 2, 0.0),
-            "coverage": np.where(visible, np.clip(px, 0.0, 1.0) ** 2, 0.0),
+            "coverage": np.where(visible, np.clip(px, 0.0, 1.0) ** 2 *
+                                 np.clip((clip[:, 3] - u["near"]) / np.maximum(diameter, 1e-30), 0.0, 1.0), 0.0),
             "visible": visible}

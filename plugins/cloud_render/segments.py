@@ -30,7 +30,8 @@ span: :func:`pack`, :func:`unpack`.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
+from functools import lru_cache
 
 import numpy as np
 
@@ -83,24 +84,29 @@ def draw_units(layout: CloudLayout, camera, keep, margin: float) -> np.ndarray:
     gx, gz = layout.grid
     near = []
     for axis, count, size in ((0, gx, layout.group[0] * layout.cell[0]), (2, gz, layout.group[1] * layout.cell[2])):
-        t = (camera[axis] - layout.lo[axis]) / size
-        b = int(np.clip(np.round(t), 0, count))
+        t = (float(camera[axis]) - float(layout.lo[axis])) / size
+        b = min(max(round(t), 0), count)                  # round half to even, as np.round
         near.append(b if 0 < b < count and abs(t - b) * size < margin else None)
-    taken = ~keep
+    bx, bz = near
+    if bx is None and bz is None:                          # no seam near the camera: every kept column alone
+        cells = np.argwhere(keep)
+        return np.column_stack([cells, np.ones_like(cells)]).astype(np.int64).reshape(-1, 4)
+    taken = (~np.asarray(keep, bool)).tolist()            # a few dozen columns: plain lists beat numpy
     units = []
 
     def claim(i, k, sx, sz):
-        if not taken[i:i + sx, k:k + sz].any():
-            taken[i:i + sx, k:k + sz] = True
+        cells = [(a, c) for a in range(i, min(i + sx, gx)) for c in range(k, min(k + sz, gz))]
+        if not any(taken[a][c] for a, c in cells):
+            for a, c in cells:
+                taken[a][c] = True
             units.append((i, k, sx, sz))
-    bx, bz = near
     if bx is not None and bz is not None:
         claim(bx - 1, bz - 1, 2, 2)
     for k in range(gz) if bx is not None else ():
         claim(bx - 1, k, 2, 1)
     for i in range(gx) if bz is not None else ():
         claim(i, bz - 1, 1, 2)
-    units += [(i, k, 1, 1) for i, k in np.argwhere(~taken)]
+    units += [(i, k, 1, 1) for i in range(gx) for k in range(gz) if not taken[i][k]]
     return np.array(units, np.int64).reshape(-1, 4)
 
 
@@ -123,62 +129,115 @@ def column_levels(distance, cell_px: float, lod_pixels: float | None, top: int) 
     return np.clip(level, 0, top).astype(np.int32)
 
 
+@lru_cache(maxsize=16)
+def _geometry(layout: CloudLayout):
+    """What a layout's columns look like, computed once per layout: unpadded column boxes (lo, hi),
+    their centres, and ``lo``/``hi`` before padding for the per-level frustum boxes."""
+    lo, hi = layout.column_boxes(0.0)
+    for a in (lo, hi):
+        a.flags.writeable = False
+    centre = (lo + hi) / 2
+    centre.flags.writeable = False
+    return lo, hi, centre
+
+
 def select_segments(layout: CloudLayout, camera_pos, view_proj=None, max_maps=None, band_height: int = 1,
                     lod_pixels: float | None = None, pixel_scale: float = 0.0,
                     top_level: int = MAX_LEVEL) -> tuple[np.ndarray, SegmentStats]:
     """(segments int32 (n, 4) as (gi, j, gk, :func:`pack` (level, span)) in draw order, stats). ``view_proj=None``: no
     frustum culling; ``max_maps=None``: no empty-space skipping; ``lod_pixels=None``: level 0 only
     (else ``pixel_scale`` is the target's pixels per world unit at distance 1, and levels go up to
-    ``min(top_level, max_level(group, ny))``)."""
+    ``min(top_level, max_level(group, ny))``). Runs every frame: the layout's geometry is cached."""
     gx, gz = layout.grid
     ny = layout.shape[1]
     cam = np.asarray(camera_pos, np.float64)
-    stats = SegmentStats(columns=gx * gz, segments=gx * gz * ny)
-    lo, hi = layout.column_boxes(0.0)
-    distance = np.linalg.norm((lo + hi) / 2 - cam, axis=-1)                  # (gx, gz)
+    lo, hi, centre = _geometry(layout)
     top = 0 if lod_pixels is None else min(top_level, max_level(layout.group, ny))
-    levels = column_levels(distance, max(layout.cell[0], layout.cell[2]) * pixel_scale, lod_pixels, top)
+    cell_px = max(layout.cell[0], layout.cell[2]) * pixel_scale
     keep = np.ones((gx, gz), bool)
     if view_proj is not None:
-        keep &= ~boxes_outside(frustum_planes(view_proj), *layout.column_boxes(1 << levels))
-        stats.columns_frustum_culled = int((~keep).sum())
-        stats.segments_frustum_culled = stats.columns_frustum_culled * ny
-    slice_ok = np.ones((gx, gz, ny), bool)
+        if top:
+            levels = column_levels(np.linalg.norm(centre - cam, axis=-1), cell_px, lod_pixels, top)
+            pad = layout.pad * (1 << levels).astype(float)[..., None]
+        else:
+            pad = layout.pad * 1.0
+        keep &= ~boxes_outside(frustum_planes(view_proj), lo - pad, hi + pad)
+    maps = None
     if max_maps is not None:
         maps = np.asarray(max_maps)
         expected = (1 + -(-ny // band_height), gx, gz)
         if maps.shape != expected:
             raise ValueError(f"max_maps must have shape (1 + bands, gx, gz) = {expected}, got {maps.shape}")
+    # the rest depends on these alone: a camera that only turns reuses the last frame's answer
+    key = (layout, cam.tobytes(), keep.tobytes(), None if maps is None else (maps.dtype.str, maps.tobytes()),
+           band_height, lod_pixels, float(pixel_scale), top)
+    if _LAST.get("key") == key:
+        return _LAST["segments"], replace(_LAST["stats"])
+    segments, stats = _select(layout, cam, keep, maps, band_height, lod_pixels, cell_px, top, view_proj is not None)
+    segments.flags.writeable = False
+    _LAST.update(key=key, segments=segments, stats=replace(stats))
+    return segments, stats
+
+
+_LAST: dict = {}     # the last select_segments' inputs and answer
+
+
+def _select(layout, cam, keep, maps, band_height, lod_pixels, cell_px, top, culled):
+    """select_segments after the frustum test (``keep``: columns inside it)."""
+    gx, gz = layout.grid
+    ny = layout.shape[1]
+    lo, hi, centre = _geometry(layout)
+    stats = SegmentStats(columns=gx * gz, segments=gx * gz * ny)
+    if culled:
+        stats.columns_frustum_culled = int((~keep).sum())
+        stats.segments_frustum_culled = stats.columns_frustum_culled * ny
+    keep = keep.copy()
+    slice_ok = None
+    if maps is not None:
         empty = keep & ~(maps[0] > 0)
         stats.columns_empty = int(empty.sum())
         keep &= ~empty
         slice_ok = maps[1 + np.arange(ny) // band_height].transpose(1, 2, 0) > 0
         stats.segments_empty = stats.columns_empty * ny + int((keep[..., None] & ~slice_ok).sum())
     units = draw_units(layout, cam, keep, 2.0 * layout.pad * (1 << top))
-    lo_u = lo[units[:, 0], units[:, 1]]
-    hi_u = hi[units[:, 0] + units[:, 2] - 1, units[:, 1] + units[:, 3] - 1]
-    unit_distance = np.linalg.norm((lo_u + hi_u) / 2 - cam, axis=-1)
+    single = bool((units[:, 2:] == 1).all())
+    if single:
+        unit_distance = np.linalg.norm(centre[units[:, 0], units[:, 1]] - cam, axis=-1)
+    else:
+        lo_u = lo[units[:, 0], units[:, 1]]
+        hi_u = hi[units[:, 0] + units[:, 2] - 1, units[:, 1] + units[:, 3] - 1]
+        unit_distance = np.linalg.norm((lo_u + hi_u) / 2 - cam, axis=-1)
     order = np.argsort(-unit_distance, kind="stable")
     units, unit_distance = units[order], unit_distance[order]
-    levels = column_levels(unit_distance, max(layout.cell[0], layout.cell[2]) * pixel_scale, lod_pixels, top)
+    levels = column_levels(unit_distance, cell_px, lod_pixels, top)
     area = units[:, 2] * units[:, 3]
     stats.columns_by_level = tuple(int(area[levels == L].sum()) for L in range(top + 1))
-    unit_ok = np.zeros((len(units), ny), bool)
-    for dx in (0, 1):
-        for dz in (0, 1):
-            member = (dx < units[:, 2]) & (dz < units[:, 3])
-            unit_ok[member] |= slice_ok[units[member, 0] + dx, units[member, 1] + dz]
+    if slice_ok is None:
+        unit_ok = np.ones((len(units), ny), bool)
+    elif single:
+        unit_ok = slice_ok[units[:, 0], units[:, 1]]
+    else:
+        unit_ok = slice_ok[units[:, 0], units[:, 1]]
+        for w in np.flatnonzero(units[:, 2] * units[:, 3] > 1):    # merged units: any of their columns
+            i, k, sx, sz = units[w]
+            unit_ok[w] = slice_ok[i:i + sx, k:k + sz].any(axis=(0, 1))
     parts = []
     for level in range(top, -1, -1):                               # levels fall along the order
-        mine, s = levels == level, 1 << level
+        mine, s = (levels == level) if top else slice(None), 1 << level
+        u_level = units[mine]
+        if not len(u_level):
+            continue
         blocks = -(-ny // s)
-        ok = np.pad(unit_ok[mine], ((0, 0), (0, blocks * s - ny))).reshape(-1, blocks, s).any(-1)
+        ok = unit_ok[mine]
+        if s > 1:
+            ok = np.pad(ok, ((0, 0), (0, blocks * s - ny))).reshape(-1, blocks, s).any(-1)
         heights = layout.base + (np.arange(blocks) * s + 0.5 * s) * layout.cell[1]
         slices = np.argsort(-np.abs(heights - cam[1]), kind="stable")
         ci, si = np.nonzero(ok[:, slices])
-        u = units[mine][ci]
+        u = u_level[ci]
         parts.append(np.stack([u[:, 0], slices[si], u[:, 1], pack(level, u[:, 2], u[:, 3])], -1))
-        stats.sprites += int((u[:, 2] * u[:, 3]).sum()) * (layout.group[0] // s) * (layout.group[1] // s)
-        stats.segments_drawn += int((u[:, 2] * u[:, 3]).sum())
-    segments = np.concatenate(parts).astype(np.int32)
+        columns = int((u[:, 2] * u[:, 3]).sum())
+        stats.sprites += columns * (layout.group[0] // s) * (layout.group[1] // s)
+        stats.segments_drawn += columns
+    segments = np.concatenate(parts).astype(np.int32) if parts else np.zeros((0, 4), np.int32)
     return segments, stats

@@ -59,6 +59,7 @@ class CloudShadowsPass(FullscreenPass):
         p["weight"].value = weight
         p["extinction"].value = sigma * params.strength
         p["t"].value = t
+        p["a_shift"].value = sim.a_shift[0], sim.a_shift[2]
         p["layer_min"].value = tuple(float(v) for v in layout.lo)
         p["cell_size"].value = layout.cell
         p["shape"].value = layout.shape

@@ -28,16 +28,25 @@ def zero_border_bilinear(plane: np.ndarray, p: np.ndarray) -> np.ndarray:
     return np.where(inside, bilinear(np.pad(np.asarray(plane, np.float64), 1), q), 0.0)
 
 
+def shifted(plane: np.ndarray, shift) -> np.ndarray:
+    """``plane`` (nx, nz) read at ``[i + shift.x, k + shift.z]``, zero past its edge."""
+    n = np.array(plane.shape)
+    i, k = np.arange(n[0])[:, None] + int(shift[0]), np.arange(n[1])[None, :] + int(shift[2])
+    inside = (i >= 0) & (i < n[0]) & (k >= 0) & (k < n[1])
+    return np.where(inside, plane[np.clip(i, 0, n[0] - 1), np.clip(k, 0, n[1] - 1)], 0.0)
+
+
 def shadow_factor(points, sums_a, sums_b, t: float, sun_direction, weight: float, extinction: float,
-                  layout: CloudLayout) -> np.ndarray:
+                  layout: CloudLayout, a_shift=(0, 0, 0)) -> np.ndarray:
     """Factor (...,) the colour at world ``points`` (..., 3) is multiplied by; ``sums_a/b`` (nx, nz)
-    the all-heights top-view maps of sets A and B; ``extinction`` = sigma·strength; ``layout`` the
-    volume's world placement (the sprite renderer's rule)."""
+    the all-heights top-view maps of sets A and B; ``extinction`` = sigma·strength; ``layout`` B's
+    world placement (the sprite renderer's rule); ``a_shift`` cells from B's column to A's
+    (:attr:`CloudSets.a_shift`), A zero past its edge."""
     points = np.asarray(points, np.float64)
     s = unit_sun(sun_direction)
     if s is None or weight <= 0.0:
         return np.ones(points.shape[:-1])
-    sums = (1.0 - t) * np.asarray(sums_a, np.float64) + t * np.asarray(sums_b, np.float64)
+    sums = (1.0 - t) * shifted(np.asarray(sums_a, np.float64), a_shift) + t * np.asarray(sums_b, np.float64)
     lo, hi, cell = layout.lo, layout.hi, np.asarray(layout.cell, np.float64)
     y = points[..., 1]
     run = np.maximum(0.5 * (lo[1] + hi[1]) - y, 0.0) / max(s[1], MIN_SUN_HEIGHT)

@@ -10,8 +10,11 @@
   covers ``x in [i * group_x, min((i + 1) * group_x, nx))`` and likewise z, so sizes that do not
   divide the volume give clamped edge segments. A segment is > 0 iff its cells hold any density.
 
-Only the tiny max maps are meant to come back to the CPU (:meth:`DensityMaps.read_max_maps`);
-the result equals :func:`atmos.plugins.clouds.reference.density_maps` up to float32 summation.
+Only the tiny max maps are meant to come back to the CPU, and without a stall:
+:meth:`DensityMaps.request_max_maps` queues their copy into a pixel buffer on the GPU and
+:meth:`DensityMaps.collect_max_maps` reads that buffer later (frames later in the cloud chain, when
+the set is first drawn; it waits only if the copy is not done yet). :meth:`DensityMaps.read_max_maps`
+reads them at once (tests and tools). The result equals :func:`atmos.plugins.clouds.reference.density_maps` up to float32 summation.
 
 Slicing: :meth:`DensityMaps.run` sums the columns ``z in [z0, z1)`` and reduces the segment rows
 whose last z row lies in ``[z0, z1)``. Run the slices of a step in increasing z order (as the frame
@@ -46,11 +49,14 @@ def _check_group_size(group_size) -> tuple[int, int]:
     return int(values[0]), int(values[1])
 
 
-def _read_array(texture) -> np.ndarray:
-    """An r32f texture array (w, h, layers) as float32 ``[layer, w, h]``."""
+def _read_array(texture, data: bytes | None = None) -> np.ndarray:
+    """An r32f texture array (w, h, layers) as float32 ``[layer, w, h]``: read now, or from ``data``
+    (its bytes, copied earlier into a pixel buffer)."""
     w, h, layers = texture.size
-    texture.ctx.memory_barrier(moderngl.TEXTURE_UPDATE_BARRIER_BIT)
-    raw = np.frombuffer(texture.read(), dtype="<f4").reshape(layers, h, w)
+    if data is None:
+        texture.ctx.memory_barrier(moderngl.TEXTURE_UPDATE_BARRIER_BIT)
+        data = texture.read()
+    raw = np.frombuffer(data, dtype="<f4").reshape(layers, h, w)
     return np.ascontiguousarray(raw.transpose(0, 2, 1))
 
 
@@ -77,13 +83,15 @@ class DensityMaps:
         check_texture_limit(ctx, (layers,), "GL_MAX_ARRAY_TEXTURE_LAYERS", "the number of maps (1 + bands)")
         self._sum_prog = gpu.program(compute_shader="clouds/density_sums.comp")
         self._max_prog = gpu.program(compute_shader="clouds/density_max.comp")
-        self.sums = self.max_maps = None
+        self.sums = self.max_maps = self._pixels = None
+        self._requested = False
         try:
             self.sums = ctx.texture_array((nx, nz, layers), 1, dtype="f4")
             self.max_maps = ctx.texture_array((*self.grid, layers), 1, dtype="f4")
             for texture in (self.sums, self.max_maps):
                 texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
                 texture.write(bytes(4 * math.prod(texture.size)))
+            self._pixels = ctx.buffer(reserve=4 * math.prod(self.max_maps.size))   # the max maps' copy
         except Exception:
             self.release()
             raise
@@ -117,8 +125,30 @@ class DensityMaps:
             self.ctx.memory_barrier()
 
     def read_max_maps(self) -> np.ndarray:
-        """The max maps as float32 ``(1 + bands, gx, gz)``: [0] all heights, [1 + b] band b."""
+        """The max maps as float32 ``(1 + bands, gx, gz)``: [0] all heights, [1 + b] band b. Waits for
+        the GPU; the per-step path is :meth:`request_max_maps` then :meth:`collect_max_maps`."""
         return _read_array(self.max_maps)
+
+    def request_max_maps(self) -> None:
+        """Queue a copy of the max maps as they are now into a pixel buffer (GPU side: nothing waits)."""
+        if self._released:
+            raise RuntimeError("these DensityMaps were released")
+        self.ctx.memory_barrier(moderngl.TEXTURE_UPDATE_BARRIER_BIT)
+        self.max_maps.read_into(self._pixels)
+        self._requested = True
+
+    @property
+    def requested(self) -> bool:
+        """True between :meth:`request_max_maps` and :meth:`collect_max_maps`."""
+        return self._requested
+
+    def collect_max_maps(self) -> np.ndarray:
+        """The max maps :meth:`request_max_maps` copied, as :meth:`read_max_maps` returns them; reading
+        the pixel buffer waits only while the copy is still on its way."""
+        if not self._requested:
+            raise RuntimeError("collect_max_maps without request_max_maps: nothing was copied")
+        self._requested = False
+        return _read_array(self.max_maps, self._pixels.read())
 
     def read_sums(self) -> np.ndarray:
         """The sum maps as float32 ``(1 + bands, nx, nz)`` (a full GPU → CPU copy: tests and tools)."""
@@ -127,10 +157,11 @@ class DensityMaps:
     def release(self) -> None:
         """Free the textures (the programs are the GpuContext's); the maps cannot be used afterwards."""
         self._released = True
-        for obj in (self.sums, self.max_maps):
+        for obj in (self.sums, self.max_maps, self._pixels):
             if obj is not None:
                 obj.release()
-        self.sums = self.max_maps = None
+        self.sums = self.max_maps = self._pixels = None
+        self._requested = False
 
     def __repr__(self) -> str:
         return (f"DensityMaps(shape={self.shape}, band_height={self.band_height}, "

@@ -6,13 +6,15 @@ from atmos.plugin import Plugin
 from atmos.plugins.clouds.sets import CLOUD_SETS
 from atmos.plugins.clouds.simulation import CloudSettings, CloudSimulation
 from atmos.checks import check_int
+from atmos.plugins.clouds.static import StaticClouds
+from atmos.shading.grid import check_density
 from atmos.plugins.weather import VolumeOrigin
 
 
 class CloudsPlugin(Plugin):
     """Weather ellipsoids → region volume → automaton → smoothing → density maps, sliced over frames.
 
-    ``CloudsPlugin(settings=None, *, seed=0, warmup_steps=0, **fields)`` with :class:`CloudSettings`
+    ``CloudsPlugin(settings=None, *, seed=0, warmup_steps=0, density=None, **fields)`` with :class:`CloudSettings`
     (its ``weather`` field the :class:`~atmos.plugins.weather.WeatherSettings`);
     ``configure(**changes)`` changes the live ones (``configure(weather={"cloud_density": 300})``
     moves the cover from the next step on). ``seed`` (the random streams) and ``warmup_steps``
@@ -20,12 +22,17 @@ class CloudsPlugin(Plugin):
     The shading task reads the ``Sun`` resource's direction when a step starts (DaylightPlugin
     moves it). Resources it adds: ``VolumeOrigin`` (move it with the viewer; one already present is
     used) and the :class:`CloudSimulation` (readers take ``view()`` and ``max_maps()`` from it).
+    ``density``: a float volume ``[x, y, z]`` (>= 0) drawn as static clouds instead, placed by the
+    documented layout (:class:`~atmos.plugins.clouds.static.StaticClouds`; no automaton or weather;
+    the settings' medium, light, cell size and base altitude apply).
     """
 
     settings_class = CloudSettings
 
-    def __init__(self, settings: CloudSettings | None = None, *, seed: int = 0, warmup_steps: int = 0, **fields):
+    def __init__(self, settings: CloudSettings | None = None, *, seed: int = 0, warmup_steps: int = 0,
+                 density=None, **fields):
         super().__init__(settings, **fields)
+        self.density = None if density is None else check_density(density)
         self.seed = check_int("CloudsPlugin", "seed", seed, 0, 2**32 - 1)
         self.warmup_steps = check_int("CloudsPlugin", "warmup_steps", warmup_steps, 0, 10**6)
         self.simulation: CloudSimulation | None = None
@@ -44,6 +51,11 @@ class CloudsPlugin(Plugin):
 
         def sun():
             return (app.get_resource(Sun) or default_sun).direction
+        if self.density is not None:
+            self.simulation = StaticClouds(app.gpu, self.density, self.settings, origin, sun)
+            app.insert_resource(origin)
+            app.graph.import_resource(CLOUD_SETS, self.simulation.sets)
+            return
         self.simulation = CloudSimulation(app.gpu, app.world, self.settings, self.seed, origin, sun)
         app.insert_resource(origin)
         app.insert_resource(self.simulation)
@@ -61,7 +73,7 @@ class CloudsPlugin(Plugin):
     def cleanup(self, app) -> None:
         if self.simulation is not None:
             app.graph.remove_import(CLOUD_SETS)
-            if self.simulation.job in app.frames:      # a scene may have paused the simulation
+            if isinstance(self.simulation, CloudSimulation) and self.simulation.job in app.frames:      # a scene may have paused the simulation
                 app.frames.remove(self.simulation.job)
             self.simulation.release()
             self.simulation = None

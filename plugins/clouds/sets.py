@@ -17,6 +17,10 @@ class CloudSets:
     """What cloud passes read this frame: sets A and B (draw ``mix(A, B, t)``), their density maps,
     the world placement (VolumeOrigin x, y, z in cells) each set was computed at and the one now.
 
+    Each set is drawn where it was computed (the automaton shifts its contents when the origin
+    moves): :meth:`layout` is B's placement, and A's cell for B's cell ``c`` is ``c + a_shift``
+    (renderers sample A through that offset, so a moving volume never jumps at a step boundary).
+
     It answers ``view()``, ``maps_of()``, ``max_maps()``, ``layout()`` and ``settings`` like the
     :class:`~atmos.plugins.clouds.CloudSimulation` it comes from, so helpers take either.
     """
@@ -43,14 +47,38 @@ class CloudSets:
             return self.maps_b
         raise ValueError("CloudSets.maps_of: only sets A and B of this frame have maps here")
 
+    @property
+    def a_shift(self) -> tuple[int, int, int]:
+        """Whole cells (x, 0, z) from B's cell to A's at the same world point: placement B − placement A."""
+        return (int(round(self.placement_b[0] - self.placement_a[0])), 0,
+                int(round(self.placement_b[2] - self.placement_a[2])))
+
     def max_maps(self) -> np.ndarray:
-        """Elementwise max of A's and B's max maps: a segment whose value is 0 is empty in both (7.2.2)."""
-        return np.maximum(self.max_a, self.max_b)
+        """Elementwise max of B's max maps and A's over the groups A's cells of each B group fall in
+        (A sampled through :attr:`a_shift`): a segment whose value is 0 is empty in both (7.2.2)."""
+        return np.maximum(shifted_max(self.max_a, self.a_shift, self.settings.group_size), self.max_b)
 
     def layout(self, base_altitude: float | None = None, cell_size=None, pad: float = 0.0) -> CloudLayout:
-        """The volume's world placement now (see :meth:`CloudSimulation.layout`)."""
+        """Where the sets are drawn: B's placement (see :meth:`CloudSimulation.layout`)."""
         s = self.settings
         cell = tuple(float(c) for c in (s.cell_size if cell_size is None else cell_size))
         base = float(s.base_altitude if base_altitude is None else base_altitude)
-        return CloudLayout(tuple(self.shape), cell, (float(self.origin[0]), float(self.origin[2])), base,
+        return CloudLayout(tuple(self.shape), cell, (float(self.placement_b[0]), float(self.placement_b[2])), base,
                            tuple(s.group_size), pad)
+
+
+def shifted_max(max_map: np.ndarray, shift, group) -> np.ndarray:
+    """Max maps (layers, gx, gz) of a set sampled ``shift`` cells (x, _, z) off, on the unshifted group
+    grid: group g covers the shifted set's cells [g·G + s, (g + 1)·G + s), i.e. at most two of its
+    groups per axis; groups past the edge count as empty."""
+    out = np.asarray(max_map)
+    for axis, s, g in ((1, shift[0], group[0]), (2, shift[2], group[1])):
+        if s == 0:
+            continue
+        n = out.shape[axis]
+        index = np.arange(n)
+        lo, hi = (index * g + s) // g, ((index + 1) * g + s - 1) // g
+        padded = np.concatenate([np.zeros_like(out.take([0], axis)), out, np.zeros_like(out.take([0], axis))], axis)
+        pick = lambda k: padded.take(np.clip(k, -1, n) + 1, axis)   # -1 and n: the empty pads
+        out = np.maximum(pick(lo), pick(hi))
+    return out

@@ -3,14 +3,17 @@
 One simulation step = region volume (weather rules + ellipsoids rendered into the region volume
 and its probabilities) → automaton step (driven by the region's probability texture, advected by
 the wind and by the volume's own motion) → smoothing (``smoothing_slices`` z ranges) → density
-maps (the same z ranges; the tiny max maps are read back once per step) → shading (inverse
+maps (the same z ranges; the tiny max maps are copied into a pixel buffer once per step and read
+when the set is first drawn, frames later: no stall) → shading (inverse
 shear-warp transmittance toward the sun, a few light-space slices per job slice; optional). The frame scheduler runs
 a few slices per frame into set C while the renderer draws sets A and B interpolated; nothing but
 the max maps comes back to the CPU.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -25,6 +28,7 @@ from atmos.plugins.clouds.layout import CloudLayout
 from atmos.plugins.clouds.sets import CloudSets
 from atmos.plugins.clouds.smoothing import FORMATS, WEIGHTS, Smoother, slice_range
 from atmos.shading.grid import check_scale, shading_shape
+from atmos.shading.medium import cell_sigma
 from atmos.shading.scattering import Scattering
 from atmos.shading.shear_warp import ShadingTask, ShearWarpShader
 from atmos.plugins.weather import RegionVolume, VolumeOrigin, WeatherSettings, ellipsoid_array, step_weather
@@ -43,14 +47,19 @@ class CloudSettings(CheckedSettings):
     to. ``smoothing_slices``: z ranges the smoothing and density maps are split into.
     ``cover_threshold``: a column counts as covered when its summed density exceeds this (cells).
     ``base_altitude``: world y of the volume's bottom (see :mod:`atmos.plugins.clouds.layout`).
-    Shading (thesis ch. 5): ``shading`` on or off; ``sigma`` extinction per cell length at density
-    1; ``scattering`` single or Harris multiple forward scattering (:class:`Scattering`, None: single);
+    The medium and its light (physical units, :mod:`atmos.shading.medium`): ``sigma_t`` extinction
+    in 1/m at density 1 (the thesis's per-cell sigma is derived: :attr:`sigma`); ``albedo``
+    single-scattering albedo; ``phase_g``, ``phase_g2``, ``phase_w`` the two Henyey-Greenstein lobes
+    and the second's weight; ``sun_intensity`` (sun irradiance = this × ``Sun.color``),
+    ``sky_intensity`` (sky radiance = this × ``Sun.ambient``), ``ground_albedo`` (light from below).
+    Shading (thesis ch. 5): ``shading`` on or off;
+    ``scattering`` single or Harris multiple forward scattering (:class:`Scattering`, None: single);
     ``shading_scale`` 1, 2 or 4 (full, half, quarter resolution); ``shading_slices_per_run``
-    light-space slices per job slice; ``cell_size`` the world size of a cell (x, y, z), so the sun
+    light-space slices per job slice; ``cell_size`` the world size of a cell (x, y, z; each >= 0.001 m), so the sun
     direction is taken into cell units (cells need not be cubes).
 
-    Live (the next step, or the next frame for placement): ``weather`` (but its ``volume_shape``),
-    ``step_seconds``, ``cover_threshold``, ``sigma``, ``scattering``, ``cell_size``,
+    Live (the next step, or the next frame for placement and light): ``weather`` (but its ``volume_shape``),
+    ``step_seconds``, ``cover_threshold``, the medium and light fields, ``scattering``, ``cell_size``,
     ``base_altitude``. FIXED (they size the automaton, the textures, the maps and the job's
     slices): the others.
     """
@@ -65,7 +74,14 @@ class CloudSettings(CheckedSettings):
     smoothing_slices: int = 4
     cover_threshold: float = 0.5
     shading: bool = True
-    sigma: float = 0.6
+    sigma_t: float = 0.6
+    albedo: float = 1.0
+    phase_g: float = 0.85
+    phase_g2: float = -0.3
+    phase_w: float = 0.1
+    sun_intensity: float = 4.0 * math.pi
+    sky_intensity: float = 1.0
+    ground_albedo: float = 0.3
     scattering: Scattering | None = None
     shading_scale: int = 1
     shading_slices_per_run: int = 8
@@ -108,17 +124,30 @@ class CloudSettings(CheckedSettings):
             smoothing_slices=check_int(o, "smoothing_slices", self.smoothing_slices, 1, nz),
             cover_threshold=check_num(o, "cover_threshold", self.cover_threshold, 0.0),
             shading=check_bool(o, "shading", self.shading),
-            sigma=check_num(o, "sigma", self.sigma, 0.0),
+            sigma_t=check_num(o, "sigma_t", self.sigma_t, 0.0),
+            albedo=check_num(o, "albedo", self.albedo, 0.0, 1.0),
+            phase_g=check_num(o, "phase_g", self.phase_g, -0.99, 0.99),
+            phase_g2=check_num(o, "phase_g2", self.phase_g2, -0.99, 0.99),
+            phase_w=check_num(o, "phase_w", self.phase_w, 0.0, 1.0),
+            sun_intensity=check_num(o, "sun_intensity", self.sun_intensity, 0.0),
+            sky_intensity=check_num(o, "sky_intensity", self.sky_intensity, 0.0),
+            ground_albedo=check_num(o, "ground_albedo", self.ground_albedo, 0.0, 1.0),
             shading_scale=shading_scale,
             shading_slices_per_run=check_int(o, "shading_slices_per_run", self.shading_slices_per_run, 1, 4096),
-            cell_size=check_vec(o, "cell_size", self.cell_size, 3, "positive"),
+            cell_size=check_vec(o, "cell_size", self.cell_size, 3, "positive", lo=1e-3),   # metres; 0 gives NaN
             base_altitude=check_num(o, "base_altitude", self.base_altitude),
         ))
 
-    @property
-    def extinction(self) -> float:
-        """The shading's extinction per cell length at density 1 (sigma, with the scattering model's)."""
-        return (self.scattering or Scattering()).extinction(self.sigma)
+    @cached_property
+    def sigma(self) -> float:
+        """Derived: extinction per cube-root cell length at density 1, ``sigma_t × cbrt(cx cy cz)``
+        (computed once per settings object: they are frozen)."""
+        return float(self.sigma_t * np.cbrt(np.prod(self.cell_size)))
+
+    def shading_sigma(self, sun_dir) -> float:
+        """The shear-warp's extinction per index-space length toward ``sun_dir`` (exact for non-cubic
+        cells, :func:`atmos.shading.medium.cell_sigma`), with the scattering model's reduction."""
+        return (self.scattering or Scattering()).extinction(cell_sigma(self.sigma_t, self.cell_size, sun_dir))
 
 
 class CloudSimulation:
@@ -171,6 +200,7 @@ class CloudSimulation:
         self._placement: dict[int, tuple] = {}    # id(texture set) -> VolumeOrigin its step began at
         self._drift = np.zeros(2)          # sub-cell wind displacement not yet applied
         self._last_origin = np.array(self.origin.as_tuple())
+        self._step_origin = self.origin.as_tuple()
         n = s.smoothing_slices
         tasks = [
             SliceTask("region", 1, self._region_slice),
@@ -179,14 +209,14 @@ class CloudSimulation:
             SliceTask("density_maps", n, self._maps_slice),
         ]
         if s.shading:                  # sigma and scattering read when each step's shading begins
-            tasks.append(ShadingTask(self.shader, self.sun_in_cells, lambda: self.settings.extinction,
+            tasks.append(ShadingTask(self.shader, self.sun_in_cells, lambda: self.settings.shading_sigma(self.sun()),
                                        slices_per_run=s.shading_slices_per_run))
         self.job = SlicedJob("clouds", tasks, self.triple)
 
     # -- tasks -------------------------------------------------------------------------------
     def _region_slice(self, index: int, job) -> None:
         origin = self.origin.as_tuple()
-        self._placement[id(job.target)] = origin
+        self._placement[id(job.target)] = self._step_origin = origin
         s = self.settings
         step_weather(self.world, s.weather, self.rng, s.step_seconds, origin)
         self.region.render(ellipsoid_array(self.world, origin))
@@ -204,11 +234,12 @@ class CloudSimulation:
         maps = self._maps[id(job.target)]
         maps.run(job.target["density"], z0, z1)
         if index == job.slices - 1:
-            self._max_maps[id(job.target)] = maps.read_max_maps()
+            maps.request_max_maps()          # read back when the set is first drawn: no stall here
 
     def _next_shift(self) -> tuple[int, int]:
-        """Whole cells the contents move this step: the wind's drift minus the volume's own motion."""
-        origin = np.array(self.origin.as_tuple())
+        """Whole cells the contents move this step: the wind's drift minus the volume's own motion
+        up to the step's placement (the origin when its region slice ran, maybe frames ago)."""
+        origin = np.array(self._step_origin)
         moved = origin - self._last_origin
         self._last_origin = origin
         wind = np.asarray(self.settings.weather.wind, float)
@@ -219,14 +250,22 @@ class CloudSimulation:
         return int(np.clip(shift[0], -limit, limit)), int(np.clip(shift[1], -limit, limit))
 
     def layout(self, base_altitude: float | None = None, cell_size=None, pad: float = 0.0) -> CloudLayout:
-        """Where the volume is in the world now (the VolumeOrigin moves it): the placement the
+        """Where the newest completed set (B) sits in the world (see :class:`CloudSets`): the placement the
         renderer, the ground shadows and the light shafts share. ``base_altitude`` and ``cell_size``
         default to the settings'; ``pad`` widens the column boxes (the sprite radius)."""
         return self.sets().layout(base_altitude, cell_size, pad)
 
+    def _max_maps_of(self, texture_set) -> np.ndarray:
+        """The max maps of ``texture_set``, collected from the pixel buffer on first use after its step."""
+        maps = self._maps[id(texture_set)]
+        if maps.requested:
+            self._max_maps[id(texture_set)] = maps.collect_max_maps()
+        return self._max_maps[id(texture_set)]
+
     def sets(self) -> CloudSets:
         """This frame's :class:`CloudSets` (the render graph's imported ``"cloud_sets"``)."""
         a, b, t = self.view()
+        self._max_maps_of(a), self._max_maps_of(b)
         here = self.origin.as_tuple()
         return CloudSets(a, b, float(t), self._maps[id(a)], self._maps[id(b)], self._max_maps[id(a)],
                          self._max_maps[id(b)], self._placement.get(id(a), here), self._placement.get(id(b), here),
@@ -247,9 +286,9 @@ class CloudSimulation:
 
     def max_maps(self) -> np.ndarray:
         """Elementwise max of the max maps of A and B, shape (1 + bands, gx, gz): a segment whose
-        value is 0 is empty in both interpolated steps and may be skipped (7.2.2)."""
-        a, b, _ = self.view()
-        return np.maximum(self._max_maps[id(a)], self._max_maps[id(b)])
+        value is 0 is empty in both interpolated steps and may be skipped (7.2.2); A's taken where it
+        is drawn (:meth:`CloudSets.max_maps`)."""
+        return self.sets().max_maps()
 
     def cover(self) -> float:
         """Covered fraction of the sky in the newest completed step (B): columns whose summed

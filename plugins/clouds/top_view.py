@@ -27,6 +27,7 @@ class CloudTopViewPass(FullscreenPass):
         sim.maps_of(a).sums.use(0)
         sim.maps_of(b).sums.use(1)
         self.program["t"].value = t
+        self.program["a_shift"].value = sim.a_shift[0], sim.a_shift[2]
         self.program["full"].value = self.plugin.settings.full_column
         self.program["aspect"].value = frame.view.aspect
         frame.fullscreen(self.program)

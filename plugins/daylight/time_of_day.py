@@ -1,57 +1,53 @@
-"""Solar position from a time of day, and the plugin that turns it into the Sun resource."""
+"""The plugin that turns a time of day into the Sun resource (the position: :mod:`.solar_position`)."""
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from atmos.checks import CheckedSettings, check_num
+from atmos.checks import CheckedSettings, check_int, check_num
 from atmos.lighting import Sun, sky_light
 from atmos.plugin import Plugin
-
-
-def solar_direction(hours: float, latitude: float = 45.0, day_of_year: float = 172.0) -> np.ndarray:
-    """Unit vector toward the sun (x east, y up, −z north) at local solar time ``hours``.
-
-    Declination δ = −23.44° cos(2π (day + 10) / 365); hour angle h = 15° (hours − 12);
-    elevation from sin e = sin φ sin δ + cos φ cos δ cos h (φ the latitude). Below the horizon the
-    vector points below it (y < 0): night.
-    """
-    phi = math.radians(latitude)
-    delta = math.radians(-23.44 * math.cos(2 * math.pi * (day_of_year + 10) / 365.0))
-    h = math.radians(15.0 * (hours - 12.0))
-    # the sun in the local east-north-up frame: rotate the equatorial direction by the latitude
-    east = -math.cos(delta) * math.sin(h)
-    north = math.sin(delta) * math.cos(phi) - math.cos(delta) * math.cos(h) * math.sin(phi)
-    up = math.sin(delta) * math.sin(phi) + math.cos(delta) * math.cos(h) * math.cos(phi)
-    v = np.array([east, up, -north])
-    return v / np.linalg.norm(v)
+from atmos.plugins.daylight.solar_position import solar_direction
 
 
 @dataclass(frozen=True)
 class DaylightSettings(CheckedSettings):
-    """``hours``: local solar time in [0, 24] the clock starts at (``configure(hours=...)`` sets the
-    clock to it); ``speed``: in-game hours per real second (0 stops the clock); ``latitude`` in
-    degrees (−90..90); ``day_of_year`` 1..366. All live (next frame)."""
+    """``hours``: the time of day in [0, 24] the clock starts at (``configure(hours=...)`` sets the
+    clock to it): local apparent solar time (12 = the sun due south or north), or, once a
+    ``longitude`` is given, clock time in the zone ``utc_offset`` hours from UTC (None: the
+    longitude's nominal zone, round(longitude / 15)); ``speed``: in-game hours per real second (0 stops
+    the clock); ``latitude`` in degrees (−90..90); ``longitude`` in degrees east (−180..180) or None;
+    ``day_of_year`` 1..366 of ``year`` (1900..2100). Positions within ~0.01° of NREL's SPA
+    (:mod:`atmos.plugins.daylight.solar_position`). All live (next frame)."""
     hours: float = 10.0
     speed: float = 0.0
     latitude: float = 45.0
     day_of_year: float = 172.0
+    year: int = 2024
+    longitude: float | None = None
+    utc_offset: float | None = None
 
     def __post_init__(self):
         o = "DaylightSettings"
         self.store(dict(hours=check_num(o, "hours", self.hours, 0.0, 24.0),
                         speed=check_num(o, "speed", self.speed),
                         latitude=check_num(o, "latitude", self.latitude, -90.0, 90.0),
-                        day_of_year=check_num(o, "day_of_year", self.day_of_year, 1.0, 366.0)))
+                        day_of_year=check_num(o, "day_of_year", self.day_of_year, 1.0, 366.0),
+                        year=check_int(o, "year", self.year, 1900, 2100),
+                        longitude=check_num(o, "longitude", self.longitude, -180.0, 180.0, optional=True),
+                        utc_offset=check_num(o, "utc_offset", self.utc_offset, -14.0, 14.0, optional=True)))
 
 
 @dataclass(slots=True)
 class TimeOfDay:
-    """The running clock (a resource the daylight system advances every frame): ``hours``, local
-    solar time in [0, 24)."""
+    """The running clock (a resource the daylight system advances every frame): ``hours`` in [0, 24),
+    solar or clock time as :class:`DaylightSettings` says; every assignment is checked (0..24, 24 is
+    midnight as 0 is)."""
     hours: float = 10.0
+
+    def __setattr__(self, name: str, value) -> None:
+        object.__setattr__(self, name, check_num("TimeOfDay", "hours", value, 0.0, 24.0) if name == "hours" else value)
 
 
 class DaylightPlugin(Plugin):
@@ -74,7 +70,7 @@ class DaylightPlugin(Plugin):
     def sun_direction(self) -> np.ndarray:
         """Unit vector toward the sun at the clock's time."""
         s = self.settings
-        return solar_direction(self.time_of_day.hours, s.latitude, s.day_of_year)
+        return solar_direction(self.time_of_day.hours, s.latitude, s.day_of_year, s.year, s.longitude, s.utc_offset)
 
     def advance(self, app) -> None:
         """System: advance the clock by ``speed × dt`` and write the Sun's direction, colour and ambient."""

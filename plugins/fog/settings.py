@@ -87,7 +87,7 @@ class FogSettings(CheckedSettings):
         self.store(dict(
             mode=mode, start=start, end=end, octaves=octaves, texels_per_cell=tpc,
             density=check_num(o, "density", self.density, 0.0),
-            fog_color=check_vec(o, "fog_color", self.fog_color, 3),
+            fog_color=check_vec(o, "fog_color", self.fog_color, 3, "non-negative"),
             sky=check_choice(o, "sky", self.sky, SKIES),
             noise=check_choice(o, "noise", self.noise, NOISES),
             resolutions=tuple(check_int(o, f"resolutions[{i}]", r, 2, MAX_TEXELS // tpc)

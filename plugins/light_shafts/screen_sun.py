@@ -5,6 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from atmos.camera import camera_matrices
 from atmos.lighting import unit_sun
 
 UV_LIMIT = 64.0     # a sun further off-screen is faded out; its uv is clamped to keep the blur finite
@@ -28,12 +29,13 @@ def screen_sun(camera, aspect: float, sun_direction, settings) -> ScreenSun:
     s = unit_sun(sun_direction)
     if s is None:
         return ScreenSun((0.5, 0.5), 0.0)
-    facing = float(np.dot(camera.forward(), s))
+    matrices = camera_matrices(camera, aspect)
+    facing = float(np.dot(-matrices.view[2, :3], s))          # the camera's forward
     strength = _smoothstep(0.0, settings.horizon_fade, s[1]) * _smoothstep(0.0, settings.front_fade, facing)
     if strength <= 0.0:
         return ScreenSun((0.5, 0.5), 0.0)
-    clip = camera.view_projection(aspect) @ np.append(s, 0.0)
-    uv = np.clip(0.5 * clip[:2] / clip[3] + 0.5, -UV_LIMIT, UV_LIMIT)
-    outside = float(np.max(np.maximum(np.maximum(-uv, uv - 1.0), 0.0)))
+    clip = matrices.view_proj[:, :3] @ s                     # (s, 0): a point at infinity
+    u, v = (min(max(float(0.5 * c / clip[3] + 0.5), -UV_LIMIT), UV_LIMIT) for c in clip[:2])
+    outside = max(-u, u - 1.0, -v, v - 1.0, 0.0)
     strength *= 1.0 - _smoothstep(0.0, settings.edge_fade, outside)
-    return ScreenSun((float(uv[0]), float(uv[1])), strength)
+    return ScreenSun((u, v), strength)

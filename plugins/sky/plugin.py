@@ -7,21 +7,24 @@ from atmos.lighting import sun_and_day
 from atmos.plugin import Plugin
 from atmos.plugins.sky.settings import SkySettings
 from atmos.plugins.sky.shader import set_sky_uniforms, sky_defines
-from atmos.render_core import COLOR
+from atmos.render_core import DEPTH, where_nothing_was_drawn
 
 
 class SkyPass(FullscreenPass):
-    """Writes the sky into every pixel of ``color`` (later passes draw over it), from the Sun resource."""
+    """Writes the sky into every pixel of ``color`` where nothing was drawn (depth 1; later passes draw
+    over it), from the Sun resource."""
     name = "sky"
     phase = "sky"
     fragment = "sky/sky.frag"
+    vertex = "lib/fullscreen_far.vert"
+    reads = (DEPTH,)
 
     def defines(self) -> dict:
         return sky_defines()
 
     def execute(self, frame: PassContext) -> None:
         view, p = frame.view, self.program
-        frame.framebuffer(color=[COLOR]).use()
+        where_nothing_was_drawn(frame)
         camera = view.camera
         set_camera_uniforms(p, camera, view.aspect)      # view_basis
         s, _ = sun_and_day(view.sun)

@@ -1,12 +1,14 @@
 """The whole sky colour in float64 numpy, as ``shaders/sky/sky.glsl`` draws it.
 
 ``sky_radiance`` (the diffuse sky, for anyone who wants the sky's light in a direction):
-``mix(night, scale · preetham, day) · below``, where ``day`` fades the Preetham sky out over twilight
+``mix(night, scale · preetham · ozone, day) · below``, where ``ozone`` is the Chappuis absorption
+Preetham leaves out (:func:`ozone_transmittance`: what keeps the twilight zenith blue, not grey;
+raised to ``max(view_y, 0)²``: full overhead, where the twilight sky is lit from high up, fading
+toward the horizon glow, lit through the lower air), ``day`` fades the Preetham sky out over twilight
 (the sun's height, sin elevation, from ``DAY_FADE[1]`` down to ``DAY_FADE[0]``) and ``below`` dims
 views under the horizon toward ``GROUND_DIM`` over view heights 0..-``BELOW_FADE``.
-``sky_color`` adds the sun disc (``sun_gain`` × the Sun resource's colour inside ``sun_size_deg``,
-soft over the outer ``DISC_EDGE`` of its radius, measured as the chord |v − s| so the GPU needs no
-inverse trigonometry there) and the stars of :mod:`atmos.plugins.sky.stars`.
+``sky_color`` adds the sun disc and its glare (:func:`sun_disc`, measured as the chord |v − s| so
+the GPU needs no inverse trigonometry there) and the stars of :mod:`atmos.plugins.sky.stars`.
 """
 from __future__ import annotations
 
@@ -19,7 +21,18 @@ from atmos.plugins.sky.settings import SkySettings
 from atmos.plugins.sky.preetham import check_turbidity, preetham_rgb, unit_vectors
 from atmos.plugins.sky.stars import smoothstep, star_field
 # the model's constants are the GLSL's (handed over as defines by .shader); kept here by name
-from atmos.plugins.sky.shader import BELOW_FADE, DAY_FADE, DISC_EDGE, GROUND_DIM, disc_chords  # noqa: F401
+from atmos.plugins.sky.shader import (BELOW_FADE, DAY_FADE, EDGE_MIN, GLARE_REACH, GROUND_DIM, LIMB_FLOOR,  # noqa: F401
+                                      OZONE_BELOW, OZONE_DEPTH, OZONE_SHELL, SUN_LIMB, disc_chord)
+
+
+def ozone_transmittance(sun_y) -> np.ndarray:
+    """(3,) RGB transmittance of the sky's light through the ozone layer relative to a sun at the
+    zenith: ``exp(−OZONE_DEPTH · (m − m_zenith))`` with the slant path through a thin shell,
+    ``m = 1 / sqrt(max(sun_y, 0)² + OZONE_SHELL)``, lengthened by ``1 + OZONE_BELOW · depth`` for a
+    sun below the horizon (its light then crosses the layer twice, tangentially)."""
+    y = float(sun_y)
+    m = (1.0 + OZONE_BELOW * max(-y, 0.0)) / math.sqrt(max(y, 0.0) ** 2 + OZONE_SHELL)
+    return np.exp(-np.array(OZONE_DEPTH) * (m - 1.0 / math.sqrt(1.0 + OZONE_SHELL)))
 
 
 def daylight(sun_y) -> np.ndarray:
@@ -40,14 +53,24 @@ def sky_radiance(view_dir, sun_dir, turbidity: float = SkySettings.turbidity, sc
     v = unit_vectors(view_dir, "view_dir")
     s = unit_vectors(sun_dir, "sun_dir").reshape(3)
     day = daylight(s[1])
-    rgb = np.asarray(night, np.float64) * (1.0 - day) + scale * preetham_rgb(v, s, turbidity) * day
+    ozone = ozone_transmittance(s[1]) ** (np.maximum(v[..., 1:2], 0.0) ** 2)
+    rgb = np.asarray(night, np.float64) * (1.0 - day) + scale * preetham_rgb(v, s, turbidity) * ozone * day
     return rgb * below_horizon(v[..., 1])[..., None]
 
 
-def sun_disc(view_dir, sun_dir, sun_color, size_deg: float, gain: float) -> np.ndarray:
-    """(..., 3) the sun disc's radiance: ``gain · sun_color`` inside, soft edge (unit directions)."""
-    inside = 1.0 - smoothstep(*disc_chords(size_deg), np.linalg.norm(view_dir - sun_dir, axis=-1))
-    return gain * inside[..., None] * np.asarray(sun_color, np.float64)
+def sun_disc(view_dir, sun_dir, sun_color, size_deg: float, gain: float, glare: float = 0.0,
+             pixel_angle: float = 0.0) -> np.ndarray:
+    """(..., 3) radiance of the sun disc and its glare (unit directions): ``gain · sun_color`` at the
+    centre, limb-darkened as ``μ^SUN_LIMB`` (μ = cos of the angle on the solar surface, at least
+    ``LIMB_FLOOR``), antialiased over one pixel (``pixel_angle``, at least ``EDGE_MIN`` of the
+    radius); the glare ``glare · gain · sun_color · (r / max(c, r))²`` fades out by ``GLARE_REACH``."""
+    c = np.linalg.norm(view_dir - sun_dir, axis=-1)[..., None]
+    r = disc_chord(size_deg)
+    half = 0.5 * max(pixel_angle, EDGE_MIN * r)
+    cover = 1.0 - smoothstep(r - half, r + half, c)
+    mu = np.sqrt(np.maximum(1.0 - (c / r) ** 2, LIMB_FLOOR ** 2))
+    halo = glare * (r / np.maximum(c, r)) ** 2 * (1.0 - smoothstep(0.0, GLARE_REACH, c))
+    return gain * (cover * mu ** np.array(SUN_LIMB) + halo) * np.asarray(sun_color, np.float64)
 
 
 def sky_color(view_dir, sun_dir, sun_color, settings: SkySettings | None = None, time: float = 0.0,
@@ -56,7 +79,7 @@ def sky_color(view_dir, sun_dir, sun_color, settings: SkySettings | None = None,
     p = settings or SkySettings()
     v = unit_vectors(view_dir, "view_dir")
     s = unit_vectors(sun_dir, "sun_dir").reshape(3)
-    extra = sun_disc(v, s, sun_color, p.sun_size_deg, p.sun_gain)
+    extra = sun_disc(v, s, sun_color, p.sun_size_deg, p.sun_gain, p.sun_glare, pixel_angle)
     if p.stars:
         extra = extra + star_field(v, s[1], time, pixel_angle, p.star_density, p.star_brightness, p.twinkle)
     return sky_radiance(v, s, p.turbidity, p.scale, p.night) + extra * below_horizon(v[..., 1])[..., None]

@@ -15,16 +15,19 @@ class SkySettings(CheckedSettings):
     """Look of the sky: haze, brightness in the HDR pipeline, sun disc, night and stars.
 
     ``scale``: HDR units per kcd/m² of Preetham luminance (0.03 puts a clear noon zenith near 0.25,
-    beside the sun colour ≈ 1 of ``sky_light``); ``sun_size_deg``: angular radius of the disc;
-    ``sun_gain``: disc radiance per unit of the Sun resource's colour; ``night``: the sky colour
+    beside the sun colour ≈ 1 of ``sky_light``); ``sun_size_deg``: angular radius of the disc
+    (the real sun's: 0.2665°, 0.53° across); ``sun_gain``: radiance at the disc's centre per unit of
+    the Sun resource's colour (limb-darkened toward the edge); ``sun_glare``: the glare round the
+    disc, as a fraction of the centre's radiance at the disc's edge (falling as 1/angle² beyond it); ``night``: the sky colour
     once the sun is well below the horizon; ``star_density``: fraction of star-grid cells holding
     a star; ``star_brightness``: HDR radiance of the brightest star; ``twinkle``: 0 steady .. 1 full.
     """
 
     turbidity: float = 2.5
     scale: float = 0.03
-    sun_size_deg: float = 0.5
+    sun_size_deg: float = 0.2665
     sun_gain: float = 20.0
+    sun_glare: float = 0.05
     night: tuple = tuple(NIGHT_SKY)
     stars: bool = True
     star_density: float = 0.08
@@ -44,6 +47,7 @@ class SkySettings(CheckedSettings):
             scale=check_num(o, "scale", self.scale, 0.0, 1e3, lo_open=True),
             sun_size_deg=check_num(o, "sun_size_deg", self.sun_size_deg, 0.0, 5.0, lo_open=True),
             sun_gain=check_num(o, "sun_gain", self.sun_gain, 0.0, 1e4),
+            sun_glare=check_num(o, "sun_glare", self.sun_glare, 0.0, 1.0),
             night=check_vec(o, "night", self.night, 3, "non-negative"),
             star_density=check_num(o, "star_density", self.star_density, 0.0, 1.0),
             star_brightness=check_num(o, "star_brightness", self.star_brightness, 0.0, 1e4),

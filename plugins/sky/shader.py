@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 
@@ -13,21 +14,32 @@ from atmos.plugins.sky.preetham import COS_FLOOR, unit_vectors
 DAY_FADE = (-0.2, 0.02)      # sun height (sin elevation): night below the first, full Preetham day above the second
 GROUND_DIM = 0.3
 BELOW_FADE = 0.1
-DISC_EDGE = 0.25
+OZONE_DEPTH = (0.0097, 0.0282, 0.0013)    # vertical optical depth of the ozone layer (Chappuis band; red, green, blue)
+OZONE_SHELL = 0.0069                      # 2 h / R: the layer's height h ≈ 22 km over the earth's radius
+OZONE_BELOW = 10.0                        # growth of the path per unit of the sun's depth below the horizon
+SUN_LIMB = (0.397, 0.503, 0.652)   # limb darkening I(μ) = μ^a per channel (red, green, blue)
+LIMB_FLOOR = 0.25                  # the μ the disc's very edge is given (its last pixel stays lit)
+GLARE_REACH = 0.2                  # chord |v − s| (≈ 11.5°) by which the glare has faded to 0
+EDGE_MIN = 0.05                    # narrowest antialiased edge, as a fraction of the disc's radius
 
 
-def disc_chords(size_deg: float) -> tuple[float, float]:
-    """Chord lengths |v − s| where the disc's soft edge starts and ends."""
-    r = math.radians(size_deg)
-    return 2.0 * math.sin(0.5 * r * (1.0 - DISC_EDGE)), 2.0 * math.sin(0.5 * r)
+def disc_chord(size_deg: float) -> float:
+    """Chord length |v − s| of the disc's angular radius ``size_deg``."""
+    return 2.0 * math.sin(0.5 * math.radians(size_deg))
 
 
+@lru_cache(maxsize=1)
 def sky_defines() -> dict:
-    """The constants of the float64 reference, handed to the GLSL as defines (one source of truth)."""
+    """The constants of the float64 reference, handed to the GLSL as defines (one source of truth).
+    Made once (the sky pass asks every frame): the same dict each time, not to be changed."""
     return {"SKY_COS_FLOOR": repr(COS_FLOOR), "DAY_LO": repr(DAY_FADE[0]), "DAY_HI": repr(DAY_FADE[1]),
             "GROUND_DIM": repr(GROUND_DIM), "BELOW_FADE": repr(BELOW_FADE),
+            "OZONE_DEPTH": "vec3({}, {}, {})".format(*OZONE_DEPTH), "OZONE_SHELL": repr(OZONE_SHELL),
+            "OZONE_BELOW": repr(OZONE_BELOW), "SUN_LIMB": "vec3({}, {}, {})".format(*SUN_LIMB), "LIMB_FLOOR": repr(LIMB_FLOOR),
+            "GLARE_REACH": repr(GLARE_REACH), "EDGE_MIN": repr(EDGE_MIN),
             "STAR_GRID": stars.STAR_GRID, "STAR_KEY_A": f"{stars.STAR_KEY[0]}u", "STAR_KEY_B": f"{stars.STAR_KEY[1]}u",
             "STAR_SIGMA": repr(stars.STAR_SIGMA), "STAR_SIGMA_MAX": repr(stars.STAR_SIGMA_MAX),
+            "STAR_FOOTPRINT": repr(stars.FOOTPRINT),
             "STAR_CUT_LO": repr(stars.STAR_CUT[0]), "STAR_CUT_HI": repr(stars.STAR_CUT[1]),
             "STAR_NIGHT_LO": repr(stars.STAR_NIGHT[0]), "STAR_NIGHT_HI": repr(stars.STAR_NIGHT[1]),
             "STAR_HORIZON": repr(stars.STAR_HORIZON),
@@ -46,14 +58,17 @@ def set_sky_uniforms(program, settings: SkySettings, sun_dir, sun_color, time: f
     s = unit_vectors(sun_dir, "sun_dir").reshape(3)
     values = {"sky_sun_dir": tuple(s), "sky_sun_color": tuple(float(c) for c in sun_color),
               "turbidity": settings.turbidity, "sky_scale": settings.scale,
-              "sun_chords": disc_chords(settings.sun_size_deg), "sun_gain": settings.sun_gain,
+              "sun_chord": disc_chord(settings.sun_size_deg), "sun_gain": settings.sun_gain,
+              "sun_glare": settings.sun_glare,
               "night_color": settings.night,
               "star_threshold": stars.star_threshold(settings.star_density) if settings.stars else 0,
               "star_brightness": settings.star_brightness, "twinkle": settings.twinkle,
               "sky_time": float(time) % stars.TWINKLE_PERIOD, "pixel_angle": float(pixel_angle)}
+    get = program.get
     for name, value in values.items():
-        if name in program:
-            program[name].value = value
+        member = get(name, None)
+        if member is not None:
+            member.value = value
 
 
 def evaluate_sky(gpu, view_dirs, sun_dir, sun_color, settings: SkySettings | None = None, time: float = 0.0,

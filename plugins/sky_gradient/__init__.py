@@ -5,7 +5,7 @@ from atmos.checks import CheckedSettings, check_vec
 from atmos.graph import FullscreenPass, PassContext
 from atmos.lighting import set_scene_uniforms
 from atmos.plugin import Plugin
-from atmos.render_core import COLOR
+from atmos.render_core import DEPTH, where_nothing_was_drawn
 
 
 @dataclass(frozen=True)
@@ -23,12 +23,15 @@ class SkyGradientSettings(CheckedSettings):
 
 
 class SkyGradientPass(FullscreenPass):
+    """The gradient where nothing was drawn (depth 1)."""
     name = "sky_gradient"
     phase = "sky"
     fragment = "sky_gradient/sky.frag"
+    vertex = "lib/fullscreen_far.vert"
+    reads = (DEPTH,)
 
     def execute(self, frame: PassContext) -> None:
-        frame.framebuffer(color=[COLOR]).use()
+        where_nothing_was_drawn(frame)
         set_scene_uniforms(self.program, frame.view)
         settings = self.plugin.settings
         self.program["zenith"].value = settings.zenith

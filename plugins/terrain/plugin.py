@@ -7,7 +7,7 @@ from atmos.checks import CheckedSettings, check_int, check_num
 from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.lighting import set_scene_uniforms
 from atmos.plugin import Plugin
-from atmos.plugins.terrain.heightfield import heightfield, triangle_count
+from atmos.plugins.terrain.heightfield import height, heightfield, triangle_count
 from atmos.render_core import COLOR, DEPTH
 
 
@@ -88,6 +88,12 @@ class TerrainPlugin(Plugin):
     @property
     def triangles(self) -> int:
         return triangle_count(self.settings.cells)
+
+    def height_at(self, x, z):
+        """The ground's height (m) under world (x, z), from the same formula as the mesh (between its
+        vertices the mesh is flat, so it may differ there by a little)."""
+        s = self.settings
+        return height(x, z, s.relief, s.size)
 
     def build(self, app) -> None:
         app.graph.add_pass(TerrainPass(self))

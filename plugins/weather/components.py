@@ -6,9 +6,12 @@ toward the target density, death at the lifetime, leaving the region, removal ab
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, fields
 
 import numpy as np
+
+from atmos.checks import check_num
 
 #: Columns of an ellipsoid array handed to :class:`RegionVolume.render` and :func:`region_volume`.
 COLUMNS = ("x", "y", "z", "yaw", "rx", "ry", "rz", "pad")
@@ -63,16 +66,55 @@ class Ellipsoid:
         return self.lifetime - self.age
 
 
+#: Largest radius and distance from the volume (in cells) an ellipsoid may have: far beyond any volume,
+#: small enough that positions relative to the viewer and radii stay finite in float32 on the GPU.
+MAX_CELLS = 1e9
+_POSITIVE = ("rx", "ry", "rz", "lifetime")
+
+
+def ellipsoid_problem(e: Ellipsoid) -> str | None:
+    """What is wrong with ``e`` (None when nothing is): every field a finite number, |value| <= MAX_CELLS
+    for the position and radii, radii and lifetime > 0."""
+    for f in fields(Ellipsoid):
+        value = getattr(e, f.name)
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+                or not math.isfinite(value):
+            return f"Ellipsoid.{f.name} must be a finite number, got {value!r}"
+        if f.name in _POSITIVE and not value > 0:
+            return f"Ellipsoid.{f.name} must be > 0, got {value!r}"
+        if f.name in ("x", "y", "z", "rx", "ry", "rz") and abs(value) > MAX_CELLS:
+            return f"Ellipsoid.{f.name} must be within ±{MAX_CELLS:g} cells, got {value!r}"
+    return None
+
+
+def add_ellipsoid(world, **fields_) -> int:
+    """Create a weather ellipsoid entity in ``world`` (an App's ``app.world``) from :class:`Ellipsoid`
+    fields, checked first: a ValueError names the field and what is allowed, and nothing is created."""
+    try:
+        e = Ellipsoid(**fields_)
+    except TypeError:
+        known = ", ".join(f.name for f in fields(Ellipsoid))
+        raise ValueError(f"add_ellipsoid takes Ellipsoid fields ({known}), got {', '.join(sorted(fields_))}") from None
+    problem = ellipsoid_problem(e)
+    if problem is not None:
+        raise ValueError(f"add_ellipsoid: {problem}")
+    return world.create_entity(e)
+
+
 @dataclass(slots=True)
 class VolumeOrigin:
     """World position (in cells) of the simulation volume's cell (0, 0, 0); moves with the viewer.
 
     An App resource of :class:`atmos.plugins.weather.WeatherPlugin`: game code moves it, the
     weather rules put the region boundings around it, and the region volume is rendered at it.
+    Every assignment is checked: finite numbers (a ValueError names ``VolumeOrigin.field``).
     """
     x: float = 0.0
     y: float = 0.0
     z: float = 0.0
+
+    def __setattr__(self, name: str, value) -> None:
+        object.__setattr__(self, name, check_num("VolumeOrigin", name, value) if name in "xyz" else value)
 
     def as_tuple(self) -> tuple[float, float, float]:
         return (self.x, self.y, self.z)

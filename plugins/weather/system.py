@@ -19,13 +19,14 @@ entity-id order, so a run is reproducible from the generator's seed.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
 from atmos.checks import check_choice, check_int
 from atmos.plugin import Plugin
-from atmos.plugins.weather.components import NCOLS, Ellipsoid, VolumeOrigin
+from atmos.plugins.weather.components import MAX_CELLS, NCOLS, Ellipsoid, VolumeOrigin, ellipsoid_problem
 from atmos.plugins.weather.settings import WeatherSettings
 
 
@@ -36,6 +37,7 @@ class StepReport:
     left: int = 0      # rule 5: left the region boundings
     created: int = 0   # rule 1
     removed: int = 0   # rule 2: above the target density
+    rejected: int = 0  # invalid ellipsoids (NaN, inf, radius <= 0, ...) removed with a warning
     count: int = 0     # ellipsoids after the step
 
 
@@ -86,7 +88,7 @@ def step_weather(world, settings: WeatherSettings, rng: np.random.Generator, dt:
         raise ValueError(f"origin must be three finite numbers (x, y, z) in cells, got {origin!r}")
     report = StepReport()
     lo, hi = settings.region_bounds(origin)
-    pairs = _sorted_ellipsoids(world)
+    pairs = _reject_invalid(world, _sorted_ellipsoids(world), report)
     doomed = []
 
     # rule 3: age; remove at the end of the lifetime
@@ -160,6 +162,36 @@ def step_weather(world, settings: WeatherSettings, rng: np.random.Generator, dt:
     return report
 
 
+def _all_valid(pairs: list) -> bool:
+    """The fast path of :func:`_reject_invalid`: every field finite, radii and lifetimes > 0, within
+    MAX_CELLS (vectorized; False sends the step through the per-ellipsoid check)."""
+    try:
+        a = np.array([(e.x, e.y, e.z, e.rx, e.ry, e.rz, e.lifetime, e.yaw, e.age, e.drift_x, e.drift_z,
+                       e.vx, e.vy, e.vz, e.scale) for _, e in pairs], dtype=np.float64)
+    except (TypeError, ValueError):
+        return False
+    return bool(np.isfinite(a).all() and (a[:, 3:7] > 0).all() and (np.abs(a[:, :6]) <= MAX_CELLS).all())
+
+
+def _reject_invalid(world, pairs: list, report: StepReport) -> list:
+    """``pairs`` without the invalid ellipsoids (:func:`ellipsoid_problem`), which are deleted from
+    ``world`` with one RuntimeWarning each naming the entity: one bad entity never stops the others
+    or later steps."""
+    if not pairs or _all_valid(pairs):
+        return pairs
+    kept = []
+    for entity, e in pairs:
+        problem = ellipsoid_problem(e)
+        if problem is None:
+            kept.append((entity, e))
+            continue
+        world.delete_entity(entity, immediate=True)
+        report.rejected += 1
+        warnings.warn(f"weather: removed invalid ellipsoid entity {entity} ({problem}); create ellipsoids "
+                      f"with atmos.plugins.weather.add_ellipsoid to have them checked", RuntimeWarning, stacklevel=3)
+    return kept
+
+
 def _random_ellipsoids(settings: WeatherSettings, rng: np.random.Generator, k: int, lo, hi, origin) -> list:
     """``k`` new ellipsoids, uniformly inside the region boundings (rule 1); one rng call."""
     if k <= 0:
@@ -192,13 +224,18 @@ def ellipsoid_array(world, origin=(0.0, 0.0, 0.0)) -> np.ndarray:
 
     Columns ``(x, y, z, yaw, rx, ry, rz, 0)``: centre relative to ``origin`` (subtracted in
     float64, so far-flown worlds keep their precision), radii multiplied by the shrink scale.
+    Ellipsoids that are not finite numbers in float32 are left out (the next :func:`step_weather`
+    removes them with a warning).
     """
     pairs = _sorted_ellipsoids(world)
     a = np.zeros((len(pairs), NCOLS), np.float64)
     for i, (_, e) in enumerate(pairs):
         a[i, :7] = (e.x, e.y, e.z, e.yaw, e.rx * e.scale, e.ry * e.scale, e.rz * e.scale)
     a[:, 0:3] -= np.asarray(origin, dtype=np.float64)
-    return a.astype(np.float32)
+    with np.errstate(over="ignore", invalid="ignore"):
+        a = a.astype(np.float32)
+    finite = np.isfinite(a).all(axis=1)
+    return a if finite.all() else a[finite]
 
 
 class WeatherPlugin(Plugin):

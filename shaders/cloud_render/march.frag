@@ -1,7 +1,8 @@
 #version 430
 // Reference image of the cloud layer: MARCH_STEPS midpoint samples per view ray through the
-// layer's box, density and light trilinear from mix(A, B, t), extinction sigma per cell length
-// (path measured in cells), stopped at scene depth. Premultiplied: rgb = light, a = 1 - transmittance.
+// layer's box, density and light trilinear from mix(A, B, t), extinction sigma_t (1/m at density 1)
+// along the world path, stopped at scene depth; the source J of volume.glsl per sample.
+// Premultiplied: rgb = light, a = 1 - transmittance.
 #include "cloud_render/volume.glsl"
 #include "lib/view_ray.glsl"
 in vec2 v_uv;
@@ -14,7 +15,7 @@ uniform float far;
 uniform vec3 layer_min;
 uniform vec3 layer_max;
 uniform vec3 cell_size;
-uniform float sigma;
+uniform float sigma_t;
 
 void main() {
     vec3 dir = view_ray_dir(v_uv, view_basis);
@@ -27,14 +28,14 @@ void main() {
     float trans = 1.0;
     if (leave > enter) {
         float dt = (leave - enter) / float(MARCH_STEPS);
-        float step_cells = dt * length(dir / cell_size);
         vec3 extent = layer_max - layer_min;
+        float ny = extent.y / cell_size.y;
         for (int i = 0; i < MARCH_STEPS && trans > 1e-4; ++i) {
             vec3 uvw = (camera_pos + dir * (enter + (float(i) + 0.5) * dt) - layer_min) / extent;
             float d = cloud_density(uvw);
             if (d <= 0.0) continue;
-            float a = 1.0 - exp(-sigma * d * step_cells);
-            light += trans * a * cloud_light(uvw);
+            float a = 1.0 - exp(-sigma_t * d * dt);
+            light += trans * a * cloud_source(uvw, dir, ny);
             trans *= 1.0 - a;
         }
     }

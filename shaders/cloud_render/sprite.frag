@@ -1,12 +1,22 @@
 #version 430
-// A soft cloud particle: opacity 1 - exp(-tau × falloff), premultiplied (blend ONE, ONE_MINUS_SRC_ALPHA).
+// A soft cloud particle: opacity 1 - exp(-tau × falloff), premultiplied (blend ONE, ONE_MINUS_SRC_ALPHA);
+// its light J (volume.glsl) with the phase function at this pixel's view ray through the sprite's plane.
+#include "cloud_render/volume.glsl"
 layout(binding = 4) uniform sampler2D particle;
-flat in vec3 v_light;
+uniform vec3 camera_pos;
+uniform vec3 camera_right;
+uniform vec3 camera_up;
+flat in vec4 v_octaves;
+flat in vec3 v_ambient;
+flat in vec3 v_center;
+flat in float v_radius;
 flat in float v_tau;
 flat in float v_coverage;
 out vec4 frag;
 
 void main() {
     float a = (1.0 - exp(-v_tau * texture(particle, gl_PointCoord).r)) * v_coverage;
-    frag = vec4(v_light * a, a);
+    vec2 q = (gl_PointCoord - 0.5) * vec2(2.0, -2.0) * v_radius;
+    vec3 ray = normalize(v_center + q.x * camera_right + q.y * camera_up - camera_pos);
+    frag = vec4((sun_part(v_octaves, dot(ray, sun_dir)) + v_ambient) * a, a);
 }

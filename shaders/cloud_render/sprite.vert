@@ -5,7 +5,8 @@
 // across a boundary the camera stands on, see segments.py). gl_VertexID is a block's place in the
 // unit's drawing order: rows along the axis the camera is farther off, each axis walked toward the
 // camera, so of two neighbouring sprites the farther is always drawn first (blending is in vertex
-// order). Density is the block's mean of mix(A, B, t) (cells past the volume's edge count as empty);
+// order). Density is the block's mean of mix(A, B, t) (cells past the volume's edge count as empty;
+// the grid is B's placement, A's cell is c + a_shift);
 // empty blocks and blocks past the edge are thrown out of the view volume.
 #include "cloud_render/volume.glsl"
 layout(location = 0) in ivec4 in_segment;
@@ -14,14 +15,19 @@ uniform ivec2 group_size;
 uniform vec3 layer_min;        // world corner of cell (0, 0, 0)
 uniform vec3 cell_size;
 uniform vec3 camera_cell;      // the camera in cells from the volume's corner
+uniform vec3 camera_pos;       // the camera in world space (the view ray to the sprite's centre)
 uniform mat4 view_proj;
 uniform float base_diameter;   // world sprite diameter of one cell at density 1: size factor × max(cx, cz)
 uniform float pixel_scale;     // pixel diameter = world diameter × pixel_scale / clip.w
 uniform float max_point_size;
+uniform float near;            // the camera's near plane: sprites fade out before their centre crosses it
 uniform float tau_scale;       // centre optical depth = tau_scale × (density summed over the block) / diameter²
-flat out vec3 v_light;
+flat out vec4 v_octaves;      // b^i T^(a^i): the sun's light per octave (volume.glsl)
+flat out vec3 v_ambient;      // sky and ground light at the sprite, dimmed by the columns above and below
+flat out vec3 v_center;       // world centre and radius: the fragment's view ray for the phase function
+flat out float v_radius;
 flat out float v_tau;
-flat out float v_coverage;     // < 1 for sprites smaller than a pixel: their area in pixels
+flat out float v_coverage;     // < 1 for sprites smaller than a pixel (their area in pixels) or near the near plane
 
 const vec4 CULLED = vec4(0.0, 0.0, 2.0, 1.0);   // z > w: outside the clip volume
 const float SMALLEST = 0.75;   // an all but empty block's sprite, relative to a dense one's: neighbours overlap
@@ -48,7 +54,10 @@ void main() {
         ? ivec2(toward(gl_VertexID / n.y, n.x, cam.x, s), toward(gl_VertexID % n.y, n.y, cam.y, s))
         : ivec2(toward(gl_VertexID % n.x, n.x, cam.x, s), toward(gl_VertexID / n.x, n.y, cam.y, s));
     ivec3 cell = ivec3(origin.x + block.x * s, in_segment.y * s, origin.y + block.y * s);
-    v_light = vec3(0.0);
+    v_octaves = vec4(0.0);
+    v_ambient = vec3(0.0);
+    v_center = vec3(0.0);
+    v_radius = 0.0;
     v_tau = 0.0;
     v_coverage = 0.0;
     gl_PointSize = 1.0;
@@ -59,19 +68,29 @@ void main() {
         for (int y = 0; y < s; ++y)
             for (int x = 0; x < s; ++x) {
                 ivec3 c = cell + ivec3(x, y, z);
+                ivec3 ca = c + a_shift;              // A's cell at the same world point; past its edge: empty
+                float da = all(greaterThanEqual(ca, ivec3(0))) && all(lessThan(ca, volume_shape))
+                    ? texelFetch(density_a, ca, 0).r : 0.0;
                 if (all(lessThan(c, volume_shape)))
-                    sum += mix(texelFetch(density_a, c, 0).r, texelFetch(density_b, c, 0).r, t);
+                    sum += mix(da, texelFetch(density_b, c, 0).r, t);
             }
     if (!(sum > 0.0)) return;
     float d = sum / float(s * s * s);
     vec3 center = vec3(cell) + 0.5 * float(s);
-    vec4 clip = view_proj * vec4(layer_min + center * cell_size, 1.0);
+    vec3 world = layer_min + center * cell_size;
+    vec4 clip = view_proj * vec4(world, 1.0);
     float diameter = float(s) * base_diameter * mix(SMALLEST, 1.0, min(d, 1.0));
     float px = diameter * pixel_scale / max(clip.w, 1e-6);
     float c = clamp(px, 0.0, 1.0);
-    v_coverage = c * c;
+    v_coverage = c * c * clamp((clip.w - near) / diameter, 0.0, 1.0);   // no pop when the near plane clips it
     gl_PointSize = clamp(px, 1.0, max_point_size);
     v_tau = tau_scale * sum / (diameter * diameter);
-    v_light = cloud_light(center / vec3(volume_shape));
+    vec3 uvw = center / vec3(volume_shape);
+    float ny = float(volume_shape.y);
+    float up = column_depth(uvw, 1.0, ny), down = column_depth(uvw, -1.0, ny);
+    v_octaves = octave_weights(cloud_transmittance(uvw), up + down);
+    v_ambient = ambient_source(up, down, normalize(world - camera_pos).y);
+    v_center = world;
+    v_radius = 0.5 * diameter;
     gl_Position = clip;
 }

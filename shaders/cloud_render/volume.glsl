@@ -1,19 +1,81 @@
 // The cloud volume as the renderers see it: density and transmittance toward the sun, each
-// mix(A, B, t) of the two latest completed steps, and the light model sun × T + ambient.
+// mix(A, B, t) of the two latest completed steps, and the light model of atmos/shading/medium.py:
+// source per unit extinction J = sun_source * sum_i m_i b^i p(cos; c^i g) T^(a^i)
+//                              + sky_source (1 + s) exp(-a tau_up) + ground_source (1 - s) exp(-a tau_down),
+// m_0 = 1, m_i = 1 - exp(-tau_up - tau_down), s = g_mean * ray_y.
 layout(binding = 0) uniform sampler3D density_a;
 layout(binding = 1) uniform sampler3D density_b;
 layout(binding = 2) uniform sampler3D trans_a;       // at the shading scale; same texture coordinates
 layout(binding = 3) uniform sampler3D trans_b;
 uniform float t;
+uniform ivec3 a_shift;         // cells from B's cell to A's at the same world point (CloudSets.a_shift)
 uniform int has_shading;       // 0: no transmittance textures, T = 1
-uniform vec3 sun_color;        // already 0 with the sun below the horizon
-uniform vec3 ambient;
+uniform vec3 sun_source;       // albedo * sun irradiance (already 0 with the sun below the horizon)
+uniform vec3 sky_source;       // albedo * sky radiance / 2
+uniform vec3 ground_source;    // albedo * ground radiance / 2
+uniform vec3 sun_dir;          // toward the sun, unit
+uniform vec3 phase_lobes;      // g, g2, w
+uniform vec3 ms_octaves;       // a (attenuation), b (contribution), c (eccentricity)
+uniform float column_tau;      // sigma_t * cell height: optical depth of one cell of density 1, vertically
+const int COLUMN_SAMPLES = 8;
+const float PI = 3.14159265358979;
 
-float cloud_density(vec3 uvw) {
-    return mix(textureLod(density_a, uvw, 0.0).r, textureLod(density_b, uvw, 0.0).r, t);
+// uvw: B's texture coordinates (the volume is drawn at B's placement); A's are offset by a_shift.
+vec3 a_uvw(vec3 uvw) {
+    vec3 size = vec3(textureSize(density_a, 0));
+    return (uvw * size + vec3(a_shift)) / size;      // a cell centre stays one exactly
 }
 
-vec3 cloud_light(vec3 uvw) {
-    float T = has_shading == 0 ? 1.0 : mix(textureLod(trans_a, uvw, 0.0).r, textureLod(trans_b, uvw, 0.0).r, t);
-    return sun_color * T + ambient;
+float cloud_density(vec3 uvw) {
+    return mix(textureLod(density_a, a_uvw(uvw), 0.0).r, textureLod(density_b, uvw, 0.0).r, t);
+}
+
+float cloud_transmittance(vec3 uvw) {
+    return has_shading == 0 ? 1.0 : mix(textureLod(trans_a, a_uvw(uvw), 0.0).r, textureLod(trans_b, uvw, 0.0).r, t);
+}
+
+// Optical depth from uvw straight up (dir 1) or down (dir -1) to the volume's face: midpoint rule.
+float column_depth(vec3 uvw, float dir, float ny) {
+    float len = dir > 0.0 ? 1.0 - uvw.y : uvw.y;
+    float sum = 0.0;
+    for (int i = 0; i < COLUMN_SAMPLES; ++i)
+        sum += cloud_density(vec3(uvw.x, uvw.y + dir * len * (float(i) + 0.5) / float(COLUMN_SAMPLES), uvw.z));
+    return column_tau * sum * len * ny / float(COLUMN_SAMPLES);
+}
+
+// Octave weights b^i T^(a^i), i = 0..3, the scattered ones (i >= 1) times the chance
+// 1 - exp(-tau_column) that light met the cloud's column through the point at all.
+vec4 octave_weights(float T, float tau_column) {
+    float a = ms_octaves.x, b = ms_octaves.y, m = 1.0 - exp(-tau_column);
+    return vec4(T, m * b * pow(T, a), m * b * b * pow(T, a * a), m * b * b * b * pow(T, a * a * a));
+}
+
+// Sky and ground light toward the eye along ray_y (the view ray's y): the phase's mean cosine
+// g_mean sends the share 1/2 (1 + g_mean ray_y) of what reaches the eye in from the sky.
+vec3 ambient_source(float tau_up, float tau_down, float ray_y) {
+    float s = ((1.0 - phase_lobes.z) * phase_lobes.x + phase_lobes.z * phase_lobes.y) * ray_y;
+    return sky_source * (1.0 + s) * exp(-ms_octaves.x * tau_up)
+         + ground_source * (1.0 - s) * exp(-ms_octaves.x * tau_down);
+}
+
+float hg(float c, float g) {
+    float d = max(1.0 + g * g - 2.0 * g * c, 1e-6);
+    return (1.0 - g * g) / (4.0 * PI * d * sqrt(d));
+}
+
+// sun_source * sum_i w_i p(cos; c^i g): the sun's part of J for a view ray with dot(ray, sun_dir) = c.
+vec3 sun_part(vec4 w, float c) {
+    float e = 1.0, sum = 0.0;
+    for (int i = 0; i < 4; ++i) {
+        sum += w[i] * mix(hg(c, phase_lobes.x * e), hg(c, phase_lobes.y * e), phase_lobes.z);
+        e *= ms_octaves.z;
+    }
+    return sun_source * sum;
+}
+
+// J at uvw for a view ray along ray_dir (world, unit).
+vec3 cloud_source(vec3 uvw, vec3 ray_dir, float ny) {
+    float up = column_depth(uvw, 1.0, ny), down = column_depth(uvw, -1.0, ny);
+    return sun_part(octave_weights(cloud_transmittance(uvw), up + down), dot(ray_dir, sun_dir))
+         + ambient_source(up, down, ray_dir.y);
 }

@@ -1,7 +1,7 @@
 #version 430
 // Cloud ground shadows (thesis 7.3.1): the scene point behind each pixel is projected along the
 // direction toward the sun onto the middle of the cloud layer, where the top-view summed density
-// mix(A, B, t) (layer 0 of the density maps) gives the optical depth. Output is the factor the
+// mix(A, B, t) (layer 0 of the density maps, each set at its own placement) gives the optical depth. Output is the factor the
 // colour is multiplied by (blend ZERO, SRC_COLOR); plugins/cloud_shadows/reference.py is the same in numpy.
 #include "lib/view_ray.glsl"
 out vec4 frag;
@@ -16,15 +16,23 @@ uniform vec3 sun_dir;          // unit, toward the sun
 uniform float weight;          // direct_fraction × horizon fade (reference.direct_weight)
 uniform float extinction;      // sigma × strength, per cell of summed density
 uniform float t;               // interpolation factor between A and B
+uniform ivec2 a_shift;         // (x, z) cells from B's column to A's at the same place (CloudSets.a_shift)
 uniform vec3 layer_min;        // world corner of cell (0, 0, 0): (origin.x·cx, base_altitude, origin.z·cz)
 uniform vec3 cell_size;
 uniform ivec3 shape;
 
 const float MIN_SUN_HEIGHT = 1e-4;
 
+bool outside(ivec2 c) {
+    return any(lessThan(c, ivec2(0))) || any(greaterThanEqual(c, shape.xz));
+}
+
+// Column c of B's placement (layer_min), A read at its own (c + a_shift): zero outside either volume.
 float column(ivec2 c) {
-    if (any(lessThan(c, ivec2(0))) || any(greaterThanEqual(c, shape.xz))) return 0.0;
-    return mix(texelFetch(sums_a, ivec3(c, 0), 0).r, texelFetch(sums_b, ivec3(c, 0), 0).r, t);
+    if (outside(c)) return 0.0;
+    ivec2 ca = c + a_shift;
+    float a = outside(ca) ? 0.0 : texelFetch(sums_a, ivec3(ca, 0), 0).r;
+    return mix(a, texelFetch(sums_b, ivec3(c, 0), 0).r, t);
 }
 
 // Bilinear, texel i centred at i, zero outside the volume.

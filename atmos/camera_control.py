@@ -1,0 +1,134 @@
+"""Camera controllers: the WASD fly camera (the default) and a chase camera that follows an entity.
+
+``DefaultPlugins()`` includes :class:`FlyCameraPlugin`; ``DefaultPlugins(fly_camera=False)`` leaves it
+out, and a game adds ``ChaseCameraPlugin(distance=12)`` and points it at its player with
+``chase.target = entity`` (an entity with a :class:`atmos.Transform`).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from atmos.camera import Camera
+from atmos.checks import CheckedSettings, check_num
+from atmos.input import Input
+from atmos.keys import key
+from atmos.orientation import angles
+from atmos.plugin import Plugin
+from atmos.transform import Transform
+
+
+@dataclass(frozen=True)
+class FlyCameraSettings(CheckedSettings):
+    """``speed``: metres per second (shift: 5×); ``turn``: radians per pixel of mouse drag. All live."""
+    speed: float = 20.0
+    turn: float = 0.004
+
+    def __post_init__(self):
+        o = "FlyCameraSettings"
+        self.store(dict(speed=check_num(o, "speed", self.speed, 0.0, 1e7),
+                        turn=check_num(o, "turn", self.turn, 0.0, 1.0)))
+
+
+class FlyCameraPlugin(Plugin):
+    """WASD/QE move, the arrow keys or a mouse drag turn, shift is 5× faster (update stage, "fly_camera")."""
+
+    settings_class = FlyCameraSettings
+
+    def build(self, app) -> None:
+        app.add_system(self.fly, "update", label="fly_camera")
+
+    def fly(self, app) -> None:
+        inp, cam = app.get_resource(Input), app.get_resource(Camera)
+        if inp is None or cam is None:
+            return
+        s, dt = self.settings, app.clock.dt
+        v = s.speed * (5.0 if {key.LSHIFT, key.RSHIFT} & inp.keys else 1.0) * dt
+        move = (cam.forward() * inp.axis(key.S, key.W) + cam.right() * inp.axis(key.A, key.D)
+                + np.array([0.0, 1.0, 0.0]) * inp.axis(key.Q, key.E))
+        cam.position = cam.position + v * move
+        drag = bool(inp.buttons)
+        cam.yaw = math.remainder(cam.yaw + drag * inp.mouse_dx * s.turn + 1.5 * dt * inp.axis(key.LEFT, key.RIGHT),
+                                 2 * math.pi)
+        pitch = cam.pitch + drag * inp.mouse_dy * s.turn + 1.5 * dt * inp.axis(key.DOWN, key.UP)
+        cam.pitch = float(np.clip(pitch, -1.55, 1.55))
+
+
+@dataclass(frozen=True)
+class ChaseCameraSettings(CheckedSettings):
+    """``distance`` behind and ``height`` above the target (m); ``look_ahead``: aims at the point this
+    far in front of it; ``stiffness``: 1/s, how fast the camera catches up (exponential; larger is
+    tighter); ``bank``: how much of the target's roll the camera takes (0 keeps the horizon level,
+    1 rolls with it). All live."""
+    distance: float = 12.0
+    height: float = 3.0
+    look_ahead: float = 8.0
+    stiffness: float = 6.0
+    bank: float = 0.5
+
+    def __post_init__(self):
+        o = "ChaseCameraSettings"
+        self.store(dict(distance=check_num(o, "distance", self.distance, 0.0, 1e6),
+                        height=check_num(o, "height", self.height, -1e6, 1e6),
+                        look_ahead=check_num(o, "look_ahead", self.look_ahead, 0.0, 1e6),
+                        stiffness=check_num(o, "stiffness", self.stiffness, 0.0, 1e6, lo_open=True),
+                        bank=check_num(o, "bank", self.bank, 0.0, 1.0)))
+
+
+def chase_point(pose, settings: ChaseCameraSettings) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(eye, look, up) for a target at ``pose`` (a :class:`atmos.transform.Pose`): the eye
+    ``distance`` behind it along its heading and ``height`` above, looking at the point ``look_ahead``
+    in front of it, with ``bank`` of its roll."""
+    b = pose.basis()
+    p = np.asarray(pose.position, np.float64)
+    heading = np.array([math.sin(pose.yaw), 0.0, -math.cos(pose.yaw)])
+    eye = p - settings.distance * heading + np.array([0.0, settings.height, 0.0])
+    up = (1.0 - settings.bank) * np.array([0.0, 1.0, 0.0]) + settings.bank * b[:, 1]
+    return eye, p + settings.look_ahead * b[:, 2], up
+
+
+def aim(direction, up) -> tuple[float, float, float]:
+    """(yaw, pitch, roll) looking along ``direction`` with ``up`` kept up as far as it goes (level when
+    ``up`` is along ``direction`` or ``direction`` is zero: then straight ahead along −z)."""
+    if not np.linalg.norm(direction) > 1e-9:
+        return 0.0, 0.0, 0.0
+    try:
+        return angles(direction, up)
+    except ValueError:
+        return angles(direction)
+
+
+class ChaseCameraPlugin(Plugin):
+    """The camera follows the entity ``target`` (with a Transform) where the target is drawn (its pose
+    interpolated by ``clock.alpha``): the eye catches up with ``stiffness``, the aim is exact. Runs in
+    the render stage before the frame is drawn ("chase_camera"); snaps to its place on the first
+    frame and after :meth:`snap`. A target that is gone leaves the camera where it is."""
+
+    settings_class = ChaseCameraSettings
+
+    def __init__(self, settings: ChaseCameraSettings | None = None, *, target: int | None = None, **fields):
+        super().__init__(settings, **fields)
+        self.target = target
+        self._snap = True
+
+    def snap(self) -> None:
+        """Jump to the place behind the target on the next frame (after a reset)."""
+        self._snap = True
+
+    def build(self, app) -> None:
+        app.add_system(self.follow, "render", label="chase_camera", before="frame_scheduler")
+
+    def follow(self, app) -> None:
+        cam = app.get_resource(Camera)
+        if cam is None or self.target is None or not app.world.has_entity(self.target):
+            return
+        transform = app.world.try_component(self.target, Transform)
+        if transform is None:
+            return
+        eye, look, up = chase_point(transform.interpolated(app.clock.alpha), self.settings)
+        k = 1.0 if self._snap else 1.0 - math.exp(-self.settings.stiffness * app.clock.dt)
+        self._snap = False
+        cam.position = cam.position + k * (eye - cam.position)     # the eye lags, the aim does not
+        cam.yaw, cam.pitch, cam.roll = aim(look - cam.position, up)

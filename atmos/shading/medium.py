@@ -1,0 +1,96 @@
+"""The radiometric model every cloud renderer draws, in physical units.
+
+The medium (``CloudSettings``): density ``rho(x)`` from the volume ``[x, y, z]`` placed by
+:mod:`atmos.plugins.clouds.layout`, trilinear between cell centres; extinction ``sigma_t * rho``
+(``sigma_t`` in 1/m at density 1; cells need not be cubes: optical depth is measured along world
+paths, so the thesis's per-cell sigma is derived, :func:`cell_sigma`); scattering
+``albedo * sigma_t * rho``; phase function ``(1 - phase_w) HG(phase_g) + phase_w HG(phase_g2)``
+(Henyey-Greenstein lobes normalised over the sphere, 1/sr).
+
+The light: sun irradiance ``E = sun_intensity * Sun.color`` (on a plane facing the sun; the colour
+already carries its path through the atmosphere and is 0 below the horizon; the default 4 pi makes
+isotropic single scattering of a unit colour equal to the colour, the old ``sun x T`` model); sky
+radiance ``L_sky = sky_intensity * Sun.ambient`` from every direction above the horizon; the ground
+below a Lambertian ``ground_albedo`` lit by both, radiance ``ground_albedo * (E * max(sun_y, 0) / pi
++ L_sky)``. :func:`environment` gives the three; :mod:`atmos.shading.path_tracer` renders exactly
+this scene (all orders), the real-time renderers approximate it (``cloud_render/volume.glsl``):
+
+    source per unit extinction J = albedo * (E * sum_i m_i b^i p(cos; c^i g) T^(a^i)
+                                             + 1/2 (1 + s) L_sky exp(-k tau_up) + 1/2 (1 - s) L_ground exp(-k tau_down))
+
+with ``T`` the transmittance toward the sun, ``p`` the phase at the angle between the view ray and
+the sun (per pixel), octaves ``i < 4`` after Wrenninge (a: ``ms_attenuation``, b:
+``ms_contribution``, c: ``ms_eccentricity``) of which the scattered ones (``m_0 = 1``, ``m_i =
+1 - exp(-(tau_up + tau_down))``) scale with the chance that light met the column through the point
+(a thin cloud scatters little twice), and the column optical depths above and below a point dimming
+the sky and ground light (``k``: ``ms_attenuation``), which reach the eye in the shares
+``1/2 (1 ± s)``, ``s = g_mean * ray_y`` (``g_mean`` the phase's mean cosine, ``ray_y`` the view ray's
+y: looking up at a cloud base sees sky light scattered forward). The octaves are fitted to the path
+tracer (``benchmarks/bench_cloud_light.py --fit``).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+OCTAVES = 4
+
+
+def hg(cos, g):
+    """One Henyey-Greenstein lobe (1/sr)."""
+    return (1.0 - g * g) / (4.0 * math.pi * np.maximum(1.0 + g * g - 2.0 * g * np.asarray(cos), 1e-12) ** 1.5)
+
+
+def phase(cos, g: float, g2: float, w: float):
+    """The two-lobe phase function (1/sr) at the cosine of the scattering angle."""
+    return (1.0 - w) * hg(cos, g) + w * hg(cos, g2)
+
+
+def cell_sigma(sigma_t: float, cell, direction) -> float:
+    """Extinction per unit index-space length along ``direction`` (world) for cells of size ``cell``:
+    what grid-space shading (the shear-warp, stepping in cells) multiplies by."""
+    cell = np.asarray(cell, np.float64)
+    u = np.asarray(direction, np.float64) / cell
+    n = np.linalg.norm(u)
+    if not (n > 0 and np.isfinite(n)):
+        return float(sigma_t * np.cbrt(cell.prod()))
+    return float(sigma_t * np.linalg.norm(u / n * cell))
+
+
+def environment(settings, sun_color, sky, sun_dir) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(sun irradiance E, sky radiance, ground radiance) as float64 RGB for a ``CloudSettings``."""
+    e = settings.sun_intensity * np.asarray(sun_color, np.float64)
+    l_sky = settings.sky_intensity * np.asarray(sky, np.float64)
+    s = np.asarray(sun_dir, np.float64)
+    up = max(float(s[1] / np.linalg.norm(s)), 0.0)
+    return e, l_sky, settings.ground_albedo * (e * up / math.pi + l_sky)
+
+
+def octave_weights(T, tau_column, a: float, b: float) -> np.ndarray:
+    """(..., 4): ``m_i b^i T^(a^i)`` of the module docstring (``tau_column = tau_up + tau_down``)."""
+    T = np.asarray(T, np.float64)
+    m = 1.0 - np.exp(-np.asarray(tau_column, np.float64))
+    return np.stack([(1.0 if i == 0 else m) * b ** i * T ** (a ** i) for i in range(OCTAVES)], -1)
+
+
+def ambient_shares(g: float, g2: float, w: float, ray_y) -> tuple[np.ndarray, np.ndarray]:
+    """(sky, ground) shares ``1 + s``, ``1 - s`` (times the 1/2 in ``sky_source``) for view rays
+    with y component ``ray_y``: ``s = g_mean * ray_y``, ``g_mean = (1 - w) g + w g2``."""
+    s = ((1.0 - w) * g + w * g2) * np.asarray(ray_y, np.float64)
+    return 1.0 + s, 1.0 - s
+
+
+def source_reference(settings, render, T, tau_up, tau_down, cos, ray_y, sun_color, sky, sun_dir) -> np.ndarray:
+    """float64 (n, 3): J of the module docstring at points with transmittance ``T``, column optical
+    depths ``tau_up``/``tau_down``, view/sun cosine ``cos`` and view ray y ``ray_y`` (``render``:
+    the CloudRenderSettings)."""
+    e, l_sky, l_ground = environment(settings, sun_color, sky, sun_dir)
+    tau_up, tau_down = np.asarray(tau_up, np.float64), np.asarray(tau_down, np.float64)
+    a, b, c = render.ms_attenuation, render.ms_contribution, render.ms_eccentricity
+    w = octave_weights(T, tau_up + tau_down, a, b)
+    sun = sum(w[..., i] * phase(cos, settings.phase_g * c ** i, settings.phase_g2 * c ** i, settings.phase_w)
+              for i in range(OCTAVES))
+    up, down = ambient_shares(settings.phase_g, settings.phase_g2, settings.phase_w, ray_y)
+    amb = (0.5 * up * np.exp(-a * tau_up))[..., None] * l_sky + (0.5 * down * np.exp(-a * tau_down))[..., None] * l_ground
+    return settings.albedo * (sun[..., None] * e + amb)

@@ -1,0 +1,345 @@
+"""Cloud light against the path tracer: error vs time of every renderer mode, and the sprite pass's
+cost with the new lighting vs the old (HEAD's shaders), in one run.
+
+Static volumes (``CloudsPlugin(density=...)``) are drawn by the sprites (downsample 1/2, LOD on/off)
+and the ray march (several step counts) and read back with ``App.read_linear()``; the reference is
+:func:`atmos.shading.path_tracer.trace` of the same medium and light (``medium.environment``), all
+orders (``--max-order 1``: single scattering only, against the renderers with
+``ms_contribution = 0``; sky and ground light are then off too). Four views: side, from below,
+toward the sun, grazing sun. Per view and mode: image-sum bias, relative RMSE (over pixels the
+reference sees cloud in) and the frame's ms (median, ``ctx.finish`` around each frame); the tracer's
+own standard error of the image sum and of the RMSE is printed beside it. Plot:
+out/bench_cloud_light.png (rel. RMSE vs ms per view; the other volumes and --max-order 1 get
+their own suffix) and the images, the reference then every mode per view, in
+out/bench_cloud_light_images_<volume>.png. ``--fit`` grid-searches the multiple-scattering octaves. Goal at the default real-time settings
+(sprites, downsample 2, no LOD): |bias| <= 10 % and rel. RMSE <= 15 % in all four views; the
+sprite pass <= 1.3x the old cost.
+
+    .venv/bin/python benchmarks/bench_cloud_light.py [--samples 64] [--volume ellipsoid] [--max-order 1]
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import re
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from atmos import App, DefaultPlugins, create_headless
+from atmos.camera import Camera, view_basis
+from atmos.gpu import add_shader_path
+from atmos.lighting import Sun
+from atmos.plugins.cloud_render import CloudMarchPlugin, CloudRenderPlugin
+from atmos.plugins.cloud_render.light import sun_light
+from atmos.plugins.clouds import CloudSettings, CloudsPlugin
+from atmos.shading.medium import environment
+from atmos.shading.path_tracer import trace
+
+ROOT = Path(__file__).resolve().parents[1]
+OUT = ROOT / "out"
+SIZE = (96, 64)
+BASE = 500.0
+SKY = (0.3, 0.4, 0.6)
+
+
+def unit_grid(shape):
+    return np.meshgrid(*[(np.arange(k) + 0.5) / k for k in shape], indexing="ij")
+
+
+def ellipsoid():
+    """The comparison volume of issue 12: a smooth ellipsoid, cubic 20 m cells, sigma_t 0.02/m."""
+    x, y, z = unit_grid((24, 12, 24))
+    d = np.clip(1.0 - ((x - .5) ** 2 / 0.12 + (y - .5) ** 2 / 0.1 + (z - .5) ** 2 / 0.12) * 4, 0, None)
+    return d.astype(np.float32), (20.0, 20.0, 20.0), 0.02
+
+
+def cumulus():
+    """A lumpy, denser cloud with a flat base on non-cubic cells (20 x 12 x 20 m), sigma_t 0.05/m."""
+    x, y, z = unit_grid((24, 16, 24))
+    rng = np.random.default_rng(7)
+    d = np.zeros_like(x)
+    for _ in range(9):
+        c = rng.uniform([0.3, 0.25, 0.3], [0.7, 0.55, 0.7])
+        r = rng.uniform(0.12, 0.22)
+        d = np.maximum(d, 1.0 - ((x - c[0]) ** 2 + ((y - c[1]) * 1.3) ** 2 + (z - c[2]) ** 2) / r ** 2)
+    d *= np.clip((y - 0.1) / 0.1, 0.0, 1.0)             # the flat base
+    return np.clip(d, 0.0, 1.0).astype(np.float32), (20.0, 12.0, 20.0), 0.05
+
+
+VOLUMES = {"ellipsoid": ellipsoid, "cumulus": cumulus}
+MODES = {   # label: (renderer fields, march steps or None)
+    "sprites 1/2": (dict(downsample=2), None),                 # the default real-time settings
+    "sprites 1/2 LOD": (dict(downsample=2, lod_pixels=4.0), None),
+    "sprites 1/1": (dict(downsample=1), None),
+    "sprites 1/1 LOD": (dict(downsample=1, lod_pixels=4.0), None),
+    "march 32": ({}, 32), "march 64": ({}, 64), "march 128": ({}, 128), "march 256": ({}, 256),
+}
+
+
+def views(lo, hi):
+    """name: (camera position, target, sun elevation in degrees; the sun's azimuth is 90: toward +x)."""
+    c = (lo + hi) / 2
+    r = float(np.max(hi - lo))
+    return {"side": (c + [0, 0, 1.9 * r], c, 90.0), "below": (c + [0, -1.25 * r, 0.6 * r], c, 90.0),
+            "toward sun": (c + [-1.7 * r, -0.2 * r, 0], c, 20.0), "grazing": (c + [0, 0.1 * r, 1.9 * r], c, 3.0)}
+
+
+class Scene:
+    """One App drawing a static volume with both renderers, switched per mode."""
+
+    def __init__(self, gpu, volume, single: bool):
+        density, cell, sigma_t = volume
+        medium = dict(sky_intensity=0.0, ground_albedo=0.0) if single else {}
+        self.settings = CloudSettings(cell_size=cell, base_altitude=BASE, sigma_t=sigma_t, group_size=(8, 8),
+                                      smoothing_slices=1, **medium)
+        self.render_fields = dict(ms_contribution=0.0) if single else {}
+        self.renderer = CloudRenderPlugin(**self.render_fields)
+        self.march = CloudMarchPlugin(self.renderer, enabled=False)
+        self.app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(self.settings, density=density),
+                                        self.renderer, self.march)
+        self.app.startup()
+        self.density, self.cell, self.sigma_t = density, cell, sigma_t
+        self.lo = np.array([0.0, BASE, 0.0])
+        self.hi = self.lo + np.array(density.shape) * np.array(cell)
+
+    def look(self, position, target, elevation):
+        sun = Sun.from_angles(elevation, 90.0)
+        sun.ambient = SKY
+        self.app.insert_resource(sun)
+        cam = self.app.resource(Camera)
+        cam.position = np.asarray(position, float)
+        cam.look_at(np.asarray(target, float))
+        cam.near, cam.far = 1.0, 20000.0
+        return cam, sun
+
+    def mode(self, fields, steps):
+        defaults = dict(downsample=2, lod_pixels=None, **self.render_fields)
+        self.renderer.configure(enabled=steps is None, **{**defaults, **fields})
+        self.march.configure(enabled=steps is not None, **({} if steps is None else {"steps": steps}))
+
+    def frame_ms(self, frames=7) -> float:
+        ctx, times = self.app.gpu.ctx, []
+        for _ in range(frames + 1):
+            ctx.finish()
+            start = time.perf_counter()
+            self.app.render()
+            ctx.finish()
+            times.append(time.perf_counter() - start)
+        return float(np.median(times[1:]) * 1e3)
+
+    def reference(self, cam, sun, samples, max_order):
+        w, h = SIZE
+        xs = 2 * (np.arange(w) + 0.5) / w - 1
+        ys = 1 - 2 * (np.arange(h) + 0.5) / h
+        d = np.stack(np.broadcast_arrays(xs[None, :], ys[:, None], 1.0), -1).reshape(-1, 3) @ view_basis(cam, w / h).T
+        color, ambient = sun_light(sun)
+        direction = np.asarray(sun.direction, float) / np.linalg.norm(sun.direction)
+        e, sky, ground = environment(self.settings, color, ambient, direction)
+        s = self.settings
+        start = time.perf_counter()
+        r = trace(self.density, self.cell, self.lo, np.broadcast_to(cam.position, d.shape), d, sigma_t=self.sigma_t,
+                  albedo=s.albedo, g=s.phase_g, g2=s.phase_g2, w=s.phase_w, sun_dir=direction, sun_irradiance=e,
+                  sky=sky, ground=ground, samples=samples, max_order=max_order, rng=np.random.default_rng(1))
+        return r.radiance.reshape(h, w, 3), r.radiance_error.reshape(h, w, 3), time.perf_counter() - start
+
+
+def errors(image, ref):
+    """(image-sum bias, relative RMSE over the pixels with cloud in the reference)."""
+    rgb = np.asarray(image, np.float64)[..., :3]
+    mask = ref.sum(-1) > 1e-3 * ref.sum(-1).max()
+    bias = rgb.sum() / ref.sum() - 1.0
+    rmse = math.sqrt(((rgb - ref) ** 2).sum(-1)[mask].mean() / (ref ** 2).sum(-1)[mask].mean())
+    return bias, rmse
+
+
+def tracer_noise(ref, err):
+    """The reference's own standard error: of its image sum (relative) and its rel. RMSE floor."""
+    mask = ref.sum(-1) > 1e-3 * ref.sum(-1).max()
+    return (math.sqrt((err ** 2).sum()) / ref.sum(),
+            math.sqrt((err ** 2).sum(-1)[mask].mean() / (ref ** 2).sum(-1)[mask].mean()))
+
+
+# -- the old lighting: HEAD's shaders in a temporary directory on the search path ------------------
+OLD_FILES = ("sprite.vert", "sprite.frag", "volume.glsl")
+
+
+def old_program(gpu, directory: Path):
+    """HEAD's sprite program, its cloud_render includes pointed at the copies (prefix "old")."""
+    for name in OLD_FILES:
+        text = subprocess.run(["git", "show", f"HEAD:shaders/cloud_render/{name}"], cwd=ROOT, check=True,
+                              capture_output=True, text=True).stdout
+        text = re.sub(r'#include "cloud_render/', '#include "old/cloud_render/', text)
+        (directory / "cloud_render").mkdir(parents=True, exist_ok=True)
+        (directory / "cloud_render" / name).write_text(text)
+    add_shader_path(directory, prefix="old")
+    return gpu.program(vertex_shader="old/cloud_render/sprite.vert", fragment_shader="old/cloud_render/sprite.frag")
+
+
+COST_SIZE = (640, 360)
+
+
+def sprite_pass_cost(rounds=5, frames=9):
+    """Median GPU ms of the "cloud_render" pass at 640x360 (the ellipsoid filling the side view,
+    downsample 2), the new program and HEAD's alternated in one App; the old one's sun_color and
+    ambient set as HEAD's Python set them."""
+    gpu = create_headless(COST_SIZE)
+    scene = Scene(gpu, ellipsoid(), False)
+    app = scene.app
+    sprite = next(p for p in app.graph.passes if p.name == "cloud_render")
+    scene.mode({}, None)
+    pos, target, elevation = views(scene.lo, scene.hi)["side"]
+    scene.look(target + (pos - target) * 0.6, target, elevation)
+    app.render()
+    new = sprite.program
+    with tempfile.TemporaryDirectory() as tmp:
+        old = old_program(gpu, Path(tmp))
+        color, ambient = sun_light(app.resource(Sun))
+        old["sun_color"].value, old["ambient"].value = color, ambient
+        app.graph.timings_enabled = True
+        ms = {"new": [], "old": []}
+        for _ in range(rounds):
+            for label, program in (("new", new), ("old", old)):
+                sprite.program = program
+                sprite._release_buffers()           # its vertex array belongs to one program
+                for i in range(frames):
+                    app.render()
+                    gpu.ctx.finish()
+                    t = app.graph.timings.get("cloud_render")
+                    if t and i >= 3:                # results lag RING - 1 frames: skip the other's
+                        ms[label].append(t[0])
+        sprite.program = new
+        sprite._release_buffers()
+        app.graph.timings_enabled = False
+    app.close()
+    gpu.release()
+    return {k: float(np.median(v)) for k, v in ms.items()}
+
+
+FIT_GRID = ((0.15, 0.25, 0.35), (0.45, 0.55, 0.65, 0.75), (0.6, 0.7, 0.8))   # around the coarse optimum
+
+
+def fit(gpu, samples, grid=FIT_GRID):
+    """Grid search of the octaves (ms_attenuation, ms_contribution, ms_eccentricity) for the ray march
+    (exact in single scattering) against all-order references of every volume and view: the
+    (a, b, c) with the least sum of bias^2 + rel. RMSE^2, and the per-view errors there."""
+    cases = []
+    for vname, make in VOLUMES.items():
+        scene = Scene(gpu, make(), False)
+        for view, (pos, target, elevation) in views(scene.lo, scene.hi).items():
+            cam, sun = scene.look(pos, target, elevation)
+            cases.append((scene, (pos, target, elevation), scene.reference(cam, sun, samples, None)[0], vname, view))
+    results = []
+    for a in grid[0]:
+        for b in grid[1]:
+            for c in grid[2]:
+                errs = []
+                for scene, look, ref, *_ in cases:
+                    scene.look(*look)
+                    scene.renderer.configure(ms_attenuation=a, ms_contribution=b, ms_eccentricity=c, enabled=False)
+                    scene.march.configure(enabled=True, steps=64)
+                    errs.append(errors(scene.app.read_linear(), ref))
+                results.append((sum(x * x + y * y for x, y in errs), (a, b, c), errs))
+    results.sort(key=lambda r: r[0])
+    for cost, abc, errs in results[:3]:
+        print(f"a, b, c = {abc}: cost {cost:.3f}; " + ", ".join(
+            f"{v}/{w} {100 * x:+.0f}%/{100 * y:.0f}%" for (x, y), (*_, v, w) in zip(errs, cases)))
+    for scene in {id(c[0]): c[0] for c in cases}.values():
+        scene.app.close()
+    return results[0][1]
+
+
+def plot(table, path):
+    import matplotlib
+    import matplotlib.ticker
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    names = list(next(iter(table.values())).keys())
+    fig, axes = plt.subplots(1, len(names), figsize=(4 * len(names), 3.6), squeeze=False)
+    for ax, view in zip(axes[0], names):
+        for mode, per_view in table.items():
+            bias, rmse, ms = per_view[view]
+            ax.scatter(ms, 100 * rmse, label=mode, marker="o" if mode.startswith("sprites") else "s")
+        ax.axhline(15, color="grey", lw=0.8, ls="--")
+        ax.set_title(view)
+        ax.set_xlabel("frame ms (llvmpipe)")
+        ax.set_ylabel("rel. RMSE %")
+        ax.set_xscale("log")
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+    axes[0][0].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def strip(images, path):
+    """One row per view: the reference then each mode, the same exposure (PNG, tone-mapped)."""
+    from PIL import Image
+
+    from atmos.render_core import tone_map
+    rows = [np.concatenate([tone_map(im[..., :3]) for im in row], 1) for row in images]
+    Image.fromarray((np.concatenate(rows, 0) * 255).astype(np.uint8)).save(path)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--samples", type=int, default=64, help="path-tracer samples per pixel")
+    ap.add_argument("--max-order", type=int, default=None, help="1: single scattering only")
+    ap.add_argument("--volume", choices=[*VOLUMES, "all"], default="all")
+    ap.add_argument("--modes", default=",".join(MODES), help="comma-separated mode labels")
+    ap.add_argument("--size", default="96x64", help="image size WxH")
+    ap.add_argument("--fit", action="store_true", help="fit the octaves to the references and stop")
+    ap.add_argument("--no-cost", action="store_true", help="skip the old-vs-new sprite pass timing")
+    args = ap.parse_args(argv)
+    global SIZE
+    SIZE = tuple(int(v) for v in args.size.lower().split("x"))
+    gpu = create_headless(SIZE)
+    single = args.max_order == 1
+    if args.fit:
+        return fit(gpu, args.samples)
+    modes = [m.strip() for m in args.modes.split(",")]
+    OUT.mkdir(exist_ok=True)
+    summary = {}
+    for vname in (VOLUMES if args.volume == "all" else [args.volume]):
+        scene = Scene(gpu, VOLUMES[vname](), single)
+        table = {m: {} for m in modes}
+        images = []
+        print(f"\n{vname}: shape {scene.density.shape}, cells {scene.cell} m, sigma_t {scene.sigma_t}/m, "
+              f"{SIZE[0]}x{SIZE[1]} px, tracer {args.samples} spp, max_order {args.max_order}")
+        print(f"{'view':11s} {'mode':16s} {'bias':>7s} {'rel RMSE':>9s} {'frame ms':>9s} {'RMSE less tracer noise':>23s}")
+        for view, (pos, target, elevation) in views(scene.lo, scene.hi).items():
+            cam, sun = scene.look(pos, target, elevation)
+            ref, err, seconds = scene.reference(cam, sun, args.samples, args.max_order)
+            noise_sum, noise_rmse = tracer_noise(ref, err)
+            print(f"{view:11s} {'path tracer':16s} ±{100 * noise_sum:5.1f}% {100 * noise_rmse:8.1f}% "
+                  f"{1e3 * seconds:9.0f}   (its standard error; time of the whole trace)")
+            row = [ref]
+            for m in modes:
+                scene.mode(*MODES[m])
+                image = scene.app.read_linear()
+                bias, rmse = errors(image, ref)
+                ms = scene.frame_ms()
+                table[m][view] = (bias, rmse, ms)
+                row.append(image)
+                clean = math.sqrt(max(rmse ** 2 - noise_rmse ** 2, 0.0))     # independent errors add in quadrature
+                print(f"{'':11s} {m:16s} {100 * bias:+6.1f}% {100 * rmse:8.1f}% {ms:9.2f} {100 * clean:22.1f}%")
+            images.append(row)
+        tag = f"{vname}{'_single' if single else ''}"
+        strip(images, OUT / f"bench_cloud_light_images_{tag}.png")
+        plot(table, OUT / f"bench_cloud_light{'' if vname == 'ellipsoid' and not single else '_' + tag}.png")
+        summary[vname] = table
+        scene.app.close()
+    gpu.release()
+    if not args.no_cost:
+        cost = sprite_pass_cost()
+        print(f"\nsprite pass GPU ms ({COST_SIZE[0]}x{COST_SIZE[1]}, side view, downsample 2): new {cost['new']:.2f}, "
+              f"old (HEAD's shaders) {cost['old']:.2f}: {cost['new'] / cost['old']:.2f}x (goal <= 1.3x)")
+    return summary
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])

@@ -1,0 +1,79 @@
+"""StaticClouds: a given density volume drawn as clouds, no automaton or weather (``CloudsPlugin(density=...)``).
+
+The volume ``[x, y, z]`` is uploaded once into one texture set shown as both A and B (t = 0) and
+placed by :mod:`atmos.plugins.clouds.layout` at the current :class:`VolumeOrigin`; its density maps
+are computed once, its transmittance toward the sun again whenever the sun's direction or the
+medium changes (checked each frame, when the graph asks for ``"cloud_sets"``).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from atmos.frames import TextureSet
+from atmos.graph import TextureDesc
+from atmos.plugins.clouds.density_maps import DensityMaps
+from atmos.plugins.clouds.sets import CloudSets
+from atmos.shading import grid
+from atmos.shading.shear_warp import ShearWarpShader
+
+
+class StaticClouds:
+    """Answers ``sets()``, ``view()``, ``max_maps()``, ``layout()`` like a CloudSimulation."""
+
+    def __init__(self, gpu, density, settings, origin, sun):
+        volume = grid.check_density(density)
+        self.shape = tuple(volume.shape)
+        self.settings, self.origin, self.sun = settings, origin, sun
+        s = settings
+        descs = {"density": TextureDesc(self.shape, 1, "f4")}
+        if s.shading:
+            descs["transmittance"] = TextureDesc(grid.shading_shape(self.shape, s.shading_scale), 1, "f2")
+        self.set = TextureSet.create(gpu, descs, "static")
+        self.shader = self.maps = None
+        try:
+            self.set["density"].write(np.ascontiguousarray(volume.transpose(2, 1, 0)).tobytes())
+            self.maps = DensityMaps(gpu, self.shape, s.band_height, s.group_size)
+            self.maps.run(self.set["density"])
+            self._max = self.maps.read_max_maps()
+            if s.shading:
+                self.shader = ShearWarpShader(gpu, self.shape, s.shading_scale)
+        except Exception:
+            self.release()
+            raise
+        self._shaded = None
+
+    def _shade(self) -> None:
+        if self.shader is None:
+            return
+        sun = np.asarray(self.sun(), np.float64)
+        key = (tuple(sun), self.settings.sigma_t, self.settings.scattering, tuple(self.settings.cell_size))
+        if key == self._shaded:
+            return
+        self.shader.begin(self.set["density"], sun / np.asarray(self.settings.cell_size, float),
+                          self.settings.shading_sigma(sun), target=self.set["transmittance"])
+        self.shader.run_all()
+        self._shaded = key
+
+    def sets(self) -> CloudSets:
+        self._shade()
+        here = self.origin.as_tuple()
+        return CloudSets(self.set, self.set, 0.0, self.maps, self.maps, self._max, self._max, here, here, here,
+                         self.settings, self.shape)
+
+    def view(self):
+        return self.set, self.set, 0.0
+
+    def max_maps(self) -> np.ndarray:
+        return self._max
+
+    def maps_of(self, texture_set) -> DensityMaps:
+        return self.maps
+
+    def layout(self, base_altitude=None, cell_size=None, pad: float = 0.0):
+        return self.sets().layout(base_altitude, cell_size, pad)
+
+    def release(self) -> None:
+        for obj in (self.shader, self.maps, self.set):
+            if obj is not None:
+                obj.release()
+        self.shader = self.maps = self.set = None

@@ -1,0 +1,17 @@
+#version 430
+// Instanced meshes (atmos.plugins.mesh): per vertex a position and normal in model space, per instance
+// a model matrix and a colour.
+in vec3 in_position;
+in vec3 in_normal;
+in mat4 in_model;
+in vec3 in_color;
+out vec3 v_normal;
+out vec3 v_color;
+uniform mat4 view_proj;
+
+void main() {
+    vec4 world = in_model * vec4(in_position, 1.0);
+    v_normal = transpose(inverse(mat3(in_model))) * in_normal;
+    v_color = in_color;
+    gl_Position = view_proj * world;
+}

@@ -1,0 +1,137 @@
+"""Issue 12's outside-comparison API: static clouds from a given density volume, the linear HDR
+readback, and no sky light without a sky (``Sun.ambient = 0``)."""
+import numpy as np
+import pytest
+
+from atmos import App, DefaultPlugins
+from atmos.camera import Camera, view_basis
+from atmos.lighting import Sun
+from atmos.plugins.cloud_render import CloudMarchPlugin, CloudRenderPlugin
+from atmos.plugins.clouds import CloudSettings, CloudsPlugin
+from atmos.plugins.sky_gradient import SkyGradientPlugin
+from atmos.plugins.weather import VolumeOrigin
+from atmos.render_core import CapturePass, RenderCorePlugin, tone_map
+
+SHAPE = (16, 4, 16)
+CELL = (20.0, 30.0, 25.0)
+BASE = 400.0
+ORIGIN = (3.0, 0.0, -2.0)                 # in cells (x, z): the layout puts cell i at (ox + i + 0.5) * cx
+BLOCK = (slice(2, 7), slice(0, 4), slice(9, 14))
+
+
+def block_density():
+    d = np.zeros(SHAPE, np.float32)
+    d[BLOCK] = 1.0
+    return d
+
+
+def static_app(gpu, density, march=False, sun=Sun.from_angles(40.0, 70.0), **medium):
+    settings = CloudSettings(cell_size=CELL, base_altitude=BASE, group_size=(8, 8), smoothing_slices=1,
+                             sigma_t=medium.pop("sigma_t", 0.02), **medium)
+    renderer = CloudRenderPlugin(downsample=1, enabled=not march)
+    plugins = [DefaultPlugins(overlay=False), CloudsPlugin(settings, density=density), renderer]
+    if march:
+        plugins.append(CloudMarchPlugin(renderer, steps=128))
+    app = App(gpu).add_plugins(*plugins)
+    origin = app.resource(VolumeOrigin)             # the one the clouds follow: moved, not replaced
+    origin.x, origin.z = ORIGIN[0], ORIGIN[2]
+    app.insert_resource(sun)
+    app.startup()
+    return app
+
+
+def aim(app, position, target):
+    cam = app.resource(Camera)
+    cam.position = np.array(position, float)
+    cam.look_at(np.array(target, float))
+    cam.near, cam.far = 1.0, 20000.0
+    return cam
+
+
+def box_hits(cam, size, lo, hi):
+    """(h, w) bool: the pixel-centre rays that cross the world box [lo, hi] (first row at the top)."""
+    w, h = size
+    xs = 2 * (np.arange(w) + 0.5) / w - 1
+    ys = 1 - 2 * (np.arange(h) + 0.5) / h
+    ndc = np.stack(np.broadcast_arrays(xs[None, :], ys[:, None], 1.0), -1)
+    d = ndc @ view_basis(cam, w / h).T
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t0, t1 = (lo - cam.position) / d, (hi - cam.position) / d
+    near = np.minimum(t0, t1).max(-1)
+    far = np.maximum(t0, t1).min(-1)
+    return far > np.maximum(near, 0.0)
+
+
+@pytest.mark.parametrize("march", [False, True], ids=["sprites", "march"])
+def test_static_clouds_sit_where_the_documented_layout_puts_them(gpu, ctx, march):
+    app = static_app(gpu, block_density(), march=march)
+    cell = np.array(CELL)
+    lo_cells = np.array([BLOCK[0].start + ORIGIN[0], BLOCK[1].start, BLOCK[2].start + ORIGIN[2]])
+    hi_cells = np.array([BLOCK[0].stop + ORIGIN[0], BLOCK[1].stop, BLOCK[2].stop + ORIGIN[2]])
+    lo = lo_cells * cell + [0, BASE, 0]
+    hi = hi_cells * cell + [0, BASE, 0]
+    center = (lo + hi) / 2
+    for offset in ([0.0, 250.0, 700.0], [-600.0, -300.0, 200.0]):
+        cam = aim(app, center + offset, center)
+        image = app.read_linear()
+        cloud = image[..., :3].sum(-1) > 0.02 * image[..., :3].sum(-1).max()
+        hits = box_hits(cam, gpu.size, lo, hi)
+        assert hits.any() and cloud.any()
+        iou = (cloud & hits).sum() / (cloud | hits).sum()
+        # the density ramps to 0 over half a cell past the block (trilinear), sprites are round
+        assert iou > (0.55 if not march else 0.7), f"cloud pixels vs the layout's box: IoU {iou:.2f}"
+        ys, xs = np.nonzero(cloud)
+        hy, hx = np.nonzero(hits)
+        assert abs(ys.mean() - hy.mean()) < 3 and abs(xs.mean() - hx.mean()) < 3, "the cloud is off its place"
+    app.close()
+
+
+@pytest.mark.parametrize("density, what", [
+    (np.zeros((4, 4)), "shape"),
+    (np.zeros((4, 0, 4)), "shape"),
+    ("clouds", "dtype"),
+    (np.zeros((2, 2, 2), complex), "dtype"),
+    (np.full((2, 2, 2), np.nan), "finite"),
+    (np.full((2, 2, 2), 1e39), "finite"),
+    (-np.ones((2, 2, 2)), ">= 0"),
+])
+def test_bad_density_arrays_are_refused_by_the_plugin_with_what_is_allowed(density, what):
+    with pytest.raises(ValueError, match="density") as info:
+        CloudsPlugin(density=density)
+    assert what in str(info.value)
+
+
+def test_read_linear_is_the_hdr_colour_before_exposure_first_row_at_the_top(gpu, ctx):
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), SkyGradientPlugin())
+    app.startup()
+    cam = aim(app, (0.0, 10.0, 0.0), (100.0, 40.0, 0.0))     # sky above, its horizon band below
+    capture = app.graph.add_pass(CapturePass())
+    core = next(p for p in app.plugins if isinstance(p, RenderCorePlugin))
+    core.configure(exposure=3.0, dither=False)
+    linear = app.read_linear()
+    assert linear.dtype == np.float32 and linear.shape == (gpu.size[1], gpu.size[0], 4)
+    assert np.array_equal(linear, capture.color[::-1].astype(np.float32)), "the same frame as a CapturePass"
+    assert not np.allclose(linear[0], linear[-1]), "a gradient, so the row order is tested"
+    shown = gpu.read_pixels() / 255.0
+    assert np.abs(tone_map(linear[..., :3], 3.0) - shown).max() < 1.5 / 255, "exposure applies after"
+    assert np.abs(tone_map(linear[..., :3], 1.0) - shown).max() > 10 / 255
+    assert cam is app.resource(Camera)
+    app.close()
+
+
+def test_without_sky_light_the_clouds_get_none(gpu, ctx):
+    """Sun.ambient = (0, 0, 0), no sky plugin, sun under the horizon: nothing lights the clouds."""
+    density = block_density()
+    for march in (False, True):
+        images = {}
+        for ambient in ((0.0, 0.0, 0.0), (0.3, 0.4, 0.6)):
+            sun = Sun.from_angles(-8.0, 70.0)
+            sun.ambient = ambient
+            app = static_app(gpu, density, march=march, sun=sun)
+            center = (np.array([4.5 + ORIGIN[0], 2.0, 11.5 + ORIGIN[2]]) * CELL) + [0, BASE, 0]
+            aim(app, center + [0.0, -250.0, 600.0], center)
+            images[ambient] = app.read_linear()[..., :3]
+            app.close()
+        lit = images[(0.3, 0.4, 0.6)]
+        assert lit.max() > 0.05, "with sky light the clouds show"
+        assert np.abs(images[(0.0, 0.0, 0.0)]).max() == 0.0, "without it they are black"
