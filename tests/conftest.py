@@ -42,3 +42,13 @@ def fresh_gpu():
     yield context
     assert context.ctx.error == "GL_NO_ERROR"
     context.release()
+
+
+@pytest.fixture(scope="session", autouse=True)
+def out_folder():
+    """The repository's out/ folder, where tests save the pictures they render to be looked at
+    (a fresh clone has none)."""
+    from pathlib import Path
+    path = Path(__file__).resolve().parents[1] / "out"
+    path.mkdir(exist_ok=True)
+    return path
