@@ -36,7 +36,8 @@ _EXPORTS = {
     "ChaseCameraPlugin": "atmos.camera_control", "HostFramePlugin": "atmos.host_frame",
     # GPU
     "GpuContext": "atmos.gpu", "GpuError": "atmos.gpu", "ShaderError": "atmos.gpu",
-    "create_headless": "atmos.gpu", "from_current": "atmos.gpu", "add_shader_path": "atmos.gpu.shaders",
+    "create_headless": "atmos.gpu", "from_current": "atmos.gpu", "wrap_context": "atmos.gpu",
+    "add_shader_path": "atmos.gpu.shaders",
     "GLMeter": "atmos.gpu.gl_meter", "GLCensus": "atmos.gpu.census", "camera_matrices": "atmos.camera", "CameraMatrices": "atmos.camera",
     # writing frames to files
     "OutputPlugin": "atmos.output", "FrameWriter": "atmos.output", "OutputError": "atmos.output",

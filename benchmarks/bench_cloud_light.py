@@ -277,11 +277,16 @@ def plot(table, path):
 
 
 def strip(images, path):
-    """One row per view: the reference then each mode, the same exposure (PNG, tone-mapped)."""
+    """One row per view: the reference then each mode, tone-mapped with one exposure per row (the
+    99th percentile of the reference's cloud pixels at 0.8)."""
     from PIL import Image
 
     from atmos.render_core import tone_map
-    rows = [np.concatenate([tone_map(im[..., :3]) for im in row], 1) for row in images]
+    rows = []
+    for row in images:
+        lit = row[0][row[0].sum(-1) > 0]
+        exposure = 0.8 / max(float(np.percentile(lit, 99)) if len(lit) else 1.0, 1e-6)
+        rows.append(np.concatenate([tone_map(im[..., :3], exposure) for im in row], 1))
     Image.fromarray((np.concatenate(rows, 0) * 255).astype(np.uint8)).save(path)
 
 

@@ -17,6 +17,7 @@ from atmos.plugins.cloud_render.example import example_weather
 from atmos.plugins.cloud_shadows import CloudShadowsPlugin
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
 from atmos.plugins.daylight import DaylightPlugin
+from atmos.plugins.fog import FogPlugin
 from atmos.plugins.light_shafts import LightShaftsPlugin
 from atmos.plugins.sky import SkyPlugin
 from atmos.plugins.terrain import TerrainPlugin
@@ -28,9 +29,10 @@ BASE_ALTITUDE = 900.0
 
 
 def build_cloudscape(app, settings, *, hours: float, speed: float = 0.0, cloud_density: int = 140,
-                     warmup_steps: int = 30, slices_per_frame: int = 3, wind=(0.6, 0.0, 0.25)):
+                     warmup_steps: int = 30, slices_per_frame: int = 3, wind=(0.6, 0.0, 0.25), haze: bool = False):
     """Add the whole scene to ``app``; returns the CloudsPlugin (``configure(weather={"cloud_density": n})``
-    changes the cover live)."""
+    changes the cover live). ``haze``: aerial perspective, an exponential fog toward the horizon sky's
+    colour that fogs terrain and clouds by their own distance (:mod:`atmos.composition`)."""
     weather = example_weather(SHAPE, cloud_density=cloud_density, wind=wind)
     clouds = CloudSettings(cell_size=CELL, base_altitude=BASE_ALTITUDE, smoothing_slices=8, group_size=(32, 32),
                            sigma_t=0.02)
@@ -44,6 +46,8 @@ def build_cloudscape(app, settings, *, hours: float, speed: float = 0.0, cloud_d
                     CloudShadowsPlugin(),
                     CloudRenderPlugin(size_factor=4.0),
                     LightShaftsPlugin())
+    if haze:
+        app.add_plugins(FogPlugin(mode="exp", density=4e-5, sky="keep", color_from="sky", fog_color=(1.0, 1.0, 1.0)))
     app.frames.slices_per_frame = slices_per_frame
     cam = app.resource(Camera)
     cam.near, cam.far = 1.0, 20000.0

@@ -8,7 +8,7 @@ from atmos.demo_registry import DemoSettings
 from atmos.demos._cloudscape import build_cloudscape
 from atmos.lighting import Sun
 
-TITLE = "clouds forming and drifting over a landscape at sunset, ground shadows and light shafts"
+TITLE = "clouds forming and drifting over a landscape at sunset, ground shadows, light shafts and haze"
 DEFAULT_FRAMES = 240
 
 
@@ -23,6 +23,6 @@ def pan_toward_the_sun(app) -> None:
 
 
 def build(app, settings) -> None:
-    build_cloudscape(app, settings, hours=19.2, speed=0.01, cloud_density=150, warmup_steps=12)
+    build_cloudscape(app, settings, hours=19.2, speed=0.01, cloud_density=150, warmup_steps=12, haze=True)
     app.resource(Camera).position = np.array([0.0, 320.0, 0.0])
     app.add_system(pan_toward_the_sun, "update", label="pan_toward_the_sun", after="daylight")

@@ -273,7 +273,7 @@ SPECS = {
         look((0.0, 3.0, 10.0), yaw=0.0, pitch=-0.05),
         dict(mode="exp", density=0.01, fog_color=(0.9, 0.1, 0.1), start=5.0, end=30.0, sky="keep", octaves=2,
              resolutions=(2, 4, 8, 8), winds=((5.0, 0.0, 0.0),) * 4, tile_size=64.0, amplitude=0.3,
-             noise="procedural", texels_per_cell=2, seed=11, time_offset=3.0),
+             noise="procedural", texels_per_cell=2, seed=11, time_offset=3.0, color_from="sky"),
         before={"start": configure_first(mode="linear"), "end": configure_first(mode="linear")}),
     "light_shafts": Spec(
         lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(), LightShaftsPlugin()],

@@ -85,11 +85,21 @@ def create_headless(size: tuple[int, int] = (640, 360), backend: str = "egl") ->
 
 
 def from_current(size: tuple[int, int]) -> "GpuContext":
-    """Wrap the OpenGL context current in this thread (a pyglet window's); draws go to its screen."""
+    """Wrap the OpenGL context current in this thread (a pyglet or Arcade window's); draws go to its screen."""
     try:
         ctx = moderngl.create_context()
     except Exception as error:
         raise GpuError(f"no usable OpenGL in the window: {error}") from None
+    return wrap_context(ctx, size)
+
+
+def wrap_context(ctx, size: tuple[int, int]) -> "GpuContext":
+    """atmos on a moderngl context the host owns (a moderngl-window ``WindowConfig``'s ``self.ctx``):
+    frames go to its window framebuffer (GL name 0) at ``size``, the framebuffer's size in pixels;
+    after a resize call ``gpu.resize(new_size)``. ``gpu.release()`` leaves the context to the host."""
+    if not isinstance(ctx, moderngl.Context):
+        raise ValueError(f"wrap_context needs a moderngl.Context (a window's, e.g. WindowConfig.ctx), got {ctx!r}; "
+                         "for the context current in this thread use atmos.from_current(size)")
     _check_version(ctx)
     return GpuContext(ctx, size, headless=False)
 

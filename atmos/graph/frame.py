@@ -34,6 +34,10 @@ class PassContext:
         self._vaos: dict[int, tuple[object, object]] = {}
         self._fresh: set[int] = set()             # framebuffers already reset in this pass
 
+    def declares(self, name: str) -> bool:
+        """Whether the running pass declared ``name`` this frame (for a declaration made only sometimes)."""
+        return name in self._declared
+
     def resource(self, name: str):
         """The resource behind ``name`` this frame: a pooled transient texture or the resolved import
         (a texture, a framebuffer such as the screen, or any imported object)."""
@@ -117,8 +121,9 @@ class PassContext:
         if id(fbo) not in self._fresh:
             self._fresh.add(id(fbo))
             fbo.depth_mask = True
-            if fbo.color_attachments:
-                fbo.color_mask = (True, True, True, True)
+            n = len(fbo.color_attachments or ())   # a window's default framebuffer has none listed
+            if n:                            # moderngl takes one mask, or one per attachment
+                fbo.color_mask = (True, True, True, True) if n == 1 else ((True, True, True, True),) * n
             fbo.viewport = (0, 0, *fbo.size)
             fbo.scissor = None
         return fbo
@@ -138,7 +143,13 @@ class PassContext:
         self.reset_state()
 
     def _end_frame(self) -> None:
+        """The frame ends as every pass starts, with the host's framebuffer (``gpu.target``: a window's
+        screen) bound at its full size, so a host that draws next draws where it expects."""
         self.reset_state()
+        target = self.gpu.target
+        target.scissor = None
+        target.viewport = (0, 0, *target.size)
+        target.use()
         self.pass_name = ""
         self._declared = frozenset()
         self._resources = {}

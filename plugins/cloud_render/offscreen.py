@@ -13,11 +13,13 @@ import math
 
 import moderngl
 
+from atmos.composition import CLOUD_DISTANCE, distance_desc
 from atmos.graph import PassBuilder, PassContext, TextureDesc
 from atmos.render_core import COLOR, DEPTH
 
 CLOUD_COLOR = "cloud_color"
 CLOUD_DEPTH = "cloud_depth"
+CLOUD_LOW_DISTANCE = "cloud_distance_low"   # the low-res "cloud_distance" (atmos.composition)
 MAX_DOWNSAMPLE = 8
 EDGE = 0.1           # relative view-depth difference between a pixel and a low-res texel that makes an edge
 
@@ -37,12 +39,14 @@ class OffscreenClouds:
         self.composite = gpu.program(vertex_shader=fullscreen, fragment_shader="cloud_render/composite.frag")
 
     @staticmethod
-    def declare(builder: PassBuilder, size, factor: int) -> None:
+    def declare(builder: PassBuilder, size, factor: int, distance: bool = False) -> None:
         low = low_size(size, factor)
         builder.create(CLOUD_COLOR, TextureDesc(low, components=4, dtype="f2", filter="nearest"))
         builder.create(CLOUD_DEPTH, TextureDesc(low, depth=True, filter="nearest"))
+        if distance:
+            builder.create(CLOUD_LOW_DISTANCE, distance_desc(low))
 
-    def begin(self, frame: PassContext, factor: int):
+    def begin(self, frame: PassContext, factor: int, distance: bool = False):
         """Write the low-res depth, clear the low-res colour; returns the framebuffer to draw sprites into."""
         ctx = frame.gpu.ctx
         frame.framebuffer(depth=CLOUD_DEPTH).use()
@@ -51,17 +55,20 @@ class OffscreenClouds:
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "1"                # always: the shader writes the block's farthest depth
         frame.fullscreen(self.far_depth)
-        fbo = frame.framebuffer(color=[CLOUD_COLOR], depth=CLOUD_DEPTH)
+        fbo = frame.framebuffer(color=[CLOUD_COLOR, CLOUD_LOW_DISTANCE] if distance else [CLOUD_COLOR],
+                                depth=CLOUD_DEPTH)
         fbo.depth_mask = False              # clear the colour only: the sprites test the depth just written
         fbo.clear(0.0, 0.0, 0.0, 0.0)
         fbo.use()                           # clear() re-binds the framebuffer bound before it
         return fbo
 
-    def end(self, frame: PassContext, factor: int, near: float, far: float) -> None:
-        """Blend the low-res clouds onto "color" (premultiplied, :meth:`PassContext.blend_over`)."""
+    def end(self, frame: PassContext, factor: int, near: float, far: float, distance: bool = False) -> None:
+        """Blend the low-res clouds onto "color" (premultiplied, :meth:`PassContext.blend_over`), and
+        their distance onto the cleared "cloud_distance" with the same weights when ``distance``."""
         frame.reset_state()                 # the sprites' depth test and point size are done
-        frame.framebuffer(color=[COLOR]).use()
-        for unit, name in enumerate((CLOUD_COLOR, CLOUD_DEPTH, DEPTH)):
+        frame.framebuffer(color=[COLOR, CLOUD_DISTANCE] if distance else [COLOR]).use()
+        names = (CLOUD_COLOR, CLOUD_DEPTH, DEPTH) + ((CLOUD_LOW_DISTANCE,) if distance else ())
+        for unit, name in enumerate(names):
             frame.resource(name).use(unit)
         p = self.composite
         p["factor"].value = factor

@@ -29,6 +29,7 @@ import numpy as np
 
 from atmos.camera import Camera, camera_matrices
 from atmos.checks import CheckedSettings, check_bool, check_int, check_num
+from atmos.composition import CLOUD_DISTANCE, composition, distance_desc
 from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.plugin import Plugin
 from atmos.plugins.cloud_render.binding import bind_volume, clamp_sampler, unbind_volume
@@ -113,7 +114,14 @@ class CloudRenderPlugin(Plugin):
         if app.graph is None:
             raise ValueError("CloudRenderPlugin needs an App with a GPU context (App(gpu))")
         self.gpu = app.gpu
+        self.composition = composition(app)
+        self.composition.writers.add("cloud_render")     # the sprites give the fog their own distance
         app.graph.add_pass(CloudSpritePass(self))
+
+    def cleanup(self, app) -> None:
+        comp = getattr(self, "composition", None)
+        if comp is not None:
+            comp.writers.discard("cloud_render")
 
     # -- shared with the reference ray marcher --------------------------------------------------
     def layout(self, sim: CloudSets) -> CloudLayout:
@@ -171,8 +179,11 @@ class CloudSpritePass(RenderPass):
         builder.read(COLOR)                 # blends onto it
         builder.write(COLOR)
         downsample = self.plugin.settings.downsample
+        distance = self.plugin.composition.distance
+        if distance:                        # a media pass reads it (atmos.composition)
+            builder.create(CLOUD_DISTANCE, distance_desc(self.plugin.gpu.size))
         if downsample > 1:
-            OffscreenClouds.declare(builder, self.plugin.gpu.size, downsample)
+            OffscreenClouds.declare(builder, self.plugin.gpu.size, downsample, distance)
 
     def prepare(self, gpu) -> None:
         self.program = gpu.program(vertex_shader="cloud_render/sprite.vert", fragment_shader="cloud_render/sprite.frag")
@@ -214,6 +225,9 @@ class CloudSpritePass(RenderPass):
     def execute(self, frame: PassContext) -> None:
         plugin = self.plugin
         settings = plugin.settings
+        distance = frame.declares(CLOUD_DISTANCE)
+        if distance:                        # created here: 0 = no cloud, even when nothing is drawn
+            frame.framebuffer(color=[CLOUD_DISTANCE]).clear(0.0, 0.0, 0.0, 0.0)
         if not settings.enabled:
             return
         view, gpu = frame.view, frame.gpu
@@ -238,10 +252,10 @@ class CloudSpritePass(RenderPass):
             self.instances.write(segments.tobytes())
             self._uploaded = segments
         if factor == 1:
-            fbo = frame.framebuffer(color=[COLOR], depth=DEPTH)
+            fbo = frame.framebuffer(color=[COLOR, CLOUD_DISTANCE] if distance else [COLOR], depth=DEPTH)
             fbo.use()
         else:
-            fbo = self.offscreen.begin(frame, factor)
+            fbo = self.offscreen.begin(frame, factor, distance)
         p["view_proj"].write(matrices.gl("view_proj"))
         for name, value in uniforms.items():
             if name in p:              # a compiler may drop a uniform a variant does not use
@@ -257,7 +271,7 @@ class CloudSpritePass(RenderPass):
         finally:
             unbind_volume(self.sampler)
         if factor > 1:
-            self.offscreen.end(frame, factor, camera.near, camera.far)
+            self.offscreen.end(frame, factor, camera.near, camera.far, distance)
 
     def _release_buffers(self) -> None:
         for obj in (self.vao, self.instances, self.commands):

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from atmos.checks import check_vec
+from atmos.composition import composition
 from atmos.gpu.context import release_gl, require_gpu
 from atmos.plugin import Plugin
 from atmos.plugins.fog.noise import NoiseVolumes
@@ -28,19 +30,34 @@ class FogPlugin(Plugin):
     def __init__(self, settings: FogSettings | None = None, **fields):
         super().__init__(settings, **fields)
         self.fog_pass: FogPass | None = None
+        self.composition = None
+        self._sky = None
 
     def build(self, app) -> None:
+        self.composition = composition(app)
+        self.composition.readers.add("fog")       # clouds fogged by their own distance
         self.fog_pass = FogPass(self)
         app.graph.add_pass(self.fog_pass)
 
+    def finish(self, app) -> None:
+        from atmos.plugins.sky import SkyPlugin
+        self._sky = next((p for p in app.plugins if isinstance(p, SkyPlugin)), None)
+
+    def sky_settings(self):
+        """The App's SkyPlugin's settings (``color_from="sky"``), None without one."""
+        return None if self._sky is None else self._sky.settings
+
     def cleanup(self, app) -> None:
+        if self.composition is not None:
+            self.composition.readers.discard("fog")
         if self.fog_pass is not None:
             self.fog_pass.release()
 
 
 def apply_fog(gpu, color, distance, mode: str = "exp2", density: float = 0.044, fog_color=(0.8, 0.8, 0.8),
               start: float = 0.0, end: float = 100.0, *, positions=None, time: float = 0.0,
-              far: float = np.inf, **noise) -> np.ndarray:
+              far: float = np.inf, cloud=None, directions=None, camera=(0.0, 0.0, 0.0), horizon=None,
+              color_from: str = "fixed", **noise) -> np.ndarray:
     """Fog ``color`` (float32 (H, W, 3)) at ``distance`` (float32 (H, W), +inf = sky) on the GPU with
     the pass's shader; returns float32 (H, W, 3).
 
@@ -48,22 +65,29 @@ def apply_fog(gpu, color, distance, mode: str = "exp2", density: float = 0.044, 
     settings of :class:`FogSettings` (``octaves``, ``resolutions``, ``winds``, ``tile_size``,
     ``amplitude``, ``noise``, ``texels_per_cell``, ``seed``) as keywords, plus ``time`` (s);
     ``sky="keep"`` leaves sky pixels alone, else they are fogged at distance ``far``.
+    ``cloud`` (H, W, 2): a layer's premultiplied (coverage × distance, coverage) as in
+    :mod:`atmos.composition`, fogged by its own distance at ``camera + directions × distance``;
+    ``directions`` (H, W, 3) unit view rays (needed with ``cloud`` or ``color_from="sky"``);
+    ``horizon`` the (SAMPLES, 3) sky colours of ``color_from="sky"`` (:mod:`.sky_color`).
     ``gpu`` is a GpuContext (the program comes from its cache).
     """
     allowed = [f for f in FogSettings.__dataclass_fields__
-               if f not in ("mode", "density", "fog_color", "start", "end", "time_offset")]
+               if f not in ("mode", "density", "fog_color", "start", "end", "time_offset", "color_from")]
     unknown = set(noise) - set(allowed)
     if unknown:
         raise ValueError(f"apply_fog got unknown keyword(s) {', '.join(sorted(unknown))}; allowed: "
                          f"{', '.join(allowed)}, positions, time, far")
-    settings = FogSettings(mode=mode, density=density, fog_color=fog_color, start=start, end=end, **noise)
+    settings = FogSettings(mode=mode, density=density, fog_color=fog_color, start=start, end=end,
+                           color_from=color_from, **noise)
     color, distance, positions = _check_inputs(color, distance, positions, settings)
+    cloud, directions, horizon = _check_layers(distance.shape, cloud, directions, horizon, settings)
+    camera = check_vec("apply_fog", "camera", camera, 3)
     far = float(far)
     if np.isnan(far) or far < 0:
         raise ValueError(f"far must be >= 0 or +inf, got {far!r}")
     h, w = distance.shape
     gl = require_gpu(gpu).ctx
-    prog = fog_program(gpu, settings, from_depth=False)
+    prog = fog_program(gpu, settings, from_depth=False, clouds=cloud is not None)
     made, volumes = [], None
     try:
         target = gl.texture((w, h), 4, np.dstack([color, np.ones((h, w), np.float32)]).tobytes(), dtype="f4")
@@ -72,7 +96,12 @@ def apply_fog(gpu, color, distance, mode: str = "exp2", density: float = 0.044, 
         made.append(dist_tex)
         pos_tex = gl.texture((w, h), 3, positions.tobytes(), dtype="f4")
         made.append(pos_tex)
-        for tex in (dist_tex, pos_tex):
+        dir_tex = gl.texture((w, h), 3, directions.tobytes(), dtype="f4")
+        made.append(dir_tex)
+        cloud_tex = gl.texture((w, h), 2, (cloud if cloud is not None else np.zeros((h, w, 2), np.float32)).tobytes(),
+                               dtype="f4")
+        made.append(cloud_tex)
+        for tex in (dist_tex, pos_tex, dir_tex, cloud_tex):
             tex.filter = (gl.NEAREST, gl.NEAREST)
         fbo = gl.framebuffer([target])
         made.append(fbo)
@@ -83,8 +112,12 @@ def apply_fog(gpu, color, distance, mode: str = "exp2", density: float = 0.044, 
             volumes.use(3)
         dist_tex.use(0)
         pos_tex.use(1)
-        set_fog_uniforms(prog, settings, time)
+        cloud_tex.use(2)
+        dir_tex.use(7)
+        set_fog_uniforms(prog, settings, time, horizon)
         prog["fog_far"].value = far
+        if "fog_camera" in prog:
+            prog["fog_camera"].value = tuple(float(v) for v in camera)
         fbo.use()
         gl.viewport = (0, 0, w, h)
         draw_state(gl)
@@ -97,6 +130,38 @@ def apply_fog(gpu, color, distance, mode: str = "exp2", density: float = 0.044, 
             volumes.release()
         for obj in reversed(made):
             release_gl(obj)
+
+
+def _check_layers(shape, cloud, directions, horizon, settings):
+    """apply_fog's cloud layer, view directions and horizon table, checked and made contiguous."""
+    from atmos.plugins.fog.sky_color import SAMPLES
+
+    h, w = shape
+    needs_dirs = cloud is not None or settings.color_from == "sky"
+    if cloud is not None:
+        cloud = np.asarray(cloud)
+        if cloud.shape != (h, w, 2) or not np.isfinite(cloud).all():
+            raise ValueError(f"cloud must be finite float32 (H, W, 2) = ({h}, {w}, 2) of (coverage × distance, "
+                             f"coverage), got shape {cloud.shape}")
+        if (cloud < 0).any() or (cloud[..., 1] > 1).any():
+            raise ValueError("cloud must hold coverage in [0, 1] and coverage × distance >= 0")
+        cloud = np.ascontiguousarray(cloud, np.float32)
+    if needs_dirs:
+        if directions is None:
+            raise ValueError("directions=(H, W, 3) unit view rays are needed with cloud= or color_from='sky'")
+        directions = np.asarray(directions)
+        if directions.shape != (h, w, 3) or not np.isfinite(directions).all():
+            raise ValueError(f"directions must be finite float32 (H, W, 3) = ({h}, {w}, 3), got shape "
+                             f"{directions.shape}")
+        directions = np.ascontiguousarray(directions, np.float32)
+    else:
+        directions = np.zeros((h, w, 3), np.float32)
+    if settings.color_from == "sky":
+        horizon = np.asarray(horizon if horizon is not None else (), np.float64)
+        if horizon.shape != (SAMPLES, 3) or not np.isfinite(horizon).all() or (horizon < 0).any():
+            raise ValueError(f"horizon must be ({SAMPLES}, 3) non-negative sky colours for color_from='sky' "
+                             f"(atmos.plugins.fog.sky_color.horizon_colors), got shape {horizon.shape}")
+    return cloud, directions, horizon
 
 
 def _check_inputs(color, distance, positions, settings):

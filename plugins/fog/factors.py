@@ -36,21 +36,32 @@ def blend(color, fog_color, f) -> np.ndarray:
 
 
 def apply_fog_ref(color, distance, settings, positions=None, time: float = 0.0, far: float = np.inf,
-                  volumes=None) -> np.ndarray:
+                  volumes=None, cloud=None, directions=None, camera=(0.0, 0.0, 0.0), horizon=None) -> np.ndarray:
     """float64 reference of :func:`atmos.plugins.fog.apply_fog` (``settings`` validated FogSettings).
 
     Sky pixels (distance +inf) use ``far`` or stay as they are when ``settings.sky == "keep"``.
-    ``volumes`` as in :func:`atmos.plugins.fog.noise.turbulence_ref` (None: procedural).
+    ``volumes`` as in :func:`atmos.plugins.fog.noise.turbulence_ref` (None: procedural). ``cloud``
+    (H, W, 2) premultiplied (a·d, a) (:mod:`atmos.composition`): f = a f(d) + (1 − a) f(behind), the
+    cloud's noise at ``camera + directions × d``; ``horizon``: ``color_from="sky"``'s table.
     """
     from atmos.plugins.fog.noise import turbulence_ref
+    from atmos.plugins.fog.sky_color import sky_fog_color
+
+    def factor(d, where):
+        turbulence = turbulence_ref(where, time, settings, volumes) if settings.heterogeneous else 1.0
+        return fog_factor(settings.mode, d, settings.density, settings.start, settings.end, turbulence)
 
     d = np.asarray(distance, np.float64)
     sky = np.isinf(d)
     d = np.where(sky, far, d)
-    turbulence = 1.0
-    if settings.heterogeneous:
-        turbulence = turbulence_ref(positions, time, settings, volumes)
-    f = fog_factor(settings.mode, d, settings.density, settings.start, settings.end, turbulence)
+    f = factor(d, positions)
     if settings.sky == "keep":
         f = np.where(sky, 1.0, f)
-    return blend(color, settings.fog_color, f)
+    if cloud is not None:
+        cloud = np.asarray(cloud, np.float64)
+        a = np.clip(cloud[..., 1], 0.0, 1.0)
+        dc = np.maximum(cloud[..., 0] / np.where(a > 0, cloud[..., 1], 1.0), 0.0)
+        where = np.asarray(camera, np.float64) + np.asarray(directions, np.float64) * dc[..., None]
+        f = np.where(a > 0, a * factor(dc, where) + (1.0 - a) * f, f)
+    fog = settings.fog_color if settings.color_from == "fixed" else sky_fog_color(directions, horizon, settings.fog_color)
+    return blend(color, fog, f)

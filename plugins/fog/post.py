@@ -3,21 +3,27 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from atmos.camera import set_camera_uniforms
+from atmos.composition import CLOUD_DISTANCE
 from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.plugins.fog.noise import NoiseVolumes, octave_key
 from atmos.plugins.fog.settings import MODES
+from atmos.plugins.fog.sky_color import SAMPLES, horizon_colors
 from atmos.render_core import COLOR, DEPTH
 
 FRAGMENT = "fog/fog.frag"
 VERTEX = "lib/fullscreen.vert"
 
 
-def fog_program(gpu, settings, from_depth: bool):
-    """The fog program for ``settings`` from ``gpu``'s cache (one variant per mode, octave count and
-    noise kind)."""
+def fog_program(gpu, settings, from_depth: bool, clouds: bool = False):
+    """The fog program for ``settings`` from ``gpu``'s cache (one variant per mode, octave count,
+    noise kind, colour source and whether clouds give their own distance)."""
     defines = {"FOG_MODE": MODES[settings.mode], "FOG_OCTAVES": settings.octaves,
-               "FOG_PROCEDURAL": int(settings.noise == "procedural"), "FOG_FROM_DEPTH": int(from_depth)}
+               "FOG_PROCEDURAL": int(settings.noise == "procedural"), "FOG_FROM_DEPTH": int(from_depth),
+               "FOG_CLOUDS": int(clouds), "FOG_SKY_COLOR": int(settings.color_from == "sky"),
+               "FOG_HORIZON_SAMPLES": SAMPLES}
     return gpu.program(defines, vertex_shader=VERTEX, fragment_shader=FRAGMENT)
 
 
@@ -31,8 +37,11 @@ def _set(prog, name, values) -> None:
     uniform.value = values
 
 
-def set_fog_uniforms(prog, settings, time: float) -> None:
-    """The factor's uniforms (fog/factor.glsl) and the fog colour and sky handling (fog/fog.frag)."""
+def set_fog_uniforms(prog, settings, time: float, horizon=None) -> None:
+    """The factor's uniforms (fog/factor.glsl) and the fog colour and sky handling (fog/fog.frag);
+    ``horizon``: the (SAMPLES, 3) sky colours of ``color_from="sky"`` (:mod:`.sky_color`)."""
+    if horizon is not None and "fog_horizon" in prog:
+        prog["fog_horizon"].write(np.asarray(horizon, np.float32).tobytes())
     _set(prog, "fog_density", settings.density)
     _set(prog, "fog_start", settings.start)
     _set(prog, "fog_end", settings.end)
@@ -80,14 +89,16 @@ class FogPass(RenderPass):
         builder.read(DEPTH)
         builder.read(COLOR)                 # blends onto it
         builder.write(COLOR)
+        if self.plugin.composition.distance:   # the clouds' own distance (atmos.composition)
+            builder.read(CLOUD_DISTANCE)
 
     def prepare(self, gpu) -> None:
         self.gpu = gpu
         self._sync(self.plugin.settings)
 
-    def _sync(self, settings):
+    def _sync(self, settings, clouds: bool = False):
         """Compile the variant and (re)make noise volumes when the settings need other ones."""
-        prog = fog_program(self.gpu, settings, from_depth=True)
+        prog = fog_program(self.gpu, settings, from_depth=True, clouds=clouds)
         wants = settings.heterogeneous and settings.noise == "texture"
         if self.volumes is not None and (not wants or not self.volumes.matches(settings)):
             self.volumes.release()
@@ -99,14 +110,18 @@ class FogPass(RenderPass):
     def execute(self, frame: PassContext) -> None:
         view, gpu = frame.view, frame.gpu
         settings = self.plugin.settings
-        prog = self._sync(settings)
+        clouds = frame.declares(CLOUD_DISTANCE)
+        prog = self._sync(settings, clouds)
         frame.framebuffer(color=[COLOR]).use()
         frame.blend_transmittance()
         frame.resource(DEPTH).use(0)
+        if clouds:
+            frame.resource(CLOUD_DISTANCE).use(2)
         if self.volumes is not None:
             self.volumes.use(3)
         set_camera_uniforms(prog, view.camera, view.aspect)
-        set_fog_uniforms(prog, settings, view.time + settings.time_offset)
+        horizon = horizon_colors(view.sun, self.plugin.sky_settings()) if settings.color_from == "sky" else None
+        set_fog_uniforms(prog, settings, view.time + settings.time_offset, horizon)
         frame.fullscreen(prog)
 
     def release(self) -> None:

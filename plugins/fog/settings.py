@@ -11,6 +11,7 @@ ALIASES = {"exponential": "exp", "exp_squared": "exp2", "squared_exponential": "
            "heterogeneous_exp": "hetero_exp", "heterogeneous_exp2": "hetero_exp2"}
 NOISES = ("texture", "procedural")
 SKIES = ("fog", "keep")
+COLOR_SOURCES = ("fixed", "sky")
 MAX_TEXELS = 256          # largest noise volume edge (resolution * texels_per_cell)
 PAPER_RESOLUTIONS = {"fine": (16, 32, 64, 128), "coarse": (8, 16, 32, 64)}
 DEFAULT_WINDS = ((1.5, 0.0, 0.5), (-1.0, 0.1, 1.2), (0.8, -0.05, -1.6), (-2.0, 0.0, -0.7))
@@ -29,7 +30,10 @@ class FogSettings(CheckedSettings):
     angles; ``noise`` is ``texture`` (GPU-made tileable 3D textures of resolution * texels_per_cell
     texels, trilinear) or ``procedural`` (the same noise evaluated per pixel); ``amplitude`` in [0, 1]
     is the grey-scale range of an octave; ``seed`` picks the lattice gradients. ``time_offset``
-    (seconds) shifts the noise animation clock. Every field is live: ``FogPlugin.configure`` changes
+    (seconds) shifts the noise animation clock. ``color_from``: ``fixed`` fogs toward ``fog_color``;
+    ``sky`` toward ``fog_color`` ⊙ the sky's horizon radiance in the pixel's azimuth (aerial
+    perspective, :mod:`atmos.plugins.fog.sky_color`; give ``fog_color=(1, 1, 1)`` for the sky's own
+    colour). Clouds that give their own distance (:mod:`atmos.composition`) are fogged by it. Every field is live: ``FogPlugin.configure`` changes
     it on the next frame (the pass fetches the program variant and noise volumes it needs).
     """
 
@@ -48,6 +52,7 @@ class FogSettings(CheckedSettings):
     texels_per_cell: int = 1
     seed: int = 0
     time_offset: float = 0.0
+    color_from: str = "fixed"
 
     @property
     def heterogeneous(self) -> bool:
@@ -97,4 +102,5 @@ class FogSettings(CheckedSettings):
             amplitude=check_num(o, "amplitude", self.amplitude, 0.0, 1.0),
             seed=check_int(o, "seed", self.seed, 0, 2**32 - 1),
             time_offset=check_num(o, "time_offset", self.time_offset),
+            color_from=check_choice(o, "color_from", self.color_from, COLOR_SOURCES),
         ))

@@ -13,10 +13,12 @@ flat in float v_radius;
 flat in float v_tau;
 flat in float v_coverage;
 out vec4 frag;
+layout(location = 1) out vec4 frag_distance;   // (a·distance, a): "cloud_distance" when attached (atmos/composition.py)
 
 void main() {
     float a = (1.0 - exp(-v_tau * texture(particle, gl_PointCoord).r)) * v_coverage;
     vec2 q = (gl_PointCoord - 0.5) * vec2(2.0, -2.0) * v_radius;
     vec3 ray = normalize(v_center + q.x * camera_right + q.y * camera_up - camera_pos);
     frag = vec4((sun_part(v_octaves, dot(ray, sun_dir)) + v_ambient) * a, a);
+    frag_distance = vec4(a * length(v_center - camera_pos), a, 0.0, a);   // blends by its own alpha
 }

@@ -3,11 +3,27 @@
 // rgb = (1 - f) * fog_color, a = f, so the target becomes f * C_current + (1 - f) * C_fog, eq. (1).
 // FOG_FROM_DEPTH 1: distance and position from the scene depth and the camera (lib/view_ray.glsl);
 // 0 (apply_fog): from a distance texture (+inf = sky) and a world-position texture.
+// FOG_CLOUDS 1: "cloud_distance" (premultiplied (a·d, a), atmos/composition.py) fogs the clouds by
+// their own distance: f = a f(d_cloud) + (1 - a) f(d_behind). FOG_SKY_COLOR 1: the fog colour is
+// fog_color × the sky's horizon radiance in the ray's azimuth (plugins/fog/sky_color.py).
 in vec2 v_uv;
 out vec4 frag;
 #include "fog/factor.glsl"
 uniform vec3 fog_color;
 uniform int fog_sky_keep;    // 1: sky pixels are left to the sky
+#if FOG_CLOUDS
+layout(binding = 2) uniform sampler2D cloud_distance;
+#endif
+#if FOG_SKY_COLOR
+uniform vec3 fog_horizon[FOG_HORIZON_SAMPLES];   // sky radiance at azimuths 2π i / n (atan2(x, -z))
+vec3 in_color(vec3 dir) {
+    float u = fract(atan(dir.x, -dir.z) / 6.28318530718) * float(FOG_HORIZON_SAMPLES);
+    int i0 = int(floor(u)) % FOG_HORIZON_SAMPLES;
+    return fog_color * mix(fog_horizon[i0], fog_horizon[(i0 + 1) % FOG_HORIZON_SAMPLES], u - floor(u));
+}
+#else
+vec3 in_color(vec3 dir) { return fog_color; }
+#endif
 #if FOG_FROM_DEPTH
 #include "lib/view_ray.glsl"
 layout(binding = 0) uniform sampler2D scene_depth;
@@ -19,6 +35,8 @@ uniform float far;
 layout(binding = 0) uniform sampler2D fog_distance;
 layout(binding = 1) uniform sampler2D fog_position;
 uniform float fog_far;       // distance sky pixels are fogged at (may be +inf)
+layout(binding = 7) uniform sampler2D fog_direction;   // unit view directions (clouds, sky colour)
+uniform vec3 fog_camera;     // the cloud's world point is fog_camera + direction × its distance
 #endif
 
 void main() {
@@ -29,17 +47,25 @@ void main() {
     float view_z = sky ? far : view_depth(z, near, far);
     vec3 world = camera_pos + ray * view_z;   // sky: the far-plane point of this pixel
     float d = view_z * length(ray);
+    vec3 dir = normalize(ray);
+    vec3 eye = camera_pos;
 #else
     ivec2 px = ivec2(gl_FragCoord.xy);
     float d = texelFetch(fog_distance, px, 0).r;
     vec3 world = texelFetch(fog_position, px, 0).xyz;
     bool sky = d > 3.0e38;
     if (sky) d = fog_far;
+    vec3 dir = texelFetch(fog_direction, px, 0).xyz;
+    vec3 eye = fog_camera;
 #endif
-    if (sky && fog_sky_keep != 0) {
-        frag = vec4(0.0, 0.0, 0.0, 1.0);
-        return;
+    float f = sky && fog_sky_keep != 0 ? 1.0 : fog_factor(d, world);
+#if FOG_CLOUDS
+    vec2 cloud = texelFetch(cloud_distance, ivec2(gl_FragCoord.xy), 0).rg;
+    float a = clamp(cloud.y, 0.0, 1.0);
+    if (a > 0.0) {
+        float dc = max(cloud.x / cloud.y, 0.0);
+        f = a * fog_factor(dc, eye + dir * dc) + (1.0 - a) * f;
     }
-    float f = fog_factor(d, world);
-    frag = vec4(fog_color * (1.0 - f), f);
+#endif
+    frag = vec4(in_color(dir) * (1.0 - f), f);
 }

@@ -1,0 +1,49 @@
+"""How translucent layers give the media passes a distance of their own.
+
+Clouds write no scene depth (they are not opaque), so a media pass (fog) would attenuate a cloud
+by whatever lies behind it. A translucent layer that knows its distance draws it premultiplied
+into ``"cloud_distance"`` (RG float32, full frame, blended like its colour: ONE,
+ONE_MINUS_SRC_ALPHA over a target cleared to 0): ``r = Σ aᵢ dᵢ Πⱼ₍in front₎ (1 − aⱼ)`` and
+``g = 1 − Π (1 − aᵢ)``, so ``r / g`` is the transmittance-weighted distance (m, from the camera)
+and ``g`` the layer's coverage. A media pass then fogs a pixel by ``g · f(r / g) + (1 − g) · f(d)``
+(``d`` from the depth buffer): exact where the layer is opaque or absent.
+
+A pass cannot declare an optional read, so the plugins meet in the App resource
+:class:`Composition`: a layer that can write the distance adds its name to ``writers`` in
+``build``, a media pass that wants it adds itself to ``readers``. The layer's pass creates
+``"cloud_distance"`` only if there is a reader, the reader reads it only if there is a writer:
+a scene without fog allocates no distance target, a fog without clouds reads none.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from atmos.graph import TextureDesc
+
+CLOUD_DISTANCE = "cloud_distance"
+
+
+def distance_desc(size) -> TextureDesc:
+    """The distance target at ``size`` (width, height): RG float32 (premultiplied distance, coverage)."""
+    return TextureDesc(tuple(size), components=2, dtype="f4", filter="nearest")
+
+
+@dataclass
+class Composition:
+    """App resource: which plugins write ``"cloud_distance"`` and which read it (names)."""
+    writers: set = field(default_factory=set)
+    readers: set = field(default_factory=set)
+
+    @property
+    def distance(self) -> bool:
+        """True when the distance is both written and read: the writer creates it, the readers read it."""
+        return bool(self.writers) and bool(self.readers)
+
+
+def composition(app) -> Composition:
+    """The App's :class:`Composition` (made on first use)."""
+    comp = app.get_resource(Composition)
+    if comp is None:
+        comp = Composition()
+        app.insert_resource(comp)
+    return comp

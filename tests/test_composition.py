@@ -1,0 +1,162 @@
+"""Issue 12, composition: clouds give the fog a distance of their own (atmos.composition), the fog
+colour can follow the sky (aerial perspective), and a scene without fog allocates no distance target."""
+import numpy as np
+import pytest
+
+from atmos import App, DefaultPlugins
+from atmos.camera import Camera, view_basis
+from atmos.composition import CLOUD_DISTANCE, Composition
+from atmos.graph import RenderPass
+from atmos.lighting import Sun
+from atmos.plugins.cloud_render import CloudRenderPlugin
+from atmos.plugins.clouds import CloudSettings, CloudsPlugin
+from atmos.plugins.fog import FogPlugin, FogSettings, apply_fog
+from atmos.plugins.fog.factors import apply_fog_ref
+from atmos.plugins.fog.sky_color import SAMPLES, horizon_colors, sky_fog_color
+from atmos.plugins.sky import SkySettings
+from atmos.plugins.weather import VolumeOrigin
+
+SHAPE = (16, 4, 16)
+CELL = (40.0, 40.0, 40.0)
+BASE = 600.0
+
+
+def unit(v):
+    v = np.asarray(v, np.float64)
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+
+def layers(rng, h=12, w=20):
+    color = rng.uniform(0.0, 1.5, (h, w, 3)).astype(np.float32)
+    distance = rng.uniform(0.0, 3000.0, (h, w)).astype(np.float32)
+    distance[::3, ::4] = np.inf                                     # sky
+    a = rng.uniform(0.0, 1.0, (h, w))
+    a[1::4] = 0.0                                                   # no cloud
+    a[2::5] = 1.0                                                   # opaque cloud
+    dc = rng.uniform(50.0, 2500.0, (h, w))
+    cloud = np.stack([a * dc, a], -1).astype(np.float32)
+    dirs = unit(rng.normal(size=(h, w, 3))).astype(np.float32)
+    positions = (dirs * np.where(np.isinf(distance), 1e4, distance)[..., None]).astype(np.float32)
+    return color, distance, cloud, dirs, positions
+
+
+@pytest.mark.parametrize("mode, sky, color_from, extra", [
+    ("exp2", "keep", "fixed", {}),
+    ("exp", "fog", "sky", {}),
+    ("hetero_exp", "keep", "sky", dict(noise="procedural", tile_size=300.0)),
+])
+def test_apply_fog_fogs_a_cloud_layer_by_its_own_distance_like_the_float64_reference(gpu, ctx, rng, mode, sky,
+                                                                                    color_from, extra):
+    color, distance, cloud, dirs, positions = layers(rng)
+    settings = FogSettings(mode=mode, density=6e-4, sky=sky, fog_color=(1.0, 0.9, 0.8), color_from=color_from,
+                           **extra)
+    horizon = horizon_colors(Sun.from_angles(5.0, 30.0), SkySettings()) if color_from == "sky" else None
+    got = apply_fog(gpu, color, distance, mode, 6e-4, (1.0, 0.9, 0.8), sky=sky, far=8000.0, cloud=cloud,
+                    directions=dirs, positions=positions, horizon=horizon, color_from=color_from, **extra)
+    want = apply_fog_ref(color, distance, settings, positions=positions, far=8000.0, cloud=cloud, directions=dirs,
+                         horizon=horizon)
+    assert np.abs(got - want).max() < 2e-4 * max(1.0, np.abs(want).max())
+    plain = apply_fog_ref(color, distance, settings, positions=positions, far=8000.0, directions=dirs,
+                          horizon=horizon)
+    covered = cloud[..., 1] > 0.05
+    assert np.abs(plain - want)[covered].max() > 0.05, "the cloud's own distance changes the fog"
+    assert np.array_equal(plain[~(cloud[..., 1] > 0)], want[~(cloud[..., 1] > 0)])
+
+
+def test_the_sky_fog_colour_is_the_horizon_sky_in_the_rays_azimuth():
+    sun = Sun.from_angles(4.6, 80.0)
+    table = horizon_colors(sun, SkySettings())
+    assert table.shape == (SAMPLES, 3) and np.isfinite(table).all()
+    toward = sky_fog_color(unit([np.sin(np.radians(80)), 0.0, -np.cos(np.radians(80))]), table, (1, 1, 1))
+    away = sky_fog_color(unit([-np.sin(np.radians(80)), 0.0, np.cos(np.radians(80))]), table, (1, 1, 1))
+    assert toward.sum() > 2.0 * away.sum(), "the horizon glows toward the low sun"
+    assert toward[0] > toward[2], "and is warm there"
+    flat = horizon_colors(Sun(ambient=(0.2, 0.3, 0.4)))          # no sky plugin: the Sun's ambient
+    assert np.allclose(sky_fog_color(unit([1.0, 0.3, 2.0]), flat, (0.5, 1, 1)), [0.1, 0.3, 0.4])
+    with pytest.raises(ValueError, match="FogSettings.color_from"):
+        FogSettings(color_from="sun")
+
+
+class DistanceReadback(RenderPass):
+    """Reads "cloud_distance" back (a reader in the App's Composition)."""
+    name = "distance_readback"
+    phase = "readback"
+    value = None
+
+    def setup(self, builder):
+        builder.read(CLOUD_DISTANCE)
+        builder.side_effect()
+
+    def execute(self, frame):
+        w, h = frame.gpu.size
+        self.value = np.frombuffer(frame.resource(CLOUD_DISTANCE).read(), np.float32).reshape(h, w, 2)[::-1]
+
+
+def cloud_app(gpu, downsample, fog=None):
+    density = np.zeros(SHAPE, np.float32)
+    density[4:12, 1:3, 4:12] = 1.0
+    density[6:10, 0:4, 6:10] = 2.0
+    settings = CloudSettings(cell_size=CELL, base_altitude=BASE, group_size=(8, 8), smoothing_slices=1, sigma_t=0.01)
+    plugins = [DefaultPlugins(overlay=False), CloudsPlugin(settings, density=density),
+               CloudRenderPlugin(downsample=downsample)]
+    app = App(gpu).add_plugins(*plugins, *([fog] if fog else []))
+    origin = app.resource(VolumeOrigin)
+    origin.x, origin.z = 0.0, 0.0
+    app.insert_resource(Sun.from_angles(40.0, 70.0))
+    app.startup()
+    cam = app.resource(Camera)
+    cam.position = np.array([320.0, 150.0, 1400.0])
+    cam.look_at(np.array([320.0, 680.0, 320.0]))                  # the clouds over the (empty) sky
+    cam.near, cam.far = 1.0, 20000.0
+    return app, cam
+
+
+def test_a_cloud_scene_without_fog_allocates_no_distance_target(fresh_gpu):
+    app, _ = cloud_app(fresh_gpu, 2)
+    app.render()
+    compiled = app.graph.compile()
+    assert CLOUD_DISTANCE not in compiled.resources and "cloud_distance_low" not in compiled.resources
+    assert not any(d.components == 2 for d in (r.desc for r in compiled.resources.values()) if d is not None)
+    assert app.resource(Composition).writers == {"cloud_render"} and not app.resource(Composition).readers
+    app.close()
+    app, _ = cloud_app(fresh_gpu, 2, FogPlugin(mode="exp", density=1e-4, sky="keep"))
+    app.render()
+    compiled = app.graph.compile()
+    assert compiled.resources[CLOUD_DISTANCE].creator == "cloud_render"
+    assert compiled.resources[CLOUD_DISTANCE].readers == ["fog"]
+    app.close()
+    app = App(fresh_gpu).add_plugins(DefaultPlugins(overlay=False), FogPlugin())     # fog without clouds
+    app.startup()
+    app.render()
+    assert CLOUD_DISTANCE not in app.graph.compile().resources
+    app.close()
+
+
+@pytest.mark.parametrize("downsample", [1, 2])
+def test_fog_attenuates_a_cloud_over_the_sky_by_the_clouds_own_distance(gpu, ctx, downsample):
+    fog = FogPlugin(mode="exp", density=0.0, sky="keep", fog_color=(0.9, 0.6, 0.3))
+    app, cam = cloud_app(gpu, downsample, fog)
+    readback = app.graph.add_pass(DistanceReadback())
+    app.resource(Composition).readers.add("distance_readback")
+    app.run_frames(2)
+    clear = app.read_linear()[..., :3].astype(np.float64)          # density 0: f = 1, the clouds unfogged
+    cloud = readback.value.astype(np.float64)
+    a = cloud[..., 1]
+    assert a.max() > 0.9 and (a == 0).mean() > 0.2, "the view holds opaque clouds and open sky"
+    dc = cloud[..., 0][a > 0.5] / a[a > 0.5]
+    near = np.linalg.norm(cam.position - np.array([320.0, 680.0, 320.0]))
+    assert 0.6 * near < np.median(dc) < 1.4 * near, "the distance is the clouds' own"
+    fog.configure(density=8e-4)
+    app.render()
+    fogged = app.read_linear()[..., :3].astype(np.float64)
+    w, h = gpu.size
+    xs, ys = 2 * (np.arange(w) + 0.5) / w - 1, 1 - 2 * (np.arange(h) + 0.5) / h
+    ndc = np.stack(np.broadcast_arrays(xs[None, :], ys[:, None], 1.0), -1)
+    dirs = unit(ndc @ view_basis(cam, w / h).T)
+    want = apply_fog_ref(clear, np.full((h, w), np.inf), fog.settings, cloud=cloud, directions=dirs,
+                         camera=cam.position)
+    assert np.abs(fogged - want).max() < 4e-3 * max(1.0, want.max())      # the colour target is float16
+    covered = a > 0.5
+    assert np.abs(fogged - clear)[covered].mean() > 0.1, "clouds over the sky are fogged (not skipped as sky)"
+    assert np.array_equal(fogged[a == 0], clear[a == 0]), "the open sky is kept"
+    app.close()
