@@ -100,7 +100,7 @@ class GifEncoder:
 
     def write(self, frame: np.ndarray) -> None:
         from PIL import Image
-        self._frames.append(Image.fromarray(np.ascontiguousarray(frame, dtype=np.uint8), "RGB"))
+        self._frames.append(Image.fromarray(np.ascontiguousarray(frame, dtype=np.uint8)))   # (h, w, 3) uint8: RGB
 
     def close(self) -> None:
         frames, self._frames = self._frames, []
