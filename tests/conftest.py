@@ -52,3 +52,17 @@ def out_folder():
     path = Path(__file__).resolve().parents[1] / "out"
     path.mkdir(exist_ok=True)
     return path
+
+
+@pytest.fixture(scope="session")
+def display():
+    """A virtual X server (Xvfb) for the window tests, one per test session; its DISPLAY name."""
+    import subprocess
+    import time
+    number = 90 + os.getpid() % 800
+    server = subprocess.Popen(["Xvfb", f":{number}", "-screen", "0", "800x600x24"],
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    time.sleep(1.0)
+    yield f":{number}"
+    server.terminate()
+    server.wait()

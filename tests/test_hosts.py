@@ -5,7 +5,6 @@ import os
 import shutil
 import subprocess
 import sys
-import time
 
 import moderngl
 import numpy as np
@@ -63,17 +62,6 @@ def test_wrap_context_takes_a_moderngl_context_and_names_what_it_got():
 
 # -- real hosts in windows -------------------------------------------------------------------------
 needs_x = pytest.mark.skipif(shutil.which("Xvfb") is None, reason="Xvfb is not installed (setup.sh installs it)")
-
-
-@pytest.fixture(scope="module")
-def display():
-    number = 600 + os.getpid() % 300
-    server = subprocess.Popen(["Xvfb", f":{number}", "-screen", "0", "800x600x24"],
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    time.sleep(1.0)
-    yield f":{number}"
-    server.terminate()
-    server.wait()
 
 
 def run_host(display, tmp_path, example: str, package: str, frames: int = 6) -> np.ndarray:

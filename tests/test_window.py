@@ -10,17 +10,6 @@ import pytest
 pytestmark = pytest.mark.skipif(shutil.which("Xvfb") is None, reason="Xvfb is not installed (setup.sh installs it)")
 
 
-@pytest.fixture(scope="module")
-def display():
-    number = 90 + os.getpid() % 500
-    server = subprocess.Popen(["Xvfb", f":{number}", "-screen", "0", "800x600x24"],
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    time.sleep(1.0)
-    yield f":{number}"
-    server.terminate()
-    server.wait()
-
-
 def demo(display, *args):
     env = dict(os.environ, DISPLAY=display)
     return subprocess.Popen([sys.executable, "-m", "atmos", "demo", "testbed", "--size", "200x120", *args],
