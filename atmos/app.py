@@ -76,13 +76,12 @@ class App:
 
     def _mark(self) -> tuple:
         """What :meth:`_undo` needs to take a failed build out again."""
-        graph = self.graph
         return (len(self.plugins), len(self.schedule.systems), dict(self.resources), list(self.frames.jobs),
-                set(graph._passes) if graph else set(), dict(graph._imports) if graph else {})
+                self.graph.mark() if self.graph is not None else None)
 
     def _undo(self, mark: tuple, error: BaseException) -> None:
         """Remove the plugins (a failed one, and what its build added) and registrations made since ``mark``."""
-        plugins, systems, resources, jobs, passes, imports = mark
+        plugins, systems, resources, jobs, graph = mark
         for plugin in reversed(self.plugins[plugins:]):
             try:
                 plugin.cleanup(self)
@@ -95,10 +94,7 @@ class App:
         for job in [j for j in self.frames.jobs if not any(j is k for k in jobs)]:
             self.frames.remove(job)
         if self.graph is not None:
-            for name in set(self.graph._passes) - passes:
-                self.graph.remove_pass(name)
-            self.graph._imports.clear()
-            self.graph._imports.update(imports)
+            self.graph.undo(graph)
 
     def add_system(self, func, stage: str = "update", label: str | None = None, before=(), after=()) -> "App":
         """Run ``func(app)`` in ``stage`` every frame (``simulate``: every fixed step)."""
@@ -191,10 +187,7 @@ class App:
     def render(self) -> None:
         """Run the render graph once with the scene as it is (what the render stage does each frame;
         tests and tools call it to draw again without advancing time)."""
-        self._check_open("render")
-        if self.graph is None:
-            raise AppError("App.render: this App has no GPU context (App(gpu)), so nothing to render")
-        self.graph.execute(SceneView.of(self))
+        self._require_graph("render").execute(SceneView.of(self))
 
     def read_linear(self):
         """Render once (like :meth:`render`) and return the linear HDR ``color`` before exposure and
@@ -202,15 +195,13 @@ class App:
         import numpy as np
 
         from atmos.render_core import LinearCapturePass
-        self._check_open("read_linear")
-        if self.graph is None:
-            raise AppError("App.read_linear: this App has no GPU context (App(gpu)), so nothing to render")
-        capture = next((p for p in self.graph.passes if isinstance(p, LinearCapturePass)), None)
+        graph = self._require_graph("read_linear")
+        capture = next((p for p in graph.passes if isinstance(p, LinearCapturePass)), None)
         if capture is None:                  # kept once added: reads back only when armed
-            capture = self.graph.add_pass(LinearCapturePass())
+            capture = graph.add_pass(LinearCapturePass())
         capture.armed = True
         try:
-            self.graph.execute(SceneView.of(self))
+            graph.execute(SceneView.of(self))
         finally:
             capture.armed = False
         return np.ascontiguousarray(capture.color[::-1], dtype=np.float32)
@@ -230,6 +221,13 @@ class App:
     def _check_open(self, what: str) -> None:
         if self._closed:
             raise AppError(f"App.{what}: this App was closed ({self._closed_by}); build a new App")
+
+    def _require_graph(self, what: str):
+        """The render graph, for ``App.<what>``: an AppError when closed or made without a GPU context."""
+        self._check_open(what)
+        if self.graph is None:
+            raise AppError(f"App.{what}: this App has no GPU context (App(gpu)), so nothing to render")
+        return self.graph
 
     def _activate(self) -> None:
         """Make this App's ECS world and GL context the current ones."""

@@ -128,7 +128,7 @@ def _check_field(name: str, value):
 
 
 def gl_matrix(m: np.ndarray) -> bytes:
-    """A 4×4 numpy matrix as the column-major float32 bytes a GLSL mat4 uniform expects."""
+    """A 4×4 (or 3×3) numpy matrix as the column-major float32 bytes a GLSL mat4 (mat3) uniform expects."""
     return np.asarray(m, np.float32).T.tobytes()
 
 
@@ -141,11 +141,6 @@ def view_basis(camera: Camera, aspect: float) -> np.ndarray:
     r, u, f = camera.basis().T
     ty = math.tan(0.5 * camera.fov_y)
     return np.column_stack([r * ty * max(aspect, 1e-6), u * ty, f])
-
-
-def gl_matrix3(m: np.ndarray) -> bytes:
-    """A 3×3 numpy matrix as the column-major float32 bytes a GLSL mat3 uniform expects."""
-    return np.asarray(m, np.float32).T.tobytes()
 
 
 class CameraMatrices:
@@ -172,7 +167,7 @@ class CameraMatrices:
             elif name == "inv_view_proj":
                 data = gl_matrix(np.linalg.inv(self.view_proj))
             elif name == "view_basis":
-                data = gl_matrix3(self.view_basis)
+                data = gl_matrix(self.view_basis)
             else:
                 raise KeyError(f"CameraMatrices.gl: no uniform {name!r} (view_proj, inv_view_proj, view_basis)")
             self._gl[name] = data

@@ -67,14 +67,13 @@ def parser() -> argparse.ArgumentParser:
 
 def _run_options(command, frames_default: str) -> None:
     """The options ``atmos demo`` and ``atmos run`` share."""
-    demo = command
-    demo.add_argument("--headless", action="store_true", help="render offscreen even when a display exists")
-    demo.add_argument("--frames", type=_positive, help=f"frames to render (headless default: the {frames_default})")
-    demo.add_argument("--size", type=_size, default=(960, 540), help="WxH, default 960x540")
-    demo.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
-    demo.add_argument("--out", type=_out, help="FILE.mp4, FILE.gif, FILE.png (last frame) or a folder of PNGs; "
-                                               "headless default: out/NAME.mp4")
-    demo.add_argument("--quiet", action="store_true", help="no progress bar")
+    command.add_argument("--headless", action="store_true", help="render offscreen even when a display exists")
+    command.add_argument("--frames", type=_positive, help=f"frames to render (headless default: the {frames_default})")
+    command.add_argument("--size", type=_size, default=(960, 540), help="WxH, default 960x540")
+    command.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
+    command.add_argument("--out", type=_out, help="FILE.mp4, FILE.gif, FILE.png (last frame) or a folder of PNGs; "
+                                                  "headless default: out/NAME.mp4")
+    command.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
 def cmd_info(args) -> int:

@@ -85,9 +85,9 @@ def sky_light(sun_dir, ambient_scale: float = 1.0) -> tuple[np.ndarray, np.ndarr
 
 def sun_and_day(sun: Sun) -> tuple[np.ndarray, float]:
     """(unit direction toward the sun, daylight 0..1 = smoothstep(-0.15, 0.1, sun height) like the sky)."""
-    s = np.asarray(sun.direction, np.float64)
-    norm = np.linalg.norm(s)
-    s = s / norm if np.isfinite(norm) and norm > 1e-9 else np.array([0.0, 1.0, 0.0])
+    s = unit_sun(sun.direction)
+    if s is None:
+        s = np.array([0.0, 1.0, 0.0])
     day = float(np.clip((s[1] + 0.15) / 0.25, 0.0, 1.0))
     return s, day * day * (3 - 2 * day)
 

@@ -38,11 +38,6 @@ def display_problem() -> str | None:
     return None
 
 
-def has_display() -> bool:
-    """True when a window can open here (:func:`display_problem` is None)."""
-    return display_problem() is None
-
-
 def load_game(game):
     """The module or object with ``build(app, settings)`` that ``game`` names: a demo name, a path to a
     ``.py`` file (``atmos run game.py``), a module, or a ``build(app, settings)`` function itself."""
@@ -112,12 +107,17 @@ def build_app(name, settings: DemoSettings, gpu, *extra_plugins, start: bool = T
         app.add_plugins(*extra_plugins)
         app.startup() if start else app.finish()
     except Exception as error:
-        try:
-            app.close()
-        except Exception as failure:           # the build error is the one to show
-            error.add_note(f"closing the half-built App also failed: {failure}")
+        _close_after(app, error, "closing the half-built App also failed")
         raise
     return app
+
+
+def _close_after(app: App, error: BaseException, note: str) -> None:
+    """Close ``app`` after ``error``; a failure to close becomes a note on ``error`` (the one to show)."""
+    try:
+        app.close()
+    except Exception as failure:
+        error.add_note(f"{note}: {failure}")
 
 
 def run_headless(name, settings: DemoSettings, out: str | None, progress: bool = True) -> dict:
@@ -148,10 +148,7 @@ def run_headless(name, settings: DemoSettings, out: str | None, progress: bool =
     except BaseException as error:
         if writer is not None:
             writer.abort()                            # a failed run leaves no file behind
-        try:
-            app.close()
-        except Exception as failure:                  # the run's error is the one to show
-            error.add_note(f"closing the App also failed: {failure}")
+        _close_after(app, error, "closing the App also failed")
         raise
     finally:
         try:

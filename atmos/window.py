@@ -30,15 +30,16 @@ class WindowEvents:
     def __init__(self, window, app):
         self.window, self.app = window, app
 
-    def _input(self):
+    def _tell(self, method: str, *args) -> None:
+        """Call ``Input.<method>(*args)`` on the App's Input resource, if it has one."""
         from atmos.input import Input
-        return self.app.get_resource(Input)
+        inp = self.app.get_resource(Input)
+        if inp is not None:
+            getattr(inp, method)(*args)
 
     def on_key_press(self, symbol, modifiers):
         from atmos.keys import key
-        inp = self._input()
-        if inp is not None:
-            inp.press(symbol)
+        self._tell("press", symbol)
         if symbol == key.F1:
             from atmos.plugins.overlay import OverlayPlugin
             overlay = next((p for p in self.app.plugins if isinstance(p, OverlayPlugin)), None)
@@ -46,37 +47,25 @@ class WindowEvents:
                 overlay.configure(visible=not overlay.settings.visible)
 
     def on_key_release(self, symbol, modifiers):
-        inp = self._input()
-        if inp is not None:
-            inp.release(symbol)
+        self._tell("release", symbol)
 
     def on_mouse_motion(self, x, y, dx, dy):
-        inp = self._input()
-        if inp is not None:
-            inp.move_mouse(x, y, dx, dy)
+        self._tell("move_mouse", x, y, dx, dy)
 
     def on_mouse_drag(self, x, y, dx, dy, buttons, modifiers):
         self.on_mouse_motion(x, y, dx, dy)
 
     def on_mouse_press(self, x, y, button, modifiers):
-        inp = self._input()
-        if inp is not None:
-            inp.press_button(button)
+        self._tell("press_button", button)
 
     def on_mouse_release(self, x, y, button, modifiers):
-        inp = self._input()
-        if inp is not None:
-            inp.release_button(button)
+        self._tell("release_button", button)
 
     def on_mouse_scroll(self, x, y, scroll_x, scroll_y):
-        inp = self._input()
-        if inp is not None:
-            inp.scroll(scroll_y, scroll_x)
+        self._tell("scroll", scroll_y, scroll_x)
 
     def on_deactivate(self):
-        inp = self._input()
-        if inp is not None:
-            inp.clear()
+        self._tell("clear")
 
     def on_resize(self, width, height):
         self.app.gpu.resize(self.window.get_framebuffer_size())

@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
-from bench_resize_memory import rss_mb, trimmed_rss_mb  # noqa: E402
+from bench_resize_memory import growth, rss_mb, trimmed_rss_mb  # noqa: E402
 
 from atmos.app import App  # noqa: E402
 from atmos.camera import Camera  # noqa: E402
@@ -179,10 +179,6 @@ def quarter_max(samples: list) -> tuple:
     """(maximum over the first quarter, maximum over the last quarter) of ``samples``."""
     q = max(1, len(samples) // 4)
     return max(samples[:q]), max(samples[-q:])
-
-
-def growth(first: float, last: float) -> float:
-    return (last - first) / first * 100.0 if first else 0.0
 
 
 def report(title: str, result: dict, objects: str) -> bool:

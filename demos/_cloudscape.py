@@ -14,6 +14,7 @@ from atmos.camera import Camera
 from atmos.defaults import DefaultPlugins
 from atmos.plugins.cloud_render import CloudRenderPlugin
 from atmos.plugins.cloud_render.example import example_weather
+from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
 from atmos.plugins.cloud_shadows import CloudShadowsPlugin
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
 from atmos.plugins.daylight import DaylightPlugin
@@ -26,16 +27,20 @@ from atmos.plugins.weather import VolumeOrigin
 SHAPE = (128, 16, 128)
 CELL = (40.0, 40.0, 40.0)
 BASE_ALTITUDE = 900.0
+EDGE_FADE = 0.35        # outer fraction of the volume's half width over which it gives way to the far field
 
 
 def build_cloudscape(app, settings, *, hours: float, speed: float = 0.0, cloud_density: int = 140,
-                     warmup_steps: int = 30, slices_per_frame: int = 3, wind=(0.6, 0.0, 0.25), haze: bool = False):
+                     warmup_steps: int = 30, slices_per_frame: int = 3, wind=(0.6, 0.0, 0.25), haze: bool = False,
+                     horizon: bool = True):
     """Add the whole scene to ``app``; returns the CloudsPlugin (``configure(weather={"cloud_density": n})``
     changes the cover live). ``haze``: aerial perspective, an exponential fog toward the horizon sky's
-    colour that fogs terrain and clouds by their own distance (:mod:`atmos.composition`)."""
+    colour that fogs terrain and clouds by their own distance (:mod:`atmos.composition`). ``horizon``:
+    clouds to the horizon, the volume fading out over its outer EDGE_FADE into the far field
+    (:mod:`atmos.plugins.cloud_far_field`)."""
     weather = example_weather(SHAPE, cloud_density=cloud_density, wind=wind)
     clouds = CloudSettings(cell_size=CELL, base_altitude=BASE_ALTITUDE, smoothing_slices=8, group_size=(32, 32),
-                           sigma_t=0.02)
+                           sigma_t=0.02, edge_fade=EDGE_FADE if horizon else 0.0)
     cloud_plugin = CloudsPlugin(clouds, weather=weather, seed=settings.seed, warmup_steps=warmup_steps)
     app.insert_resource(VolumeOrigin(-SHAPE[0] / 2, 0.0, -SHAPE[2] / 2))
     app.add_plugins(DefaultPlugins(overlay=not settings.headless),
@@ -46,6 +51,8 @@ def build_cloudscape(app, settings, *, hours: float, speed: float = 0.0, cloud_d
                     CloudShadowsPlugin(),
                     CloudRenderPlugin(size_factor=4.0),
                     LightShaftsPlugin())
+    if horizon:
+        app.add_plugins(CloudFarFieldPlugin())
     if haze:
         app.add_plugins(FogPlugin(mode="exp", density=4e-5, sky="keep", color_from="sky", fog_color=(1.0, 1.0, 1.0)))
     app.frames.slices_per_frame = slices_per_frame

@@ -88,6 +88,9 @@ def rolled_frames(name, size=48):
             setup(app)
         from atmos.render_core import RenderCorePlugin
         next(p for p in app.plugins if isinstance(p, RenderCorePlugin)).configure(dither=False)  # per-pixel noise
+        from atmos.plugins.light_shafts import LightShaftsPlugin
+        for shafts in (p for p in app.plugins if isinstance(p, LightShaftsPlugin)):
+            shafts.configure(steps=128, downsample=1)   # the march's jitter and low-res blocks are screen-space patterns
         app.run_frames(4, 1 / 30)
         cam = app.resource(Camera)
         if name == "sky_day":

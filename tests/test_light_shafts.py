@@ -27,7 +27,7 @@ def random_params(rng, **fixed) -> LightShaftSettings:
                   weight=rng.uniform(0.01, 0.2), exposure=rng.uniform(0.2, 2.0), threshold=rng.uniform(0.0, 1.0), ceiling=rng.uniform(0.1, 3.0),
                   radius=rng.uniform(0.1, 1.0))
     values.update(fixed)
-    return LightShaftSettings(**values)
+    return LightShaftSettings(mode="screen", **values)
 
 
 def gpu_blur(gpu, mask: np.ndarray, sun_uv, params, strength=1.0) -> np.ndarray:
@@ -182,7 +182,7 @@ def test_bright_cloud_over_the_sky_cuts_the_mask_through_alpha(gpu, ctx):
     sky pixels are sky) kept it in the mask; with color.a (sky occlusion) it is cut, partly where
     it is partly transparent, and the open sky around it still casts."""
     w, h = gpu.size
-    params = LightShaftSettings(downsample=1, threshold=0.6, ceiling=3.0, radius=0.6)
+    params = LightShaftSettings(mode="screen", downsample=1, threshold=0.6, ceiling=3.0, radius=0.6)
     opaque = ((int(0.55 * w), int(0.45 * h), int(0.15 * w), int(0.25 * h)), (6.0, 5.5, 5.0), 1.0)
     half = ((int(0.25 * w), int(0.45 * h), int(0.15 * w), int(0.25 * h)), (6.0, 5.5, 5.0), 0.5)
     before, probe = CaptureBefore(), MaskProbe()
@@ -281,7 +281,7 @@ def test_screen_sun_fades():
 def test_extremes_no_nan_no_gl_error(case):
     size = {"tiny": (1, 1), "minimized": (0, 0)}.get(case, (96, 54))
     gpu = create_headless(size)
-    app, plugin, _, probe = shafts_app(gpu, LightShaftSettings(), scene=True)
+    app, plugin, _, probe = shafts_app(gpu, LightShaftSettings(mode="screen"), scene=True)
     cam = app.resource(Camera)
     cam.position = np.array([0.0, 5.0, 0.0])
     cam.look_at((0.0, 8.0, -20.0))
@@ -313,7 +313,7 @@ def test_shafts_around_clouds_at_sunset_look_right():
     """A low orange sun just above drifting cloud blobs: a glow streaked by the clouds' shadows."""
     gpu = create_headless((480, 270))
     box = VolumeBox(center=(0.0, 16.0, -40.0), size=(70.0, 14.0, 30.0))
-    params = LightShaftSettings(exposure=1.0, threshold=0.3)
+    params = LightShaftSettings(mode="screen", exposure=1.0, threshold=0.3)
     probe = CapturePass()
     plugin = LightShaftsPlugin(params)
     app = App(gpu).add_plugins(DefaultPlugins(overlay=False),

@@ -33,6 +33,7 @@ from atmos.plugins.cloud_render import CloudMarchPlugin, CloudRenderPlugin
 from atmos.plugins.cloud_render.example import example_weather
 from atmos.plugins.cloud_render.offscreen import CLOUD_COLOR
 from atmos.plugins.cloud_shadows import CloudShadowsPlugin
+from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
 from atmos.plugins.clouds.top_view import CloudTopViewPlugin
 from atmos.plugins.daylight import DaylightPlugin, TimeOfDay
@@ -201,6 +202,13 @@ def clouds(shape=(32, 8, 32), cell=(20.0, 15.0, 20.0), cover=40, **settings):
 CLOUD_CENTER = (320.0, 360.0, 320.0)
 
 
+def march_under_clouds(app, plugin):
+    """Marched shafts seen from under the clouds of :func:`clouds`, toward a sun behind them."""
+    plugin.configure(mode="march")
+    look((320.0, 40.0, 900.0), target=(320.0, 250.0, 300.0), far=6000.0)(app)
+    app.insert_resource(Sun(np.array([0.0, 0.6, -1.0]) / math.hypot(0.6, 1.0), (1.0, 0.95, 0.85)))
+
+
 @dataclass
 class Spec:
     """A plugin's scene and, per live field, the new value (``changes``); ``observe``: fields whose
@@ -275,13 +283,17 @@ SPECS = {
              resolutions=(2, 4, 8, 8), winds=((5.0, 0.0, 0.0),) * 4, tile_size=64.0, amplitude=0.3,
              noise="procedural", texels_per_cell=2, seed=11, time_offset=3.0, color_from="sky"),
         before={"start": configure_first(mode="linear"), "end": configure_first(mode="linear")}),
-    "light_shafts": Spec(
-        lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(), LightShaftsPlugin()],
+    "light_shafts": Spec(     # the screen mode; the march's fields under the clouds (march_under_clouds)
+        lambda: [DefaultPlugins(overlay=False), clouds(shading=False), SkyGradientPlugin(), GroundPlugin(),
+                 LightShaftsPlugin(mode="screen")],
         LightShaftsPlugin,
         look((0.0, 2.0, 10.0), yaw=0.0, pitch=0.05),
         dict(samples=8, density=0.4, decay=0.7, weight=0.3, exposure=2.0, threshold=0.2, ceiling=0.05, radius=0.1,
-             downsample=4, horizon_fade=0.9, front_fade=1.0, edge_fade=2.0),
-        before={"__all__": sun_at((0.5, 0.55)), "edge_fade": sun_at((1.15, 0.55))},
+             downsample=4, horizon_fade=0.9, front_fade=1.0, edge_fade=2.0, mode="march", steps=3,
+             scattering=1e-4, max_distance=400.0, phase_g=0.0, phase_g2=0.6, phase_w=0.7, sun_intensity=2.0),
+        before={"__all__": sun_at((0.5, 0.55)), "edge_fade": sun_at((1.15, 0.55)),
+                **{f: march_under_clouds for f in ("steps", "scattering", "max_distance", "phase_g", "phase_g2",
+                                                    "phase_w", "sun_intensity")}},
         observe={"downsample": resource_size(MASK)}),
     "test_volume": Spec(
         lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(),
@@ -315,6 +327,14 @@ SPECS = {
              ms_eccentricity=0.0, enabled=False),
         observe={"frustum_culling": culling_counters, "empty_space_skipping": culling_counters,
                  "downsample": resource_size(CLOUD_COLOR)}),
+    "cloud_far_field": Spec(
+        lambda: [DefaultPlugins(overlay=False), clouds(cover=20, edge_fade=0.5), SkyGradientPlugin(), GroundPlugin(),
+                 CloudRenderPlugin(), CloudFarFieldPlugin(size=32)],
+        CloudFarFieldPlugin,
+        look((320.0, 60.0, 320.0), yaw=0.3, pitch=0.15, far=60000.0),     # the horizon beyond the volume
+        dict(softness=0.9, thickness=0.5, optical_depth=0.5, tile_size=1000.0, wind=(500.0, 0.0), horizon_fade=0.9,
+             size=16, base_frequency=9, seed=7, light_step=0.2, animate=False, enabled=False),
+        before={"animate": configure_first(wind=(500.0, 0.0))}),
 }
 
 
@@ -323,7 +343,7 @@ def _clouds_spec():
     changes = dict(step_seconds=3.0, cover_threshold=6.0, sigma_t=2.0, scattering=Scattering("multiple-forward"),
                    albedo=0.5, phase_g=0.2, phase_g2=0.6, phase_w=0.7, sun_intensity=2.0, sky_intensity=4.0,
                    ground_albedo=1.0,
-                   cell_size=(10.0, 30.0, 10.0), base_altitude=150.0)
+                   cell_size=(10.0, 30.0, 10.0), base_altitude=150.0, edge_fade=0.8)
     changes.update(weather_changes(weather))
     observe = {"step_seconds": next_step_reads("dt"), "cover_threshold": lambda app, plugin: plugin.simulation.cover(),
                "scattering": shading_extinction}

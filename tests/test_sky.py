@@ -8,7 +8,7 @@ import pytest
 from PIL import Image
 
 from atmos.app import App
-from atmos.camera import Camera
+from atmos.camera import Camera, set_camera_uniforms, view_basis
 from atmos.cli import main
 from atmos.defaults import DefaultPlugins
 from atmos.gpu import create_headless
@@ -18,7 +18,7 @@ from atmos.plugins.ground import GroundPlugin
 from atmos.lighting import sky_light
 from atmos.plugins.sky import SkySettings, SkyPlugin, evaluate_sky, sky_color, sky_radiance
 from atmos.plugins.sky.preetham import preetham_rgb
-from atmos.plugins.sky.shader import LIMB_FLOOR, set_sky_uniforms, set_view_basis, sky_defines, view_basis
+from atmos.plugins.sky.shader import LIMB_FLOOR, set_sky_uniforms, sky_defines
 from fullscreen_probe import run_fullscreen
 
 OUT = os.path.join(os.path.dirname(__file__), "..", "out", "sky")
@@ -96,7 +96,7 @@ def render_sky(gpu, camera: Camera, size, params: SkySettings, sun, sun_color, t
     w, h = size
 
     def uniforms(prog):
-        set_view_basis(prog, camera, w / h)
+        set_camera_uniforms(prog, camera, w / h)      # view_basis
         set_sky_uniforms(prog, params, sun, sun_color, time, camera.fov_y / h)
     return run_fullscreen(gpu, "sky/sky.frag", size, (), uniforms, defines=sky_defines())
 

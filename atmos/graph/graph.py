@@ -72,10 +72,26 @@ class RenderGraph:
                              "a callable returning one")
         self._imports[name] = source
 
+    def imports(self, name: str) -> bool:
+        """Whether the graph imports a resource called ``name`` (a pass may read an optional one)."""
+        return name in self._imports
+
     def remove_import(self, name: str) -> None:
         """Forget the imported resource ``name`` (a plugin that made it is going away)."""
         if self._imports.pop(name, None) is None:
             raise GraphError(f"the graph imports no resource '{name}' (imports: {', '.join(self._imports) or 'none'})")
+
+    def mark(self) -> tuple:
+        """The registered passes and imports now, for :meth:`undo`."""
+        return set(self._passes), dict(self._imports)
+
+    def undo(self, mark: tuple) -> None:
+        """Go back to ``mark``: remove the passes added since, restore the imports (a failed plugin build)."""
+        passes, imports = mark
+        for name in set(self._passes) - passes:
+            self.remove_pass(name)
+        self._imports.clear()
+        self._imports.update(imports)
 
     # -- compiling and running ---------------------------------------------------------------
     def declare(self) -> dict[str, PassBuilder]:

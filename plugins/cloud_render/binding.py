@@ -33,7 +33,8 @@ def bind_volume(program, sim, sampler, sun: Sun | None, octaves=DEFAULT_OCTAVES)
     program["t"].value = float(t)
     if "a_shift" in program:
         program["a_shift"].value = (sim if isinstance(sim, CloudSets) else sim.sets()).a_shift
-    values = {"has_shading": int(shading), **light_uniforms(sim.settings, sun, octaves)}
+    values = {"has_shading": int(shading), "edge_fade": float(sim.settings.edge_fade),
+              **light_uniforms(sim.settings, sun, octaves)}
     for name, value in values.items():
         if name in program:
             program[name].value = value

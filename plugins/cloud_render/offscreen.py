@@ -33,46 +33,51 @@ class OffscreenClouds:
     """The low-res targets' declarations and the depth and composite draws of a cloud pass
     (programs belong to the GpuContext)."""
 
-    def __init__(self, gpu):
+    def __init__(self, gpu, color: str = CLOUD_COLOR, depth: str = CLOUD_DEPTH):
+        self.color, self.depth = color, depth         # the low-res targets' names (another pass: its own)
         fullscreen = "lib/fullscreen.vert"
         self.far_depth = gpu.program(vertex_shader=fullscreen, fragment_shader="cloud_render/far_depth.frag")
         self.composite = gpu.program(vertex_shader=fullscreen, fragment_shader="cloud_render/composite.frag")
 
     @staticmethod
-    def declare(builder: PassBuilder, size, factor: int, distance: bool = False) -> None:
+    def declare(builder: PassBuilder, size, factor: int, distance: bool = False, color: str = CLOUD_COLOR,
+                depth: str = CLOUD_DEPTH) -> None:
         low = low_size(size, factor)
-        builder.create(CLOUD_COLOR, TextureDesc(low, components=4, dtype="f2", filter="nearest"))
-        builder.create(CLOUD_DEPTH, TextureDesc(low, depth=True, filter="nearest"))
+        builder.create(color, TextureDesc(low, components=4, dtype="f2", filter="nearest"))
+        builder.create(depth, TextureDesc(low, depth=True, filter="nearest"))
         if distance:
             builder.create(CLOUD_LOW_DISTANCE, distance_desc(low))
 
     def begin(self, frame: PassContext, factor: int, distance: bool = False):
         """Write the low-res depth, clear the low-res colour; returns the framebuffer to draw sprites into."""
         ctx = frame.gpu.ctx
-        frame.framebuffer(depth=CLOUD_DEPTH).use()
+        frame.framebuffer(depth=self.depth).use()
         frame.resource(DEPTH).use(0)
         self.far_depth["factor"].value = factor
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "1"                # always: the shader writes the block's farthest depth
         frame.fullscreen(self.far_depth)
-        fbo = frame.framebuffer(color=[CLOUD_COLOR, CLOUD_LOW_DISTANCE] if distance else [CLOUD_COLOR],
-                                depth=CLOUD_DEPTH)
+        fbo = frame.framebuffer(color=[self.color, CLOUD_LOW_DISTANCE] if distance else [self.color],
+                                depth=self.depth)
         fbo.depth_mask = False              # clear the colour only: the sprites test the depth just written
         fbo.clear(0.0, 0.0, 0.0, 0.0)
         fbo.use()                           # clear() re-binds the framebuffer bound before it
         return fbo
 
-    def end(self, frame: PassContext, factor: int, near: float, far: float, distance: bool = False) -> None:
+    def end(self, frame: PassContext, factor: int, near: float, far: float, distance: bool = False,
+            medium: bool = False) -> None:
         """Blend the low-res clouds onto "color" (premultiplied, :meth:`PassContext.blend_over`), and
-        their distance onto the cleared "cloud_distance" with the same weights when ``distance``."""
+        their distance onto the cleared "cloud_distance" with the same weights when ``distance``;
+        ``medium``: the low-res target holds (in-scattered light, transmittance) of a medium instead,
+        blended by :meth:`PassContext.blend_transmittance` (alpha kept)."""
         frame.reset_state()                 # the sprites' depth test and point size are done
         frame.framebuffer(color=[COLOR, CLOUD_DISTANCE] if distance else [COLOR]).use()
-        names = (CLOUD_COLOR, CLOUD_DEPTH, DEPTH) + ((CLOUD_LOW_DISTANCE,) if distance else ())
+        names = (self.color, self.depth, DEPTH) + ((CLOUD_LOW_DISTANCE,) if distance else ())
         for unit, name in enumerate(names):
             frame.resource(name).use(unit)
         p = self.composite
         p["factor"].value = factor
         p["inv_near_far"].value = (1.0 / near, 1.0 / far)
         p["edge"].value = EDGE
-        frame.blend_over()
+        frame.blend_transmittance() if medium else frame.blend_over()
         frame.fullscreen(p)

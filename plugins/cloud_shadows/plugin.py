@@ -29,6 +29,17 @@ def cloud_layout(sim, settings: CloudShadowSettings) -> CloudLayout:
     return sim.layout(settings.base_altitude, settings.cell_size)
 
 
+def column_uniforms(program, sim: CloudSets, layout: CloudLayout, extinction: float) -> None:
+    """Set the uniforms of shaders/cloud_shadows/column.glsl (bind B's and A's sums to units 1 and 0 yourself)."""
+    program["extinction"].value = extinction
+    program["t"].value = sim.t
+    program["a_shift"].value = sim.a_shift[0], sim.a_shift[2]
+    program["layer_min"].value = tuple(float(v) for v in layout.lo)
+    program["cell_size"].value = layout.cell
+    program["shape"].value = layout.shape
+    program["edge_fade"].value = float(sim.settings.edge_fade)
+
+
 class CloudShadowsPass(FullscreenPass):
     """Multiplies "color" by the shadow factor where "depth" has geometry (blend ZERO, SRC_COLOR)."""
     name = "cloud_shadows"
@@ -57,12 +68,7 @@ class CloudShadowsPass(FullscreenPass):
         set_camera_uniforms(p, view.camera, view.aspect)
         p["sun_dir"].value = tuple(unit_sun(sun.direction))
         p["weight"].value = weight
-        p["extinction"].value = sigma * params.strength
-        p["t"].value = t
-        p["a_shift"].value = sim.a_shift[0], sim.a_shift[2]
-        p["layer_min"].value = tuple(float(v) for v in layout.lo)
-        p["cell_size"].value = layout.cell
-        p["shape"].value = layout.shape
+        column_uniforms(p, sim, layout, sigma * params.strength)
         frame.fullscreen(p)
 
 

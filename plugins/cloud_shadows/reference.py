@@ -2,8 +2,8 @@
 
 A surface point P is projected along the direction toward the sun onto the middle plane of the cloud
 layer, Q = P + s·max(y_mid − P.y, 0)/s.y, and the top-view summed density (layer 0 of the density
-maps, mix(A, B, t)) is read there bilinearly, zero outside the volume. The optical depth
-``tau = sigma·strength·sum·above`` (``above``: the fraction of the layer's height above P, 1 on the
+maps, mix(A, B, t)) is read there bilinearly, zero outside the volume, times the volume's edge
+fade at Q (:mod:`atmos.plugins.clouds.edge`). The optical depth ``tau = sigma·strength·sum·fade·above`` (``above``: the fraction of the layer's height above P, 1 on the
 ground below it, 0 above its top) dims the direct light only:
 ``factor = mix(1, exp(−tau), weight)`` with ``weight`` from :func:`direct_weight`.
 """
@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from atmos.plugins.clouds.edge import edge_weight, footprint_uv
 from atmos.plugins.clouds.layout import CloudLayout
 from atmos.shading.reference import bilinear
 from atmos.lighting import unit_sun
@@ -37,21 +38,30 @@ def shifted(plane: np.ndarray, shift) -> np.ndarray:
 
 
 def shadow_factor(points, sums_a, sums_b, t: float, sun_direction, weight: float, extinction: float,
-                  layout: CloudLayout, a_shift=(0, 0, 0)) -> np.ndarray:
+                  layout: CloudLayout, a_shift=(0, 0, 0), edge_fade: float = 0.0) -> np.ndarray:
     """Factor (...,) the colour at world ``points`` (..., 3) is multiplied by; ``sums_a/b`` (nx, nz)
     the all-heights top-view maps of sets A and B; ``extinction`` = sigma·strength; ``layout`` B's
     world placement (the sprite renderer's rule); ``a_shift`` cells from B's column to A's
-    (:attr:`CloudSets.a_shift`), A zero past its edge."""
+    (:attr:`CloudSets.a_shift`), A zero past its edge; ``edge_fade`` the CloudSettings'."""
     points = np.asarray(points, np.float64)
     s = unit_sun(sun_direction)
     if s is None or weight <= 0.0:
         return np.ones(points.shape[:-1])
+    tau = sun_optical_depth(points, sums_a, sums_b, t, s, extinction, layout, a_shift, edge_fade)
+    return 1.0 - weight * (1.0 - np.exp(-tau))
+
+
+def sun_optical_depth(points, sums_a, sums_b, t: float, sun_dir, extinction: float, layout: CloudLayout,
+                      a_shift=(0, 0, 0), edge_fade: float = 0.0) -> np.ndarray:
+    """Optical depth (...,) from world ``points`` (..., 3) toward the sun (``sun_dir`` unit, y > 0)
+    through the clouds: ``extinction · column · above`` (module docstring; shaders/cloud_shadows/column.glsl)."""
+    points, s = np.asarray(points, np.float64), np.asarray(sun_dir, np.float64)
     sums = (1.0 - t) * shifted(np.asarray(sums_a, np.float64), a_shift) + t * np.asarray(sums_b, np.float64)
     lo, hi, cell = layout.lo, layout.hi, np.asarray(layout.cell, np.float64)
     y = points[..., 1]
     run = np.maximum(0.5 * (lo[1] + hi[1]) - y, 0.0) / max(s[1], MIN_SUN_HEIGHT)
     q = points + run[..., None] * s
     texel = (q[..., [0, 2]] - lo[[0, 2]]) / cell[[0, 2]] - 0.5        # map texel (i, k) centred at (i, k)
-    column = zero_border_bilinear(sums, texel)
+    column = zero_border_bilinear(sums, texel) * edge_weight(footprint_uv(layout, q[..., [0, 2]]), edge_fade)
     above = np.clip((hi[1] - y) / (hi[1] - lo[1]), 0.0, 1.0)
-    return 1.0 - weight * (1.0 - np.exp(-extinction * column * above))
+    return extinction * column * above

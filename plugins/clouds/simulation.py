@@ -47,6 +47,8 @@ class CloudSettings(CheckedSettings):
     to. ``smoothing_slices``: z ranges the smoothing and density maps are split into.
     ``cover_threshold``: a column counts as covered when its summed density exceeds this (cells).
     ``base_altitude``: world y of the volume's bottom (see :mod:`atmos.plugins.clouds.layout`).
+    ``edge_fade`` (0..1): the renderers fade the density to 0 over this outer fraction of the
+    volume's half width, toward its inscribed circle (:mod:`atmos.plugins.clouds.edge`; 0: the square).
     The medium and its light (physical units, :mod:`atmos.shading.medium`): ``sigma_t`` extinction
     in 1/m at density 1 (the thesis's per-cell sigma is derived: :attr:`sigma`); ``albedo``
     single-scattering albedo; ``phase_g``, ``phase_g2``, ``phase_w`` the two Henyey-Greenstein lobes
@@ -60,7 +62,7 @@ class CloudSettings(CheckedSettings):
 
     Live (the next step, or the next frame for placement and light): ``weather`` (but its ``volume_shape``),
     ``step_seconds``, ``cover_threshold``, the medium and light fields, ``scattering``, ``cell_size``,
-    ``base_altitude``. FIXED (they size the automaton, the textures, the maps and the job's
+    ``base_altitude``, ``edge_fade``. FIXED (they size the automaton, the textures, the maps and the job's
     slices): the others.
     """
     weather: WeatherSettings = WeatherSettings()
@@ -87,6 +89,7 @@ class CloudSettings(CheckedSettings):
     shading_slices_per_run: int = 8
     cell_size: tuple = (1.0, 1.0, 1.0)
     base_altitude: float = 100.0
+    edge_fade: float = 0.0
 
     FIXED = ("layout", "density_dtype", "radius", "weights", "band_height", "group_size", "smoothing_slices",
              "shading", "shading_scale", "shading_slices_per_run")
@@ -136,6 +139,7 @@ class CloudSettings(CheckedSettings):
             shading_slices_per_run=check_int(o, "shading_slices_per_run", self.shading_slices_per_run, 1, 4096),
             cell_size=check_vec(o, "cell_size", self.cell_size, 3, "positive", lo=1e-3),   # metres; 0 gives NaN
             base_altitude=check_num(o, "base_altitude", self.base_altitude),
+            edge_fade=check_num(o, "edge_fade", self.edge_fade, 0.0, 1.0),
         ))
 
     @cached_property

@@ -10,6 +10,7 @@ lattice units, in a (P_i texels_per_cell)^3 r32f volume sampled with repeat + tr
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 
@@ -21,8 +22,9 @@ GRADIENTS = np.array([(1, 1, 0), (-1, 1, 0), (1, -1, 0), (-1, -1, 0), (1, 0, 1),
                       (1, 0, -1), (-1, 0, -1), (0, 1, 1), (0, -1, 1), (0, 1, -1), (0, -1, -1)], np.float64)
 
 
+@lru_cache(maxsize=64)
 def octave_key(seed: int, octave: int) -> tuple[int, int]:
-    """The (ka, kb) hash keys of one octave's gradients."""
+    """The (ka, kb) hash keys of one octave's gradients (cached: the fog pass writes them every frame)."""
     ka, kb = stream_key(seed, 0, FOG_RULE, octave)
     return int(ka), int(kb)
 

@@ -1,10 +1,13 @@
-"""LightShaftsPlugin: shafts of light from the sky near the sun, cut by clouds and geometry (thesis 7.3.2)."""
+"""LightShaftsPlugin: shafts of sun light between the clouds, marched through the cloud shadow map
+(the default) or blurred from the open sky near the sun in screen space (thesis 7.3.2)."""
 from __future__ import annotations
 
 import math
 
 from atmos.graph import PassBuilder, PassContext, RenderPass, TextureDesc
 from atmos.plugin import Plugin
+from atmos.plugins.clouds.sets import CLOUD_SETS
+from atmos.plugins.light_shafts.march import MarchedShafts
 from atmos.plugins.light_shafts.settings import LightShaftSettings
 from atmos.plugins.light_shafts.screen_sun import screen_sun
 from atmos.render_core import COLOR, DEPTH
@@ -24,8 +27,11 @@ def blur_uniforms(program, sun_uv, settings: LightShaftSettings, strength: float
 
 
 class LightShaftsPass(RenderPass):
-    """Mask (reads "color" with its alpha, the sky occlusion, and "depth") → radial blur → added onto
-    "color" (blend ONE, ONE; alpha kept).
+    """``mode="march"``: :class:`~atmos.plugins.light_shafts.march.MarchedShafts` (reads "depth" and,
+    when the graph imports them, "cloud_sets"; blends onto "color", alpha kept).
+
+    ``mode="screen"``: mask (reads "color" with its alpha, the sky occlusion, and "depth") → radial
+    blur → added onto "color" (blend ONE, ONE; alpha kept).
 
     The mask and the blur are transients at 1/``downsample`` of the frame; "color" is only sampled
     while the mask is drawn and only written by the last draw, so it is never read and written at once.
@@ -35,11 +41,18 @@ class LightShaftsPass(RenderPass):
 
     def __init__(self, plugin: "LightShaftsPlugin"):
         self.plugin = plugin
-        self.mask = self.blur = self.composite = None
+        self.mask = self.blur = self.composite = self.marched = None
+
+    def clouds(self) -> bool:
+        """Whether the march reads cloud shadows (a clouds plugin imported "cloud_sets")."""
+        return self.plugin.graph.imports(CLOUD_SETS)
 
     def setup(self, builder: PassBuilder) -> None:
         w, h = self.plugin.gpu.size
         d = self.plugin.settings.downsample
+        if self.plugin.settings.mode == "march":
+            MarchedShafts.declare(builder, (w, h), d, self.clouds())
+            return
         desc = TextureDesc((math.ceil(w / d), math.ceil(h / d)), components=4, dtype="f2")
         builder.create(MASK, desc)
         builder.create(BLUR, desc)
@@ -52,9 +65,13 @@ class LightShaftsPass(RenderPass):
         self.mask = gpu.program(vertex_shader=fullscreen, fragment_shader="light_shafts/mask.frag")
         self.blur = gpu.program(vertex_shader=fullscreen, fragment_shader="light_shafts/blur.frag")
         self.composite = gpu.program(vertex_shader=fullscreen, fragment_shader="light_shafts/composite.frag")
+        self.marched = MarchedShafts(gpu)
 
     def execute(self, frame: PassContext) -> None:
         view, gpu, params = frame.view, frame.gpu, self.plugin.settings
+        if params.mode == "march":
+            self.marched.execute(frame, params, frame.declares(CLOUD_SETS))
+            return
         w, h = view.size
         where = screen_sun(view.camera, view.aspect, view.sun.direction, params)
         if where.strength <= 0.0 or params.exposure == 0.0 or params.weight == 0.0:
@@ -85,18 +102,19 @@ class LightShaftsPass(RenderPass):
 
 
 class LightShaftsPlugin(Plugin):
-    """Screen-space light shafts around the sun (phase post: after the sky, the scene, the clouds
-    and the fog). ``LightShaftsPlugin(settings=None, **fields)`` with :class:`LightShaftSettings`;
-    ``configure(**changes)`` changes any of them live (next frame; ``downsample`` resizes the mask)."""
+    """Light shafts (phase post: after the sky, the scene, the clouds and the fog), marched through the
+    cloud shadow map or in screen space (``mode``). ``LightShaftsPlugin(settings=None, **fields)``
+    with :class:`LightShaftSettings`; ``configure(**changes)`` changes any of them live (next frame;
+    ``mode`` and ``downsample`` change the pass's targets)."""
 
     settings_class = LightShaftSettings
 
     def __init__(self, settings: LightShaftSettings | None = None, **fields):
         super().__init__(settings, **fields)
-        self.gpu = None
+        self.gpu = self.graph = None
 
     def build(self, app) -> None:
         if app.graph is None:
             raise ValueError("LightShaftsPlugin needs an App with a GPU context (App(gpu))")
-        self.gpu = app.gpu
+        self.gpu, self.graph = app.gpu, app.graph
         app.graph.add_pass(LightShaftsPass(self))

@@ -1,4 +1,5 @@
-"""numpy float64 references of the light shafts: the occlusion mask and the radial blur toward the sun.
+"""numpy float64 references of the light shafts: the screen mode's occlusion mask and radial blur
+toward the sun, and the march mode's in-scattering along the view rays (:func:`march_shafts`).
 
 Images are (h, w, c) in GL row order (row 0 at the bottom), pixel (x, y) at uv ((x+0.5)/w, (y+0.5)/h).
 """
@@ -6,7 +7,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from atmos.hashing import lowbias32
 from atmos.plugins.cloud_shadows.reference import zero_border_bilinear
+from atmos.shading.medium import phase
 
 LUMA = np.array([0.2126, 0.7152, 0.0722])
 
@@ -50,3 +53,38 @@ def radial_blur(mask, sun_uv, settings, strength: float = 1.0) -> np.ndarray:
             out[..., ch] += zero_border_bilinear(mask[..., ch], p) * (settings.weight * falloff)
         falloff *= settings.decay
     return out * (settings.exposure * strength)
+
+
+def march_jitter(w: int, h: int) -> np.ndarray:
+    """(h, w) start offsets in [0, 1) of the marched shafts' low-res texels (shaders/light_shafts/march.frag)."""
+    x, y = np.meshgrid(np.arange(w, dtype=np.uint64), np.arange(h, dtype=np.uint64))
+    return (lowbias32((x + 65536 * y) & 0xFFFFFFFF) >> np.uint32(8)).astype(np.float64) / 16777216.0
+
+
+def march_shafts(low_depth, basis, camera_pos, near: float, far: float, frame_size, factor: int, sun_dir,
+                 irradiance, settings, optical_depth=None) -> np.ndarray:
+    """(h, w, 4) (in-scattered light, transmittance) of the marched shafts at the low-res texels of
+    ``low_depth`` (window depth, row 0 at the bottom): ``settings.steps`` samples at ``(i + jitter)·ds``
+    along each texel's view ray (through its block's centre; ``basis``: :func:`atmos.camera.view_basis`)
+    to its depth or ``max_distance``, ``L = Σ σ p(cos) E exp(−τ_sun − σ s_i) ds``, ``T = exp(−σ d)``;
+    ``optical_depth(points (..., 3)) -> (...)`` the sun's optical depth through the clouds (None: 0),
+    e.g. :func:`atmos.plugins.cloud_shadows.reference.sun_optical_depth` bound to a volume."""
+    depth = np.asarray(low_depth, np.float64)
+    h, w = depth.shape
+    x, y = np.meshgrid(np.arange(w), np.arange(h))
+    uv = np.stack([(x + 0.5) * factor / frame_size[0], (y + 0.5) * factor / frame_size[1]], -1)
+    ray = np.concatenate([uv * 2.0 - 1.0, np.ones((h, w, 1))], -1) @ np.asarray(basis, np.float64).T
+    length = np.linalg.norm(ray, axis=-1)
+    direction = ray / length[..., None]
+    view_z = near / ((1.0 - depth) + depth * (near / far))
+    d = np.minimum(np.where(depth >= 1.0, settings.max_distance, view_z * length), settings.max_distance)
+    ds = d / settings.steps
+    sigma, j = settings.scattering, march_jitter(w, h)
+    total = np.zeros((h, w))
+    for i in range(settings.steps):
+        s = (i + j) * ds
+        tau = 0.0 if optical_depth is None else optical_depth(np.asarray(camera_pos, np.float64) + direction * s[..., None])
+        total += np.exp(-tau - sigma * s)
+    p = phase(direction @ np.asarray(sun_dir, np.float64), settings.phase_g, settings.phase_g2, settings.phase_w)
+    light = np.asarray(irradiance, np.float64) * (sigma * p * total * ds)[..., None]
+    return np.concatenate([light, np.exp(-sigma * d)[..., None]], -1)

@@ -1,19 +1,36 @@
 """LightShaftSettings: the settings of the light shafts, checked as a whole before any is used (all live)."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
-from atmos.checks import CheckedSettings, check_int, check_num
+from atmos.checks import CheckedSettings, check_choice, check_int, check_num
 
+MODES = ("march", "screen")
 MAX_SAMPLES = 256
+MAX_STEPS = 256
 MAX_DOWNSAMPLE = 8
 _OWNER = "LightShaftSettings"
 
 
 @dataclass(frozen=True)
 class LightShaftSettings(CheckedSettings):
-    """Occlusion mask, radial blur toward the sun (GPU Gems 3, ch. 13) and when the effect shows.
+    """Light shafts marched through the cloud shadow map (``mode="march"``, the default) or an
+    occlusion mask blurred radially toward the sun (``mode="screen"``, GPU Gems 3, ch. 13), and when
+    the effect shows.
 
+    March (:mod:`atmos.plugins.light_shafts.march`): along each pixel's view ray to the scene depth
+    (the sky: ``max_distance`` metres), ``steps`` samples from a per-pixel jittered start gather sun
+    light scattered by a thin haze of scattering coefficient ``scattering`` (1/m, albedo 1) with the
+    two-lobe Henyey-Greenstein phase ``phase_g``, ``phase_g2``, ``phase_w`` of
+    :mod:`atmos.shading.medium`, the sun irradiance ``sun_intensity × Sun.color`` reaching each
+    sample through the clouds (the ground shadows' density maps, :mod:`atmos.plugins.cloud_shadows`;
+    no clouds: unshadowed haze) and the haze's own transmittance toward the eye, which also dims the
+    colour behind. At 1/``downsample`` resolution, upsampled by depth. Shafts are real rays: the air
+    between cloud shadows is lit, the air in them is not. ``horizon_fade`` fades it with the sun's
+    height; ``samples`` … ``ceiling``, ``radius``, ``front_fade``, ``edge_fade`` are the screen mode's.
+
+    Screen:
     Mask: sky pixels (depth 1) whose luminance exceeds ``threshold`` (linear HDR) keep the excess,
     at most ``ceiling`` (so the sun disc does not outshine the sky around it), in their own colour,
     times how open to the sky they are, ``1 − color.a``, times ``exp(−(r/radius)²)``, r the distance
@@ -31,6 +48,14 @@ class LightShaftSettings(CheckedSettings):
     outside it (in screen widths/heights).
     """
 
+    mode: str = "march"
+    steps: int = 24
+    scattering: float = 2e-5
+    max_distance: float = 6000.0
+    phase_g: float = 0.7
+    phase_g2: float = -0.2
+    phase_w: float = 0.2
+    sun_intensity: float = 4.0 * math.pi
     samples: int = 48
     density: float = 0.9
     decay: float = 0.96
@@ -47,6 +72,14 @@ class LightShaftSettings(CheckedSettings):
     def __post_init__(self):
         o = _OWNER
         checked = dict(
+            mode=check_choice(o, "mode", self.mode, MODES),
+            steps=check_int(o, "steps", self.steps, 1, MAX_STEPS),
+            scattering=check_num(o, "scattering", self.scattering, 0.0, 1.0),
+            max_distance=check_num(o, "max_distance", self.max_distance, 0.0, 1e7, lo_open=True),
+            phase_g=check_num(o, "phase_g", self.phase_g, -0.99, 0.99),
+            phase_g2=check_num(o, "phase_g2", self.phase_g2, -0.99, 0.99),
+            phase_w=check_num(o, "phase_w", self.phase_w, 0.0, 1.0),
+            sun_intensity=check_num(o, "sun_intensity", self.sun_intensity, 0.0),
             samples=check_int(o, "samples", self.samples, 1, MAX_SAMPLES),
             density=check_num(o, "density", self.density, 0.0, 1.0, lo_open=True),
             decay=check_num(o, "decay", self.decay, 0.0, 1.0, lo_open=True),

@@ -67,7 +67,7 @@ class MeshPass(RenderPass):
     def __init__(self, plugin: "MeshPlugin"):
         self.plugin = plugin
         self.program = None
-        self.buffers: dict[int, list] = {}       # mesh id -> [vbo, ibo, instance buffer, vao, last frame used]
+        self.buffers: dict[int, list] = {}       # mesh id -> [vbo, ibo, instance buffer, vao, last frame used, vertices]
         self.frame = 0
 
     def setup(self, builder: PassBuilder) -> None:
@@ -102,7 +102,7 @@ class MeshPass(RenderPass):
         set_scene_uniforms(self.program, frame.view)
         self.program["sky_ambient"].value = tuple(float(v) for v in frame.view.sun.ambient)
         for mesh, data in self.plugin.instances.items():
-            vbo, ibo, inst, vao, _, vertices = self._buffers(gpu, mesh, len(data))
+            _, _, inst, vao, _, vertices = self._buffers(gpu, mesh, len(data))
             inst.write(data.tobytes())
             vao.render(gpu.ctx.TRIANGLES, vertices=vertices, instances=len(data))
         for mesh_id in [k for k, e in self.buffers.items() if self.frame - e[4] > EVICT_FRAMES]:

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from atmos.checks import CheckedSettings, check_bool, check_int
-from atmos.graph import PassBuilder, PassContext, RenderPass
+from atmos.graph import FullscreenPass, PassBuilder, PassContext
 from atmos.plugin import Plugin
 from atmos.render_core import SCREEN
 
@@ -62,23 +62,24 @@ def record_frame_time(app) -> None:
     app.resource(FrameTimes).record()
 
 
-class OverlayPass(RenderPass):
+class OverlayPass(FullscreenPass):
     name = "overlay"
     phase = "overlay"
+    fragment = "overlay/bars.frag"
+    reads = (SCREEN,)                       # blends onto it
+    writes = (SCREEN,)
 
     def __init__(self, plugin: "OverlayPlugin"):
-        self.plugin = plugin
+        super().__init__(plugin)
         self.times = plugin.times
-        self.program = self.data = None
+        self.data = None
 
     def setup(self, builder: PassBuilder) -> None:
-        if not self.plugin.settings.visible:
-            return                          # declares nothing: culled until it is shown again
-        builder.read(SCREEN)                # blends onto it
-        builder.write(SCREEN)
+        if self.plugin.settings.visible:    # hidden: declares nothing, culled until it is shown again
+            super().setup(builder)
 
     def prepare(self, gpu) -> None:
-        self.program = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="overlay/bars.frag")
+        super().prepare(gpu)
         self.data = gpu.track(gpu.ctx.texture((HISTORY, 1), 1, dtype="f4"))
         self.data.filter = (gpu.ctx.NEAREST, gpu.ctx.NEAREST)
 

@@ -3,7 +3,6 @@ from __future__ import annotations
 
 from atmos.camera import set_camera_uniforms
 from atmos.graph import FullscreenPass, PassContext
-from atmos.lighting import sun_and_day
 from atmos.plugin import Plugin
 from atmos.plugins.sky.settings import SkySettings
 from atmos.plugins.sky.shader import set_sky_uniforms, sky_defines
@@ -27,8 +26,8 @@ class SkyPass(FullscreenPass):
         where_nothing_was_drawn(frame)
         camera = view.camera
         set_camera_uniforms(p, camera, view.aspect)      # view_basis
-        s, _ = sun_and_day(view.sun)
-        set_sky_uniforms(p, self.plugin.settings, s, view.sun.color, view.time, camera.fov_y / max(1, view.size[1]))
+        set_sky_uniforms(p, self.plugin.settings, view.sun.direction, view.sun.color, view.time,
+                         camera.fov_y / max(1, view.size[1]))
         frame.fullscreen(p)
 
 

@@ -6,7 +6,6 @@ from functools import lru_cache
 
 import numpy as np
 
-from atmos.camera import gl_matrix3, view_basis
 from atmos.plugins.sky import stars
 from atmos.plugins.sky.settings import SkySettings
 from atmos.plugins.sky.preetham import COS_FLOOR, unit_vectors
@@ -45,11 +44,6 @@ def sky_defines() -> dict:
             "STAR_HORIZON": repr(stars.STAR_HORIZON),
             "TWINKLE_PERIOD": repr(stars.TWINKLE_PERIOD), "TWINKLE_CYCLES_LO": stars.TWINKLE_CYCLES[0],
             "TWINKLE_CYCLES_HI": stars.TWINKLE_CYCLES[1]}
-
-
-def set_view_basis(program, camera, aspect: float) -> None:
-    """Write the ``view_basis`` uniform of ``sky/sky.frag`` (:func:`atmos.camera.view_basis`)."""
-    program["view_basis"].write(gl_matrix3(view_basis(camera, aspect)))
 
 
 def set_sky_uniforms(program, settings: SkySettings, sun_dir, sun_color, time: float = 0.0,

@@ -10,13 +10,13 @@ i.e. 1 at the centre falling *linearly* with the normalized ellipsoid distance r
 surface (the thesis: "a linear interpolation between the center and the surface"), 0 outside
 every ellipsoid. Ellipsoids with a radius <= 0 (fully shrunk) contribute nothing.
 
-Ellipsoid arrays are (n, 8) with the columns of :data:`COLUMNS`: centre relative to the volume
+Ellipsoid arrays are (n, 8) with the columns of :data:`.components.COLUMNS`: centre relative to the volume
 origin, yaw (radians, around y), the radii already multiplied by the shrink scale, and a pad.
 """
 from __future__ import annotations
 
 import numpy as np
-from atmos.plugins.weather.components import COLUMNS, NCOLS, check_ellipsoid_array
+from atmos.plugins.weather.components import check_ellipsoid_array
 
 
 def region_volume(ellipsoids, shape) -> np.ndarray:

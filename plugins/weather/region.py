@@ -20,6 +20,7 @@ import math
 import moderngl
 import numpy as np
 
+from atmos.checks import check_shape
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.plugins.weather.components import check_ellipsoid_array
 
@@ -34,16 +35,10 @@ class RegionVolume:
 
     def __init__(self, gpu: GpuContext, shape, dtype: str = "f4"):
         self.gpu, self.ctx = require_gpu(gpu), gpu.ctx
-        try:
-            shape = tuple(shape)
-        except TypeError:
-            shape = None
-        if (shape is None or len(shape) != 3
-                or not all(isinstance(n, (int, np.integer)) and not isinstance(n, bool) and n >= 1 for n in shape)):
-            raise ValueError(f"shape must be three positive ints (nx, ny, nz), got {shape!r}")
+        shape = check_shape(shape)
         if dtype not in _FORMATS:
             raise ValueError(f"dtype must be one of {tuple(_FORMATS)} (r32f or r16f), got {dtype!r}")
-        self.shape = tuple(int(n) for n in shape)
+        self.shape = shape
         self.dtype = dtype
         cells = math.prod(self.shape)
         limit = int(self.ctx.info.get("GL_MAX_SHADER_STORAGE_BLOCK_SIZE", 2**27))

@@ -74,9 +74,10 @@ void main() {
                 if (all(lessThan(c, volume_shape)))
                     sum += mix(da, texelFetch(density_b, c, 0).r, t);
             }
+    vec3 center = vec3(cell) + 0.5 * float(s);
+    sum *= cloud_edge_weight(center.xz / vec2(volume_shape.xz), edge_fade);
     if (!(sum > 0.0)) return;
     float d = sum / float(s * s * s);
-    vec3 center = vec3(cell) + 0.5 * float(s);
     vec3 world = layer_min + center * cell_size;
     vec4 clip = view_proj * vec4(world, 1.0);
     float diameter = float(s) * base_diameter * mix(SMALLEST, 1.0, min(d, 1.0));

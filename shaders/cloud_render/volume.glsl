@@ -17,6 +17,8 @@ uniform vec3 sun_dir;          // toward the sun, unit
 uniform vec3 phase_lobes;      // g, g2, w
 uniform vec3 ms_octaves;       // a (attenuation), b (contribution), c (eccentricity)
 uniform float column_tau;      // sigma_t * cell height: optical depth of one cell of density 1, vertically
+uniform float edge_fade;       // CloudSettings.edge_fade: density fades to 0 toward the inscribed circle
+#include "clouds/edge.glsl"
 const int COLUMN_SAMPLES = 8;
 const float PI = 3.14159265358979;
 
@@ -27,7 +29,7 @@ vec3 a_uvw(vec3 uvw) {
 }
 
 float cloud_density(vec3 uvw) {
-    return mix(textureLod(density_a, a_uvw(uvw), 0.0).r, textureLod(density_b, uvw, 0.0).r, t);
+    return cloud_edge_weight(uvw.xz, edge_fade) * mix(textureLod(density_a, a_uvw(uvw), 0.0).r, textureLod(density_b, uvw, 0.0).r, t);
 }
 
 float cloud_transmittance(vec3 uvw) {
@@ -58,10 +60,7 @@ vec3 ambient_source(float tau_up, float tau_down, float ray_y) {
          + ground_source * (1.0 - s) * exp(-ms_octaves.x * tau_down);
 }
 
-float hg(float c, float g) {
-    float d = max(1.0 + g * g - 2.0 * g * c, 1e-6);
-    return (1.0 - g * g) / (4.0 * PI * d * sqrt(d));
-}
+#include "lib/phase.glsl"
 
 // sun_source * sum_i w_i p(cos; c^i g): the sun's part of J for a view ray with dot(ray, sun_dir) = c.
 vec3 sun_part(vec4 w, float c) {

@@ -1,0 +1,60 @@
+"""CloudFarFieldSettings: the far field's look, checked as a whole before any of it is used (all live)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from atmos.checks import CheckedSettings, check_bool, check_int, check_num, check_vec
+
+_OWNER = "CloudFarFieldSettings"
+TEXTURE_SETTINGS = ("size", "base_frequency", "seed", "light_step")   # changing one re-bakes the octaves
+
+
+@dataclass(frozen=True)
+class CloudFarFieldSettings(CheckedSettings):
+    """The cloud layer beyond the simulated volume (:mod:`atmos.plugins.cloud_far_field`).
+
+    Its cover follows the simulation's (the covered fraction of the volume's columns, measured on
+    the GPU each frame); ``softness`` is the fbm range over which a column goes from clear to
+    cloud. ``thickness``: how fast coverage rises with the remapped density (α = 1 − exp(−thickness·d)).
+    ``optical_depth``: optical depth of a full column, vertically and toward the sun (its light
+    comes from the cloud medium's own model, ``cloud_render/volume.glsl``). ``tile_size``: metres
+    one octave-texture repeat covers; ``wind``: (x, z) drift in m/s (the pattern moves with the
+    App clock unless ``animate`` is False). ``horizon_fade``: it fades in while the view ray's
+    height rises from 0 to this (sin of the elevation). ``size``, ``base_frequency``, ``seed``,
+    ``light_step``: the octave textures (:class:`atmos.plugins.sky_layer.octaves.OctaveTextures`).
+    ``enabled`` False draws nothing.
+    """
+
+    softness: float = 0.2
+    thickness: float = 3.0
+    optical_depth: float = 8.0
+    tile_size: float = 8000.0
+    wind: tuple = (0.0, 0.0)
+    horizon_fade: float = 0.015
+    size: int = 256
+    base_frequency: int = 4
+    seed: int = 0
+    light_step: float = 0.01
+    animate: bool = True
+    enabled: bool = True
+
+    def __post_init__(self):
+        o = _OWNER
+        self.store(dict(
+            softness=check_num(o, "softness", self.softness, 1e-3, 1.0),
+            thickness=check_num(o, "thickness", self.thickness, 0.0),
+            optical_depth=check_num(o, "optical_depth", self.optical_depth, 0.0, 1e3),
+            tile_size=check_num(o, "tile_size", self.tile_size, 1.0, 1e7),
+            wind=check_vec(o, "wind", self.wind, 2),
+            horizon_fade=check_num(o, "horizon_fade", self.horizon_fade, 0.0, 1.0, lo_open=True),
+            size=check_int(o, "size", self.size, 16, 2048),
+            base_frequency=check_int(o, "base_frequency", self.base_frequency, 1, 64),
+            seed=check_int(o, "seed", self.seed, 0, 2**32 - 1),
+            light_step=check_num(o, "light_step", self.light_step, 0.0, 0.25),
+            animate=check_bool(o, "animate", self.animate),
+            enabled=check_bool(o, "enabled", self.enabled),
+        ))
+
+    def texture_key(self) -> tuple:
+        """The settings the baked octave textures depend on (what ``OctaveTextures`` asks of its settings)."""
+        return tuple(getattr(self, name) for name in TEXTURE_SETTINGS)

@@ -1,0 +1,76 @@
+"""The march mode of the light shafts: sun light scattered by a thin haze along each view ray,
+shadowed by the clouds through the ground shadows' density maps (shaders/light_shafts/march.frag),
+at low resolution and upsampled by depth with the off-screen clouds' draws
+(:class:`~atmos.plugins.cloud_render.offscreen.OffscreenClouds`). Reference: :func:`.reference.march_shafts`."""
+from __future__ import annotations
+
+import numpy as np
+
+from atmos.camera import set_camera_uniforms
+from atmos.graph import PassBuilder, PassContext
+from atmos.lighting import unit_sun
+from atmos.plugins.cloud_render.offscreen import OffscreenClouds
+from atmos.plugins.cloud_shadows.plugin import column_uniforms
+from atmos.plugins.clouds.sets import CLOUD_SETS, CloudSets
+from atmos.render_core import COLOR, DEPTH
+
+SHAFT_COLOR = "light_shafts_march"     # low-res (in-scattered light, transmittance)
+SHAFT_DEPTH = "light_shafts_depth"     # low-res farthest scene depth
+
+
+def march_irradiance(sun, settings) -> np.ndarray | None:
+    """The sun irradiance the haze is lit by, ``sun_intensity × Sun.color`` × smoothstep(0,
+    ``horizon_fade``, sun height); None when nothing would show (no sun, below the horizon, black)."""
+    s = unit_sun(sun.direction)
+    if s is None or s[1] <= 0.0 or settings.scattering == 0.0:
+        return None
+    x = min(float(s[1]) / settings.horizon_fade, 1.0)
+    e = settings.sun_intensity * x * x * (3.0 - 2.0 * x) * np.asarray(sun.color, np.float64)
+    return e if e.max() > 0.0 else None
+
+
+class MarchedShafts:
+    """The march's declarations and draws for a LightShaftsPass (programs belong to the GpuContext)."""
+
+    def __init__(self, gpu):
+        self.offscreen = OffscreenClouds(gpu, SHAFT_COLOR, SHAFT_DEPTH)
+        self.march = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="light_shafts/march.frag")
+
+    @staticmethod
+    def declare(builder: PassBuilder, size, factor: int, clouds: bool) -> None:
+        OffscreenClouds.declare(builder, size, factor, color=SHAFT_COLOR, depth=SHAFT_DEPTH)
+        builder.read(DEPTH)
+        builder.read(COLOR)
+        builder.write(COLOR)
+        if clouds:
+            builder.read(CLOUD_SETS)
+
+    def execute(self, frame: PassContext, settings, clouds: bool) -> None:
+        view = frame.view
+        irradiance = march_irradiance(view.sun, settings)
+        if irradiance is None:
+            return
+        factor = settings.downsample
+        self.offscreen.begin(frame, factor)
+        frame.reset_state()
+        frame.framebuffer(color=[SHAFT_COLOR]).use()
+        p = self.march
+        frame.resource(SHAFT_DEPTH).use(2)
+        if clouds:
+            sim: CloudSets = frame.resource(CLOUD_SETS)
+            a, b, _ = sim.view()
+            sim.maps_of(a).sums.use(0)
+            sim.maps_of(b).sums.use(1)
+            column_uniforms(p, sim, sim.layout(), sim.settings.sigma)
+        p["has_clouds"].value = int(clouds)
+        set_camera_uniforms(p, view.camera, view.aspect)
+        p["sun_dir"].value = tuple(unit_sun(view.sun.direction))
+        p["irradiance"].value = tuple(float(v) for v in irradiance)
+        p["lobes"].value = settings.phase_g, settings.phase_g2, settings.phase_w
+        p["scattering"].value = settings.scattering
+        p["max_distance"].value = settings.max_distance
+        p["steps"].value = settings.steps
+        p["factor"].value = factor
+        p["frame_size"].value = tuple(float(v) for v in view.size)
+        frame.fullscreen(p)
+        self.offscreen.end(frame, factor, view.camera.near, view.camera.far, medium=True)
