@@ -1,6 +1,7 @@
 """numpy float64 references of the off-screen clouds' depth and composite draws (:mod:`.offscreen`).
 
-Images are (h, w, ...) in GL row order (row 0 at the bottom).
+Images are (h, w, ...) in GL row order (row 0 at the bottom). The sprites drawn off screen fade against
+:func:`far_depth` (:func:`atmos.plugins.cloud_render.reference.soft_fade`).
 """
 from __future__ import annotations
 

@@ -8,7 +8,9 @@ vertex order, so the back-to-front order holds inside a unit too). The vertex sh
 density and transmittance as mix(A, B, t), throws empty cells out of the view volume, sizes the
 sprite from distance and density, and lights it (the source J of :mod:`atmos.shading.medium`: octave
 weights of the sun's transmittance, sky and ground light dimmed by the columns above and below); the
-fragment shader applies the soft particle and the phase function at its own view ray. Blending is premultiplied (ONE, ONE_MINUS_SRC_ALPHA), so "color"'s alpha stays
+fragment shader applies the particle profile and the phase function at its own view ray, and fades the
+sprite out over its radius in front of the scene's depth (soft particles: no hard line where a sprite
+meets terrain). Blending is premultiplied (ONE, ONE_MINUS_SRC_ALPHA), so "color"'s alpha stays
 in [0, 1]; the depth test runs against the scene's "depth" with depth writes off.
 
 Opacity: a sprite of world diameter D = ``size_factor × max(cx, cz) × (0.75 + 0.25 min(density, 1))``
@@ -156,6 +158,7 @@ def sprite_uniforms(plugin, sim, layout: CloudLayout, camera: Camera, aspect: fl
             "base_diameter": float(settings.size_factor * max(cell[0], cell[2])),
             "pixel_scale": float(height) / 2.0 * float(camera_matrices(camera, aspect).projection[1, 1]),
             "max_point_size": float(limit), "tau_scale": float(tau_scale), "near": float(camera.near),
+            "far": float(camera.far),
             "camera_pos": tuple(float(v) for v in camera.position),
             "camera_right": tuple(float(v) for v in camera.right()),
             "camera_up": tuple(float(v) for v in camera.up())}
@@ -256,6 +259,8 @@ class CloudSpritePass(RenderPass):
             fbo.use()
         else:
             fbo = self.offscreen.begin(frame, factor, distance)
+        # the soft particles' scene depth: the attached depth target's (sampled, never written)
+        frame.resource(DEPTH if factor == 1 else self.offscreen.depth).use(5)
         p["view_proj"].write(matrices.gl("view_proj"))
         for name, value in uniforms.items():
             if name in p:              # a compiler may drop a uniform a variant does not use

@@ -3,9 +3,10 @@
 Given the densities and transmittances of sets A and B (``[x, y, z]`` arrays, the transmittance at
 its own shading resolution), the segments and the uniforms, it returns what every
 (instance, vertex) outputs, instance-major like the GPU: the clip position (``CULLED`` for empty
-blocks and blocks past the edge), point size, the light (octave weights of the sun's transmittance,
-the sky and ground light dimmed by the columns above and below: :mod:`atmos.shading.medium`), world
-centre and radius, centre optical depth and coverage.
+blocks and blocks past the edge), point size, the light (octave weights of the sun's transmittance
+averaged over 8 samples spread like the block's mass, the sky and ground light dimmed by the columns
+above and below: :mod:`atmos.shading.medium`), the world centre of mass and radius, centre optical depth and coverage; :func:`soft_fade` is the fragment's fade
+against the scene depth.
 """
 from __future__ import annotations
 
@@ -19,6 +20,7 @@ CULLED = np.array([0.0, 0.0, 2.0, 1.0])
 
 
 SMALLEST = 0.75     # an all but empty block's sprite diameter relative to a dense one's
+HAT_SPREAD = 1.0 / 9.0   # sprite.vert: light samples at the centre of mass ± sqrt(variance + 1/9) cells
 
 
 def toward(k, n: int, c: float, s: int):
@@ -92,7 +94,7 @@ def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, 
     d_full = shifted(a64, shift) * (1.0 - t) + b64 * t
     levels, spans_x, spans_z = unpack(seg[:, 3])
     padded = np.pad(d_full, [(0, 1 << int(levels.max(initial=0)))] * 3)   # cells past the edge are empty
-    cells, sums, spans = [], [], []
+    cells, sums, firsts, seconds, spans = [], [], [], [], []
     camera = np.asarray(u["camera_cell"], np.float32)
     for (gi, j, gk, _), level, sx, sz in zip(seg, levels, spans_x, spans_z):
         s = 1 << level
@@ -100,7 +102,10 @@ def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, 
         origin = np.stack([gi * gx + local[:, 0], np.full(len(local), j * s), gk * gz + local[:, 1]], -1)
         offsets = np.stack(np.meshgrid(*[np.arange(s)] * 3, indexing="ij"), -1).reshape(-1, 3)
         idx = np.minimum(origin[:, None, :] + offsets[None], np.array(padded.shape) - 1)
-        sums.append(padded[idx[..., 0], idx[..., 1], idx[..., 2]].sum(1))
+        mass = padded[idx[..., 0], idx[..., 1], idx[..., 2]]
+        sums.append(mass.sum(1))
+        firsts.append(mass @ (offsets + 0.5))
+        seconds.append(mass @ (offsets + 0.5) ** 2)
         cells.append(origin)
         spans.append(np.full(len(local), s))
     c = np.concatenate(cells)
@@ -109,20 +114,25 @@ def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, 
     inside = (c < shape).all(-1)
     visible = inside & (total > 0)
     d = total / s ** 3
-    center = c + 0.5 * s[:, None]
-    if trans_a is None:
-        T = np.ones(len(c))
-    else:
-        points = center / shape * np.array(np.shape(trans_a)) - 0.5
-        points_a = (center + shift) / shape * np.array(np.shape(trans_a)) - 0.5
-        T = trilinear(np.asarray(trans_a, np.float64), points_a) * (1 - t) + \
-            trilinear(np.asarray(trans_b, np.float64), points) * t
+    weight = np.maximum(total, 1e-300)[:, None]
+    mean = np.concatenate(firsts) / weight
+    spread = np.sqrt(np.maximum(np.concatenate(seconds) / weight - mean ** 2, 0.0) + HAT_SPREAD)
+    center = c + np.where(visible[:, None], mean, 0.5 * s[:, None])     # the block's centre of mass
     a_ms, b_ms, _ = light["ms_octaves"]
     uvw = center / shape
     uvw_a = (center + shift) / shape
     up, down = ((1.0 - t) * column_depth(a64, uvw_a, d, light["column_tau"]) +
                 t * column_depth(b64, uvw, d, light["column_tau"]) for d in (1.0, -1.0))
-    octaves = octave_weights(T, up + down, a_ms, b_ms)
+    octaves = np.zeros((len(c), 4))
+    for side in np.stack(np.meshgrid(*[(-1.0, 1.0)] * 3, indexing="ij"), -1).reshape(-1, 3):
+        tap = center + side * spread
+        if trans_a is None:
+            T = np.ones(len(c))
+        else:
+            tex = np.array(np.shape(trans_a))
+            T = trilinear(np.asarray(trans_a, np.float64), (tap + shift) / shape * tex - 0.5) * (1 - t) + \
+                trilinear(np.asarray(trans_b, np.float64), tap / shape * tex - 0.5) * t
+        octaves += octave_weights(T, up + down, a_ms, b_ms) / 8.0
     world = np.asarray(u["layer_min"]) + center * np.asarray(u["cell_size"])
     ray = world - np.asarray(u["camera_pos"], np.float64)
     sky_share, ground_share = ambient_shares(*light["phase_lobes"], ray[:, 1] / np.linalg.norm(ray, axis=1))
@@ -141,3 +151,12 @@ def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, 
             "coverage": np.where(visible, np.clip(px, 0.0, 1.0) ** 2 *
                                  np.clip((clip[:, 3] - u["near"]) / np.maximum(diameter, 1e-30), 0.0, 1.0), 0.0),
             "visible": visible}
+
+
+def soft_fade(scene_depth, sprite_depth, radius, near: float, far: float) -> np.ndarray:
+    """The soft-particle factor of ``sprite.frag``: clamp((scene view depth − sprite view depth) / radius,
+    0, 1), ``scene_depth`` the window depth under the fragment (off screen: :func:`.offscreen_reference.far_depth`
+    of the frame's), ``sprite_depth`` the sprite centre's view depth (its clip w)."""
+    d = np.asarray(scene_depth, np.float64)
+    scene = near / ((1.0 - d) + d * (near / far))
+    return np.clip((scene - np.asarray(sprite_depth, np.float64)) / np.asarray(radius, np.float64), 0.0, 1.0)

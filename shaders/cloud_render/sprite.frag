@@ -1,8 +1,15 @@
 #version 430
 // A soft cloud particle: opacity 1 - exp(-tau × falloff), premultiplied (blend ONE, ONE_MINUS_SRC_ALPHA);
 // its light J (volume.glsl) with the phase function at this pixel's view ray through the sprite's plane.
+// Soft particle: × clamp((scene view depth - sprite view depth) / radius, 0, 1), so a sprite meeting
+// terrain fades out over its radius instead of cutting a line (float64: reference.soft_fade). The scene
+// depth is the attached depth target's (depth writes are off): "depth", or off screen the block's farthest.
 #include "cloud_render/volume.glsl"
+#include "lib/view_ray.glsl"
 layout(binding = 4) uniform sampler2D particle;
+layout(binding = 5) uniform sampler2D scene_depth;
+uniform float near;
+uniform float far;
 uniform vec3 camera_pos;
 uniform vec3 camera_right;
 uniform vec3 camera_up;
@@ -16,7 +23,9 @@ out vec4 frag;
 layout(location = 1) out vec4 frag_distance;   // (a·distance, a): "cloud_distance" when attached (atmos/composition.py)
 
 void main() {
-    float a = (1.0 - exp(-v_tau * texture(particle, gl_PointCoord).r)) * v_coverage;
+    float scene = view_depth(texelFetch(scene_depth, ivec2(gl_FragCoord.xy), 0).r, near, far);
+    float soft = clamp((scene - 1.0 / gl_FragCoord.w) / v_radius, 0.0, 1.0);   // 1 / w: the sprite's view depth
+    float a = (1.0 - exp(-v_tau * texture(particle, gl_PointCoord).r)) * v_coverage * soft;
     vec2 q = (gl_PointCoord - 0.5) * vec2(2.0, -2.0) * v_radius;
     vec3 ray = normalize(v_center + q.x * camera_right + q.y * camera_up - camera_pos);
     frag = vec4((sun_part(v_octaves, dot(ray, sun_dir)) + v_ambient) * a, a);
