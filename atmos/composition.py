@@ -10,15 +10,16 @@ and ``g`` the layer's coverage. A media pass then fogs a pixel by ``g · f(r / g
 
 A pass cannot declare an optional read, so the plugins meet in the App resource
 :class:`Composition`: a layer that can write the distance adds its name to ``writers`` in
-``build``, a media pass that wants it adds itself to ``readers``. The layer's pass creates
-``"cloud_distance"`` only if there is a reader, the reader reads it only if there is a writer:
-a scene without fog allocates no distance target, a fog without clouds reads none.
+``build``, a media pass that wants it adds itself to ``readers``. When there are both, the pass
+:class:`ClearDistance` (phase clear, added with the Composition) creates ``"cloud_distance"`` and
+clears it to 0, every layer reads and writes it (the far field, then the sprites over it), and the
+readers read it: a scene without fog allocates no distance target, a fog without clouds reads none.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from atmos.graph import TextureDesc
+from atmos.graph import RenderPass, TextureDesc
 
 CLOUD_DISTANCE = "cloud_distance"
 
@@ -40,10 +41,30 @@ class Composition:
         return bool(self.writers) and bool(self.readers)
 
 
+class ClearDistance(RenderPass):
+    """Pass "cloud_distance_clear" (phase clear): creates ``"cloud_distance"`` at the frame's size and
+    clears it to 0 (no layer) when the Composition has a writer and a reader; else declares nothing
+    (culled)."""
+    name = "cloud_distance_clear"
+    phase = "clear"
+
+    def __init__(self, comp: Composition, gpu):
+        self.comp, self.gpu = comp, gpu
+
+    def setup(self, builder) -> None:
+        if self.comp.distance:
+            builder.create(CLOUD_DISTANCE, distance_desc(self.gpu.size))
+
+    def execute(self, frame) -> None:
+        frame.framebuffer(color=[CLOUD_DISTANCE]).clear(0.0, 0.0, 0.0, 0.0)
+
+
 def composition(app) -> Composition:
-    """The App's :class:`Composition` (made on first use)."""
+    """The App's :class:`Composition` (made on first use, with its :class:`ClearDistance` pass)."""
     comp = app.get_resource(Composition)
     if comp is None:
         comp = Composition()
         app.insert_resource(comp)
+        if app.graph is not None:
+            app.graph.add_pass(ClearDistance(comp, app.gpu))
     return comp

@@ -7,7 +7,8 @@ from atmos.camera import Camera
 from atmos.demo_registry import DemoSettings
 from atmos.gpu import create_headless
 from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
-from atmos.plugins.cloud_far_field.cover import emptiness, fbm_quantiles, volume_cover
+from atmos.plugins.cloud_far_field.cover import emptiness, fbm_quantiles
+from atmos.plugins.cloud_far_field.reference import volume_cover
 from atmos.plugins.clouds import CloudSimulation
 from atmos.plugins.clouds.edge import edge_weight
 from atmos.runner import build_app

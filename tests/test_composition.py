@@ -5,7 +5,7 @@ import pytest
 
 from atmos import App, DefaultPlugins
 from atmos.camera import Camera, view_basis
-from atmos.composition import CLOUD_DISTANCE, Composition
+from atmos.composition import CLOUD_DISTANCE, ClearDistance, Composition
 from atmos.graph import RenderPass
 from atmos.lighting import Sun
 from atmos.plugins.cloud_render import CloudRenderPlugin
@@ -122,8 +122,8 @@ def test_a_cloud_scene_without_fog_allocates_no_distance_target(fresh_gpu):
     app, _ = cloud_app(fresh_gpu, 2, FogPlugin(mode="exp", density=1e-4, sky="keep"))
     app.render()
     compiled = app.graph.compile()
-    assert compiled.resources[CLOUD_DISTANCE].creator == "cloud_render"
-    assert compiled.resources[CLOUD_DISTANCE].readers == ["fog"]
+    assert compiled.resources[CLOUD_DISTANCE].creator == ClearDistance.name      # the shared clear
+    assert compiled.resources[CLOUD_DISTANCE].readers == ["cloud_render", "fog"]   # the layer blends onto it
     app.close()
     app = App(fresh_gpu).add_plugins(DefaultPlugins(overlay=False), FogPlugin())     # fog without clouds
     app.startup()
@@ -158,5 +158,48 @@ def test_fog_attenuates_a_cloud_over_the_sky_by_the_clouds_own_distance(gpu, ctx
     assert np.abs(fogged - want).max() < 4e-3 * max(1.0, want.max())      # the colour target is float16
     covered = a > 0.5
     assert np.abs(fogged - clear)[covered].mean() > 0.1, "clouds over the sky are fogged (not skipped as sky)"
+    assert np.array_equal(fogged[a == 0], clear[a == 0]), "the open sky is kept"
+    app.close()
+
+
+def test_fog_attenuates_the_far_field_by_its_own_distance(gpu, ctx):
+    from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
+    fog = FogPlugin(mode="exp", density=0.0, sky="keep", fog_color=(0.9, 0.6, 0.3))
+    density = np.zeros(SHAPE, np.float32)
+    density[4:12, 1:3, 4:12] = 1.0
+    settings = CloudSettings(cell_size=CELL, base_altitude=BASE, group_size=(8, 8), smoothing_slices=1, sigma_t=0.01,
+                             edge_fade=0.4)                        # the far field fills what the volume fades out
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(settings, density=density),
+                               CloudFarFieldPlugin(animate=False), fog)
+    readback = app.graph.add_pass(DistanceReadback())
+    app.resource(Composition).readers.add("distance_readback")
+    origin = app.resource(VolumeOrigin)
+    origin.x, origin.z = 0.0, 0.0
+    app.insert_resource(Sun.from_angles(40.0, 70.0))
+    app.startup()
+    cam = app.resource(Camera)
+    cam.position = np.array([320.0, 150.0, 1400.0])
+    cam.look_at(np.array([320.0, 1400.0, 9000.0]))                # away from the volume: only the far field
+    cam.near, cam.far = 1.0, 20000.0
+    app.run_frames(2)
+    clear = app.read_linear()[..., :3].astype(np.float64)
+    cloud = readback.value.astype(np.float64)
+    a = cloud[..., 1]
+    assert a.max() > 0.5 and (a == 0).mean() > 0.05, "the view holds far-field clouds and open sky"
+    w, h = gpu.size
+    xs, ys = 2 * (np.arange(w) + 0.5) / w - 1, 1 - 2 * (np.arange(h) + 0.5) / h
+    ndc = np.stack(np.broadcast_arrays(xs[None, :], ys[:, None], 1.0), -1)
+    dirs = unit(ndc @ view_basis(cam, w / h).T)
+    layout = next(p for p in app.plugins if isinstance(p, CloudsPlugin)).simulation.sets().layout()
+    plane = (0.5 * (layout.lo[1] + layout.hi[1]) - cam.position[1]) / dirs[..., 1]   # float64: the layer's hit
+    seen = a > 0.05
+    assert np.abs(cloud[..., 0][seen] / a[seen] / plane[seen] - 1.0).max() < 2e-3, "the far field's own distance"
+    fog.configure(density=1e-4)
+    app.render()
+    fogged = app.read_linear()[..., :3].astype(np.float64)
+    want = apply_fog_ref(clear, np.full((h, w), np.inf), fog.settings, cloud=cloud, directions=dirs,
+                         camera=cam.position)
+    assert np.abs(fogged - want).max() < 4e-3 * max(1.0, want.max())      # the colour target is float16
+    assert np.abs(fogged - clear)[a > 0.5].mean() > 0.05, "far-field clouds over the sky are fogged"
     assert np.array_equal(fogged[a == 0], clear[a == 0]), "the open sky is kept"
     app.close()

@@ -3,7 +3,7 @@
 On the GPU (``cloud_far_field/cover.comp``), each frame: the edge-weighted fraction of the volume's
 columns that are covered (summed density of mix(A, B, t) above ``CloudSettings.cover_threshold``),
 ``cover = Σ w·[sum > threshold] / Σ w`` with ``w`` the edge weight (:mod:`atmos.plugins.clouds.edge`)
-at the column's centre; :func:`volume_cover` is it in float64. The far-field shader turns it into
+at the column's centre; :func:`.reference.volume_cover` is it in float64. The far-field shader turns it into
 the fbm threshold that leaves that fraction of its layer clear of cloud: the (1 − cover) quantile of
 the layer's fbm, interpolated in the table :func:`fbm_quantiles` makes once per texture setting.
 """
@@ -13,10 +13,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from atmos.plugins.clouds.edge import edge_weight
-from atmos.plugins.cloud_shadows.reference import shifted
-from atmos.plugins.sky_layer.octaves import OCTAVES, octave_key
-from atmos.plugins.sky_layer.reference import WEIGHTS, tile_noise
+from atmos.plugins.sky_layer.octaves import OCTAVES, WEIGHTS, octave_key, tile_noise
 
 QUANTILES = 33          # table entries: quantiles at 0, 1/32, ..., 1
 GRID = 64               # samples per side of the tile the table is measured on
@@ -37,13 +34,3 @@ def emptiness(quantiles, cover: float) -> float:
     x = (1.0 - float(np.clip(cover, 0.0, 1.0))) * (len(q) - 1)
     k = min(int(x), len(q) - 2)
     return float(q[k] + (q[k + 1] - q[k]) * (x - k))
-
-
-def volume_cover(sums_a, sums_b, t: float, a_shift, threshold: float, fade: float) -> float:
-    """Edge-weighted covered fraction of the columns of mix(A, B, t); ``sums_a/b`` (nx, nz), A read at
-    ``c + a_shift`` (zero past its edge)."""
-    sums = (1.0 - t) * shifted(np.asarray(sums_a, np.float64), a_shift) + t * np.asarray(sums_b, np.float64)
-    n = np.array(sums.shape)
-    uv = np.stack(np.meshgrid(*((np.arange(m) + 0.5) / m for m in n), indexing="ij"), -1)
-    w = edge_weight(uv, fade)
-    return float((w * (sums > threshold)).sum() / max(w.sum(), 1e-30))

@@ -4,6 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from atmos.camera import set_camera_uniforms
+from atmos.composition import CLOUD_DISTANCE, composition
 from atmos.graph import FullscreenPass, PassContext
 from atmos.plugin import Plugin
 from atmos.plugins.cloud_far_field.cover import fbm_quantiles
@@ -24,11 +25,18 @@ def drift(settings: CloudFarFieldSettings, time: float) -> np.ndarray:
 
 class CloudFarFieldPass(FullscreenPass):
     """Phase translucent, before the cloud renderers (its clouds are behind theirs): blends the far
-    field onto ``color`` (premultiplied) where the layer's middle plane is in front of ``depth``."""
+    field onto ``color`` (premultiplied) where the layer's middle plane is in front of ``depth``, and
+    its distance onto ``"cloud_distance"`` when a media pass reads it (:mod:`atmos.composition`)."""
     name = "cloud_far_field"
     phase = "translucent"
     fragment = "cloud_far_field/far.frag"
     reads = (COLOR, DEPTH, CLOUD_SETS)
+
+    def setup(self, builder) -> None:
+        super().setup(builder)
+        if self.plugin.composition.distance:
+            builder.read(CLOUD_DISTANCE)
+            builder.write(CLOUD_DISTANCE)
 
     def prepare(self, gpu) -> None:
         super().prepare(gpu)
@@ -60,7 +68,8 @@ class CloudFarFieldPass(FullscreenPass):
             self.octaves.bake(params, sun_dir)
         self.measure_cover(sim)
         layout = sim.layout()
-        frame.framebuffer(color=[COLOR]).use()
+        distance = frame.declares(CLOUD_DISTANCE)
+        frame.framebuffer(color=[COLOR, CLOUD_DISTANCE] if distance else [COLOR]).use()
         frame.blend_over()
         self.octaves.use(5)
         frame.resource(DEPTH).use(9)
@@ -105,8 +114,15 @@ class CloudFarFieldPlugin(Plugin):
     def build(self, app) -> None:
         if app.graph is None:
             raise ValueError("CloudFarFieldPlugin needs an App with a GPU context (App(gpu))")
+        self.composition = composition(app)
+        self.composition.writers.add("cloud_far_field")   # the fog gets the layer's own distance
         self.pass_ = CloudFarFieldPass(self)
         app.graph.add_pass(self.pass_)
+
+    def cleanup(self, app) -> None:
+        comp = getattr(self, "composition", None)
+        if comp is not None:
+            comp.writers.discard("cloud_far_field")
 
     def finish(self, app) -> None:
         """Run before every other translucent pass (the cloud renderers draw nearer clouds over it)."""

@@ -31,7 +31,7 @@ import numpy as np
 
 from atmos.camera import Camera, camera_matrices
 from atmos.checks import CheckedSettings, check_bool, check_int, check_num
-from atmos.composition import CLOUD_DISTANCE, composition, distance_desc
+from atmos.composition import CLOUD_DISTANCE, composition
 from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.plugin import Plugin
 from atmos.plugins.cloud_render.binding import bind_volume, clamp_sampler, unbind_volume
@@ -183,8 +183,9 @@ class CloudSpritePass(RenderPass):
         builder.write(COLOR)
         downsample = self.plugin.settings.downsample
         distance = self.plugin.composition.distance
-        if distance:                        # a media pass reads it (atmos.composition)
-            builder.create(CLOUD_DISTANCE, distance_desc(self.plugin.gpu.size))
+        if distance:                        # a media pass reads it: blend onto it (atmos.composition)
+            builder.read(CLOUD_DISTANCE)
+            builder.write(CLOUD_DISTANCE)
         if downsample > 1:
             OffscreenClouds.declare(builder, self.plugin.gpu.size, downsample, distance)
 
@@ -229,8 +230,6 @@ class CloudSpritePass(RenderPass):
         plugin = self.plugin
         settings = plugin.settings
         distance = frame.declares(CLOUD_DISTANCE)
-        if distance:                        # created here: 0 = no cloud, even when nothing is drawn
-            frame.framebuffer(color=[CLOUD_DISTANCE]).clear(0.0, 0.0, 0.0, 0.0)
         if not settings.enabled:
             return
         view, gpu = frame.view, frame.gpu

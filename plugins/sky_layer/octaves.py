@@ -7,12 +7,23 @@ import moderngl
 import numpy as np
 
 from atmos.plugins.sky_layer.settings import SkyLayerSettings
-from atmos.value_noise import key
+from atmos.value_noise import key, value_noise
+
+WEIGHTS = np.array([0.5, 0.25, 0.125, 0.0625])      # the octaves' fbm weights
 
 
 def octave_key(seed: int, octave: int) -> int:
     """The lattice key of octave ``octave`` (a different noise per octave)."""
     return int(key((seed + 0x9E3779B1 * octave) % 2**32))
+
+
+def tile_noise(uv: np.ndarray, frequency: float, k) -> np.ndarray:
+    """4D value noise on two circles of radius frequency/2π: periodic with period 1 in u and v
+    (what ``sky_layer/octaves.comp`` bakes; float64)."""
+    a = 2 * np.pi * np.asarray(uv, np.float64)
+    r = frequency / (2 * np.pi)
+    x = r * np.stack([np.cos(a[..., 0]), np.sin(a[..., 0]), np.cos(a[..., 1]), np.sin(a[..., 1])], axis=-1)
+    return value_noise(x, k)
 
 
 def light_shift(sun_dir, light_step: float) -> np.ndarray:

@@ -3,19 +3,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.plugins.sky_layer.octaves import light_shift, octave_key  # noqa: F401  (the GPU side's own)
-from atmos.value_noise import value_noise
+from atmos.plugins.sky_layer.octaves import WEIGHTS, light_shift, octave_key, tile_noise  # noqa: F401  (the GPU side's own)
 
-WEIGHTS = np.array([0.5, 0.25, 0.125, 0.0625])
 RAY = np.array([0.0, 0.2, 0.4, 0.6])
-
-
-def tile_noise(uv: np.ndarray, frequency: float, k) -> np.ndarray:
-    """4D value noise on two circles of radius frequency/2π: periodic with period 1 in u and v."""
-    a = 2 * np.pi * np.asarray(uv, np.float64)
-    r = frequency / (2 * np.pi)
-    x = r * np.stack([np.cos(a[..., 0]), np.sin(a[..., 0]), np.cos(a[..., 1]), np.sin(a[..., 1])], axis=-1)
-    return value_noise(x, k)
 
 
 def octave_texture(size: int, frequency: float, k, light_shift) -> np.ndarray:

@@ -7,11 +7,13 @@
 //   alpha = (1 - exp(-thickness d.x)) * (1 - edge weight at the hit) * smoothstep(0, horizon_fade, |ray.y|)
 // lit by the cloud medium's own model (cloud_render/volume.glsl): sun transmittance exp(-optical_depth
 // amount), column optical depth optical_depth d.x (half above, half below). Premultiplied (blend_over).
+// frag_distance: (alpha * distance to the hit, alpha), "cloud_distance" when attached (atmos/composition.py).
 #include "lib/view_ray.glsl"
 #include "sky_layer/layer.glsl"
 #include "cloud_render/volume.glsl"
 in vec2 v_uv;
 out vec4 frag;
+layout(location = 1) out vec4 frag_distance;   // blends by its own alpha
 layout(binding = 5) uniform sampler2D octave0;
 layout(binding = 6) uniform sampler2D octave1;
 layout(binding = 7) uniform sampler2D octave2;
@@ -44,6 +46,7 @@ float threshold(float c) {
 
 void main() {
     frag = vec4(0.0);
+    frag_distance = vec4(0.0);
     vec3 ray = view_ray(v_uv, view_basis);
     float s = (mid_height - camera_pos.y) / ray.y;            // view depth of the plane
     if (!(s > 0.0) || isinf(s)) return;
@@ -70,4 +73,5 @@ void main() {
     vec3 light = sun_part(octave_weights(exp(-optical_depth * amount), tau), dot(dir, sun_dir))
                + ambient_source(0.5 * tau, 0.5 * tau, dir.y);
     frag = vec4(light * alpha, alpha);
+    frag_distance = vec4(alpha * length(hit - camera_pos), alpha, 0.0, alpha);
 }
