@@ -12,6 +12,17 @@ from atmos.graph.errors import GraphError
 FRAMEBUFFER_CACHE = 64  # framebuffers kept per graph, least recently used dropped first
 STATE_FLAGS = moderngl.BLEND | moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.PROGRAM_POINT_SIZE
 
+# The blend modes passes use (colour factors, then alpha factors); see the PassContext methods.
+BLEND_OVER = (moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA, moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA)
+BLEND_TRANSMITTANCE = (moderngl.ONE, moderngl.SRC_ALPHA, moderngl.ZERO, moderngl.ONE)
+BLEND_ALPHA = (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA, moderngl.ZERO, moderngl.ONE)
+
+
+def blend(ctx, factors) -> None:
+    """Enable blending with ``factors`` (one of the BLEND_* modes); also for draws outside a graph."""
+    ctx.enable(moderngl.BLEND)
+    ctx.blend_func = factors
+
 
 class PassContext:
     """Handed to :meth:`RenderPass.execute`; one object per graph, reused every frame.
@@ -94,18 +105,19 @@ class PassContext:
         """Blend a participating medium's (in-scattered light, transmittance T) over the colour:
         rgb = light + T · rgb, alpha kept: the medium does not occlude the sky (``color.a``, see
         :mod:`atmos.render_core`). What the fog passes output."""
-        ctx = self.gpu.ctx
-        ctx.enable(moderngl.BLEND)
-        ctx.blend_func = moderngl.ONE, moderngl.SRC_ALPHA, moderngl.ZERO, moderngl.ONE
+        blend(self.gpu.ctx, BLEND_TRANSMITTANCE)
 
     def blend_over(self) -> None:
         """Blend a premultiplied layer (light, coverage a = 1 − T) over the colour, (ONE, ONE_MINUS_SRC_ALPHA)
         on colour and alpha: rgb = light + (1 − a) · rgb and alpha = a + (1 − a) · alpha, so the layer
         adds its coverage to the sky occlusion in ``color.a`` (see :mod:`atmos.render_core`). What
         clouds and cloud layers output."""
-        ctx = self.gpu.ctx
-        ctx.enable(moderngl.BLEND)
-        ctx.blend_func = (moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA, moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA)
+        blend(self.gpu.ctx, BLEND_OVER)
+
+    def blend_alpha(self) -> None:
+        """Blend straight-alpha colour (rgb, a) over the target, its alpha kept: what HUD layers (text,
+        frame-time bars) draw onto the presented screen, whose alpha stays 1."""
+        blend(self.gpu.ctx, BLEND_ALPHA)
 
     def reset_state(self) -> None:
         """The GL state every pass starts from (and a frame ends with)."""

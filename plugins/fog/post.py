@@ -8,6 +8,7 @@ import numpy as np
 from atmos.camera import set_camera_uniforms
 from atmos.composition import CLOUD_DISTANCE
 from atmos.graph import PassBuilder, PassContext, RenderPass
+from atmos.graph.frame import BLEND_TRANSMITTANCE, blend
 from atmos.plugins.fog.noise import NoiseVolumes, octave_key
 from atmos.plugins.fog.settings import MODES
 from atmos.plugins.fog.sky_color import SAMPLES, horizon_colors
@@ -66,8 +67,7 @@ def draw_state(ctx) -> None:
     a fogged sky (``sky="fog"``) is still sky there: the light shafts see it by its colour, which the
     fog has already pulled toward the fog colour (only what stays brighter than their threshold casts)."""
     ctx.disable(ctx.DEPTH_TEST)
-    ctx.enable(ctx.BLEND)
-    ctx.blend_func = ctx.ONE, ctx.SRC_ALPHA, ctx.ZERO, ctx.ONE
+    blend(ctx, BLEND_TRANSMITTANCE)          # what PassContext.blend_transmittance sets in the graph
 
 
 def restore_state(ctx) -> None:

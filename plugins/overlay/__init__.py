@@ -91,9 +91,7 @@ class OverlayPass(FullscreenPass):
         self.data.write(np.asarray(self.times.ms, np.float32).tobytes())
         self.data.use(0)
         gpu.ctx.viewport = (4, 4, w, h) if gpu.size[0] > w + 8 else (0, 0, w, h)   # the graph resets it
-        gpu.ctx.enable(gpu.ctx.BLEND)
-        # over the screen; its alpha stays what present wrote (1)
-        gpu.ctx.blend_func = gpu.ctx.SRC_ALPHA, gpu.ctx.ONE_MINUS_SRC_ALPHA, gpu.ctx.ZERO, gpu.ctx.ONE
+        frame.blend_alpha()                  # over the screen; its alpha stays what present wrote (1)
         frame.fullscreen(self.program)
 
     def release(self) -> None:

@@ -13,7 +13,6 @@ from __future__ import annotations
 from collections import OrderedDict
 from dataclasses import dataclass
 
-import moderngl
 
 from atmos.checks import check_int, check_num, check_vec
 from atmos.graph import FullscreenPass, PassContext
@@ -87,8 +86,7 @@ class TextPass(FullscreenPass):
     def execute(self, frame: PassContext) -> None:
         ctx = frame.gpu.ctx
         frame.resource(SCREEN).use()
-        ctx.enable(moderngl.BLEND)
-        ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA, moderngl.ZERO, moderngl.ONE
+        frame.blend_alpha()
         w, h = frame.gpu.size
         program = self.program
         for label in self.plugin.labels:
