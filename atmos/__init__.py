@@ -25,7 +25,7 @@ _EXPORTS = {
     "PassContext": "atmos.graph", "RenderGraph": "atmos.graph", "TextureDesc": "atmos.graph",
     "GraphError": "atmos.graph", "PHASES": "atmos.graph",
     "COLOR": "atmos.render_core", "DEPTH": "atmos.render_core", "SCREEN": "atmos.render_core",
-    "CapturePass": "atmos.render_core", "RenderCorePlugin": "atmos.render_core",
+    "CapturePass": "atmos.render_core", "OpaquePass": "atmos.render_core", "RenderCorePlugin": "atmos.render_core",
     # what passes see and write
     "SceneView": "atmos.scene_view", "Camera": "atmos.camera", "CameraPlugin": "atmos.camera", "set_camera_uniforms": "atmos.camera", "Sun": "atmos.lighting",
     "set_sun_uniforms": "atmos.lighting", "set_scene_uniforms": "atmos.lighting", "FixedClock": "atmos.clock",

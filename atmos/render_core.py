@@ -129,6 +129,25 @@ class PresentPass(FullscreenPass):
         frame.fullscreen(self.program)
 
 
+class OpaquePass(RenderPass):
+    """Depth-tested geometry drawn into ``color`` and ``depth`` (phase opaque, alpha 1). A subclass makes
+    ``self.program`` in ``prepare`` and starts its ``execute`` with :meth:`begin`."""
+    phase = "opaque"
+    program = None
+
+    def setup(self, builder: PassBuilder) -> None:
+        builder.write(COLOR)
+        builder.read(DEPTH)                 # depth-tested
+        builder.write(DEPTH)
+
+    def begin(self, frame: PassContext) -> None:
+        """Bind colour and depth, turn the depth test on, write the camera and sun uniforms."""
+        from atmos.lighting import set_scene_uniforms
+        frame.framebuffer(color=[COLOR], depth=DEPTH).use()
+        frame.gpu.ctx.enable(moderngl.DEPTH_TEST)
+        set_scene_uniforms(self.program, frame.view)
+
+
 class CapturePass(RenderPass):
     """Copies the final HDR ``color`` (float, (h, w, 4)) and ``depth`` ((h, w)) to numpy each frame,
     rows bottom-up as OpenGL stores them. For tests, tools and HDR screenshots; a side effect."""

@@ -5,10 +5,9 @@ import numpy as np
 
 from atmos.checks import CheckedSettings, check_num, check_vec
 
-from atmos.graph import PassBuilder, PassContext, RenderPass
-from atmos.lighting import set_scene_uniforms
+from atmos.graph import PassContext
 from atmos.plugin import Plugin
-from atmos.render_core import COLOR, DEPTH
+from atmos.render_core import OpaquePass
 
 
 @dataclass(frozen=True)
@@ -32,18 +31,12 @@ def ground_quad(half_size: float) -> bytes:
     return np.array([[-h, -h], [h, -h], [-h, h], [h, h]], np.float32).tobytes()
 
 
-class GroundPass(RenderPass):
+class GroundPass(OpaquePass):
     name = "ground"
-    phase = "opaque"
 
     def __init__(self, plugin: "GroundPlugin"):
         self.plugin = plugin
         self.program = self.vao = self.vbo = None
-
-    def setup(self, builder: PassBuilder) -> None:
-        builder.write(COLOR)
-        builder.read(DEPTH)                 # depth-tested
-        builder.write(DEPTH)
 
     def prepare(self, gpu) -> None:
         self.program = gpu.program(vertex_shader="ground/ground.vert", fragment_shader="ground/ground.frag")
@@ -53,9 +46,7 @@ class GroundPass(RenderPass):
 
     def execute(self, frame: PassContext) -> None:
         gpu = frame.gpu
-        frame.framebuffer(color=[COLOR], depth=DEPTH).use()
-        gpu.ctx.enable(gpu.ctx.DEPTH_TEST)
-        set_scene_uniforms(self.program, frame.view)
+        self.begin(frame)
         settings = self.plugin.settings
         if settings.half_size != self.half_size:           # a live change: the same 4 corners, moved
             self.half_size = settings.half_size

@@ -17,11 +17,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from atmos.checks import check_vec
-from atmos.graph import PassBuilder, PassContext, RenderPass
-from atmos.lighting import set_scene_uniforms
+from atmos.graph import PassContext
 from atmos.plugin import Plugin
 from atmos.plugins.mesh.geometry import Mesh, box, glider
-from atmos.render_core import COLOR, DEPTH
+from atmos.render_core import OpaquePass
 from atmos.transform import Transform
 
 __all__ = ["Mesh", "MeshInstance", "MeshPlugin", "box", "glider"]
@@ -60,20 +59,14 @@ def collect_instances(world, alpha: float) -> dict:
     return out
 
 
-class MeshPass(RenderPass):
+class MeshPass(OpaquePass):
     name = "meshes"
-    phase = "opaque"
 
     def __init__(self, plugin: "MeshPlugin"):
         self.plugin = plugin
         self.program = None
         self.buffers: dict[int, list] = {}       # mesh id -> [vbo, ibo, instance buffer, vao, last frame used, vertices]
         self.frame = 0
-
-    def setup(self, builder: PassBuilder) -> None:
-        builder.write(COLOR)
-        builder.read(DEPTH)                      # depth-tested
-        builder.write(DEPTH)
 
     def prepare(self, gpu) -> None:
         self.program = gpu.program(vertex_shader="mesh/mesh.vert", fragment_shader="mesh/mesh.frag")
@@ -97,9 +90,7 @@ class MeshPass(RenderPass):
     def execute(self, frame: PassContext) -> None:
         gpu = frame.gpu
         self.frame += 1
-        frame.framebuffer(color=[COLOR], depth=DEPTH).use()
-        gpu.ctx.enable(gpu.ctx.DEPTH_TEST)
-        set_scene_uniforms(self.program, frame.view)
+        self.begin(frame)
         self.program["sky_ambient"].value = tuple(float(v) for v in frame.view.sun.ambient)
         for mesh, data in self.plugin.instances.items():
             _, _, inst, vao, _, vertices = self._buffers(gpu, mesh, len(data))

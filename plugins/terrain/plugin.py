@@ -4,11 +4,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from atmos.checks import CheckedSettings, check_int, check_num
-from atmos.graph import PassBuilder, PassContext, RenderPass
-from atmos.lighting import set_scene_uniforms
+from atmos.graph import PassContext
 from atmos.plugin import Plugin
 from atmos.plugins.terrain.heightfield import height, heightfield, triangle_count
-from atmos.render_core import COLOR, DEPTH
+from atmos.render_core import OpaquePass
 
 
 @dataclass(frozen=True)
@@ -29,19 +28,13 @@ class TerrainSettings(CheckedSettings):
         return self.size, self.cells, self.relief
 
 
-class TerrainPass(RenderPass):
+class TerrainPass(OpaquePass):
     name = "terrain"
-    phase = "opaque"
 
     def __init__(self, plugin: "TerrainPlugin"):
         self.plugin = plugin
         self.program = self.vao = self.vbo = self.ibo = None
         self.mesh_key = None
-
-    def setup(self, builder: PassBuilder) -> None:
-        builder.write(COLOR)
-        builder.read(DEPTH)                 # depth-tested
-        builder.write(DEPTH)
 
     def prepare(self, gpu) -> None:
         self.program = gpu.program(vertex_shader="terrain/terrain.vert", fragment_shader="terrain/terrain.frag")
@@ -60,9 +53,7 @@ class TerrainPass(RenderPass):
 
     def execute(self, frame: PassContext) -> None:
         gpu = frame.gpu
-        frame.framebuffer(color=[COLOR], depth=DEPTH).use()
-        gpu.ctx.enable(gpu.ctx.DEPTH_TEST)
-        set_scene_uniforms(self.program, frame.view)
+        self.begin(frame)
         if self.plugin.settings.mesh_key() != self.mesh_key:
             self.make_mesh(gpu)
         self.program["relief"].value = self.plugin.settings.relief

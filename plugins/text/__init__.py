@@ -13,7 +13,6 @@ from __future__ import annotations
 from collections import OrderedDict
 from dataclasses import dataclass
 
-
 from atmos.checks import check_int, check_num, check_vec
 from atmos.graph import FullscreenPass, PassContext
 from atmos.plugin import Plugin
