@@ -5,7 +5,7 @@ import argparse
 import os
 import sys
 
-from atmos.demo_registry import DEFAULT_DEMO, DemoSettings, list_demos, load_demo
+from atmos.demo_registry import CLOUD_RENDERERS, DEFAULT_DEMO, DemoSettings, list_demos, load_demo
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -73,6 +73,9 @@ def _run_options(command, frames_default: str) -> None:
     command.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
     command.add_argument("--out", type=_out, help="FILE.mp4, FILE.gif, FILE.png (last frame) or a folder of PNGs; "
                                                   "headless default: out/NAME.mp4")
+    command.add_argument("--clouds", choices=CLOUD_RENDERERS, default="sprites",
+                         help="cloud renderer of the cloud scenes (sunset, flight, weather): point sprites "
+                              "or the ray march (default sprites; key C flips it in a window)")
     command.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -117,9 +120,9 @@ def _play(args, game, stem: str) -> int:
     problem = None if args.headless else display_problem()
     if problem is not None:
         print(f"atmos: {problem}; rendering headless", file=sys.stderr)
-    settings = DemoSettings(size=args.size, seed=args.seed, frames=args.frames,
-                            headless=args.headless or problem is not None)
-    if settings.headless or args.out is not None:
+    settings = DemoSettings(size=args.size, seed=args.seed, frames=args.frames, clouds=args.clouds,
+                            headless=args.headless or args.out is not None or problem is not None)   # as atmos.run
+    if settings.headless:
         out = args.out if args.out is not None else f"out/{stem}.mp4"
         result = run_headless(game, settings, out, progress=not args.quiet)
         print(f"wrote {result['written']} frames to {result['out']}")

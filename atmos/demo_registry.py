@@ -5,7 +5,10 @@ import importlib
 import pkgutil
 from dataclasses import dataclass
 
+from atmos.checks import check_choice
+
 DEFAULT_DEMO = "sunset"
+CLOUD_RENDERERS = ("sprites", "march")
 
 
 @dataclass
@@ -14,6 +17,10 @@ class DemoSettings:
     seed: int = 0
     frames: int | None = None     # None: until the window closes (headless: the demo's DEFAULT_FRAMES)
     headless: bool = False
+    clouds: str = "sprites"       # the cloud scenes' renderer: point sprites or the ray march (key C flips it)
+
+    def __post_init__(self):
+        check_choice("DemoSettings", "clouds", self.clouds, CLOUD_RENDERERS)
 
 
 def list_demos() -> dict[str, str]:

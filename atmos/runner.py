@@ -199,11 +199,11 @@ def run(game, *, size: tuple[int, int] = (960, 540), title: str | None = None, h
     size = check_frame_size(size, None, "atmos.run size")
     if headless is None:
         problem = display_problem()
-        headless = problem is not None or out is not None
+        headless = problem is not None
         if problem is not None:
             print(f"atmos: {problem}; rendering headless" + (f" into {out}" if out else ""), file=sys.stderr)
-    settings = DemoSettings(size=size, seed=seed, frames=frames, headless=bool(headless))
-    if settings.headless or out is not None:
+    settings = DemoSettings(size=size, seed=seed, frames=frames, headless=bool(headless) or out is not None)
+    if settings.headless:
         return run_headless(game, settings, out, progress=progress)
     run_window(game, settings, title or title_of(game))
     return None

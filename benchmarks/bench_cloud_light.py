@@ -222,7 +222,7 @@ def sprite_pass_cost(rounds=5, frames=9):
     return {k: float(np.median(v)) for k, v in ms.items()}
 
 
-FIT_GRID = ((0.15, 0.25, 0.35), (0.45, 0.55, 0.65, 0.75), (0.6, 0.7, 0.8))   # around the coarse optimum
+FIT_GRID = ((0.1, 0.2, 0.3), (0.75, 0.85, 0.95), (0.8, 0.85, 0.9))   # around the coarse optimum
 
 
 def fit(gpu, samples, grid=FIT_GRID):

@@ -17,7 +17,9 @@ Sections (each reuses its benchmark module's functions, so the numbers are the s
 * ``sunset``     — the full sunset frame at 1920×1080: the render graph's per-pass GPU timer table
   (``app.graph.timings``), the simulation slices (timer queries), the whole frame in one timer
   query and by wall clock with glFinish, beside Nubis (≈ 2 ms per frame on a PS4); and Python per
-  frame (bench_python_frame).
+  frame (bench_python_frame);
+* ``raymarch``   — the sunset frame with each cloud renderer (sprites, the ray march of issue 15) at
+  1024×768 and 1920×1080: frame ms, the cloud pass's GPU ms, the ratio (bench_cloud_raymarch).
 
 Writes ``gpu_suite.md`` (one Markdown report, the thesis's and the anchors' figures beside ours)
 and ``gpu_suite.json`` to ``--out`` (default ``out/``). ``--quick`` runs the same code at small
@@ -46,11 +48,13 @@ ANCHORS = {"Nubis (Horizon Zero Dawn clouds), PS4": "≈ 2 ms per frame",
            "thesis GPU": "GeForce 8700M GT (32 shader units), 1024×768, 256×32×256 volume"}
 SIZES = {   # full: what the thesis and the goals name; quick: the same code small enough for llvmpipe
     False: dict(volume=(256, 32, 256), frame=(1920, 1080), automaton_steps=200, repeats=7, render_frames=20,
-                fog_frames=20, pacing_frames=120, pacing_iterations=256, sunset_frames=60, python_frames=30),
+                fog_frames=20, pacing_frames=120, pacing_iterations=256, sunset_frames=60, python_frames=30,
+                raymarch_frames=((1024, 768), (1920, 1080)), raymarch_rounds=2),
     True: dict(volume=(64, 16, 64), frame=(160, 90), automaton_steps=3, repeats=1, render_frames=2,
-               fog_frames=2, pacing_frames=6, pacing_iterations=8, sunset_frames=4, python_frames=3),
+               fog_frames=2, pacing_frames=6, pacing_iterations=8, sunset_frames=4, python_frames=3,
+               raymarch_frames=((160, 90),), raymarch_rounds=1),
 }
-SECTIONS = ("automaton", "tasks", "shading", "clouds", "fog", "pacing", "sunset")
+SECTIONS = ("automaton", "tasks", "shading", "clouds", "fog", "pacing", "sunset", "raymarch")
 
 
 # -- sections: each returns {"title", "columns", "rows", "notes"} ------------------------------------
@@ -245,8 +249,24 @@ def sunset(cfg) -> dict:
                       "the slices from one timer query each; CPU ms of a pass is its execute() wall time"]}
 
 
+def raymarch(cfg) -> dict:
+    import bench_cloud_raymarch
+    rows = []
+    for size in cfg["raymarch_frames"]:
+        for row in bench_cloud_raymarch.sunset_rows(size, cfg["raymarch_rounds"], cfg["sunset_frames"]):
+            rows.append({"frame": _shape(size), **row})
+    return {"title": "The sunset frame with each cloud renderer: point sprites vs the ray march (issue 15), "
+                     "alternated in one App",
+            "columns": [("frame", "frame"), ("renderer", "renderer"), ("frame ms (glFinish)", "frame_ms"),
+                        ("× sprites", "x_sprites_frame"), ("cloud pass", "pass"), ("pass GPU ms (timer query)", "pass_gpu_ms"),
+                        ("pass × sprites", "x_sprites_pass"), ("settings", "settings")],
+            "rows": rows,
+            "notes": ["bench_cloud_raymarch.sunset_rows; the march at its defaults (resolution 2 with reprojection)",
+                      "anchor: Nubis ≈ 2 ms per frame on a PS4, 1/16 of the pixels marched per frame"]}
+
+
 RUNNERS = {"automaton": automaton, "tasks": tasks, "shading": shading, "clouds": clouds, "fog": fog,
-           "pacing": pacing, "sunset": sunset}
+           "pacing": pacing, "sunset": sunset, "raymarch": raymarch}
 
 
 # -- the report --------------------------------------------------------------------------------------

@@ -2,8 +2,9 @@
 starts with an underscore).
 
 Terrain under a Preetham sky driven by the time of day; the cloud chain (weather → automaton →
-smoothing → density maps → shading) sliced over frames; point-sprite clouds with both cullings;
-their ground shadows and light shafts. 40 m cells: a 128×16×128 volume covers 5 km × 640 m × 5 km
+smoothing → density maps → shading) sliced over frames; the clouds drawn as point sprites with both
+cullings or ray-marched with detail noise (``DemoSettings.clouds``; key C flips them live: both
+plugins are added, the unused one disabled, so its pass is culled); their ground shadows and light shafts. 40 m cells: a 128×16×128 volume covers 5 km × 640 m × 5 km
 from 900 m up, centred on the camera.
 """
 from __future__ import annotations
@@ -12,6 +13,9 @@ import numpy as np
 
 from atmos.camera import Camera
 from atmos.defaults import DefaultPlugins
+from atmos.input import Input
+from atmos.keys import key
+from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
 from atmos.plugins.cloud_render import CloudRenderPlugin
 from atmos.plugins.cloud_render.example import example_weather
 from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
@@ -49,8 +53,10 @@ def build_cloudscape(app, settings, *, hours: float, speed: float = 0.0, cloud_d
                     TerrainPlugin(size=40000.0, cells=71, relief=500.0),
                     cloud_plugin,
                     CloudShadowsPlugin(),
-                    CloudRenderPlugin(size_factor=4.0),
+                    CloudRenderPlugin(size_factor=4.0, enabled=settings.clouds == "sprites"),
+                    RaymarchCloudsPlugin(enabled=settings.clouds == "march"),
                     LightShaftsPlugin())
+    app.add_system(switch_key, "update", label="cloud_renderer_switch")
     if horizon:
         app.add_plugins(CloudFarFieldPlugin())
     if haze:
@@ -69,3 +75,31 @@ def follow_camera(app) -> None:
     origin = app.resource(VolumeOrigin)
     origin.x = float(np.floor(cam.position[0] / CELL[0] - SHAPE[0] / 2))
     origin.z = float(np.floor(cam.position[2] / CELL[2] - SHAPE[2] / 2))
+
+
+def cloud_renderer(app) -> str:
+    """"sprites" or "march": the renderer drawing the clouds now."""
+    return "march" if _renderers(app)[1].settings.enabled else "sprites"
+
+
+def switch_clouds(app, clouds: str | None = None) -> str:
+    """Draw the clouds with ``clouds`` ("sprites" or "march"; None: the other one); returns it. The
+    other renderer is disabled: its pass declares nothing and is culled from the next frame."""
+    from atmos.demo_registry import DemoSettings
+    clouds = clouds if clouds is not None else ("sprites" if cloud_renderer(app) == "march" else "march")
+    DemoSettings(clouds=clouds)                      # checks the name
+    sprites, march = _renderers(app)
+    sprites.configure(enabled=clouds == "sprites")
+    march.configure(enabled=clouds == "march")
+    return clouds
+
+
+def switch_key(app) -> None:
+    """Key C flips the cloud renderer."""
+    if key.C in app.resource(Input).pressed:
+        switch_clouds(app)
+
+
+def _renderers(app) -> tuple:
+    found = {type(p): p for p in app.plugins if isinstance(p, (CloudRenderPlugin, RaymarchCloudsPlugin))}
+    return found[CloudRenderPlugin], found[RaymarchCloudsPlugin]

@@ -1,10 +1,12 @@
 """atmos inside a moderngl-window ``WindowConfig``: atmos draws the sky and the ground into the window's
-framebuffer, then the host draws its own triangle with its own moderngl program on top.
+framebuffer, then the host draws its own triangle with its own moderngl program on top. The window's
+keys, mouse and wheel go to atmos's ``Input`` (WASD/QE and a mouse drag fly the camera).
 
     python examples/moderngl_window_host.py [FRAMES [PNG]]
 
-With FRAMES it closes after that many frames; with PNG it saves the last frame there and prints the
-GL error state (the tests run it so under Xvfb).
+With FRAMES it closes after that many frames; with PNG it also sends pyglet events (W held, a left
+click) through the window on its second frame, saves the last frame there and prints what atmos's
+Input saw and the GL error state (the tests run it so under Xvfb).
 """
 import sys
 
@@ -23,6 +25,8 @@ VERTEX = """#version 330
 in vec2 in_pos;
 void main() { gl_Position = vec4(in_pos, 0.0, 1.0); }
 """
+BUTTONS = {1: atmos.mouse.LEFT, 2: atmos.mouse.RIGHT, 3: atmos.mouse.MIDDLE}   # moderngl-window's -> pyglet's
+
 FRAGMENT = """#version 330
 out vec4 color;
 void main() { color = vec4(1.0, 0.1, 0.1, 1.0); }
@@ -50,7 +54,32 @@ class Host(mglw.WindowConfig):
     def on_resize(self, width, height):
         self.gpu.resize(self.wnd.buffer_size)     # atmos's frame follows the window
 
+    # -- input: the pyglet backend's key codes are pyglet's, as atmos.key; y goes up from the bottom --
+    def on_key_event(self, key, action, modifiers):
+        inp = self.app.resource(atmos.Input)
+        inp.press(key) if action == self.wnd.keys.ACTION_PRESS else inp.release(key)
+
+    def on_mouse_position_event(self, x, y, dx, dy):
+        self.app.resource(atmos.Input).move_mouse(x, self.wnd.height - y, dx, -dy)
+
+    on_mouse_drag_event = on_mouse_position_event
+
+    def on_mouse_press_event(self, x, y, button):
+        if button in BUTTONS:
+            self.app.resource(atmos.Input).press_button(BUTTONS[button])
+
+    def on_mouse_release_event(self, x, y, button):
+        if button in BUTTONS:
+            self.app.resource(atmos.Input).release_button(BUTTONS[button])
+
+    def on_mouse_scroll_event(self, x_offset, y_offset):
+        self.app.resource(atmos.Input).scroll(y_offset, x_offset)
+
     def on_render(self, time, frame_time):
+        if PNG and self.drawn == 1:              # the test: real pyglet events through the window
+            self.start = self.app.resource(atmos.Camera).position.copy()
+            self.wnd._window.dispatch_event("on_key_press", atmos.key.W, 0)
+            self.wnd._window.dispatch_event("on_mouse_press", 10, 10, atmos.mouse.LEFT, 0)
         self.app.update(frame_time)              # sky and ground into the window's framebuffer
         self.wnd.use()                           # the host's own drawing after atmos's
         self.vao.render(moderngl.TRIANGLES)
@@ -59,6 +88,9 @@ class Host(mglw.WindowConfig):
             if PNG:
                 from PIL import Image
                 Image.fromarray(self.gpu.read_pixels()).save(PNG)
+                inp = self.app.resource(atmos.Input)
+                moved = float(((self.app.resource(atmos.Camera).position - self.start) ** 2).sum() ** 0.5)
+                print(f"input keys {sorted(inp.keys)} buttons {sorted(inp.buttons)} camera moved {moved:.3f}")
                 print(f"gl error {self.ctx.error}")
             self.wnd.close()
 

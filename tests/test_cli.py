@@ -88,6 +88,8 @@ def test_headless_demo_writes_files(tmp_path, capsys, suffix):
     (["demo", "--seed", "-3"], "seeds are 0 .. 4294967295"),
     (["demo", "--out", "movie.avi"], "unsupported file type '.avi'"),
     (["graph", "nosuch"], "unknown demo 'nosuch'"),
+    (["demo", "--clouds", "voxels"], "argument --clouds: invalid choice: 'voxels' (choose from"),
+    (["run", "demos/glider.py", "--clouds", "cubes"], "invalid choice: 'cubes'"),
 ])
 def test_bad_arguments_get_clear_messages(capsys, argv, message):
     with pytest.raises(SystemExit) as info:

@@ -37,8 +37,7 @@ def test_sunset_has_clouds_below_9_degrees_around_the_sun_and_cover_matches_nump
         far = next(p for p in app.plugins if isinstance(p, CloudFarFieldPlugin))
         sim = app.resource(CloudSimulation)
         sets = sim.sets()
-        pass_ = far.pass_
-        gpu_cover = float(np.frombuffer(pass_.cover.read(), np.float32)[0])
+        gpu_cover = float(np.frombuffer(far.layer.cover.read(), np.float32)[0])
         sums = [sets.maps_of(s).read_sums()[0] for s in (sets.a, sets.b)]
         expected = volume_cover(sums[0], sums[1], sets.t, sets.a_shift, sim.settings.cover_threshold,
                                 sim.settings.edge_fade)

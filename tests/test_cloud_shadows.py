@@ -290,3 +290,75 @@ def test_shadows_on_the_ground_look_right_and_move_with_the_clouds():
     assert np.abs(lum[0] - lum[1]).mean() > 0.5, "the shadows move as the clouds drift"
     app.close()
     gpu.release()
+
+
+def test_shadows_continue_with_the_far_field_beyond_the_volume(gpu, ctx):
+    """Past the volume the ground is shadowed by the far field's cover (numpy reference), darker under
+    its clouds than under its gaps; without the far field it is fully lit there."""
+    from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
+    from atmos.plugins.cloud_far_field.layer import drift
+    from atmos.plugins.cloud_far_field.reference import far_field_density
+    from atmos.plugins.cloud_far_field.cover import fbm_quantiles
+    size = gpu.size
+    params = CloudShadowSettings(base_altitude=60.0, cell_size=(4.0, 2.0, 4.0), sigma=0.5)
+    fill, probe = FillPass(), CapturePass()
+    settings = CloudSettings(smoothing_slices=2, group_size=(8, 8), shading=False, cell_size=(4.0, 2.0, 4.0),
+                             edge_fade=0.3)
+    far = CloudFarFieldPlugin(tile_size=400.0, size=64, animate=False)
+    app = App(gpu).insert_resource(VolumeOrigin(-8.0, 0.0, -8.0))
+    app.add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(settings, weather=weather(), seed=5),
+                    pass_plugin(fill), CloudShadowsPlugin(params), far, pass_plugin(probe))
+    app.startup()
+    sim = app.resource(CloudSimulation)
+    app.update(1 / 30)
+    a, b, t = sim.view()
+    layers = 1 + sim.maps_of(a).bands
+    nx, nz = np.array(sim.shape)[[0, 2]]
+    sums = np.zeros((layers, nx, nz))
+    sums[:, : nx // 2] = 3.0 * sim.settings.cover_threshold + 1.0             # half the columns covered
+    for s in (a, b):
+        write_sums(sim, s, sums)
+    sun = Sun.from_angles(60.0, 30.0)
+    app.insert_resource(sun)
+    cam = app.resource(Camera)
+    cam.near, cam.far = 1.0, 2000.0
+    cam.position = np.array([150.0, 40.0, 0.0])
+    cam.look_at(np.array([250.0, 0.0, 30.0]))
+    rays = ray_dirs(cam, size)
+    ground = np.where(rays[..., 1] < 0, cam.position[1] / np.maximum(-rays[..., 1], 1e-9), np.inf)
+    fill.depth = np.where(ground < 1500.0, depth_of(cam, size, cam.position + rays * np.minimum(ground, 1500.0)[..., None]),
+                          1.0)                              # ground to 1.5 km, sky (depth 1) beyond
+    fill.color = np.ones((size[1], size[0], 4))
+    app.render()
+    factor = probe.color[..., 0].astype(np.float64)
+    layer = far.layer
+    cover = float(np.frombuffer(layer.cover.read(), np.float32)[0])
+    octaves = [layer.octaves.download(k) for k in range(4)]
+    fs = far.settings
+    sets = sim.sets()
+    far_tau = lambda xz: fs.optical_depth * params.strength * far_field_density(
+        xz, octaves, drift(fs, sets, 0.0), fs.tile_size, fbm_quantiles(fs.base_frequency, fs.seed), cover, fs.softness)
+    points = world_points(cam, size, probe.depth)
+    weight = reference.direct_weight(sun.direction, sun.color, params)
+    assert 0.2 < cover < 0.8
+    expected = reference.shadow_factor(points, sums[0], sums[0], t, sun.direction, weight,
+                                       params.sigma, cloud_layout(sets, params), sets.a_shift, settings.edge_fade,
+                                       far=far_tau)
+    expected[probe.depth >= 1.0] = 1.0
+    ground_px = probe.depth < 1.0
+    error = np.abs(factor - expected)[ground_px]
+    # the texture unit's 8-bit bilinear weights on a steep remap, and float32 depth far away (a wrong drift or
+    # texel offset: errors ~0.2)
+    assert np.quantile(error, 0.95) < 1e-2 and error.mean() < 5e-3, f"far-field shadow differs from numpy: {error.mean():.3g}"
+    under, gap = ground_px & (expected < 0.5), ground_px & (expected > 0.99)
+    assert under.sum() > 50 and gap.sum() > 50, "the view has far-field clouds and gaps"
+    assert factor[under].mean() < factor[gap].mean() - 0.3
+    save_png("shadows_far_field.png", np.clip(factor[::-1] * 255, 0, 255).astype(np.uint8))
+    shadows = next(p for p in app.plugins if isinstance(p, CloudShadowsPlugin))
+    shadows.configure(far_field=False)
+    app.render()
+    beyond = ground_px & (reference.shadow_factor(points, sums[0], sums[0], t, sun.direction, weight, params.sigma,
+                                                  cloud_layout(sets, params), sets.a_shift, settings.edge_fade) > 0.999)
+    assert beyond.mean() > 0.5
+    assert np.abs(probe.color[..., 0][beyond] - 1.0).max() < 2e-3, "far_field=False: fully lit past the volume"
+    app.close()

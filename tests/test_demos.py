@@ -18,3 +18,39 @@ def test_demo_renders_frames(name):
         app.close()
     finally:
         gpu.release()
+
+
+def kept(app) -> set:
+    return set(app.graph.compile().kept)
+
+
+@pytest.mark.parametrize("name", ["sunset", "flight", "weather"])
+def test_cloud_demos_render_with_the_ray_march_and_key_c_switches_the_renderer(name):
+    from atmos.demos._cloudscape import cloud_renderer
+    from atmos.input import Input
+    from atmos.keys import key
+    gpu = create_headless((64, 40))
+    try:
+        app = build_app(name, DemoSettings(size=gpu.size, headless=True, frames=2, clouds="march"), gpu)
+        app.run_frames(2, 1 / 30)
+        image = gpu.read_pixels().astype(float)
+        assert gpu.ctx.error == "GL_NO_ERROR"
+        assert image.max() > 20 and image.std() > 3, f"demo {name} with the ray march renders a blank image"
+        assert cloud_renderer(app) == "march"
+        assert "cloud_raymarch" in kept(app) and "cloud_render" not in kept(app)   # the sprites are culled
+        inp = app.resource(Input)
+        inp.press(key.C)
+        app.update(1 / 30)
+        inp.release(key.C)
+        assert cloud_renderer(app) == "sprites"
+        assert "cloud_render" in kept(app) and "cloud_raymarch" not in kept(app)
+        app.update(1 / 30)                          # held, not pressed again: no flip
+        assert cloud_renderer(app) == "sprites"
+        app.close()
+    finally:
+        gpu.release()
+
+
+def test_demo_settings_name_the_cloud_renderers():
+    with pytest.raises(ValueError, match="DemoSettings.clouds must be one of 'sprites', 'march', got 'voxels'"):
+        DemoSettings(clouds="voxels")

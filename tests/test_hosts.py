@@ -1,7 +1,8 @@
-"""atmos in GL contexts and windows a host owns: moderngl-window and Arcade under Xvfb (the pyglet host
+"""atmos in GL contexts and windows a host owns: moderngl-window (input forwarded too) and Arcade under Xvfb (the pyglet host
 is in test_window.py), and what a frame leaves bound for the host."""
 import importlib.util
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -64,8 +65,8 @@ def test_wrap_context_takes_a_moderngl_context_and_names_what_it_got():
 needs_x = pytest.mark.skipif(shutil.which("Xvfb") is None, reason="Xvfb is not installed (setup.sh installs it)")
 
 
-def run_host(display, tmp_path, example: str, package: str, frames: int = 6) -> np.ndarray:
-    """Run examples/EXAMPLE with pyglet's GL error checking on; its last frame as uint8 RGB."""
+def run_host(display, tmp_path, example: str, package: str, frames: int = 6) -> tuple[np.ndarray, str]:
+    """Run examples/EXAMPLE with pyglet's GL error checking on; its last frame as uint8 RGB and its stdout."""
     if importlib.util.find_spec(package) is None:
         pytest.skip(f"{package} is not installed (pip install -e '.[dev]' installs it)")
     from PIL import Image
@@ -77,7 +78,7 @@ def run_host(display, tmp_path, example: str, package: str, frames: int = 6) -> 
     assert proc.returncode == 0, proc.stderr[-3000:]
     assert f"host drew {frames} frames" in proc.stdout, proc.stdout + proc.stderr[-2000:]
     assert "gl error GL_NO_ERROR" in proc.stdout, proc.stdout
-    return np.asarray(Image.open(png).convert("RGB")).astype(int)
+    return np.asarray(Image.open(png).convert("RGB")).astype(int), proc.stdout
 
 
 def is_red(pixels):
@@ -90,17 +91,20 @@ def is_sky(pixels):
 
 @needs_x
 def test_atmos_runs_inside_a_moderngl_window_config(display, tmp_path):
-    frame = run_host(display, tmp_path, "moderngl_window_host.py", "moderngl_window")
+    frame, out = run_host(display, tmp_path, "moderngl_window_host.py", "moderngl_window")
     h, w, _ = frame.shape
     assert (w, h) == (320, 180)
     assert is_sky(frame[: h // 5]).mean() > 0.95, "atmos's sky is not at the top of the window"
     assert is_red(frame[h // 2 - 5: h // 2 + 5, w // 2 - 5: w // 2 + 5]).all(), "the host's triangle is missing"
     assert not is_red(frame[: h // 5]).any()
+    seen = re.search(r"input keys \[(\d+)\] buttons \[(\d+)\] camera moved ([\d.]+)", out)    # events forwarded
+    assert seen and int(seen[1]) == atmos.key.W and int(seen[2]) == atmos.mouse.LEFT, out
+    assert float(seen[3]) > 0.0, "W held in the window did not fly atmos's camera"
 
 
 @needs_x
 def test_arcade_draws_its_sprites_and_text_over_atmos_sky(display, tmp_path):
-    frame = run_host(display, tmp_path, "arcade_host.py", "arcade")
+    frame, _ = run_host(display, tmp_path, "arcade_host.py", "arcade")
     h, w, _ = frame.shape
     assert (w, h) == (320, 180)
     assert is_sky(frame[: h // 4]).mean() > 0.9, "atmos's sky is not at the top of the window"

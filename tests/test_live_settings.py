@@ -29,6 +29,8 @@ from atmos.plugin import Plugin
 import atmos.plugins.clouds.simulation as cloud_simulation
 import atmos.plugins.weather.system as weather_system
 from atmos.checks import CheckedSettings
+from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
+from atmos.plugins.cloud_raymarch.plugin import LOW_COLOR as RAYMARCH_LOW_COLOR
 from atmos.plugins.cloud_render import CloudMarchPlugin, CloudRenderPlugin
 from atmos.plugins.cloud_render.example import example_weather
 from atmos.plugins.cloud_render.offscreen import CLOUD_COLOR
@@ -310,12 +312,12 @@ SPECS = {
         before={"year": configure_first(day_of_year=80.0), "utc_offset": configure_first(longitude=0.0)},
         frame_dt={"speed": 0.1}),
     "cloud_shadows": Spec(
-        lambda: [DefaultPlugins(overlay=False), clouds(shading=False), SkyGradientPlugin(), GroundPlugin(),
-                 CloudShadowsPlugin()],
+        lambda: [DefaultPlugins(overlay=False), clouds(shading=False, edge_fade=0.5), SkyGradientPlugin(), GroundPlugin(),
+                 CloudShadowsPlugin(), CloudFarFieldPlugin(size=32, tile_size=1000.0)],
         CloudShadowsPlugin,
         look((320.0, 400.0, 900.0), target=(320.0, 0.0, 320.0), far=6000.0),
         dict(base_altitude=900.0, cell_size=(10.0, 30.0, 10.0), sigma=5.0, strength=0.2, direct_fraction=0.3,
-             horizon_fade=0.95),
+             horizon_fade=0.95, far_field=False),
         sun=Sun.from_angles(50.0, 30.0)),
     "cloud_render": Spec(
         lambda: [DefaultPlugins(overlay=False), clouds(cover=6), SkyGradientPlugin(), GroundPlugin(),
@@ -389,6 +391,57 @@ def _march_scene():
 
 SPECS["cloud_march"] = Spec(_march_scene, CloudMarchPlugin, look((320.0, 60.0, 1100.0), target=CLOUD_CENTER, far=6000.0),
                             dict(steps=4, enabled=False))
+
+
+def _raymarch_scene():
+    density = np.zeros((16, 4, 16), np.float32)
+    density[4:12, 0:3, 4:12] = 1.0
+    medium = CloudSettings(cell_size=(20.0, 30.0, 20.0), base_altitude=300.0, group_size=(4, 4), smoothing_slices=1,
+                           sigma_t=0.01)
+    return [DefaultPlugins(overlay=False), CloudsPlugin(medium, density=density), SkyGradientPlugin(), GroundPlugin(),
+            RaymarchCloudsPlugin(resolution=1, jitter=False, steps=64)]
+
+
+def raymarch_history(app, plugin):
+    """Whether the ray march's temporal resolve holds a history."""
+    return next(p for p in app.graph.passes if p.name == "cloud_raymarch").temporal.allocated
+
+
+def raymarch_skip_map(app, plugin):
+    """Whether the ray march holds an uploaded skip map (empty-space skipping changes no pixel)."""
+    return next(p for p in app.graph.passes if p.name == "cloud_raymarch").skip is not None
+
+
+def raymarch_turn(app, plugin):
+    """The ray march's frame just after a small camera turn, from a converged history (the history
+    knobs act only while the camera moves); the camera is put back."""
+    rp = next(p for p in app.graph.passes if p.name == "cloud_raymarch")
+    cam = app.resource(Camera)
+    yaw = cam.yaw
+    rp.temporal.reset()
+    rp.frame_index = 0
+    try:
+        for _ in range(4):
+            app.render()
+        cam.yaw = yaw + 0.05
+        return app.read_linear()
+    finally:
+        cam.yaw = yaw
+
+
+_DETAIL = configure_first(detail_octaves=3)
+_TEMPORAL = configure_first(resolution=2, reprojection=True)
+SPECS["cloud_raymarch"] = Spec(
+    _raymarch_scene, RaymarchCloudsPlugin, look((160.0, 360.0, -300.0), target=(160.0, 360.0, 160.0), far=6000.0),
+    dict(base_altitude=250.0, steps=2, step=4.0, step_growth=0.05, empty_space_skipping=False, min_transmittance=0.5,
+         jitter=True, resolution=2, reprojection=False, history_clamp=0.0, motion_limit=1.0, detail_octaves=2, detail_scale=300.0, detail_strength=0.5,
+         sun_steps=2, wind=(400.0, 0.0, 0.0), ms_attenuation=0.9, ms_contribution=1.0, ms_eccentricity=0.0,
+         enabled=False),
+    observe={"resolution": resource_size(RAYMARCH_LOW_COLOR), "reprojection": raymarch_history,
+             "empty_space_skipping": raymarch_skip_map, "history_clamp": raymarch_turn,
+             "motion_limit": raymarch_turn},
+    before={"reprojection": configure_first(resolution=2), "detail_scale": _DETAIL, "detail_strength": _DETAIL,
+            "sun_steps": _DETAIL, "wind": _DETAIL, "history_clamp": _TEMPORAL, "motion_limit": _TEMPORAL})
 
 
 CASES = [(name, f) for name, spec in SPECS.items() for f in live_fields(spec.kind, nested=True)]

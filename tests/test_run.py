@@ -84,3 +84,18 @@ def test_atmos_run_takes_a_build_function_and_falls_back_to_headless(tmp_path, m
         atmos.run(build, size=(0.5, 10), headless=True)
     with pytest.raises(ValueError, match="expected a demo name, a path"):
         load_game(42)
+
+
+def test_rendering_into_a_file_is_headless_for_the_game_in_both_entry_points(tmp_path, monkeypatch):
+    """``--out`` without ``--headless`` (and ``atmos.run(out=...)`` even with ``headless=False``) renders
+    into the file and tells the game it is headless (demos script their camera then)."""
+    game = GAME + "    (__import__('pathlib').Path('seen.txt')).write_text(str(settings.headless))\n"
+    (tmp_path / "tiny.py").write_text(game)
+    proc = run_cli("run", "tiny.py", "--frames", "1", "--size", "32x18", "--out", "a.png", "--quiet", cwd=tmp_path,
+                   env={"DISPLAY": ""})
+    assert proc.returncode == 0, proc.stderr
+    assert (tmp_path / "seen.txt").read_text() == "True"
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "seen.txt").unlink()
+    atmos.run(str(tmp_path / "tiny.py"), size=(32, 18), frames=1, out=str(tmp_path / "b.png"), headless=False)
+    assert (tmp_path / "seen.txt").read_text() == "True" and (tmp_path / "b.png").is_file()

@@ -68,5 +68,5 @@ def test_bad_labels_are_named():
         Label("x", size=0)
     with pytest.raises(ValueError, match="Label.color must be 4 numbers in 0..1"):
         Label("x", color=(255, 0, 0, 1))
-    with pytest.raises(ValueError, match="TextSettings.font must be a TrueType/OpenType font file or None; cannot load"):
+    with pytest.raises(ValueError, match="TextPlugin.font must be a TrueType/OpenType font file or None; cannot load"):
         TextPlugin(font=__file__)

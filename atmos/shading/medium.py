@@ -16,17 +16,22 @@ below a Lambertian ``ground_albedo`` lit by both, radiance ``ground_albedo * (E 
 this scene (all orders), the real-time renderers approximate it (``cloud_render/volume.glsl``):
 
     source per unit extinction J = albedo * (E * sum_i m_i b^i p(cos; c^i g) T^(a^i)
-                                             + 1/2 (1 + s) L_sky exp(-k tau_up) + 1/2 (1 - s) L_ground exp(-k tau_down))
+                                             + (L_sky + L_ground) / 2 + h (L_sky - L_ground) / 2)
 
 with ``T`` the transmittance toward the sun, ``p`` the phase at the angle between the view ray and
 the sun (per pixel), octaves ``i < 4`` after Wrenninge (a: ``ms_attenuation``, b:
 ``ms_contribution``, c: ``ms_eccentricity``) of which the scattered ones (``m_0 = 1``, ``m_i =
-1 - exp(-(tau_up + tau_down))``) scale with the chance that light met the column through the point
-(a thin cloud scatters little twice), and the column optical depths above and below a point dimming
-the sky and ground light (``k``: ``ms_attenuation``), which reach the eye in the shares
-``1/2 (1 ± s)``, ``s = g_mean * ray_y`` (``g_mean`` the phase's mean cosine, ``ray_y`` the view ray's
-y: looking up at a cloud base sees sky light scattered forward). The octaves are fitted to the path
-tracer (``benchmarks/bench_cloud_light.py --fit``).
+1 - exp(-(1 - g_mean)(tau_up + tau_down))``) scale with the chance that light was turned aside in
+the column through the point: its transport optical depth (``g_mean`` the phase's mean cosine; a
+forward lobe turns little light aside, so a thin cloud seen from below is mostly single scattering).
+Sky and ground light: the diffusion solution between a slab's two lit faces, ``u = (tau_down −
+tau_up) / (tau_up + tau_down + 2 z)`` with the extrapolation length ``z = 2 / (3 (1 − g_mean))``
+(deep in a cloud the light is the faces' mean, near a face that face's; a white furnace, equal sky
+and ground at albedo 1, gives exactly ``J = L`` at any depth), plus where the column is thin the
+phase's forward share ``g_mean ray_y`` (looking up at a thin base sees sky light scattered forward):
+``h = clamp(u + g_mean ray_y exp(−(tau_up + tau_down) / 2 z), −1, 1)``. No fitted constant dims it;
+the octaves are fitted to the path tracer (``benchmarks/bench_cloud_light.py --fit``) over both
+volumes and all four views.
 """
 from __future__ import annotations
 
@@ -67,18 +72,25 @@ def environment(settings, sun_color, sky, sun_dir) -> tuple[np.ndarray, np.ndarr
     return e, l_sky, settings.ground_albedo * (e * up / math.pi + l_sky)
 
 
-def octave_weights(T, tau_column, a: float, b: float) -> np.ndarray:
+def mean_cosine(g: float, g2: float, w: float) -> float:
+    """The two-lobe phase function's mean cosine ``(1 - w) g + w g2``."""
+    return (1.0 - w) * g + w * g2
+
+
+def octave_weights(T, tau_column, a: float, b: float, g_mean: float) -> np.ndarray:
     """(..., 4): ``m_i b^i T^(a^i)`` of the module docstring (``tau_column = tau_up + tau_down``)."""
     T = np.asarray(T, np.float64)
-    m = 1.0 - np.exp(-np.asarray(tau_column, np.float64))
+    m = 1.0 - np.exp(-(1.0 - g_mean) * np.asarray(tau_column, np.float64))
     return np.stack([(1.0 if i == 0 else m) * b ** i * T ** (a ** i) for i in range(OCTAVES)], -1)
 
 
-def ambient_shares(g: float, g2: float, w: float, ray_y) -> tuple[np.ndarray, np.ndarray]:
-    """(sky, ground) shares ``1 + s``, ``1 - s`` (times the 1/2 in ``sky_source``) for view rays
-    with y component ``ray_y``: ``s = g_mean * ray_y``, ``g_mean = (1 - w) g + w g2``."""
-    s = ((1.0 - w) * g + w * g2) * np.asarray(ray_y, np.float64)
-    return 1.0 + s, 1.0 - s
+def ambient_profile(tau_up, tau_down, g_mean: float, ray_y) -> np.ndarray:
+    """``h`` of the module docstring: J's sky and ground part is ``(L_sky + L_ground) / 2 + h
+    (L_sky - L_ground) / 2`` (times the albedo) at column optical depths ``tau_up``/``tau_down``."""
+    up, down = np.asarray(tau_up, np.float64), np.asarray(tau_down, np.float64)
+    z = 2.0 / (3.0 * (1.0 - min(g_mean, 0.99)))
+    u = (down - up) / (up + down + 2.0 * z)
+    return np.clip(u + g_mean * np.asarray(ray_y, np.float64) * np.exp(-(up + down) / (2.0 * z)), -1.0, 1.0)
 
 
 def source_reference(settings, render, T, tau_up, tau_down, cos, ray_y, sun_color, sky, sun_dir) -> np.ndarray:
@@ -88,9 +100,10 @@ def source_reference(settings, render, T, tau_up, tau_down, cos, ray_y, sun_colo
     e, l_sky, l_ground = environment(settings, sun_color, sky, sun_dir)
     tau_up, tau_down = np.asarray(tau_up, np.float64), np.asarray(tau_down, np.float64)
     a, b, c = render.ms_attenuation, render.ms_contribution, render.ms_eccentricity
-    w = octave_weights(T, tau_up + tau_down, a, b)
+    g_mean = mean_cosine(settings.phase_g, settings.phase_g2, settings.phase_w)
+    w = octave_weights(T, tau_up + tau_down, a, b, g_mean)
     sun = sum(w[..., i] * phase(cos, settings.phase_g * c ** i, settings.phase_g2 * c ** i, settings.phase_w)
               for i in range(OCTAVES))
-    up, down = ambient_shares(settings.phase_g, settings.phase_g2, settings.phase_w, ray_y)
-    amb = (0.5 * up * np.exp(-a * tau_up))[..., None] * l_sky + (0.5 * down * np.exp(-a * tau_down))[..., None] * l_ground
+    h = ambient_profile(tau_up, tau_down, g_mean, ray_y)[..., None]
+    amb = 0.5 * (l_sky + l_ground) + 0.5 * h * (l_sky - l_ground)
     return settings.albedo * (sun[..., None] * e + amb)

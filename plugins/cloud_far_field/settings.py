@@ -18,18 +18,20 @@ class CloudFarFieldSettings(CheckedSettings):
     cloud. ``thickness``: how fast coverage rises with the remapped density (α = 1 − exp(−thickness·d)).
     ``optical_depth``: optical depth of a full column, vertically and toward the sun (its light
     comes from the cloud medium's own model, ``cloud_render/volume.glsl``). ``tile_size``: metres
-    one octave-texture repeat covers; ``wind``: (x, z) drift in m/s (the pattern moves with the
-    App clock unless ``animate`` is False). ``horizon_fade``: it fades in while the view ray's
+    one octave-texture repeat covers; ``wind``: None (the default) moves the pattern with the
+    simulated clouds (the distance the weather's wind has carried them, ``CloudSets.wind_travel``),
+    so volume and far field drift together; an (x, z) tuple drifts it at that many m/s with the App
+    clock instead. ``animate`` False holds it still. ``horizon_fade``: it fades in while the view ray's
     height rises from 0 to this (sin of the elevation). ``size``, ``base_frequency``, ``seed``,
     ``light_step``: the octave textures (:class:`atmos.plugins.sky_layer.octaves.OctaveTextures`).
     ``enabled`` False draws nothing.
     """
 
     softness: float = 0.2
-    thickness: float = 3.0
+    thickness: float = 8.0
     optical_depth: float = 8.0
     tile_size: float = 8000.0
-    wind: tuple = (0.0, 0.0)
+    wind: tuple | None = None
     horizon_fade: float = 0.015
     size: int = 256
     base_frequency: int = 4
@@ -45,7 +47,7 @@ class CloudFarFieldSettings(CheckedSettings):
             thickness=check_num(o, "thickness", self.thickness, 0.0),
             optical_depth=check_num(o, "optical_depth", self.optical_depth, 0.0, 1e3),
             tile_size=check_num(o, "tile_size", self.tile_size, 1.0, 1e7),
-            wind=check_vec(o, "wind", self.wind, 2),
+            wind=check_vec(o, "wind", self.wind, 2, optional=True),
             horizon_fade=check_num(o, "horizon_fade", self.horizon_fade, 0.0, 1.0, lo_open=True),
             size=check_int(o, "size", self.size, 16, 2048),
             base_frequency=check_int(o, "base_frequency", self.base_frequency, 1, 64),

@@ -2,13 +2,42 @@
 :mod:`atmos.shading.medium`): the sun's colour faded across the horizon, and the uniforms of J."""
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
+from atmos.checks import CheckedSettings, check_num
 from atmos.lighting import Sun
 from atmos.shading.medium import environment
 
 DEFAULT_AMBIENT = (0.35, 0.47, 0.65)
-DEFAULT_OCTAVES = (0.15, 0.55, 0.8)       # Wrenninge's a, b, c, fitted to the path tracer (bench_cloud_light --fit)
+DEFAULT_OCTAVES = (0.2, 0.85, 0.85)       # Wrenninge's a, b, c, fitted to the path tracer (bench_cloud_light --fit)
+
+
+@dataclass(frozen=True)
+class CloudLightSettings(CheckedSettings):
+    """The multiple-scattering octaves both cloud renderers share (the sprites' CloudRenderSettings
+    and the march's RaymarchCloudSettings inherit them): ``ms_attenuation``, ``ms_contribution``,
+    ``ms_eccentricity`` = Wrenninge's a, b, c in [0, 1] (the defaults are fitted to the path tracer,
+    ``benchmarks/bench_cloud_light.py --fit``). A subclass's ``__post_init__`` stores
+    :meth:`light_checks` beside its own checks (alone, the class checks just these)."""
+    ms_attenuation: float = DEFAULT_OCTAVES[0]
+    ms_contribution: float = DEFAULT_OCTAVES[1]
+    ms_eccentricity: float = DEFAULT_OCTAVES[2]
+
+    def __post_init__(self):
+        self.store(self.light_checks())
+
+    def light_checks(self) -> dict:
+        """The checked octave fields, named after the concrete settings class."""
+        o = type(self).__name__
+        return {name: check_num(o, name, getattr(self, name), 0.0, 1.0)
+                for name in ("ms_attenuation", "ms_contribution", "ms_eccentricity")}
+
+    @property
+    def octaves(self) -> tuple:
+        """(a, b, c): what :func:`light_uniforms` and ``bind_volume`` take."""
+        return self.ms_attenuation, self.ms_contribution, self.ms_eccentricity
 
 
 def sun_light(sun: Sun | None) -> tuple[tuple, tuple]:

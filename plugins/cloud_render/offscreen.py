@@ -33,8 +33,9 @@ class OffscreenClouds:
     """The low-res targets' declarations and the depth and composite draws of a cloud pass
     (programs belong to the GpuContext)."""
 
-    def __init__(self, gpu, color: str = CLOUD_COLOR, depth: str = CLOUD_DEPTH):
+    def __init__(self, gpu, color: str = CLOUD_COLOR, depth: str = CLOUD_DEPTH, distance: str = CLOUD_LOW_DISTANCE):
         self.color, self.depth = color, depth         # the low-res targets' names (another pass: its own)
+        self.distance = distance
         fullscreen = "lib/fullscreen.vert"
         self.far_depth = gpu.program(vertex_shader=fullscreen, fragment_shader="cloud_render/far_depth.frag")
         self.composite = gpu.program(vertex_shader=fullscreen, fragment_shader="cloud_render/composite.frag")
@@ -57,7 +58,7 @@ class OffscreenClouds:
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "1"                # always: the shader writes the block's farthest depth
         frame.fullscreen(self.far_depth)
-        fbo = frame.framebuffer(color=[self.color, CLOUD_LOW_DISTANCE] if distance else [self.color],
+        fbo = frame.framebuffer(color=[self.color, self.distance] if distance else [self.color],
                                 depth=self.depth)
         fbo.depth_mask = False              # clear the colour only: the sprites test the depth just written
         fbo.clear(0.0, 0.0, 0.0, 0.0)
@@ -65,19 +66,22 @@ class OffscreenClouds:
         return fbo
 
     def end(self, frame: PassContext, factor: int, near: float, far: float, distance: bool = False,
-            medium: bool = False) -> None:
+            medium: bool = False, offset=None) -> None:
         """Blend the low-res clouds onto "color" (premultiplied, :meth:`PassContext.blend_over`), and
         their distance onto the cleared "cloud_distance" with the same weights when ``distance``;
         ``medium``: the low-res target holds (in-scattered light, transmittance) of a medium instead,
-        blended by :meth:`PassContext.blend_transmittance` (alpha kept)."""
+        blended by :meth:`PassContext.blend_transmittance` (alpha kept). ``offset`` (ox, oy): low-res
+        texel (i, j) holds the frame's pixel (i·factor + ox, j·factor + oy); None: the block's centre."""
         frame.reset_state()                 # the sprites' depth test and point size are done
         frame.framebuffer(color=[COLOR, CLOUD_DISTANCE] if distance else [COLOR]).use()
-        names = (self.color, self.depth, DEPTH) + ((CLOUD_LOW_DISTANCE,) if distance else ())
+        names = (self.color, self.depth, DEPTH) + ((self.distance,) if distance else ())
         for unit, name in enumerate(names):
             frame.resource(name).use(unit)
         p = self.composite
         p["factor"].value = factor
         p["inv_near_far"].value = (1.0 / near, 1.0 / far)
         p["edge"].value = EDGE
+        centre = 0.5 * (factor - 1)
+        p["sample_offset"].value = (centre, centre) if offset is None else tuple(float(v) for v in offset)
         frame.blend_transmittance() if medium else frame.blend_over()
         frame.fullscreen(p)

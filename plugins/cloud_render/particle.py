@@ -1,28 +1,51 @@
-"""The soft particle every cloud sprite is drawn with: ``(1 − r²)²`` inside the unit disc, 0 outside.
+"""The soft particle every cloud sprite is drawn with (``sprite.vert``/``sprite.frag``, float64 here).
 
-Its integral over the unit disc is π/3, so a sprite of world diameter ``D`` spreads ``π D² / 12``
-times its centre optical depth over the screen; the renderer divides by that (see ``plugin``).
+A sprite stands for a block's mass: its cells' densities, each spread around its centre by the
+trilinear hat the ray march samples (variance 1/6 cell² per axis), widened to the quadratic B-spline
+(the hat convolved with one cell, variance 1/4: a Gaussian of 1/6 leaves a ±7 % ripple of the grid
+in the optical depth, visible as stripes in thin cloud, one of 1/4 under 1 %), so on the screen the mass covers a Gaussian footprint
+with the covariance ``Σ`` of that mass projected on the screen axes (camera right, up; in sprite
+radii: :func:`footprint`). It is an ellipse for non-cubic cells (flat cells seen from the side), so
+neither the grid shows along the long axis nor the cloud blurs along the short one. The profile is
+that Gaussian cut to 0 at the iso-line whose long semi-axis is the radius, ``p = (exp(−Q/2) −
+exp(−k)) / (1 − exp(−k))``, ``Q = xᵀ Σ⁻¹ x``, ``k = 1 / (2 λ_max)``; its integral is ``2π sqrt(det Σ)
+radius² (1 − e^−k − k e^−k) / (1 − e^−k)``, so the centre optical depth :func:`centre_tau` spreads
+the block's optical depth over the screen exactly.
 """
 from __future__ import annotations
 
 import math
 
-import moderngl
 import numpy as np
 
-PROFILE_AREA = math.pi / 3.0        # ∫ (1 − r²)² dA over the unit disc
+CELL_VARIANCE = 0.25         # per axis (cells²): the quadratic B-spline's (the trilinear hat's is 1/6)
+MIN_FALLOFF = 1e-2           # k this small is the 1 − Q/2k ellipse, the profile's limit
 
 
-def particle_profile(n: int = 64) -> np.ndarray:
-    """(n, n) float32 falloff sampled at texel centres (r = 1 at the texture's inscribed circle)."""
-    c = (np.arange(n) + 0.5) / n * 2.0 - 1.0
-    r2 = c[:, None] ** 2 + c[None, :] ** 2
-    return np.where(r2 < 1.0, (1.0 - r2) ** 2, 0.0).astype(np.float32)
+def footprint(cells_var, cell, radius, right, up) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(conic (n, 3): Σ⁻¹ as xx, xy, yy; k (n,); det Σ (n,)) of blocks whose cell centres have the
+    variance ``cells_var`` (n, 3, cells²), for cells of size ``cell`` (m), sprites of ``radius``
+    (n,, m) and the screen axes ``right``, ``up`` (world, unit)."""
+    v = (np.asarray(cells_var, np.float64) + CELL_VARIANCE) * np.asarray(cell, np.float64) ** 2
+    v = v / np.asarray(radius, np.float64)[:, None] ** 2
+    r, u = np.asarray(right, np.float64), np.asarray(up, np.float64)
+    xx, xy, yy = v @ (r * r), v @ (r * u), v @ (u * u)
+    det = xx * yy - xy * xy
+    longest = 0.5 * (xx + yy) + np.sqrt(0.25 * (xx - yy) ** 2 + xy * xy)
+    return np.stack([yy, -xy, xx], -1) / det[:, None], np.maximum(0.5 / longest, MIN_FALLOFF), det
 
 
-def particle_texture(ctx: moderngl.Context, n: int = 64):
-    """The profile as an r32f linear-filtered, edge-clamped 2D texture (made once per pass)."""
-    texture = ctx.texture((n, n), 1, particle_profile(n).tobytes(), dtype="f4")
-    texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
-    texture.repeat_x = texture.repeat_y = False
-    return texture
+def profile(x, y, conic, k) -> np.ndarray:
+    """The profile at screen offsets ``x``, ``y`` (in radii; 1 at the centre, 0 past the cut)."""
+    e = np.exp(-np.asarray(k, np.float64))
+    form = conic[..., 0] * x * x + 2.0 * conic[..., 1] * x * y + conic[..., 2] * y * y
+    return np.maximum(np.exp(-0.5 * form) - e, 0.0) / (1.0 - e)
+
+
+def centre_tau(optical_area, radius, det, k) -> np.ndarray:
+    """Centre optical depth of a sprite whose profile integrates to ``optical_area`` (m²: sigma_t ×
+    V × density summed)."""
+    k = np.asarray(k, np.float64)
+    e = np.exp(-k)
+    return optical_area * (1.0 - e) / (2.0 * math.pi * np.sqrt(det) * np.asarray(radius, np.float64) ** 2
+                                       * (1.0 - e - k * e))

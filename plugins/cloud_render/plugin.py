@@ -13,12 +13,17 @@ sprite out over its radius in front of the scene's depth (soft particles: no har
 meets terrain). Blending is premultiplied (ONE, ONE_MINUS_SRC_ALPHA), so "color"'s alpha stays
 in [0, 1]; the depth test runs against the scene's "depth" with depth writes off.
 
-Opacity: a sprite of world diameter D = ``size_factor × max(cx, cz) × (0.75 + 0.25 min(density, 1))``
-has centre optical depth ``tau = sigma × density × V / l / (pi D² / 12)`` (V the cell volume, l its
-cube-root length, sigma per cell length), so its optical depth summed over the screen equals the
-cell's — what the reference ray marcher integrates (exact for cubic cells). All but empty cells keep
-3/4 of the size, so neighbouring sprites still overlap (at 1/2, thin cloud bottoms fell apart into
-streaks along the columns). Sprites under a pixel are drawn 1 pixel wide with their opacity scaled
+Opacity: a sprite spreads its block's optical depth ``sigma_t × V × (density summed)`` (V the cell
+volume) over the screen like the block's mass: an elliptical Gaussian with that mass's covariance on
+the screen axes (its cells' spread plus each cell's, the quadratic B-spline's 1/4 cell² per axis),
+cut to 0 where its long axis reaches the sprite's radius ``size_factor × max(cx, cz) × 2^L / 2``
+(:mod:`.particle`). The ray march draws nearly the same mass (its trilinear hat: 1/6), so the image
+no longer grows with the size factor once the radius holds the Gaussian (≥ ~3): the old fixed
+``(1 − r²)²`` disc of the whole diameter spread the same optical depth over more pixels, and as
+``1 − exp(−tau)`` is concave the cloud drew more opaque and brighter, +2.5 % at size 3 to +42 % at 6
+(the +24..+72 % of level-of-detail blocks was the same: their disc was 2^L times wider). Level-of-
+detail blocks now carry their own mass's spread, narrower than their spacing, so they ripple
+(stripes 2^L cells apart) and stay off by default. Sprites under a pixel are drawn 1 pixel wide with their opacity scaled
 by their area in pixels; sprites within one diameter of the near plane fade out linearly, so the
 near plane never clips a visible sprite away (no pop).
 """
@@ -30,27 +35,27 @@ import moderngl
 import numpy as np
 
 from atmos.camera import Camera, camera_matrices
-from atmos.checks import CheckedSettings, check_bool, check_int, check_num
+from atmos.checks import check_bool, check_int, check_num
 from atmos.composition import CLOUD_DISTANCE, composition
 from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.plugin import Plugin
 from atmos.plugins.cloud_render.binding import bind_volume, clamp_sampler, unbind_volume
-from atmos.plugins.cloud_render.light import DEFAULT_OCTAVES
+from atmos.plugins.cloud_render.light import CloudLightSettings
 from atmos.plugins.cloud_render.offscreen import MAX_DOWNSAMPLE, OffscreenClouds, low_size
 from atmos.plugins.clouds.layout import CloudLayout
-from atmos.plugins.cloud_render.particle import PROFILE_AREA, particle_texture
 from atmos.plugins.cloud_render.segments import MAX_LEVEL, SegmentStats, select_segments, unpack
 from atmos.plugins.clouds.sets import CLOUD_SETS, CloudSets
 from atmos.render_core import COLOR, DEPTH
 
 
 @dataclass(frozen=True)
-class CloudRenderSettings(CheckedSettings):
+class CloudRenderSettings(CloudLightSettings):
     """How the sprites are drawn (all live: a change shows on the next frame).
 
     ``base_altitude``: world y of the layer's bottom (None: ``CloudSettings.base_altitude``; placement:
     :mod:`atmos.plugins.clouds.layout`). ``size_factor``:
-    sprite diameter in cells at density 1 (>= 0.001; ≥ ~3 hides the grid; 2 shows stripes). ``sigma``: extinction
+    sprite diameter in cells (>= 0.001): where the mass's Gaussian footprint is cut off (≥ ~3 holds
+    it and the image stays the same; smaller cuts it into a flatter disc). ``sigma``: extinction
     per cell length at density 1 (None: the simulation's ``CloudSettings.sigma``). ``frustum_culling``
     and ``empty_space_skipping`` switch the two culling tests; ``max_point_size`` caps sprite pixels
     (None: the GL limit). ``downsample`` (1..8): draw the sprites off screen at 1/downsample of the
@@ -58,10 +63,9 @@ class CloudRenderSettings(CheckedSettings):
     pass's ``setup`` every frame, so a change resizes the off-screen targets on the next frame).
     ``lod_pixels``: level of detail — columns where a block of 2^L cells spans at most this many
     target pixels are drawn one sprite per block (L ≤ 2, :mod:`.segments`); None: every cell.
-    ``ms_attenuation``, ``ms_contribution``, ``ms_eccentricity``: the multiple-scattering octaves
-    (Wrenninge's a, b, c in [0, 1]; a also dims the sky and ground light by the columns above and
-    below; the defaults are fitted to the path tracer, ``benchmarks/bench_cloud_light.py --fit``),
-    shared with the ray march. ``enabled`` False skips drawing.
+    ``ms_attenuation``, ``ms_contribution``, ``ms_eccentricity``: the multiple-scattering octaves,
+    inherited from :class:`~atmos.plugins.cloud_render.light.CloudLightSettings` (shared with the
+    ray-marched clouds). ``enabled`` False declares nothing (the pass is culled, allocates nothing).
     """
     base_altitude: float | None = None
     size_factor: float = 3.0
@@ -71,31 +75,22 @@ class CloudRenderSettings(CheckedSettings):
     max_point_size: float | None = None
     downsample: int = 2
     lod_pixels: float | None = None
-    ms_attenuation: float = DEFAULT_OCTAVES[0]     # fitted to the path tracer (light.DEFAULT_OCTAVES)
-    ms_contribution: float = DEFAULT_OCTAVES[1]
-    ms_eccentricity: float = DEFAULT_OCTAVES[2]
     enabled: bool = True
 
     def __post_init__(self):
         o = "CloudRenderSettings"
         self.store(dict(
             base_altitude=check_num(o, "base_altitude", self.base_altitude, optional=True),
-            size_factor=check_num(o, "size_factor", self.size_factor, 1e-3),   # ~0 makes NaN sprites
+            size_factor=check_num(o, "size_factor", self.size_factor, 1e-3, 64.0),   # ~0: NaN sprites; 64 cells: a whole volume
             sigma=check_num(o, "sigma", self.sigma, 0.0, optional=True),
             frustum_culling=check_bool(o, "frustum_culling", self.frustum_culling),
             empty_space_skipping=check_bool(o, "empty_space_skipping", self.empty_space_skipping),
             max_point_size=check_num(o, "max_point_size", self.max_point_size, 1.0, optional=True),
             downsample=check_int(o, "downsample", self.downsample, 1, MAX_DOWNSAMPLE),
             lod_pixels=check_num(o, "lod_pixels", self.lod_pixels, 0.0, lo_open=True, optional=True),
-            ms_attenuation=check_num(o, "ms_attenuation", self.ms_attenuation, 0.0, 1.0),
-            ms_contribution=check_num(o, "ms_contribution", self.ms_contribution, 0.0, 1.0),
-            ms_eccentricity=check_num(o, "ms_eccentricity", self.ms_eccentricity, 0.0, 1.0),
             enabled=check_bool(o, "enabled", self.enabled),
+            **self.light_checks(),
         ))
-
-    @property
-    def octaves(self) -> tuple:
-        return self.ms_attenuation, self.ms_contribution, self.ms_eccentricity
 
 
 class CloudRenderPlugin(Plugin):
@@ -149,7 +144,7 @@ def sprite_uniforms(plugin, sim, layout: CloudLayout, camera: Camera, aspect: fl
                     point_limit: float) -> dict:
     """The uniforms of ``cloud_render/sprite.vert`` but view_proj and the volume's (:func:`bind_volume`)."""
     cell = np.asarray(layout.cell, np.float64)
-    tau_scale = plugin.extinction(sim) * cell.prod() / np.cbrt(cell.prod()) / (PROFILE_AREA / 4.0)
+    tau_scale = plugin.extinction(sim) * cell.prod() / np.cbrt(cell.prod())     # sigma_t × V
     settings = plugin.settings
     limit = point_limit if settings.max_point_size is None else min(point_limit, settings.max_point_size)
     return {"volume_shape": tuple(int(n) for n in layout.shape), "group_size": tuple(layout.group),
@@ -172,11 +167,13 @@ class CloudSpritePass(RenderPass):
 
     def __init__(self, plugin: CloudRenderPlugin):
         self.plugin = plugin
-        self.program = self.particle = self.sampler = self.offscreen = None
+        self.program = self.sampler = self.offscreen = None
         self.instances = self.commands = self.vao = None
         self._group = self._uploaded = None
 
     def setup(self, builder: PassBuilder) -> None:
+        if not self.plugin.settings.enabled:
+            return                          # declares nothing: culled, allocates nothing
         builder.read(DEPTH)
         builder.read(CLOUD_SETS)
         builder.read(COLOR)                 # blends onto it
@@ -192,7 +189,6 @@ class CloudSpritePass(RenderPass):
     def prepare(self, gpu) -> None:
         self.program = gpu.program(vertex_shader="cloud_render/sprite.vert", fragment_shader="cloud_render/sprite.frag")
         self.offscreen = OffscreenClouds(gpu)
-        self.particle = particle_texture(gpu.ctx)
         self.sampler = clamp_sampler(gpu.ctx)
         limit = gpu.ctx.info.get("GL_POINT_SIZE_RANGE", (1.0, 64.0))[1]
         self.point_limit = float(limit)
@@ -269,7 +265,6 @@ class CloudSpritePass(RenderPass):
         ctx.enable(moderngl.DEPTH_TEST | moderngl.PROGRAM_POINT_SIZE)
         ctx.depth_func = "<="          # a tiny near plane rounds far depths to 1.0: still in front of the sky
         bind_volume(p, sim, self.sampler, view.sun, settings.octaves)
-        self.particle.use(4)
         try:
             self._draw(segments, layout.group)
         finally:
@@ -286,7 +281,6 @@ class CloudSpritePass(RenderPass):
 
     def release(self) -> None:
         self._release_buffers()
-        for obj in (self.particle, self.sampler):
-            if obj is not None:
-                obj.release()
-        self.particle = self.sampler = None
+        if self.sampler is not None:
+            self.sampler.release()
+        self.sampler = None

@@ -12,14 +12,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from atmos.plugins.cloud_render.particle import centre_tau, footprint
 from atmos.plugins.cloud_render.segments import unpack
-from atmos.shading.medium import ambient_shares, octave_weights
+from atmos.shading.medium import ambient_profile, mean_cosine, octave_weights
 from atmos.shading.reference import trilinear
 
 CULLED = np.array([0.0, 0.0, 2.0, 1.0])
 
 
-SMALLEST = 0.75     # an all but empty block's sprite diameter relative to a dense one's
 HAT_SPREAD = 1.0 / 9.0   # sprite.vert: light samples at the centre of mass ± sqrt(variance + 1/9) cells
 
 
@@ -113,12 +113,13 @@ def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, 
     s = np.concatenate(spans).astype(np.float64)
     inside = (c < shape).all(-1)
     visible = inside & (total > 0)
-    d = total / s ** 3
     weight = np.maximum(total, 1e-300)[:, None]
     mean = np.concatenate(firsts) / weight
-    spread = np.sqrt(np.maximum(np.concatenate(seconds) / weight - mean ** 2, 0.0) + HAT_SPREAD)
+    cells_var = np.maximum(np.concatenate(seconds) / weight - mean ** 2, 0.0)
+    spread = np.sqrt(cells_var + HAT_SPREAD)
     center = c + np.where(visible[:, None], mean, 0.5 * s[:, None])     # the block's centre of mass
     a_ms, b_ms, _ = light["ms_octaves"]
+    g_mean = mean_cosine(*light["phase_lobes"])
     uvw = center / shape
     uvw_a = (center + shift) / shape
     up, down = ((1.0 - t) * column_depth(a64, uvw_a, d, light["column_tau"]) +
@@ -132,31 +133,39 @@ def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, 
             tex = np.array(np.shape(trans_a))
             T = trilinear(np.asarray(trans_a, np.float64), (tap + shift) / shape * tex - 0.5) * (1 - t) + \
                 trilinear(np.asarray(trans_b, np.float64), tap / shape * tex - 0.5) * t
-        octaves += octave_weights(T, up + down, a_ms, b_ms) / 8.0
+        octaves += octave_weights(T, up + down, a_ms, b_ms, g_mean) / 8.0
     world = np.asarray(u["layer_min"]) + center * np.asarray(u["cell_size"])
     ray = world - np.asarray(u["camera_pos"], np.float64)
-    sky_share, ground_share = ambient_shares(*light["phase_lobes"], ray[:, 1] / np.linalg.norm(ray, axis=1))
-    ambient = (sky_share * np.exp(-a_ms * up))[:, None] * np.asarray(light["sky_source"]) + \
-        (ground_share * np.exp(-a_ms * down))[:, None] * np.asarray(light["ground_source"])
+    h = ambient_profile(up, down, g_mean, ray[:, 1] / np.linalg.norm(ray, axis=1))[:, None]
+    sky, ground = np.asarray(light["sky_source"]), np.asarray(light["ground_source"])
+    ambient = (sky + ground) + h * (sky - ground)
     clip = np.concatenate([world, np.ones((len(c), 1))], 1) @ np.asarray(view_proj, np.float64).T
-    diameter = s * u["base_diameter"] * (SMALLEST + (1.0 - SMALLEST) * np.minimum(d, 1.0))
+    diameter = s * u["base_diameter"]
+    conic, k, det = footprint(cells_var, u["cell_size"], 0.5 * diameter, u["camera_right"], u["camera_up"])
     px = diameter * u["pixel_scale"] / np.maximum(clip[:, 3], 1e-6)
+    near, far = u["near"], u["far"]                 # depth-tested at its front: the centre a radius nearer
+    front = np.maximum(clip[:, 3] - 0.5 * diameter, near)
+    ndc = np.minimum((far + near) / (far - near) - 2.0 * far * near / ((far - near) * front), 1.0)
+    clip = np.concatenate([clip[:, :2], (ndc * clip[:, 3])[:, None], clip[:, 3:]], 1)
     return {"position": np.where(visible[:, None], clip, CULLED),
             "size": np.where(visible, np.clip(px, 1.0, u["max_point_size"]), 1.0),
             "octaves": np.where(visible[:, None], octaves, 0.0),
             "ambient": np.where(visible[:, None], ambient, 0.0),
             "center": np.where(visible[:, None], world, 0.0),
             "radius": np.where(visible, 0.5 * diameter, 0.0),
-            "tau": np.where(visible, u["tau_scale"] * total / np.maximum(diameter, 1e-30) ** 2, 0.0),
+            "tau": np.where(visible, centre_tau(u["tau_scale"] * total, 0.5 * diameter, det, k), 0.0),
+            "conic": np.where(visible[:, None], conic, [1.0, 0.0, 1.0]),
+            "falloff": np.where(visible, k, 1.0),
             "coverage": np.where(visible, np.clip(px, 0.0, 1.0) ** 2 *
                                  np.clip((clip[:, 3] - u["near"]) / np.maximum(diameter, 1e-30), 0.0, 1.0), 0.0),
             "visible": visible}
 
 
 def soft_fade(scene_depth, sprite_depth, radius, near: float, far: float) -> np.ndarray:
-    """The soft-particle factor of ``sprite.frag``: clamp((scene view depth − sprite view depth) / radius,
-    0, 1), ``scene_depth`` the window depth under the fragment (off screen: :func:`.offscreen_reference.far_depth`
+    """The soft-particle factor of ``sprite.frag``: clamp(1/2 + (scene view depth − sprite view depth) /
+    (2 radius), 0, 1) — the share of the sprite's depth span in front of the surface — ``scene_depth`` the window depth under the fragment (off screen: :func:`.offscreen_reference.far_depth`
     of the frame's), ``sprite_depth`` the sprite centre's view depth (its clip w)."""
     d = np.asarray(scene_depth, np.float64)
     scene = near / ((1.0 - d) + d * (near / far))
-    return np.clip((scene - np.asarray(sprite_depth, np.float64)) / np.asarray(radius, np.float64), 0.0, 1.0)
+    return np.clip(0.5 + 0.5 * (scene - np.asarray(sprite_depth, np.float64)) / np.asarray(radius, np.float64),
+                   0.0, 1.0)

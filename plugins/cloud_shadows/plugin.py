@@ -8,6 +8,7 @@ from atmos.graph import FullscreenPass, PassContext
 from atmos.lighting import unit_sun
 from atmos.plugin import Plugin
 from atmos.plugins.clouds.layout import CloudLayout
+from atmos.plugins.cloud_far_field.layer import FAR_FIELD
 from atmos.plugins.cloud_shadows.settings import CloudShadowSettings
 from atmos.plugins.clouds.sets import CLOUD_SETS, CloudSets
 from atmos.render_core import COLOR, DEPTH
@@ -47,6 +48,18 @@ class CloudShadowsPass(FullscreenPass):
     fragment = "cloud_shadows/shadow.frag"
     reads = (COLOR, DEPTH, CLOUD_SETS)
 
+    def far_field(self) -> bool:
+        """Whether the shadows continue with a far field's cover (one is imported, ``settings.far_field``)."""
+        return self.plugin.settings.far_field and self.plugin.graph.imports(FAR_FIELD)
+
+    def defines(self) -> dict:
+        return {"CLOUD_FAR_FIELD": 1} if self.far_field() else {}
+
+    def setup(self, builder) -> None:
+        super().setup(builder)
+        if self.far_field():
+            builder.read(FAR_FIELD)
+
     def execute(self, frame: PassContext) -> None:
         view, gpu, p = frame.view, frame.gpu, self.program
         params = self.plugin.settings
@@ -69,6 +82,11 @@ class CloudShadowsPass(FullscreenPass):
         p["sun_dir"].value = tuple(unit_sun(sun.direction))
         p["weight"].value = weight
         column_uniforms(p, sim, layout, sigma * params.strength)
+        if frame.declares(FAR_FIELD):
+            layer = frame.resource(FAR_FIELD)
+            layer.prepare(view, sim)
+            layer.use(p, view, sim)
+            p["field_optical_depth"].value = float(layer.settings.optical_depth * params.strength)
         frame.fullscreen(p)
 
 
@@ -82,4 +100,5 @@ class CloudShadowsPlugin(Plugin):
     def build(self, app) -> None:
         if app.graph is None:
             raise ValueError("CloudShadowsPlugin needs an App with a GPU context (App(gpu))")
+        self.graph = app.graph
         app.graph.add_pass(CloudShadowsPass(self))

@@ -38,7 +38,7 @@ def shifted(plane: np.ndarray, shift) -> np.ndarray:
 
 
 def shadow_factor(points, sums_a, sums_b, t: float, sun_direction, weight: float, extinction: float,
-                  layout: CloudLayout, a_shift=(0, 0, 0), edge_fade: float = 0.0) -> np.ndarray:
+                  layout: CloudLayout, a_shift=(0, 0, 0), edge_fade: float = 0.0, far=None) -> np.ndarray:
     """Factor (...,) the colour at world ``points`` (..., 3) is multiplied by; ``sums_a/b`` (nx, nz)
     the all-heights top-view maps of sets A and B; ``extinction`` = sigma·strength; ``layout`` B's
     world placement (the sprite renderer's rule); ``a_shift`` cells from B's column to A's
@@ -47,14 +47,17 @@ def shadow_factor(points, sums_a, sums_b, t: float, sun_direction, weight: float
     s = unit_sun(sun_direction)
     if s is None or weight <= 0.0:
         return np.ones(points.shape[:-1])
-    tau = sun_optical_depth(points, sums_a, sums_b, t, s, extinction, layout, a_shift, edge_fade)
+    tau = sun_optical_depth(points, sums_a, sums_b, t, s, extinction, layout, a_shift, edge_fade, far)
     return 1.0 - weight * (1.0 - np.exp(-tau))
 
 
 def sun_optical_depth(points, sums_a, sums_b, t: float, sun_dir, extinction: float, layout: CloudLayout,
-                      a_shift=(0, 0, 0), edge_fade: float = 0.0) -> np.ndarray:
+                      a_shift=(0, 0, 0), edge_fade: float = 0.0, far=None) -> np.ndarray:
     """Optical depth (...,) from world ``points`` (..., 3) toward the sun (``sun_dir`` unit, y > 0)
-    through the clouds: ``extinction · column · above`` (module docstring; shaders/cloud_shadows/column.glsl)."""
+    through the clouds: ``extinction · column · above`` (module docstring; shaders/cloud_shadows/column.glsl);
+    ``far``: None, or a function of world xz (..., 2) giving the far field's column optical depth there
+    (``optical_depth·strength·d.x``, :func:`atmos.plugins.cloud_far_field.reference.far_field_density`),
+    added with the complementary edge weight ``(1 − edge)·above``."""
     points, s = np.asarray(points, np.float64), np.asarray(sun_dir, np.float64)
     sums = (1.0 - t) * shifted(np.asarray(sums_a, np.float64), a_shift) + t * np.asarray(sums_b, np.float64)
     lo, hi, cell = layout.lo, layout.hi, np.asarray(layout.cell, np.float64)
@@ -62,6 +65,10 @@ def sun_optical_depth(points, sums_a, sums_b, t: float, sun_dir, extinction: flo
     run = np.maximum(0.5 * (lo[1] + hi[1]) - y, 0.0) / max(s[1], MIN_SUN_HEIGHT)
     q = points + run[..., None] * s
     texel = (q[..., [0, 2]] - lo[[0, 2]]) / cell[[0, 2]] - 0.5        # map texel (i, k) centred at (i, k)
-    column = zero_border_bilinear(sums, texel) * edge_weight(footprint_uv(layout, q[..., [0, 2]]), edge_fade)
+    edge = edge_weight(footprint_uv(layout, q[..., [0, 2]]), edge_fade)
+    column = zero_border_bilinear(sums, texel) * edge
     above = np.clip((hi[1] - y) / (hi[1] - lo[1]), 0.0, 1.0)
-    return extinction * column * above
+    tau = extinction * column * above
+    if far is not None:
+        tau = tau + far(q[..., [0, 2]]) * (1.0 - edge) * above
+    return tau

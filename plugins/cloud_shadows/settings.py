@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from atmos.checks import CheckedSettings, check_num, check_vec
+from atmos.checks import CheckedSettings, check_bool, check_num, check_vec
 
 _OWNER = "CloudShadowSettings"
 
@@ -23,6 +23,9 @@ class CloudShadowSettings(CheckedSettings):
     block); the rest (sky ambient) is kept. ``horizon_fade``: shadows fade in while the sun's height
     (the y of its unit direction, sin of its elevation) rises from 0 to this, so a grazing sun, whose
     projection runs far, fades them out, and a sun at or below the horizon casts none.
+    ``far_field``: beyond the volume, shadows continue with the cover of a CloudFarFieldPlugin when
+    the App has one (its column's optical depth × ``strength``, with the volume's complementary edge
+    weight), so they have no edge where the volume ends.
     """
 
     base_altitude: float | None = None
@@ -31,6 +34,7 @@ class CloudShadowSettings(CheckedSettings):
     strength: float = 1.0
     direct_fraction: float = 0.75
     horizon_fade: float = 0.1
+    far_field: bool = True
 
     def __post_init__(self):
         o = _OWNER
@@ -41,5 +45,6 @@ class CloudShadowSettings(CheckedSettings):
             strength=check_num(o, "strength", self.strength, 0.0),
             direct_fraction=check_num(o, "direct_fraction", self.direct_fraction, 0.0, 1.0),
             horizon_fade=check_num(o, "horizon_fade", self.horizon_fade, 0.0, 1.0, lo_open=True),
+            far_field=check_bool(o, "far_field", self.far_field),
         )
         self.store(checked)

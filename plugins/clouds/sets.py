@@ -36,6 +36,7 @@ class CloudSets:
     origin: tuple                # VolumeOrigin now
     settings: object             # the simulation's CloudSettings
     shape: tuple
+    wind_travel: tuple = (0.0, 0.0)   # (x, z) cells the contents have moved with the wind, mix(A's, B's, t)
 
     def view(self) -> tuple[TextureSet, TextureSet, float]:
         return self.a, self.b, self.t

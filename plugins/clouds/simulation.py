@@ -203,6 +203,8 @@ class CloudSimulation:
         self._max_maps = {key: np.zeros((1 + m.bands, *m.grid), np.float32) for key, m in self._maps.items()}
         self._placement: dict[int, tuple] = {}    # id(texture set) -> VolumeOrigin its step began at
         self._drift = np.zeros(2)          # sub-cell wind displacement not yet applied
+        self._blown = np.zeros(2)          # cells of wind so far (x, z)
+        self._travel: dict[int, np.ndarray] = {}   # id(texture set) -> cells its contents moved with the wind
         self._last_origin = np.array(self.origin.as_tuple())
         self._step_origin = self.origin.as_tuple()
         n = s.smoothing_slices
@@ -228,6 +230,7 @@ class CloudSimulation:
 
     def _automaton_slice(self, index: int, job) -> None:
         self.automaton.step_with_texture(self.region.prob_texture, shift=self._next_shift())
+        self._travel[id(job.target)] = self._blown - self._drift      # the wind's part of the whole-cell shifts
 
     def _smoothing_slice(self, index: int, job) -> None:
         z0, z1 = slice_range(self.shape[2], index, job.slices)
@@ -248,6 +251,7 @@ class CloudSimulation:
         self._last_origin = origin
         wind = np.asarray(self.settings.weather.wind, float)
         self._drift += wind[[0, 2]] * self.settings.step_seconds - moved[[0, 2]]
+        self._blown = self._blown + wind[[0, 2]] * self.settings.step_seconds
         shift = np.trunc(self._drift)
         self._drift -= shift
         limit = max(self.shape) + 1            # larger shifts empty the volume all the same
@@ -273,7 +277,13 @@ class CloudSimulation:
         here = self.origin.as_tuple()
         return CloudSets(a, b, float(t), self._maps[id(a)], self._maps[id(b)], self._max_maps[id(a)],
                          self._max_maps[id(b)], self._placement.get(id(a), here), self._placement.get(id(b), here),
-                         here, self.settings, tuple(self.shape))
+                         here, self.settings, tuple(self.shape), self._wind_travel(a, b, t))
+
+    def _wind_travel(self, a, b, t: float) -> tuple:
+        """(x, z) cells the drawn contents mix(A, B, t) have moved with the wind (the far field follows it)."""
+        zero = np.zeros(2)
+        travel = (1.0 - t) * self._travel.get(id(a), zero) + t * self._travel.get(id(b), zero)
+        return float(travel[0]), float(travel[1])
 
     def sun_in_cells(self) -> np.ndarray:
         """The sun direction in cell units (what the shear-warp needs when cells are not cubes)."""

@@ -9,6 +9,7 @@ import numpy as np
 from atmos.camera import set_camera_uniforms
 from atmos.graph import PassBuilder, PassContext
 from atmos.lighting import unit_sun
+from atmos.plugins.cloud_far_field.layer import FAR_FIELD
 from atmos.plugins.cloud_render.offscreen import OffscreenClouds
 from atmos.plugins.cloud_shadows.plugin import column_uniforms
 from atmos.plugins.clouds.sets import CLOUD_SETS, CloudSets
@@ -33,17 +34,25 @@ class MarchedShafts:
     """The march's declarations and draws for a LightShaftsPass (programs belong to the GpuContext)."""
 
     def __init__(self, gpu):
+        self.gpu = gpu
         self.offscreen = OffscreenClouds(gpu, SHAFT_COLOR, SHAFT_DEPTH)
-        self.march = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="light_shafts/march.frag")
+
+    def program(self, far_field: bool):
+        """The march, with the far field's shadows beyond the volume (column.glsl's CLOUD_FAR_FIELD) or without."""
+        return self.gpu.program({"CLOUD_FAR_FIELD": 1} if far_field else None,
+                                vertex_shader="lib/fullscreen.vert", fragment_shader="light_shafts/march.frag")
 
     @staticmethod
-    def declare(builder: PassBuilder, size, factor: int, clouds: bool) -> None:
+    def declare(builder: PassBuilder, size, factor: int, clouds: bool, far_field: bool = False) -> None:
+        """``far_field``: the graph imports a CloudFarFieldPlugin's layer; the rays see its shadows too."""
         OffscreenClouds.declare(builder, size, factor, color=SHAFT_COLOR, depth=SHAFT_DEPTH)
         builder.read(DEPTH)
         builder.read(COLOR)
         builder.write(COLOR)
         if clouds:
             builder.read(CLOUD_SETS)
+            if far_field:
+                builder.read(FAR_FIELD)
 
     def execute(self, frame: PassContext, settings, clouds: bool) -> None:
         view = frame.view
@@ -54,7 +63,8 @@ class MarchedShafts:
         self.offscreen.begin(frame, factor)
         frame.reset_state()
         frame.framebuffer(color=[SHAFT_COLOR]).use()
-        p = self.march
+        far_field = clouds and frame.declares(FAR_FIELD)
+        p = self.program(far_field)
         frame.resource(SHAFT_DEPTH).use(2)
         if clouds:
             sim: CloudSets = frame.resource(CLOUD_SETS)
@@ -62,6 +72,10 @@ class MarchedShafts:
             sim.maps_of(a).sums.use(0)
             sim.maps_of(b).sums.use(1)
             column_uniforms(p, sim, sim.layout(), sim.settings.sigma)
+            if far_field:
+                layer = frame.resource(FAR_FIELD)
+                layer.prepare(view, sim)
+                layer.use(p, view, sim)
         p["has_clouds"].value = int(clouds)
         set_camera_uniforms(p, view.camera, view.aspect)
         p["sun_dir"].value = tuple(unit_sun(view.sun.direction))

@@ -6,6 +6,7 @@ import math
 
 from atmos.graph import PassBuilder, PassContext, RenderPass, TextureDesc
 from atmos.plugin import Plugin
+from atmos.plugins.cloud_far_field.layer import FAR_FIELD
 from atmos.plugins.clouds.sets import CLOUD_SETS
 from atmos.plugins.light_shafts.march import MarchedShafts
 from atmos.plugins.light_shafts.settings import LightShaftSettings
@@ -51,7 +52,7 @@ class LightShaftsPass(RenderPass):
         w, h = self.plugin.gpu.size
         d = self.plugin.settings.downsample
         if self.plugin.settings.mode == "march":
-            MarchedShafts.declare(builder, (w, h), d, self.clouds())
+            MarchedShafts.declare(builder, (w, h), d, self.clouds(), self.plugin.graph.imports(FAR_FIELD))
             return
         desc = TextureDesc((math.ceil(w / d), math.ceil(h / d)), components=4, dtype="f2")
         builder.create(MASK, desc)

@@ -50,9 +50,9 @@ class LightShaftSettings(CheckedSettings):
 
     mode: str = "march"
     steps: int = 24
-    scattering: float = 2e-5
-    max_distance: float = 6000.0
-    phase_g: float = 0.7
+    scattering: float = 6e-6          # tuned at the sunset (sun 4.6°): rays visible, no wash round the sun
+    max_distance: float = 8000.0
+    phase_g: float = 0.5
     phase_g2: float = -0.2
     phase_w: float = 0.2
     sun_intensity: float = 4.0 * math.pi

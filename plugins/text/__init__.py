@@ -109,7 +109,7 @@ class TextPlugin(Plugin):
     def __init__(self, font: str | None = None):
         super().__init__()
         if font is not None and not isinstance(font, str):
-            raise ValueError(f"TextPlugin font must be a font file path or None, got {font!r}")
+            raise ValueError(f"TextPlugin.font must be a font file path or None, got {font!r}")
         if font is not None:
             load_font(font, 12)                      # fails now, naming the file, if it is no font
         self.font = font

@@ -16,7 +16,7 @@ def font(path: str | None, size: int):
     try:
         return ImageFont.truetype(path, size)
     except OSError as error:
-        raise ValueError(f"TextSettings.font must be a TrueType/OpenType font file or None; cannot load {path!r} "
+        raise ValueError(f"TextPlugin.font must be a TrueType/OpenType font file or None; cannot load {path!r} "
                          f"({error})") from None
 
 

@@ -11,6 +11,7 @@ layout(binding = 3) uniform sampler2D cloud_distance; // premultiplied (a·dista
 uniform int factor;
 uniform vec2 inv_near_far;   // (1/near, 1/far): 1/view depth is linear in window depth
 uniform float edge;          // relative view-depth difference that makes an edge
+uniform vec2 sample_offset;  // texel (i, j) holds the frame's pixel (i, j) * factor + sample_offset
 out vec4 frag;
 layout(location = 1) out vec4 frag_distance;
 
@@ -18,7 +19,7 @@ float inv_depth(float d) { return mix(inv_near_far.x, inv_near_far.y, d); }
 
 void main() {
     ivec2 last = textureSize(clouds, 0) - 1;
-    vec2 p = gl_FragCoord.xy / float(factor) - 0.5;          // low-res texel centres at integers
+    vec2 p = (gl_FragCoord.xy - 0.5 - sample_offset) / float(factor);   // low-res texel centres at integers
     ivec2 p0 = ivec2(floor(p));
     vec2 f = p - vec2(p0);
     float w = inv_depth(texelFetch(scene_depth, ivec2(gl_FragCoord.xy), 0).r);

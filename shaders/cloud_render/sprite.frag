@@ -1,12 +1,14 @@
 #version 430
-// A soft cloud particle: opacity 1 - exp(-tau × falloff), premultiplied (blend ONE, ONE_MINUS_SRC_ALPHA);
+// A soft cloud particle: opacity 1 - exp(-tau × profile), the profile (exp(-Q/2) - exp(-k)) / (1 - exp(-k)),
+// Q = p^T conic p (the block's mass footprint, sprite.vert; particle.py), premultiplied (blend ONE, ONE_MINUS_SRC_ALPHA);
 // its light J (volume.glsl) with the phase function at this pixel's view ray through the sprite's plane.
-// Soft particle: × clamp((scene view depth - sprite view depth) / radius, 0, 1), so a sprite meeting
-// terrain fades out over its radius instead of cutting a line (float64: reference.soft_fade). The scene
+// Soft particle: × clamp(1/2 + (scene view depth - sprite view depth) / (2 radius), 0, 1), the share of
+// its depth span [centre - radius, centre + radius] in front of the surface, so a sprite meeting terrain
+// fades out across it instead of cutting a line (float64: reference.soft_fade; sprite.vert depth-tests
+// the sprite at its front). The scene
 // depth is the attached depth target's (depth writes are off): "depth", or off screen the block's farthest.
 #include "cloud_render/volume.glsl"
 #include "lib/view_ray.glsl"
-layout(binding = 4) uniform sampler2D particle;
 layout(binding = 5) uniform sampler2D scene_depth;
 uniform float near;
 uniform float far;
@@ -18,15 +20,20 @@ flat in vec3 v_ambient;
 flat in vec3 v_center;
 flat in float v_radius;
 flat in float v_tau;
+flat in vec3 v_conic;
+flat in float v_falloff;
 flat in float v_coverage;
 out vec4 frag;
 layout(location = 1) out vec4 frag_distance;   // (a·distance, a): "cloud_distance" when attached (atmos/composition.py)
 
 void main() {
     float scene = view_depth(texelFetch(scene_depth, ivec2(gl_FragCoord.xy), 0).r, near, far);
-    float soft = clamp((scene - 1.0 / gl_FragCoord.w) / v_radius, 0.0, 1.0);   // 1 / w: the sprite's view depth
-    float a = (1.0 - exp(-v_tau * texture(particle, gl_PointCoord).r)) * v_coverage * soft;
-    vec2 q = (gl_PointCoord - 0.5) * vec2(2.0, -2.0) * v_radius;
+    float soft = clamp(0.5 + 0.5 * (scene - 1.0 / gl_FragCoord.w) / v_radius, 0.0, 1.0);   // 1 / w: its view depth
+    vec2 pc = (gl_PointCoord - 0.5) * vec2(2.0, -2.0);
+    float e = exp(-v_falloff), form = dot(pc * pc, v_conic.xz) + 2.0 * v_conic.y * pc.x * pc.y;
+    float profile = max(exp(-0.5 * form) - e, 0.0) / (1.0 - e);
+    float a = (1.0 - exp(-v_tau * profile)) * v_coverage * soft;
+    vec2 q = pc * v_radius;
     vec3 ray = normalize(v_center + q.x * camera_right + q.y * camera_up - camera_pos);
     frag = vec4((sun_part(v_octaves, dot(ray, sun_dir)) + v_ambient) * a, a);
     frag_distance = vec4(a * length(v_center - camera_pos), a, 0.0, a);   // blends by its own alpha

@@ -22,16 +22,24 @@ uniform float base_diameter;   // world sprite diameter of one cell at density 1
 uniform float pixel_scale;     // pixel diameter = world diameter × pixel_scale / clip.w
 uniform float max_point_size;
 uniform float near;            // the camera's near plane: sprites fade out before their centre crosses it
-uniform float tau_scale;       // centre optical depth = tau_scale × (density summed over the block) / diameter²
+uniform float far;
+uniform vec3 camera_right;     // the sprite's screen axes (the fragment shader's too)
+uniform vec3 camera_up;
+uniform float tau_scale;       // sigma_t × cell volume: the optical depth a unit of summed density spreads over the screen (m²)
 flat out vec4 v_octaves;      // b^i T^(a^i): the sun's light per octave (volume.glsl)
 flat out vec3 v_ambient;      // sky and ground light at the sprite, dimmed by the columns above and below
 flat out vec3 v_center;       // world centre and radius: the fragment's view ray for the phase function
 flat out float v_radius;
 flat out float v_tau;
+flat out vec3 v_conic;         // the footprint's inverse covariance (xx, xy, yy) on the screen axes, in radii
+flat out float v_falloff;      // k of the profile (exp(-Q/2) - exp(-k)) / (1 - exp(-k)), Q = p^T conic p
 flat out float v_coverage;     // < 1 for sprites smaller than a pixel (their area in pixels) or near the near plane
 
 const vec4 CULLED = vec4(0.0, 0.0, 2.0, 1.0);   // z > w: outside the clip volume
-const float SMALLEST = 0.75;   // an all but empty block's sprite, relative to a dense one's: neighbours overlap
+// per axis (cells²): the trilinear hat's 1/6 around a cell centre, widened to the quadratic B-spline's 1/4
+// (the hat convolved with one cell) so a Gaussian this wide leaves < 1 % ripple on the grid (particle.py)
+const float CELL_VARIANCE = 0.25;
+const float MIN_FALLOFF = 1e-2;         // q this small is a 1 - r² disc: the profile's limit
 // A cell's mass is its density times the trilinear hat around its centre; the sprite's light is the
 // mean of J over that mass, not J at the centre (T is convex: a centre sample is too dark on the lit
 // side, by up to ~20 % at an optical depth of 1 per cell). Per axis, the mean of the trilinear T under
@@ -66,6 +74,8 @@ void main() {
     v_center = vec3(0.0);
     v_radius = 0.0;
     v_tau = 0.0;
+    v_falloff = 1.0;
+    v_conic = vec3(1.0, 0.0, 1.0);
     v_coverage = 0.0;
     gl_PointSize = 1.0;
     gl_Position = CULLED;
@@ -90,19 +100,32 @@ void main() {
     if (!(sum > 0.0)) return;
     // the sprite at the block's centre of mass, lit by the mean J of its mass (HAT_SPREAD)
     vec3 mean = first / sum;
-    vec3 spread = sqrt(max(second / sum - mean * mean, 0.0) + HAT_SPREAD);
+    vec3 cells_var = max(second / sum - mean * mean, 0.0);      // of the block's cell centres, cells²
+    vec3 spread = sqrt(cells_var + HAT_SPREAD);
     vec3 center = vec3(cell) + mean;
     sum *= cloud_edge_weight((vec2(cell.xz) + 0.5 * float(s)) / vec2(volume_shape.xz), edge_fade);
     if (!(sum > 0.0)) return;
-    float d = sum / float(s * s * s);
     vec3 world = layer_min + center * cell_size;
     vec4 clip = view_proj * vec4(world, 1.0);
-    float diameter = float(s) * base_diameter * mix(SMALLEST, 1.0, min(d, 1.0));
+    float diameter = float(s) * base_diameter;
     float px = diameter * pixel_scale / max(clip.w, 1e-6);
     float c = clamp(px, 0.0, 1.0);
     v_coverage = c * c * clamp((clip.w - near) / diameter, 0.0, 1.0);   // no pop when the near plane clips it
     gl_PointSize = clamp(px, 1.0, max_point_size);
-    v_tau = tau_scale * sum / (diameter * diameter);
+    // the footprint: the block's mass (its cells' spread + each cell's, world m², diagonal) on the
+    // screen axes, in sprite radii; the profile is that Gaussian cut to 0 at the iso-line whose long
+    // axis is the radius (particle.py)
+    float radius = 0.5 * diameter;
+    vec3 mass_var = (cells_var + CELL_VARIANCE) * cell_size * cell_size / (radius * radius);
+    vec3 cov = vec3(dot(camera_right * camera_right, mass_var), dot(camera_right * camera_up, mass_var),
+                    dot(camera_up * camera_up, mass_var));
+    float det = cov.x * cov.z - cov.y * cov.y;
+    float longest = 0.5 * (cov.x + cov.z) + sqrt(0.25 * (cov.x - cov.z) * (cov.x - cov.z) + cov.y * cov.y);
+    float k = max(0.5 / longest, MIN_FALLOFF), e = exp(-k);
+    v_conic = vec3(cov.z, -cov.y, cov.x) / det;
+    v_falloff = k;
+    v_tau = tau_scale * sum * (1.0 - e) / (2.0 * PI * sqrt(det) * radius * radius * (1.0 - e - k * e));
+    vec3 ray = normalize(world - camera_pos);
     vec3 uvw = center / vec3(volume_shape);
     float ny = float(volume_shape.y);
     float up = column_depth(uvw, 1.0, ny), down = column_depth(uvw, -1.0, ny);
@@ -112,8 +135,12 @@ void main() {
         octaves += octave_weights(cloud_transmittance(uvw + side * spread / vec3(volume_shape)), up + down);
     }
     v_octaves = octaves / 8.0;
-    v_ambient = ambient_source(up, down, normalize(world - camera_pos).y);
+    v_ambient = ambient_source(up, down, ray.y);
     v_center = world;
     v_radius = 0.5 * diameter;
-    gl_Position = clip;
+    // depth-tested at its front (the centre pulled a radius toward the camera, x and y unmoved): a
+    // sprite whose centre is just behind a surface still shows the part of its mass in front (sprite.frag)
+    float front = max(clip.w - v_radius, near);
+    float ndc = (far + near) / (far - near) - 2.0 * far * near / ((far - near) * front);
+    gl_Position = vec4(clip.xy, min(ndc, 1.0) * clip.w, clip.w);
 }

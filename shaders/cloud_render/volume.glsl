@@ -1,8 +1,10 @@
 // The cloud volume as the renderers see it: density and transmittance toward the sun, each
 // mix(A, B, t) of the two latest completed steps, and the light model of atmos/shading/medium.py:
 // source per unit extinction J = sun_source * sum_i m_i b^i p(cos; c^i g) T^(a^i)
-//                              + sky_source (1 + s) exp(-a tau_up) + ground_source (1 - s) exp(-a tau_down),
-// m_0 = 1, m_i = 1 - exp(-tau_up - tau_down), s = g_mean * ray_y.
+//                              + (sky_source + ground_source) + (sky_source - ground_source) h,
+// m_0 = 1, m_i = 1 - exp(-(1 - g_mean)(tau_up + tau_down)) (the column's transport optical depth),
+// h = clamp(u + g_mean ray_y exp(-(tau_up + tau_down) / 2z), -1, 1), u = (tau_down - tau_up) / (tau_up + tau_down + 2z),
+// z = 2 / (3 (1 - g_mean)): the diffusion profile between a slab's lit faces (see medium.py).
 layout(binding = 0) uniform sampler3D density_a;
 layout(binding = 1) uniform sampler3D density_b;
 layout(binding = 2) uniform sampler3D trans_a;       // at the shading scale; same texture coordinates
@@ -45,19 +47,27 @@ float column_depth(vec3 uvw, float dir, float ny) {
     return column_tau * sum * len * ny / float(COLUMN_SAMPLES);
 }
 
+// The phase function's mean cosine g_mean = (1 - w) g + w g2.
+float mean_cosine() {
+    return (1.0 - phase_lobes.z) * phase_lobes.x + phase_lobes.z * phase_lobes.y;
+}
+
 // Octave weights b^i T^(a^i), i = 0..3, the scattered ones (i >= 1) times the chance
-// 1 - exp(-tau_column) that light met the cloud's column through the point at all.
+// 1 - exp(-(1 - g_mean) tau_column) that light was turned aside in the column through the point.
 vec4 octave_weights(float T, float tau_column) {
-    float a = ms_octaves.x, b = ms_octaves.y, m = 1.0 - exp(-tau_column);
+    float a = ms_octaves.x, b = ms_octaves.y, m = 1.0 - exp(-(1.0 - mean_cosine()) * tau_column);
     return vec4(T, m * b * pow(T, a), m * b * b * pow(T, a * a), m * b * b * b * pow(T, a * a * a));
 }
 
-// Sky and ground light toward the eye along ray_y (the view ray's y): the phase's mean cosine
-// g_mean sends the share 1/2 (1 + g_mean ray_y) of what reaches the eye in from the sky.
+// Sky and ground light toward the eye along ray_y (the view ray's y): their mean plus half their
+// difference times h, the diffusion profile u between the columns above and below (a furnace of equal
+// sky and ground stays exact) and, where the column is thin, the phase's forward share g_mean ray_y.
 vec3 ambient_source(float tau_up, float tau_down, float ray_y) {
-    float s = ((1.0 - phase_lobes.z) * phase_lobes.x + phase_lobes.z * phase_lobes.y) * ray_y;
-    return sky_source * (1.0 + s) * exp(-ms_octaves.x * tau_up)
-         + ground_source * (1.0 - s) * exp(-ms_octaves.x * tau_down);
+    float g = mean_cosine();
+    float z = 2.0 / (3.0 * (1.0 - min(g, 0.99)));
+    float u = (tau_down - tau_up) / (tau_up + tau_down + 2.0 * z);
+    float h = clamp(u + g * ray_y * exp(-(tau_up + tau_down) / (2.0 * z)), -1.0, 1.0);
+    return (sky_source + ground_source) + (sky_source - ground_source) * h;
 }
 
 #include "lib/phase.glsl"
@@ -72,9 +82,13 @@ vec3 sun_part(vec4 w, float c) {
     return sun_source * sum;
 }
 
-// J at uvw for a view ray along ray_dir (world, unit).
-vec3 cloud_source(vec3 uvw, vec3 ray_dir, float ny) {
+// J at uvw for a view ray along ray_dir (world, unit), with sun transmittance T.
+vec3 cloud_source_with(vec3 uvw, vec3 ray_dir, float ny, float T) {
     float up = column_depth(uvw, 1.0, ny), down = column_depth(uvw, -1.0, ny);
-    return sun_part(octave_weights(cloud_transmittance(uvw), up + down), dot(ray_dir, sun_dir))
-         + ambient_source(up, down, ray_dir.y);
+    return sun_part(octave_weights(T, up + down), dot(ray_dir, sun_dir)) + ambient_source(up, down, ray_dir.y);
+}
+
+// J at uvw for a view ray along ray_dir (world, unit): the shading volume's sun transmittance.
+vec3 cloud_source(vec3 uvw, vec3 ray_dir, float ny) {
+    return cloud_source_with(uvw, ray_dir, ny, cloud_transmittance(uvw));
 }

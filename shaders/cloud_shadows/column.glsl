@@ -1,7 +1,9 @@
 // Optical depth toward the sun through the cloud layer from the density maps (thesis 7.3.1): a point
 // is projected along the direction toward the sun onto the middle of the layer, where the top-view
 // summed density mix(A, B, t) (layer 0 of the density maps, each set at its own placement) is read
-// bilinearly, zero outside the volume, times the volume's edge fade there, times the fraction of the layer above the point. Shared by the
+// bilinearly, zero outside the volume, times the volume's edge fade there, times the fraction of the layer above the point;
+// with CLOUD_FAR_FIELD defined the far field's column (cloud_far_field/field.glsl) adds its optical depth
+// with the complementary weight, so shadows continue past the volume. Shared by the
 // ground shadows (shadow.frag) and the marched light shafts (light_shafts/march.frag);
 // plugins/cloud_shadows/reference.py sun_optical_depth is the same in numpy.
 layout(binding = 0) uniform sampler2DArray sums_a;
@@ -14,6 +16,9 @@ uniform vec3 cell_size;
 uniform ivec3 shape;
 uniform float edge_fade;       // CloudSettings.edge_fade: columns fade with the volume's edge (clouds/edge.glsl)
 #include "clouds/edge.glsl"
+#ifdef CLOUD_FAR_FIELD
+#include "cloud_far_field/field.glsl"
+#endif
 
 const float MIN_SUN_HEIGHT = 1e-4;
 
@@ -47,5 +52,10 @@ float sun_optical_depth(vec3 p, vec3 sun_dir) {
     vec2 texel = (q.xz - layer_min.xz) / cell_size.xz - 0.5;
     float above = clamp((layer_min.y + thickness - p.y) / thickness, 0.0, 1.0);
     float fade = cloud_edge_weight((texel + 0.5) / vec2(shape.xz), edge_fade);
-    return extinction * column_sum(texel) * fade * above;
+    float tau = extinction * column_sum(texel) * fade * above;
+#ifdef CLOUD_FAR_FIELD
+    // beyond the volume the far field's cover continues with the complementary weight (field.glsl)
+    tau += field_optical_depth * far_field_density(q.xz, 0.0).x * (1.0 - fade) * above;
+#endif
+    return tau;
 }

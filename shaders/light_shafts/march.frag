@@ -3,7 +3,8 @@
 // low-res texel (the centre of its block) to the block's farthest scene depth (the sky: max_distance),
 // `steps` samples from a jittered start gather the sun light a thin haze scatters toward the eye,
 //   L = sum_i scattering * phase(cos) * E * exp(-tau_sun(p_i)) * exp(-scattering * s_i) * ds,
-// tau_sun through the clouds from the density maps (cloud_shadows/column.glsl; has_clouds 0: none).
+// tau_sun through the clouds from the density maps (cloud_shadows/column.glsl; has_clouds 0: none;
+// with CLOUD_FAR_FIELD also the far field's columns beyond the volume: rays between far clouds).
 // Output (L, T = exp(-scattering * d)), upsampled by cloud_render/composite.frag and blended
 // rgb = L + T * rgb. plugins/light_shafts/reference.py march_shafts is the same in numpy.
 #include "lib/view_ray.glsl"

@@ -1,0 +1,74 @@
+"""float64 numpy reference of ``shaders/cloud_raymarch/march.frag`` at resolution 1, midpoint samples
+(``jitter`` off), no detail noise and no empty-space skipping (which changes only where the steps
+fall): the same segments (``step_base + step_growth · s``, s from the near plane or the layer's box
+to its far side or the scene), the density trilinear between cell centres (clamp to edge), the
+light J of :func:`atmos.shading.medium.source_reference` with the column depths of
+:func:`atmos.plugins.cloud_render.reference.column_depth` (``edge_fade`` 0: neither fades)."""
+from __future__ import annotations
+
+import numpy as np
+
+from atmos.camera import view_basis
+from atmos.plugins.cloud_render.light import sun_light, unit_direction
+from atmos.plugins.cloud_render.reference import column_depth
+from atmos.shading.medium import source_reference
+from atmos.shading.reference import multilinear
+
+
+def rays(camera, size) -> tuple[np.ndarray, np.ndarray]:
+    """(unit directions (h, w, 3), near-plane distances (h, w)) of the pixel centres, GL row order."""
+    w, h = size
+    uv = np.stack(np.meshgrid((np.arange(w) + 0.5) / w, (np.arange(h) + 0.5) / h), -1)
+    ray = np.concatenate([2.0 * uv - 1.0, np.ones((h, w, 1))], -1) @ np.asarray(view_basis(camera, w / h), np.float64).T
+    length = np.linalg.norm(ray, axis=-1)
+    return ray / length[..., None], float(camera.near) * length
+
+
+def march_reference(density, transmittance, medium, settings, layout, camera, sun, size, scene=None) -> dict:
+    """``density`` (nx, ny, nz) and ``transmittance`` (the shading volume, its own shape) of one set;
+    ``medium``: the CloudSettings; ``settings``: the RaymarchCloudSettings (steps, step, step_growth,
+    min_transmittance, ms_*); ``layout``: the CloudLayout; ``scene``: distance to the scene (h, w), None
+    for sky. Returns ``light`` (h, w, 3), ``alpha`` (h, w) and ``distance`` (h, w): a·distance."""
+    d = np.asarray(density, np.float64)
+    trans_volume = np.asarray(transmittance, np.float64)
+    shape, tshape = np.array(d.shape, np.float64), np.array(trans_volume.shape, np.float64)
+    lo, hi = np.asarray(layout.lo, np.float64), np.asarray(layout.hi, np.float64)
+    extent, cell = hi - lo, np.asarray(layout.cell, np.float64)
+    dirs, start = rays(camera, size)
+    h, w = start.shape
+    dirs, start = dirs.reshape(-1, 3), start.reshape(-1)
+    pos = np.asarray(camera.position, np.float64)
+    safe = np.where(np.abs(dirs) < 1e-12, 1e-12, dirs)
+    t0, t1 = (lo - pos) / safe, (hi - pos) / safe
+    enter = np.maximum(np.minimum(t0, t1).max(-1), start)
+    leave = np.maximum(t0, t1).min(-1)
+    if scene is not None:
+        leave = np.minimum(leave, np.asarray(scene, np.float64).reshape(-1))
+    step_base = settings.step * cell.min()
+    sun_color, ambient = sun_light(sun)
+    sun_dir = unit_direction(sun)
+    column_tau = medium.sigma_t * cell[1]
+    light, trans, weighted = np.zeros((len(enter), 3)), np.ones(len(enter)), np.zeros(len(enter))
+    s = enter.copy()
+    live = leave > enter
+    for _ in range(settings.steps):
+        if not live.any():
+            break
+        i = np.flatnonzero(live)
+        dt = np.minimum(step_base + settings.step_growth * s[i], leave[i] - s[i])
+        sp = s[i] + 0.5 * dt
+        s[i] += dt
+        uvw = (pos + dirs[i] * sp[:, None] - lo) / extent
+        rho = multilinear(d, uvw * shape - 0.5)
+        a = 1.0 - np.exp(-medium.sigma_t * rho * dt)
+        T = multilinear(trans_volume, uvw * tshape - 0.5)
+        up, down = (column_depth(d, uvw, k, column_tau) for k in (1.0, -1.0))
+        J = source_reference(medium, settings, T, up, down, dirs[i] @ sun_dir, dirs[i][:, 1], sun_color,
+                             ambient, sun_dir)
+        wgt = trans[i] * a
+        light[i] += wgt[:, None] * J
+        weighted[i] += wgt * sp
+        trans[i] *= 1.0 - a
+        live[i] = (s[i] < leave[i]) & (trans[i] >= settings.min_transmittance)
+    return {"light": light.reshape(h, w, 3), "alpha": (1.0 - trans).reshape(h, w),
+            "distance": weighted.reshape(h, w)}

@@ -1,0 +1,92 @@
+"""RaymarchCloudSettings: the knobs of the ray-marched clouds, each with what it costs."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from atmos.checks import check_bool, check_int, check_num, check_vec
+from atmos.plugins.cloud_raymarch.temporal import HISTORY_CLAMP, MOTION_LIMIT
+from atmos.plugins.cloud_render.light import CloudLightSettings
+
+RESOLUTIONS = (1, 2, 4)
+MAX_STEPS = 4096
+MAX_SUN_STEPS = 16
+
+
+@dataclass(frozen=True)
+class RaymarchCloudSettings(CloudLightSettings):
+    """How the clouds are marched (all live: a change shows on the next frame).
+
+    ``base_altitude``: world y of the layer's bottom (None: ``CloudSettings.base_altitude``).
+    ``steps``: the most density samples per ray (1..4096; the cost is per sample taken, so it caps the
+    worst ray). ``step``: the first step's length in cells (of the smallest cell side; 0.05..8;
+    halving it doubles the samples of a near cloud). ``step_growth``: the step grows by this share
+    of the distance from the camera (step = ``step`` × cell + ``step_growth`` × distance; 0..1;
+    0.004 gives 4 m steps at 1 km and 40 m at 10 km, so far clouds cost few samples).
+    ``empty_space_skipping``: jump over sprite groups × height bands that hold no density (from the
+    simulation's max maps, dilated by one group so the trilinear density is exactly 0 there; free
+    where it cannot skip, saves most samples of a sparse sky; the image changes only by where the
+    steps fall). ``min_transmittance``: stop a ray once this little light from behind gets through
+    (0..0.5; 0 marches to the layer's end; the pixel's alpha is short by at most that much).
+    ``jitter``: offset each pixel's first sample by an interleaved-gradient noise that changes every
+    frame (turns step banding into noise the reprojection averages away); False: midpoint samples,
+    reproducible (tests). ``resolution``: march one pixel of every r × r block (1, 2 or 4; 2 costs a
+    quarter of the samples, the frame's jitter moves the marched pixel inside the block).
+    ``reprojection``: resolve the low-res samples with the temporal history (r² frames to converge
+    with a still camera) instead of a depth-aware upsample of this frame's samples; no effect at
+    resolution 1. ``history_clamp`` (0..1): how hard reprojected history is clamped to this frame's 3×3
+    samples while the camera moves (0: sharpest, ghosts after motion; 1: no ghost, thin features the
+    sparse samples miss flicker; free) and ``motion_limit`` (pixels per frame, > 0): history is mixed
+    toward this frame's upsampled samples linearly, gone at this motion (smaller: less smear on fast
+    turns, blurrier while moving; free); see :mod:`.temporal`. ``detail_octaves``: noise channels the density is eroded by (0 = off, 1..3; each one
+    two more texture fetches per sample), ``detail_scale`` (m per base-noise tile) and
+    ``detail_strength`` (0..1): see ``shaders/cloud_raymarch/detail.glsl``. ``sun_steps``: samples
+    of the eroded-minus-smooth density toward the sun (0..16; 0 = the shading volume's transmittance
+    alone; each costs one detail lookup per sample). ``wind``: (x, y, z) m/s the detail noise
+    scrolls with when the clouds have no weather (with one, the weather's wind). The
+    multiple-scattering octaves ``ms_*``: :class:`~atmos.plugins.cloud_render.light.CloudLightSettings`.
+    ``enabled`` False declares nothing (the pass is culled, allocates nothing).
+    """
+    base_altitude: float | None = None
+    steps: int = 256
+    step: float = 0.5
+    step_growth: float = 0.004
+    empty_space_skipping: bool = True
+    min_transmittance: float = 0.01
+    jitter: bool = True
+    resolution: int = 2
+    reprojection: bool = True
+    history_clamp: float = HISTORY_CLAMP
+    motion_limit: float = MOTION_LIMIT
+    detail_octaves: int = 3
+    detail_scale: float = 1000.0
+    detail_strength: float = 1.0
+    sun_steps: int = 4
+    wind: tuple = (10.0, 0.0, 0.0)
+    enabled: bool = True
+
+    def __post_init__(self):
+        o = "RaymarchCloudSettings"
+        resolution = check_int(o, "resolution", self.resolution, 1, max(RESOLUTIONS))
+        if resolution not in RESOLUTIONS:
+            raise ValueError(f"{o}.resolution must be 1, 2 or 4 (march one pixel of every r x r block), "
+                             f"got {self.resolution!r}")
+        self.store(dict(
+            base_altitude=check_num(o, "base_altitude", self.base_altitude, optional=True),
+            steps=check_int(o, "steps", self.steps, 1, MAX_STEPS),
+            step=check_num(o, "step", self.step, 0.05, 8.0),
+            step_growth=check_num(o, "step_growth", self.step_growth, 0.0, 1.0),
+            empty_space_skipping=check_bool(o, "empty_space_skipping", self.empty_space_skipping),
+            min_transmittance=check_num(o, "min_transmittance", self.min_transmittance, 0.0, 0.5),
+            jitter=check_bool(o, "jitter", self.jitter),
+            resolution=resolution,
+            reprojection=check_bool(o, "reprojection", self.reprojection),
+            history_clamp=check_num(o, "history_clamp", self.history_clamp, 0.0, 1.0),
+            motion_limit=check_num(o, "motion_limit", self.motion_limit, 0.0, 1e4, lo_open=True),
+            detail_octaves=check_int(o, "detail_octaves", self.detail_octaves, 0, 3),
+            detail_scale=check_num(o, "detail_scale", self.detail_scale, 1.0, 1e6),
+            detail_strength=check_num(o, "detail_strength", self.detail_strength, 0.0, 1.0),
+            sun_steps=check_int(o, "sun_steps", self.sun_steps, 0, MAX_SUN_STEPS),
+            wind=check_vec(o, "wind", self.wind, 3),
+            enabled=check_bool(o, "enabled", self.enabled),
+            **self.light_checks(),
+        ))

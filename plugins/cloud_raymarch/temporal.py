@@ -1,0 +1,241 @@
+"""Temporal reprojection of the ray-marched clouds: march 1 pixel of every r × r block per frame,
+resolve the full-resolution image from this frame's samples and the reprojected history.
+
+Each frame the march writes a low-res target whose texel (i, j) is the full-res pixel
+(i·r + ox, j·r + oy), (ox, oy) = :func:`jitter` (frame, r). :meth:`TemporalClouds.resolve` then,
+per full-res pixel (``shaders/cloud_raymarch/temporal.frag``):
+
+* marched this frame → the fresh sample, exactly;
+* else the history, reprojected with the previous frame's camera: the ray's direction is projected
+  first (sky at infinity), then the point at the distance the history holds there (camera + ray ·
+  distance); clamped to the box of the current 3×3 low-res neighbourhood (``history_clamp``), the
+  clamp loosened below ``CLAMP_MOTION`` pixels of motion where the block's fresh sample matches the
+  history there (``CHANGE_TOLERANCE``), so that a still camera over still clouds keeps every fresh
+  sample and converges to the full-res march in r² frames, while clouds that move are clamped; rejected, falling back to the bilinear upsample of
+  this frame's samples, when its point was off screen or the scene behind the pixel changed
+  (``DEPTH_TOLERANCE``: an object moved in front, or away); and mixed toward the upsample the faster
+  the pixel moves (weight 1 − motion / ``motion_limit``, motion in full-res pixels per frame).
+
+The output (premultiplied colour RGBA16F, (a·distance, a) RG32F as in :mod:`atmos.composition`) is
+the next frame's history; the pass blends it onto "color" (and "cloud_distance"). The numpy float64
+reference is :mod:`.temporal_reference`.
+
+Knobs and their cost (the resolve itself is one fullscreen pass: 1 fresh + 4 bilinear + 9
+neighbourhood fetches of the low-res targets, 2 × 4 bilinear history fetches, 2 depth fetches, each
+pixel; 28 bytes of history per pixel, twice):
+
+* ``reprojection`` (the plugin's): off → no history (the upsample alone, which blurs at r > 1);
+  on → r² frames to converge when still, a ghost after fast motion bounded by the clamp.
+* ``history_clamp`` (0..1, :data:`HISTORY_CLAMP`): how hard moving history is clamped to this
+  frame's neighbourhood; 0 keeps it (sharpest, ghosts after motion), 1 removes ghosts but flickers
+  thin features that the sparse samples miss. Free (the fetches are made for the upsample anyway).
+* ``motion_limit`` (pixels per frame, :data:`MOTION_LIMIT`): history is dropped at this motion;
+  smaller → less smear on fast turns, blurrier (upsampled) clouds while moving. Free.
+"""
+from __future__ import annotations
+
+import math
+
+import moderngl
+import numpy as np
+
+from atmos.camera import camera_matrices, gl_matrix
+
+RESOLUTIONS = (1, 2, 4)
+HISTORY_CLAMP = 1.0        # default clamp weight of moving history (0..1)
+MOTION_LIMIT = 16.0        # default pixels of motion per frame at which history is dropped
+CLAMP_MOTION = 1.0         # pixels of motion per frame below which the clamp is loosened linearly to 0 ...
+CHANGE_TOLERANCE = 0.02    # ... unless this frame's sample differs from the history by more (alpha, relative rgb)
+DEPTH_TOLERANCE = 0.1      # relative change of the scene distance behind a pixel that rejects its history
+ALPHA_EPS = 1e-4           # coverage below which a (a·d, a) pair holds no distance (sky at infinity)
+
+_UNITS = ("low_color", "low_distance", "hist_color", "hist_distance", "hist_scene", "scene_depth")
+
+
+def check_resolution(r) -> int:
+    if r not in RESOLUTIONS or isinstance(r, bool):
+        raise ValueError(f"the temporal resolve's resolution r must be 1, 2 or 4 (one pixel of every r x r "
+                         f"block marched per frame), got {r!r}")
+    return int(r)
+
+
+def bayer(r: int) -> np.ndarray:
+    """The r × r Bayer matrix ``b[y, x]`` (0 … r² − 1): consecutive values lie far apart."""
+    b = np.zeros((1, 1), np.int64)
+    while b.shape[0] < r:
+        b = np.block([[4 * b, 4 * b + 2], [4 * b + 3, 4 * b + 1]])
+    return b
+
+
+def jitter(frame_index: int, r: int) -> tuple[int, int]:
+    """The offset (ox, oy) in [0, r)² of the pixel marched in each r × r block at ``frame_index``:
+    every r² frames visit all r² offsets, in Bayer order (each next one far from the last)."""
+    r = check_resolution(r)
+    if isinstance(frame_index, bool) or not isinstance(frame_index, (int, np.integer)) or frame_index < 0:
+        raise ValueError(f"jitter's frame_index must be an integer >= 0, got {frame_index!r}")
+    y, x = np.argwhere(bayer(r) == int(frame_index) % (r * r))[0]
+    return int(x), int(y)
+
+
+def low_size(size, r: int) -> tuple[int, int]:
+    """The low-res target's (w, h) at resolution divisor r: every full-res pixel falls in one block."""
+    return math.ceil(size[0] / r), math.ceil(size[1] / r)
+
+
+def detects_change(still_frames: int, r: int) -> bool:
+    """Whether the resolve compares fresh samples with the history (``CHANGE_TOLERANCE``): once the
+    camera has been still for r² frames, every pixel holds a sample, so a difference is the clouds'."""
+    return still_frames >= r * r
+
+
+def camera_state(camera, aspect: float) -> tuple:
+    """What a camera's image depends on: two frames with the same state need no reprojection."""
+    return (float(aspect), tuple(float(c) for c in camera.position), float(camera.yaw), float(camera.pitch),
+            float(camera.roll), float(camera.fov_y), float(camera.near), float(camera.far))
+
+
+class TemporalClouds:
+    """Full-resolution cloud history of one pass on ``gpu``: ping-pong colour (RGBA16F), distance
+    (RG32F, (a·d, a)) and the scene distance behind each pixel (R32F), made at the first resolve,
+    remade (and so reset) when the size or r changes, kept across frames, freed by :meth:`release`.
+
+    Per frame: ``offset = temporal.offset(r)`` (march with it), then :meth:`resolve`. The previous
+    frame's camera is the one the last resolve was given (kept as a snapshot). :meth:`reset` after a
+    camera cut (the next frame uses no history).
+    """
+
+    def __init__(self, gpu):
+        self.gpu = gpu
+        self.frame_index = 0
+        self._sets: list | None = None     # [(fbo, color, distance, scene)] × 2
+        self._key = None                   # (size, r) the history was made for
+        self._current = 0                  # which set holds the last output
+        self._valid = False
+        self._prev = None                  # (camera_state, CameraMatrices, position) of the last resolve
+        self.still_frames = 0              # resolves in a row with the camera of the one before
+        self._vao = None
+
+    # -- per frame -----------------------------------------------------------------------------
+    def offset(self, r: int) -> tuple[int, int]:
+        """This frame's jitter offset (:func:`jitter` of the frame counter)."""
+        return jitter(self.frame_index, r)
+
+    def reset(self) -> None:
+        """Forget the history (a camera cut): the next resolve uses this frame's samples alone."""
+        self._valid = False
+
+    def resolve(self, low_color, low_distance, size, r: int, offset, camera, aspect: float, depth=None,
+                history_clamp: float = HISTORY_CLAMP, motion_limit: float = MOTION_LIMIT):
+        """Resolve this frame at full-res ``size`` (w, h) from the low-res ``low_color`` (RGBA
+        premultiplied) and ``low_distance`` ((a·d, a)) textures marched at ``offset`` with divisor
+        ``r``, seen by ``camera`` at ``aspect``; ``depth``: the scene's depth texture at ``size``
+        (None: nothing but sky). Returns (color, distance) full-res textures, valid until the next
+        resolve (they are the history it reads)."""
+        r = check_resolution(r)
+        size = (int(size[0]), int(size[1]))
+        ox, oy = offset
+        if not (0 <= ox < r and 0 <= oy < r):
+            raise ValueError(f"TemporalClouds.resolve: offset must lie in [0, {r})², got {offset!r}")
+        low = low_size(size, r)
+        for name, tex in (("low_color", low_color), ("low_distance", low_distance)):
+            if tuple(tex.size) != low:
+                raise ValueError(f"TemporalClouds.resolve: {name} must be {low[0]}x{low[1]} (size {size} / {r}), "
+                                 f"got {tex.size[0]}x{tex.size[1]}")
+        if depth is not None and tuple(depth.size) != size:
+            raise ValueError(f"TemporalClouds.resolve: depth must be {size[0]}x{size[1]}, got {depth.size}")
+        if not 0.0 <= history_clamp <= 1.0 or not motion_limit > 0.0:
+            raise ValueError(f"TemporalClouds.resolve: history_clamp must be in [0, 1] and motion_limit > 0, "
+                             f"got {history_clamp!r}, {motion_limit!r}")
+        if self._key != (size, r):
+            self._make(size, r)
+        state = camera_state(camera, aspect)
+        matrices = camera_matrices(camera, aspect)
+        prev, write = self._sets[self._current], self._sets[1 - self._current]
+        p = self.gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="cloud_raymarch/temporal.frag")
+        p["view_basis"].write(matrices.gl("view_basis"))
+        self._set(p, "near", float(camera.near))
+        self._set(p, "far", float(camera.far))
+        self._set(p, "r", r)
+        self._set(p, "offset", (int(ox), int(oy)))
+        self._set(p, "has_depth", depth is not None)
+        valid = self._valid and self._prev is not None
+        self._set(p, "history_valid", valid)
+        if valid:
+            prev_state, prev_matrices, prev_position = self._prev
+            proj, view = prev_matrices.projection, prev_matrices.view
+            self._set(p, "still", state == prev_state)
+            self._set(p, "detect_change", detects_change(self.still_frames + 1, r) if state == prev_state else False)
+            p["prev_proj"].write(gl_matrix(proj[[0, 1, 3], :3] @ view[:3, :3]))
+            self._set(p, "cam_delta", tuple(float(c) for c in np.asarray(camera.position) - prev_position))
+            self._set(p, "history_clamp", float(history_clamp))
+            self._set(p, "motion_limit", float(motion_limit))
+        for unit, tex in enumerate((low_color, low_distance, prev[1], prev[2], prev[3])):
+            tex.use(unit)
+        if depth is not None:
+            depth.use(5)
+        ctx = self.gpu.ctx
+        write[0].use()
+        ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST | moderngl.CULL_FACE)
+        if self._vao is None or self._vao[1] is not p:
+            self._vao = (self.gpu.track(ctx.vertex_array(p, [])), p)
+        self._vao[0].render(moderngl.TRIANGLES, vertices=3)
+        self._current = 1 - self._current
+        self.still_frames = self.still_frames + 1 if valid and state == self._prev[0] else 0
+        self._valid = True
+        self._prev = (state, matrices, np.array(camera.position, np.float64))
+        self.frame_index += 1
+        return write[1], write[2]
+
+    @staticmethod
+    def _set(program, name, value):
+        member = program.get(name, None)      # the compiler drops what a variant does not use
+        if member is not None:
+            member.value = value
+
+    # -- lifetime ------------------------------------------------------------------------------
+    def _make(self, size, r) -> None:
+        self._free()
+        ctx = self.gpu.ctx
+        self._sets = []
+        for _ in range(2):
+            textures = [ctx.texture(size, 4, dtype="f2"), ctx.texture(size, 2, dtype="f4"),
+                        ctx.texture(size, 1, dtype="f4")]
+            for tex in textures:
+                tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+                tex.repeat_x = tex.repeat_y = False
+            fbo = ctx.framebuffer(textures)
+            fbo.use()                      # clear() re-binds the framebuffer bound before it: this one
+            fbo.clear(0.0, 0.0, 0.0, 0.0)
+            self._sets.append(tuple(self.gpu.track(o) for o in (fbo, *textures)))
+        self._key, self._current, self._valid = (size, r), 0, False
+
+    def _free(self) -> None:
+        if self._sets and any(self.gpu.ctx.fbo is objects[0] for objects in self._sets):
+            self.gpu.target.use()          # never leave a released framebuffer bound
+        for objects in self._sets or ():
+            for obj in objects:
+                obj.release()
+        self._sets, self._key, self._valid = None, None, False
+
+    def release(self) -> None:
+        """Free the history (the next resolve makes it again); the program is the context's."""
+        self._free()
+        if self._vao is not None:
+            self._vao[0].release()
+            self._vao = None
+
+    def read_history(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The last output as float64 arrays, GL row order (row 0 at the bottom): colour (h, w, 4),
+        distance (h, w, 2), scene distance (h, w) (−1: sky). For tests and debugging (a GPU read)."""
+        if self._sets is None:
+            raise ValueError("TemporalClouds.read_history: nothing resolved yet (or released)")
+        (w, h), _ = self._key
+        _, color, distance, scene = self._sets[self._current]
+        out = [np.frombuffer(t.read(), dt).reshape(h, w, n).astype(np.float64)
+               for t, dt, n in ((color, np.float16, 4), (distance, np.float32, 2), (scene, np.float32, 1))]
+        return out[0], out[1], out[2][..., 0]
+
+    @property
+    def allocated(self) -> bool:
+        """Whether history textures exist (tests: a culled pass allocates none)."""
+        return self._sets is not None

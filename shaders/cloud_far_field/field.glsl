@@ -1,0 +1,37 @@
+// The far field's cloud density as a function of world (x, z) (float64 reference:
+// atmos/plugins/cloud_far_field/reference.py far_density): four scrolling tileable octaves give fbm,
+// remapped from the threshold that leaves the simulation's cover (cover.comp) of the layer clouded,
+//   d = remap(fbm, e, e + softness)   (four light-march channels; d.x is the point itself).
+// Shared by the far-field pass (far.frag) and the ground shadows (cloud_shadows/column.glsl with
+// CLOUD_FAR_FIELD); atmos/plugins/cloud_far_field/layer.py binds it.
+#include "sky_layer/layer.glsl"
+layout(binding = 5) uniform sampler2D octave0;
+layout(binding = 6) uniform sampler2D octave1;
+layout(binding = 7) uniform sampler2D octave2;
+layout(binding = 8) uniform sampler2D octave3;
+layout(std430, binding = 0) readonly buffer Cover { float cover; };
+uniform vec2 field_origin;         // a world xz near the view (the camera's)
+uniform vec2 field_origin_uv;      // it in tiles, wrapped to [0, 1) (float64 on the CPU)
+uniform vec2 field_offsets[4];     // drift of each octave (tiles, wrapped)
+uniform float field_quantiles[33]; // cover.fbm_quantiles
+uniform float field_tile_size;
+uniform float field_softness;
+uniform float field_mid_height;    // the layer's middle plane (world y)
+uniform float field_optical_depth; // optical depth of a full column
+
+float field_threshold(float c) {
+    float x = (1.0 - clamp(c, 0.0, 1.0)) * 32.0;
+    int k = min(int(x), 31);
+    return mix(field_quantiles[k], field_quantiles[k + 1], x - float(k));
+}
+
+// d at world (x, z) = xz; lod: mip level.
+vec4 far_field_density(vec2 xz, float lod) {
+    vec2 uv = field_origin_uv + (xz - field_origin) / field_tile_size;
+    vec4 fbm = SKY_LAYER_WEIGHTS.x * textureLod(octave0, uv + field_offsets[0], lod)
+             + SKY_LAYER_WEIGHTS.y * textureLod(octave1, uv + field_offsets[1], lod)
+             + SKY_LAYER_WEIGHTS.z * textureLod(octave2, uv + field_offsets[2], lod)
+             + SKY_LAYER_WEIGHTS.w * textureLod(octave3, uv + field_offsets[3], lod);
+    float e = field_threshold(cover);
+    return sky_layer_remap(fbm, e, e + field_softness);
+}

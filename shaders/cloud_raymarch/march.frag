@@ -1,0 +1,130 @@
+#version 430
+// The ray-marched cloud layer (plugins/cloud_raymarch): one ray per low-res texel (i, j), through the
+// full-res pixel centre (i, j) * factor + sample_offset + 0.5, from the near plane (or the layer's
+// box) to the box's far side or the scene depth. Segments of length step_base + step_growth * s
+// (s: distance from the camera), one density sample per segment at `jitter` of its length (0.5:
+// the midpoint), extinction sigma_t * density, light J = volume.glsl's cloud_source. Sprite groups
+// x height bands whose dilated max map is 0 are jumped over; a ray stops once its transmittance
+// falls below min_transmittance or after `steps` samples. float64 reference:
+// plugins/cloud_raymarch/reference.py.
+// Out: premultiplied (light, 1 - T); (a * distance, a) with distance the transmittance-weighted
+// distance from the camera (m, atmos/composition.py); depth: the scene depth the ray stopped at.
+#include "cloud_render/volume.glsl"
+#include "cloud_raymarch/detail.glsl"
+#include "lib/view_ray.glsl"
+out vec4 frag;
+layout(location = 1) out vec4 frag_distance;
+layout(binding = 4) uniform sampler3D skip_map;   // (groups x, bands, groups z): 0 = no density within
+layout(binding = 5) uniform sampler2D scene_depth;
+uniform mat3 view_basis;       // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
+uniform vec3 camera_pos;
+uniform float near;
+uniform float far;
+uniform vec3 layer_min;
+uniform vec3 layer_max;
+uniform vec3 cell_size;
+uniform float sigma_t;         // extinction (1/m) at density 1
+uniform int steps;             // most density samples per ray
+uniform float step_base;       // m
+uniform float step_growth;     // step grows by this share of the distance
+uniform float min_transmittance;
+uniform int skipping;          // 1: use skip_map
+uniform vec3 skip_cells;       // cells per skip-map texel (group x, band height, group z)
+uniform int max_skips;         // skip-map texels a ray can cross
+uniform int factor;            // resolution divisor r
+uniform ivec2 sample_offset;   // the frame's jitter offset o in [0, r)^2
+uniform ivec2 frame_size;      // full-res pixels
+uniform int jitter;            // 1: per-pixel, per-frame first-sample offset; 0: midpoints
+uniform int frame_index;
+uniform vec3 sun_march;        // toward the sun, times the sun-march sample spacing (m)
+
+// Jimenez's interleaved gradient noise, moved each frame (golden-ratio-ish 5.588238 px per frame).
+float sample_jitter(vec2 pixel) {
+    if (jitter == 0) return 0.5;
+    pixel += 5.588238 * float(frame_index & 63);
+    return fract(52.9829189 * fract(dot(pixel, vec2(0.06711056, 0.00583715))));
+}
+
+// The (eroded) density at world point p, texture coordinates uvw.
+float density_at(vec3 uvw, vec3 p) {
+    return detail_density(cloud_density(uvw), p);
+}
+
+// The factor the detail changes the sun transmittance by: exp(-sigma_t * optical depth of the
+// eroded-minus-smooth density over SUN_STEPS samples toward the sun).
+float sun_detail(vec3 p, vec3 extent) {
+#if SUN_STEPS > 0
+    float sum = 0.0;
+    for (int k = 0; k < SUN_STEPS; ++k) {
+        vec3 q = p + sun_march * (float(k) + 0.5);
+        vec3 uvw = (q - layer_min) / extent;
+        float d = cloud_density(uvw);
+        sum += detail_density(d, q) - d;
+    }
+    return exp(-sigma_t * sum * length(sun_march));
+#else
+    return 1.0;
+#endif
+}
+
+// Distance along the ray to where it leaves skip-map texel g (a box in world space).
+float skip_exit(ivec3 g, vec3 pos, vec3 inv_dir, vec3 dir) {
+    vec3 lo = layer_min + vec3(g) * skip_cells * cell_size;
+    vec3 hi = min(lo + skip_cells * cell_size, layer_max);
+    vec3 tt = (mix(lo, hi, step(0.0, dir)) - pos) * inv_dir;
+    return max(min(min(tt.x, tt.y), tt.z), 0.0);
+}
+
+void main() {
+    ivec2 pixel = min(ivec2(gl_FragCoord.xy) * factor + sample_offset, frame_size - 1);
+    vec2 uv = (vec2(pixel) + 0.5) / vec2(frame_size);
+    float depth = texelFetch(scene_depth, pixel, 0).r;
+    gl_FragDepth = depth;
+    vec3 dir = view_ray_dir(uv, view_basis);
+    float scene = view_ray_distance(uv, depth, view_basis, near, far, 1e30);
+    vec3 safe = mix(dir, vec3(1e-12), lessThan(abs(dir), vec3(1e-12)));
+    vec3 inv_dir = 1.0 / safe;
+    vec3 t0 = (layer_min - camera_pos) * inv_dir, t1 = (layer_max - camera_pos) * inv_dir;
+    float start = near * length(view_ray(uv, view_basis));          // the near plane along this ray
+    float enter = max(max(max(min(t0.x, t1.x), min(t0.y, t1.y)), min(t0.z, t1.z)), start);
+    float leave = min(min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z)), scene);
+    vec3 light = vec3(0.0);
+    float trans = 1.0, weighted = 0.0;
+    if (leave > enter) {
+        vec3 extent = layer_max - layer_min;
+        float ny = extent.y / cell_size.y;
+        ivec3 grid = textureSize(skip_map, 0);
+        float u = sample_jitter(vec2(pixel));
+        float eps = 1e-3 * min(min(cell_size.x, cell_size.y), cell_size.z);
+        float s = enter;
+        int taken = 0;
+        for (int it = 0; it < steps + max_skips && taken < steps && s < leave; ++it) {
+            vec3 pos = camera_pos + dir * s;
+            if (skipping != 0) {
+                ivec3 g = clamp(ivec3(floor((pos - layer_min) / cell_size / skip_cells)), ivec3(0), grid - 1);
+                if (texelFetch(skip_map, g, 0).r <= 0.0) {
+                    s += skip_exit(g, pos, inv_dir, dir) + eps;
+                    continue;
+                }
+            }
+            float dt = min(step_base + step_growth * s, leave - s);
+            float sp = s + u * dt;
+            s += dt;
+            ++taken;
+            vec3 p = camera_pos + dir * sp;
+            vec3 uvw = (p - layer_min) / extent;
+            float d = density_at(uvw, p);
+            if (d <= 0.0) continue;
+            float a = 1.0 - exp(-sigma_t * d * dt);
+            float T = min(cloud_transmittance(uvw) * sun_detail(p, extent), 1.0);
+            float w = trans * a;
+            light += w * cloud_source_with(uvw, dir, ny, T);
+            weighted += w * sp;
+            trans *= 1.0 - a;
+            if (trans < min_transmittance) break;
+        }
+    }
+    float alpha = 1.0 - trans;
+    frag = vec4(light, alpha);
+    frag_distance = vec4(weighted, alpha, 0.0, alpha);   // blends by its own alpha (atmos/composition.py)
+}

@@ -1,0 +1,208 @@
+"""No hard edge where the simulated cloud volume ends and the far field takes over (issue 12, item 4).
+
+In the sunset and flight scenes, the clouds' coverage seen from the ground and their brightness seen
+from 2 km above the layer are binned by where each pixel's ray meets the layer's middle plane,
+``r = |2 uv − 1|`` in the volume's footprint (1 on its inscribed circle, where the volume has faded
+out): a band well inside (the volume alone) and a band just outside (the far field alone) must agree.
+With the far field switched off the outside band is empty and the tests fail. The ground shadows:
+the volume's (exp(−σ · column sum)) and the far field's (exp(−optical_depth · d)) mean transmittance
+agree for the same measured cover.
+"""
+import math
+
+import numpy as np
+import pytest
+
+from atmos.camera import Camera
+from atmos.demo_registry import DemoSettings
+from atmos.gpu import create_headless
+from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
+from atmos.plugins.cloud_far_field.cover import fbm_quantiles
+from atmos.plugins.cloud_far_field.layer import drift
+from atmos.plugins.cloud_far_field.reference import far_field_density
+from atmos.plugins.cloud_render.plugin import CloudRenderPlugin
+from atmos.plugins.cloud_shadows import CloudShadowsPlugin
+from atmos.plugins.cloud_shadows.reference import shifted
+from atmos.plugins.clouds import CloudSimulation
+from atmos.plugins.clouds.edge import edge_weight
+from atmos.runner import build_app
+
+SIZE = (160, 96)
+INSIDE = (0.40, 0.65)        # r: the volume at full weight
+OUTSIDE = (1.0, 1.35)        # r: the far field alone
+TOLERANCE = 0.35             # |outside − inside| / inside
+
+
+@pytest.fixture(scope="module")
+def scenes():
+    gpu = create_headless(SIZE)
+    apps = {}
+    try:
+        for demo in ("sunset", "flight"):
+            app = build_app(demo, DemoSettings(size=gpu.size, headless=True), gpu)
+            app.run_frames(4, 1 / 30)
+            apps[demo] = app
+        yield gpu, apps
+    finally:
+        for app in apps.values():
+            app.close()
+        gpu.release()
+
+
+def plugin(app, kind):
+    return next(p for p in app.plugins if isinstance(p, kind))
+
+
+def rays(cam: Camera, size) -> np.ndarray:
+    """(h, w, 3) unit view directions, first row at the top (as app.read_linear)."""
+    w, h = size
+    ty = math.tan(cam.fov_y / 2)
+    x = (2.0 * (np.arange(w) + 0.5) / w - 1.0) * ty * w / h
+    y = (1.0 - 2.0 * (np.arange(h) + 0.5) / h) * ty
+    local = np.stack(np.broadcast_arrays(x[None, :], y[:, None], np.ones((h, w))), -1)
+    d = local @ cam.basis().T
+    return d / np.linalg.norm(d, axis=-1, keepdims=True)
+
+
+def plane_radius(app, cam: Camera) -> np.ndarray:
+    """(h, w) r of each pixel's hit on the layer's middle plane (inf where the ray misses it)."""
+    layout = app.resource(CloudSimulation).sets().layout()
+    mid = 0.5 * (layout.lo[1] + layout.hi[1])
+    d = rays(cam, SIZE)
+    s = (mid - cam.position[1]) / np.where(np.abs(d[..., 1]) > 1e-6, d[..., 1], np.nan)
+    hit = cam.position[[0, 2]] + s[..., None] * d[..., [0, 2]]
+    lo, hi = layout.lo[[0, 2]], layout.hi[[0, 2]]
+    r = np.linalg.norm(2.0 * (hit - lo) / (hi - lo) - 1.0, axis=-1)
+    return np.where(s > 0, r, np.inf)
+
+
+def render(app, *, far=True, clouds=True):
+    far_plugin, sprites = plugin(app, CloudFarFieldPlugin), plugin(app, CloudRenderPlugin)
+    far_plugin.configure(enabled=far and clouds)
+    sprites.configure(enabled=clouds)
+    try:
+        app.render()
+        return app.read_linear().astype(np.float64)
+    finally:
+        far_plugin.configure(enabled=True)
+        sprites.configure(enabled=True)
+
+
+def bands(metric, r, valid):
+    inside = valid & (r > INSIDE[0]) & (r < INSIDE[1])
+    outside = valid & (r > OUTSIDE[0]) & (r < OUTSIDE[1])
+    assert inside.sum() > 100 and outside.sum() > 100, "the view holds both bands"
+    return metric[inside].mean(), metric[outside].mean()
+
+
+def column_outliers(metric, r, valid) -> float:
+    """The largest per-column mean over the border band (r 0.85..1.15), in robust spreads from the median."""
+    border = valid & (r > 0.85) & (r < 1.15)
+    cols = [metric[:, c][border[:, c]].mean() for c in range(metric.shape[1]) if border[:, c].sum() >= 3]
+    cols = np.asarray(cols)
+    spread = max(np.median(np.abs(cols - np.median(cols))), 0.02 * max(np.median(cols), 1e-6))
+    return float(np.abs(cols - np.median(cols)).max() / spread)
+
+
+YAWS = 0.3 + 0.5 * np.pi * np.arange(4)      # four views round the horizon: more clouds per band
+
+
+def ground_view(app, yaw) -> tuple:
+    cam = app.resource(Camera)
+    cam.position = np.array([0.0, 320.0, 0.0])
+    cam.yaw, cam.pitch, cam.roll = yaw, math.radians(24.0), 0.0
+    r = plane_radius(app, cam)
+    valid = rays(cam, SIZE)[..., 1] > math.sin(math.radians(3.0))
+    return r, valid
+
+
+def above_view(app, yaw) -> tuple:
+    cam = app.resource(Camera)
+    layout = app.resource(CloudSimulation).sets().layout()
+    cam.position = np.array([0.0, layout.hi[1] + 2000.0, 0.0])
+    cam.yaw, cam.pitch, cam.roll = yaw, math.radians(-45.0), 0.0
+    return plane_radius(app, cam), np.ones(SIZE[::-1], bool)
+
+
+def panorama(app, view, metric, **which) -> tuple:
+    """(metric, r, valid) of the four views side by side: ``metric(app, image)`` per pixel."""
+    parts = []
+    for yaw in YAWS:
+        r, valid = view(app, yaw)
+        parts.append((metric(app, render(app, **which)), r, valid))
+    return tuple(np.concatenate(p, axis=1) for p in zip(*parts))
+
+
+def coverage(app, img):
+    return np.clip(img[..., 3], 0.0, 1.0)           # the sky occlusion: the clouds' coverage
+
+
+def luminance(img):
+    return img[..., :3] @ np.array([0.2126, 0.7152, 0.0722])
+
+
+def cloud_change(app, img):
+    """|luminance − the same view without clouds| (the bare view rendered for the current camera)."""
+    return np.abs(luminance(img) - luminance(render(app, clouds=False)))
+
+
+@pytest.mark.parametrize("demo, view", [
+    ("sunset", "ground"), ("flight", "ground"), ("flight", "above"),
+    pytest.param("sunset", "above", marks=pytest.mark.xfail(strict=True, reason=(
+        "open gap: from above the sparse sunset far field is ~40 % brighter than the volume's sprites"))),
+])
+def test_clouds_have_no_step_at_the_volume_edge(scenes, demo, view):
+    """From the ground: the coverage (sky occlusion); from 2 km above the layer: what the clouds change
+    in luminance. Band means inside vs outside within TOLERANCE, no outlier column along the border."""
+    _, apps = scenes
+    app = apps[demo]
+    look, metric = (ground_view, coverage) if view == "ground" else (above_view, cloud_change)
+    values, r, valid = panorama(app, look, metric)
+    inside, outside = bands(values, r, valid)
+    assert inside > 0.01, f"{demo}: the volume is seen ({inside:.3f})"
+    assert abs(outside - inside) < TOLERANCE * inside, f"{demo} {view}: {inside:.3f} inside vs {outside:.3f} outside"
+    assert column_outliers(values, r, valid) < 12.0
+    values, r, valid = panorama(app, look, metric, far=False)
+    _, without = bands(values, r, valid)
+    assert abs(without - inside) > 0.5 * inside, "without the far field the step is there (the test can fail)"
+
+
+@pytest.mark.parametrize("demo", ["sunset", "flight"])
+def test_volume_and_far_field_shadows_are_as_dark_for_the_same_cover(scenes, demo):
+    """Mean sun transmittance of the volume's columns (edge-weighted) vs the far field's over a tile."""
+    _, apps = scenes
+    app = apps[demo]
+    far, shadows = plugin(app, CloudFarFieldPlugin), plugin(app, CloudShadowsPlugin)
+    sim = app.resource(CloudSimulation)
+    sets = sim.sets()
+    sa, sb = (sets.maps_of(s).read_sums()[0].astype(np.float64) for s in (sets.a, sets.b))
+    sums = (1.0 - sets.t) * shifted(sa, sets.a_shift) + sets.t * sb
+    uv = np.stack(np.meshgrid(*((np.arange(m) + 0.5) / m for m in sums.shape), indexing="ij"), -1)
+    w = edge_weight(uv, sim.settings.edge_fade)
+    strength = shadows.settings.strength
+    volume = float((w * np.exp(-sim.settings.sigma * strength * sums)).sum() / w.sum())
+    fs = far.settings
+    cover = float(np.frombuffer(far.layer.cover.read(), np.float32)[0])
+    octaves = [far.layer.octaves.download(k) for k in range(4)]
+    g = (np.arange(256) + 0.5) * fs.tile_size / 256
+    xz = np.stack(np.meshgrid(g, g, indexing="ij"), -1)
+    d = far_field_density(xz, octaves, drift(fs, sets, 0.0), fs.tile_size, fbm_quantiles(fs.base_frequency, fs.seed),
+                          cover, fs.softness)
+    field = float(np.exp(-fs.optical_depth * strength * d).mean())
+    assert 0.1 < cover < 0.9
+    assert abs(volume - field) < 0.06, f"{demo}: mean shadow transmittance {volume:.3f} (volume) vs {field:.3f} (far field)"
+
+
+if __name__ == "__main__":      # the radial profiles (mean of each band of r) the tests check
+    gpu = create_headless(SIZE)
+    edges = np.array([0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2, 1.35, 1.5, 1.8])
+    for demo in ("sunset", "flight"):
+        app = build_app(demo, DemoSettings(size=gpu.size, headless=True), gpu)
+        app.run_frames(4, 1 / 30)
+        for view, look, metric in (("ground", ground_view, coverage), ("above", above_view, cloud_change)):
+            for far in (True, False):
+                v, r, ok = panorama(app, look, metric, far=far)
+                prof = [v[ok & (r > lo) & (r < hi)].mean() for lo, hi in zip(edges[:-1], edges[1:])]
+                print(demo, view, "far" if far else "nofar", " ".join(f"{p:.3f}" for p in prof))
+        app.close()
+    gpu.release()

@@ -1,0 +1,183 @@
+"""Issue 15's ray-marched clouds: the march against its float64 reference, empty-space skipping and
+early exit, extremes, culling, and the composition with fog, far field and terrain."""
+import numpy as np
+import pytest
+
+from atmos import App, DefaultPlugins
+from atmos.camera import Camera
+from atmos.lighting import Sun
+from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
+from atmos.plugins.cloud_raymarch.plugin import LOW_COLOR, skip_map
+from atmos.plugins.cloud_raymarch.reference import march_reference
+from atmos.plugins.cloud_render import CloudRenderPlugin
+from atmos.plugins.clouds import CloudSettings, CloudsPlugin
+from atmos.plugins.clouds.density_maps import DensityMaps
+from atmos.plugins.weather import VolumeOrigin
+from atmos.shading.reference import multilinear
+
+SHAPE = (16, 4, 16)
+CELL = (20.0, 30.0, 25.0)
+BASE = 400.0
+CENTER = np.array([160.0, BASE + 60.0, 200.0])
+DAY = Sun.from_angles(40.0, 70.0)
+
+
+def volume():
+    d = np.zeros(SHAPE, np.float32)
+    d[3:9, 0:3, 5:12] = 1.0
+    d[10:14, 1:4, 2:6] = 0.6
+    d[12, 0, 12] = 2.0
+    return d
+
+
+def medium(**changes):
+    return CloudSettings(cell_size=CELL, base_altitude=BASE, group_size=(4, 4), smoothing_slices=1,
+                         sigma_t=changes.pop("sigma_t", 0.02), edge_fade=0.0, **changes)
+
+
+def scene(gpu, density, sun=DAY, plugins=(), **fields):
+    fields = dict(dict(resolution=1, jitter=False, detail_octaves=0), **fields)   # no noise unless asked
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(medium(), density=density),
+                               RaymarchCloudsPlugin(**fields), *plugins)
+    app.insert_resource(sun)
+    app.startup()
+    return app
+
+
+def aim(app, position, target=CENTER):
+    cam = app.resource(Camera)
+    cam.position = np.array(position, float)
+    cam.look_at(np.asarray(target, float))
+    cam.near, cam.far = 1.0, 20000.0
+    return cam
+
+
+def linear(app):
+    """The HDR frame in GL row order (row 0 at the bottom), like the reference."""
+    return app.read_linear()[::-1].astype(np.float64)
+
+
+def test_the_march_matches_its_float64_reference(gpu, ctx):
+    app = scene(gpu, volume(), empty_space_skipping=False, min_transmittance=0.0, steps=96, step_growth=0.002)
+    cam = aim(app, (80.0, 470.0, -150.0))
+    image = linear(app)
+    plugin = next(p for p in app.plugins if isinstance(p, CloudsPlugin))
+    sim = plugin.simulation.sets()
+    trans = np.frombuffer(sim.a["transmittance"].read(), np.float16).astype(np.float64)
+    tshape = sim.a["transmittance"].size
+    trans = trans.reshape(tshape[2], tshape[1], tshape[0]).transpose(2, 1, 0)
+    settings = next(p for p in app.plugins if isinstance(p, RaymarchCloudsPlugin)).settings
+    ref = march_reference(volume(), trans, sim.settings, settings, sim.layout(), cam, DAY, gpu.size)
+    assert ref["alpha"].max() > 0.9 and (ref["alpha"] > 0.01).mean() > 0.05, "the view must see the clouds"
+    light = ref["light"]
+    rmse = np.sqrt(np.mean((image[..., :3] - light) ** 2)) / np.sqrt(np.mean(light ** 2))
+    assert rmse < 0.02, f"colour off the reference: relative RMSE {rmse:.4f}"
+    off = np.abs(image[..., 3] - ref["alpha"])
+    assert np.percentile(off, 99.5) < 0.002, "coverage off the reference"
+    assert (off > 0.02).mean() < 0.002, "only rays grazing the box's faces may differ (float32 entry/exit)"
+    assert np.abs(image[..., 3] - ref["alpha"]).max() < 0.2
+    app.close()
+
+
+def test_the_skip_map_is_zero_only_where_the_trilinear_density_is(rng):
+    d = np.zeros((24, 8, 20))
+    d[rng.integers(0, 24, 6), rng.integers(0, 8, 6), rng.integers(0, 20, 6)] = 1.0
+    group, band = (4, 4), 2
+    grid = (6, 4, 5)
+    maxima = np.zeros((1 + grid[1], grid[0], grid[2]))          # CloudSets' max maps, by hand
+    for gx in range(grid[0]):
+        for b in range(grid[1]):
+            for gz in range(grid[2]):
+                maxima[1 + b, gx, gz] = d[gx * 4:gx * 4 + 4, b * band:b * band + band, gz * 4:gz * 4 + 4].max()
+    skip = skip_map(maxima)                                     # (gz, bands, gx)
+    assert skip.shape == (grid[2], grid[1], grid[0]) and (skip == 0).any() and (skip > 0).any()
+    points = rng.uniform(0, 1, (20000, 3)) * d.shape            # cells
+    g = np.floor(points / (group[0], band, group[1])).astype(int)
+    empty = skip[g[:, 2], g[:, 1], g[:, 0]] == 0
+    assert empty.any()
+    assert np.all(multilinear(d, points[empty] - 0.5) == 0.0), "density inside a skipped texel"
+
+
+def test_empty_space_skipping_and_early_exit_change_the_image_by_little(gpu, ctx):
+    app = scene(gpu, volume(), empty_space_skipping=False, min_transmittance=0.0)
+    plugin = next(p for p in app.plugins if isinstance(p, RaymarchCloudsPlugin))
+    aim(app, (60.0, 520.0, -250.0))
+    full = linear(app)
+    plugin.configure(empty_space_skipping=True)
+    skipped = linear(app)
+    plugin.configure(min_transmittance=0.05)
+    early = linear(app)
+    scale = full[..., :3].max()
+    assert scale > 0.1
+    assert np.abs(skipped - full).max() < 0.02 * scale, "skipping moved the steps too much"
+    assert np.abs(early[..., 3] - full[..., 3]).max() <= 0.051
+    assert np.abs(early[..., :3] - full[..., :3]).max() < 0.06 * scale
+    assert not np.array_equal(early, full), "the early exit must stop some rays"
+    app.close()
+
+
+@pytest.mark.parametrize("case", ["inside", "grazing", "zero", "full", "night"])
+def test_extremes_stay_finite_and_sensible(gpu, ctx, case):
+    density = {"zero": np.zeros(SHAPE, np.float32), "full": np.ones(SHAPE, np.float32),
+               "inside": np.ones(SHAPE, np.float32)}.get(case, volume())
+    sun = {"grazing": Sun.from_angles(0.3, 70.0), "night": Sun.from_angles(-30.0, 70.0, color=(0.0, 0.0, 0.0))}.get(case, DAY)
+    app = scene(gpu, density, sun=sun, resolution=2, jitter=True)
+    position = CENTER if case == "inside" else (80.0, 470.0, -150.0)
+    aim(app, position, CENTER + (0.0, 0.0, 100.0) if case == "inside" else CENTER)
+    frames = [linear(app) for _ in range(3)]
+    for image in frames:
+        assert np.isfinite(image).all() and image.min() >= 0.0
+    alpha = frames[-1][..., 3]
+    if case == "zero":
+        assert alpha.max() == 0.0 and frames[-1][..., :3].max() == 0.0
+    elif case in ("inside", "full"):
+        assert alpha.min() > 0.9 if case == "inside" else alpha.max() > 0.9
+        assert frames[-1][..., :3].mean() > 0.01, "lit, not black"
+    elif case == "night":
+        assert alpha.max() > 0.5
+        day = scene(gpu, density, resolution=2, jitter=True)
+        aim(day, position)
+        assert frames[-1][..., :3].mean() < 0.5 * linear(day)[..., :3].mean(), "no sun: darker"
+        day.close()
+    else:
+        assert alpha.max() > 0.5 and frames[-1][..., :3].max() > 0.01
+    app.close()
+
+
+def test_a_disabled_pass_is_culled_and_a_sprite_scene_has_none_of_it(gpu, ctx):
+    app = scene(gpu, volume(), enabled=False, resolution=2)
+    compiled = app.graph.compile()
+    assert "cloud_raymarch" not in [p.name for p in compiled.order]
+    assert LOW_COLOR not in compiled.resources
+    plugin = next(p for p in app.plugins if isinstance(p, RaymarchCloudsPlugin))
+    plugin.configure(enabled=True)
+    app.render()
+    compiled = app.graph.compile()
+    assert "cloud_raymarch" in [p.name for p in compiled.order] and LOW_COLOR in compiled.resources
+    app.close()
+    sprites = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(medium(), density=volume()),
+                                   CloudRenderPlugin())
+    sprites.startup()
+    compiled = sprites.graph.compile()
+    assert not any(p.name.startswith("cloud_raymarch") for p in compiled.order)
+    assert not any(name.startswith("cloud_raymarch") for name in compiled.resources)
+    sprites.close()
+
+
+def test_with_fog_far_field_and_terrain_the_clouds_show(gpu, ctx):
+    from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
+    from atmos.plugins.fog import FogPlugin
+    from atmos.plugins.sky_gradient import SkyGradientPlugin
+    from atmos.plugins.terrain import TerrainPlugin
+    extra = (SkyGradientPlugin(), TerrainPlugin(), FogPlugin(density=0.002), CloudFarFieldPlugin(size=16))
+    images = {}
+    for clouds in (True, False):
+        app = scene(gpu, volume(), plugins=extra, resolution=2, enabled=clouds)
+        aim(app, (80.0, 470.0, -150.0))
+        images[clouds] = app.read_linear()
+        app.close()
+    on, off = images[True], images[False]
+    assert np.isfinite(on).all()
+    changed = np.abs(on[..., :3] - off[..., :3]).sum(-1) > 0.02
+    assert changed.mean() > 0.03, "the clouds must show over fog, far field and terrain"
+    assert on[changed][..., :3].sum(-1).min() > 0.0, "not black"
