@@ -62,6 +62,7 @@ def parser() -> argparse.ArgumentParser:
     graph = sub.add_parser("graph", help="print a demo's compiled render graph")
     graph.add_argument("name", nargs="?", default=DEFAULT_DEMO)
     graph.add_argument("--dot", action="store_true", help="Graphviz dot instead of text")
+    _clouds_option(graph)
     return top
 
 
@@ -73,10 +74,14 @@ def _run_options(command, frames_default: str) -> None:
     command.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
     command.add_argument("--out", type=_out, help="FILE.mp4, FILE.gif, FILE.png (last frame) or a folder of PNGs; "
                                                   "headless default: out/NAME.mp4")
+    _clouds_option(command)
+    command.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def _clouds_option(command) -> None:
     command.add_argument("--clouds", choices=CLOUD_RENDERERS, default="sprites",
                          help="cloud renderer of the cloud scenes (sunset, flight, weather): point sprites "
                               "or the ray march (default sprites; key C flips it in a window)")
-    command.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
 def cmd_info(args) -> int:
@@ -139,7 +144,7 @@ def cmd_graph(args, top) -> int:
     except ValueError as error:
         top.error(str(error))
     gpu = create_headless((320, 180))
-    app = build_app(args.name, DemoSettings(size=gpu.size, headless=True), gpu, start=False)
+    app = build_app(args.name, DemoSettings(size=gpu.size, headless=True, clouds=args.clouds), gpu, start=False)
     try:
         print(app.graph.to_dot() if args.dot else app.graph.dump())
     finally:

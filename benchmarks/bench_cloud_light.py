@@ -2,7 +2,7 @@
 cost with the new lighting vs the old (HEAD's shaders), in one run.
 
 Static volumes (``CloudsPlugin(density=...)``) are drawn by the sprites (downsample 1/2, LOD on/off)
-and the ray march (several step counts) and read back with ``App.read_linear()``; the reference is
+and the ray march (``RaymarchCloudsPlugin.reference()`` at several step lengths) and read back with ``App.read_linear()``; the reference is
 :func:`atmos.shading.path_tracer.trace` of the same medium and light (``medium.environment``), all
 orders (``--max-order 1``: single scattering only, against the renderers with
 ``ms_contribution = 0``; sky and ground light are then off too). Four views: side, from below,
@@ -20,6 +20,8 @@ sprite pass <= 1.3x the old cost.
 from __future__ import annotations
 
 import argparse
+import hashlib
+import itertools
 import math
 import re
 import subprocess
@@ -34,7 +36,9 @@ from atmos import App, DefaultPlugins, create_headless
 from atmos.camera import Camera, view_basis
 from atmos.gpu import add_shader_path
 from atmos.lighting import Sun
-from atmos.plugins.cloud_render import CloudMarchPlugin, CloudRenderPlugin
+from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
+from atmos.plugins.cloud_raymarch.settings import REFERENCE
+from atmos.plugins.cloud_render import CloudRenderPlugin
 from atmos.plugins.cloud_render.light import sun_light
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
 from atmos.shading.medium import environment
@@ -72,12 +76,13 @@ def cumulus():
 
 
 VOLUMES = {"ellipsoid": ellipsoid, "cumulus": cumulus}
-MODES = {   # label: (renderer fields, march steps or None)
+MODES = {   # label: (sprite fields, None) or ({}, reference-march fields: the step in cells)
     "sprites 1/2": (dict(downsample=2), None),                 # the default real-time settings
     "sprites 1/2 LOD": (dict(downsample=2, lod_pixels=4.0), None),
     "sprites 1/1": (dict(downsample=1), None),
     "sprites 1/1 LOD": (dict(downsample=1, lod_pixels=4.0), None),
-    "march 32": ({}, 32), "march 64": ({}, 64), "march 128": ({}, 128), "march 256": ({}, 256),
+    "march 1 cell": ({}, dict(step=1.0)), "march 1/2 cell": ({}, dict(step=0.5)),
+    "march 1/4 cell": ({}, {}), "march 1/8 cell": ({}, dict(step=0.125)),        # {}: the reference's step
 }
 
 
@@ -99,7 +104,7 @@ class Scene:
                                       smoothing_slices=1, **medium)
         self.render_fields = dict(ms_contribution=0.0) if single else {}
         self.renderer = CloudRenderPlugin(**self.render_fields)
-        self.march = CloudMarchPlugin(self.renderer, enabled=False)
+        self.march = RaymarchCloudsPlugin.reference(enabled=False, **self.render_fields)
         self.app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(self.settings, density=density),
                                         self.renderer, self.march)
         self.app.startup()
@@ -117,10 +122,10 @@ class Scene:
         cam.near, cam.far = 1.0, 20000.0
         return cam, sun
 
-    def mode(self, fields, steps):
+    def mode(self, fields, march):
         defaults = dict(downsample=2, lod_pixels=None, **self.render_fields)
-        self.renderer.configure(enabled=steps is None, **{**defaults, **fields})
-        self.march.configure(enabled=steps is not None, **({} if steps is None else {"steps": steps}))
+        self.renderer.configure(enabled=march is None, **{**defaults, **fields})
+        self.march.configure(enabled=march is not None, **{"step": REFERENCE["step"], **(march or {})})
 
     def frame_ms(self, frames=7) -> float:
         ctx, times = self.app.gpu.ctx, []
@@ -146,6 +151,24 @@ class Scene:
                   albedo=s.albedo, g=s.phase_g, g2=s.phase_g2, w=s.phase_w, sun_dir=direction, sun_irradiance=e,
                   sky=sky, ground=ground, samples=samples, max_order=max_order, rng=np.random.default_rng(1))
         return r.radiance.reshape(h, w, 3), r.radiance_error.reshape(h, w, 3), time.perf_counter() - start
+
+
+OCTAVE_FIELDS = ("ms_attenuation", "ms_contribution", "ms_eccentricity")
+
+
+def cached_reference(scene, cam, sun, samples):
+    """:meth:`Scene.reference`'s radiance (all orders), kept in out/bench_cloud_light_cache/ under a
+    hash of everything it depends on (volume, medium, camera, sun, size, samples)."""
+    key = hashlib.sha1(b"".join([scene.density.tobytes(), repr((scene.cell, scene.sigma_t, scene.settings, SIZE,
+                                 samples, tuple(cam.position), cam.yaw, cam.pitch, cam.roll, cam.fov_y,
+                                 tuple(sun.direction), tuple(sun.color), tuple(sun.ambient))).encode()])).hexdigest()
+    path = OUT / "bench_cloud_light_cache" / f"{key[:20]}.npy"
+    if path.exists():
+        return np.load(path)
+    ref = scene.reference(cam, sun, samples, None)[0]
+    path.parent.mkdir(parents=True, exist_ok=True)
+    np.save(path, ref)
+    return ref
 
 
 def errors(image, ref):
@@ -228,24 +251,23 @@ FIT_GRID = ((0.1, 0.2, 0.3), (0.75, 0.85, 0.95), (0.8, 0.85, 0.9))   # around th
 def fit(gpu, samples, grid=FIT_GRID):
     """Grid search of the octaves (ms_attenuation, ms_contribution, ms_eccentricity) for the ray march
     (exact in single scattering) against all-order references of every volume and view: the
-    (a, b, c) with the least sum of bias^2 + rel. RMSE^2, and the per-view errors there."""
+    (a, b, c) with the least sum of bias^2 + rel. RMSE^2, and the per-view errors there.
+    ``grid``: three tuples of candidates (or ``--fit-grid "a1,a2;b1;c1,c2"``)."""
     cases = []
     for vname, make in VOLUMES.items():
         scene = Scene(gpu, make(), False)
         for view, (pos, target, elevation) in views(scene.lo, scene.hi).items():
             cam, sun = scene.look(pos, target, elevation)
-            cases.append((scene, (pos, target, elevation), scene.reference(cam, sun, samples, None)[0], vname, view))
+            cases.append((scene, (pos, target, elevation), cached_reference(scene, cam, sun, samples), vname, view))
     results = []
-    for a in grid[0]:
-        for b in grid[1]:
-            for c in grid[2]:
-                errs = []
-                for scene, look, ref, *_ in cases:
-                    scene.look(*look)
-                    scene.renderer.configure(ms_attenuation=a, ms_contribution=b, ms_eccentricity=c, enabled=False)
-                    scene.march.configure(enabled=True, steps=64)
-                    errs.append(errors(scene.app.read_linear(), ref))
-                results.append((sum(x * x + y * y for x, y in errs), (a, b, c), errs))
+    for abc in itertools.product(*grid):
+        errs = []
+        for scene, look, ref, *_ in cases:
+            scene.look(*look)
+            scene.renderer.configure(enabled=False)
+            scene.march.configure(enabled=True, step=0.5, **dict(zip(OCTAVE_FIELDS, abc)))
+            errs.append(errors(scene.app.read_linear(), ref))
+        results.append((sum(x * x + y * y for x, y in errs), abc, errs))
     results.sort(key=lambda r: r[0])
     for cost, abc, errs in results[:3]:
         print(f"a, b, c = {abc}: cost {cost:.3f}; " + ", ".join(
@@ -300,6 +322,7 @@ def main(argv=None):
     ap.add_argument("--modes", default=",".join(MODES), help="comma-separated mode labels")
     ap.add_argument("--size", default="96x64", help="image size WxH")
     ap.add_argument("--fit", action="store_true", help="fit the octaves to the references and stop")
+    ap.add_argument("--fit-grid", default=None, help='candidates "a1,a2;b1,b2;c1" (default FIT_GRID)')
     ap.add_argument("--no-cost", action="store_true", help="skip the old-vs-new sprite pass timing")
     args = ap.parse_args(argv)
     global SIZE
@@ -307,7 +330,12 @@ def main(argv=None):
     gpu = create_headless(SIZE)
     single = args.max_order == 1
     if args.fit:
-        return fit(gpu, args.samples)
+        grid = FIT_GRID if args.fit_grid is None else tuple(
+            tuple(float(v) for v in part.split(",")) for part in args.fit_grid.split(";"))
+        if len(grid) != len(OCTAVE_FIELDS):
+            ap.error(f"--fit-grid takes {len(OCTAVE_FIELDS)} ';'-separated candidate lists "
+                     f"({', '.join(OCTAVE_FIELDS)}); got {len(grid)}")
+        return fit(gpu, args.samples, grid)
     modes = [m.strip() for m in args.modes.split(",")]
     OUT.mkdir(exist_ok=True)
     summary = {}

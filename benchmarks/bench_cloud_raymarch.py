@@ -48,6 +48,7 @@ import bench_cloud_light as light  # noqa: E402  (its volumes, views, references
 from atmos import create_headless  # noqa: E402
 from atmos.camera import Camera  # noqa: E402
 from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin  # noqa: E402
+from atmos.plugins.cloud_raymarch.settings import REFERENCE  # noqa: E402
 from atmos.plugins.cloud_render import CloudRenderPlugin  # noqa: E402
 
 ROOT = HERE.parent
@@ -56,6 +57,7 @@ PARTS = ("error", "sunset", "stability", "ghost")
 DEFAULT = dict(steps=256, resolution=2, reprojection=True, detail_octaves=0, jitter=True,
                history_clamp=RaymarchCloudsPlugin.settings_class.history_clamp,
                motion_limit=RaymarchCloudsPlugin.settings_class.motion_limit)
+REAL_TIME = {name: getattr(RaymarchCloudsPlugin.settings_class, name) for name in REFERENCE}   # the defaults
 ROWS = {    # label: march fields over DEFAULT (None: the default sprites, downsample 2)
     "sprites 1/2": None,
     "march 32 r1": dict(steps=32, resolution=1), "march 64 r1": dict(steps=64, resolution=1),
@@ -79,17 +81,14 @@ def say(line: str = "") -> None:
 
 # -- a bench_cloud_light scene with the ray march added --------------------------------------------
 class MarchScene:
-    """bench_cloud_light's Scene (sprites + the reference march, both switchable) plus a
-    RaymarchCloudsPlugin; :meth:`use` switches to one row's renderer."""
+    """bench_cloud_light's Scene (sprites + the ray march, both switchable), its march set to the
+    real-time defaults | DEFAULT | a row's fields; :meth:`use` switches to one row's renderer."""
 
     def __init__(self, gpu, volume):
         self.scene = light.Scene(gpu, volume, False)
         self.app = self.scene.app
-        self.plugin = RaymarchCloudsPlugin(enabled=False)
-        self.app.add_plugins(self.plugin)
+        self.plugin = self.scene.march
         self.pass_ = next(p for p in self.app.graph.passes if p.name == "cloud_raymarch")
-        # the Scene's CloudMarchPlugin declares its writes even when disabled: order the two
-        self.pass_.after = (*self.pass_.after, "cloud_march")
 
     def use(self, fields):
         """``fields`` None: the default sprites; else the ray march with DEFAULT | fields."""
@@ -99,8 +98,7 @@ class MarchScene:
             self.plugin.configure(enabled=False)
         else:
             s.renderer.configure(enabled=False)
-            s.march.configure(enabled=False)
-            self.plugin.configure(enabled=True, **{**DEFAULT, **fields})
+            self.plugin.configure(enabled=True, **{**REAL_TIME, **DEFAULT, **fields})
 
     def converged(self, fields):
         """The image a still camera shows once the history holds every offset (r² + CONVERGE frames

@@ -9,8 +9,8 @@ A plain script (``python benchmarks/bench_cloud_render.py [--quick]``):
    1/2 resolution, plus levels of detail); render-graph time of the whole frame (sky, ground,
    clouds; no simulation slices), ``ctx.finish()`` per frame, median of 20 frames; printed beside
    the thesis's fps and speed-ups.
-2. 96×16×96 cells at 480×360: RMSE (display values 0..1) of the sprite image against a
-   1024-sample ray march of the same volume against frame time, per group size × sprite size
+2. 96×16×96 cells at 480×360: RMSE (display values 0..1) of the sprite image against the
+   reference ray march of the same volume (``RaymarchCloudsPlugin.reference()``) against frame time, per group size × sprite size
    factor × culling, and per downsample × level of detail; a table and ``out/bench_cloud_render.png``.
 3. The same volume seen from the side, from below and edge-on (the defaults: group 16, size 3,
    culled, 1/2 resolution): RMSE per view; the images beside their references in ``out/``.
@@ -30,7 +30,8 @@ from atmos.camera import Camera
 from atmos.defaults import DefaultPlugins
 from atmos.gpu import create_headless
 from atmos.lighting import Sun
-from atmos.plugins.cloud_render import CloudMarchPlugin, CloudRenderPlugin
+from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
+from atmos.plugins.cloud_render import CloudRenderPlugin
 from atmos.plugins.cloud_render.example import example_weather
 from atmos.plugins.clouds import CloudSettings, CloudSimulation, CloudsPlugin
 from atmos.plugins.ground import GroundPlugin
@@ -43,15 +44,15 @@ COVERS = {"low": 50, "medium": 150, "high": 400}      # ellipsoids (cloud_densit
 BASE = 600.0
 
 
-def make_app(gpu, shape, cloud_density, group, cell, size_factor=3.0, reference_steps=0, warmup=16):
+def make_app(gpu, shape, cloud_density, group, cell, size_factor=3.0, reference=False, warmup=16):
     app = App(gpu)
     app.insert_resource(Sun.from_angles(30.0, 40.0))
-    settings = CloudSettings(smoothing_slices=4, group_size=group, cell_size=cell)
+    settings = CloudSettings(smoothing_slices=4, group_size=group, cell_size=cell, base_altitude=BASE)
     weather = example_weather(shape, cloud_density, density_adaption=max(4, cloud_density // 10))
-    renderer = CloudRenderPlugin(base_altitude=BASE, size_factor=size_factor)
+    renderer = CloudRenderPlugin(size_factor=size_factor)
     plugins = [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(),
                CloudsPlugin(settings, weather=weather, seed=1, warmup_steps=warmup), renderer]
-    reference = CloudMarchPlugin(renderer, steps=reference_steps, enabled=False) if reference_steps else None
+    reference = RaymarchCloudsPlugin.reference(enabled=False) if reference else None
     app.add_plugins(*plugins, *([reference] if reference else []))
     app.startup()
     app.update(1 / 60)
@@ -143,8 +144,7 @@ VIEWS = {"side": ((200.0, BASE - 150.0, 1700.0), (960.0, BASE + 120.0, 700.0)),
 
 
 def error_app(gpu, group):
-    app, renderer, reference = make_app(gpu, ERROR_SHAPE, 80, (group, group), ERROR_CELL, reference_steps=1024,
-                                        warmup=20)
+    app, renderer, reference = make_app(gpu, ERROR_SHAPE, 80, (group, group), ERROR_CELL, reference=True, warmup=20)
     look_from(app, *VIEWS["side"])
     return app, renderer, reference
 
@@ -170,7 +170,7 @@ def error_table():
     shape, size = ERROR_SHAPE, ERROR_SIZE
     gpu = create_headless(size)
     print(f"\n2) error vs run time, {shape[0]}x{shape[1]}x{shape[2]} cells, {size[0]}x{size[1]}, "
-          "RMSE of display values (0..1) against a 1024-sample ray march")
+          "RMSE of display values (0..1) against the reference ray march")
     print(f"{'group':>6} {'size':>5} {'culling':>8} {'downsample':>10} {'LOD px':>7} {'ms':>8} {'RMSE':>8} "
           f"{'sprites':>8}")
     sweeps = {8: [(f, c, 1, None) for f in (1.5, 2.0, 3.0, 4.0) for c in (False, True)],

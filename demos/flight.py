@@ -47,5 +47,5 @@ def fly(app) -> None:
 
 
 def build(app, settings) -> None:
-    build_cloudscape(app, settings, hours=11.0, cloud_density=170, warmup_steps=30)
+    build_cloudscape(app, settings, hours=11.0, cloud_density=170, warmup_steps=30, haze=True)
     app.add_system(fly, "update", label="fly", after="fly_camera")

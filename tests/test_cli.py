@@ -55,6 +55,16 @@ def test_graph_of_the_cloud_demo_runs_no_simulation(capsys, monkeypatch):
     for phase in ("[sky]", "[opaque]", "[shadows]", "[translucent]", "[post]", "[present]"):
         assert phase in out
     assert "cloud_sets@0" in out and "(plugins/cloud_render/plugin.py:" in out
+    kept, culled = out.split("culled:")[0], out.split("culled:")[1].split("resources:")[0]
+    assert ". cloud_render " in kept and "- cloud_raymarch " in culled, "sprites by default, the ray march off"
+
+
+def test_graph_of_the_cloud_demo_with_the_ray_march(capsys):
+    code, out, _ = run(capsys, "graph", "sunset", "--clouds", "march")
+    assert code == 0
+    kept, culled = out.split("culled:")[0], out.split("culled:")[1].split("resources:")[0]
+    assert ". cloud_raymarch " in kept and "(plugins/cloud_raymarch/plugin.py:" in kept
+    assert "- cloud_render " in culled and ". cloud_render " not in kept, "the sprites are off (culled)"
 
 
 def test_headless_demo_frames_are_not_blank_and_move(tmp_path, capsys):
@@ -90,6 +100,7 @@ def test_headless_demo_writes_files(tmp_path, capsys, suffix):
     (["graph", "nosuch"], "unknown demo 'nosuch'"),
     (["demo", "--clouds", "voxels"], "argument --clouds: invalid choice: 'voxels' (choose from"),
     (["run", "demos/glider.py", "--clouds", "cubes"], "invalid choice: 'cubes'"),
+    (["graph", "sunset", "--clouds", "both"], "argument --clouds: invalid choice: 'both' (choose from"),
 ])
 def test_bad_arguments_get_clear_messages(capsys, argv, message):
     with pytest.raises(SystemExit) as info:

@@ -6,7 +6,8 @@ import pytest
 from atmos import App, DefaultPlugins
 from atmos.camera import Camera, view_basis
 from atmos.lighting import Sun
-from atmos.plugins.cloud_render import CloudMarchPlugin, CloudRenderPlugin
+from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
+from atmos.plugins.cloud_render import CloudRenderPlugin
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
 from atmos.plugins.sky_gradient import SkyGradientPlugin
 from atmos.plugins.weather import VolumeOrigin
@@ -28,11 +29,8 @@ def block_density():
 def static_app(gpu, density, march=False, sun=Sun.from_angles(40.0, 70.0), **medium):
     settings = CloudSettings(cell_size=CELL, base_altitude=BASE, group_size=(8, 8), smoothing_slices=1,
                              sigma_t=medium.pop("sigma_t", 0.02), **medium)
-    renderer = CloudRenderPlugin(downsample=1, enabled=not march)
-    plugins = [DefaultPlugins(overlay=False), CloudsPlugin(settings, density=density), renderer]
-    if march:
-        plugins.append(CloudMarchPlugin(renderer, steps=128))
-    app = App(gpu).add_plugins(*plugins)
+    renderer = RaymarchCloudsPlugin.reference() if march else CloudRenderPlugin(downsample=1)
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(settings, density=density), renderer)
     origin = app.resource(VolumeOrigin)             # the one the clouds follow: moved, not replaced
     origin.x, origin.z = ORIGIN[0], ORIGIN[2]
     app.insert_resource(sun)
@@ -148,7 +146,7 @@ def test_sprite_image_does_not_grow_with_the_size_factor(gpu, ctx):
     sums = {}
     for march in (True, False):
         app = static_app(gpu, density, march=march, sigma_t=0.05)
-        renderer = next(p for p in app.plugins if isinstance(p, CloudRenderPlugin))
+        renderer = next(p for p in app.plugins if isinstance(p, (CloudRenderPlugin, RaymarchCloudsPlugin)))
         center = (np.array([8.0 + ORIGIN[0], 2.0, 8.0 + ORIGIN[2]]) * CELL) + [0, BASE, 0]
         aim(app, center + [100.0, 150.0, 700.0], center)
         for label, fields in ((("march",), {}),) if march else (

@@ -1,8 +1,6 @@
 """The ray march's detail noise (plugins/cloud_raymarch/noise.py): the GPU textures against their float64
 reference, exact tiling, the erosion detail_density against its reference and at the extremes, bind,
 and the per-context cache (one build, freed with the context)."""
-from types import SimpleNamespace
-
 import moderngl
 import numpy as np
 import pytest
@@ -15,7 +13,7 @@ from atmos.plugins.cloud_raymarch.noise import (BASE_LAYOUT, COVERAGE, DETAIL_LA
 from fullscreen_probe import run_fullscreen
 
 BASE, FINE = 16, 8
-SETTINGS = SimpleNamespace(detail_scale=900.0, detail_strength=0.8)
+SCALE, STRENGTH = 900.0, 0.8     # base tile (m), strength
 LAYER = (-2000.0, 4000.0)      # (base y, height) m: the test points span the whole height gradient
 
 
@@ -23,13 +21,13 @@ def random_seed(rng) -> int:
     return int(rng.integers(0, 2**32))
 
 
-def probe(gpu, noise, points, d, octaves, settings=SETTINGS, time=37.0, wind=(12.0, -1.0, 4.0)):
+def probe(gpu, noise, points, d, octaves, strength=STRENGTH, time=37.0, wind=(12.0, -1.0, 4.0)):
     """detail_density on the GPU at ``points`` (h, w, 3) m with densities ``d`` (h, w)."""
     h, w = d.shape
     data = np.concatenate([points, d[..., None]], -1).astype(np.float32)
     out = run_fullscreen(gpu, "test/detail_probe.frag", (w, h), inputs=[data], nearest=True,
                          defines=detail_defines(octaves),
-                         set_uniforms=lambda p: noise.bind(p, time, wind, settings, layer=LAYER))
+                         set_uniforms=lambda p: noise.bind(p, time, wind, SCALE, strength, layer=LAYER))
     return out[..., 0]
 
 
@@ -71,16 +69,16 @@ def test_detail_density_matches_its_float64_reference(gpu, ctx, rng):
     d[1, :8] = 1.0
     for octaves in (1, 2, 3):
         got = probe(gpu, noise, points, d, octaves)
-        want = ref.detail_density(d, points, base, detail, octaves, SETTINGS.detail_scale,
-                                  SETTINGS.detail_strength, 37.0, (12.0, -1.0, 4.0), LAYER)
+        want = ref.detail_density(d, points, base, detail, octaves, SCALE, STRENGTH, 37.0, (12.0, -1.0, 4.0), LAYER)
         # the GPU filters with ~8-bit sub-texel weights; the erosion's remap amplifies that up to 5x
         assert np.abs(got - want).max() < 0.015, octaves
         assert np.abs(got - want).mean() < 1.5e-3, octaves
-        assert 0.05 < np.mean(want[(d > 0.2) & (d < 0.8)] < d[(d > 0.2) & (d < 0.8)] - 0.01)   # it erodes
+        band = (d > 0.02) & (d < COVERAGE)
+        assert 0.05 < np.mean(want[band] < d[band] - 0.01)     # it carves the edge in
+        assert 0.05 < np.mean(want[band] > d[band] + 0.01)     # and grows billows out of the thin density
     thin = 0.25 * d                                     # below the coverage density: the eroded band
-    assert np.std(ref.detail_density(thin, points, base, detail, 3, SETTINGS.detail_scale, 0.8, layer=LAYER)
-                  - ref.detail_density(thin, points + (50.0, 0.0, 0.0), base, detail, 3, SETTINGS.detail_scale, 0.8,
-                                       layer=LAYER)) > 0.01
+    assert np.std(ref.detail_density(thin, points, base, detail, 3, SCALE, 0.8, layer=LAYER)
+                  - ref.detail_density(thin, points + (50.0, 0.0, 0.0), base, detail, 3, SCALE, 0.8, layer=LAYER)) > 0.01
     body = d >= COVERAGE                                # a cloud's body is never eroded
     assert np.array_equal(want[body], np.minimum(d, 1.0)[body])
 
@@ -101,16 +99,30 @@ def test_detail_density_at_the_extremes(gpu, ctx, rng):
         huge = probe(gpu, noise, huge_p, np.full((h, w), 1e30), octaves,
                      time=1e12, wind=(1e6, 0.0, -1e6))
         assert np.all(np.isfinite(huge)) and np.all((huge >= 0.0) & (huge <= 1.0))
-    full = SimpleNamespace(detail_scale=900.0, detail_strength=1.0)
     base, _ = noise.read()
     darkest = np.array(np.unravel_index(np.argmin(base[..., 0]), base.shape[:3]))   # e = 1 there
     u = (darkest + 0.5) / BASE + detail_offsets(37.0, (12.0, -1.0, 4.0), 900.0)[0]
     at_dark = np.broadcast_to(u * 900.0, (h, w, 3))
     for octaves in (1, 3):
         for where in (points, at_dark):
-            assert np.allclose(probe(gpu, noise, where, d, octaves, settings=full)[:, d[0] >= 1.0], 1.0)
-    none = SimpleNamespace(detail_scale=900.0, detail_strength=0.0)
-    assert np.allclose(probe(gpu, noise, points, d, 3, settings=none), np.minimum(d, 1.0), atol=1e-6)
+            assert np.allclose(probe(gpu, noise, where, d, octaves, strength=1.0)[:, d[0] >= 1.0], 1.0)
+    assert np.allclose(probe(gpu, noise, points, d, 3, strength=0.0), np.minimum(d, 1.0), atol=1e-6)
+
+
+def test_the_detail_scrolls_with_the_wind_and_nothing_else(gpu, ctx, rng):
+    """Frame to frame the detail moves only by the wind: at time t + dt the pattern at p + wind dt is
+    the one at p at time t (a frozen sky, a still camera: the same detail every frame)."""
+    noise = DetailNoise(gpu, BASE, FINE, seed=random_seed(rng))
+    points = rng.uniform(-3000.0, 3000.0, (16, 24, 3))
+    d = rng.uniform(0.0, COVERAGE, (16, 24))
+    wind, dt = np.array([12.0, 0.0, -5.0]), 0.7
+    for octaves in (1, 3):
+        now = probe(gpu, noise, points, d, octaves, time=40.0, wind=tuple(wind))
+        assert np.array_equal(probe(gpu, noise, points, d, octaves, time=40.0, wind=tuple(wind)), now)
+        later = probe(gpu, noise, points + wind * dt, d, octaves, time=40.0 + dt, wind=tuple(wind))
+        assert np.abs(later - now).max() < 0.01, octaves         # the float32 texel weights, no drift
+        still = probe(gpu, noise, points, d, octaves, time=40.0 + dt, wind=tuple(wind))
+        assert np.abs(still - now).mean() > 5 * np.abs(later - now).mean()   # it does move
 
 
 def test_bind_sets_only_the_uniforms_the_program_has(gpu, ctx):
@@ -118,10 +130,12 @@ def test_bind_sets_only_the_uniforms_the_program_has(gpu, ctx):
     for octaves in (0, 1, 3):
         program = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="test/detail_probe.frag",
                               defines=detail_defines(octaves))
-        noise.bind(program, 10.0, (3.0, 0.0, 1.0), SETTINGS)
+        noise.bind(program, 10.0, (3.0, 0.0, 1.0), SCALE, STRENGTH)
         if octaves == 3:
-            assert program["detail_fine_noise"].value == 7 and program["detail_base_noise"].value == 6
+            from atmos.plugins.cloud_raymarch.noise import BASE_UNIT, DETAIL_UNIT
+            assert program["detail_fine_noise"].value == DETAIL_UNIT and program["detail_base_noise"].value == BASE_UNIT
             assert program["detail_band_strength"].value == pytest.approx(0.4)
+            assert program["detail_band_width"].value == pytest.approx(1.0 - 0.75 * STRENGTH)
         if octaves == 1:
             assert program.get("detail_fine_noise", None) is None
 

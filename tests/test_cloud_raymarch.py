@@ -164,6 +164,32 @@ def test_a_disabled_pass_is_culled_and_a_sprite_scene_has_none_of_it(gpu, ctx):
     sprites.close()
 
 
+def test_a_scene_draws_with_one_cloud_renderer_never_both(gpu, ctx):
+    from atmos.graph import GraphError
+    both = r"'cloud_raymarch' and 'cloud_render' are alternatives \(exclusive group 'cloud volume'\)"
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(medium(), density=volume()),
+                               CloudRenderPlugin(), RaymarchCloudsPlugin())
+    with pytest.raises(GraphError, match=both):
+        app.startup()                       # refused when the graph is first compiled
+    app.close()
+    sprites = CloudRenderPlugin(enabled=False)
+    app = scene(gpu, volume(), plugins=(sprites,))
+    march = next(p for p in app.plugins if isinstance(p, RaymarchCloudsPlugin))
+    aim(app, (80.0, 470.0, -150.0))
+    marched = linear(app)
+    sprites.configure(enabled=True)         # turned on live beside the march: refused on the next frame
+    with pytest.raises(GraphError, match=both):
+        app.render()
+    march.configure(enabled=False)          # the switch (either order between two frames)
+    drawn = linear(app)
+    assert [p.name for p in app.graph.compile().order if p.exclusive] == ["cloud_render"]
+    sprites.configure(enabled=False)
+    empty = linear(app)
+    for image in (marched, drawn):          # each renderer alone draws the clouds
+        assert (np.abs(image - empty)[..., :3].sum(-1) > 0.05).mean() > 0.05
+    app.close()
+
+
 def test_with_fog_far_field_and_terrain_the_clouds_show(gpu, ctx):
     from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
     from atmos.plugins.fog import FogPlugin
@@ -181,3 +207,18 @@ def test_with_fog_far_field_and_terrain_the_clouds_show(gpu, ctx):
     changed = np.abs(on[..., :3] - off[..., :3]).sum(-1) > 0.02
     assert changed.mean() > 0.03, "the clouds must show over fog, far field and terrain"
     assert on[changed][..., :3].sum(-1).min() > 0.0, "not black"
+
+
+def test_with_frozen_clouds_and_a_still_camera_the_detail_is_the_same_every_frame(gpu, ctx):
+    app = scene(gpu, volume(), detail_octaves=3, wind=(0.0, 0.0, 0.0), empty_space_skipping=False)
+    aim(app, (80.0, 470.0, -150.0))
+    march = next(p for p in app.plugins if isinstance(p, RaymarchCloudsPlugin))
+    first = linear(app)
+    app.run_frames(3, 1 / 30)
+    assert np.array_equal(linear(app), first), "no drift of the detail without wind (jitter off)"
+    march.configure(detail_octaves=0)
+    assert np.abs(linear(app)[..., 3] - first[..., 3]).mean() > 1e-3, "the detail must show"
+    march.configure(detail_octaves=3, wind=(20.0, 0.0, 0.0))
+    app.run_frames(3, 1 / 30)
+    assert np.abs(linear(app)[..., 3] - first[..., 3]).mean() > 1e-4, "with wind the detail scrolls"
+    app.close()

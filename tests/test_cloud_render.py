@@ -12,8 +12,8 @@ from atmos.camera import Camera
 from atmos.defaults import DefaultPlugins
 from atmos.gpu.shaders import load_source
 from atmos.lighting import Sun
-from atmos.plugins.cloud_render import (CloudLayout, CloudMarchPlugin, CloudRenderPlugin, select_segments,
-                                        sun_light)
+from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
+from atmos.plugins.cloud_render import CloudLayout, CloudRenderPlugin, select_segments, sun_light
 from atmos.plugins.cloud_render.binding import bind_volume, clamp_sampler, unbind_volume
 from atmos.plugins.cloud_render.light import light_uniforms
 from atmos.plugins.cloud_render.example import example_weather
@@ -33,14 +33,15 @@ BASE = 300.0
 
 def scene(gpu, cloud_density=60, shading_scale=1, warmup=25, seed=3, sun=(25.0, 40.0), reference=False, adaption=4,
           **render):
-    settings = CloudSettings(smoothing_slices=2, group_size=(16, 16), cell_size=CELL, shading_scale=shading_scale)
+    settings = CloudSettings(smoothing_slices=2, group_size=(16, 16), cell_size=CELL, base_altitude=BASE,
+                             shading_scale=shading_scale)      # the medium and the base both renderers use
     app = App(gpu)
     app.insert_resource(Sun.from_angles(*sun))
-    renderer = CloudRenderPlugin(base_altitude=BASE, **render)
+    renderer = CloudRenderPlugin(**render)
     plugins = [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(),
                CloudsPlugin(settings, weather=example_weather(SHAPE, cloud_density, density_adaption=adaption), seed=seed, warmup_steps=warmup), renderer]
     if reference:
-        plugins.append(CloudMarchPlugin(renderer, steps=192, enabled=False))
+        plugins.append(RaymarchCloudsPlugin.reference(enabled=False))
     app.add_plugins(*plugins)
     app.startup()
     return app, renderer
@@ -348,7 +349,7 @@ def test_cloud_images_show_clouds_near_the_reference_and_move(gpu, ctx, view):
     gpu.resize((320, 180))
     try:
         app, renderer = scene(gpu, reference=True)
-        ref_plugin = next(p for p in app.plugins if isinstance(p, CloudMarchPlugin))
+        ref_plugin = next(p for p in app.plugins if isinstance(p, RaymarchCloudsPlugin))
         look(app, *(BELOW if view == "below" else ABOVE))
         img = frame(app, gpu)
         save(img, f"cloud_render_{view}.png")
@@ -480,5 +481,3 @@ def test_needs_the_cloud_simulation(gpu):
     with pytest.raises(GraphError, match=r"'cloud_render' reads 'cloud_sets'.*is the plugin that provides it added"):
         app.update(1 / 60)
     app.close()
-    with pytest.raises(ValueError, match=r"CloudMarchSettings\.steps must be a whole number 1\.\.65536"):
-        CloudMarchPlugin(CloudRenderPlugin(), steps=0)

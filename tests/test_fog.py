@@ -220,10 +220,11 @@ def test_fog_pass_on_a_known_depth_buffer_matches_reference(gpu, rng, mode, nois
         distance = np.linalg.norm(world - cam.position, axis=-1)
         sky_px = probe.depth >= 1.0
         volumes = reference_volumes(settings) if noise == "texture" else None
+        directions = (world - cam.position) / distance[..., None]
+        distance = np.where(sky_px & (sky == "keep"), np.inf, distance)   # "fog": the far-plane point's
         ref = apply_fog_ref(color[..., :3].astype(np.float16).astype(np.float64), distance, settings, world,
-                            app.clock.frame_time, volumes=volumes)
-        if sky == "keep":
-            ref[sky_px] = color[..., :3].astype(np.float16)[sky_px]
+                            app.clock.frame_time, volumes=volumes, directions=directions,
+                            camera=cam.position, ground=True)
         np.testing.assert_allclose(probe.color[..., :3], ref, atol=4e-3, rtol=2e-3)
         assert np.abs(ref - color[..., :3]).mean() > 0.05
         app.close()

@@ -86,7 +86,8 @@ def is_red(pixels):
 
 
 def is_sky(pixels):
-    return (pixels[..., 2] > 120) & (pixels[..., 2] >= pixels[..., 0])
+    """Blue sky, or the white of a sunlit cloud (blue at most a little under red)."""
+    return (pixels[..., 2] > 120) & (pixels[..., 2] >= pixels[..., 0] - 10)
 
 
 @needs_x

@@ -31,7 +31,7 @@ import atmos.plugins.weather.system as weather_system
 from atmos.checks import CheckedSettings
 from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
 from atmos.plugins.cloud_raymarch.plugin import LOW_COLOR as RAYMARCH_LOW_COLOR
-from atmos.plugins.cloud_render import CloudMarchPlugin, CloudRenderPlugin
+from atmos.plugins.cloud_render import CloudRenderPlugin
 from atmos.plugins.cloud_render.example import example_weather
 from atmos.plugins.cloud_render.offscreen import CLOUD_COLOR
 from atmos.plugins.cloud_shadows import CloudShadowsPlugin
@@ -292,11 +292,13 @@ SPECS = {
         look((0.0, 2.0, 10.0), yaw=0.0, pitch=0.05),
         dict(samples=8, density=0.4, decay=0.7, weight=0.3, exposure=2.0, threshold=0.2, ceiling=0.05, radius=0.1,
              downsample=4, horizon_fade=0.9, front_fade=1.0, edge_fade=2.0, mode="march", steps=3,
-             scattering=1e-4, max_distance=400.0, phase_g=0.0, phase_g2=0.6, phase_w=0.7, sun_intensity=2.0),
+             scattering=1e-4, max_distance=400.0, phase_g=0.0, phase_g2=0.6, phase_w=0.7, sun_intensity=2.0,
+             fog_sun_share=0.3),
         before={"__all__": sun_at((0.5, 0.55)), "edge_fade": sun_at((1.15, 0.55)),
                 **{f: march_under_clouds for f in ("steps", "scattering", "max_distance", "phase_g", "phase_g2",
                                                     "phase_w", "sun_intensity")}},
-        observe={"downsample": resource_size(MASK)}),
+        # fog_sun_share acts only with a FogPlugin (tests/test_light_shafts_fog.py renders it): the setting read
+        observe={"downsample": resource_size(MASK), "fog_sun_share": lambda app, plugin: plugin.settings.fog_sun_share}),
     "test_volume": Spec(
         lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(),
                  TestVolumePlugin(resolution=(16, 8, 16), slices=4, march_steps=24)], TestVolumePlugin,
@@ -383,23 +385,13 @@ SPECS["cloud_top_view"] = Spec(
     look((0.0, 3.0, 10.0), yaw=0.0, pitch=0.0), dict(full_column=0.5))
 
 
-def _march_scene():
-    renderer = CloudRenderPlugin(enabled=False)
-    return [DefaultPlugins(overlay=False), clouds(), SkyGradientPlugin(), GroundPlugin(), renderer,
-            CloudMarchPlugin(renderer, steps=32)]
-
-
-SPECS["cloud_march"] = Spec(_march_scene, CloudMarchPlugin, look((320.0, 60.0, 1100.0), target=CLOUD_CENTER, far=6000.0),
-                            dict(steps=4, enabled=False))
-
-
 def _raymarch_scene():
     density = np.zeros((16, 4, 16), np.float32)
     density[4:12, 0:3, 4:12] = 1.0
     medium = CloudSettings(cell_size=(20.0, 30.0, 20.0), base_altitude=300.0, group_size=(4, 4), smoothing_slices=1,
                            sigma_t=0.01)
     return [DefaultPlugins(overlay=False), CloudsPlugin(medium, density=density), SkyGradientPlugin(), GroundPlugin(),
-            RaymarchCloudsPlugin(resolution=1, jitter=False, steps=64)]
+            RaymarchCloudsPlugin(resolution=1, jitter=False, steps=64), CloudFarFieldPlugin(size=32)]
 
 
 def raymarch_history(app, plugin):
@@ -410,6 +402,12 @@ def raymarch_history(app, plugin):
 def raymarch_skip_map(app, plugin):
     """Whether the ray march holds an uploaded skip map (empty-space skipping changes no pixel)."""
     return next(p for p in app.graph.passes if p.name == "cloud_raymarch").skip is not None
+
+
+def raymarch_far_distance(app, plugin):
+    """The far-field march's end distance as the last frame's program holds it (this view's far
+    clouds end in the haze before either value)."""
+    return next(p for p in app.graph.passes if p.name == "cloud_raymarch").program(True)["far_distance"].value
 
 
 def raymarch_turn(app, plugin):
@@ -436,10 +434,10 @@ SPECS["cloud_raymarch"] = Spec(
     dict(base_altitude=250.0, steps=2, step=4.0, step_growth=0.05, empty_space_skipping=False, min_transmittance=0.5,
          jitter=True, resolution=2, reprojection=False, history_clamp=0.0, motion_limit=1.0, detail_octaves=2, detail_scale=300.0, detail_strength=0.5,
          sun_steps=2, wind=(400.0, 0.0, 0.0), ms_attenuation=0.9, ms_contribution=1.0, ms_eccentricity=0.0,
-         enabled=False),
+         far_field=False, far_distance=1000.0, far_step_growth=0.3, enabled=False),
     observe={"resolution": resource_size(RAYMARCH_LOW_COLOR), "reprojection": raymarch_history,
              "empty_space_skipping": raymarch_skip_map, "history_clamp": raymarch_turn,
-             "motion_limit": raymarch_turn},
+             "motion_limit": raymarch_turn, "far_distance": raymarch_far_distance},
     before={"reprojection": configure_first(resolution=2), "detail_scale": _DETAIL, "detail_strength": _DETAIL,
             "sun_steps": _DETAIL, "wind": _DETAIL, "history_clamp": _TEMPORAL, "motion_limit": _TEMPORAL})
 

@@ -104,6 +104,20 @@ def test_two_unordered_writers_in_one_phase_are_an_error_naming_both(graph):
         graph.compile()
 
 
+def test_two_passes_of_one_exclusive_group_may_not_both_be_on(graph):
+    graph.add_pass(P("make", creates={"x": SMALL}, phase="clear"))
+    a, b = P("a", reads=["x"], writes=["x"], side=True), P("b", reads=["x"], writes=["x"], side=True, after=["a"])
+    a.exclusive = b.exclusive = "look"
+    graph.add_pass(a)
+    graph.add_pass(b)
+    with pytest.raises(GraphError, match=r"passes 'a' and 'b' are alternatives \(exclusive group 'look'\).*"
+                                         r"configure\(enabled=False\)"):
+        graph.compile()                     # even though after= orders them
+    b.reads = b.writes = ()
+    b.side = False                          # b is off: declares nothing
+    assert names(graph.compile()) == ["make", "a"]
+
+
 def test_opaque_writers_commute_in_name_order(graph):
     graph.add_pass(P("make", creates={"x": SMALL}, phase="clear"))
     graph.add_pass(P("terrain", reads=["x"], writes=["x"], side=True, phase="opaque"))

@@ -99,3 +99,23 @@ def test_rendering_into_a_file_is_headless_for_the_game_in_both_entry_points(tmp
     (tmp_path / "seen.txt").unlink()
     atmos.run(str(tmp_path / "tiny.py"), size=(32, 18), frames=1, out=str(tmp_path / "b.png"), headless=False)
     assert (tmp_path / "seen.txt").read_text() == "True" and (tmp_path / "b.png").is_file()
+
+
+def test_atmos_run_chooses_the_cloud_renderer_like_the_demo_option(tmp_path):
+    """``atmos.run(..., clouds=...)`` reaches the game as ``settings.clouds`` (the cloud demos build that
+    renderer: tests/test_demos.py); anything but "sprites" or "march" is refused before the game is built."""
+    from atmos.plugins.sky_gradient import SkyGradientPlugin
+    built = []
+
+    def build(app, settings):
+        built.append(settings.clouds)
+        app.add_plugins(atmos.DefaultPlugins(overlay=False), SkyGradientPlugin())
+
+    for clouds in ("march", "sprites"):
+        atmos.run(build, size=(32, 18), frames=1, out=str(tmp_path / f"{clouds}.png"), clouds=clouds)
+    atmos.run(build, size=(32, 18), frames=1, out=str(tmp_path / "default.png"))
+    assert built == ["march", "sprites", "sprites"]
+    for bad in ("voxels", None, 2):
+        with pytest.raises(ValueError, match=r"atmos\.run\.clouds must be one of 'sprites', 'march', got "):
+            atmos.run(build, size=(32, 18), frames=1, headless=True, clouds=bad)
+    assert len(built) == 3, "refused before the game was built"

@@ -70,6 +70,7 @@ def compile_graph(passes: list[RenderPass], builders: dict[str, PassBuilder], im
     imports = set(imports)
     passes = sorted(passes, key=lambda p: (PHASE_INDEX[p.phase], p.name))
     phase_of = {p.name: p.phase for p in passes}
+    _check_exclusive(passes, builders)
     resources = _resources(builders, imports)
     edges, conflicts = _edges(passes, builders, resources, phase_of)
     sorted_names = _order(passes, edges)
@@ -235,6 +236,20 @@ def _order(passes: list[RenderPass], edges: dict[tuple[str, str], str]) -> list[
                              + ", ".join(f"'{n}'" for n in cycle)
                              + ": " + "; ".join(f"{a} -> {b} ({edges[(a, b)]})" for a, b in links)) from None
     return order
+
+
+def _check_exclusive(passes, builders) -> None:
+    """A GraphError if two passes of one ``exclusive`` group both declare something this frame."""
+    groups: dict[str, list[str]] = {}
+    for p in passes:
+        b = builders[p.name]
+        if p.exclusive and (b.names or b.has_side_effect):
+            groups.setdefault(p.exclusive, []).append(p.name)
+    for group, names in groups.items():
+        if len(names) > 1:
+            raise GraphError(f"passes {' and '.join(repr(n) for n in names)} are alternatives (exclusive group "
+                             f"'{group}'), but more than one is on this frame; switch all but one off "
+                             "(configure(enabled=False) on its plugin, or leave the plugin out)")
 
 
 def _check_conflicts(conflicts, edges, order) -> None:

@@ -17,12 +17,16 @@ class RenderPass:
     lazily, for passes that survive culling, before their first ``execute`` — make buffers there,
     never in ``__init__`` or ``setup``; ``release`` frees what ``prepare`` made. ``before``/``after``
     name passes of the same phase this one must run before/after (rarely needed: prefer data).
+    ``exclusive``: a group name for passes that are alternatives to each other (the two cloud
+    renderers: "cloud volume"): at most one pass of a group may declare anything in a frame, else
+    the compile raises a GraphError naming them (a pass that is switched off declares nothing).
     """
 
     name: str = ""
     phase: str = ""
     before: tuple[str, ...] = ()
     after: tuple[str, ...] = ()
+    exclusive: str = ""
 
     def setup(self, builder: PassBuilder) -> None:
         """Declare the resources this pass creates, reads and writes (every frame)."""

@@ -24,6 +24,8 @@ the sun (per pixel), octaves ``i < 4`` after Wrenninge (a: ``ms_attenuation``, b
 1 - exp(-(1 - g_mean)(tau_up + tau_down))``) scale with the chance that light was turned aside in
 the column through the point: its transport optical depth (``g_mean`` the phase's mean cosine; a
 forward lobe turns little light aside, so a thin cloud seen from below is mostly single scattering).
+``tau_up``/``tau_down`` (straight up and down to the volume's faces) come from the light volume's
+columns, computed once per texture set (:mod:`atmos.shading.columns`).
 Sky and ground light: the diffusion solution between a slab's two lit faces, ``u = (tau_down −
 tau_up) / (tau_up + tau_down + 2 z)`` with the extrapolation length ``z = 2 / (3 (1 − g_mean))``
 (deep in a cloud the light is the faces' mean, near a face that face's; a white furnace, equal sky

@@ -6,6 +6,13 @@ columns that are covered (summed density of mix(A, B, t) above ``CloudSettings.c
 at the column's centre; :func:`.reference.volume_cover` is it in float64. The far-field shader turns it into
 the fbm threshold that leaves that fraction of its layer clear of cloud: the (1 − cover) quantile of
 the layer's fbm, interpolated in the table :func:`fbm_quantiles` makes once per texture setting.
+
+Per detail level: far away the shader samples blurred mip levels of the octaves, whose fbm has a
+narrower spread round the same mean, so one threshold from the sharp pattern would let a blurred
+pattern clear it everywhere (cover > 0.5: a white overcast band at the horizon) or nowhere.
+:func:`level_table` gives each mip level its own quantiles (of the pattern box-filtered as the mip
+chain is) and the spread ratio the softness is scaled by, so every level is clouded over the same
+fraction with the same distribution of density.
 """
 from __future__ import annotations
 
@@ -16,16 +23,41 @@ import numpy as np
 from atmos.plugins.sky_layer.octaves import OCTAVES, WEIGHTS, octave_key, tile_noise
 
 QUANTILES = 33          # table entries: quantiles at 0, 1/32, ..., 1
-GRID = 64               # samples per side of the tile the table is measured on
+GRID = 256              # most samples per side of the tile the table is measured on
+LEVELS = 8              # table rows: mip levels 0..7 of the table's grid (field.glsl FIELD_LEVELS)
+MIN_SPREAD = 0.05       # the softness never shrinks below this fraction of the sharp pattern's
+
+
+def spread(q) -> float:
+    """The 10..90 % range of a quantile row (what the softness is scaled by)."""
+    return float(np.interp(0.9, np.linspace(0, 1, len(q)), q) - np.interp(0.1, np.linspace(0, 1, len(q)), q))
 
 
 @lru_cache(maxsize=8)
-def fbm_quantiles(base_frequency: int, seed: int) -> tuple:
-    """(QUANTILES,) fbm values q_k with the fraction k/(QUANTILES − 1) of the layer's fbm at or below q_k."""
-    i = (np.arange(GRID) + 0.5) / GRID
+def level_table(base_frequency: int, seed: int, size: int = GRID) -> tuple:
+    """(quantiles (LEVELS, QUANTILES), softness scale (LEVELS,), first level) for octave textures of
+    ``size`` texels: row m holds the quantiles of the fbm on a ``min(size, GRID)`` grid box-filtered m
+    times (2×2 means, as the mip chain), its spread over level 0's (at least MIN_SPREAD), and
+    ``first`` = log2(size / grid): texture mip level L reads row L − first (clamped; rows past the
+    2×2 level repeat it)."""
+    grid = min(int(size), GRID)
+    i = (np.arange(grid) + 0.5) / grid
     uv = np.stack(np.meshgrid(i, i, indexing="ij"), -1)
     fbm = sum(w * tile_noise(uv, base_frequency * 2 ** k, octave_key(seed, k)) for k, w in zip(range(OCTAVES), WEIGHTS))
-    return tuple(float(v) for v in np.quantile(fbm, np.linspace(0.0, 1.0, QUANTILES)))
+    rows = []
+    while len(rows) < LEVELS:
+        rows.append(np.quantile(fbm, np.linspace(0.0, 1.0, QUANTILES)))
+        if fbm.shape[0] > 2:
+            fbm = 0.25 * (fbm[0::2, 0::2] + fbm[1::2, 0::2] + fbm[0::2, 1::2] + fbm[1::2, 1::2])
+    q = np.array(rows)
+    scale = np.maximum([spread(r) / spread(q[0]) for r in q], MIN_SPREAD)
+    return q, scale, float(np.log2(size / grid))
+
+
+def fbm_quantiles(base_frequency: int, seed: int) -> tuple:
+    """(QUANTILES,) fbm values q_k with the fraction k/(QUANTILES − 1) of the layer's sharp fbm (mip 0)
+    at or below q_k."""
+    return tuple(float(v) for v in level_table(base_frequency, seed)[0][0])
 
 
 def emptiness(quantiles, cover: float) -> float:

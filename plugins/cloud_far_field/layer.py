@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.plugins.cloud_far_field.cover import fbm_quantiles
+from atmos.plugins.cloud_far_field.cover import level_table
 from atmos.plugins.cloud_render.light import light_uniforms
 from atmos.plugins.clouds.sets import CloudSets
 from atmos.plugins.sky_layer.octaves import OctaveTextures
@@ -82,7 +82,12 @@ class FarFieldLayer:
             if name in program:
                 program[name].value = value
         program["field_offsets"].write(drift(params, sim, time).astype("f4").tobytes())
-        program["field_quantiles"].write(np.asarray(fbm_quantiles(params.base_frequency, params.seed), "f4").tobytes())
+        quantiles, scale, first = level_table(params.base_frequency, params.seed, params.size)
+        program["field_quantiles"].write(np.asarray(quantiles, "f4").tobytes())
+        if "field_scale" in program:
+            program["field_scale"].write(np.asarray(scale, "f4").tobytes())
+        if "field_first_level" in program:
+            program["field_first_level"].value = first
 
     def release(self) -> None:
         if self.octaves is not None:

@@ -24,6 +24,8 @@ class CloudFarFieldPass(FullscreenPass):
     reads = (COLOR, DEPTH, CLOUD_SETS, FAR_FIELD)
 
     def setup(self, builder) -> None:
+        if self.plugin.drawn_by_march():
+            return                          # a ray march draws the far field volumetrically: culled
         super().setup(builder)
         if self.plugin.composition.distance:
             builder.read(CLOUD_DISTANCE)
@@ -71,6 +73,7 @@ class CloudFarFieldPlugin(Plugin):
         self.composition = composition(app)
         self.composition.writers.add("cloud_far_field")   # the fog gets the layer's own distance
         self.layer = FarFieldLayer(app.gpu, self)          # also read by the ground shadows
+        self.marchers = set()       # renderers that may march the far field themselves (drawn_by_march)
         app.graph.import_resource(FAR_FIELD, self.layer)
         self.pass_ = CloudFarFieldPass(self)
         app.graph.add_pass(self.pass_)
@@ -82,6 +85,12 @@ class CloudFarFieldPlugin(Plugin):
         comp = getattr(self, "composition", None)
         if comp is not None:
             comp.writers.discard("cloud_far_field")
+
+    def drawn_by_march(self) -> bool:
+        """Whether a cloud renderer marches the far field itself this frame (a registered renderer's
+        ``marches_far_field()``, e.g. RaymarchCloudsPlugin with ``far_field``): the 2D pass then
+        declares nothing and is culled; the layer stays imported for the shadows and the march."""
+        return any(m.marches_far_field() for m in getattr(self, "marchers", ()))
 
     def finish(self, app) -> None:
         """Run before every other translucent pass (the cloud renderers draw nearer clouds over it)."""

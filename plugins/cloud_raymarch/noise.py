@@ -10,10 +10,10 @@ The definitions, in float64: :mod:`atmos.plugins.cloud_raymarch.noise_reference`
 sample): the values are in [0, 1] and an 8-bit step (0.004) is far below what the erosion shows.
 Repeat wrap, linear filter, no mipmaps (``detail.glsl`` samples level 0).
 
-The march plugin's settings (``RaymarchCloudSettings``) that :meth:`DetailNoise.bind` reads:
-``detail_scale`` (m per base tile, > 0; the detail tile is ``detail_scale / DETAIL_RATIO``: at
-1500 m, base billows of 375 m (R, G) down to 94 m (A) and detail cells of 94, 47 and 23 m against
-the 40 m automaton cells), ``detail_strength`` (0..1, 0 = no erosion) and, as the define
+:meth:`DetailNoise.bind` sets the uniforms from the march's settings (``RaymarchCloudSettings``):
+the base tile ``scale`` in m (``detail_scale`` cells × the cell; the detail tile is
+``scale / DETAIL_RATIO``: at the default 8 cells of 40 m, Perlin–Worley billows of 80 m (R, G) down
+to 20 m (A) and detail cells of 20, 10 and 5 m), ``strength`` (0..1, 0 = d itself) and, as the define
 ``DETAIL_OCTAVES`` (:func:`detail_defines`), ``detail_octaves`` (0..3: 0 no read, 1 and 2 one RGBA8
 3D read per call, 3 two). The wind (m/s) and the time (s) scroll both textures.
 """
@@ -33,11 +33,12 @@ PERLIN_GAIN = 1.5            # Perlin FBM -> [0, 1]: clamp(0.5 + 0.5 GAIN fbm)
 DETAIL_RATIO = 8             # base tile / detail tile
 PW_RANGE = (0.45, 0.85)      # stored channels: clamp((v - lo) / (hi - lo)) of the raw noise, so the
 WORLEY_RANGE = (0.2, 0.75)   # 8 bits and the erosion thresholds span [0, 1] (~0.5 % clipped each end)
-COVERAGE = 0.3              # detail.glsl's K: densities at or above it are a cloud's body, never eroded
+COVERAGE = 0.6              # detail.glsl's K: densities at or above it are a cloud's body, never eroded
 BAND_STRENGTH = 0.5          # the detail band (octave 3) erodes by BAND_STRENGTH × detail_strength
+BAND_WIDTH = 0.25            # W: at full strength the shape band remaps coverage e..e + W to 0..1
 BASE_LAYOUT = (0, 4, (4, 8, 16))     # (texture index, Perlin frequency, Worley FBM frequencies)
 DETAIL_LAYOUT = (1, 0, (2, 4, 8))    # Perlin frequency 0: no Perlin–Worley; A = 1
-BASE_UNIT, DETAIL_UNIT = 6, 7        # texture units bind() uses
+BASE_UNIT, DETAIL_UNIT = 12, 13      # texture units bind() uses (5..8: the far field's octaves)
 SIZES = (4, 8, 16, 32, 64, 128, 256)
 
 _CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()   # GpuContext -> {(sizes, seed): textures}
@@ -48,6 +49,11 @@ def detail_offsets(time: float, wind, scale: float) -> tuple[np.ndarray, np.ndar
     (so the shader's coordinates keep their precision however long the game runs)."""
     shift = np.asarray(wind, np.float64) * float(time) / float(scale)
     return shift % 1.0, (shift * DETAIL_RATIO) % 1.0
+
+
+def band_width(strength: float) -> float:
+    """w = 1 - (1 - BAND_WIDTH) strength: the width the shape band remaps (1 at strength 0: d itself)."""
+    return 1.0 - (1.0 - BAND_WIDTH) * float(strength)
 
 
 def detail_defines(octaves: int) -> dict:
@@ -117,20 +123,20 @@ class DetailNoise:
             raise
         return tuple(made)
 
-    def bind(self, program, time: float, wind, settings, layer=(0.0, 1.0)) -> None:
-        """Bind ``base`` to unit 6 and ``detail`` to unit 7 and set the uniforms of ``detail.glsl``
+    def bind(self, program, time: float, wind, scale: float, strength: float, layer=(0.0, 1.0)) -> None:
+        """Bind ``base`` to unit 12 and ``detail`` to unit 13 and set the uniforms of ``detail.glsl``
         that ``program`` has (a compiler drops unused ones): the scroll of ``wind`` (m/s, 3 numbers)
-        over ``time`` (s), ``settings.detail_scale``, ``settings.detail_strength`` and ``layer``, the
+        over ``time`` (s), the base tile ``scale`` (m), the ``strength`` (0..1) and ``layer``, the
         layer's (base y, height) in m (the height gradient)."""
         self.base.use(BASE_UNIT)
         self.detail.use(DETAIL_UNIT)
-        offset_base, offset_fine = detail_offsets(time, wind, settings.detail_scale)
+        offset_base, offset_fine = detail_offsets(time, wind, scale)
+        strength = float(strength)
         for name, value in (("detail_base_noise", BASE_UNIT), ("detail_fine_noise", DETAIL_UNIT),
                             ("detail_offset_base", tuple(offset_base)), ("detail_offset_fine", tuple(offset_fine)),
-                            ("detail_inv_scale", 1.0 / settings.detail_scale),
-                            ("detail_inv_scale_fine", DETAIL_RATIO / settings.detail_scale),
-                            ("detail_strength", float(settings.detail_strength)),
-                            ("detail_band_strength", BAND_STRENGTH * settings.detail_strength),
+                            ("detail_inv_scale", 1.0 / scale), ("detail_inv_scale_fine", DETAIL_RATIO / scale),
+                            ("detail_strength", strength), ("detail_band_strength", BAND_STRENGTH * strength),
+                            ("detail_band_width", band_width(strength)),
                             ("detail_layer", (float(layer[0]), 1.0 / max(float(layer[1]), 1e-6))),
                             ("detail_coverage", COVERAGE)):
             member = program.get(name, None)

@@ -23,19 +23,23 @@ from atmos.camera import set_camera_uniforms
 from atmos.composition import CLOUD_DISTANCE, composition, distance_desc
 from atmos.graph import PassBuilder, PassContext, RenderPass, TextureDesc
 from atmos.plugin import Plugin
-from atmos.plugins.cloud_raymarch.settings import RaymarchCloudSettings
+from atmos.plugins.cloud_far_field.layer import FAR_FIELD
+from atmos.plugins.cloud_far_field.plugin import CloudFarFieldPlugin
+from atmos.plugins.cloud_raymarch.far import far_uniforms
+from atmos.plugins.cloud_raymarch.settings import REFERENCE, RaymarchCloudSettings
 from atmos.plugins.cloud_raymarch.temporal import TemporalClouds, jitter
 from atmos.plugins.cloud_render.binding import bind_volume, clamp_sampler, unbind_volume
 from atmos.plugins.cloud_render.light import unit_direction
 from atmos.plugins.cloud_render.offscreen import OffscreenClouds, low_size
-from atmos.plugins.clouds.sets import CLOUD_SETS, CloudSets
+from atmos.plugins.clouds.sets import CLOUD_SETS, CLOUD_VOLUME, CloudSets
 from atmos.plugins.clouds.simulation import CloudSimulation
 from atmos.render_core import COLOR, DEPTH
 
 LOW_COLOR = "cloud_raymarch_color"
 LOW_DISTANCE = "cloud_raymarch_distance"
 LOW_DEPTH = "cloud_raymarch_depth"
-SKIP_UNIT, DEPTH_UNIT = 4, 5
+SKIP_UNIT, DEPTH_UNIT = 4, 9              # (5..8: the far field's octaves, field.glsl)
+SUN_SPACING = 0.5        # cells between the sun_steps detail samples (a billow is ~2 cells across)
 
 
 def skip_map(max_maps: np.ndarray) -> np.ndarray:
@@ -67,8 +71,15 @@ class RaymarchCloudsPlugin(Plugin):
 
     def __init__(self, settings: RaymarchCloudSettings | None = None, **fields):
         super().__init__(settings, **fields)
-        self.gpu = self.composition = None
+        self.gpu = self.composition = self.far = None
         self.simulated = False
+
+    @classmethod
+    def reference(cls, **fields) -> "RaymarchCloudsPlugin":
+        """The march in the reference configuration (:data:`.settings.REFERENCE`: full resolution,
+        uniform quarter-cell midpoint steps, no noise, jitter, history or early exit); ``fields``
+        change any setting (e.g. ``step=0.1``, ``enabled=False``, ``base_altitude``)."""
+        return cls(**{**REFERENCE, **fields})
 
     def build(self, app) -> None:
         if app.graph is None:
@@ -80,10 +91,22 @@ class RaymarchCloudsPlugin(Plugin):
 
     def finish(self, app) -> None:
         self.simulated = app.get_resource(CloudSimulation) is not None     # weather-driven, not static
+        self.far = next((p for p in app.plugins if isinstance(p, CloudFarFieldPlugin)), None)
+        if self.far is not None:
+            self.far.marchers.add(self)     # its 2D pass steps aside while this marches the far field
+
+    def marches_far_field(self) -> bool:
+        """Whether the march goes on through the volumetric far field (``far_field`` on, enabled, and a
+        CloudFarFieldPlugin, whose cover it uses, in the scene and enabled)."""
+        s = self.settings
+        return bool(s.enabled and s.far_field and self.far is not None and self.far.settings.enabled)
 
     def cleanup(self, app) -> None:
         if self.composition is not None:
             self.composition.writers.discard(RaymarchPass.name)
+        if self.far is not None:
+            self.far.marchers.discard(self)
+            self.far = None
 
     def sigma_t(self, sim: CloudSets) -> float:
         """Extinction in 1/m at density 1: the medium's."""
@@ -101,6 +124,7 @@ class RaymarchPass(RenderPass):
     """Pass "cloud_raymarch"; see the module docstring. ``enabled`` False: declares nothing (culled)."""
     name = "cloud_raymarch"
     phase = "translucent"
+    exclusive = CLOUD_VOLUME                # never on beside the sprites (a GraphError names both)
 
     def __init__(self, plugin: RaymarchCloudsPlugin):
         self.plugin = plugin
@@ -114,6 +138,8 @@ class RaymarchPass(RenderPass):
             return
         builder.read(DEPTH)
         builder.read(CLOUD_SETS)
+        if self.plugin.marches_far_field():
+            builder.read(FAR_FIELD)
         builder.read(COLOR)                 # blends onto it
         builder.write(COLOR)
         if self.plugin.composition.distance:
@@ -131,13 +157,13 @@ class RaymarchPass(RenderPass):
         self.offscreen = OffscreenClouds(gpu, LOW_COLOR, LOW_DEPTH, LOW_DISTANCE)
         self.temporal = TemporalClouds(gpu)
 
-    @property
-    def program(self):
-        """The variant for the detail octaves and sun steps (the program cache: a dict lookup)."""
+    def program(self, far: bool = False):
+        """The variant for the detail octaves, sun steps and far field (the program cache: a dict lookup)."""
         s = self.plugin.settings
         return self.gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="cloud_raymarch/march.frag",
                                 defines={"DETAIL_OCTAVES": s.detail_octaves,
-                                         "SUN_STEPS": s.sun_steps if s.detail_octaves else 0})
+                                         "SUN_STEPS": s.sun_steps if s.detail_octaves else 0,
+                                         "FAR_FIELD": int(far)})
 
     def _skip_texture(self, sim: CloudSets):
         """The dilated skip map as a small r32f 3D texture, re-uploaded when the max maps change."""
@@ -170,7 +196,7 @@ class RaymarchPass(RenderPass):
                 "skip_cells": skip_cells, "max_skips": int(sum(grid)) + 3, "factor": s.resolution,
                 "sample_offset": tuple(offset), "frame_size": tuple(int(v) for v in view.size),
                 "jitter": int(s.jitter), "frame_index": self.frame_index % 64,
-                "sun_march": tuple(float(v) for v in sun * cell.min())}
+                "sun_march": tuple(float(v) for v in sun * SUN_SPACING * cell.min())}
 
     def execute(self, frame: PassContext) -> None:
         s, view = self.plugin.settings, frame.view
@@ -178,7 +204,8 @@ class RaymarchPass(RenderPass):
         r = s.resolution
         offset = sample_offset(self.frame_index, r) if r > 1 else (0, 0)
         distance = frame.declares(CLOUD_DISTANCE)
-        p = self.program
+        far = frame.declares(FAR_FIELD)
+        p = self.program(far)
         if r == 1:                          # straight onto the frame
             frame.framebuffer(color=[COLOR, CLOUD_DISTANCE] if distance else [COLOR]).use()
             frame.blend_over()
@@ -196,10 +223,12 @@ class RaymarchPass(RenderPass):
         else:                               # nothing uploaded; the shader reads no skip map
             self._release_skip()
         frame.resource(DEPTH).use(DEPTH_UNIT)
+        if far:
+            self._bind_far(frame, p, sim)
         if s.detail_octaves:
             layout = sim.layout(s.base_altitude)
-            self._detail().bind(p, view.time, self.plugin.wind(sim), s,
-                                layer=(float(layout.lo[1]), float(layout.hi[1] - layout.lo[1])))
+            self._detail().bind(p, view.time, self.plugin.wind(sim), s.detail_scale * float(np.min(layout.cell)),
+                                s.detail_strength, layer=(float(layout.lo[1]), float(layout.hi[1] - layout.lo[1])))
         try:
             frame.fullscreen(p)
         finally:
@@ -211,6 +240,17 @@ class RaymarchPass(RenderPass):
         else:
             self.temporal.release()         # no history at full resolution
         self.frame_index += 1
+
+    def _bind_far(self, frame: PassContext, p, sim: CloudSets) -> None:
+        """The far field's textures, cover and uniforms (field.glsl, far.glsl) for this frame."""
+        view, s = frame.view, self.plugin.settings
+        layer = frame.resource(FAR_FIELD)
+        layer.prepare(view, sim)
+        layer.use(p, view, sim)
+        values = far_uniforms(s, layer.settings, sim.layout(s.base_altitude), view, unit_direction(view.sun))
+        for name, value in values.items():
+            if name in p:
+                p[name].value = value
 
     def _detail(self):
         from atmos.plugins.cloud_raymarch.noise import DetailNoise
@@ -227,7 +267,7 @@ class RaymarchPass(RenderPass):
             return self.temporal.resolve(frame.resource(low_color), frame.resource(low_distance), view.size,
                                          self.plugin.settings.resolution, offset, camera, view.aspect,
                                          depth=frame.resource(DEPTH), history_clamp=s.history_clamp,
-                                         motion_limit=s.motion_limit)
+                                         motion_limit=s.motion_limit, low_depth=frame.resource(LOW_DEPTH))
         self.temporal.release()
         self.offscreen.end(frame, self.plugin.settings.resolution, camera.near, camera.far,
                            frame.declares(CLOUD_DISTANCE), offset=offset)

@@ -48,27 +48,40 @@ def march_reference(density, transmittance, medium, settings, layout, camera, su
     sun_color, ambient = sun_light(sun)
     sun_dir = unit_direction(sun)
     column_tau = medium.sigma_t * cell[1]
+
+    def sample(i, p):
+        uvw = (p - lo) / extent
+        T = multilinear(trans_volume, uvw * tshape - 0.5)
+        up, down = column_depth(d, uvw, column_tau, trans_volume.shape)
+        return multilinear(d, uvw * shape - 0.5), source_reference(
+            medium, settings, T, up, down, dirs[i] @ sun_dir, dirs[i][:, 1], sun_color, ambient, sun_dir)
+
+    return integrate(pos, dirs, enter, leave, settings.steps, step_base, settings.step_growth,
+                     settings.min_transmittance, medium.sigma_t, sample, (h, w))
+
+
+def integrate(pos, dirs, enter, leave, steps, step_base, growth, min_transmittance, sigma_t, sample, shape) -> dict:
+    """The march both references share: per ray from ``enter`` to ``leave``, steps ``step_base +
+    growth · s`` with a midpoint sample, ``sample(rays, points) -> (density, J)``, stopped below
+    ``min_transmittance`` or after ``steps``. Returns ``light`` (h, w, 3), ``alpha`` (h, w) and
+    ``distance`` (h, w): a·distance."""
     light, trans, weighted = np.zeros((len(enter), 3)), np.ones(len(enter)), np.zeros(len(enter))
     s = enter.copy()
     live = leave > enter
-    for _ in range(settings.steps):
+    for _ in range(steps):
         if not live.any():
             break
         i = np.flatnonzero(live)
-        dt = np.minimum(step_base + settings.step_growth * s[i], leave[i] - s[i])
+        dt = np.minimum(step_base + growth * s[i], leave[i] - s[i])
         sp = s[i] + 0.5 * dt
         s[i] += dt
-        uvw = (pos + dirs[i] * sp[:, None] - lo) / extent
-        rho = multilinear(d, uvw * shape - 0.5)
-        a = 1.0 - np.exp(-medium.sigma_t * rho * dt)
-        T = multilinear(trans_volume, uvw * tshape - 0.5)
-        up, down = (column_depth(d, uvw, k, column_tau) for k in (1.0, -1.0))
-        J = source_reference(medium, settings, T, up, down, dirs[i] @ sun_dir, dirs[i][:, 1], sun_color,
-                             ambient, sun_dir)
+        rho, J = sample(i, pos + dirs[i] * sp[:, None])
+        a = 1.0 - np.exp(-sigma_t * rho * dt)
         wgt = trans[i] * a
         light[i] += wgt[:, None] * J
         weighted[i] += wgt * sp
         trans[i] *= 1.0 - a
-        live[i] = (s[i] < leave[i]) & (trans[i] >= settings.min_transmittance)
+        live[i] = (s[i] < leave[i]) & (trans[i] >= min_transmittance)
+    h, w = shape
     return {"light": light.reshape(h, w, 3), "alpha": (1.0 - trans).reshape(h, w),
             "distance": weighted.reshape(h, w)}

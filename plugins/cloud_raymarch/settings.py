@@ -10,6 +10,13 @@ from atmos.plugins.cloud_render.light import CloudLightSettings
 RESOLUTIONS = (1, 2, 4)
 MAX_STEPS = 4096
 MAX_SUN_STEPS = 16
+REFERENCE = dict(resolution=1, jitter=False, reprojection=False, detail_octaves=0, step=0.25, step_growth=0.0,
+                 steps=MAX_STEPS, min_transmittance=0.0)
+"""The reference configuration (:meth:`RaymarchCloudsPlugin.reference`): every pixel marched, one sample
+at the midpoint of every quarter-cell step to the layer's end or the scene depth (at most 4096 samples
+in occupied space), no detail noise, jitter, history or early exit; empty-space skipping stays on (it
+moves where the steps fall, nothing else). The image the sprites and the real-time settings are
+measured against."""
 
 
 @dataclass(frozen=True)
@@ -38,12 +45,27 @@ class RaymarchCloudSettings(CloudLightSettings):
     sparse samples miss flicker; free) and ``motion_limit`` (pixels per frame, > 0): history is mixed
     toward this frame's upsampled samples linearly, gone at this motion (smaller: less smear on fast
     turns, blurrier while moving; free); see :mod:`.temporal`. ``detail_octaves``: noise channels the density is eroded by (0 = off, 1..3; each one
-    two more texture fetches per sample), ``detail_scale`` (m per base-noise tile) and
+    two more texture fetches per sample), ``detail_scale`` (cells of the smallest side per base-noise tile, 0.5..1e4; 8: billows 2 cells
+    across; free) and
     ``detail_strength`` (0..1): see ``shaders/cloud_raymarch/detail.glsl``. ``sun_steps``: samples
     of the eroded-minus-smooth density toward the sun (0..16; 0 = the shading volume's transmittance
-    alone; each costs one detail lookup per sample). ``wind``: (x, y, z) m/s the detail noise
+    alone; each costs one density and one detail lookup per sample). Cost of the march at 640×360 on
+    llvmpipe (sunset demo, frame minus the frame without the march, one noisy run on shared cores):
+    resolution 1 octaves 0 244 ms, octaves 3 sun_steps 0 230 ms, octaves 3 sun_steps 4 951 ms (the
+    sun steps are the detail's cost); the defaults (resolution 2, reprojection, octaves 3, sun_steps 4)
+    218 ms. ``wind``: (x, y, z) m/s the detail noise
     scrolls with when the clouds have no weather (with one, the weather's wind). The
     multiple-scattering octaves ``ms_*``: :class:`~atmos.plugins.cloud_render.light.CloudLightSettings`.
+    ``far_field`` (with a CloudFarFieldPlugin in the scene; else no effect): march on beyond the
+    simulated volume through the layer's altitude band out to ``far_distance`` m (1e3..1e6) through a
+    volumetric far field (its cover, the same as the 2D far field's and the ground shadows', times a
+    vertical profile, eroded by the detail noise: ``shaders/cloud_raymarch/far.glsl``), cross-faded with
+    the volume over its edge fade; the 2D far-field pass is then culled. ``far_step_growth`` (0..1): the
+    step's growth with distance there (0.02 with 40 m cells: 70 m steps at 2.5 km, 420 m at 20 km;
+    halving it about doubles the far samples). Cost of the march pass with the far field over without
+    (which draws the 2D far-field pass instead), 640×360 llvmpipe, defaults, one noisy run on shared
+    cores: flight from 2.5 km 1.5× (380 vs 258 ms), from 320 m under the deck 2.0× (612 vs 298 ms:
+    grazing rays cross tens of km of layer), sunset from the ground 1.3× (273 vs 208 ms).
     ``enabled`` False declares nothing (the pass is culled, allocates nothing).
     """
     base_altitude: float | None = None
@@ -58,10 +80,13 @@ class RaymarchCloudSettings(CloudLightSettings):
     history_clamp: float = HISTORY_CLAMP
     motion_limit: float = MOTION_LIMIT
     detail_octaves: int = 3
-    detail_scale: float = 1000.0
+    detail_scale: float = 8.0
     detail_strength: float = 1.0
     sun_steps: int = 4
     wind: tuple = (10.0, 0.0, 0.0)
+    far_field: bool = True
+    far_distance: float = 60000.0
+    far_step_growth: float = 0.02
     enabled: bool = True
 
     def __post_init__(self):
@@ -83,10 +108,13 @@ class RaymarchCloudSettings(CloudLightSettings):
             history_clamp=check_num(o, "history_clamp", self.history_clamp, 0.0, 1.0),
             motion_limit=check_num(o, "motion_limit", self.motion_limit, 0.0, 1e4, lo_open=True),
             detail_octaves=check_int(o, "detail_octaves", self.detail_octaves, 0, 3),
-            detail_scale=check_num(o, "detail_scale", self.detail_scale, 1.0, 1e6),
+            detail_scale=check_num(o, "detail_scale", self.detail_scale, 0.5, 1e4),
             detail_strength=check_num(o, "detail_strength", self.detail_strength, 0.0, 1.0),
             sun_steps=check_int(o, "sun_steps", self.sun_steps, 0, MAX_SUN_STEPS),
             wind=check_vec(o, "wind", self.wind, 3),
+            far_field=check_bool(o, "far_field", self.far_field),
+            far_distance=check_num(o, "far_distance", self.far_distance, 1e3, 1e6),
+            far_step_growth=check_num(o, "far_step_growth", self.far_step_growth, 0.0, 1.0),
             enabled=check_bool(o, "enabled", self.enabled),
             **self.light_checks(),
         ))

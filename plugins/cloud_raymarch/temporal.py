@@ -8,12 +8,18 @@ per full-res pixel (``shaders/cloud_raymarch/temporal.frag``):
 * marched this frame → the fresh sample, exactly;
 * else the history, reprojected with the previous frame's camera: the ray's direction is projected
   first (sky at infinity), then the point at the distance the history holds there (camera + ray ·
-  distance); clamped to the box of the current 3×3 low-res neighbourhood (``history_clamp``), the
-  clamp loosened below ``CLAMP_MOTION`` pixels of motion where the block's fresh sample matches the
+  distance; where it holds no cloud, the scene's distance behind the pixel, so cloudless terrain
+  moves with the terrain instead of staying put as sky would — the flight demo's 2-pixel stripes); clamped to the box of the current 3×3 low-res neighbourhood (``history_clamp``), the
+  history first corrected by this frame's samples (the upsample's weights times fresh − history at
+  each sample, reprojected with this pixel's motion: history and fresh samples agree, no 2-pixel
+  pattern while moving), the clamp and the correction loosened below ``CLAMP_MOTION`` pixels of motion where the block's fresh sample matches the
   history there (``CHANGE_TOLERANCE``), so that a still camera over still clouds keeps every fresh
-  sample and converges to the full-res march in r² frames, while clouds that move are clamped; rejected, falling back to the bilinear upsample of
-  this frame's samples, when its point was off screen or the scene behind the pixel changed
-  (``DEPTH_TOLERANCE``: an object moved in front, or away); and mixed toward the upsample the faster
+  sample and converges to the full-res march in r² frames, while clouds that move are clamped; rejected, falling back to the depth-aware upsample
+  of this frame's samples (``cloud_render/upsample.glsl``, shared with OffscreenClouds' composite), when its point was off screen or the scene behind the pixel changed
+  (``DEPTH_TOLERANCE``: an object moved in front, or away), or, under a still camera, where the
+block's fresh sample differs from the history by more than ``CHANGE_TOLERANCE`` (clouds drifting:
+all of it from the tolerance, none below half; the stale history is worse than the upsample at
+0.1–2 px/frame of drift); and mixed toward the upsample the faster
   the pixel moves (weight 1 − motion / ``motion_limit``, motion in full-res pixels per frame).
 
 The output (premultiplied colour RGBA16F, (a·distance, a) RG32F as in :mod:`atmos.composition`) is
@@ -22,7 +28,8 @@ reference is :mod:`.temporal_reference`.
 
 Knobs and their cost (the resolve itself is one fullscreen pass: 1 fresh + 4 bilinear + 9
 neighbourhood fetches of the low-res targets, 2 × 4 bilinear history fetches, 2 depth fetches, each
-pixel; 28 bytes of history per pixel, twice):
+pixel, plus 4 × 2 × 4 for the correction while moving: 1.43× the resolve without it, 640×360 r 2 on
+llvmpipe; 28 bytes of history per pixel, twice):
 
 * ``reprojection`` (the plugin's): off → no history (the upsample alone, which blurs at r > 1);
   on → r² frames to converge when still, a ghost after fast motion bounded by the clamp.
@@ -40,6 +47,7 @@ import moderngl
 import numpy as np
 
 from atmos.camera import camera_matrices, gl_matrix
+from atmos.plugins.cloud_render.offscreen import EDGE
 
 RESOLUTIONS = (1, 2, 4)
 HISTORY_CLAMP = 1.0        # default clamp weight of moving history (0..1)
@@ -47,6 +55,8 @@ MOTION_LIMIT = 16.0        # default pixels of motion per frame at which history
 CLAMP_MOTION = 1.0         # pixels of motion per frame below which the clamp is loosened linearly to 0 ...
 CHANGE_TOLERANCE = 0.02    # ... unless this frame's sample differs from the history by more (alpha, relative rgb)
 DEPTH_TOLERANCE = 0.1      # relative change of the scene distance behind a pixel that rejects its history
+CUT_DISTANCE = 100.0       # m the camera moves in one frame that make a camera cut (history reset) ...
+CUT_TURN = math.radians(30.0)   # ... or radians its view direction turns
 ALPHA_EPS = 1e-4           # coverage below which a (a·d, a) pair holds no distance (sky at infinity)
 
 _UNITS = ("low_color", "low_distance", "hist_color", "hist_distance", "hist_scene", "scene_depth")
@@ -94,14 +104,21 @@ def camera_state(camera, aspect: float) -> tuple:
             float(camera.roll), float(camera.fov_y), float(camera.near), float(camera.far))
 
 
+def forward_of(camera) -> np.ndarray:
+    """The unit view direction of ``camera`` (what :meth:`TemporalClouds.is_cut` compares)."""
+    f = np.asarray(camera.forward(), np.float64)
+    return f / max(float(np.linalg.norm(f)), 1e-30)
+
+
 class TemporalClouds:
     """Full-resolution cloud history of one pass on ``gpu``: ping-pong colour (RGBA16F), distance
     (RG32F, (a·d, a)) and the scene distance behind each pixel (R32F), made at the first resolve,
     remade (and so reset) when the size or r changes, kept across frames, freed by :meth:`release`.
 
     Per frame: ``offset = temporal.offset(r)`` (march with it), then :meth:`resolve`. The previous
-    frame's camera is the one the last resolve was given (kept as a snapshot). :meth:`reset` after a
-    camera cut (the next frame uses no history).
+    frame's camera is the one the last resolve was given (kept as a snapshot). The history resets by
+    itself on a camera cut (:meth:`is_cut`: more than :data:`CUT_DISTANCE` m or :data:`CUT_TURN` in
+    one frame) and when the size or r changes; :meth:`reset` forgets it by hand.
     """
 
     def __init__(self, gpu):
@@ -120,16 +137,25 @@ class TemporalClouds:
         """This frame's jitter offset (:func:`jitter` of the frame counter)."""
         return jitter(self.frame_index, r)
 
+    @staticmethod
+    def is_cut(camera, prev_position, prev_forward) -> bool:
+        """Whether ``camera`` jumped since the last resolve: moved more than :data:`CUT_DISTANCE` m
+        or turned its view more than :data:`CUT_TURN` (a teleport or a cut; reprojecting would smear)."""
+        moved = float(np.linalg.norm(np.asarray(camera.position, np.float64) - prev_position))
+        cos = float(np.clip(np.dot(forward_of(camera), prev_forward), -1.0, 1.0))
+        return not (moved <= CUT_DISTANCE and math.acos(cos) <= CUT_TURN)
+
     def reset(self) -> None:
         """Forget the history (a camera cut): the next resolve uses this frame's samples alone."""
         self._valid = False
 
     def resolve(self, low_color, low_distance, size, r: int, offset, camera, aspect: float, depth=None,
-                history_clamp: float = HISTORY_CLAMP, motion_limit: float = MOTION_LIMIT):
+                history_clamp: float = HISTORY_CLAMP, motion_limit: float = MOTION_LIMIT, low_depth=None):
         """Resolve this frame at full-res ``size`` (w, h) from the low-res ``low_color`` (RGBA
         premultiplied) and ``low_distance`` ((a·d, a)) textures marched at ``offset`` with divisor
         ``r``, seen by ``camera`` at ``aspect``; ``depth``: the scene's depth texture at ``size``
-        (None: nothing but sky). Returns (color, distance) full-res textures, valid until the next
+        (None: nothing but sky); ``low_depth``: the depth each sample's ray saw (low-res; with ``depth``
+        the upsample is depth-aware, :data:`~atmos.plugins.cloud_render.offscreen.EDGE`). Returns (color, distance) full-res textures, valid until the next
         resolve (they are the history it reads)."""
         r = check_resolution(r)
         size = (int(size[0]), int(size[1]))
@@ -143,6 +169,8 @@ class TemporalClouds:
                                  f"got {tex.size[0]}x{tex.size[1]}")
         if depth is not None and tuple(depth.size) != size:
             raise ValueError(f"TemporalClouds.resolve: depth must be {size[0]}x{size[1]}, got {depth.size}")
+        if low_depth is not None and tuple(low_depth.size) != low:
+            raise ValueError(f"TemporalClouds.resolve: low_depth must be {low[0]}x{low[1]}, got {low_depth.size}")
         if not 0.0 <= history_clamp <= 1.0 or not motion_limit > 0.0:
             raise ValueError(f"TemporalClouds.resolve: history_clamp must be in [0, 1] and motion_limit > 0, "
                              f"got {history_clamp!r}, {motion_limit!r}")
@@ -158,10 +186,11 @@ class TemporalClouds:
         self._set(p, "r", r)
         self._set(p, "offset", (int(ox), int(oy)))
         self._set(p, "has_depth", depth is not None)
-        valid = self._valid and self._prev is not None
+        self._set(p, "edge", EDGE if depth is not None and low_depth is not None else 1e30)
+        valid = self._valid and self._prev is not None and not self.is_cut(camera, self._prev[2], self._prev[3])
         self._set(p, "history_valid", valid)
         if valid:
-            prev_state, prev_matrices, prev_position = self._prev
+            prev_state, prev_matrices, prev_position, _ = self._prev
             proj, view = prev_matrices.projection, prev_matrices.view
             self._set(p, "still", state == prev_state)
             self._set(p, "detect_change", detects_change(self.still_frames + 1, r) if state == prev_state else False)
@@ -173,6 +202,7 @@ class TemporalClouds:
             tex.use(unit)
         if depth is not None:
             depth.use(5)
+        (low_depth if low_depth is not None else low_color).use(6)     # unit 6 read only at edge < 1e30
         ctx = self.gpu.ctx
         write[0].use()
         ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST | moderngl.CULL_FACE)
@@ -182,7 +212,7 @@ class TemporalClouds:
         self._current = 1 - self._current
         self.still_frames = self.still_frames + 1 if valid and state == self._prev[0] else 0
         self._valid = True
-        self._prev = (state, matrices, np.array(camera.position, np.float64))
+        self._prev = (state, matrices, np.array(camera.position, np.float64), forward_of(camera))
         self.frame_index += 1
         return write[1], write[2]
 

@@ -11,7 +11,10 @@ import numpy as np
 
 from atmos.camera import Camera, view_basis
 
-from .temporal import ALPHA_EPS, CHANGE_TOLERANCE, CLAMP_MOTION, DEPTH_TOLERANCE, HISTORY_CLAMP, MOTION_LIMIT, camera_state, detects_change
+from atmos.plugins.cloud_render.offscreen import EDGE
+from atmos.plugins.cloud_render.offscreen_reference import inv_depth, upsample_weights
+
+from .temporal import ALPHA_EPS, TemporalClouds, forward_of, CHANGE_TOLERANCE, CLAMP_MOTION, DEPTH_TOLERANCE, HISTORY_CLAMP, MOTION_LIMIT, camera_state, detects_change
 
 
 def bilinear(image: np.ndarray, px: np.ndarray, py: np.ndarray) -> np.ndarray:
@@ -49,13 +52,14 @@ def _rays(camera, aspect: float, size) -> np.ndarray:
 
 def resolve_reference(history, low_color, low_distance, depth, size, r: int, offset, camera, prev, aspect: float,
                       history_clamp: float = HISTORY_CLAMP, motion_limit: float = MOTION_LIMIT,
-                      detect_change: bool = False):
+                      detect_change: bool = False, low_depth=None):
     """One resolve at full-res ``size`` (w, h). ``history``: None (no valid history) or (color (h, w, 4),
     distance (h, w, 2), scene distance (h, w)) of the previous frame; ``low_color`` (lh, lw, 4),
     ``low_distance`` (lh, lw, 2): this frame's samples at full-res pixels (i·r + ox, j·r + oy);
     ``depth``: the window-space scene depth (h, w) or None; ``prev``: (camera, aspect) of the
     history's frame; ``detect_change``: :func:`.temporal.detects_change` of the frames the camera
-    has been still. Returns (color, distance, scene distance): the frame and the next history."""
+    has been still; ``low_depth``: the window depth each sample's ray saw (lh, lw), with ``depth``
+    making the upsample depth-aware. Returns (color, distance, scene distance): the frame and the next history."""
     lh, lw = low_color.shape[:2]
     w, h = size
     ox, oy = offset
@@ -64,22 +68,26 @@ def resolve_reference(history, low_color, low_distance, depth, size, r: int, off
 
     # this frame's samples upsampled (bilinear in the low-res grid) and their 3x3 neighbourhood box
     lx, ly = (x - ox) / r, (y - oy) / r
-    up_c, up_d = bilinear(low_color, lx, ly), bilinear(low_distance, lx, ly)
+    aware = depth is not None and low_depth is not None
+    pixel_inv = inv_depth(depth if depth is not None else np.ones((h, w)), camera.near, camera.far)
+    taps = upsample_weights(low_depth if aware else np.ones((lh, lw)), lx, ly, pixel_inv, camera.near, camera.far,
+                            EDGE if aware else 1e30)
+    both = np.concatenate([low_color, low_distance], axis=-1)
+    up = sum(weight[..., None] * both[ty, tx] for tx, ty, weight in taps)
     cx = np.clip(np.floor(lx + 0.5), 0, lw - 1).astype(np.int64)
     cy = np.clip(np.floor(ly + 0.5), 0, lh - 1).astype(np.int64)
-    both = np.concatenate([low_color, low_distance], axis=-1)
     neigh = np.stack([both[np.clip(cy + j, 0, lh - 1), np.clip(cx + i, 0, lw - 1)]
                       for j in (-1, 0, 1) for i in (-1, 0, 1)])
     lo, hi = neigh.min(axis=0), neigh.max(axis=0)
 
-    out = np.concatenate([up_c, up_d], axis=-1)
+    out = up
     if history is not None:
         hist = np.concatenate([history[0], history[1]], axis=-1)
         prev_camera, prev_aspect = prev
         if camera_state(camera, aspect) == camera_state(prev_camera, prev_aspect):
             qx, qy, inside = x, y, np.ones((h, w), bool)
         else:
-            qx, qy, inside = _reproject(history[1], camera, prev_camera, prev_aspect, aspect, size)
+            qx, qy, inside = _reproject(history[1], camera, prev_camera, prev_aspect, aspect, size, scene)
         motion = np.hypot(qx - x, qy - y)
         sampled = bilinear(hist, qx, qy)
         # disocclusion: the scene behind this pixel is not the one the history saw there
@@ -99,10 +107,15 @@ def resolve_reference(history, low_color, low_distance, depth, size, r: int, off
         scale = np.maximum(hi[..., :3].max(axis=-1), 1e-3)
         change = np.maximum(np.abs(now[..., 3] - predicted[..., 3]),
                             np.abs(now[..., :3] - predicted[..., :3]).max(axis=-1) / scale) * detect_change
-        clamp_w = (history_clamp * np.maximum(np.minimum(motion / CLAMP_MOTION, 1.0),
-                                              np.minimum(change / CHANGE_TOLERANCE, 1.0)))[..., None]
+        moved = np.maximum(np.minimum(motion / CLAMP_MOTION, 1.0), np.minimum(change / CHANGE_TOLERANCE, 1.0))[..., None]
+        # the history corrected by this frame's samples: (fresh - history at the sample, moved like this pixel)
+        correction = sum(weight[..., None] * (both[ty, tx] - bilinear(hist, tx * r + ox + (qx - x), ty * r + oy + (qy - y)))
+                         for tx, ty, weight in taps)
+        sampled = sampled + moved * correction
+        clamp_w = history_clamp * moved
         sampled = sampled + clamp_w * (np.clip(sampled, lo, hi) - sampled)
-        keep = np.where(inside & same, np.clip(1.0 - motion / motion_limit, 0.0, 1.0), 0.0)[..., None]
+        trust = 1.0 - np.clip(2.0 * change / CHANGE_TOLERANCE - 1.0, 0.0, 1.0)     # drifting clouds: the upsample
+        keep = np.where(inside & same, trust * np.clip(1.0 - motion / motion_limit, 0.0, 1.0), 0.0)[..., None]
         out = out + keep * (sampled - out)
 
     fresh = ((x - ox) % r == 0) & ((y - oy) % r == 0)
@@ -112,9 +125,10 @@ def resolve_reference(history, low_color, low_distance, depth, size, r: int, off
     return out[..., :4], out[..., 4:], scene
 
 
-def _reproject(hist_distance, camera, prev_camera, prev_aspect, aspect, size):
+def _reproject(hist_distance, camera, prev_camera, prev_aspect, aspect, size, scene):
     """Where each pixel's cloud was in the previous frame (texel-centre coordinates) and whether it
-    was on screen: first by direction (sky at infinity), then at the distance the history holds there."""
+    was on screen: first by direction (sky at infinity), then at the distance the history holds there,
+    or where it holds no cloud at the ``scene`` distance (h, w) behind the pixel (−1: sky, stays at infinity)."""
     w, h = size
     rays = _rays(camera, aspect, size)
     dirs = rays / np.linalg.norm(rays, axis=-1, keepdims=True)
@@ -130,8 +144,10 @@ def _reproject(hist_distance, camera, prev_camera, prev_aspect, aspect, size):
 
     qx, qy, front = project(np.concatenate([dirs, np.zeros((h, w, 1))], axis=-1))
     ad = bilinear(hist_distance, qx, qy)
-    has = front & (ad[..., 1] > ALPHA_EPS)
-    d = np.where(has, ad[..., 0] / np.where(has, ad[..., 1], 1.0), 0.0)
+    cloud = ad[..., 1] > ALPHA_EPS
+    d = np.where(cloud, ad[..., 0] / np.where(cloud, ad[..., 1], 1.0), scene)
+    has = front & (d > 0)
+    d = np.where(has, d, 0.0)
     points = np.asarray(camera.position) + dirs * d[..., None]
     px, py, pfront = project(np.concatenate([points, np.ones((h, w, 1))], axis=-1))
     qx, qy = np.where(has, px, qx), np.where(has, py, qy)
@@ -142,7 +158,7 @@ def _reproject(hist_distance, camera, prev_camera, prev_aspect, aspect, size):
 
 class ReferenceHistory:
     """The reference's history across frames, reset like :class:`.temporal.TemporalClouds` (on a
-    resolution change; ``history = None`` by hand for a cut)."""
+    resolution change and a camera cut; ``history = None`` by hand)."""
 
     def __init__(self, size):
         self.size = tuple(size)
@@ -150,7 +166,8 @@ class ReferenceHistory:
         self.still_frames = 0
 
     def resolve(self, low_color, low_distance, depth, r, offset, camera, aspect, **knobs):
-        if r != self.r:
+        if r != self.r or (self.prev is not None and TemporalClouds.is_cut(camera, np.asarray(self.prev[0].position, np.float64),
+                                                                           forward_of(self.prev[0]))):
             self.history, self.r = None, r
         still = self.history is not None and camera_state(camera, aspect) == camera_state(*self.prev)
         self.still_frames = self.still_frames + 1 if still else 0

@@ -6,8 +6,9 @@ import moderngl
 from atmos.lighting import Sun
 from atmos.plugins.cloud_render.light import DEFAULT_OCTAVES, light_uniforms
 from atmos.plugins.clouds.sets import CloudSets
+from atmos.shading.columns import COLUMNS
 
-UNITS = (0, 1, 2, 3)        # density_a, density_b, trans_a, trans_b
+UNITS = (0, 1, 2, 3, 10, 11)   # density, transmittance, columns (each a, b)
 
 
 def clamp_sampler(ctx: moderngl.Context):
@@ -17,7 +18,7 @@ def clamp_sampler(ctx: moderngl.Context):
 
 def bind_volume(program, sim, sampler, sun: Sun | None, octaves=DEFAULT_OCTAVES) -> float:
     """Bind mix(A, B, t)'s textures (``sim``: the frame's CloudSets, or the CloudSimulation) to units
-    0..3 with ``sampler`` and set ``t``, ``a_shift`` (A drawn where it was computed), ``has_shading``
+    0..3 (density, transmittance) and 10, 11 (the light volume's columns) with ``sampler`` and set ``t``, ``a_shift`` (A drawn where it was computed), ``has_shading``
     and the light (:func:`light_uniforms` of the simulation's medium, the sun and the
     multiple-scattering ``octaves``); returns t. Call
     :func:`unbind_volume` when the draw is done."""
@@ -28,6 +29,8 @@ def bind_volume(program, sim, sampler, sun: Sun | None, octaves=DEFAULT_OCTAVES)
     light = "transmittance" if shading else "density"      # without shading: a placeholder, unread
     a[light].use(2)
     b[light].use(3)
+    a[COLUMNS].use(10)
+    b[COLUMNS].use(11)
     for unit in UNITS:
         sampler.use(unit)
     program["t"].value = float(t)
@@ -42,6 +45,6 @@ def bind_volume(program, sim, sampler, sun: Sun | None, octaves=DEFAULT_OCTAVES)
 
 
 def unbind_volume(sampler) -> None:
-    """Unbind the sampler from units 0..3 so later passes sample with their textures' own settings."""
+    """Unbind the sampler from the volume's units so later passes sample with their textures' own settings."""
     for unit in UNITS:
         sampler.clear(unit)

@@ -19,32 +19,41 @@ def far_depth(depth: np.ndarray, factor: int) -> np.ndarray:
     return padded.reshape(lh, factor, lw, factor).max(axis=(1, 3))
 
 
-def composite(clouds: np.ndarray, cloud_depth: np.ndarray, scene_depth: np.ndarray, factor: int,
-              near: float, far: float, edge: float = EDGE) -> np.ndarray:
-    """(h, w, 4) premultiplied clouds at full resolution: bilinear between the four nearest low-res
-    texels unless one's view depth differs from the pixel's by more than ``edge`` (relative), then
-    the texel nearest in depth (the first of equals, in the order (0,0), (1,0), (0,1), (1,1))."""
-    h, w = scene_depth.shape
-    lh, lw = cloud_depth.shape
-    inv = lambda d: (1.0 - d) / near + d / far          # 1 / view depth, linear in window depth
-    ys, xs = np.mgrid[0:h, 0:w]
-    px, py = (xs + 0.5) / factor - 0.5, (ys + 0.5) / factor - 0.5
+def upsample_weights(low_depth: np.ndarray, px: np.ndarray, py: np.ndarray, pixel_inv: np.ndarray,
+                     near: float, far: float, edge: float = EDGE):
+    """``cloud_render/upsample.glsl``: the four low-res texels around (px, py) (texel centres at
+    integers, clamped) as [(qx, qy, weight)], bilinear unless one's view depth differs from the
+    pixel's (``pixel_inv`` = 1 / view depth) by more than ``edge`` (relative); then weight 1 on the
+    texel nearest in depth (the first of equals, in the order (0,0), (1,0), (0,1), (1,1))."""
+    lh, lw = low_depth.shape
     x0, y0 = np.floor(px).astype(int), np.floor(py).astype(int)
     fx, fy = px - x0, py - y0
-    wp = inv(scene_depth.astype(np.float64))
-    total = np.zeros((h, w, 4))
-    nearest = np.zeros((h, w, 4))
-    best = np.full((h, w), np.inf)
-    is_edge = np.zeros((h, w), bool)
-    for ox, oy in ((0, 0), (1, 0), (0, 1), (1, 1)):
+    taps, best = [], np.full(px.shape, np.inf)
+    nearest = np.zeros(px.shape, int)
+    is_edge = np.zeros(px.shape, bool)
+    for k, (ox, oy) in enumerate(((0, 0), (1, 0), (0, 1), (1, 1))):
         qx, qy = np.clip(x0 + ox, 0, lw - 1), np.clip(y0 + oy, 0, lh - 1)
-        c = clouds[qy, qx].astype(np.float64)
-        wq = inv(cloud_depth[qy, qx].astype(np.float64))
-        rel = np.abs(wp - wq) / np.maximum(np.minimum(wp, wq), 1e-30)
-        weight = (fx if ox else 1 - fx) * (fy if oy else 1 - fy)
-        total += weight[..., None] * c
+        wq = inv_depth(low_depth[qy, qx].astype(np.float64), near, far)
+        rel = np.abs(pixel_inv - wq) / np.maximum(np.minimum(pixel_inv, wq), 1e-30)
         is_edge |= rel > edge
-        closer = rel < best
-        best = np.where(closer, rel, best)
-        nearest = np.where(closer[..., None], c, nearest)
-    return np.where(is_edge[..., None], nearest, total)
+        nearest = np.where(rel < best, k, nearest)
+        best = np.minimum(rel, best)
+        taps.append((qx, qy, (fx if ox else 1 - fx) * (fy if oy else 1 - fy)))
+    return [(qx, qy, np.where(is_edge, (nearest == k).astype(float), weight)) for k, (qx, qy, weight) in enumerate(taps)]
+
+
+def inv_depth(window_depth, near: float, far: float):
+    """1 / view depth, linear in window depth."""
+    return (1.0 - window_depth) / near + window_depth / far
+
+
+def composite(clouds: np.ndarray, cloud_depth: np.ndarray, scene_depth: np.ndarray, factor: int,
+              near: float, far: float, edge: float = EDGE) -> np.ndarray:
+    """(h, w, 4) premultiplied clouds at full resolution, depth-aware (:func:`upsample_weights`), the
+    low-res texels at the blocks' centres."""
+    h, w = scene_depth.shape
+    ys, xs = np.mgrid[0:h, 0:w]
+    px, py = (xs + 0.5) / factor - 0.5, (ys + 0.5) / factor - 0.5
+    wp = inv_depth(scene_depth.astype(np.float64), near, far)
+    return sum(weight[..., None] * clouds[qy, qx].astype(np.float64)
+               for qx, qy, weight in upsample_weights(cloud_depth, px, py, wp, near, far, edge))

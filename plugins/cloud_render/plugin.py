@@ -44,7 +44,7 @@ from atmos.plugins.cloud_render.light import CloudLightSettings
 from atmos.plugins.cloud_render.offscreen import MAX_DOWNSAMPLE, OffscreenClouds, low_size
 from atmos.plugins.clouds.layout import CloudLayout
 from atmos.plugins.cloud_render.segments import MAX_LEVEL, SegmentStats, select_segments, unpack
-from atmos.plugins.clouds.sets import CLOUD_SETS, CloudSets
+from atmos.plugins.clouds.sets import CLOUD_SETS, CLOUD_VOLUME, CloudSets
 from atmos.render_core import COLOR, DEPTH
 
 
@@ -164,6 +164,7 @@ class CloudSpritePass(RenderPass):
     onto "color" (with ``downsample`` > 1 through the low-res "cloud_color"/"cloud_depth" it creates)."""
     name = "cloud_render"
     phase = "translucent"
+    exclusive = CLOUD_VOLUME                # never on beside the ray march (a GraphError names both)
 
     def __init__(self, plugin: CloudRenderPlugin):
         self.plugin = plugin

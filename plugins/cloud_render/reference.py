@@ -5,7 +5,7 @@ its own shading resolution), the segments and the uniforms, it returns what ever
 (instance, vertex) outputs, instance-major like the GPU: the clip position (``CULLED`` for empty
 blocks and blocks past the edge), point size, the light (octave weights of the sun's transmittance
 averaged over 8 samples spread like the block's mass, the sky and ground light dimmed by the columns
-above and below: :mod:`atmos.shading.medium`), the world centre of mass and radius, centre optical depth and coverage; :func:`soft_fade` is the fragment's fade
+above and below, the light volume's columns (:mod:`atmos.shading.columns`): :mod:`atmos.shading.medium`), the world centre of mass and radius, centre optical depth and coverage; :func:`soft_fade` is the fragment's fade
 against the scene depth.
 """
 from __future__ import annotations
@@ -15,6 +15,9 @@ import numpy as np
 from atmos.plugins.cloud_render.particle import centre_tau, footprint
 from atmos.plugins.cloud_render.segments import unpack
 from atmos.shading.medium import ambient_profile, mean_cosine, octave_weights
+from atmos.shading.columns import column_reference, columns_at
+from atmos.shading.grid import SCALES
+from atmos.shading.grid import shading_shape as grid_shape
 from atmos.shading.reference import trilinear
 
 CULLED = np.array([0.0, 0.0, 2.0, 1.0])
@@ -50,20 +53,16 @@ def group_cells(group, level: int, camera) -> np.ndarray:
     return (np.stack([bx, bz], -1) * s).astype(np.int32)
 
 
-COLUMN_SAMPLES = 8
-
-
-def column_depth(density, uvw, direction: float, column_tau: float) -> np.ndarray:
-    """Optical depth from ``uvw`` (n, 3) straight up (1) or down (-1) to the volume's face: the
-    midpoint rule of ``volume.glsl`` on the clamp-to-edge trilinear density."""
-    shape = np.array(density.shape)
-    length = 1.0 - uvw[:, 1] if direction > 0 else uvw[:, 1]
-    total = np.zeros(len(uvw))
-    for i in range(COLUMN_SAMPLES):
-        q = uvw.copy()
-        q[:, 1] += direction * length * (i + 0.5) / COLUMN_SAMPLES
-        total += trilinear(density, q * shape - 0.5)
-    return column_tau * total * length * shape[1] / COLUMN_SAMPLES
+def column_depth(density, uvw, column_tau: float, shading_shape=None) -> tuple[np.ndarray, np.ndarray]:
+    """(tau_up, tau_down) at ``uvw`` (n, 3): ``volume.glsl``'s cloud_columns, the light volume's
+    columns (:func:`atmos.shading.columns.column_reference` at the scale whose grid is ``shading_shape``,
+    None: full resolution) sampled trilinearly, times ``column_tau``."""
+    shape = np.shape(density)
+    scale = next((s for s in SCALES if shading_shape is None or grid_shape(shape, s) == tuple(shading_shape)), None)
+    if scale is None:
+        raise ValueError(f"shading_shape {tuple(shading_shape)} is no shading grid of {shape} (scales {SCALES})")
+    c = column_tau * columns_at(column_reference(density, scale), uvw)
+    return c[:, 0], c[:, 1]
 
 
 def shifted(volume: np.ndarray, shift) -> np.ndarray:
@@ -122,8 +121,9 @@ def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, 
     g_mean = mean_cosine(*light["phase_lobes"])
     uvw = center / shape
     uvw_a = (center + shift) / shape
-    up, down = ((1.0 - t) * column_depth(a64, uvw_a, d, light["column_tau"]) +
-                t * column_depth(b64, uvw, d, light["column_tau"]) for d in (1.0, -1.0))
+    grid = None if trans_a is None else np.shape(trans_a)
+    (up_a, down_a), (up_b, down_b) = (column_depth(d, w, light["column_tau"], grid) for d, w in ((a64, uvw_a), (b64, uvw)))
+    up, down = (1.0 - t) * up_a + t * up_b, (1.0 - t) * down_a + t * down_b
     octaves = np.zeros((len(c), 4))
     for side in np.stack(np.meshgrid(*[(-1.0, 1.0)] * 3, indexing="ij"), -1).reshape(-1, 3):
         tap = center + side * spread

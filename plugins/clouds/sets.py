@@ -10,6 +10,7 @@ from atmos.plugins.clouds.density_maps import DensityMaps
 from atmos.plugins.clouds.layout import CloudLayout
 
 CLOUD_SETS = "cloud_sets"
+CLOUD_VOLUME = "cloud volume"   # RenderPass.exclusive of the passes that draw the volume: one renderer a frame
 
 
 @dataclass(frozen=True)

@@ -4,7 +4,8 @@ One simulation step = region volume (weather rules + ellipsoids rendered into th
 and its probabilities) → automaton step (driven by the region's probability texture, advected by
 the wind and by the volume's own motion) → smoothing (``smoothing_slices`` z ranges) → density
 maps (the same z ranges; the tiny max maps are copied into a pixel buffer once per step and read
-when the set is first drawn, frames later: no stall) → shading (inverse
+when the set is first drawn, frames later: no stall) → columns (the light volume's density integrals
+up and down, :mod:`atmos.shading.columns`, the same number of z ranges) → shading (inverse
 shear-warp transmittance toward the sun, a few light-space slices per job slice; optional). The frame scheduler runs
 a few slices per frame into set C while the renderer draws sets A and B interpolated; nothing but
 the max maps comes back to the CPU.
@@ -27,6 +28,7 @@ from atmos.plugins.clouds.density_maps import DensityMaps
 from atmos.plugins.clouds.layout import CloudLayout
 from atmos.plugins.clouds.sets import CloudSets
 from atmos.plugins.clouds.smoothing import FORMATS, WEIGHTS, Smoother, slice_range
+from atmos.shading.columns import COLUMNS, ColumnShader, ColumnTask, column_desc
 from atmos.shading.grid import check_scale, shading_shape
 from atmos.shading.medium import cell_sigma
 from atmos.shading.scattering import Scattering
@@ -162,6 +164,7 @@ class CloudSimulation:
     Readers use :meth:`view` (sets A and B, the interpolation factor) and :meth:`max_maps`
     (empty-space skipping); a set's ``["density"]`` is the smoothed density,
     ``["transmittance"]`` (with shading) the transmittance toward the sun at the shading scale,
+    ``["columns"]`` the light volume's column integrals (:mod:`atmos.shading.columns`) at that scale,
     and ``maps_of(set).sums`` the top-view sums (layer 0 all heights, then one per height band).
     """
 
@@ -187,7 +190,7 @@ class CloudSimulation:
             made.append(self.automaton)
             self.smoother = Smoother.for_automaton(self.automaton, s.radius, s.weights)
             made.append(self.smoother)
-            descs = {"density": TextureDesc(shape, 1, s.density_dtype)}
+            descs = {"density": TextureDesc(shape, 1, s.density_dtype), COLUMNS: column_desc(shape, s.shading_scale)}
             if s.shading:
                 descs["transmittance"] = TextureDesc(shading_shape(shape, s.shading_scale), 1, "f2")
                 self.shader = ShearWarpShader(gpu, shape, s.shading_scale)
@@ -213,6 +216,7 @@ class CloudSimulation:
             SliceTask("automaton", 1, self._automaton_slice),
             SliceTask("smoothing", n, self._smoothing_slice),
             SliceTask("density_maps", n, self._maps_slice),
+            ColumnTask(ColumnShader(gpu, shape, s.shading_scale), n),
         ]
         if s.shading:                  # sigma and scattering read when each step's shading begins
             tasks.append(ShadingTask(self.shader, self.sun_in_cells, lambda: self.settings.shading_sigma(self.sun()),

@@ -2,7 +2,7 @@
 
 The volume ``[x, y, z]`` is uploaded once into one texture set shown as both A and B (t = 0) and
 placed by :mod:`atmos.plugins.clouds.layout` at the current :class:`VolumeOrigin`; its density maps
-are computed once, its transmittance toward the sun again whenever the sun's direction or the
+and light-volume columns are computed once, its transmittance toward the sun again whenever the sun's direction or the
 medium changes (checked each frame, when the graph asks for ``"cloud_sets"``).
 """
 from __future__ import annotations
@@ -14,6 +14,7 @@ from atmos.graph import TextureDesc
 from atmos.plugins.clouds.density_maps import DensityMaps
 from atmos.plugins.clouds.sets import CloudSets
 from atmos.shading import grid
+from atmos.shading.columns import COLUMNS, ColumnShader, column_desc
 from atmos.shading.shear_warp import ShearWarpShader
 
 
@@ -25,7 +26,7 @@ class StaticClouds:
         self.shape = tuple(volume.shape)
         self.settings, self.origin, self.sun = settings, origin, sun
         s = settings
-        descs = {"density": TextureDesc(self.shape, 1, "f4")}
+        descs = {"density": TextureDesc(self.shape, 1, "f4"), COLUMNS: column_desc(self.shape, s.shading_scale)}
         if s.shading:
             descs["transmittance"] = TextureDesc(grid.shading_shape(self.shape, s.shading_scale), 1, "f2")
         self.set = TextureSet.create(gpu, descs, "static")
@@ -35,6 +36,7 @@ class StaticClouds:
             self.maps = DensityMaps(gpu, self.shape, s.band_height, s.group_size)
             self.maps.run(self.set["density"])
             self._max = self.maps.read_max_maps()
+            ColumnShader(gpu, self.shape, s.shading_scale).run(self.set["density"], self.set[COLUMNS])
             if s.shading:
                 self.shader = ShearWarpShader(gpu, self.shape, s.shading_scale)
         except Exception:

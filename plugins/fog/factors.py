@@ -36,13 +36,16 @@ def blend(color, fog_color, f) -> np.ndarray:
 
 
 def apply_fog_ref(color, distance, settings, positions=None, time: float = 0.0, far: float = np.inf,
-                  volumes=None, cloud=None, directions=None, camera=(0.0, 0.0, 0.0), horizon=None) -> np.ndarray:
+                  volumes=None, cloud=None, directions=None, camera=(0.0, 0.0, 0.0), horizon=None,
+                  ground: bool = False) -> np.ndarray:
     """float64 reference of :func:`atmos.plugins.fog.apply_fog` (``settings`` validated FogSettings).
 
     Sky pixels (distance +inf) use ``far`` or stay as they are when ``settings.sky == "keep"``.
     ``volumes`` as in :func:`atmos.plugins.fog.noise.turbulence_ref` (None: procedural). ``cloud``
     (H, W, 2) premultiplied (a·d, a) (:mod:`atmos.composition`): f = a f(d) + (1 − a) f(behind), the
     cloud's noise at ``camera + directions × d``; ``horizon``: ``color_from="sky"``'s table.
+    ``ground`` (the fog pass from depth, ``fog/fog.frag``): with ``sky="keep"``, sky below the horizon
+    seen from above y = 0 is fogged as that plane at ``camera.y / −direction.y``.
     """
     from atmos.plugins.fog.noise import turbulence_ref
     from atmos.plugins.fog.sky_color import sky_fog_color
@@ -54,6 +57,13 @@ def apply_fog_ref(color, distance, settings, positions=None, time: float = 0.0, 
     d = np.asarray(distance, np.float64)
     sky = np.isinf(d)
     d = np.where(sky, far, d)
+    if ground and settings.sky == "keep" and camera[1] > 0.0:
+        down = np.asarray(directions, np.float64)[..., 1]
+        below = sky & (down < 0.0)
+        d = np.where(below, camera[1] / np.maximum(-down, 1e-6), d)
+        positions = np.where(below[..., None], np.asarray(camera, np.float64) + np.asarray(directions) * d[..., None],
+                             positions)
+        sky = sky & ~below
     f = factor(d, positions)
     if settings.sky == "keep":
         f = np.where(sky, 1.0, f)

@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from atmos.camera import set_camera_uniforms
+from atmos.composition import CLOUD_DISTANCE
 from atmos.graph import PassBuilder, PassContext
 from atmos.lighting import unit_sun
 from atmos.plugins.cloud_far_field.layer import FAR_FIELD
@@ -37,14 +38,23 @@ class MarchedShafts:
         self.gpu = gpu
         self.offscreen = OffscreenClouds(gpu, SHAFT_COLOR, SHAFT_DEPTH)
 
-    def program(self, far_field: bool):
-        """The march, with the far field's shadows beyond the volume (column.glsl's CLOUD_FAR_FIELD) or without."""
-        return self.gpu.program({"CLOUD_FAR_FIELD": 1} if far_field else None,
-                                vertex_shader="lib/fullscreen.vert", fragment_shader="light_shafts/march.frag")
+    def program(self, far_field: bool, fog=None):
+        """The march, with the far field's shadows beyond the volume (column.glsl's CLOUD_FAR_FIELD) or
+        without; ``fog`` (FogSettings): the variant that shadows the fog's in-scatter (SHAFT_FOG; its
+        turbulence evaluated procedurally, the fog's noise volumes are not bound here)."""
+        defines = {"CLOUD_FAR_FIELD": 1} if far_field else {}
+        if fog is not None:
+            from atmos.plugins.fog.settings import MODES
+            from atmos.plugins.fog.sky_color import SAMPLES
+            defines.update(SHAFT_FOG=1, FOG_MODE=MODES[fog.mode], FOG_OCTAVES=fog.octaves, FOG_PROCEDURAL=1,
+                           FOG_SKY_COLOR=int(fog.color_from == "sky"), FOG_HORIZON_SAMPLES=SAMPLES)
+        return self.gpu.program(defines or None, vertex_shader="lib/fullscreen.vert",
+                                fragment_shader="light_shafts/march.frag")
 
     @staticmethod
-    def declare(builder: PassBuilder, size, factor: int, clouds: bool, far_field: bool = False) -> None:
-        """``far_field``: the graph imports a CloudFarFieldPlugin's layer; the rays see its shadows too."""
+    def declare(builder: PassBuilder, size, factor: int, clouds: bool, far_field: bool = False, fog=None) -> None:
+        """``far_field``: the graph imports a CloudFarFieldPlugin's layer; the rays see its shadows too.
+        ``fog``: the App's FogPlugin; its clouds' own distance is read when the fog reads one."""
         OffscreenClouds.declare(builder, size, factor, color=SHAFT_COLOR, depth=SHAFT_DEPTH)
         builder.read(DEPTH)
         builder.read(COLOR)
@@ -53,8 +63,10 @@ class MarchedShafts:
             builder.read(CLOUD_SETS)
             if far_field:
                 builder.read(FAR_FIELD)
+        if fog is not None and fog.composition is not None and fog.composition.distance:
+            builder.read(CLOUD_DISTANCE)
 
-    def execute(self, frame: PassContext, settings, clouds: bool) -> None:
+    def execute(self, frame: PassContext, settings, clouds: bool, fog=None) -> None:
         view = frame.view
         irradiance = march_irradiance(view.sun, settings)
         if irradiance is None:
@@ -64,7 +76,7 @@ class MarchedShafts:
         frame.reset_state()
         frame.framebuffer(color=[SHAFT_COLOR]).use()
         far_field = clouds and frame.declares(FAR_FIELD)
-        p = self.program(far_field)
+        p = self.program(far_field, fog.settings if fog is not None else None)
         frame.resource(SHAFT_DEPTH).use(2)
         if clouds:
             sim: CloudSets = frame.resource(CLOUD_SETS)
@@ -76,15 +88,30 @@ class MarchedShafts:
                 layer = frame.resource(FAR_FIELD)
                 layer.prepare(view, sim)
                 layer.use(p, view, sim)
-        p["has_clouds"].value = int(clouds)
         set_camera_uniforms(p, view.camera, view.aspect)
-        p["sun_dir"].value = tuple(unit_sun(view.sun.direction))
-        p["irradiance"].value = tuple(float(v) for v in irradiance)
-        p["lobes"].value = settings.phase_g, settings.phase_g2, settings.phase_w
-        p["scattering"].value = settings.scattering
-        p["max_distance"].value = settings.max_distance
-        p["steps"].value = settings.steps
-        p["factor"].value = factor
-        p["frame_size"].value = tuple(float(v) for v in view.size)
+        values = dict(has_clouds=int(clouds), sun_dir=tuple(unit_sun(view.sun.direction)),
+                      irradiance=tuple(float(v) for v in irradiance),
+                      lobes=(settings.phase_g, settings.phase_g2, settings.phase_w), scattering=settings.scattering,
+                      max_distance=settings.max_distance, steps=settings.steps, factor=factor,
+                      frame_size=tuple(float(v) for v in view.size))
+        if fog is not None:
+            self.fog_uniforms(frame, p, fog, settings)
+        for name, value in values.items():
+            if name in p:
+                p[name].value = value
         frame.fullscreen(p)
         self.offscreen.end(frame, factor, view.camera.near, view.camera.far, medium=True)
+
+    @staticmethod
+    def fog_uniforms(frame: PassContext, program, fog, settings) -> None:
+        """The fog's factor and colour (as its own pass sets them) and its clouds' distance (unit 3)."""
+        from atmos.plugins.fog.post import set_fog_uniforms
+        from atmos.plugins.fog.sky_color import horizon_colors
+        view, fs = frame.view, fog.settings
+        horizon = horizon_colors(view.sun, fog.sky_settings()) if fs.color_from == "sky" else None
+        set_fog_uniforms(program, fs, view.time + fs.time_offset, horizon)
+        clouds = frame.declares(CLOUD_DISTANCE)
+        if clouds:
+            frame.resource(CLOUD_DISTANCE).use(3)
+        program["fog_clouds"].value = int(clouds)
+        program["fog_sun_share"].value = settings.fog_sun_share

@@ -52,7 +52,8 @@ class LightShaftsPass(RenderPass):
         w, h = self.plugin.gpu.size
         d = self.plugin.settings.downsample
         if self.plugin.settings.mode == "march":
-            MarchedShafts.declare(builder, (w, h), d, self.clouds(), self.plugin.graph.imports(FAR_FIELD))
+            MarchedShafts.declare(builder, (w, h), d, self.clouds(), self.plugin.graph.imports(FAR_FIELD),
+                                  self.plugin.fog)
             return
         desc = TextureDesc((math.ceil(w / d), math.ceil(h / d)), components=4, dtype="f2")
         builder.create(MASK, desc)
@@ -71,7 +72,7 @@ class LightShaftsPass(RenderPass):
     def execute(self, frame: PassContext) -> None:
         view, gpu, params = frame.view, frame.gpu, self.plugin.settings
         if params.mode == "march":
-            self.marched.execute(frame, params, frame.declares(CLOUD_SETS))
+            self.marched.execute(frame, params, frame.declares(CLOUD_SETS), self.plugin.fog)
             return
         w, h = view.size
         where = screen_sun(view.camera, view.aspect, view.sun.direction, params)
@@ -106,16 +107,22 @@ class LightShaftsPlugin(Plugin):
     """Light shafts (phase post: after the sky, the scene, the clouds and the fog), marched through the
     cloud shadow map or in screen space (``mode``). ``LightShaftsPlugin(settings=None, **fields)``
     with :class:`LightShaftSettings`; ``configure(**changes)`` changes any of them live (next frame;
-    ``mode`` and ``downsample`` change the pass's targets)."""
+    ``mode`` and ``downsample`` change the pass's targets). With a FogPlugin the march only takes away the
+    fog's in-scatter in cloud shadow (the fog owns the air's light: :class:`LightShaftSettings`)."""
 
     settings_class = LightShaftSettings
 
     def __init__(self, settings: LightShaftSettings | None = None, **fields):
         super().__init__(settings, **fields)
         self.gpu = self.graph = None
+        self.fog = None                 # the App's FogPlugin (finish), whose in-scatter the march shadows
 
     def build(self, app) -> None:
         if app.graph is None:
             raise ValueError("LightShaftsPlugin needs an App with a GPU context (App(gpu))")
         self.gpu, self.graph = app.gpu, app.graph
         app.graph.add_pass(LightShaftsPass(self))
+
+    def finish(self, app) -> None:
+        from atmos.plugins.fog import FogPlugin
+        self.fog = next((p for p in app.plugins if isinstance(p, FogPlugin)), None)

@@ -27,7 +27,11 @@ class LightShaftSettings(CheckedSettings):
     sample through the clouds (the ground shadows' density maps, :mod:`atmos.plugins.cloud_shadows`;
     no clouds: unshadowed haze) and the haze's own transmittance toward the eye, which also dims the
     colour behind. At 1/``downsample`` resolution, upsampled by depth. Shafts are real rays: the air
-    between cloud shadows is lit, the air in them is not. ``horizon_fade`` fades it with the sun's
+    between cloud shadows is lit, the air in them is not. With a FogPlugin in the App the fog owns the
+    air's in-scattering (its colour already holds it): the shafts then add no light and no extinction
+    of their own but take away the share ``fog_sun_share`` (the part of the fog's colour that is
+    sunlight; the rest is sky light, which cloud shadow leaves) of the fog's in-scatter along each ray
+    where the clouds shadow the air, so the haze is counted once (``shaders/light_shafts/march.frag``). ``horizon_fade`` fades it with the sun's
     height; ``samples`` … ``ceiling``, ``radius``, ``front_fade``, ``edge_fade`` are the screen mode's.
 
     Screen:
@@ -68,6 +72,7 @@ class LightShaftSettings(CheckedSettings):
     horizon_fade: float = 0.1
     front_fade: float = 0.3
     edge_fade: float = 0.5
+    fog_sun_share: float = 0.8
 
     def __post_init__(self):
         o = _OWNER
@@ -92,5 +97,6 @@ class LightShaftSettings(CheckedSettings):
             horizon_fade=check_num(o, "horizon_fade", self.horizon_fade, 0.0, 1.0, lo_open=True),
             front_fade=check_num(o, "front_fade", self.front_fade, 0.0, 1.0, lo_open=True),
             edge_fade=check_num(o, "edge_fade", self.edge_fade, 0.0, lo_open=True),
+            fog_sun_share=check_num(o, "fog_sun_share", self.fog_sun_share, 0.0, 1.0),
         )
         self.store(checked)

@@ -1,7 +1,10 @@
 #version 430
 // The cloud field beyond the simulated volume (float64 reference: atmos/plugins/cloud_far_field/
 // reference.py). The view ray meets the layer's middle plane y = field_mid_height at the view depth s;
-// where that is in front of the scene, d = far_field_density there (field.glsl), amount = the sky layer's light march of d toward the sun,
+// where that is in front of the scene, d = far_field_density there (field.glsl), amount = the layer's
+// optical depth toward the sun per field_optical_depth: from the column's middle the sun's ray climbs
+// half the column over a path 1/sun_dir.y times longer (capped like the view, MIN_SLANT), through the
+// mean d of the four light-march samples along it: amount = 0.5 mean(d) / max(sun_dir.y, MIN_SLANT),
 //   alpha = (1 - exp(-thickness d.x / max(|dir.y|, MIN_SLANT))) * (1 - edge weight at the hit) * smoothstep(0, horizon_fade, |ray.y|)
 // lit by the cloud medium's own model (cloud_render/volume.glsl): sun transmittance exp(-optical_depth
 // amount), column optical depth optical_depth d.x (half above, half below). Premultiplied (blend_over).
@@ -42,7 +45,9 @@ void main() {
     if (fade <= 0.0) return;
     float lod = log2(max(lod_scale * length(hit - camera_pos) / max(abs(dir.y), 1e-3), 1e-6));
     vec4 d = far_field_density(hit.xz, lod);
-    float amount = dot(max(d - SKY_LAYER_RAY, 0.0), vec4(0.25));
+    // (the sky layer's own amount, max(d - SKY_LAYER_RAY, 0) / 4, is a quarter of the vertical depth
+    // even for a grazing sun: its tops lit 1.5-2x brighter than the volume's from above at sunset)
+    float amount = 0.5 * dot(d, vec4(0.25)) / max(sun_dir.y, MIN_SLANT);
     // the view crosses the layer's column obliquely: thickness * d.x is its vertical opacity, the path
     // through it 1/|dir.y| times longer (capped at the horizon), as the volume's own clouds are seen
     float alpha = (1.0 - exp(-thickness * d.x / max(abs(dir.y), MIN_SLANT))) * fade;

@@ -1,7 +1,9 @@
 // The far field's cloud density as a function of world (x, z) (float64 reference:
 // atmos/plugins/cloud_far_field/reference.py far_density): four scrolling tileable octaves give fbm,
 // remapped from the threshold that leaves the simulation's cover (cover.comp) of the layer clouded,
-//   d = remap(fbm, e, e + softness)   (four light-march channels; d.x is the point itself).
+//   d = remap(fbm, e, e + softness)   (four light-march channels; d.x is the point itself),
+// e and the softness's scale taken per mip level (cover.py level_table: a blurred far pattern is
+// thresholded by its own quantiles, so it is clouded over the same fraction, not overcast or clear).
 // Shared by the far-field pass (far.frag) and the ground shadows (cloud_shadows/column.glsl with
 // CLOUD_FAR_FIELD); atmos/plugins/cloud_far_field/layer.py binds it.
 #include "sky_layer/layer.glsl"
@@ -13,16 +15,19 @@ layout(std430, binding = 0) readonly buffer Cover { float cover; };
 uniform vec2 field_origin;         // a world xz near the view (the camera's)
 uniform vec2 field_origin_uv;      // it in tiles, wrapped to [0, 1) (float64 on the CPU)
 uniform vec2 field_offsets[4];     // drift of each octave (tiles, wrapped)
-uniform float field_quantiles[33]; // cover.fbm_quantiles
+#define FIELD_LEVELS 8
+uniform float field_quantiles[FIELD_LEVELS * 33]; // cover.level_table: 33 per level
+uniform float field_scale[FIELD_LEVELS];          // the softness's scale per level
+uniform float field_first_level;                  // the mip level of table row 0
 uniform float field_tile_size;
 uniform float field_softness;
 uniform float field_mid_height;    // the layer's middle plane (world y)
 uniform float field_optical_depth; // optical depth of a full column
 
-float field_threshold(float c) {
+float field_threshold(float c, int level) {
     float x = (1.0 - clamp(c, 0.0, 1.0)) * 32.0;
-    int k = min(int(x), 31);
-    return mix(field_quantiles[k], field_quantiles[k + 1], x - float(k));
+    int k = min(int(x), 31) + 33 * level;
+    return mix(field_quantiles[k], field_quantiles[k + 1], x - floor(x));
 }
 
 // d at world (x, z) = xz; lod: mip level.
@@ -32,6 +37,10 @@ vec4 far_field_density(vec2 xz, float lod) {
              + SKY_LAYER_WEIGHTS.y * textureLod(octave1, uv + field_offsets[1], lod)
              + SKY_LAYER_WEIGHTS.z * textureLod(octave2, uv + field_offsets[2], lod)
              + SKY_LAYER_WEIGHTS.w * textureLod(octave3, uv + field_offsets[3], lod);
-    float e = field_threshold(cover);
-    return sky_layer_remap(fbm, e, e + field_softness);
+    float m = clamp(lod - field_first_level, 0.0, float(FIELD_LEVELS - 1));
+    int m0 = min(int(m), FIELD_LEVELS - 2);
+    float t = m - float(m0);         // trilinear filtering mixes two levels: so do the thresholds
+    float e = mix(field_threshold(cover, m0), field_threshold(cover, m0 + 1), t);
+    float soft = field_softness * mix(field_scale[m0], field_scale[m0 + 1], t);
+    return sky_layer_remap(fbm, e, e + soft);
 }

@@ -7,15 +7,25 @@
 // x height bands whose dilated max map is 0 are jumped over; a ray stops once its transmittance
 // falls below min_transmittance or after `steps` samples. float64 reference:
 // plugins/cloud_raymarch/reference.py.
+// FAR_FIELD 1: the ray goes on through the layer's altitude band beyond the volume, to far_distance,
+// through the volumetric far field (cloud_raymarch/far.glsl) weighted by 1 - the volume's edge weight
+// (so the two cross-fade over the edge fade); from where the ray first reaches the fade ring the step
+// grows by mix(step_growth, far_growth, that weight) of the distance and nothing is skipped.
 // Out: premultiplied (light, 1 - T); (a * distance, a) with distance the transmittance-weighted
 // distance from the camera (m, atmos/composition.py); depth: the scene depth the ray stopped at.
 #include "cloud_render/volume.glsl"
 #include "cloud_raymarch/detail.glsl"
+#ifndef FAR_FIELD
+#define FAR_FIELD 0
+#endif
+#if FAR_FIELD
+#include "cloud_raymarch/far.glsl"
+#endif
 #include "lib/view_ray.glsl"
 out vec4 frag;
 layout(location = 1) out vec4 frag_distance;
 layout(binding = 4) uniform sampler3D skip_map;   // (groups x, bands, groups z): 0 = no density within
-layout(binding = 5) uniform sampler2D scene_depth;
+layout(binding = 9) uniform sampler2D scene_depth;
 uniform mat3 view_basis;       // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
 uniform vec3 camera_pos;
 uniform float near;
@@ -37,17 +47,14 @@ uniform ivec2 frame_size;      // full-res pixels
 uniform int jitter;            // 1: per-pixel, per-frame first-sample offset; 0: midpoints
 uniform int frame_index;
 uniform vec3 sun_march;        // toward the sun, times the sun-march sample spacing (m)
+uniform float far_distance;    // FAR_FIELD: the march ends this far from the camera (m)
+uniform float far_growth;      // FAR_FIELD: the step's growth per metre of distance in the far field
 
 // Jimenez's interleaved gradient noise, moved each frame (golden-ratio-ish 5.588238 px per frame).
 float sample_jitter(vec2 pixel) {
     if (jitter == 0) return 0.5;
     pixel += 5.588238 * float(frame_index & 63);
     return fract(52.9829189 * fract(dot(pixel, vec2(0.06711056, 0.00583715))));
-}
-
-// The (eroded) density at world point p, texture coordinates uvw.
-float density_at(vec3 uvw, vec3 p) {
-    return detail_density(cloud_density(uvw), p);
 }
 
 // The factor the detail changes the sun transmittance by: exp(-sigma_t * optical depth of the
@@ -65,6 +72,29 @@ float sun_detail(vec3 p, vec3 extent) {
 #else
     return 1.0;
 #endif
+}
+
+// 1 - the volume's edge weight at footprint uv (1 outside the footprint, also with no edge fade).
+float far_weight(vec2 uv) {
+    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return 1.0;
+    return 1.0 - cloud_edge_weight(uv, edge_fade);
+}
+
+// Distance along the ray to where it first reaches the far field: the edge fade's inner circle
+// |2 uv - 1| = 1 - edge_fade (the footprint's edge without a fade); 0 when the camera is past it.
+float far_entry(vec3 dir) {
+    vec2 size = (layer_max - layer_min).xz;
+    vec2 a = 2.0 * (camera_pos.xz - layer_min.xz) / size - 1.0, b = 2.0 * dir.xz / size;
+    if (edge_fade <= 0.0) {                        // leave the square |a + s b|_inf = 1
+        if (max(abs(a.x), abs(a.y)) >= 1.0) return 0.0;
+        vec2 bb = mix(b, vec2(1e-12), lessThan(abs(b), vec2(1e-12)));
+        vec2 tt = (sign(bb) - a) / bb;
+        return min(tt.x, tt.y);
+    }
+    float r = 1.0 - edge_fade, bb = dot(b, b), ab = dot(a, b), aa = dot(a, a) - r * r;
+    if (aa >= 0.0) return 0.0;
+    if (bb < 1e-20) return 1e30;
+    return (-ab + sqrt(max(ab * ab - bb * aa, 0.0))) / bb;
 }
 
 // Distance along the ray to where it leaves skip-map texel g (a box in world space).
@@ -88,6 +118,20 @@ void main() {
     float start = near * length(view_ray(uv, view_basis));          // the near plane along this ray
     float enter = max(max(max(min(t0.x, t1.x), min(t0.y, t1.y)), min(t0.z, t1.z)), start);
     float leave = min(min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z)), scene);
+    float far_from = 1e30;                         // no far field: never reached
+#if FAR_FIELD
+    {   // the band's part beyond the far field's entry, joined to the box's (the box is inside the band)
+        float b0 = (layer_min.y - camera_pos.y) * inv_dir.y, b1 = (layer_max.y - camera_pos.y) * inv_dir.y;
+        far_from = far_entry(dir);
+        float fin = max(max(min(b0, b1), start), far_from);
+        float fout = min(min(max(b0, b1), scene), far_distance);
+        if (fout > fin) {
+            bool box = leave > enter;
+            enter = box ? min(enter, fin) : fin;
+            leave = box ? max(leave, fout) : fout;
+        }
+    }
+#endif
     vec3 light = vec3(0.0);
     float trans = 1.0, weighted = 0.0;
     if (leave > enter) {
@@ -100,25 +144,51 @@ void main() {
         int taken = 0;
         for (int it = 0; it < steps + max_skips && taken < steps && s < leave; ++it) {
             vec3 pos = camera_pos + dir * s;
-            if (skipping != 0) {
+            bool far_zone = s >= far_from;
+            if (skipping != 0 && !far_zone) {
                 ivec3 g = clamp(ivec3(floor((pos - layer_min) / cell_size / skip_cells)), ivec3(0), grid - 1);
                 if (texelFetch(skip_map, g, 0).r <= 0.0) {
-                    s += skip_exit(g, pos, inv_dir, dir) + eps;
+                    s = min(s + skip_exit(g, pos, inv_dir, dir) + eps, max(far_from, s + eps));
                     continue;
                 }
             }
-            float dt = min(step_base + step_growth * s, leave - s);
+            float growth = step_growth;
+#if FAR_FIELD
+            float fw = far_zone ? far_weight((pos.xz - layer_min.xz) / extent.xz) : 0.0;
+            growth = mix(step_growth, far_growth, fw);
+#endif
+            float dt = min(step_base + growth * s, leave - s);
             float sp = s + u * dt;
             s += dt;
             ++taken;
             vec3 p = camera_pos + dir * sp;
             vec3 uvw = (p - layer_min) / extent;
-            float d = density_at(uvw, p);
+            bool in_box = all(greaterThanEqual(uvw, vec3(0.0))) && all(lessThanEqual(uvw, vec3(1.0)));
+            float dv = in_box ? cloud_density(uvw) : 0.0, df = 0.0;
+#if FAR_FIELD
+            vec4 fc = vec4(0.0);
+            float fh = far_height(p.y);
+            if (far_zone) {
+                fw = far_weight((p.xz - layer_min.xz) / extent.xz);
+                if (fw > 0.0) {
+                    fc = far_cover(p.xz, sp);
+                    df = fw * far_body * far_profile(fh, fc.x);
+                }
+            }
+#endif
+            float d = detail_density(dv + df, p);
             if (d <= 0.0) continue;
             float a = 1.0 - exp(-sigma_t * d * dt);
-            float T = min(cloud_transmittance(uvw) * sun_detail(p, extent), 1.0);
             float w = trans * a;
-            light += w * cloud_source_with(uvw, dir, ny, T);
+            vec3 J = vec3(0.0);
+            if (dv > 0.0) {
+                float T = min(cloud_transmittance(uvw) * sun_detail(p, extent), 1.0);
+                J = cloud_source_with(uvw, dir, ny, T);
+            }
+#if FAR_FIELD
+            if (df > 0.0) J = mix(J, far_source(fc, fh, dir, sigma_t), df / (dv + df));
+#endif
+            light += w * J;
             weighted += w * sp;
             trans *= 1.0 - a;
             if (trans < min_transmittance) break;

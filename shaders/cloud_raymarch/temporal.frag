@@ -3,6 +3,7 @@
 // why; float64 reference: plugins/cloud_raymarch/temporal_reference.py). Drawn over the full-res
 // history target: colour (premultiplied), distance (a·d, a), and the scene distance behind the pixel.
 #include "lib/view_ray.glsl"
+#include "cloud_render/upsample.glsl"
 
 layout(binding = 0) uniform sampler2D low_color;      // this frame's samples: texel (i, j) = pixel (i·r + ox, j·r + oy)
 layout(binding = 1) uniform sampler2D low_distance;
@@ -10,12 +11,14 @@ layout(binding = 2) uniform sampler2D hist_color;     // the previous frame's ou
 layout(binding = 3) uniform sampler2D hist_distance;
 layout(binding = 4) uniform sampler2D hist_scene;     // its scene distance (m), -1 = sky
 layout(binding = 5) uniform sampler2D scene_depth;    // this frame's depth (when has_depth)
+layout(binding = 6) uniform sampler2D low_depth;      // the scene depth each sample's ray saw (edge < 1e30)
 
 uniform mat3 view_basis;      // this frame's rays (lib/view_ray.glsl)
 uniform float near, far;
 uniform int r;
 uniform ivec2 offset;
 uniform bool has_depth;
+uniform float edge;           // the depth-aware upsample's edge (offscreen.EDGE; 1e30: bilinear)
 uniform bool history_valid;
 uniform bool still;           // the camera did not change: the history is at this very pixel
 uniform bool detect_change;   // still for r² frames: every pixel holds a sample, a change is the clouds'
@@ -78,14 +81,21 @@ void main() {
     }
     // this frame's samples upsampled, and the box of the 3x3 low-res texels around the pixel
     vec2 lp = (vec2(pix) - vec2(offset)) / float(r);
-    vec4 c; vec2 d;
-    bilinear2(low_color, low_distance, lp, c, d);
+    ivec2 last = textureSize(low_color, 0) - 1;
+    ivec2 taps[4];
+    float weights[4];
+    float inv_pixel = upsample_inv_depth(has_depth ? texelFetch(scene_depth, pix, 0).r : 1.0, vec2(1.0 / near, 1.0 / far));
+    upsample_taps(low_depth, last, lp, inv_pixel, vec2(1.0 / near, 1.0 / far), edge, taps, weights);
+    vec4 c = vec4(0.0); vec2 d = vec2(0.0);
+    for (int k = 0; k < 4; ++k) {
+        c += weights[k] * texelFetch(low_color, taps[k], 0);
+        d += weights[k] * texelFetch(low_distance, taps[k], 0).rg;
+    }
     if (!history_valid) {
         out_color = c;
         out_distance = vec4(d, 0.0, 1.0);
         return;
     }
-    ivec2 last = textureSize(low_color, 0) - 1;
     ivec2 centre = clamp(ivec2(floor(lp + 0.5)), ivec2(0), last);
     vec4 lo_c = vec4(1e30), hi_c = vec4(-1e30);
     vec2 lo_d = vec2(1e30), hi_d = vec2(-1e30);
@@ -99,13 +109,16 @@ void main() {
         }
 
     // where this pixel's cloud was: by direction first, then at the distance the history holds there
+    // (or, where it holds no cloud, the scene's)
     vec2 q = vec2(pix);
     bool inside = true;
     if (!still) {
         inside = project(dir, size, q);
         vec4 hc; vec2 hd;
         bilinear2(hist_color, hist_distance, q, hc, hd);
-        if (inside && hd.y > ALPHA_EPS) inside = project(cam_delta + dir * (hd.x / hd.y), size, q);
+        // no cloud held there: the scene behind the pixel moves it (terrain), else it is sky at infinity
+        float at = hd.y > ALPHA_EPS ? hd.x / hd.y : scene;
+        if (inside && at > 0.0) inside = project(cam_delta + dir * at, size, q);
         inside = inside && all(greaterThanEqual(q, vec2(-0.5))) && all(lessThanEqual(q, size - 0.5));
     }
     float motion = length(q - vec2(pix));
@@ -125,10 +138,27 @@ void main() {
     vec3 drgb = abs(now.rgb - predicted.rgb);
     float change = !detect_change ? 0.0 : max(abs(now.a - predicted.a),
                        max(drgb.r, max(drgb.g, drgb.b)) / max(max(hi_c.r, max(hi_c.g, hi_c.b)), 1e-3));
-    float clamp_w = history_clamp * max(min(motion / CLAMP_MOTION, 1.0), min(change / CHANGE_TOLERANCE, 1.0));
+    float moved = max(min(motion / CLAMP_MOTION, 1.0), min(change / CHANGE_TOLERANCE, 1.0));
+    // correct the history by this frame's samples: their bilinear blend of (fresh - history at the
+    // sample, moved like this pixel), with the upsample's depth-aware weights, so history and fresh
+    // samples agree (no 2-pixel pattern)
+    vec4 dc = vec4(0.0); vec2 dd = vec2(0.0);
+    for (int k = 0; k < 4; ++k) {
+        if (weights[k] == 0.0) continue;
+        vec4 pc; vec2 pd;
+        bilinear2(hist_color, hist_distance, vec2(taps[k] * r + offset) + (q - vec2(pix)), pc, pd);
+        dc += weights[k] * (texelFetch(low_color, taps[k], 0) - pc);
+        dd += weights[k] * (texelFetch(low_distance, taps[k], 0).rg - pd);
+    }
+    hc += moved * dc;
+    hd += moved * dd;
+    float clamp_w = history_clamp * moved;
     hc = mix(hc, clamp(hc, lo_c, hi_c), clamp_w);
     hd = mix(hd, clamp(hd, lo_d, hi_d), clamp_w);
-    float keep = (inside && same) ? clamp(1.0 - motion / motion_limit, 0.0, 1.0) : 0.0;
+    // clouds that drift under a still camera: the history is stale where its sample changed, the
+    // upsample of this frame's samples is nearer (all of it from CHANGE_TOLERANCE, none below half)
+    float trust = 1.0 - clamp(2.0 * change / CHANGE_TOLERANCE - 1.0, 0.0, 1.0);
+    float keep = (inside && same) ? trust * clamp(1.0 - motion / motion_limit, 0.0, 1.0) : 0.0;
     out_color = (1.0 - keep) * c + keep * hc;                 // not mix(): exact at keep = 1
     out_distance = vec4((1.0 - keep) * d + keep * hd, 0.0, 1.0);
 }

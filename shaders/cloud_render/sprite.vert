@@ -127,8 +127,8 @@ void main() {
     v_tau = tau_scale * sum * (1.0 - e) / (2.0 * PI * sqrt(det) * radius * radius * (1.0 - e - k * e));
     vec3 ray = normalize(world - camera_pos);
     vec3 uvw = center / vec3(volume_shape);
-    float ny = float(volume_shape.y);
-    float up = column_depth(uvw, 1.0, ny), down = column_depth(uvw, -1.0, ny);
+    vec2 col = cloud_columns(uvw);
+    float up = col.x, down = col.y;
     vec4 octaves = vec4(0.0);
     for (int i = 0; i < 8; ++i) {
         vec3 side = vec3((i & 1) == 0 ? -1.0 : 1.0, (i & 2) == 0 ? -1.0 : 1.0, (i & 4) == 0 ? -1.0 : 1.0);

@@ -9,6 +9,8 @@ layout(binding = 0) uniform sampler3D density_a;
 layout(binding = 1) uniform sampler3D density_b;
 layout(binding = 2) uniform sampler3D trans_a;       // at the shading scale; same texture coordinates
 layout(binding = 3) uniform sampler3D trans_b;
+layout(binding = 10) uniform sampler3D columns_a;     // the light volume's columns (up, down), shading scale
+layout(binding = 11) uniform sampler3D columns_b;
 uniform float t;
 uniform ivec3 a_shift;         // cells from B's cell to A's at the same world point (CloudSets.a_shift)
 uniform int has_shading;       // 0: no transmittance textures, T = 1
@@ -21,7 +23,6 @@ uniform vec3 ms_octaves;       // a (attenuation), b (contribution), c (eccentri
 uniform float column_tau;      // sigma_t * cell height: optical depth of one cell of density 1, vertically
 uniform float edge_fade;       // CloudSettings.edge_fade: density fades to 0 toward the inscribed circle
 #include "clouds/edge.glsl"
-const int COLUMN_SAMPLES = 8;
 const float PI = 3.14159265358979;
 
 // uvw: B's texture coordinates (the volume is drawn at B's placement); A's are offset by a_shift.
@@ -38,13 +39,12 @@ float cloud_transmittance(vec3 uvw) {
     return has_shading == 0 ? 1.0 : mix(textureLod(trans_a, a_uvw(uvw), 0.0).r, textureLod(trans_b, uvw, 0.0).r, t);
 }
 
-// Optical depth from uvw straight up (dir 1) or down (dir -1) to the volume's face: midpoint rule.
-float column_depth(vec3 uvw, float dir, float ny) {
-    float len = dir > 0.0 ? 1.0 - uvw.y : uvw.y;
-    float sum = 0.0;
-    for (int i = 0; i < COLUMN_SAMPLES; ++i)
-        sum += cloud_density(vec3(uvw.x, uvw.y + dir * len * (float(i) + 0.5) / float(COLUMN_SAMPLES), uvw.z));
-    return column_tau * sum * len * ny / float(COLUMN_SAMPLES);
+// (tau_up, tau_down): optical depth from uvw straight up and straight down to the volume's faces, from
+// the light volume's columns (atmos/shading/columns.py: density integrals in fine cells, per set, at the
+// shading scale) times column_tau and the edge fade (which depends on x and z only).
+vec2 cloud_columns(vec3 uvw) {
+    vec2 c = mix(textureLod(columns_a, a_uvw(uvw), 0.0).rg, textureLod(columns_b, uvw, 0.0).rg, t);
+    return column_tau * cloud_edge_weight(uvw.xz, edge_fade) * c;
 }
 
 // The phase function's mean cosine g_mean = (1 - w) g + w g2.
@@ -82,10 +82,11 @@ vec3 sun_part(vec4 w, float c) {
     return sun_source * sum;
 }
 
-// J at uvw for a view ray along ray_dir (world, unit), with sun transmittance T.
+// J at uvw for a view ray along ray_dir (world, unit), with sun transmittance T (ny: unused, kept
+// for the callers).
 vec3 cloud_source_with(vec3 uvw, vec3 ray_dir, float ny, float T) {
-    float up = column_depth(uvw, 1.0, ny), down = column_depth(uvw, -1.0, ny);
-    return sun_part(octave_weights(T, up + down), dot(ray_dir, sun_dir)) + ambient_source(up, down, ray_dir.y);
+    vec2 c = cloud_columns(uvw);
+    return sun_part(octave_weights(T, c.x + c.y), dot(ray_dir, sun_dir)) + ambient_source(c.x, c.y, ray_dir.y);
 }
 
 // J at uvw for a view ray along ray_dir (world, unit): the shading volume's sun transmittance.

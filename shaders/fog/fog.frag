@@ -9,21 +9,11 @@
 in vec2 v_uv;
 out vec4 frag;
 #include "fog/factor.glsl"
-uniform vec3 fog_color;
 uniform int fog_sky_keep;    // 1: sky pixels are left to the sky
 #if FOG_CLOUDS
 layout(binding = 2) uniform sampler2D cloud_distance;
 #endif
-#if FOG_SKY_COLOR
-uniform vec3 fog_horizon[FOG_HORIZON_SAMPLES];   // sky radiance at azimuths 2π i / n (atan2(x, -z))
-vec3 in_color(vec3 dir) {
-    float u = fract(atan(dir.x, -dir.z) / 6.28318530718) * float(FOG_HORIZON_SAMPLES);
-    int i0 = int(floor(u)) % FOG_HORIZON_SAMPLES;
-    return fog_color * mix(fog_horizon[i0], fog_horizon[(i0 + 1) % FOG_HORIZON_SAMPLES], u - floor(u));
-}
-#else
-vec3 in_color(vec3 dir) { return fog_color; }
-#endif
+#include "fog/color.glsl"
 #if FOG_FROM_DEPTH
 #include "lib/view_ray.glsl"
 layout(binding = 0) uniform sampler2D scene_depth;
@@ -57,6 +47,15 @@ void main() {
     if (sky) d = fog_far;
     vec3 dir = texelFetch(fog_direction, px, 0).xyz;
     vec3 eye = fog_camera;
+#endif
+#if FOG_FROM_DEPTH
+    // "keep" leaves the sky above the horizon to the sky; below it (seen from the air, past the terrain)
+    // is the ground's continuation: fogged as the plane y = 0 at its distance (haze to the horizon)
+    if (sky && fog_sky_keep != 0 && dir.y < 0.0 && eye.y > 0.0) {
+        d = eye.y / max(-dir.y, 1e-6);
+        world = eye + dir * d;
+        sky = false;
+    }
 #endif
     float f = sky && fog_sky_keep != 0 ? 1.0 : fog_factor(d, world);
 #if FOG_CLOUDS

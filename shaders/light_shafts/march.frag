@@ -7,6 +7,13 @@
 // with CLOUD_FAR_FIELD also the far field's columns beyond the volume: rays between far clouds).
 // Output (L, T = exp(-scattering * d)), upsampled by cloud_render/composite.frag and blended
 // rgb = L + T * rgb. plugins/light_shafts/reference.py march_shafts is the same in numpy.
+// SHAFT_FOG 1 (a FogPlugin owns the air's in-scattering, so the haze is counted once): no light and no
+// extinction of the shafts' own; they take away the fog's in-scatter lost in cloud shadow,
+//   L = -fog_sun_share * C_fog(dir) * sum_i w(s_i) [f(s_i) - f(s_i+1)] (1 - V(s_i)),  T = 1,
+// f = fog/factor.glsl (at the fog's end point: the sum of [f(s_i) - f(s_i+1)] telescopes to the fog's own
+// 1 - f), V = exp(-tau_sun) the sun's visibility through the clouds, w the share of the fog in front of
+// s_i (a cloud in front, "cloud_distance": a before it, 1 - a behind; sky="keep" sky: none). It never
+// exceeds the fog's in-scatter. plugins/light_shafts/reference.py fog_shadow is the same in numpy.
 #include "lib/view_ray.glsl"
 #include "lib/hash.glsl"
 #include "lib/phase.glsl"
@@ -26,6 +33,14 @@ uniform int has_clouds;
 uniform int factor;
 uniform vec2 frame_size;
 out vec4 frag;
+#if SHAFT_FOG
+#include "fog/factor.glsl"
+#include "fog/color.glsl"
+uniform int fog_sky_keep;
+uniform float fog_sun_share;   // LightShaftSettings.fog_sun_share
+uniform int fog_clouds;        // 1: cloud_distance is bound (unit 3)
+layout(binding = 3) uniform sampler2D cloud_distance;
+#endif
 
 // Per-texel start offset in [0, 1): lowbias32 of x + 65536 y (atmos.hashing.lowbias32), 24 bits.
 float jitter(ivec2 q) {
@@ -39,8 +54,35 @@ void main() {
     vec3 dir = normalize(ray);
     float d = min(view_ray_distance(uv, texelFetch(low_depth, q, 0).r, view_basis, near, far, max_distance),
                   max_distance);
-    float ds = d / float(steps);
     float j = jitter(q);
+#if SHAFT_FOG
+    // the fog's own distance: the scene's, the sky's far plane, or (keep) none above the horizon and
+    // the ground plane's below it (fog.frag)
+    float z = texelFetch(low_depth, q, 0).r;
+    float behind = z < 1.0 ? d : (fog_sky_keep == 0 ? far * length(ray)
+                 : (dir.y < 0.0 && camera_pos.y > 0.0 ? camera_pos.y / max(-dir.y, 1e-6) : 0.0));
+    vec2 cloud = fog_clouds != 0 ? texture(cloud_distance, uv).rg : vec2(0.0);
+    float a = clamp(cloud.y, 0.0, 1.0);
+    float dc = a > 0.0 ? max(cloud.x / cloud.y, 0.0) : 0.0;
+    float reach = max(behind, a > 0.0 ? dc : 0.0);
+    vec3 end = camera_pos + dir * reach;
+    float dm = min(reach, max_distance);
+    float dsf = dm / float(steps);
+    float lost = 0.0;
+    float f0 = fog_factor(0.0, end);
+    for (int i = 0; i < steps; ++i) {
+        float s0 = float(i) * dsf;
+        float f1 = fog_factor(s0 + dsf, end);
+        float s = s0 + j * dsf;
+        float w = (s < dc ? a : 0.0) + (s < behind ? 1.0 - a : 0.0);
+        float tau = has_clouds != 0 ? sun_optical_depth(camera_pos + dir * s, sun_dir) : 0.0;
+        lost += w * (f0 - f1) * (1.0 - exp(-tau));
+        f0 = f1;
+    }
+    frag = vec4(-fog_sun_share * in_color(dir) * lost, 1.0);
+    return;
+#endif
+    float ds = d / float(steps);
     float sum = 0.0;
     for (int i = 0; i < steps; ++i) {
         float s = (float(i) + j) * ds;

@@ -1,0 +1,133 @@
+"""The ray march's volumetric far field (issues 15 and 12): the march beyond the volume against its
+float64 reference, the 2D far-field pass culled while the march draws the far field, and extremes."""
+import numpy as np
+import pytest
+
+from atmos import App, DefaultPlugins
+from atmos.camera import Camera
+from atmos.lighting import Sun
+from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
+from atmos.plugins.cloud_far_field.cover import level_table
+from atmos.plugins.cloud_far_field.layer import drift
+from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
+from atmos.plugins.cloud_raymarch.far_reference import FarField, far_march_reference
+from atmos.plugins.clouds import CloudSettings, CloudsPlugin
+
+SHAPE = (16, 8, 16)
+CELL = (40.0, 40.0, 40.0)
+BASE = 400.0
+DAY = Sun.from_angles(35.0, 70.0)
+FAR = dict(size=64, tile_size=20000.0, base_frequency=4, animate=False)   # mip 0 out to far_distance
+
+
+def columns():
+    """Half the columns full: the far field's measured cover about a half."""
+    d = np.zeros(SHAPE, np.float32)
+    x, z = np.meshgrid(np.arange(SHAPE[0]), np.arange(SHAPE[2]), indexing="ij")
+    d.transpose(0, 2, 1)[((x // 4 + z // 4) % 2 == 0)] = 1.0
+    return d
+
+
+def scene(gpu, sun=DAY, far=True, **fields):
+    fields = dict(dict(resolution=1, jitter=False, detail_octaves=0, min_transmittance=0.0, far_distance=8000.0,
+                       far_step_growth=0.01), **fields)
+    medium = CloudSettings(cell_size=CELL, base_altitude=BASE, group_size=(4, 4), smoothing_slices=1, sigma_t=0.02,
+                           edge_fade=0.2)
+    plugins = [DefaultPlugins(overlay=False), CloudsPlugin(medium, density=columns()), RaymarchCloudsPlugin(**fields)]
+    if far:
+        plugins.append(CloudFarFieldPlugin(**FAR))
+    app = App(gpu).add_plugins(*plugins)
+    app.insert_resource(sun)
+    app.startup()
+    return app
+
+
+def aim(app, position, yaw=0.0, pitch=0.0):
+    cam = app.resource(Camera)
+    cam.position = np.array(position, float)
+    cam.yaw, cam.pitch = yaw, pitch
+    cam.near, cam.far = 1.0, 20000.0
+    return cam
+
+
+def of(app, kind):
+    return next(p for p in app.plugins if isinstance(p, kind))
+
+
+def field_reference(app) -> FarField:
+    """The far field's cover at mip 0 in float64, from the GPU's textures and measured cover."""
+    far = of(app, CloudFarFieldPlugin)
+    layer, params = far.layer, far.settings
+    sim = of(app, CloudsPlugin).simulation.sets()
+    quantiles = level_table(params.base_frequency, params.seed, params.size)[0][0]
+    cover = float(np.frombuffer(layer.cover.read(), np.float32)[0])
+    return FarField(params.light_step * params.tile_size,
+                    octaves=[layer.octaves.download(k) for k in range(4)], offsets=drift(params, sim, 0.0),
+                    tile_size=params.tile_size, quantiles=quantiles, cover=cover, softness=params.softness)
+
+
+def test_the_far_field_march_matches_its_float64_reference(gpu, ctx):
+    app = scene(gpu, steps=256)
+    cam = aim(app, (-2500.0, BASE + 150.0, 200.0), yaw=-np.pi / 2, pitch=-0.05)   # outside, looking away
+    image = app.read_linear()[::-1].astype(np.float64)
+    sim = of(app, CloudsPlugin).simulation.sets()
+    layout = sim.layout()
+    band = (float(layout.lo[1]), float(layout.hi[1] - layout.lo[1]))
+    ref = far_march_reference(field_reference(app), sim.settings, of(app, RaymarchCloudsPlugin).settings, band,
+                              cam, DAY, gpu.size)
+    alpha = ref["alpha"]
+    assert 0.05 < (alpha > 0.05).mean() < 0.95 and alpha.max() > 0.5, "the view must see far clouds and gaps"
+    light = ref["light"]
+    rmse = np.sqrt(np.mean((image[..., :3] - light) ** 2)) / np.sqrt(np.mean(light ** 2))
+    assert rmse < 0.03, f"colour off the reference: relative RMSE {rmse:.4f}"
+    off = np.abs(image[..., 3] - alpha)
+    assert np.percentile(off, 99) < 0.01 and off.mean() < 0.003, f"coverage off the reference: {off.max():.4f}"
+    app.close()
+
+
+def test_the_2d_pass_is_culled_while_the_march_draws_the_far_field(gpu, ctx):
+    app = scene(gpu)
+    names = lambda: [p.name for p in app.graph.compile().order]
+    app.render()
+    assert "cloud_far_field" not in names() and "cloud_raymarch" in names()
+    march = of(app, RaymarchCloudsPlugin)
+    for change in (dict(far_field=False), dict(far_field=True, enabled=False)):
+        march.configure(**change)
+        app.render()
+        assert "cloud_far_field" in names(), f"the 2D far field draws again with {change}"
+    app.close()
+
+
+def test_the_march_continues_the_clouds_past_the_volume(gpu, ctx):
+    """From above, looking out past the volume: with the far field the march's clouds go on."""
+    images = {}
+    for far in (False, True):
+        app = scene(gpu, far=far, far_distance=20000.0, resolution=2, jitter=True)
+        aim(app, (320.0, 2000.0, 320.0), pitch=-0.15)           # the view meets the layer ~8 km out
+        images[far] = app.read_linear()
+        app.close()
+    h = images[True].shape[0]
+    band = slice(h // 3, 2 * h // 3)                     # around the horizon
+    assert images[False][band, :, 3].mean() < 0.5 * images[True][band, :, 3].mean()
+
+
+@pytest.mark.parametrize("case", ["above_10km", "below", "grazing", "night"])
+def test_far_field_extremes_stay_finite_and_sensible(gpu, ctx, case):
+    sun = Sun.from_angles(-20.0, 70.0, color=(0.0, 0.0, 0.0)) if case == "night" else DAY
+    if case == "night":
+        sun.ambient = (0.0, 0.0, 0.0)
+    app = scene(gpu, sun=sun, resolution=2, jitter=True, detail_octaves=3, far_distance=60000.0,
+                far_step_growth=0.02)
+    position, pitch = {"above_10km": ((160.0, 10000.0, 320.0), -0.6), "below": ((160.0, 50.0, 320.0), 0.15),
+                       "grazing": ((160.0, BASE + 160.0, 320.0), 0.0), "night": ((160.0, 50.0, 320.0), 0.15)}[case]
+    aim(app, position, pitch=pitch)
+    frames = [app.read_linear() for _ in range(3)]
+    for image in frames:
+        assert np.isfinite(image).all() and image.min() >= 0.0 and image[..., 3].max() <= 1.0 + 1e-3
+    alpha, rgb = frames[-1][..., 3], frames[-1][..., :3]
+    assert alpha.max() > 0.3, "far clouds in view"
+    if case == "night":
+        assert rgb.max() < 0.05 * alpha.max() + 1e-3, "no sun, no sky: dark"
+    else:
+        assert rgb[alpha > 0.3].mean() > 0.05, "lit, not black"
+    app.close()

@@ -1,0 +1,69 @@
+"""The haze counted once: with a FogPlugin the marched shafts add no light of their own, they take
+away the fog's in-scatter where the clouds shadow the air (plugins/light_shafts/march.py, SHAFT_FOG)."""
+import math
+
+import numpy as np
+import pytest
+
+from atmos.app import App
+from atmos.camera import Camera
+from atmos.defaults import DefaultPlugins
+from atmos.gpu import create_headless
+from atmos.lighting import Sun
+from atmos.plugins.clouds import CloudSettings, CloudsPlugin
+from atmos.plugins.fog import FogPlugin
+from atmos.plugins.ground import GroundPlugin
+from atmos.plugins.light_shafts import LightShaftsPlugin
+from atmos.plugins.sky_gradient import SkyGradientPlugin
+from tests.test_light_shafts_march import BASE, CELL, SIZE, columns_volume
+
+
+@pytest.fixture(scope="module")
+def fog_gpu():
+    gpu = create_headless(SIZE)
+    yield gpu
+    gpu.release()
+
+
+def frame(gpu, density, shafts: bool, sky="fog", fog=True, color=(0.9, 0.9, 1.0)) -> np.ndarray:
+    """Linear colour of the gap view (test_light_shafts_march) under an exponential fog, with or without shafts."""
+    extra = [LightShaftsPlugin(steps=48, max_distance=3000.0)] if shafts else []
+    if fog:
+        extra.append(FogPlugin(mode="exp", density=1.5e-3, sky=sky, fog_color=color))
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(),
+                               CloudsPlugin(CloudSettings(cell_size=CELL, base_altitude=BASE, shading=False,
+                                                          sigma_t=0.05), density=density), *extra)
+    app.insert_resource(Sun(np.array([0.0, 1.0, 0.25]), (1.0, 0.95, 0.9)))
+    app.startup()
+    cam = app.resource(Camera)
+    cam.position = np.array([320.0, 60.0, 20.0])
+    cam.yaw, cam.pitch, cam.far = math.pi, 0.25, 5000.0
+    try:
+        app.render()
+        assert gpu.ctx.error == "GL_NO_ERROR"
+        return app.read_linear()[..., :3].astype(np.float64)
+    finally:
+        app.close()
+
+
+def test_shafts_add_nothing_to_the_fog_where_nothing_shadows_the_air(fog_gpu):
+    empty = np.zeros((32, 4, 32), np.float32)
+    alone, both = frame(fog_gpu, empty, False), frame(fog_gpu, empty, True)
+    assert np.abs(both - alone).max() < 2e-3 * max(alone.max(), 1.0), "the fog's in-scatter is not counted twice"
+    kept = frame(fog_gpu, columns_volume(), True, sky="keep")
+    assert np.isfinite(kept).all()
+
+
+def test_cloud_shadows_show_as_darker_rays_in_the_fog(fog_gpu):
+    volume = columns_volume()
+    alone, both = frame(fog_gpu, volume, False), frame(fog_gpu, volume, True)
+    attenuated = frame(fog_gpu, volume, False, color=(0.0, 0.0, 0.0))     # f · scene: the fog without its light
+    dark = (alone - both).mean(-1)                     # what the shafts took away
+    assert np.isfinite(both).all() and dark.min() > -2e-3, "the shafts only take light away"
+    lost = dark.mean(axis=0)                           # per image column
+    w = lost.size
+    centre = lost[int(0.45 * w):int(0.55 * w)].mean()
+    sides = np.concatenate([lost[int(0.02 * w):int(0.2 * w)], lost[int(0.8 * w):int(0.98 * w)]]).mean()
+    assert sides > 0.02 and sides > 3.0 * centre, f"shadowed air darker ({sides:.3f}) than the lit gap ({centre:.3f})"
+    inscatter = (alone - attenuated).mean(-1)          # (1 − f) C_fog: never more is taken away
+    assert (dark <= inscatter + 4e-3).all()
