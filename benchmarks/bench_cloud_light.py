@@ -97,7 +97,8 @@ def views(lo, hi):
 class Scene:
     """One App drawing a static volume with both renderers, switched per mode."""
 
-    def __init__(self, gpu, volume, single: bool):
+    def __init__(self, gpu, volume, single: bool, extra=()):
+        """``extra``: more plugins for the App (e.g. a MeshPlugin)."""
         density, cell, sigma_t = volume
         medium = dict(sky_intensity=0.0, ground_albedo=0.0) if single else {}
         self.settings = CloudSettings(cell_size=cell, base_altitude=BASE, sigma_t=sigma_t, group_size=(8, 8),
@@ -106,7 +107,7 @@ class Scene:
         self.renderer = CloudRenderPlugin(**self.render_fields)
         self.march = RaymarchCloudsPlugin.reference(enabled=False, **self.render_fields)
         self.app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(self.settings, density=density),
-                                        self.renderer, self.march)
+                                        self.renderer, self.march, *extra)
         self.app.startup()
         self.density, self.cell, self.sigma_t = density, cell, sigma_t
         self.lo = np.array([0.0, BASE, 0.0])

@@ -20,13 +20,18 @@
    image is exact and the error is the ghost alone). Plot out/bench_cloud_raymarch_ghost_<turn>deg.png; frames
    1 and 4 after the turn, the converged one, then |frame 1 − converged| and |frame 4 − converged|
    (white = 25 % of the mean cloud radiance) in out/cloud_temporal_ghost_<turn>deg_<clamp>_<limit>.png.
+5. **Ghosting after scene motion, still camera**: the clouds drift (the static volume's origin moves
+   0.5 and 3 px per frame), only the detail noise scrolls with the wind, or a box crosses in front
+   (4 px per frame); per frame the error vs the resolution-1 march of the same frame (mean |Δ| and
+   p99, the same units) for r2 and r4 reprojection and the r2 upsample; frames in
+   out/cloud_temporal_ghost_<case>_<row>.png.
 
 On llvmpipe only the ratios of times inside one run mean anything. The tables also go to
 out/bench_cloud_raymarch_<W>x<H>.txt. References are cached in out/cache/ keyed by everything they
 depend on (the shading modules' source included).
 
     .venv/bin/python benchmarks/bench_cloud_raymarch.py [--quick] [--size 192x128] [--samples 128]
-        [--only error sunset stability ghost]
+        [--only error sunset stability ghost events]
 """
 from __future__ import annotations
 
@@ -53,7 +58,7 @@ from atmos.plugins.cloud_render import CloudRenderPlugin  # noqa: E402
 
 ROOT = HERE.parent
 OUT = ROOT / "out"
-PARTS = ("error", "sunset", "stability", "ghost")
+PARTS = ("error", "sunset", "stability", "ghost", "events")
 DEFAULT = dict(steps=256, resolution=2, reprojection=True, detail_octaves=0, jitter=True,
                history_clamp=RaymarchCloudsPlugin.settings_class.history_clamp,
                motion_limit=RaymarchCloudsPlugin.settings_class.motion_limit)
@@ -84,8 +89,8 @@ class MarchScene:
     """bench_cloud_light's Scene (sprites + the ray march, both switchable), its march set to the
     real-time defaults | DEFAULT | a row's fields; :meth:`use` switches to one row's renderer."""
 
-    def __init__(self, gpu, volume):
-        self.scene = light.Scene(gpu, volume, False)
+    def __init__(self, gpu, volume, extra=()):
+        self.scene = light.Scene(gpu, volume, False, extra)
         self.app = self.scene.app
         self.plugin = self.scene.march
         self.pass_ = next(p for p in self.app.graph.passes if p.name == "cloud_raymarch")
@@ -414,6 +419,149 @@ def ghost_after(gpu, turn, frames, clamps, limits):
     return curves
 
 
+# -- 5. ghosting after scene motion under a still camera -----------------------------------------
+EVENT_ROWS = {"r2 reproj": dict(resolution=2), "r4 reproj": dict(resolution=4),
+              "r2 upsample": dict(resolution=2, reprojection=False), "r4 upsample": dict(resolution=4, reprojection=False)}
+EVENT_COLUMNS = (1, 2, 3, 4, 8, 12)
+
+
+class Drift:
+    """The whole static volume drifts sideways (+x) ``px`` image pixels per frame (the VolumeOrigin
+    moves by fractional cells), camera still: wind carrying the clouds."""
+
+    def __init__(self, px):
+        self.px, self.fields = px, {}
+
+    def start(self, ms, cam, target):
+        from atmos.plugins.weather import VolumeOrigin
+        self.origin = ms.app.resource(VolumeOrigin)
+        self.x0 = self.origin.x
+        focal = 0.5 * light.SIZE[1] / math.tan(cam.fov_y / 2)
+        self.cells = self.px * float(np.linalg.norm(cam.position - target)) / focal / ms.scene.cell[0]
+        return f"{self.cells * ms.scene.cell[0]:.2f} m/frame, {30 * self.cells * ms.scene.cell[0]:.0f} m/s at 30 frames/s"
+
+    def at(self, ms, k):
+        self.origin.x = self.x0 + k * self.cells
+
+    def stop(self, ms):
+        self.origin.x = self.x0
+
+
+class DetailWind:
+    """Only the detail noise moves: ``detail_octaves`` 3 scrolling with ``wind`` m/s at 30 frames/s
+    (the frame clock advanced by hand), the smooth density still."""
+
+    def __init__(self, speed):
+        self.speed, self.fields = speed, dict(detail_octaves=3, wind=(speed, 0.0, 0.0))
+
+    def start(self, ms, cam, target):
+        self.t0 = ms.app.clock.frame_time
+        return f"{self.speed / 30:.2f} m/frame of noise scroll"
+
+    def at(self, ms, k):
+        ms.app.clock.frame_time = self.t0 + k / 30
+
+    def stop(self, ms):
+        ms.app.clock.frame_time = self.t0
+
+
+class Crossing:
+    """A box (the cloud's height, a fifth of the view wide) at a third of the way to the cloud crosses
+    in front of it sideways ``px`` pixels per frame, starting just left of the cloud's middle."""
+
+    occluder = True      # the error is taken over the cloud's pixels without the box (the box's own are exact)
+
+    def __init__(self, px):
+        self.px, self.fields = px, {}
+
+    def start(self, ms, cam, target):
+        from atmos import Transform
+        from atmos.plugins.mesh import MeshInstance, box
+        self.mesh = next(p for p in ms.app.plugins if type(p).__name__ == "MeshPlugin")
+        d = float(np.linalg.norm(cam.position - target)) / 3
+        focal = 0.5 * light.SIZE[1] / math.tan(cam.fov_y / 2)
+        right = cam.basis()[:, 0]
+        width = 0.2 * light.SIZE[0] * d / focal
+        self.step = right * self.px * d / focal
+        self.p0 = cam.position + (target - cam.position) / 3 - right * width
+        self.entity = ms.app.world.create_entity(Transform(self.p0.copy()),
+                                                 MeshInstance(box((width, 0.5 * width, width)), (0.5, 0.45, 0.4)))
+        self.transform = ms.app.world.component_for_entity(self.entity, Transform)
+        self.at(ms, 0)
+        return f"{width:.0f} m box at {d:.0f} m"
+
+    def at(self, ms, k):
+        self.transform.teleport(self.p0 + k * self.step)
+        self.mesh.collect(ms.app)
+
+    def stop(self, ms):
+        ms.app.world.delete_entity(self.entity, immediate=True)
+        self.mesh.collect(ms.app)
+
+
+EVENTS = {"drift_0.5px": Drift(0.5), "drift_3px": Drift(3.0), "detail_wind": DetailWind(15.0),
+          "crossing_4px": Crossing(4.0)}
+
+
+def events(gpu, frames, cases):
+    """Per case and row: converged with everything still, then the scene moves each frame; error per
+    frame vs the resolution-1 march of that frame (jitter off), mean |Δ| and p99 over the cloud's
+    pixels / mean cloud radiance; frames 1, 4 and the last of each case's r2 row in
+    out/cloud_temporal_ghost_<case>_<row>.png (then |Δ| ×4)."""
+    from PIL import Image
+
+    from atmos.plugins.mesh import MeshPlugin
+    from atmos.render_core import tone_map
+    say(f"\n== 5. ghosting after scene motion, still camera (cumulus, side view at {NEAR:g} x its distance, jitter off): "
+        f"error per frame vs the resolution-1 march of the same frame over the cloud pixels, mean |Δ| / p99 in % of the mean cloud radiance ==")
+    ms = MarchScene(gpu, light.cumulus(), extra=(MeshPlugin(),))
+    s = ms.scene
+    pos, target, elevation = light.views(s.lo, s.hi)["side"]
+    cam, _ = s.look(target + (pos - target) * NEAR, target, elevation)
+    cols = [k for k in EVENT_COLUMNS if k <= frames]
+    say(f"{'case':13s} {'row':12s} " + "  ".join(f"{'f' + str(k):>11s}" for k in cols) + f"  {'all frames':>11s}")
+    results = {}
+    for case in cases:
+        ev = EVENTS[case]
+        ms.use(dict(resolution=1, jitter=False, **ev.fields))
+        clean = cloud_mask(ms.app.read_linear())
+        what = ev.start(ms, cam, target)
+        truths = []
+        for k in range(frames + 1):
+            ev.at(ms, k)
+            truths.append(ms.app.read_linear()[..., :3].astype(np.float64))
+        ev.at(ms, 0)
+        scale = cloud_scale(truths[0])
+        exposure = 0.8 / max(float(np.percentile(truths[0][truths[0].sum(-1) > 0], 99)), 1e-6)
+        for label, row in EVENT_ROWS.items():
+            fields = dict(jitter=False, **ev.fields, **row)
+            ms.use(fields)
+            ev.at(ms, 0)
+            ms.converged(fields)
+            seq = []
+            for k in range(1, frames + 1):
+                ev.at(ms, k)
+                seq.append(ms.app.read_linear()[..., :3].astype(np.float64))
+            e = [np.abs(im - t).sum(-1)[clean if getattr(ev, "occluder", False) else cloud_mask(im, t)]
+                 for im, t in zip(seq, truths[1:])]
+            mean = np.array([x.mean() / scale for x in e])
+            p99 = np.array([np.percentile(x, 99) / scale for x in e])
+            results[(case, label)] = (mean, p99)
+            say(f"{case:13s} {label:12s} " + "  ".join(f"{100 * mean[k - 1]:5.2f}/{100 * p99[k - 1]:5.1f}" for k in cols)
+                + f"  {100 * mean.mean():5.2f}/{100 * p99.mean():5.1f}")
+            picks = sorted({0, min(3, frames - 1), frames - 1})
+            diffs = [np.repeat((4 * np.abs(seq[i] - truths[i + 1]).sum(-1, keepdims=True) / scale).clip(0, 1), 3, -1) for i in picks]
+            strip = np.concatenate([np.concatenate([tone_map(seq[i], exposure) for i in picks], 1),
+                                    np.concatenate([tone_map(truths[i + 1], exposure) for i in picks], 1),
+                                    np.concatenate(diffs, 1)], 0).repeat(2, 0).repeat(2, 1)
+            Image.fromarray((strip * 255).astype(np.uint8)).save(OUT / f"cloud_temporal_ghost_{case}_{label.replace(' ', '_')}.png")
+        ev.at(ms, 0)
+        say(f"{'':13s} ({what}; frames {[k + 1 for k in picks]}: image, truth, |Δ| ×4)")
+        ev.stop(ms)
+    ms.close()
+    return results
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="fewer rows, views, frames and tracer samples")
@@ -437,6 +585,8 @@ def main(argv=None):
             stability(gpu, 12 if q else 32, ("r1", "r2 reproj") if q else list(STABILITY))
         if "ghost" in args.only:
             ghosting(gpu, 6 if q else 12, (0.0, 1.0) if q else (0.0, 0.5, 1.0), (16.0, 64.0) if q else (4.0, 16.0, 64.0))
+        if "events" in args.only:
+            events(gpu, 6 if q else 12, ("drift_3px", "crossing_4px") if q else list(EVENTS))
     finally:
         gpu.release()
     if "sunset" in args.only:

@@ -20,6 +20,7 @@ from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
 from atmos.plugins.cloud_far_field.cover import fbm_quantiles
 from atmos.plugins.cloud_far_field.layer import drift
 from atmos.plugins.cloud_far_field.reference import far_field_density
+from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
 from atmos.plugins.cloud_render.plugin import CloudRenderPlugin
 from atmos.plugins.cloud_shadows import CloudShadowsPlugin
 from atmos.plugins.cloud_shadows.reference import shifted
@@ -41,7 +42,7 @@ def scenes():
         for demo in ("sunset", "flight"):
             app = build_app(demo, DemoSettings(size=gpu.size, headless=True), gpu)
             app.run_frames(4, 1 / 30)
-            apps[demo] = app
+            apps[(demo, "sprites")] = app
         yield gpu, apps
     finally:
         for app in apps.values():
@@ -51,6 +52,16 @@ def scenes():
 
 def plugin(app, kind):
     return next(p for p in app.plugins if isinstance(p, kind))
+
+
+def scene(scenes, demo, clouds="sprites"):
+    """The demo's App (built with ``clouds``, the renderer, on first use), run 4 frames."""
+    gpu, apps = scenes
+    if (demo, clouds) not in apps:
+        app = build_app(demo, DemoSettings(size=gpu.size, headless=True, clouds=clouds), gpu)
+        app.run_frames(4, 1 / 30)
+        apps[(demo, clouds)] = app
+    return apps[(demo, clouds)]
 
 
 def rays(cam: Camera, size) -> np.ndarray:
@@ -77,15 +88,18 @@ def plane_radius(app, cam: Camera) -> np.ndarray:
 
 
 def render(app, *, far=True, clouds=True):
-    far_plugin, sprites = plugin(app, CloudFarFieldPlugin), plugin(app, CloudRenderPlugin)
+    """The linear frame with the clouds (the enabled renderer: sprites + 2D far field, or the march with
+    its volumetric far field) and the far field each on or off."""
+    far_plugin, sprites, march = (plugin(app, k) for k in (CloudFarFieldPlugin, CloudRenderPlugin, RaymarchCloudsPlugin))
+    renderer = march if march.settings.enabled else sprites
     far_plugin.configure(enabled=far and clouds)
-    sprites.configure(enabled=clouds)
+    renderer.configure(enabled=clouds, **({"far_field": far} if renderer is march else {}))
     try:
         app.render()
         return app.read_linear().astype(np.float64)
     finally:
         far_plugin.configure(enabled=True)
-        sprites.configure(enabled=True)
+        renderer.configure(enabled=True, **({"far_field": True} if renderer is march else {}))
 
 
 def bands(metric, r, valid):
@@ -146,17 +160,23 @@ def cloud_change(app, img):
     return np.abs(luminance(img) - luminance(render(app, clouds=False)))
 
 
-@pytest.mark.parametrize("demo, view", [
-    ("sunset", "ground"), ("flight", "ground"), ("flight", "above"),
-    pytest.param("sunset", "above", marks=pytest.mark.xfail(strict=True, reason=(
-        "open gap: from above the sparse sunset far field changes the terrain's luminance ~2x as much as the "
-        "volume (0.02 vs 0.05), though its radiance per cover now matches (test below) and its cover is lower"))),
+@pytest.mark.parametrize("demo, view, clouds", [
+    ("sunset", "ground", "sprites"), ("flight", "ground", "sprites"), ("flight", "above", "sprites"),
+    ("flight", "ground", "march"),
+    *(pytest.param(demo, view, "march", marks=pytest.mark.xfail(strict=True, reason=(
+        "open gap: the march's volumetric far field covers about half as much as its volume at the border "
+        "(coverage 0.107 vs 0.212 sunset ground, 0.384 vs 0.600 flight ground; change 0.280 vs 0.528 flight above)")))
+      for demo, view in (("sunset", "ground"), ("flight", "above"), ("sunset", "above"))),
+    pytest.param("sunset", "above", "sprites", marks=pytest.mark.xfail(strict=True, reason=(
+        "open gap: the band means now agree (0.048 inside vs 0.036 outside) but the column-outlier check fails "
+        "(92 spreads): the sparse field's median column is cloud-free, and the same check gives 37 in r 0.25-0.55, "
+        "wholly inside the volume, so it flags single sunlit clouds, not a seam"))),
 ])
-def test_clouds_have_no_step_at_the_volume_edge(scenes, demo, view):
+def test_clouds_have_no_step_at_the_volume_edge(scenes, demo, view, clouds):
     """From the ground: the coverage (sky occlusion); from 2 km above the layer: what the clouds change
-    in luminance. Band means inside vs outside within TOLERANCE, no outlier column along the border."""
-    _, apps = scenes
-    app = apps[demo]
+    in luminance. Band means inside vs outside within TOLERANCE, no outlier column along the border.
+    Both renderers: the sprites with the 2D far field, the march with its volumetric one."""
+    app = scene(scenes, demo, clouds)
     look, metric = (ground_view, coverage) if view == "ground" else (above_view, cloud_change)
     values, r, valid = panorama(app, look, metric)
     inside, outside = bands(values, r, valid)
@@ -171,8 +191,7 @@ def test_clouds_have_no_step_at_the_volume_edge(scenes, demo, view):
 @pytest.mark.parametrize("demo", ["sunset", "flight"])
 def test_volume_and_far_field_shadows_are_as_dark_for_the_same_cover(scenes, demo):
     """Mean sun transmittance of the volume's columns (edge-weighted) vs the far field's over a tile."""
-    _, apps = scenes
-    app = apps[demo]
+    app = scene(scenes, demo)
     far, shadows = plugin(app, CloudFarFieldPlugin), plugin(app, CloudShadowsPlugin)
     sim = app.resource(CloudSimulation)
     sets = sim.sets()

@@ -8,8 +8,8 @@ import pytest
 from atmos.gpu import GpuError, create_headless
 from atmos.gpu.census import GLCensus
 from atmos.plugins.cloud_raymarch import noise_reference as ref
-from atmos.plugins.cloud_raymarch.noise import (BASE_LAYOUT, COVERAGE, DETAIL_LAYOUT, DetailNoise, detail_defines,
-                                                detail_offsets)
+from atmos.plugins.cloud_raymarch.noise import (BASE_LAYOUT, COVERAGE, DETAIL_FADE, DETAIL_LAYOUT, DETAIL_RATIO,
+                                                DetailNoise, detail_defines, detail_offsets)
 from fullscreen_probe import run_fullscreen
 
 BASE, FINE = 16, 8
@@ -21,13 +21,19 @@ def random_seed(rng) -> int:
     return int(rng.integers(0, 2**32))
 
 
-def probe(gpu, noise, points, d, octaves, strength=STRENGTH, time=37.0, wind=(12.0, -1.0, 4.0)):
-    """detail_density on the GPU at ``points`` (h, w, 3) m with densities ``d`` (h, w)."""
+def probe(gpu, noise, points, d, octaves, strength=STRENGTH, time=37.0, wind=(12.0, -1.0, 4.0), footprint=0.0):
+    """detail_density on the GPU at ``points`` (h, w, 3) m with densities ``d`` (h, w), for pixels
+    ``footprint`` m wide."""
     h, w = d.shape
     data = np.concatenate([points, d[..., None]], -1).astype(np.float32)
+
+    def uniforms(p):
+        noise.bind(p, time, wind, SCALE, strength, layer=LAYER)
+        if "probe_footprint" in p:      # 0 octaves: the compiler drops it
+            p["probe_footprint"].value = footprint
+
     out = run_fullscreen(gpu, "test/detail_probe.frag", (w, h), inputs=[data], nearest=True,
-                         defines=detail_defines(octaves),
-                         set_uniforms=lambda p: noise.bind(p, time, wind, SCALE, strength, layer=LAYER))
+                         defines=detail_defines(octaves), set_uniforms=uniforms)
     return out[..., 0]
 
 
@@ -81,6 +87,28 @@ def test_detail_density_matches_its_float64_reference(gpu, ctx, rng):
                   - ref.detail_density(thin, points + (50.0, 0.0, 0.0), base, detail, 3, SCALE, 0.8, layer=LAYER)) > 0.01
     body = d >= COVERAGE                                # a cloud's body is never eroded
     assert np.array_equal(want[body], np.minimum(d, 1.0)[body])
+
+
+def test_each_band_fades_out_where_the_pixel_outgrows_its_noise(gpu, ctx, rng):
+    """Noise finer than a pixel aliases (stripes, crawling edges on far clouds): the fine band is gone
+    once a pixel spans DETAIL_FADE[1] of its tile, the shape band at that many base tiles (d itself)."""
+    noise = DetailNoise(gpu, BASE, FINE, seed=random_seed(rng))
+    base, detail = noise.read()
+    points = rng.uniform(-4000.0, 4000.0, (16, 24, 3))
+    d = rng.uniform(0.02, 0.9 * COVERAGE, (16, 24))
+    fine_gone, base_gone = DETAIL_FADE[1] * SCALE / DETAIL_RATIO, DETAIL_FADE[1] * SCALE
+    args = (base, detail, 3, SCALE, STRENGTH, 37.0, (12.0, -1.0, 4.0), LAYER)
+    sharp = ref.detail_density(d, points, *args)
+    for footprint in (0.0, 0.5 * fine_gone, fine_gone, 0.5 * base_gone, base_gone, 1e6):
+        got = probe(gpu, noise, points, d, 3, footprint=footprint)
+        want = ref.detail_density(d, points, *args, footprint=footprint)
+        assert np.abs(got - want).max() < 0.015 and np.abs(got - want).mean() < 1.5e-3, footprint
+        if footprint == fine_gone:     # the fine band is gone: as with the shape band alone
+            assert np.allclose(got, probe(gpu, noise, points, d, 2, footprint=footprint), atol=1e-6)
+        if footprint >= base_gone:
+            assert np.allclose(got, d, atol=1e-6), "no noise left: the smooth density itself"
+    half = ref.detail_density(d, points, *args, footprint=0.5 * base_gone)
+    assert np.abs(half - d).mean() > 0.01 and np.abs(half - sharp).mean() > 0.01, "a gradual fade"
 
 
 def test_detail_density_at_the_extremes(gpu, ctx, rng):

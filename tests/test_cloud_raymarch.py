@@ -222,3 +222,21 @@ def test_with_frozen_clouds_and_a_still_camera_the_detail_is_the_same_every_fram
     app.run_frames(3, 1 / 30)
     assert np.abs(linear(app)[..., 3] - first[..., 3]).mean() > 1e-4, "with wind the detail scrolls"
     app.close()
+
+
+def test_detail_finer_than_a_pixel_fades_out_instead_of_aliasing(gpu, ctx):
+    """From the same view the detail shows where its noise is many pixels wide, and is gone (the image
+    of the smooth density) where a pixel spans a quarter of its tile (noise.py DETAIL_FADE): a far
+    cloud keeps its shape instead of stripes and crawling jaggies."""
+    app = scene(gpu, np.minimum(volume(), 1.0), detail_octaves=3, detail_scale=8.0, wind=(0.0, 0.0, 0.0))
+    aim(app, CENTER + (-150.0, 60.0, -580.0))         # ~600 m: a pixel spans ~5 m
+    march = next(p for p in app.plugins if isinstance(p, RaymarchCloudsPlugin))
+    coarse = linear(app)
+    march.configure(detail_octaves=0)
+    smooth = linear(app)
+    march.configure(detail_octaves=3, detail_scale=0.5)   # 10 m tiles: a pixel spans half of one
+    fine = linear(app)
+    app.close()
+    assert smooth[..., 3].max() > 0.5, "the cloud is in view"
+    assert np.abs(coarse[..., 3] - smooth[..., 3]).mean() > 1e-3, "8-cell billows show at this distance"
+    assert np.abs(fine - smooth).max() < 1e-4, "noise finer than the pixel leaves the smooth density"

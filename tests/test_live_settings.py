@@ -432,7 +432,7 @@ _TEMPORAL = configure_first(resolution=2, reprojection=True)
 SPECS["cloud_raymarch"] = Spec(
     _raymarch_scene, RaymarchCloudsPlugin, look((160.0, 360.0, -300.0), target=(160.0, 360.0, 160.0), far=6000.0),
     dict(base_altitude=250.0, steps=2, step=4.0, step_growth=0.05, empty_space_skipping=False, min_transmittance=0.5,
-         jitter=True, resolution=2, reprojection=False, history_clamp=0.0, motion_limit=1.0, detail_octaves=2, detail_scale=300.0, detail_strength=0.5,
+         jitter=True, resolution=2, reprojection=False, history_clamp=0.0, motion_limit=1.0, detail_octaves=1, detail_scale=300.0, detail_strength=0.5,
          sun_steps=2, wind=(400.0, 0.0, 0.0), ms_attenuation=0.9, ms_contribution=1.0, ms_eccentricity=0.0,
          far_field=False, far_distance=1000.0, far_step_growth=0.3, enabled=False),
     observe={"resolution": resource_size(RAYMARCH_LOW_COLOR), "reprojection": raymarch_history,

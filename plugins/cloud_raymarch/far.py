@@ -8,11 +8,9 @@ replaces it (:meth:`atmos.plugins.cloud_far_field.plugin.CloudFarFieldPlugin.dra
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from atmos.plugins.cloud_raymarch.noise import COVERAGE
+from atmos.plugins.cloud_raymarch.noise import COVERAGE, pixel_angle
 
 FAR_BASE, FAR_BASE_SOFT, FAR_TOP_SOFT = 0.1, 0.05, 0.3     # far.glsl's profile (height fractions)
 FAR_BODY = COVERAGE                                        # a far cloud body's density (detail.glsl's K)
@@ -39,7 +37,7 @@ def far_uniforms(march, far, layout, view, sun_dir) -> dict:
     """The far field's march uniforms: ``march`` RaymarchCloudSettings, ``far`` CloudFarFieldSettings,
     ``layout`` the march's layer layout, ``view`` the SceneView, ``sun_dir`` unit toward the sun."""
     base, height = float(layout.lo[1]), float(layout.hi[1] - layout.lo[1])
-    pixel = 2.0 * math.tan(view.camera.fov_y / 2) / max(view.size[1], 1)
+    pixel = pixel_angle(view)
     return {"far_distance": float(march.far_distance), "far_growth": float(march.far_step_growth),
             "far_lod_scale": float(far.size / far.tile_size * pixel), "far_band": (base, height),
             "far_body": float(FAR_BODY),

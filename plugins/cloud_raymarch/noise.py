@@ -15,7 +15,8 @@ the base tile ``scale`` in m (``detail_scale`` cells × the cell; the detail til
 ``scale / DETAIL_RATIO``: at the default 8 cells of 40 m, Perlin–Worley billows of 80 m (R, G) down
 to 20 m (A) and detail cells of 20, 10 and 5 m), ``strength`` (0..1, 0 = d itself) and, as the define
 ``DETAIL_OCTAVES`` (:func:`detail_defines`), ``detail_octaves`` (0..3: 0 no read, 1 and 2 one RGBA8
-3D read per call, 3 two). The wind (m/s) and the time (s) scroll both textures.
+3D read per call, 3 two). The wind (m/s) and the time (s) scroll both textures. Each band fades out
+as the pixel grows past its features (:func:`detail_fade`), so far clouds keep the smooth shape.
 """
 from __future__ import annotations
 
@@ -36,6 +37,7 @@ WORLEY_RANGE = (0.2, 0.75)   # 8 bits and the erosion thresholds span [0, 1] (~0
 COVERAGE = 0.6              # detail.glsl's K: densities at or above it are a cloud's body, never eroded
 BAND_STRENGTH = 0.5          # the detail band (octave 3) erodes by BAND_STRENGTH × detail_strength
 BAND_WIDTH = 0.25            # W: at full strength the shape band remaps coverage e..e + W to 0..1
+DETAIL_FADE = (1 / 16, 1 / 4)   # a band's strength fades from 1 to 0 as the pixel's width grows over this many of its tiles
 BASE_LAYOUT = (0, 4, (4, 8, 16))     # (texture index, Perlin frequency, Worley FBM frequencies)
 DETAIL_LAYOUT = (1, 0, (2, 4, 8))    # Perlin frequency 0: no Perlin–Worley; A = 1
 BASE_UNIT, DETAIL_UNIT = 12, 13      # texture units bind() uses (5..8: the far field's octaves)
@@ -54,6 +56,19 @@ def detail_offsets(time: float, wind, scale: float) -> tuple[np.ndarray, np.ndar
 def band_width(strength: float) -> float:
     """w = 1 - (1 - BAND_WIDTH) strength: the width the shape band remaps (1 at strength 0: d itself)."""
     return 1.0 - (1.0 - BAND_WIDTH) * float(strength)
+
+
+def detail_fade(footprint, tile):
+    """detail.glsl's keep: the share of a noise band's strength left where a pixel is ``footprint`` m
+    wide, for the band's ``tile`` (m): 1 up to DETAIL_FADE[0] tiles, 0 from DETAIL_FADE[1] (noise
+    finer than the pixel would alias: stripes and crawling edges on far clouds), linear between."""
+    lo, hi = DETAIL_FADE
+    return 1.0 - np.clip((np.asarray(footprint, np.float64) / tile - lo) / (hi - lo), 0.0, 1.0)
+
+
+def pixel_angle(view) -> float:
+    """A full-res pixel's angle (rad) for the SceneView ``view``: its width per metre of distance."""
+    return 2.0 * math.tan(view.camera.fov_y / 2) / max(view.size[1], 1)
 
 
 def detail_defines(octaves: int) -> dict:

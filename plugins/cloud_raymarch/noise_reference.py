@@ -27,7 +27,8 @@ import numpy as np
 
 from atmos.hashing import hash_counter, stream_key
 from atmos.plugins.cloud_raymarch.noise import (BAND_STRENGTH, BASE_LAYOUT, COVERAGE, DETAIL_LAYOUT, DETAIL_RATIO, NOISE_RULE,
-                                                PERLIN_GAIN, PW_RANGE, WORLEY_RANGE, band_width, detail_offsets)
+                                                PERLIN_GAIN, PW_RANGE, WORLEY_RANGE, band_width, detail_fade,
+                                                detail_offsets)
 from atmos.plugins.fog.noise import periodic_noise, sample_repeat_trilinear
 
 WORLEY_WEIGHTS = (0.625, 0.25, 0.125)
@@ -112,12 +113,13 @@ def erode(x, e) -> np.ndarray:
 
 
 def detail_density(d, p, base, detail, octaves: int, scale: float, strength: float,
-                   time: float = 0.0, wind=(0.0, 0.0, 0.0), layer=(0.0, 1.0)) -> np.ndarray:
+                   time: float = 0.0, wind=(0.0, 0.0, 0.0), layer=(0.0, 1.0), footprint=0.0) -> np.ndarray:
     """What ``detail_density(d, p)`` returns for densities ``d`` (...) at world points ``p`` (..., 3) m,
     with ``base`` and ``detail`` the textures as [x, y, z, channel] arrays in [0, 1] (as read back) and
     ``layer`` the layer's (base y, height) in m, ``scale`` the base tile in m: 0 octaves d itself, else
     clamp(d, 0, 1) grown and carved by the shape noise and eroded by the detail noise as
-    ``detail.glsl`` describes."""
+    ``detail.glsl`` describes, each band's strength scaled by :func:`detail_fade` of ``footprint``
+    (the pixel's width in m at each point, (...) or a number)."""
     if octaves == 0:
         return np.asarray(d, np.float64)
     x = np.clip(np.nan_to_num(np.asarray(d, np.float64)), 0.0, 1.0)
@@ -131,10 +133,12 @@ def detail_density(d, p, base, detail, octaves: int, scale: float, strength: flo
     if octaves >= 2:
         fbm = n[..., 1:] @ np.array(WORLEY_WEIGHTS)
         shape = np.clip((shape + 1.0 - fbm) / (2.0 - fbm), 0.0, 1.0)
-    w = band_width(strength)         # the shape band: a threshold e and a sharp remap (the dilation)
-    out = np.clip((out - np.minimum(strength * (1.0 - shape) * (0.45 + 0.55 * h), 1.0 - w)) / w, 0.0, 1.0)
+    keep = detail_fade(footprint, scale)
+    w = 1.0 - (1.0 - band_width(strength)) * keep   # the shape band: a threshold e and a sharp remap (the dilation)
+    out = np.clip((out - np.minimum(keep * strength * (1.0 - shape) * (0.45 + 0.55 * h), 1.0 - w)) / w, 0.0, 1.0)
     if octaves >= 3:
         v = p * (DETAIL_RATIO / scale) - off_fine
         fine = sum(w * sample_repeat_trilinear(detail[..., c], v) for c, w in enumerate(WORLEY_WEIGHTS))
-        out = erode(out, BAND_STRENGTH * strength * (fine + (1.0 - 2.0 * fine) * np.clip(3.0 * h, 0.0, 1.0)))
+        keep_fine = detail_fade(footprint, scale / DETAIL_RATIO)
+        out = erode(out, keep_fine * BAND_STRENGTH * strength * (fine + (1.0 - 2.0 * fine) * np.clip(3.0 * h, 0.0, 1.0)))
     return np.where(x >= COVERAGE, x, COVERAGE * out)

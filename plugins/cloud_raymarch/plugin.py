@@ -26,6 +26,7 @@ from atmos.plugin import Plugin
 from atmos.plugins.cloud_far_field.layer import FAR_FIELD
 from atmos.plugins.cloud_far_field.plugin import CloudFarFieldPlugin
 from atmos.plugins.cloud_raymarch.far import far_uniforms
+from atmos.plugins.cloud_raymarch.noise import pixel_angle
 from atmos.plugins.cloud_raymarch.settings import REFERENCE, RaymarchCloudSettings
 from atmos.plugins.cloud_raymarch.temporal import TemporalClouds, jitter
 from atmos.plugins.cloud_render.binding import bind_volume, clamp_sampler, unbind_volume
@@ -196,7 +197,8 @@ class RaymarchPass(RenderPass):
                 "skip_cells": skip_cells, "max_skips": int(sum(grid)) + 3, "factor": s.resolution,
                 "sample_offset": tuple(offset), "frame_size": tuple(int(v) for v in view.size),
                 "jitter": int(s.jitter), "frame_index": self.frame_index % 64,
-                "sun_march": tuple(float(v) for v in sun * SUN_SPACING * cell.min())}
+                "sun_march": tuple(float(v) for v in sun * SUN_SPACING * cell.min()),
+                "pixel_angle": pixel_angle(view)}
 
     def execute(self, frame: PassContext) -> None:
         s, view = self.plugin.settings, frame.view

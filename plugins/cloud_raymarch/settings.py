@@ -46,7 +46,8 @@ class RaymarchCloudSettings(CloudLightSettings):
     toward this frame's upsampled samples linearly, gone at this motion (smaller: less smear on fast
     turns, blurrier while moving; free); see :mod:`.temporal`. ``detail_octaves``: noise channels the density is eroded by (0 = off, 1..3; each one
     two more texture fetches per sample), ``detail_scale`` (cells of the smallest side per base-noise tile, 0.5..1e4; 8: billows 2 cells
-    across; free) and
+    across; free; each band fades out where a pixel spans 1/16..1/4 of its tile, so far clouds
+    keep their smooth shape instead of aliased stripes and skip the noise reads) and
     ``detail_strength`` (0..1): see ``shaders/cloud_raymarch/detail.glsl``. ``sun_steps``: samples
     of the eroded-minus-smooth density toward the sun (0..16; 0 = the shading volume's transmittance
     alone; each costs one density and one detail lookup per sample). Cost of the march at 640×360 on

@@ -2,7 +2,7 @@
 // plugins/cloud_raymarch/noise_reference.py detail_density. The textures and every uniform here are
 // set by DetailNoise.bind (plugins/cloud_raymarch/noise.py); only those the program uses are set.
 //
-// detail_density(d, p): the smoothed automaton density d at world point p (m) gives the coverage; with
+// detail_density(d, p, footprint): the smoothed automaton density d at world point p (m) gives the coverage; with
 // DETAIL_OCTAVES 0 d itself, else x = d clamped to [0, 1] (NaN -> 0): where x >= K (detail_coverage,
 // the density of a cloud's body) x itself (interiors stay dense); below it the coverage c = x / K is
 // reshaped by the noise and scaled back by K. h = the height fraction of p in the layer (0 base, 1 top).
@@ -19,6 +19,10 @@
 //         detail_scale / 8, a second 3D read), B = detail_band_strength / strength: wispy strands at
 //         the base (the FBM's cells), cauliflower billows above (its inverse).
 // c = 1 stays 1 (e <= 1 - w; a core is never holed) and the result grows with d.
+// footprint: the pixel's width at p (m). A band's noise finer than the pixel aliases (stripes and
+// crawling jaggies on far clouds), so each band's strength is scaled by keep = detail_fade(footprint in
+// its tiles): 1 up to DETAIL_FADE.x tiles, 0 from DETAIL_FADE.y (noise.py DETAIL_FADE); at 0 the band
+// leaves c unchanged (strength 0: e = 0, w = 1), and with both at 0 no texture is read.
 // Settings behind the uniforms (RaymarchCloudSettings): detail_scale (cells per base tile, bound in m),
 // detail_strength (0..1), detail_octaves (the define), the layer's base and height (m) and the wind
 // (m/s) × time both textures scroll with (the scroll is reduced to [0, 1) tiles on the CPU in
@@ -39,18 +43,24 @@ uniform float detail_band_strength;    // band 3: 0.5 detail_strength
 uniform vec2 detail_layer;             // (base y m, 1 / height m) of the layer
 uniform float detail_coverage;         // K: the density at and above which nothing is eroded
 uniform float detail_band_width;       // w = 1 - (1 - W) strength: the shape band's remap width
+const vec2 DETAIL_FADE = vec2(1.0 / 16.0, 0.25);   // noise.py DETAIL_FADE (pixel footprint in tiles)
+
+float detail_fade(float tiles) {
+    return 1.0 - clamp((tiles - DETAIL_FADE.x) / (DETAIL_FADE.y - DETAIL_FADE.x), 0.0, 1.0);
+}
 
 float detail_erode(float x, float e) {
     e = min(e, 0.98);                         // x = 1 stays 1 (a core is never holed)
     return clamp((x - e) / (1.0 - e), 0.0, 1.0);
 }
 
-float detail_density(float d, vec3 p) {
+float detail_density(float d, vec3 p, float footprint) {
 #if DETAIL_OCTAVES == 0
     return d;
 #else
     float x = d > 0.0 ? min(d, 1.0) : 0.0;
-    if (x >= detail_coverage) return x;
+    float keep = detail_fade(footprint * detail_inv_scale);    // the fine band's keep is never larger
+    if (x >= detail_coverage || keep <= 0.0) return x;
     float c = x / detail_coverage;
     float h = clamp((p.y - detail_layer.x) * detail_layer.y, 0.0, 1.0);
     vec4 n = textureLod(detail_base_noise, fract(p * detail_inv_scale - detail_offset_base), 0.0);
@@ -59,12 +69,13 @@ float detail_density(float d, vec3 p) {
     float fbm = dot(n.gba, vec3(0.625, 0.25, 0.125));
     shape = clamp((shape + 1.0 - fbm) / (2.0 - fbm), 0.0, 1.0);
 #endif
-    float w = detail_band_width;
-    c = clamp((c - min(detail_strength * (1.0 - shape) * (0.45 + 0.55 * h), 1.0 - w)) / w, 0.0, 1.0);
+    float w = 1.0 - (1.0 - detail_band_width) * keep;
+    c = clamp((c - min(keep * detail_strength * (1.0 - shape) * (0.45 + 0.55 * h), 1.0 - w)) / w, 0.0, 1.0);
 #if DETAIL_OCTAVES >= 3
     vec3 f = textureLod(detail_fine_noise, fract(p * detail_inv_scale_fine - detail_offset_fine), 0.0).rgb;
     float fine = dot(f, vec3(0.625, 0.25, 0.125));
-    c = detail_erode(c, detail_band_strength * mix(fine, 1.0 - fine, clamp(3.0 * h, 0.0, 1.0)));
+    float keep_fine = detail_fade(footprint * detail_inv_scale_fine);
+    c = detail_erode(c, keep_fine * detail_band_strength * mix(fine, 1.0 - fine, clamp(3.0 * h, 0.0, 1.0)));
 #endif
     return detail_coverage * c;
 #endif

@@ -49,6 +49,7 @@ uniform int frame_index;
 uniform vec3 sun_march;        // toward the sun, times the sun-march sample spacing (m)
 uniform float far_distance;    // FAR_FIELD: the march ends this far from the camera (m)
 uniform float far_growth;      // FAR_FIELD: the step's growth per metre of distance in the far field
+uniform float pixel_angle;     // a full-res pixel's angle (rad): its width per metre of distance
 
 // Jimenez's interleaved gradient noise, moved each frame (golden-ratio-ish 5.588238 px per frame).
 float sample_jitter(vec2 pixel) {
@@ -59,14 +60,14 @@ float sample_jitter(vec2 pixel) {
 
 // The factor the detail changes the sun transmittance by: exp(-sigma_t * optical depth of the
 // eroded-minus-smooth density over SUN_STEPS samples toward the sun).
-float sun_detail(vec3 p, vec3 extent) {
+float sun_detail(vec3 p, vec3 extent, float footprint) {
 #if SUN_STEPS > 0
     float sum = 0.0;
     for (int k = 0; k < SUN_STEPS; ++k) {
         vec3 q = p + sun_march * (float(k) + 0.5);
         vec3 uvw = (q - layer_min) / extent;
         float d = cloud_density(uvw);
-        sum += detail_density(d, q) - d;
+        sum += detail_density(d, q, footprint) - d;
     }
     return exp(-sigma_t * sum * length(sun_march));
 #else
@@ -176,13 +177,14 @@ void main() {
                 }
             }
 #endif
-            float d = detail_density(dv + df, p);
+            float footprint = pixel_angle * sp;        // the full-res pixel's width here (detail.glsl)
+            float d = detail_density(dv + df, p, footprint);
             if (d <= 0.0) continue;
             float a = 1.0 - exp(-sigma_t * d * dt);
             float w = trans * a;
             vec3 J = vec3(0.0);
             if (dv > 0.0) {
-                float T = min(cloud_transmittance(uvw) * sun_detail(p, extent), 1.0);
+                float T = min(cloud_transmittance(uvw) * sun_detail(p, extent, footprint), 1.0);
                 J = cloud_source_with(uvw, dir, ny, T);
             }
 #if FAR_FIELD
