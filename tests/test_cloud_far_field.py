@@ -8,7 +8,7 @@ from atmos.demo_registry import DemoSettings
 from atmos.gpu import create_headless
 from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
 from atmos.plugins.cloud_far_field.cover import emptiness, fbm_quantiles
-from atmos.plugins.cloud_far_field.reference import volume_cover
+from atmos.plugins.cloud_far_field.reference import column_quantiles, volume_cover
 from atmos.plugins.clouds import CloudSimulation
 from atmos.plugins.clouds.edge import edge_weight
 from atmos.runner import build_app
@@ -37,11 +37,17 @@ def test_sunset_has_clouds_below_9_degrees_around_the_sun_and_cover_matches_nump
         far = next(p for p in app.plugins if isinstance(p, CloudFarFieldPlugin))
         sim = app.resource(CloudSimulation)
         sets = sim.sets()
-        gpu_cover = float(np.frombuffer(far.layer.cover.read(), np.float32)[0])
+        gpu_cover, gpu_columns = far.layer.read_cover()
         sums = [sets.maps_of(s).read_sums()[0] for s in (sets.a, sets.b)]
         expected = volume_cover(sums[0], sums[1], sets.t, sets.a_shift, sim.settings.cover_threshold,
                                 sim.settings.edge_fade)
         assert 0.0 < expected < 1.0 and abs(gpu_cover - expected) < 1e-4
+        # the column-sum quantiles the march's far field takes (cover.comp's histogram: within a bin)
+        columns = column_quantiles(sums[0], sums[1], sets.t, sets.a_shift, sim.settings.edge_fade)
+        bin_width = sets.shape[1] / 256
+        assert columns[-1] > 1.0 and np.all(np.diff(gpu_columns) >= 0.0)
+        assert np.abs(gpu_columns - columns).max() < 1.5 * bin_width, np.c_[gpu_columns, columns]
+        assert abs(np.mean(gpu_columns > sim.settings.cover_threshold) - expected) < 2.0 / 32   # covered at the same ranks
         cam = app.resource(Camera)
         with_far = app.read_linear()
         far.configure(enabled=False)

@@ -240,3 +240,21 @@ def test_detail_finer_than_a_pixel_fades_out_instead_of_aliasing(gpu, ctx):
     assert smooth[..., 3].max() > 0.5, "the cloud is in view"
     assert np.abs(coarse[..., 3] - smooth[..., 3]).mean() > 1e-3, "8-cell billows show at this distance"
     assert np.abs(fine - smooth).max() < 1e-4, "noise finer than the pixel leaves the smooth density"
+
+
+@pytest.mark.parametrize("resolution", [1, 2])
+def test_a_still_camera_over_still_clouds_gives_a_still_picture_with_jitter_on(gpu, ctx, resolution):
+    """The first-sample jitter is a pattern of the pixel, fixed in time: the resolve keeps each pixel's
+    latest sample (no averaging), so an offset that moved per frame only made a still picture flicker."""
+    app = scene(gpu, volume(), resolution=resolution, jitter=True, step=1.0, step_growth=0.0)
+    aim(app, (80.0, 470.0, -150.0))
+    frames = [linear(app) for _ in range(resolution ** 2 + 3)]
+    app.close()
+    plain = scene(gpu, volume(), resolution=resolution, jitter=False, step=1.0, step_growth=0.0)
+    aim(plain, (80.0, 470.0, -150.0))
+    midpoints = [linear(plain) for _ in range(resolution ** 2 + 1)][-1]
+    plain.close()
+    still = frames[-1]
+    assert np.abs(still - midpoints).max() > 1e-3, "the jitter is in effect (coarse steps, other sample points)"
+    change = max(np.abs(b - a).max() for a, b in zip(frames[resolution ** 2:], frames[resolution ** 2 + 1:]))
+    assert change < 1e-6 * max(still[..., :3].max(), 1e-6), f"a still scene flickers: max |frame - previous| {change:.3g}"

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.plugins.cloud_far_field.cover import level_table
+from atmos.plugins.cloud_far_field.cover import QUANTILES, level_table
 from atmos.plugins.cloud_render.light import light_uniforms
 from atmos.plugins.clouds.sets import CloudSets
 from atmos.plugins.sky_layer.octaves import OctaveTextures
@@ -39,7 +39,7 @@ class FarFieldLayer:
         self.gpu, self.plugin = gpu, plugin
         self.octaves = OctaveTextures(gpu)
         self.cover_program = gpu.program(compute_shader="cloud_far_field/cover.comp")
-        self.cover = gpu.track(gpu.ctx.buffer(reserve=4))
+        self.cover = gpu.track(gpu.ctx.buffer(reserve=4 * (1 + QUANTILES)))   # cover, column_quantiles
 
     @property
     def settings(self):
@@ -54,7 +54,8 @@ class FarFieldLayer:
         self.measure_cover(sim)
 
     def measure_cover(self, sim: CloudSets) -> None:
-        """The simulation's edge-weighted cover into the 4-byte buffer the shaders read."""
+        """The simulation's edge-weighted cover and column-sum quantiles into the buffer the shaders
+        read (float32: cover, then QUANTILES column sums in cells; :meth:`read_cover`)."""
         c = self.cover_program
         sim.maps_of(sim.a).sums.use(0)
         sim.maps_of(sim.b).sums.use(1)
@@ -62,9 +63,15 @@ class FarFieldLayer:
         c["a_shift"].value = sim.a_shift[0], sim.a_shift[2]
         c["threshold"].value = float(sim.settings.cover_threshold)
         c["edge_fade"].value = float(sim.settings.edge_fade)
+        c["max_sum"].value = float(sim.shape[1])
         self.cover.bind_to_storage_buffer(0)
         c.run(1)
         self.gpu.ctx.memory_barrier()
+
+    def read_cover(self) -> tuple[float, np.ndarray]:
+        """(cover, (QUANTILES,) column-sum quantiles) as last measured (a GPU → CPU copy: tests and tools)."""
+        values = np.frombuffer(self.cover.read(), np.float32).astype(np.float64)
+        return float(values[0]), values[1:]
 
     def use(self, program, view, sim: CloudSets) -> None:
         """Bind the textures (units 5..8), the cover (storage buffer 0) and set field.glsl's uniforms."""

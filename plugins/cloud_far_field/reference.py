@@ -17,11 +17,27 @@ def volume_cover(sums_a, sums_b, t: float, a_shift, threshold: float, fade: floa
     return float((w * (sums > threshold)).sum() / max(w.sum(), 1e-30))
 
 
-def far_field_density(xz, octaves, offsets, tile_size: float, quantiles, cover: float, softness: float) -> np.ndarray:
-    """d.x (...,) of ``cloud_far_field/field.glsl`` at world ``xz`` (..., 2), mip 0: ``octaves`` the four
-    downloaded textures (size, size, 4) [x, y, channel] (``OctaveTextures.download``), ``offsets`` (4, 2)
-    the drift in tiles; bilinear with repeat, texel i centred at (i + 0.5)/size."""
-    from atmos.plugins.cloud_far_field.cover import emptiness
+def column_quantiles(sums_a, sums_b, t: float, a_shift, fade: float, count: int = 33) -> np.ndarray:
+    """(count,) edge-weighted quantiles 0 .. 1 of the column sums of mix(A, B, t) (``cover.comp``'s
+    column_quantiles, which bins the sums into a histogram: within one bin of these): 0 inside the
+    empty columns' share, else the weighted empirical distribution of the others, linear between them."""
+    sums = (1.0 - t) * shifted(np.asarray(sums_a, np.float64), a_shift) + t * np.asarray(sums_b, np.float64)
+    n = np.array(sums.shape)
+    uv = np.stack(np.meshgrid(*((np.arange(m) + 0.5) / m for m in n), indexing="ij"), -1)
+    w, s = np.round(edge_weight(uv, fade) * 1024.0).ravel(), sums.ravel()     # cover.comp's fixed point
+    full = (s > 1e-6) & (w > 0)
+    total, empty = w.sum(), w[(s <= 1e-6)].sum()
+    order = np.argsort(s[full])
+    values, cum = s[full][order], empty + np.cumsum(w[full][order])
+    target = total * np.linspace(0.0, 1.0, count)
+    out = np.interp(target, np.concatenate([[empty], cum]), np.concatenate([[0.0], values]))
+    return np.where(target <= empty, 0.0, out) if total > 0 else np.zeros(count)
+
+
+def field_fbm(xz, octaves, offsets, tile_size: float) -> np.ndarray:
+    """The fbm (...,) of ``cloud_far_field/field.glsl`` at world ``xz`` (..., 2), mip 0: ``octaves`` the
+    four downloaded textures (size, size, 4) [x, y, channel] (``OctaveTextures.download``), ``offsets``
+    (4, 2) the drift in tiles; bilinear with repeat, texel i centred at (i + 0.5)/size."""
     from atmos.plugins.sky_layer.octaves import WEIGHTS
     xz = np.asarray(xz, np.float64)
     fbm = np.zeros(xz.shape[:-1])
@@ -34,5 +50,39 @@ def far_field_density(xz, octaves, offsets, tile_size: float, quantiles, cover: 
         at = lambda di, dk: plane[(i0[..., 0] + di) % n, (i0[..., 1] + dk) % n]
         fbm += w * ((1 - f[..., 0]) * (1 - f[..., 1]) * at(0, 0) + f[..., 0] * (1 - f[..., 1]) * at(1, 0)
                     + (1 - f[..., 0]) * f[..., 1] * at(0, 1) + f[..., 0] * f[..., 1] * at(1, 1))
+    return fbm
+
+
+def field_rank(fbm, quantiles) -> np.ndarray:
+    """field.glsl's field_rank: the fraction of the layer's fbm at or below ``fbm`` (linear between the
+    ``quantiles``, 0 below the first, 1 above the last)."""
+    q = np.asarray(quantiles, np.float64)
+    return np.interp(fbm, q, np.linspace(0.0, 1.0, len(q)))
+
+
+def column_at_rank(rank, columns) -> np.ndarray:
+    """field.glsl's far_quantile: the volume's column sum (cells) at ``rank`` (...,), linear between
+    its ``columns`` quantiles (:func:`column_quantiles`)."""
+    c = np.asarray(columns, np.float64)
+    return np.interp(np.clip(rank, 0.0, 1.0), np.linspace(0.0, 1.0, len(c)), c)
+
+
+MIN_SLANT = 0.1     # far.frag's horizon cap on the slant
+
+
+def far_field_alpha(xz, dir_y, octaves, offsets, tile_size: float, quantiles, columns, column_tau: float,
+                    thickness: float = 1.0) -> np.ndarray:
+    """far.frag's opacity (...,) at world ``xz`` (..., 2) seen with view direction height ``dir_y``, mip 0,
+    before the edge and horizon fades: vertical optical depth thickness · column_tau (sigma_t · cell
+    height) · the volume's column sum at the point's rank, along the slant 1 / max(|dir_y|, MIN_SLANT)."""
+    rank = field_rank(field_fbm(xz, octaves, offsets, tile_size), quantiles)
+    tau = float(thickness) * float(column_tau) * column_at_rank(rank, columns)
+    return 1.0 - np.exp(-tau / np.maximum(np.abs(dir_y), MIN_SLANT))
+
+
+def far_field_density(xz, octaves, offsets, tile_size: float, quantiles, cover: float, softness: float) -> np.ndarray:
+    """d.x (...,) of ``cloud_far_field/field.glsl`` at world ``xz`` (..., 2), mip 0 (:func:`field_fbm`'s
+    arguments), remapped from the threshold that leaves ``cover`` of the layer clouded."""
+    from atmos.plugins.cloud_far_field.cover import emptiness
     e = emptiness(quantiles, cover)
-    return (np.clip(fbm, e, e + softness) - e) / softness
+    return (np.clip(field_fbm(xz, octaves, offsets, tile_size), e, e + softness) - e) / softness

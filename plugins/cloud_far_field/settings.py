@@ -15,9 +15,13 @@ class CloudFarFieldSettings(CheckedSettings):
 
     Its cover follows the simulation's (the covered fraction of the volume's columns, measured on
     the GPU each frame); ``softness`` is the fbm range over which a column goes from clear to
-    cloud. ``thickness``: how fast coverage rises with the remapped density (α = 1 − exp(−thickness·d)).
-    ``optical_depth``: optical depth of a full column, vertically and toward the sun (its light
-    comes from the cloud medium's own model, ``cloud_render/volume.glsl``). ``tile_size``: metres
+    cloud. ``thickness``: a scale (default 1) on the layer's opacity, which comes from the volume: a
+    point whose fbm has rank r in the layer gets the volume's column sum at the same rank (its
+    edge-weighted column-sum quantiles), vertical optical depth τ = thickness · sigma_t · cell height ·
+    that sum, seen along the view's slant (α = 1 − exp(−τ / |dir.y|), capped near the horizon); 0: no far field.
+    Its light comes from the cloud medium's own model (``cloud_render/volume.glsl``) with the same
+    column (toward the sun along the sun's slant). ``optical_depth``: optical depth of a full
+    remapped column in the ground shadows (:mod:`atmos.plugins.cloud_shadows`). ``tile_size``: metres
     one octave-texture repeat covers; ``wind``: None (the default) moves the pattern with the
     simulated clouds (the distance the weather's wind has carried them, ``CloudSets.wind_travel``),
     so volume and far field drift together; an (x, z) tuple drifts it at that many m/s with the App
@@ -28,7 +32,7 @@ class CloudFarFieldSettings(CheckedSettings):
     """
 
     softness: float = 0.2
-    thickness: float = 8.0
+    thickness: float = 1.0
     optical_depth: float = 8.0
     tile_size: float = 8000.0
     wind: tuple | None = None
@@ -44,7 +48,7 @@ class CloudFarFieldSettings(CheckedSettings):
         o = _OWNER
         self.store(dict(
             softness=check_num(o, "softness", self.softness, 1e-3, 1.0),
-            thickness=check_num(o, "thickness", self.thickness, 0.0),
+            thickness=check_num(o, "thickness", self.thickness, 0.0, 1e3),
             optical_depth=check_num(o, "optical_depth", self.optical_depth, 0.0, 1e3),
             tile_size=check_num(o, "tile_size", self.tile_size, 1.0, 1e7),
             wind=check_vec(o, "wind", self.wind, 2, optional=True),

@@ -5,19 +5,26 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.plugins.cloud_far_field.reference import far_field_density
-from atmos.plugins.cloud_raymarch.far import FAR_BASE, FAR_BASE_SOFT, FAR_BODY, FAR_TOP_SOFT, SUN_STEPS, sun_steps
+from atmos.plugins.cloud_far_field.reference import column_at_rank, field_fbm, field_rank
+from atmos.plugins.cloud_raymarch.far import FAR_BASE, FAR_BASE_SOFT, FAR_BODY, FAR_MAX, FAR_TOP_SOFT, SUN_STEPS, sun_steps
 from atmos.plugins.cloud_raymarch.reference import integrate, rays
 from atmos.plugins.cloud_render.light import sun_light, unit_direction
 from atmos.shading.medium import source_reference
 
 
-def profile(h, c) -> np.ndarray:
-    """far.glsl's far_profile: the vertical profile at height fraction ``h`` under cover ``c``."""
-    h, c = np.asarray(h, np.float64), np.asarray(c, np.float64)
-    top = FAR_BASE + (1.0 - FAR_BASE) * c
-    p = np.clip((h - FAR_BASE) / FAR_BASE_SOFT, 0, 1) * np.clip((top - h) / FAR_TOP_SOFT, 0, 1)
-    return np.where(c > 0.0, p, 0.0)
+def column(I) -> tuple[np.ndarray, np.ndarray]:
+    """far.glsl's far_column: (top, density factor) of a column ``I`` (profile units)."""
+    I = np.asarray(I, np.float64)
+    x = np.where(I >= 0.5 * FAR_TOP_SOFT, I + 0.5 * FAR_TOP_SOFT, np.sqrt(2.0 * FAR_TOP_SOFT * np.maximum(I, 0.0)))
+    return np.where(I > FAR_MAX, 1.0, FAR_BASE + x), np.maximum(I / FAR_MAX, 1.0)
+
+
+def profile(h, I) -> np.ndarray:
+    """far.glsl's far_profile: the vertical profile at height fraction ``h`` of a column ``I``."""
+    h, I = np.asarray(h, np.float64), np.asarray(I, np.float64)
+    top, factor = column(I)
+    p = factor * np.clip((h - FAR_BASE) / FAR_BASE_SOFT + 0.5, 0, 1) * np.clip((top - h) / FAR_TOP_SOFT, 0, 1)
+    return np.where(I > 0.0, p, 0.0)
 
 
 def above(h, top) -> np.ndarray:
@@ -27,23 +34,27 @@ def above(h, top) -> np.ndarray:
 
 
 class FarField:
-    """The far field's cover as a function of world xz at mip 0: ``field`` a dict of
-    :func:`atmos.plugins.cloud_far_field.reference.far_field_density`'s arguments but ``xz``
-    (octaves, offsets, tile_size, quantiles, cover, softness) and ``light_step_m`` (the channels'
-    spacing toward the sun, m)."""
+    """The far field's columns I (profile units) as a function of world xz at mip 0: the fbm
+    (:func:`atmos.plugins.cloud_far_field.reference.field_fbm` of ``octaves``, ``offsets``,
+    ``tile_size``) ranked among the layer's ``quantiles`` (level 0), the volume's column sum at that
+    rank (``columns``: its QUANTILES column-sum quantiles in cells, FarFieldLayer.read_cover) times
+    ``amount`` (far.py far_amount); ``light_step_m`` the channels' spacing toward the sun (m)."""
 
-    def __init__(self, light_step_m: float, **field):
-        self.field, self.light_step_m = field, float(light_step_m)
+    def __init__(self, light_step_m: float, *, octaves, offsets, tile_size: float, quantiles, columns, amount: float):
+        self.light_step_m, self.amount = float(light_step_m), float(amount)
+        self.field = dict(octaves=octaves, offsets=offsets, tile_size=tile_size)
+        self.quantiles, self.columns = np.asarray(quantiles, np.float64), np.asarray(columns, np.float64)
 
-    def cover(self, xz) -> np.ndarray:
-        return far_field_density(xz, **self.field)
+    def column(self, xz) -> np.ndarray:
+        rank = field_rank(field_fbm(xz, **self.field), self.quantiles)
+        return self.amount * column_at_rank(rank, self.columns)
 
     def channels(self, xz, sun_dir) -> np.ndarray:
-        """(..., 4): the cover at xz and 1..3 light steps toward the sun (the baked channels)."""
+        """(..., 4): the column at xz and 1..3 light steps toward the sun (the baked channels)."""
         s = np.asarray(sun_dir, np.float64)[[0, 2]]
         n = np.linalg.norm(s)
         shift = s / n * self.light_step_m if n > 1e-6 else np.zeros(2)
-        return np.stack([self.cover(np.asarray(xz, np.float64) + k * shift) for k in range(4)], -1)
+        return np.stack([self.column(np.asarray(xz, np.float64) + k * shift) for k in range(4)], -1)
 
 
 def far_source(field: FarField, medium, settings, p, dirs, band, sun) -> np.ndarray:
@@ -58,8 +69,8 @@ def far_source(field: FarField, medium, settings, p, dirs, band, sun) -> np.ndar
         i = min(int(x), 2)
         depth += profile(h + (k + 0.5) * rise, c[:, i] + (c[:, i + 1] - c[:, i]) * (x - i))
     T = np.exp(-medium.sigma_t * FAR_BODY * ds * depth)
-    top, hb = FAR_BASE + (1.0 - FAR_BASE) * c[:, 0], np.maximum(h, FAR_BASE)
-    k = medium.sigma_t * FAR_BODY * band[1]
+    (top, factor), hb = column(c[:, 0]), np.maximum(h, FAR_BASE)
+    k = medium.sigma_t * FAR_BODY * band[1] * factor
     up, down = k * above(hb, top), k * (above(FAR_BASE, top) - above(hb, top))
     sun_color, ambient = sun_light(sun)
     return source_reference(medium, settings, T, up, down, dirs @ sun_dir, dirs[:, 1], sun_color, ambient, sun_dir)
@@ -81,7 +92,7 @@ def far_march_reference(field: FarField, medium, settings, band, camera, sun, si
     step_base = settings.step * float(np.min(medium.cell_size))
 
     def sample(i, p):
-        rho = FAR_BODY * profile((p[:, 1] - band[0]) / band[1], field.cover(p[:, [0, 2]]))
+        rho = FAR_BODY * profile((p[:, 1] - band[0]) / band[1], field.column(p[:, [0, 2]]))
         return rho, far_source(field, medium, settings, p, dirs[i], band, sun)
 
     return integrate(pos, dirs, enter, leave, settings.steps, step_base, settings.far_step_growth,

@@ -196,7 +196,7 @@ class RaymarchPass(RenderPass):
                 "min_transmittance": s.min_transmittance, "skipping": int(s.empty_space_skipping),
                 "skip_cells": skip_cells, "max_skips": int(sum(grid)) + 3, "factor": s.resolution,
                 "sample_offset": tuple(offset), "frame_size": tuple(int(v) for v in view.size),
-                "jitter": int(s.jitter), "frame_index": self.frame_index % 64,
+                "jitter": int(s.jitter),
                 "sun_march": tuple(float(v) for v in sun * SUN_SPACING * cell.min()),
                 "pixel_angle": pixel_angle(view)}
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.plugins.cloud_render.particle import centre_tau, footprint
+from atmos.plugins.cloud_render.particle import centre_tau, footprint, screen_axes
 from atmos.plugins.cloud_render.segments import unpack
 from atmos.shading.medium import ambient_profile, mean_cosine, octave_weights
 from atmos.shading.columns import column_reference, columns_at
@@ -80,7 +80,7 @@ def shifted(volume: np.ndarray, shift) -> np.ndarray:
 def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, uniforms: dict, view_proj,
                     light: dict, a_shift=(0, 0, 0)) -> dict:
     """Arrays over the vertices of every segment (gi, j, gk, packed level and span), in order: ``position`` (n, 4),
-    ``size``, ``octaves`` (n, 4), ``ambient`` (n, 3), ``center`` (n, 3), ``radius``, ``tau``, ``coverage``,
+    ``size``, ``octaves`` (n, 4), ``ambient`` (n, 3), ``center`` (n, 3), ``radius``, ``tau``, ``stretch``, ``coverage``,
     ``visible``. ``trans_a``/``trans_b`` None: no shading (T = 1). ``light``: the light uniforms
     (:func:`atmos.plugins.cloud_render.light.light_uniforms`). ``a_shift``: A's cell for B's cell c is
     c + a_shift (zero past A's edge for the cell sums; clamp-to-edge for the sampled light, as the GPU)."""
@@ -141,8 +141,9 @@ def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, 
     ambient = (sky + ground) + h * (sky - ground)
     clip = np.concatenate([world, np.ones((len(c), 1))], 1) @ np.asarray(view_proj, np.float64).T
     diameter = s * u["base_diameter"]
-    conic, k, det = footprint(cells_var, u["cell_size"], 0.5 * diameter, u["camera_right"], u["camera_up"])
-    px = diameter * u["pixel_scale"] / np.maximum(clip[:, 3], 1e-6)
+    axis_x, axis_y, stretch = screen_axes(ray, u["camera_right"], u["camera_up"], u["near"])
+    conic, k, det = footprint(cells_var, u["cell_size"], 0.5 * diameter, axis_x, axis_y)
+    px = stretch * diameter * u["pixel_scale"] / np.maximum(clip[:, 3], 1e-6)
     near, far = u["near"], u["far"]                 # depth-tested at its front: the centre a radius nearer
     front = np.maximum(clip[:, 3] - 0.5 * diameter, near)
     ndc = np.minimum((far + near) / (far - near) - 2.0 * far * near / ((far - near) * front), 1.0)
@@ -153,7 +154,8 @@ def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, 
             "ambient": np.where(visible[:, None], ambient, 0.0),
             "center": np.where(visible[:, None], world, 0.0),
             "radius": np.where(visible, 0.5 * diameter, 0.0),
-            "tau": np.where(visible, centre_tau(u["tau_scale"] * total, 0.5 * diameter, det, k), 0.0),
+            "tau": np.where(visible, centre_tau(u["tau_scale"] * total, 0.5 * diameter, det, k, stretch), 0.0),
+            "stretch": np.where(visible, stretch, 1.0),
             "conic": np.where(visible[:, None], conic, [1.0, 0.0, 1.0]),
             "falloff": np.where(visible, k, 1.0),
             "coverage": np.where(visible, np.clip(px, 0.0, 1.0) ** 2 *

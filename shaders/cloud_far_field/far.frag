@@ -1,13 +1,17 @@
 #version 430
 // The cloud field beyond the simulated volume (float64 reference: atmos/plugins/cloud_far_field/
 // reference.py). The view ray meets the layer's middle plane y = field_mid_height at the view depth s;
-// where that is in front of the scene, d = far_field_density there (field.glsl), amount = the layer's
-// optical depth toward the sun per field_optical_depth: from the column's middle the sun's ray climbs
-// half the column over a path 1/sun_dir.y times longer (capped like the view, MIN_SLANT), through the
-// mean d of the four light-march samples along it: amount = 0.5 mean(d) / max(sun_dir.y, MIN_SLANT),
-//   alpha = (1 - exp(-thickness d.x / max(|dir.y|, MIN_SLANT))) * (1 - edge weight at the hit) * smoothstep(0, horizon_fade, |ray.y|)
-// lit by the cloud medium's own model (cloud_render/volume.glsl): sun transmittance exp(-optical_depth
-// amount), column optical depth optical_depth d.x (half above, half below). Premultiplied (blend_over).
+// where that is in front of the scene, r = far_field_rank there (field.glsl: the fraction of the
+// layer's fbm below the point's, per light-march channel) and the column takes the volume's own
+// column sum at the same rank (far_quantile: column_quantiles, cover.comp), so it is as thick per
+// cover as the volume, from the medium, with no hand-set opacity:
+//   tau = thickness * column_tau * far_quantile(r)   (column_tau = sigma_t * cell height; four channels)
+//   alpha = (1 - exp(-tau.x / max(|dir.y|, MIN_SLANT))) * (1 - edge weight at the hit) * smoothstep(0, horizon_fade, |ray.y|)
+// (the view crosses the column along its slant, capped at the horizon), lit by the cloud medium's own
+// model (cloud_render/volume.glsl): from the column's middle the sun's ray climbs half the column over
+// a path 1/sun_dir.y times longer (capped like the view), through the mean of the four channels:
+// sun transmittance exp(-0.5 mean(tau) / max(sun_dir.y, MIN_SLANT)); sky light with tau.x half above,
+// half below. Premultiplied (blend_over).
 // frag_distance: (alpha * distance to the hit, alpha), "cloud_distance" when attached (atmos/composition.py).
 #include "lib/view_ray.glsl"
 #include "cloud_far_field/field.glsl"
@@ -44,15 +48,14 @@ void main() {
     float fade = open * w * smoothstep(0.0, horizon_fade, abs(dir.y));
     if (fade <= 0.0) return;
     float lod = log2(max(lod_scale * length(hit - camera_pos) / max(abs(dir.y), 1e-3), 1e-6));
-    vec4 d = far_field_density(hit.xz, lod);
+    vec4 r = far_field_rank(hit.xz, lod);
+    vec4 col = thickness * column_tau * vec4(far_quantile(r.x), far_quantile(r.y), far_quantile(r.z), far_quantile(r.w));
     // (the sky layer's own amount, max(d - SKY_LAYER_RAY, 0) / 4, is a quarter of the vertical depth
     // even for a grazing sun: its tops lit 1.5-2x brighter than the volume's from above at sunset)
-    float amount = 0.5 * dot(d, vec4(0.25)) / max(sun_dir.y, MIN_SLANT);
-    // the view crosses the layer's column obliquely: thickness * d.x is its vertical opacity, the path
-    // through it 1/|dir.y| times longer (capped at the horizon), as the volume's own clouds are seen
-    float alpha = (1.0 - exp(-thickness * d.x / max(abs(dir.y), MIN_SLANT))) * fade;
-    float tau = field_optical_depth * d.x;
-    vec3 light = sun_part(octave_weights(exp(-field_optical_depth * amount), tau), dot(dir, sun_dir))
+    float amount = 0.5 * dot(col, vec4(0.25)) / max(sun_dir.y, MIN_SLANT);
+    float tau = col.x;
+    float alpha = (1.0 - exp(-tau / max(abs(dir.y), MIN_SLANT))) * fade;
+    vec3 light = sun_part(octave_weights(exp(-amount), tau), dot(dir, sun_dir))
                + ambient_source(0.5 * tau, 0.5 * tau, dir.y);
     frag = vec4(light * alpha, alpha);
     frag_distance = vec4(alpha * length(hit - camera_pos), alpha, 0.0, alpha);

@@ -44,17 +44,17 @@ uniform int max_skips;         // skip-map texels a ray can cross
 uniform int factor;            // resolution divisor r
 uniform ivec2 sample_offset;   // the frame's jitter offset o in [0, r)^2
 uniform ivec2 frame_size;      // full-res pixels
-uniform int jitter;            // 1: per-pixel, per-frame first-sample offset; 0: midpoints
-uniform int frame_index;
+uniform int jitter;            // 1: per-pixel first-sample offset, fixed in time; 0: midpoints
 uniform vec3 sun_march;        // toward the sun, times the sun-march sample spacing (m)
 uniform float far_distance;    // FAR_FIELD: the march ends this far from the camera (m)
 uniform float far_growth;      // FAR_FIELD: the step's growth per metre of distance in the far field
 uniform float pixel_angle;     // a full-res pixel's angle (rad): its width per metre of distance
 
-// Jimenez's interleaved gradient noise, moved each frame (golden-ratio-ish 5.588238 px per frame).
+// Jimenez's interleaved gradient noise of the full-res pixel, the same every frame: the temporal
+// resolve keeps each pixel's latest sample (it does not average), so an offset that moved per frame
+// only flickered (1.1 levels per frame at resolution 1, 5x the clouds' own change in sunset).
 float sample_jitter(vec2 pixel) {
     if (jitter == 0) return 0.5;
-    pixel += 5.588238 * float(frame_index & 63);
     return fract(52.9829189 * fract(dot(pixel, vec2(0.06711056, 0.00583715))));
 }
 

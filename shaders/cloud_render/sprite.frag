@@ -23,6 +23,7 @@ flat in float v_tau;
 flat in vec3 v_conic;
 flat in float v_falloff;
 flat in float v_coverage;
+flat in float v_stretch;
 out vec4 frag;
 layout(location = 1) out vec4 frag_distance;   // (a·distance, a): "cloud_distance" when attached (atmos/composition.py)
 
@@ -33,7 +34,7 @@ void main() {
     float e = exp(-v_falloff), form = dot(pc * pc, v_conic.xz) + 2.0 * v_conic.y * pc.x * pc.y;
     float profile = max(exp(-0.5 * form) - e, 0.0) / (1.0 - e);
     float a = (1.0 - exp(-v_tau * profile)) * v_coverage * soft;
-    vec2 q = pc * v_radius;
+    vec2 q = pc * (v_radius * v_stretch);          // the point's side spans stretch × diameter (sprite.vert)
     vec3 ray = normalize(v_center + q.x * camera_right + q.y * camera_up - camera_pos);
     frag = vec4((sun_part(v_octaves, dot(ray, sun_dir)) + v_ambient) * a, a);
     frag_distance = vec4(a * length(v_center - camera_pos), a, 0.0, a);   // blends by its own alpha

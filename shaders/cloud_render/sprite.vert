@@ -34,12 +34,14 @@ flat out float v_tau;
 flat out vec3 v_conic;         // the footprint's inverse covariance (xx, xy, yy) on the screen axes, in radii
 flat out float v_falloff;      // k of the profile (exp(-Q/2) - exp(-k)) / (1 - exp(-k)), Q = p^T conic p
 flat out float v_coverage;     // < 1 for sprites smaller than a pixel (their area in pixels) or near the near plane
+flat out float v_stretch;      // the point's half side over the radius, in the screen-parallel plane (>= 1 off-axis)
 
 const vec4 CULLED = vec4(0.0, 0.0, 2.0, 1.0);   // z > w: outside the clip volume
 // per axis (cells²): the trilinear hat's 1/6 around a cell centre, widened to the quadratic B-spline's 1/4
 // (the hat convolved with one cell) so a Gaussian this wide leaves < 1 % ripple on the grid (particle.py)
 const float CELL_VARIANCE = 0.25;
 const float MIN_FALLOFF = 1e-2;         // q this small is a 1 - r² disc: the profile's limit
+const float MAX_OFF_AXIS = 4.0;         // |x/z|, |y/z| of the Jacobian's m (76°): beyond, centres are far off screen
 // A cell's mass is its density times the trilinear hat around its centre; the sprite's light is the
 // mean of J over that mass, not J at the centre (T is convex: a centre sample is too dark on the lit
 // side, by up to ~20 % at an optical depth of 1 per cell). Per axis, the mean of the trilinear T under
@@ -77,6 +79,7 @@ void main() {
     v_falloff = 1.0;
     v_conic = vec3(1.0, 0.0, 1.0);
     v_coverage = 0.0;
+    v_stretch = 1.0;
     gl_PointSize = 1.0;
     gl_Position = CULLED;
     if (any(greaterThanEqual(cell, volume_shape))) return;
@@ -108,23 +111,31 @@ void main() {
     vec3 world = layer_min + center * cell_size;
     vec4 clip = view_proj * vec4(world, 1.0);
     float diameter = float(s) * base_diameter;
-    float px = diameter * pixel_scale / max(clip.w, 1e-6);
+    // the perspective's Jacobian at the sprite (EWA splatting): off-axis a blob's depth projects
+    // sideways, so its footprint and the spacing of its neighbours stretch by up to sqrt(1 + |m|²)
+    // radially; without it the footprint is too narrow there and the grid shows (particle.py)
+    vec3 rel = world - camera_pos, forward = cross(camera_up, camera_right);
+    vec2 m = clamp(vec2(dot(rel, camera_right), dot(rel, camera_up)) / max(dot(rel, forward), near),
+                   -MAX_OFF_AXIS, MAX_OFF_AXIS);       // behind the camera: culled anyway, no degenerate axes
+    float stretch = sqrt(1.0 + dot(m, m));
+    vec3 axis_x = (camera_right - m.x * forward) / stretch, axis_y = (camera_up - m.y * forward) / stretch;
+    float px = stretch * diameter * pixel_scale / max(clip.w, 1e-6);
     float c = clamp(px, 0.0, 1.0);
     v_coverage = c * c * clamp((clip.w - near) / diameter, 0.0, 1.0);   // no pop when the near plane clips it
     gl_PointSize = clamp(px, 1.0, max_point_size);
-    // the footprint: the block's mass (its cells' spread + each cell's, world m², diagonal) on the
-    // screen axes, in sprite radii; the profile is that Gaussian cut to 0 at the iso-line whose long
-    // axis is the radius (particle.py)
+    // the footprint: the block's mass (its cells' spread + each cell's, world m², diagonal) through
+    // the Jacobian (axis_x, axis_y), in the point's half sides (stretch radii); the profile is that
+    // Gaussian cut to 0 at the iso-line whose long axis is the half side (particle.py)
     float radius = 0.5 * diameter;
     vec3 mass_var = (cells_var + CELL_VARIANCE) * cell_size * cell_size / (radius * radius);
-    vec3 cov = vec3(dot(camera_right * camera_right, mass_var), dot(camera_right * camera_up, mass_var),
-                    dot(camera_up * camera_up, mass_var));
+    vec3 cov = vec3(dot(axis_x * axis_x, mass_var), dot(axis_x * axis_y, mass_var), dot(axis_y * axis_y, mass_var));
     float det = cov.x * cov.z - cov.y * cov.y;
     float longest = 0.5 * (cov.x + cov.z) + sqrt(0.25 * (cov.x - cov.z) * (cov.x - cov.z) + cov.y * cov.y);
     float k = max(0.5 / longest, MIN_FALLOFF), e = exp(-k);
     v_conic = vec3(cov.z, -cov.y, cov.x) / det;
     v_falloff = k;
-    v_tau = tau_scale * sum * (1.0 - e) / (2.0 * PI * sqrt(det) * radius * radius * (1.0 - e - k * e));
+    v_tau = tau_scale * sum * (1.0 - e) / (2.0 * PI * sqrt(det) * radius * radius * stretch * (1.0 - e - k * e));
+    v_stretch = stretch;
     vec3 ray = normalize(world - camera_pos);
     vec3 uvw = center / vec3(volume_shape);
     vec2 col = cloud_columns(uvw);
