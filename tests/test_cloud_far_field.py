@@ -7,7 +7,6 @@ from atmos.camera import Camera
 from atmos.demo_registry import DemoSettings
 from atmos.gpu import create_headless
 from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
-from atmos.plugins.cloud_far_field.cover import emptiness, fbm_quantiles
 from atmos.plugins.cloud_far_field.reference import column_quantiles, volume_cover
 from atmos.plugins.clouds import CloudSimulation
 from atmos.plugins.clouds.edge import edge_weight
@@ -21,12 +20,6 @@ def test_edge_weight_is_one_inside_zero_on_the_circle_and_smooth():
     assert np.all(np.diff(w) <= 0.0) and np.abs(np.diff(w)).max() < 0.05       # no step
     assert edge_weight([[1.0, 1.0]], 0.4)[0] == 0.0                             # the square's corners are gone
     assert np.all(edge_weight(np.random.default_rng(0).random((50, 2)), 0.0) == 1.0)
-
-
-def test_emptiness_leaves_the_cover_clouded():
-    q = fbm_quantiles(4, 0)
-    assert emptiness(q, 0.0) == q[-1] and emptiness(q, 1.0) == q[0]
-    assert q[0] < emptiness(q, 0.7) < emptiness(q, 0.3) < q[-1]
 
 
 def test_sunset_has_clouds_below_9_degrees_around_the_sun_and_cover_matches_numpy():

@@ -5,7 +5,7 @@ from 2 km above the layer are binned by where each pixel's ray meets the layer's
 ``r = |2 uv − 1|`` in the volume's footprint (1 on its inscribed circle, where the volume has faded
 out): a band well inside (the volume alone) and a band just outside (the far field alone) must agree.
 With the far field switched off the outside band is empty and the tests fail. The ground shadows:
-the volume's (exp(−σ · column sum)) and the far field's (exp(−optical_depth · d)) mean transmittance
+the volume's (exp(−σ · column sum)) and the far field's (exp(−column_tau · column sum at the rank)) mean transmittance
 agree for the same measured cover.
 """
 import math
@@ -18,8 +18,8 @@ from atmos.demo_registry import DemoSettings
 from atmos.gpu import create_headless
 from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
 from atmos.plugins.cloud_far_field.cover import fbm_quantiles
-from atmos.plugins.cloud_far_field.layer import drift
-from atmos.plugins.cloud_far_field.reference import far_field_density
+from atmos.plugins.cloud_far_field.layer import column_tau, drift
+from atmos.plugins.cloud_far_field.reference import far_optical_depth
 from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
 from atmos.plugins.cloud_render.plugin import CloudRenderPlugin
 from atmos.plugins.cloud_shadows import CloudShadowsPlugin
@@ -205,13 +205,13 @@ def test_volume_and_far_field_shadows_are_as_dark_for_the_same_cover(scenes, dem
     strength = shadows.settings.strength
     volume = float((w * np.exp(-sim.settings.sigma * strength * sums)).sum() / w.sum())
     fs = far.settings
-    cover = float(np.frombuffer(far.layer.cover.read(), np.float32)[0])
+    cover, columns = far.layer.read_cover()
     octaves = [far.layer.octaves.download(k) for k in range(4)]
     g = (np.arange(256) + 0.5) * fs.tile_size / 256
     xz = np.stack(np.meshgrid(g, g, indexing="ij"), -1)
-    d = far_field_density(xz, octaves, drift(fs, sets, 0.0), fs.tile_size, fbm_quantiles(fs.base_frequency, fs.seed),
-                          cover, fs.softness)
-    field = float(np.exp(-fs.optical_depth * strength * d).mean())
+    tau = far_optical_depth(xz, octaves, drift(fs, sets, 0.0), fs.tile_size, fbm_quantiles(fs.base_frequency, fs.seed, fs.size),
+                            columns, column_tau(fs, sets))
+    field = float(np.exp(-strength * tau).mean())
     assert 0.1 < cover < 0.9
     assert abs(volume - field) < 0.06, f"{demo}: mean shadow transmittance {volume:.3f} (volume) vs {field:.3f} (far field)"
 

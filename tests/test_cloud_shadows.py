@@ -296,8 +296,8 @@ def test_shadows_continue_with_the_far_field_beyond_the_volume(gpu, ctx):
     """Past the volume the ground is shadowed by the far field's cover (numpy reference), darker under
     its clouds than under its gaps; without the far field it is fully lit there."""
     from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
-    from atmos.plugins.cloud_far_field.layer import drift
-    from atmos.plugins.cloud_far_field.reference import far_field_density
+    from atmos.plugins.cloud_far_field.layer import column_tau, drift
+    from atmos.plugins.cloud_far_field.reference import far_optical_depth
     from atmos.plugins.cloud_far_field.cover import fbm_quantiles
     size = gpu.size
     params = CloudShadowSettings(base_altitude=60.0, cell_size=(4.0, 2.0, 4.0), sigma=0.5)
@@ -332,12 +332,13 @@ def test_shadows_continue_with_the_far_field_beyond_the_volume(gpu, ctx):
     app.render()
     factor = probe.color[..., 0].astype(np.float64)
     layer = far.layer
-    cover = float(np.frombuffer(layer.cover.read(), np.float32)[0])
+    cover, columns = layer.read_cover()
     octaves = [layer.octaves.download(k) for k in range(4)]
     fs = far.settings
     sets = sim.sets()
-    far_tau = lambda xz: fs.optical_depth * params.strength * far_field_density(
-        xz, octaves, drift(fs, sets, 0.0), fs.tile_size, fbm_quantiles(fs.base_frequency, fs.seed), cover, fs.softness)
+    far_tau = lambda xz: params.strength * far_optical_depth(    # the column the far field draws
+        xz, octaves, drift(fs, sets, 0.0), fs.tile_size, fbm_quantiles(fs.base_frequency, fs.seed, fs.size), columns,
+        column_tau(fs, sets))
     points = world_points(cam, size, probe.depth)
     weight = reference.direct_weight(sun.direction, sun.color, params)
     assert 0.2 < cover < 0.8
@@ -347,9 +348,9 @@ def test_shadows_continue_with_the_far_field_beyond_the_volume(gpu, ctx):
     expected[probe.depth >= 1.0] = 1.0
     ground_px = probe.depth < 1.0
     error = np.abs(factor - expected)[ground_px]
-    # the texture unit's 8-bit bilinear weights on a steep remap, and float32 depth far away (a wrong drift or
-    # texel offset: errors ~0.2)
-    assert np.quantile(error, 0.95) < 1e-2 and error.mean() < 5e-3, f"far-field shadow differs from numpy: {error.mean():.3g}"
+    # float32 depth far away (llvmpipe: p95 2.3e-4, mean 1e-4); the rank table of a 256-texel layer instead of
+    # the layer's own (64): p95 1e-2, mean 1e-3; a wrong drift or texel offset: errors ~0.2
+    assert np.quantile(error, 0.95) < 3e-3 and error.mean() < 5e-4, f"far-field shadow differs from numpy: {error.mean():.3g}"
     under, gap = ground_px & (expected < 0.5), ground_px & (expected > 0.99)
     assert under.sum() > 50 and gap.sum() > 50, "the view has far-field clouds and gaps"
     assert factor[under].mean() < factor[gap].mean() - 0.3

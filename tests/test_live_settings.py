@@ -336,13 +336,9 @@ SPECS = {
                  CloudRenderPlugin(), CloudFarFieldPlugin(size=32)],
         CloudFarFieldPlugin,
         look((320.0, 60.0, 320.0), yaw=0.3, pitch=0.15, far=60000.0),     # the horizon beyond the volume
-        dict(softness=0.9, thickness=0.5, optical_depth=0.5, tile_size=1000.0, wind=(500.0, 0.0), horizon_fade=0.9,
+        dict(thickness=0.5, tile_size=1000.0, wind=(500.0, 0.0), horizon_fade=0.9,
              size=16, base_frequency=9, seed=7, light_step=0.2, animate=False, enabled=False),
-        before={"animate": configure_first(wind=(500.0, 0.0))},
-        # softness and optical_depth act only in the ground shadows' far field (tests/test_cloud_shadows.py
-        # renders them; the drawn layer takes the volume's columns at its rank): the setting read
-        observe={name: (lambda app, plugin, name=name: getattr(plugin.settings, name))
-                 for name in ("softness", "optical_depth")}),
+        before={"animate": configure_first(wind=(500.0, 0.0))}),
 }
 
 

@@ -1,7 +1,7 @@
 """FarFieldLayer: the far field's textures and cover for one frame, shared by every pass that needs it.
 
 The far field's clouds are a function of world (x, z): the four octave textures at
-``uv = x/tile_size + drift_k`` thresholded to the simulation's cover (:mod:`.cover`). The far-field
+``uv = x/tile_size + drift_k``, each point taking the volume's column sum at its rank (:mod:`.cover`). The far-field
 pass draws them; the ground shadows (:mod:`atmos.plugins.cloud_shadows`) darken the ground under them
 with the same function (``shaders/cloud_far_field/field.glsl``). The plugin imports this object as the
 graph resource ``"far_field"``; each pass that uses it calls :meth:`prepare` (re-bakes the octaves
@@ -30,6 +30,13 @@ def drift(settings, sets: CloudSets, time: float) -> np.ndarray:
     else:
         metres = np.asarray(settings.wind, np.float64) * float(time)
     return np.mod(np.broadcast_to(metres / settings.tile_size, (4, 2)), 1.0)
+
+
+def column_tau(settings, sets: CloudSets) -> float:
+    """field.glsl's field_column_tau: optical depth per cell of a column sum, ``thickness · sigma_t ·
+    cell height`` (the column far.frag draws and the ground shadows take beyond the volume)."""
+    medium = sets.settings
+    return float(settings.thickness * medium.sigma_t * medium.cell_size[1])
 
 
 class FarFieldLayer:
@@ -82,17 +89,15 @@ class FarFieldLayer:
         layout = sim.layout()
         camera = np.asarray(view.camera.position, np.float64)
         values = dict(field_origin=tuple(camera[[0, 2]]), field_origin_uv=tuple(np.mod(camera[[0, 2]] / params.tile_size, 1.0)),
-                      field_tile_size=float(params.tile_size), field_softness=float(params.softness),
+                      field_tile_size=float(params.tile_size),
                       field_mid_height=float(0.5 * (layout.lo[1] + layout.hi[1])),
-                      field_optical_depth=float(params.optical_depth))
+                      field_column_tau=column_tau(params, sim))
         for name, value in values.items():
             if name in program:
                 program[name].value = value
         program["field_offsets"].write(drift(params, sim, time).astype("f4").tobytes())
-        quantiles, scale, first = level_table(params.base_frequency, params.seed, params.size)
+        quantiles, first = level_table(params.base_frequency, params.seed, params.size)
         program["field_quantiles"].write(np.asarray(quantiles, "f4").tobytes())
-        if "field_scale" in program:
-            program["field_scale"].write(np.asarray(scale, "f4").tobytes())
         if "field_first_level" in program:
             program["field_first_level"].value = first
 

@@ -75,14 +75,13 @@ def far_field_alpha(xz, dir_y, octaves, offsets, tile_size: float, quantiles, co
     """far.frag's opacity (...,) at world ``xz`` (..., 2) seen with view direction height ``dir_y``, mip 0,
     before the edge and horizon fades: vertical optical depth thickness · column_tau (sigma_t · cell
     height) · the volume's column sum at the point's rank, along the slant 1 / max(|dir_y|, MIN_SLANT)."""
-    rank = field_rank(field_fbm(xz, octaves, offsets, tile_size), quantiles)
-    tau = float(thickness) * float(column_tau) * column_at_rank(rank, columns)
+    tau = far_optical_depth(xz, octaves, offsets, tile_size, quantiles, columns, float(thickness) * float(column_tau))
     return 1.0 - np.exp(-tau / np.maximum(np.abs(dir_y), MIN_SLANT))
 
 
-def far_field_density(xz, octaves, offsets, tile_size: float, quantiles, cover: float, softness: float) -> np.ndarray:
-    """d.x (...,) of ``cloud_far_field/field.glsl`` at world ``xz`` (..., 2), mip 0 (:func:`field_fbm`'s
-    arguments), remapped from the threshold that leaves ``cover`` of the layer clouded."""
-    from atmos.plugins.cloud_far_field.cover import emptiness
-    e = emptiness(quantiles, cover)
-    return (np.clip(field_fbm(xz, octaves, offsets, tile_size), e, e + softness) - e) / softness
+def far_optical_depth(xz, octaves, offsets, tile_size: float, quantiles, columns, column_tau: float) -> np.ndarray:
+    """The far field's vertical optical depth (...,) at world ``xz`` (..., 2), mip 0: ``column_tau`` (optical
+    depth per summed cell) × the volume's column sum at the point's rank (far.frag's tau.x; the ground
+    shadows' term beyond the volume, cloud_shadows/column.glsl)."""
+    rank = field_rank(field_fbm(xz, octaves, offsets, tile_size), quantiles)
+    return float(column_tau) * column_at_rank(rank, columns)

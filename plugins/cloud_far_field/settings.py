@@ -13,15 +13,14 @@ TEXTURE_SETTINGS = ("size", "base_frequency", "seed", "light_step")   # changing
 class CloudFarFieldSettings(CheckedSettings):
     """The cloud layer beyond the simulated volume (:mod:`atmos.plugins.cloud_far_field`).
 
-    Its cover follows the simulation's (the covered fraction of the volume's columns, measured on
-    the GPU each frame); ``softness`` is the fbm range over which a column goes from clear to
-    cloud. ``thickness``: a scale (default 1) on the layer's opacity, which comes from the volume: a
+    Its cover follows the simulation's (the volume's columns, measured on the GPU each frame).
+    ``thickness``: a scale (default 1) on the layer's opacity, which comes from the volume: a
     point whose fbm has rank r in the layer gets the volume's column sum at the same rank (its
     edge-weighted column-sum quantiles), vertical optical depth τ = thickness · sigma_t · cell height ·
     that sum, seen along the view's slant (α = 1 − exp(−τ / |dir.y|), capped near the horizon); 0: no far field.
     Its light comes from the cloud medium's own model (``cloud_render/volume.glsl``) with the same
-    column (toward the sun along the sun's slant). ``optical_depth``: optical depth of a full
-    remapped column in the ground shadows (:mod:`atmos.plugins.cloud_shadows`). ``tile_size``: metres
+    column (toward the sun along the sun's slant); the ground shadows (:mod:`atmos.plugins.cloud_shadows`)
+    and light shafts take the same column beyond the volume. ``tile_size``: metres
     one octave-texture repeat covers; ``wind``: None (the default) moves the pattern with the
     simulated clouds (the distance the weather's wind has carried them, ``CloudSets.wind_travel``),
     so volume and far field drift together; an (x, z) tuple drifts it at that many m/s with the App
@@ -31,9 +30,7 @@ class CloudFarFieldSettings(CheckedSettings):
     ``enabled`` False draws nothing.
     """
 
-    softness: float = 0.2
     thickness: float = 1.0
-    optical_depth: float = 8.0
     tile_size: float = 8000.0
     wind: tuple | None = None
     horizon_fade: float = 0.015
@@ -47,9 +44,7 @@ class CloudFarFieldSettings(CheckedSettings):
     def __post_init__(self):
         o = _OWNER
         self.store(dict(
-            softness=check_num(o, "softness", self.softness, 1e-3, 1.0),
             thickness=check_num(o, "thickness", self.thickness, 0.0, 1e3),
-            optical_depth=check_num(o, "optical_depth", self.optical_depth, 0.0, 1e3),
             tile_size=check_num(o, "tile_size", self.tile_size, 1.0, 1e7),
             wind=check_vec(o, "wind", self.wind, 2, optional=True),
             horizon_fade=check_num(o, "horizon_fade", self.horizon_fade, 0.0, 1.0, lo_open=True),

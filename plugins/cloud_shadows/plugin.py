@@ -8,7 +8,7 @@ from atmos.graph import FullscreenPass, PassContext
 from atmos.lighting import unit_sun
 from atmos.plugin import Plugin
 from atmos.plugins.clouds.layout import CloudLayout
-from atmos.plugins.cloud_far_field.layer import FAR_FIELD
+from atmos.plugins.cloud_far_field.layer import FAR_FIELD, column_tau
 from atmos.plugins.cloud_shadows.settings import CloudShadowSettings
 from atmos.plugins.clouds.sets import CLOUD_SETS, CloudSets
 from atmos.render_core import COLOR, DEPTH
@@ -86,7 +86,7 @@ class CloudShadowsPass(FullscreenPass):
             layer = frame.resource(FAR_FIELD)
             layer.prepare(view, sim)
             layer.use(p, view, sim)
-            p["field_optical_depth"].value = float(layer.settings.optical_depth * params.strength)
+            p["field_column_tau"].value = column_tau(layer.settings, sim) * params.strength
         frame.fullscreen(p)
 
 

@@ -56,7 +56,8 @@ def sun_optical_depth(points, sums_a, sums_b, t: float, sun_dir, extinction: flo
     """Optical depth (...,) from world ``points`` (..., 3) toward the sun (``sun_dir`` unit, y > 0)
     through the clouds: ``extinction · column · above`` (module docstring; shaders/cloud_shadows/column.glsl);
     ``far``: None, or a function of world xz (..., 2) giving the far field's column optical depth there
-    (``optical_depth·strength·d.x``, :func:`atmos.plugins.cloud_far_field.reference.far_field_density`),
+    (``column_tau·strength·column_at_rank(rank)``, the column far.frag draws:
+    :func:`atmos.plugins.cloud_far_field.reference.far_field_alpha`),
     added with the complementary edge weight ``(1 − edge)·above``."""
     points, s = np.asarray(points, np.float64), np.asarray(sun_dir, np.float64)
     sums = (1.0 - t) * shifted(np.asarray(sums_a, np.float64), a_shift) + t * np.asarray(sums_b, np.float64)

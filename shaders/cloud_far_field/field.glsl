@@ -1,14 +1,11 @@
-// The far field's cloud density as a function of world (x, z) (float64 reference:
-// atmos/plugins/cloud_far_field/reference.py far_density): four scrolling tileable octaves give fbm,
-// remapped from the threshold that leaves the simulation's cover (cover.comp) of the layer clouded,
-//   d = remap(fbm, e, e + softness)   (four light-march channels; d.x is the point itself),
-// e and the softness's scale taken per mip level (cover.py level_table: a blurred far pattern is
-// thresholded by its own quantiles, so it is clouded over the same fraction, not overcast or clear).
-// Shared by the far-field pass (far.frag) and the ground shadows (cloud_shadows/column.glsl with
-// CLOUD_FAR_FIELD); atmos/plugins/cloud_far_field/layer.py binds it. far_field_rank(xz, lod): the
-// fraction of the layer whose fbm lies below this point's (the table's inverse), for a far field that
-// takes the volume's own column statistics at the same rank (column_quantiles, cover.comp: the ray
-// march's volumetric far field, cloud_raymarch/far.glsl).
+// The far field's cloud pattern as a function of world (x, z) (float64 reference:
+// atmos/plugins/cloud_far_field/reference.py): four scrolling tileable octaves give fbm;
+// far_field_rank(xz, lod) is the fraction of the layer whose fbm lies below this point's (per mip level:
+// cover.py level_table, a blurred pattern ranked by its own quantiles), and far_quantile(r) the volume's
+// column sum at that rank (column_quantiles, cover.comp), so the far field is clouded as often, and as
+// thick per cover, as the volume. Shared by the far-field pass (far.frag), the ray march's volumetric
+// far field (cloud_raymarch/far.glsl) and the ground shadows and light shafts (cloud_shadows/column.glsl
+// with CLOUD_FAR_FIELD: field_column_tau × far_quantile); atmos/plugins/cloud_far_field/layer.py binds it.
 #include "sky_layer/layer.glsl"
 layout(binding = 5) uniform sampler2D octave0;
 layout(binding = 6) uniform sampler2D octave1;
@@ -20,21 +17,12 @@ uniform vec2 field_origin_uv;      // it in tiles, wrapped to [0, 1) (float64 on
 uniform vec2 field_offsets[4];     // drift of each octave (tiles, wrapped)
 #define FIELD_LEVELS 8
 uniform float field_quantiles[FIELD_LEVELS * 33]; // cover.level_table: 33 per level
-uniform float field_scale[FIELD_LEVELS];          // the softness's scale per level
 uniform float field_first_level;                  // the mip level of table row 0
 uniform float field_tile_size;
-uniform float field_softness;
 uniform float field_mid_height;    // the layer's middle plane (world y)
-uniform float field_optical_depth; // optical depth of a full column
+uniform float field_column_tau;    // thickness · sigma_t · cell height: optical depth per summed cell
 
-float field_threshold(float c, int level) {
-    float x = (1.0 - clamp(c, 0.0, 1.0)) * 32.0;
-    int k = min(int(x), 31) + 33 * level;
-    return mix(field_quantiles[k], field_quantiles[k + 1], x - floor(x));
-}
-
-// The fraction of level `level`'s fbm at or below f (field_threshold's inverse: binary search, linear
-// between the 33 quantiles).
+// The fraction of level `level`'s fbm at or below f (binary search, linear between the 33 quantiles).
 float field_rank(float f, int level) {
     int base = 33 * level, lo = 0, hi = 32;
     if (f <= field_quantiles[base]) return 0.0;
@@ -67,17 +55,6 @@ vec4 field_fbm(vec2 xz, float lod) {
 // The table row (and the share of the next) that mip level lod reads.
 float field_level(float lod) {
     return clamp(lod - field_first_level, 0.0, float(FIELD_LEVELS - 1));
-}
-
-// d at world (x, z) = xz; lod: mip level.
-vec4 far_field_density(vec2 xz, float lod) {
-    vec4 fbm = field_fbm(xz, lod);
-    float m = field_level(lod);
-    int m0 = min(int(m), FIELD_LEVELS - 2);
-    float t = m - float(m0);         // trilinear filtering mixes two levels: so do the thresholds
-    float e = mix(field_threshold(cover, m0), field_threshold(cover, m0 + 1), t);
-    float soft = field_softness * mix(field_scale[m0], field_scale[m0 + 1], t);
-    return sky_layer_remap(fbm, e, e + soft);
 }
 
 // The rank (field_rank) of the point's fbm at world xz among its level's, per channel.

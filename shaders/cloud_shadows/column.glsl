@@ -3,7 +3,9 @@
 // summed density mix(A, B, t) (layer 0 of the density maps, each set at its own placement) is read
 // bilinearly, zero outside the volume, times the volume's edge fade there, times the fraction of the layer above the point;
 // with CLOUD_FAR_FIELD defined the far field's column (cloud_far_field/field.glsl) adds its optical depth
-// with the complementary weight, so shadows continue past the volume. Shared by the
+// with the complementary weight, so shadows continue past the volume: the column the far field draws
+// (far.frag), field_column_tau (thickness · sigma_t · cell height) × the volume's column sum at the
+// rank of the point where the sun's ray meets the middle plane (far_quantile(far_field_rank)). Shared by the
 // ground shadows (shadow.frag) and the marched light shafts (light_shafts/march.frag);
 // plugins/cloud_shadows/reference.py sun_optical_depth is the same in numpy.
 layout(binding = 0) uniform sampler2DArray sums_a;
@@ -55,7 +57,7 @@ float sun_optical_depth(vec3 p, vec3 sun_dir) {
     float tau = extinction * column_sum(texel) * fade * above;
 #ifdef CLOUD_FAR_FIELD
     // beyond the volume the far field's cover continues with the complementary weight (field.glsl)
-    tau += field_optical_depth * far_field_density(q.xz, 0.0).x * (1.0 - fade) * above;
+    tau += field_column_tau * far_quantile(far_field_rank(q.xz, 0.0).x) * (1.0 - fade) * above;
 #endif
     return tau;
 }
