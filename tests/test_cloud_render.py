@@ -175,7 +175,11 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale,
     scale = np.abs(ref["position"]).max(axis=1, keepdims=True)
     got_pos, ref_pos = got[:, :4] / scale, ref["position"] / scale
     np.testing.assert_allclose(got_pos[:, [0, 1, 3]], ref_pos[:, [0, 1, 3]], atol=2e-5)   # float32 matrix products
-    np.testing.assert_allclose(got_pos[:, 2], ref_pos[:, 2], atol=2e-4)   # the front's depth: float32 cancellation
+    # the depth the sprite is tested at (its front, a radius nearer): compared as view depth, since its window z
+    # is ill-conditioned near the near plane (float32 clip w moves it by ~1e-3 there); a missing pull is off by r/w
+    n, f = uniforms["near"], uniforms["far"]
+    front = lambda pos: 2 * f * n / ((f + n) - (f - n) * pos[vis, 2] / pos[vis, 3])
+    np.testing.assert_allclose(front(got[:, :4]), front(ref["position"]), rtol=1e-3)
     np.testing.assert_allclose(got[:, 4], ref["size"], rtol=2e-5)
     # the light samples sit between texels, and GPUs (llvmpipe too) filter with 8-bit sub-texel weights:
     # up to ~0.3 % of a value apart; a coarser shading volume (scale > 1) interpolates further still
