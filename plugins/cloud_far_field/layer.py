@@ -47,13 +47,18 @@ class FarFieldLayer:
         self.octaves = OctaveTextures(gpu)
         self.cover_program = gpu.program(compute_shader="cloud_far_field/cover.comp")
         self.cover = gpu.track(gpu.ctx.buffer(reserve=4 * (1 + QUANTILES)))   # cover, column_quantiles
+        self._prepared = None                # the SceneView of the frame prepared last (held: never a reused id)
 
     @property
     def settings(self):
         return self.plugin.settings
 
     def prepare(self, view, sim: CloudSets) -> None:
-        """Bake (when needed) and measure the cover (one small dispatch; every user calls it)."""
+        """Bake (when needed) and measure the cover (one small dispatch), once per frame: every user
+        (the far-field pass or the march, the shadows, the shafts) calls it, the first one does it."""
+        if view is self._prepared:
+            return
+        self._prepared = view
         params = self.settings
         sun_dir = light_uniforms(sim.settings, view.sun)["sun_dir"]
         if self.octaves.needs_bake(params, sun_dir, REBAKE_TOLERANCE):

@@ -129,7 +129,7 @@ class RaymarchPass(RenderPass):
 
     def __init__(self, plugin: RaymarchCloudsPlugin):
         self.plugin = plugin
-        self.gpu = self.sampler = self.offscreen = self.skip = self.temporal = None
+        self.gpu = self.sampler = self.offscreen = self.skip = self.temporal = self.noise = None
         self._skip_key = None
         self.frame_index = 0
 
@@ -255,8 +255,11 @@ class RaymarchPass(RenderPass):
                 p[name].value = value
 
     def _detail(self):
-        from atmos.plugins.cloud_raymarch.noise import DetailNoise
-        return DetailNoise(self.gpu)
+        """The context's detail noise (built on first use, then held: no lookup per frame)."""
+        if self.noise is None:
+            from atmos.plugins.cloud_raymarch.noise import DetailNoise
+            self.noise = DetailNoise(self.gpu)
+        return self.noise
 
     def _resolve(self, frame: PassContext, low_color: str, low_distance: str, offset):
         """The temporal resolve's hook. ``reprojection`` on: :class:`.temporal.TemporalClouds`
@@ -295,5 +298,5 @@ class RaymarchPass(RenderPass):
             self.temporal.release()
         if self.sampler is not None:
             self.sampler.release()
-        self.sampler = None
+        self.sampler = self.noise = None     # the noise textures belong to the context's cache
         self._release_skip()
