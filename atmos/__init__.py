@@ -20,6 +20,8 @@ _EXPORTS = {
     "check_vec": "atmos.checks", "check_bool": "atmos.checks", "check_choice": "atmos.checks",
     "declared_rules": "atmos.checks", "Rule": "atmos.checks",
     "RenderCoreSettings": "atmos.render_core",
+    # the sky's two models (SkySettings.model) and the physical one's atmosphere
+    "SkyPlugin": "atmos.plugins.sky", "SkySettings": "atmos.plugins.sky", "AtmosphereSettings": "atmos.plugins.sky",
     # render passes and the graph
     "RenderPass": "atmos.graph", "FullscreenPass": "atmos.graph", "PassBuilder": "atmos.graph",
     "PassContext": "atmos.graph", "RenderGraph": "atmos.graph", "TextureDesc": "atmos.graph",

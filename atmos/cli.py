@@ -5,7 +5,7 @@ import argparse
 import os
 import sys
 
-from atmos.demo_registry import CLOUD_RENDERERS, DEFAULT_DEMO, DemoSettings, list_demos, load_demo
+from atmos.demo_registry import CLOUD_RENDERERS, DEFAULT_DEMO, SKY_MODELS, DemoSettings, list_demos, load_demo
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -82,6 +82,9 @@ def _clouds_option(command) -> None:
     command.add_argument("--clouds", choices=CLOUD_RENDERERS, default="sprites",
                          help="cloud renderer of the cloud scenes (sunset, flight, weather): point sprites "
                               "or the ray march (default sprites; key C flips it in a window)")
+    command.add_argument("--sky", choices=SKY_MODELS, default="preetham",
+                         help="sky model of the demos with a sky: the Preetham analytic sky or the physical "
+                              "atmosphere after Hillaire 2020, which also lights the sun and ambient (default preetham)")
 
 
 def cmd_info(args) -> int:
@@ -125,7 +128,7 @@ def _play(args, game, stem: str) -> int:
     problem = None if args.headless else display_problem()
     if problem is not None:
         print(f"atmos: {problem}; rendering headless", file=sys.stderr)
-    settings = DemoSettings(size=args.size, seed=args.seed, frames=args.frames, clouds=args.clouds,
+    settings = DemoSettings(size=args.size, seed=args.seed, frames=args.frames, clouds=args.clouds, sky=args.sky,
                             headless=args.headless or args.out is not None or problem is not None)   # as atmos.run
     if settings.headless:
         out = args.out if args.out is not None else f"out/{stem}.mp4"
@@ -144,7 +147,7 @@ def cmd_graph(args, top) -> int:
     except ValueError as error:
         top.error(str(error))
     gpu = create_headless((320, 180))
-    app = build_app(args.name, DemoSettings(size=gpu.size, headless=True, clouds=args.clouds), gpu, start=False)
+    app = build_app(args.name, DemoSettings(size=gpu.size, headless=True, clouds=args.clouds, sky=args.sky), gpu, start=False)
     try:
         print(app.graph.to_dot() if args.dot else app.graph.dump())
     finally:

@@ -9,6 +9,7 @@ from atmos.checks import check_choice
 
 DEFAULT_DEMO = "sunset"
 CLOUD_RENDERERS = ("sprites", "march")
+SKY_MODELS = ("preetham", "physical")      # atmos.plugins.sky.MODELS (kept here so the CLI imports no plugin)
 
 
 @dataclass
@@ -18,9 +19,11 @@ class DemoSettings:
     frames: int | None = None     # None: until the window closes (headless: the demo's DEFAULT_FRAMES)
     headless: bool = False
     clouds: str = "sprites"       # the cloud scenes' renderer: point sprites or the ray march (key C flips it)
+    sky: str = "preetham"         # the sky's model in the demos with a sky (SkySettings.model)
 
     def __post_init__(self):
         check_choice("DemoSettings", "clouds", self.clouds, CLOUD_RENDERERS)
+        check_choice("DemoSettings", "sky", self.sky, SKY_MODELS)
 
 
 def list_demos() -> dict[str, str]:

@@ -93,9 +93,9 @@ def sun_and_day(sun: Sun) -> tuple[np.ndarray, float]:
 
 
 def set_sun_uniforms(program, sun: Sun) -> None:
-    """Write ``sun_dir`` and ``sun_color`` where the program has them."""
+    """Write ``sun_dir``, ``sun_color`` and ``sky_ambient`` (the Sun's ambient) where the program has them."""
     get = program.get
-    for name, value in (("sun_dir", sun.direction), ("sun_color", sun.color)):
+    for name, value in (("sun_dir", sun.direction), ("sun_color", sun.color), ("sky_ambient", sun.ambient)):
         member = get(name, None)
         if member is not None:
             member.value = tuple(float(v) for v in value)

@@ -49,7 +49,7 @@ def build_cloudscape(app, settings, *, hours: float, speed: float = 0.0, cloud_d
     app.insert_resource(VolumeOrigin(-SHAPE[0] / 2, 0.0, -SHAPE[2] / 2))
     app.add_plugins(DefaultPlugins(overlay=not settings.headless),
                     DaylightPlugin(hours=hours, speed=speed),
-                    SkyPlugin(),
+                    SkyPlugin(model=settings.sky),
                     TerrainPlugin(size=40000.0, cells=71, relief=500.0),
                     cloud_plugin,
                     CloudShadowsPlugin(),

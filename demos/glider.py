@@ -101,7 +101,7 @@ def hud(app) -> None:
 def build(app, settings) -> None:
     terrain, chase = TerrainPlugin(size=12000.0, cells=96, relief=260.0), ChaseCameraPlugin(distance=16.0, height=4.0, bank=0.6)
     app.add_plugins(DefaultPlugins(overlay=False, fly_camera=False), DaylightPlugin(hours=16.5, speed=0.02),
-                    SkyPlugin(), terrain, CloudSky("fair_weather", seed=settings.seed, altitude=700.0),
+                    SkyPlugin(model=settings.sky), terrain, CloudSky("fair_weather", seed=settings.seed, altitude=700.0),
                     FogPlugin(mode="exp", density=0.0001, sky="keep", color_from="sky", fog_color=(1.0, 1.0, 1.0)),
                     MeshPlugin(), TextPlugin(), chase)
     cam = app.resource(Camera)

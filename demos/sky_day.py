@@ -1,4 +1,4 @@
-"""sky_day: a day–night cycle of the Preetham sky over the ground plane, facing the sun."""
+"""sky_day: a day–night cycle of the sky (Preetham, or ``--sky physical``) over the ground plane, facing the sun."""
 import math
 
 import numpy as np
@@ -35,11 +35,28 @@ def face_the_sun(app) -> None:
     cam.yaw, cam.pitch = math.atan2(s[0], -s[2]), 0.18
 
 
+EXPOSURE = (0.05, 1.0, 6.0)     # the physical sky: (sky-light luminance exposed at 1 and above, adaptation power, widest)
+
+
+def expose_for_the_sky(app) -> None:
+    """With the physical sky, twilight is ~100× darker than day: the exposure follows the sky's light
+    like a camera's after sunset (``(Y0 / Y)^p`` of the ambient's luminance Y, within 1..max: 1 by day and at
+    sunset), so the blue hour shows."""
+    from atmos.render_core import RenderCorePlugin
+    amb = np.asarray(app.resource(Sun).ambient, np.float64)
+    y = max(float(amb @ (0.2126, 0.7152, 0.0722)), 1e-6)
+    y0, power, widest = EXPOSURE
+    core = next(p for p in app.plugins if isinstance(p, RenderCorePlugin))
+    core.configure(exposure=min(max((y0 / y) ** power, 1.0), widest))
+
+
 def build(app, settings) -> None:
     daylight = DaylightPlugin(hours=17.0, speed=HOURS_PER_SECOND, latitude=45.0, day_of_year=172.0)
-    app.add_plugins(DefaultPlugins(overlay=not settings.headless), daylight, SkyPlugin(), GroundPlugin())
+    app.add_plugins(DefaultPlugins(overlay=not settings.headless), daylight, SkyPlugin(model=settings.sky), GroundPlugin())
     cam = app.resource(Camera)
     cam.position = np.array([0.0, 2.0, 0.0])
     cam.fov_y = math.radians(70.0)
     app.add_system(pacer(daylight), "update", label="pace_time", before="daylight")
     app.add_system(face_the_sun, "update", label="face_the_sun", after="daylight")
+    if settings.sky == "physical":
+        app.add_system(expose_for_the_sky, "update", label="expose_for_the_sky", after="sky_light")

@@ -1,15 +1,18 @@
 """Clouds to the horizon: the volume's edge fade, the far field's cover, and the sunset horizon by pixels."""
+import dataclasses
 import math
 
 import numpy as np
+import pytest
 
 from atmos.camera import Camera
 from atmos.demo_registry import DemoSettings
 from atmos.gpu import create_headless
 from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
-from atmos.plugins.cloud_far_field.reference import column_quantiles, volume_cover
-from atmos.plugins.clouds import CloudSimulation
+from atmos.plugins.cloud_far_field.reference import column_profile, column_quantiles, volume_cover
+from atmos.plugins.clouds import CloudSimulation, CloudsPlugin
 from atmos.plugins.clouds.edge import edge_weight
+from atmos.plugins.clouds.smoothing import read_volume
 from atmos.runner import build_app
 
 
@@ -20,6 +23,25 @@ def test_edge_weight_is_one_inside_zero_on_the_circle_and_smooth():
     assert np.all(np.diff(w) <= 0.0) and np.abs(np.diff(w)).max() < 0.05       # no step
     assert edge_weight([[1.0, 1.0]], 0.4)[0] == 0.0                             # the square's corners are gone
     assert np.all(edge_weight(np.random.default_rng(0).random((50, 2)), 0.0) == 1.0)
+
+
+def check_profile_matches_numpy(layer, sets, fade, quantiles):
+    """cover.comp's vertical profile by rank against column_profile (ranked by the GPU's quantiles):
+    each interval's shape R per unit column sum and share above G; and it is the volume's shape (the
+    clouds of this volume sit mid-layer: little density in the lowest and highest quarter). A sprite
+    scene measures no profile (only a march's far field uses it): measured here on request."""
+    assert layer.profile is None, "no profile measured for the sprites"
+    layer.measure_cover(sets, profile=True)
+    gpu_profile = layer.read_profile()
+    density = [read_volume(s["density"]) for s in (sets.a, sets.b)]
+    ref = column_profile(density[0], density[1], sets.t, sets.a_shift, fade, quantiles)
+    assert gpu_profile.shape == ref.shape == (32, sets.shape[1], 2)
+    ny = sets.shape[1]
+    assert np.allclose(gpu_profile[..., 0].sum(1), 1.0, atol=1e-4), "R sums to one column sum"
+    off = np.abs(gpu_profile - ref).max(axis=(1, 2)) / np.maximum(ref[..., 0].max(1), 1e-6)
+    assert np.median(off) < 0.01 and off.max() < 0.05, off        # an interval's edge may hold a column more or less
+    weight = gpu_profile[..., 0].mean(0)
+    assert weight[: ny // 4].sum() + weight[-(ny // 4):].sum() < 0.25, weight
 
 
 def test_sunset_has_clouds_below_9_degrees_around_the_sun_and_cover_matches_numpy():
@@ -41,6 +63,7 @@ def test_sunset_has_clouds_below_9_degrees_around_the_sun_and_cover_matches_nump
         assert columns[-1] > 1.0 and np.all(np.diff(gpu_columns) >= 0.0)
         assert np.abs(gpu_columns - columns).max() < 1.5 * bin_width, np.c_[gpu_columns, columns]
         assert abs(np.mean(gpu_columns > sim.settings.cover_threshold) - expected) < 2.0 / 32   # covered at the same ranks
+        check_profile_matches_numpy(far.layer, sets, sim.settings.edge_fade, gpu_columns)
         cam = app.resource(Camera)
         with_far = app.read_linear()
         far.configure(enabled=False)
@@ -55,3 +78,137 @@ def test_sunset_has_clouds_below_9_degrees_around_the_sun_and_cover_matches_nump
     finally:
         app.close()
         gpu.release()
+
+
+@pytest.mark.parametrize("shape, base", [((16, 8, 16), 0.25), ((16, 80, 16), 0.6), ((16, 8, 16), None)])
+def test_the_profile_by_rank_is_the_volumes_vertical_shape(gpu, ctx, shape, base):
+    """cover.comp's profile for static volumes against column_profile: clouds whose height grows with
+    their thickness, centred at ``base`` of the layer (80 cells: 64 samples, the nearest cell); None:
+    no cloud at all (uniform R, no NaN)."""
+    from atmos import App, DefaultPlugins
+    from atmos.plugins.clouds import CloudSettings, CloudsPlugin
+    nx, ny, nz = shape
+    d = np.zeros(shape, np.float32)
+    if base is not None:
+        x, z = np.meshgrid(np.arange(nx), np.arange(nz), indexing="ij")
+        thick = (0.05 + 0.25 * ((x + 2 * z) % 7) / 6.0) * ((x // 4 + z // 4) % 2 == 0)   # half the columns
+        h = (np.arange(ny) + 0.5) / ny
+        d[:] = np.exp(-0.5 * ((h[None, :, None] - base) / np.maximum(thick[:, None, :], 1e-3)) ** 2) * (thick[:, None, :] > 0)
+    medium = CloudSettings(cell_size=(40.0, 40.0, 40.0), base_altitude=400.0, group_size=(4, 4), smoothing_slices=1,
+                           sigma_t=0.02, edge_fade=0.2)
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(medium, density=d), CloudFarFieldPlugin(size=64))
+    try:
+        app.startup()
+        app.render()
+        far = next(p for p in app.plugins if isinstance(p, CloudFarFieldPlugin))
+        sets = next(p for p in app.plugins if isinstance(p, CloudsPlugin)).simulation.sets()
+        far.layer.measure_cover(sets, profile=True)
+        _, quantiles = far.layer.read_cover()
+        got = far.layer.read_profile()
+        density = [read_volume(s["density"]) for s in (sets.a, sets.b)]
+        want = column_profile(density[0], density[1], sets.t, sets.a_shift, 0.2, quantiles, heights=min(ny, 64))
+        assert got.shape == want.shape == (32, min(ny, 64), 2) and np.isfinite(got).all()
+        assert np.abs(got - want).max() < 1e-3 * max(want[..., 0].max(), 1.0) + 1e-4, np.abs(got - want).max()
+        if base is None:
+            assert np.allclose(got[..., 0], 1.0 / ny)
+        else:
+            heights = (np.arange(got.shape[1]) + 0.5) / got.shape[1]
+            centre = (got[..., 0] * heights).sum(1) / got[..., 0].sum(1)
+            columns = d.transpose(0, 2, 1)[d.sum(1) > 0]              # (n, ny): the covered columns
+            own = (columns * (np.arange(ny) + 0.5) / ny).sum(1) / columns.sum(1)
+            assert own.min() - 0.02 < centre.min() and centre.max() < own.max() + 0.02, (centre, own)   # where the volume's clouds sit
+            assert abs(centre.mean() - base) < abs(centre.mean() - 0.5) or base == 0.5
+            spread = np.sqrt((got[..., 0] * (heights - centre[:, None]) ** 2).sum(1) / got[..., 0].sum(1))
+            assert spread[-1] > 1.5 * spread[-16], spread              # thicker columns, taller clouds
+    finally:
+        app.close()
+
+
+def far_scene(gpu, **far):
+    """A static volume (half its columns clouded, in 4-cell blocks) with a far field; rendered once."""
+    from atmos import App, DefaultPlugins
+    from atmos.plugins.clouds import CloudSettings, CloudsPlugin
+    d = np.zeros((32, 8, 32), np.float32)
+    x, z = np.meshgrid(np.arange(32), np.arange(32), indexing="ij")
+    d[:, 2:6] = ((x // 4 + z // 4) % 2 == 0)[:, None, :]
+    medium = CloudSettings(cell_size=(40.0, 40.0, 40.0), base_altitude=400.0, group_size=(4, 4), smoothing_slices=1,
+                           sigma_t=0.02, edge_fade=0.2)
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(medium, density=d), CloudFarFieldPlugin(**far))
+    app.startup()
+    app.render()
+    return app
+
+
+def correlation(a, b) -> float:
+    a, b = a - a.mean(), b - b.mean()
+    return float((a * b).mean() / max(a.std() * b.std(), 1e-12))
+
+
+def test_the_far_fields_cover_repeats_at_no_tile_lag(gpu, ctx):
+    """The cover (fbm above its median) of the pattern drawn (the GPU's baked octaves, each turned and
+    with its own period: pattern.py) correlates along x and along z at lags of 1, 2, 3 tiles no more
+    than at lags between them; with one period and no turn for all octaves it repeated exactly (1.0)."""
+    from atmos.plugins.cloud_far_field.layer import drift
+    from atmos.plugins.cloud_far_field.reference import field_fbm
+    app = far_scene(gpu, size=128, tile_size=1000.0, animate=False)
+    try:
+        far = next(p for p in app.plugins if isinstance(p, CloudFarFieldPlugin))
+        sets = next(p for p in app.plugins if isinstance(p, CloudsPlugin)).simulation.sets()
+        layer, tile = far.layer, 1000.0
+        octaves = [layer.octaves.download(k) for k in range(4)]
+        offsets = drift(far.settings, sets, 0.0, tile)
+        xs = np.arange(0.0, 4.0 * tile, tile / 32.0)
+        across = np.arange(64) * 0.377 * tile
+        line = lambda lag, axis: np.stack(np.broadcast_arrays(*((xs[None, :] + lag, across[:, None])[::1 - 2 * axis])), -1)
+        tile_lags, other_lags = (1.0, 2.0, 3.0), (0.63, 1.37, 1.61, 2.29, 2.71, 3.45)
+        for axis in (0, 1):
+            base = field_fbm(line(0.0, axis), octaves, offsets, tile)
+            cover = lambda f: (f > np.median(base)).astype(np.float64)
+            acf = {lag: correlation(cover(base), cover(field_fbm(line(lag * tile, axis), octaves, offsets, tile)))
+                   for lag in tile_lags + other_lags}
+            at_tiles, between = max(acf[l] for l in tile_lags), max(abs(acf[l]) for l in other_lags)
+            assert at_tiles < between + 0.05 and at_tiles < 0.3, (axis, acf)
+        # every octave drifts by the same world distance: the pattern after t seconds of wind is the
+        # pattern at 0 carried along by wind * t
+        windy = dataclasses.replace(far.settings, wind=(7.0, -3.0))
+        xz = line(0.0, 0)
+        moved = field_fbm(xz, octaves, drift(windy, sets, 1000.0, tile), tile)
+        assert np.allclose(moved, field_fbm(xz + np.array([7000.0, -3000.0]), octaves, drift(windy, sets, 0.0, tile), tile), atol=1e-9)
+    finally:
+        app.close()
+
+
+def test_the_far_fields_clouds_change_as_often_per_metre_as_the_volumes(gpu, ctx):
+    """tile_size None: the layer's tile is chosen from the volume's cover transitions (cover.comp, against
+    volume_transitions in float64), so the cover drawn (column sum at the rank above the cover threshold,
+    the GPU's octaves in float64) changes along a line as often per metre as the volume's, within 15 %;
+    a fixed 8 km tile (the old default) made the far field's clouds 2.5-3x wider."""
+    from atmos.plugins.cloud_far_field.cover import fbm_quantiles
+    from atmos.plugins.cloud_far_field.layer import drift
+    from atmos.plugins.cloud_far_field.reference import column_at_rank, field_fbm, field_rank, volume_transitions
+    app = far_scene(gpu, size=128, animate=False)
+    try:
+        far = next(p for p in app.plugins if isinstance(p, CloudFarFieldPlugin))
+        sim = next(p for p in app.plugins if isinstance(p, CloudsPlugin)).simulation
+        sets = sim.sets()
+        layer = far.layer
+        cover, transitions = layer.read_transitions()
+        sums = [sets.maps_of(s).read_sums()[0] for s in (sets.a, sets.b)]
+        want = volume_transitions(sums[0], sums[1], sets.t, sets.a_shift, sim.settings.cover_threshold, 0.2)
+        assert 0.05 < want < 0.5 and abs(transitions - want) < 1e-4, (transitions, want)
+        volume_rate = want / 40.0                                        # per metre
+        tile = layer.tile_size
+        octaves = [layer.octaves.download(k) for k in range(4)]
+        _, columns = layer.read_cover()
+        xs = np.arange(0.0, 12.0 * tile, 20.0)
+        lines = np.stack(np.broadcast_arrays(xs[None, :], (np.arange(48) * 0.613 * tile)[:, None]), -1)
+        rates = []
+        for pts in (lines, lines[..., ::-1]):
+            rank = field_rank(field_fbm(pts, octaves, drift(far.settings, sets, 0.0, tile), tile),
+                              fbm_quantiles(far.settings.base_frequency, far.settings.seed, far.settings.size))
+            covered = column_at_rank(rank, columns) > sim.settings.cover_threshold
+            assert abs(covered.mean() - cover) < 0.1, (covered.mean(), cover)
+            rates.append(np.diff(covered, axis=-1).mean() / 20.0)
+        assert abs(np.mean(rates) / volume_rate - 1.0) < 0.15, (np.mean(rates), volume_rate, tile)
+    finally:
+        app.close()

@@ -3,8 +3,13 @@
 In the sunset and flight scenes, the clouds' coverage seen from the ground and their brightness seen
 from 2 km above the layer are binned by where each pixel's ray meets the layer's middle plane,
 ``r = |2 uv − 1|`` in the volume's footprint (1 on its inscribed circle, where the volume has faded
-out): a band well inside (the volume alone) and a band just outside (the far field alone) must agree.
-With the far field switched off the outside band is empty and the tests fail. The ground shadows:
+out): a band well inside (the volume alone) and a band just outside (the far field alone) must agree,
+and no column along the border may stand out more than the field's columns do in bands as wide
+wholly inside or wholly outside (a sparse field's single bright cloud is an outlier anywhere; a seam
+only at the border). With the far field switched off the outside band is empty and the tests fail.
+One realisation of the far field's pattern is measured (its seed): per seed the far field alone covers
+0.3–1.2x what the volume covers in the same view, one ring of some ten clouds (README, "Cloud renderers",
+far_field). The ground shadows:
 the volume's (exp(−σ · column sum)) and the far field's (exp(−column_tau · column sum at the rank)) mean transmittance
 agree for the same measured cover.
 """
@@ -109,13 +114,29 @@ def bands(metric, r, valid):
     return metric[inside].mean(), metric[outside].mean()
 
 
-def column_outliers(metric, r, valid) -> float:
-    """The largest per-column mean over the border band (r 0.85..1.15), in robust spreads from the median."""
-    border = valid & (r > 0.85) & (r < 1.15)
-    cols = [metric[:, c][border[:, c]].mean() for c in range(metric.shape[1]) if border[:, c].sum() >= 3]
-    cols = np.asarray(cols)
-    spread = max(np.median(np.abs(cols - np.median(cols))), 0.02 * max(np.median(cols), 1e-6))
+BORDER = (0.85, 1.15)         # r: where the volume gives way to the far field
+ELSEWHERE = ((0.25, 0.55), (1.2, 1.5))   # bands as wide wholly inside the volume and wholly outside
+OUTLIER_FACTOR = 1.5          # the border's column outlier may not exceed the field's own by more
+
+
+def column_outliers(metric, r, valid, band=BORDER) -> float:
+    """The largest per-column mean over ``band`` of r, in robust spreads (median absolute deviation,
+    at least 5 % of the volume's own mean level r < 0.65) from the median column; inf where the band
+    holds fewer than 20 columns."""
+    inside = valid & (r > band[0]) & (r < band[1])
+    cols = np.asarray([metric[:, c][inside[:, c]].mean() for c in range(metric.shape[1]) if inside[:, c].sum() >= 3])
+    if len(cols) < 20:
+        return math.inf
+    floor = 0.05 * metric[valid & (r < 0.65)].mean()
+    spread = max(np.median(np.abs(cols - np.median(cols))), floor, 1e-9)
     return float(np.abs(cols - np.median(cols)).max() / spread)
+
+
+def seam_outliers(metric, r, valid) -> tuple[float, float]:
+    """(the border band's column outlier, the largest of the same statistic over bands as wide inside
+    and outside): a single bright cloud in a sparse field is as much an outlier anywhere, a seam only at
+    the border."""
+    return column_outliers(metric, r, valid), max(column_outliers(metric, r, valid, band) for band in ELSEWHERE)
 
 
 YAWS = 0.3 + 0.5 * np.pi * np.arange(4)      # four views round the horizon: more clouds per band
@@ -163,29 +184,29 @@ def cloud_change(app, img):
 @pytest.mark.parametrize("demo, view, clouds", [
     ("sunset", "ground", "sprites"), ("flight", "ground", "sprites"), ("flight", "above", "sprites"),
     ("flight", "ground", "march"), ("flight", "above", "march"),
-    *(pytest.param(demo, view, "march", marks=pytest.mark.xfail(strict=True, reason=(
-        "open gap: the march's far field now takes the volume's column-sum quantiles (the same cover and "
-        "vertical optical depth per rank; flight passes) but in sunset covers more than the volume at "
-        "the border (coverage 0.229 inside vs 0.326 outside from the ground; change 0.046 vs 0.076 from "
-        "above; the same with the detail noise off): its clouds' 3D shape (flat base at 0.1 of the layer, "
-        "domes) vs the volume's small mid-layer blobs, seen obliquely")))
-      for demo, view in (("sunset", "ground"), ("sunset", "above"))),
-    pytest.param("sunset", "above", "sprites", marks=pytest.mark.xfail(strict=True, reason=(
-        "open gap: the band means now agree (0.051 inside vs 0.045 outside) but the column-outlier check fails "
-        "(25 spreads, limit 12): the sparse field's median column is cloud-free, and the same check gives 37 in r 0.25-0.55, "
-        "wholly inside the volume, so it flags single sunlit clouds, not a seam"))),
+    *(pytest.param("sunset", view, "march", marks=pytest.mark.xfail(strict=True, reason=(
+        "open gap: with the far field's octaves turned and sized to the volume's clouds, seed 0's pattern "
+        "is cloudier just outside the volume (inside 0.229 vs outside 0.378 from the ground, 0.045 vs 0.087 "
+        "from above) and the march's volumetric far field covers more than the 2D one there (far field "
+        "alone vs volume from the ground: march 1.27x, sprites 1.12x; seeds 1-2: 1.03-1.07x): one pattern, "
+        "about ten clouds in the ring")))
+      for view in ("ground", "above")),
+    ("sunset", "above", "sprites"),
 ])
 def test_clouds_have_no_step_at_the_volume_edge(scenes, demo, view, clouds):
     """From the ground: the coverage (sky occlusion); from 2 km above the layer: what the clouds change
-    in luminance. Band means inside vs outside within TOLERANCE, no outlier column along the border.
-    Both renderers: the sprites with the 2D far field, the march with its volumetric one."""
+    in luminance. Band means inside vs outside within TOLERANCE, and no column along the border more of
+    an outlier than the field's columns are inside the volume or outside it (OUTLIER_FACTOR). Both
+    renderers: the sprites with the 2D far field, the march with its volumetric one (its density at each
+    height the volume's own profile at the point's rank)."""
     app = scene(scenes, demo, clouds)
     look, metric = (ground_view, coverage) if view == "ground" else (above_view, cloud_change)
     values, r, valid = panorama(app, look, metric)
     inside, outside = bands(values, r, valid)
     assert inside > 0.01, f"{demo}: the volume is seen ({inside:.3f})"
     assert abs(outside - inside) < TOLERANCE * inside, f"{demo} {view}: {inside:.3f} inside vs {outside:.3f} outside"
-    assert column_outliers(values, r, valid) < 12.0
+    border, elsewhere = seam_outliers(values, r, valid)
+    assert border < OUTLIER_FACTOR * elsewhere, f"{demo} {view}: column outlier {border:.1f} at the border vs {elsewhere:.1f} elsewhere"
     values, r, valid = panorama(app, look, metric, far=False)
     _, without = bands(values, r, valid)
     assert abs(without - inside) > 0.5 * inside, "without the far field the step is there (the test can fail)"
@@ -207,9 +228,10 @@ def test_volume_and_far_field_shadows_are_as_dark_for_the_same_cover(scenes, dem
     fs = far.settings
     cover, columns = far.layer.read_cover()
     octaves = [far.layer.octaves.download(k) for k in range(4)]
-    g = (np.arange(256) + 0.5) * fs.tile_size / 256
+    tile = far.layer.tile_size
+    g = (np.arange(256) + 0.5) * 7.0 * tile / 256           # the coarsest octave repeats every φ⁴ tiles
     xz = np.stack(np.meshgrid(g, g, indexing="ij"), -1)
-    tau = far_optical_depth(xz, octaves, drift(fs, sets, 0.0), fs.tile_size, fbm_quantiles(fs.base_frequency, fs.seed, fs.size),
+    tau = far_optical_depth(xz, octaves, drift(fs, sets, 0.0, tile), tile, fbm_quantiles(fs.base_frequency, fs.seed, fs.size),
                             columns, column_tau(fs, sets))
     field = float(np.exp(-strength * tau).mean())
     assert 0.1 < cover < 0.9
@@ -250,16 +272,46 @@ def test_far_field_is_as_bright_per_cover_as_the_volume_from_above_at_sunset():
         app.close()
         gpu.release()
 
-if __name__ == "__main__":      # the radial profiles (mean of each band of r) the tests check
-    gpu = create_headless(SIZE)
+def away(view, offset=(40000.0, 0.0, 0.0)):
+    """``view`` with the camera moved by ``offset`` (m), r still of the volume's footprint as seen from
+    the unmoved camera: the far field alone in the same geometry as the volume's bands."""
+    def look(app, yaw):
+        r, valid = view(app, yaw)
+        cam = app.resource(Camera)
+        cam.position = cam.position + np.asarray(offset)
+        return r, valid
+    return look
+
+
+def far_alone_vs_volume(app, seeds=range(4)) -> dict:
+    """Per view: (the volume's coverage in the INSIDE band, the far field's alone in the same band),
+    each averaged over far-field ``seeds`` (the realisations of its pattern); opaque passes, fog and
+    shafts removed so that the alpha is the clouds' own."""
+    for name in [p.name for p in app.graph.passes if p.phase == "opaque" or p.name in ("fog", "light_shafts")]:
+        app.graph.remove_pass(name)
+    far, out = plugin(app, CloudFarFieldPlugin), {}
+    for seed in seeds:
+        far.configure(seed=seed)
+        for name, view in (("ground", ground_view), ("above", above_view)):
+            got = [bands(*panorama(app, look, coverage))[0] for look in (view, away(view))]
+            out.setdefault(name, []).append(got)
+    far.configure(seed=CloudFarFieldPlugin().settings.seed)
+    return {name: tuple(np.mean(v, axis=0)) for name, v in out.items()}
+
+
+if __name__ == "__main__":      # the radial profiles (mean of each band of r) the tests check; then the
+    gpu = create_headless(SIZE)  # far field alone vs the volume over four seeds (README, "Cloud renderers")
     edges = np.array([0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2, 1.35, 1.5, 1.8])
     for demo in ("sunset", "flight"):
-        app = build_app(demo, DemoSettings(size=gpu.size, headless=True), gpu)
-        app.run_frames(4, 1 / 30)
-        for view, look, metric in (("ground", ground_view, coverage), ("above", above_view, cloud_change)):
-            for far in (True, False):
-                v, r, ok = panorama(app, look, metric, far=far)
-                prof = [v[ok & (r > lo) & (r < hi)].mean() for lo, hi in zip(edges[:-1], edges[1:])]
-                print(demo, view, "far" if far else "nofar", " ".join(f"{p:.3f}" for p in prof))
-        app.close()
+        for clouds in ("sprites", "march"):
+            app = build_app(demo, DemoSettings(size=gpu.size, headless=True, clouds=clouds), gpu)
+            app.run_frames(4, 1 / 30)
+            for view, look, metric in (("ground", ground_view, coverage), ("above", above_view, cloud_change)):
+                for far in (True, False):
+                    v, r, ok = panorama(app, look, metric, far=far)
+                    prof = [v[ok & (r > lo) & (r < hi)].mean() for lo, hi in zip(edges[:-1], edges[1:])]
+                    print(demo, clouds, view, "far" if far else "nofar", " ".join(f"{p:.3f}" for p in prof))
+            for view, (volume, alone) in far_alone_vs_volume(app).items():
+                print(demo, clouds, view, f"coverage: volume {volume:.3f}, far field alone {alone:.3f} ({alone / volume:.2f}x)")
+            app.close()
     gpu.release()

@@ -10,7 +10,6 @@ from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
 from atmos.plugins.cloud_far_field.cover import level_table
 from atmos.plugins.cloud_far_field.layer import drift
 from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
-from atmos.plugins.cloud_raymarch.far import far_amount
 from atmos.plugins.cloud_raymarch.far_reference import FarField, far_march_reference
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
 
@@ -21,11 +20,15 @@ DAY = Sun.from_angles(35.0, 70.0)
 FAR = dict(size=64, tile_size=20000.0, base_frequency=4, animate=False)   # mip 0 out to far_distance
 
 
+PROFILE = np.array([0.1, 0.5, 1.0, 1.0, 0.8, 0.5, 0.25, 0.0], np.float32)   # a cloud's density by height
+
+
 def columns():
-    """Half the columns full: the far field's measured cover about a half."""
+    """Half the columns full, a base and a fading top (PROFILE): the far field's measured cover about a
+    half, its vertical profile that shape."""
     d = np.zeros(SHAPE, np.float32)
     x, z = np.meshgrid(np.arange(SHAPE[0]), np.arange(SHAPE[2]), indexing="ij")
-    d.transpose(0, 2, 1)[((x // 4 + z // 4) % 2 == 0)] = 1.0
+    d.transpose(0, 2, 1)[((x // 4 + z // 4) % 2 == 0)] = PROFILE
     return d
 
 
@@ -62,15 +65,17 @@ def field_reference(app) -> FarField:
     sim = of(app, CloudsPlugin).simulation.sets()
     quantiles = level_table(params.base_frequency, params.seed, params.size)[0][0]
     _, columns = layer.read_cover()
-    return FarField(params.light_step * params.tile_size,
-                    octaves=[layer.octaves.download(k) for k in range(4)], offsets=drift(params, sim, 0.0),
-                    tile_size=params.tile_size, quantiles=quantiles, columns=columns, amount=far_amount(SHAPE[1]))
+    return FarField(params.light_step * layer.tile_size,
+                    octaves=[layer.octaves.download(k) for k in range(4)], offsets=drift(params, sim, 0.0, layer.tile_size),
+                    tile_size=layer.tile_size, quantiles=quantiles, columns=columns, profile=layer.read_profile())
 
 
 def test_the_far_field_march_matches_its_float64_reference(gpu, ctx):
     app = scene(gpu, steps=256)
     cam = aim(app, (-2500.0, BASE + 900.0, 200.0), yaw=-np.pi / 2, pitch=-0.3)   # outside, above, looking away
     image = app.read_linear()[::-1].astype(np.float64)
+    shape = of(app, CloudFarFieldPlugin).layer.read_profile()[-1, :, 0]
+    assert np.allclose(shape, PROFILE / PROFILE.sum(), atol=1e-3), "the far field's profile is the volume's"
     sim = of(app, CloudsPlugin).simulation.sets()
     layout = sim.layout()
     band = (float(layout.lo[1]), float(layout.hi[1] - layout.lo[1]))

@@ -337,7 +337,7 @@ def test_shadows_continue_with_the_far_field_beyond_the_volume(gpu, ctx):
     fs = far.settings
     sets = sim.sets()
     far_tau = lambda xz: params.strength * far_optical_depth(    # the column the far field draws
-        xz, octaves, drift(fs, sets, 0.0), fs.tile_size, fbm_quantiles(fs.base_frequency, fs.seed, fs.size), columns,
+        xz, octaves, drift(fs, sets, 0.0, layer.tile_size), layer.tile_size, fbm_quantiles(fs.base_frequency, fs.seed, fs.size), columns,
         column_tau(fs, sets))
     points = world_points(cam, size, probe.depth)
     weight = reference.direct_weight(sun.direction, sun.color, params)

@@ -228,6 +228,15 @@ class Spec:
     warm: float = 0.5                  # seconds of clock run before the scene is frozen (animation time > 0)
 
 
+# the physical sky's atmosphere (SkySettings.model = "physical"), field by field
+PHYSICAL_CHANGES = {
+    "atmosphere.planet_radius": 2000e3, "atmosphere.atmosphere_height": 30e3,
+    "atmosphere.rayleigh_scattering": (20e-6, 10e-6, 5e-6), "atmosphere.rayleigh_scale_height": 3000.0,
+    "atmosphere.mie_scattering": (4e-5, 4e-5, 4e-5), "atmosphere.mie_absorption": (4e-5, 4e-5, 4e-5),
+    "atmosphere.mie_scale_height": 5000.0, "atmosphere.mie_g": 0.2, "atmosphere.ozone_absorption": (5e-6, 1e-6, 1e-5),
+    "atmosphere.ozone_altitude": 5000.0, "atmosphere.ozone_width": 8000.0, "atmosphere.ground_albedo": (1.0, 1.0, 1.0),
+    "atmosphere.sun_color": (1.0, 0.5, 0.2), "atmosphere.sun_intensity": 3.0, "atmosphere.multiple_scattering": 0.0}
+
 SPECS = {
     "render_core": Spec(
         lambda: [DefaultPlugins(overlay=False), GroundPlugin()], RenderCorePlugin,
@@ -254,9 +263,10 @@ SPECS = {
         lambda: [DefaultPlugins(overlay=False), SkyPlugin(star_density=0.5)], SkyPlugin,
         look((0.0, 2.0, 0.0), yaw=math.radians(200.0), pitch=0.45),
         dict(turbidity=8.0, scale=0.08, sun_size_deg=4.0, sun_gain=200.0, sun_glare=0.5, night=(0.2, 0.1, 0.3), stars=False,
-             star_density=0.9, star_brightness=40.0, twinkle=1.0),
+             star_density=0.9, star_brightness=40.0, twinkle=1.0, model="physical", **PHYSICAL_CHANGES),
         before={"sun_gain": configure_first(sun_size_deg=4.0), "night": set_sun(NIGHT), "stars": set_sun(NIGHT), "star_density": set_sun(NIGHT),
-                "star_brightness": set_sun(NIGHT), "twinkle": set_sun(NIGHT)}),
+                "star_brightness": set_sun(NIGHT), "twinkle": set_sun(NIGHT),
+                **{name: configure_first(model="physical") for name in PHYSICAL_CHANGES}}),
     "sky_layer": Spec(
         lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), SkyLayerPlugin(size=32)], SkyLayerPlugin,
         look((123.0, 3.0, -77.0), yaw=0.3, pitch=0.6),
@@ -328,7 +338,7 @@ SPECS = {
         look((320.0, 60.0, 500.0), target=(320.0, 360.0, 100.0), far=6000.0),     # some columns out of view
         dict(base_altitude=200.0, size_factor=6.0, sigma=0.05, frustum_culling=False, empty_space_skipping=False,
              max_point_size=1.0, downsample=4, lod_pixels=40.0, ms_attenuation=0.1, ms_contribution=1.0,
-             ms_eccentricity=0.0, enabled=False),
+             ms_eccentricity=0.0, ms_diffusion=2.0, enabled=False),
         observe={"frustum_culling": culling_counters, "empty_space_skipping": culling_counters,
                  "downsample": resource_size(CLOUD_COLOR)}),
     "cloud_far_field": Spec(
@@ -434,7 +444,7 @@ SPECS["cloud_raymarch"] = Spec(
     dict(base_altitude=250.0, steps=2, step=4.0, step_growth=0.05, empty_space_skipping=False, min_transmittance=0.5,
          jitter=True, resolution=2, reprojection=False, history_clamp=0.0, motion_limit=1.0, detail_octaves=1, detail_scale=300.0, detail_strength=0.5,
          sun_steps=2, wind=(400.0, 0.0, 0.0), ms_attenuation=0.9, ms_contribution=1.0, ms_eccentricity=0.0,
-         far_field=False, far_distance=1000.0, far_step_growth=0.3, enabled=False),
+         ms_diffusion=0.0, far_field=False, far_distance=1000.0, far_step_growth=0.3, enabled=False),
     observe={"resolution": resource_size(RAYMARCH_LOW_COLOR), "reprojection": raymarch_history,
              "empty_space_skipping": raymarch_skip_map, "history_clamp": raymarch_turn,
              "motion_limit": raymarch_turn, "far_distance": raymarch_far_distance},

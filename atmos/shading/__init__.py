@@ -3,7 +3,8 @@
 ``compute_transmittance`` is the one-shot entry point; ``ShearWarpShader`` / ``ShadingTask`` the
 sliced GPU path for the frame scheduler; ``raymarch`` the reference-quality GPU path; ``grid``
 the input checks and slice geometry; ``columns`` the light volume's column integrals up and down
-(one texture per set for the renderers' sky light and octaves); ``reference`` the float64 numpy references (test oracles);
+(one texture per set for the renderers' sky light and octaves); ``diffusion`` the diffusion field of
+the sun's scattered fluence (a CG solve per set, the multiple-scattering term beside the octaves); ``reference`` the float64 numpy references (test oracles);
 ``scattering`` the cloud light colour (sun x transmittance + ambient, multiple forward scattering
 option; the sun and sky colours by time of day are :func:`atmos.lighting.sky_light`).
 """

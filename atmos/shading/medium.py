@@ -95,10 +95,13 @@ def ambient_profile(tau_up, tau_down, g_mean: float, ray_y) -> np.ndarray:
     return np.clip(u + g_mean * np.asarray(ray_y, np.float64) * np.exp(-(up + down) / (2.0 * z)), -1.0, 1.0)
 
 
-def source_reference(settings, render, T, tau_up, tau_down, cos, ray_y, sun_color, sky, sun_dir) -> np.ndarray:
+def source_reference(settings, render, T, tau_up, tau_down, cos, ray_y, sun_color, sky, sun_dir,
+                     diffusion=None) -> np.ndarray:
     """float64 (n, 3): J of the module docstring at points with transmittance ``T``, column optical
     depths ``tau_up``/``tau_down``, view/sun cosine ``cos`` and view ray y ``ray_y`` (``render``:
-    the CloudRenderSettings)."""
+    the CloudRenderSettings or RaymarchCloudSettings); ``diffusion``: the diffusion field's radiance
+    there (:func:`atmos.shading.diffusion.diffusion_radiance`, unit irradiance), added with the weight
+    ``render.ms_diffusion`` (None: no field)."""
     e, l_sky, l_ground = environment(settings, sun_color, sky, sun_dir)
     tau_up, tau_down = np.asarray(tau_up, np.float64), np.asarray(tau_down, np.float64)
     a, b, c = render.ms_attenuation, render.ms_contribution, render.ms_eccentricity
@@ -106,6 +109,9 @@ def source_reference(settings, render, T, tau_up, tau_down, cos, ray_y, sun_colo
     w = octave_weights(T, tau_up + tau_down, a, b, g_mean)
     sun = sum(w[..., i] * phase(cos, settings.phase_g * c ** i, settings.phase_g2 * c ** i, settings.phase_w)
               for i in range(OCTAVES))
+    if diffusion is not None:
+        from atmos.shading.diffusion import diffusion_weight
+        sun = sun + diffusion_weight(render.ms_diffusion, sun_dir, cos) * np.asarray(diffusion, np.float64)
     h = ambient_profile(tau_up, tau_down, g_mean, ray_y)[..., None]
     amb = 0.5 * (l_sky + l_ground) + 0.5 * h * (l_sky - l_ground)
     return settings.albedo * (sun[..., None] * e + amb)

@@ -1,17 +1,22 @@
 """FarFieldLayer: the far field's textures and cover for one frame, shared by every pass that needs it.
 
-The far field's clouds are a function of world (x, z): the four octave textures at
-``uv = x/tile_size + drift_k``, each point taking the volume's column sum at its rank (:mod:`.cover`). The far-field
+The far field's clouds are a function of world (x, z): the four octave textures, each at its own
+turned uv (:mod:`.pattern`, drift included), each point taking the volume's column sum at its rank
+(:mod:`.cover`). The tile they are drawn at, :attr:`FarFieldLayer.tile_size`, is the setting's or
+(None) sized so that their cover changes per metre as often as the volume's (:meth:`update_tile`). The far-field
 pass draws them; the ground shadows (:mod:`atmos.plugins.cloud_shadows`) darken the ground under them
 with the same function (``shaders/cloud_far_field/field.glsl``). The plugin imports this object as the
 graph resource ``"far_field"``; each pass that uses it calls :meth:`prepare` (re-bakes the octaves
-when the sun turned, measures the cover) and :meth:`use`.
+when the sun turned, measures the cover) and :meth:`use`. The same measure gives the volume's vertical
+shape by rank (:attr:`FarFieldLayer.profile`, :meth:`read_profile`), which the ray march's volumetric
+far field takes its density from.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from atmos.plugins.cloud_far_field.cover import QUANTILES, level_table
+from atmos.plugins.cloud_far_field.cover import QUANTILES, level_table, matched_tile_size, pattern_crossings
+from atmos.plugins.cloud_far_field.pattern import PERIODS, octave_frequencies, octave_offsets, rotations
 from atmos.plugins.cloud_render.light import light_uniforms
 from atmos.plugins.clouds.sets import CloudSets
 from atmos.plugins.sky_layer.octaves import OctaveTextures
@@ -19,17 +24,32 @@ from atmos.plugins.sky_layer.octaves import OctaveTextures
 FAR_FIELD = "far_field"          # the imported graph resource
 REBAKE_TOLERANCE = 0.05          # re-bake the octaves when the sun moved the light step by this fraction
 OCTAVE_UNIT = 5                  # texture units 5..8 (field.glsl)
+DENSITY_UNIT = 14                # cover.comp reads the sets' density at units 14, 15 (3D; no renderer binds them)
+PROFILE_UNIT = 14                # the profile texture for the shaders that declare far_profile (2D)
+INTERVALS = QUANTILES - 1        # the profile's rank intervals (between the quantiles)
+MAX_HEIGHTS = 64                 # cover.comp's most height samples
+TILE_TIME = 5.0                  # s: the matched tile follows a change of the volume's with this time constant
 
 
-def drift(settings, sets: CloudSets, time: float) -> np.ndarray:
-    """(4, 2) offsets of the octaves in tiles, wrapped to [0, 1). ``settings.wind`` None: the distance
-    the simulated clouds have moved with their wind (``CloudSets.wind_travel``, cells × cell size), so
-    both move together; a tuple: that (x, z) drift in m/s with the App clock ``time``."""
+def profile_heights(layers: int) -> int:
+    """Height samples of the measured profile: the layer's height in cells, at most MAX_HEIGHTS."""
+    return max(1, min(int(layers), MAX_HEIGHTS))
+
+
+def travel(settings, sets: CloudSets, time: float) -> np.ndarray:
+    """(2,) metres the pattern has drifted. ``settings.wind`` None: the distance the simulated clouds
+    have moved with their wind (``CloudSets.wind_travel``, cells × cell size), so both move together;
+    a tuple: that (x, z) drift in m/s with the App clock ``time``."""
     if settings.wind is None:
-        metres = np.asarray(sets.wind_travel, np.float64) * np.asarray(sets.settings.cell_size, np.float64)[[0, 2]]
-    else:
-        metres = np.asarray(settings.wind, np.float64) * float(time)
-    return np.mod(np.broadcast_to(metres / settings.tile_size, (4, 2)), 1.0)
+        return np.asarray(sets.wind_travel, np.float64) * np.asarray(sets.settings.cell_size, np.float64)[[0, 2]]
+    return np.asarray(settings.wind, np.float64) * float(time)
+
+
+def drift(settings, sets: CloudSets, time: float, tile_size: float) -> np.ndarray:
+    """(4, 2) each octave's drift in its own uv (turned, its period: :mod:`.pattern`), wrapped to [0, 1):
+    the same world travel (:func:`travel`) for every octave, with the layer's tile ``tile_size`` (m,
+    FarFieldLayer.tile_size)."""
+    return octave_offsets(travel(settings, sets, time), tile_size)
 
 
 def column_tau(settings, sets: CloudSets) -> float:
@@ -45,8 +65,11 @@ class FarFieldLayer:
     def __init__(self, gpu, plugin):
         self.gpu, self.plugin = gpu, plugin
         self.octaves = OctaveTextures(gpu)
-        self.cover_program = gpu.program(compute_shader="cloud_far_field/cover.comp")
-        self.cover = gpu.track(gpu.ctx.buffer(reserve=4 * (1 + QUANTILES)))   # cover, column_quantiles
+        self.cover = gpu.track(gpu.ctx.buffer(reserve=4 * (2 + QUANTILES)))   # cover, column_quantiles, transitions
+        self.tile_size = float(self.plugin.settings.tile_size or 8000.0)    # metres per tile as drawn (update_tile)
+        self._tile_time = None               # App time of the last update_tile
+        self._matched = False                # tile_size follows a measure (else the first one sets it)
+        self.profile = None                  # (INTERVALS, heights) rg32f: the volume's shape by rank (cover.comp)
         self._prepared = None                # the SceneView of the frame prepared last (held: never a reused id)
 
     @property
@@ -62,15 +85,50 @@ class FarFieldLayer:
         params = self.settings
         sun_dir = light_uniforms(sim.settings, view.sun)["sun_dir"]
         if self.octaves.needs_bake(params, sun_dir, REBAKE_TOLERANCE):
-            self.octaves.bake(params, sun_dir)
+            self.octaves.bake(params, sun_dir, octave_frequencies(params.base_frequency), rotations())
+        first = self._tile_time is None
+        if not first:
+            self.update_tile(sim, float(view.time))     # from the last frame's measure: no wait on this one
         self.measure_cover(sim)
+        if first:
+            self.update_tile(sim, float(view.time))
 
-    def measure_cover(self, sim: CloudSets) -> None:
+    def update_tile(self, sim: CloudSets, time: float) -> None:
+        """:attr:`tile_size` from the last measure: ``settings.tile_size`` when set, else the tile at which
+        the far field's cover changes along a line as often per metre as the volume's (cover.comp's
+        transitions per cell / the cell size; :func:`.cover.matched_tile_size`), followed with the time
+        constant TILE_TIME (the pattern zooms slowly, never jumps; a first measure is taken at once)."""
+        params = self.settings
+        dt = time - self._tile_time if self._tile_time is not None else 0.0
+        self._tile_time = time
+        if params.tile_size is not None:
+            self._matched = False
+            self.tile_size = float(params.tile_size)
+            return
+        cover, transitions = self.read_transitions()
+        cell = float(np.mean(np.asarray(sim.settings.cell_size, np.float64)[[0, 2]]))
+        target = matched_tile_size(pattern_crossings(params.base_frequency, params.seed, params.size), cover,
+                                   transitions / cell)
+        if target is None:
+            return
+        k = min(1.0, max(dt, 0.0) / TILE_TIME) if self._matched else 1.0
+        self.tile_size *= (target / self.tile_size) ** k
+        self._matched = True
+
+    def measure_cover(self, sim: CloudSets, profile: bool | None = None) -> None:
         """The simulation's edge-weighted cover and column-sum quantiles into the buffer the shaders
-        read (float32: cover, then QUANTILES column sums in cells; :meth:`read_cover`)."""
-        c = self.cover_program
+        read (float32: cover, then QUANTILES column sums in cells; :meth:`read_cover`), and with
+        ``profile`` (None: when the ray march draws the far field, ``drawn_by_march()``; it reads the
+        sets' density) the covered columns' vertical profile per rank interval into :attr:`profile`
+        (:meth:`read_profile`)."""
+        profile = self.plugin.drawn_by_march() if profile is None else bool(profile)
+        c = self.gpu.program(compute_shader="cloud_far_field/cover.comp", defines={"PROFILE": int(profile)})
         sim.maps_of(sim.a).sums.use(0)
         sim.maps_of(sim.b).sums.use(1)
+        if profile:
+            sim.a["density"].use(DENSITY_UNIT)
+            sim.b["density"].use(DENSITY_UNIT + 1)
+            self._profile_texture(profile_heights(sim.shape[1])).bind_to_image(0, read=False, write=True)
         c["t"].value = float(sim.t)
         c["a_shift"].value = sim.a_shift[0], sim.a_shift[2]
         c["threshold"].value = float(sim.settings.cover_threshold)
@@ -80,27 +138,54 @@ class FarFieldLayer:
         c.run(1)
         self.gpu.ctx.memory_barrier()
 
+    def _profile_texture(self, heights: int):
+        if self.profile is None or self.profile.size != (INTERVALS, heights):
+            if self.profile is not None:
+                self.profile.release()
+            self.profile = self.gpu.track(self.gpu.ctx.texture((INTERVALS, heights), 2, dtype="f4"))
+            self.profile.repeat_x = self.profile.repeat_y = False      # clamp: ranks 0 and 1, base and top
+        return self.profile
+
+    def read_profile(self) -> np.ndarray:
+        """(INTERVALS, heights, 2) as last measured: [k, j] = (density per unit column sum, share of the
+        column above) of rank interval k at height sample j (a GPU → CPU copy: tests and tools)."""
+        if self.profile is None:
+            raise RuntimeError("FarFieldLayer.read_profile: no profile measured yet; it is measured while a ray "
+                               "march draws the far field, or by measure_cover(sim, profile=True)")
+        self.gpu.ctx.memory_barrier()
+        w, h = self.profile.size
+        return np.frombuffer(self.profile.read(), np.float32).reshape(h, w, 2).transpose(1, 0, 2).astype(np.float64)
+
     def read_cover(self) -> tuple[float, np.ndarray]:
         """(cover, (QUANTILES,) column-sum quantiles) as last measured (a GPU → CPU copy: tests and tools)."""
         values = np.frombuffer(self.cover.read(), np.float32).astype(np.float64)
-        return float(values[0]), values[1:]
+        return float(values[0]), values[1:1 + QUANTILES]
+
+    def read_transitions(self) -> tuple[float, float]:
+        """(cover, the cover's transitions per cell along a line) as last measured (a small GPU → CPU copy)."""
+        values = np.frombuffer(self.cover.read(), np.float32).astype(np.float64)
+        return float(values[0]), float(values[1 + QUANTILES])
 
     def use(self, program, view, sim: CloudSets) -> None:
         """Bind the textures (units 5..8), the cover (storage buffer 0) and set field.glsl's uniforms."""
         params = self.settings
         self.octaves.use(OCTAVE_UNIT)
         self.cover.bind_to_storage_buffer(0)
+        if "far_profile" in program and self.profile is not None:
+            self.profile.use(PROFILE_UNIT)
         time = float(view.time) if params.animate else 0.0
         layout = sim.layout()
         camera = np.asarray(view.camera.position, np.float64)
-        values = dict(field_origin=tuple(camera[[0, 2]]), field_origin_uv=tuple(np.mod(camera[[0, 2]] / params.tile_size, 1.0)),
-                      field_tile_size=float(params.tile_size),
+        offsets = octave_offsets(camera[[0, 2]] + travel(params, sim, time), self.tile_size)
+        values = dict(field_origin=tuple(camera[[0, 2]]), field_tile_size=float(self.tile_size),
+                      field_lod_shift=tuple(np.log2(PERIODS)),
                       field_mid_height=float(0.5 * (layout.lo[1] + layout.hi[1])),
                       field_column_tau=column_tau(params, sim))
         for name, value in values.items():
             if name in program:
                 program[name].value = value
-        program["field_offsets"].write(drift(params, sim, time).astype("f4").tobytes())
+        program["field_offsets"].write(offsets.astype("f4").tobytes())
+        program["field_turns"].write(np.transpose(rotations(), (0, 2, 1)).astype("f4").tobytes())   # column-major
         quantiles, first = level_table(params.base_frequency, params.seed, params.size)
         program["field_quantiles"].write(np.asarray(quantiles, "f4").tobytes())
         if "field_first_level" in program:
@@ -113,3 +198,6 @@ class FarFieldLayer:
         if self.cover is not None:
             self.cover.release()
             self.cover = None
+        if self.profile is not None:
+            self.profile.release()
+            self.profile = None

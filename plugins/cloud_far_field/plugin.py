@@ -49,7 +49,7 @@ class CloudFarFieldPass(FullscreenPass):
         values = dict(light_uniforms(sim.settings, view.sun),
                       footprint_min=tuple(layout.lo[[0, 2]]), footprint_size=tuple(layout.hi[[0, 2]] - layout.lo[[0, 2]]),
                       edge_fade=float(sim.settings.edge_fade),
-                      lod_scale=float(params.size / params.tile_size * 2.0 * np.tan(view.camera.fov_y / 2)
+                      lod_scale=float(params.size / layer.tile_size * 2.0 * np.tan(view.camera.fov_y / 2)
                                       / max(view.size[1], 1)),
                       **{name: float(getattr(params, name)) for name in
                          ("thickness", "horizon_fade")})

@@ -17,6 +17,19 @@ def volume_cover(sums_a, sums_b, t: float, a_shift, threshold: float, fade: floa
     return float((w * (sums > threshold)).sum() / max(w.sum(), 1e-30))
 
 
+def volume_transitions(sums_a, sums_b, t: float, a_shift, threshold: float, fade: float) -> float:
+    """cover.comp's ``transitions``: the fraction of neighbouring column pairs (along x and along z) of
+    mix(A, B, t) that differ in cover (sum above ``threshold``), each weighted by the lesser edge weight
+    of the two: the cover's changes per cell along a line."""
+    sums = (1.0 - t) * shifted(np.asarray(sums_a, np.float64), a_shift) + t * np.asarray(sums_b, np.float64)
+    n = np.array(sums.shape)
+    uv = np.stack(np.meshgrid(*((np.arange(m) + 0.5) / m for m in n), indexing="ij"), -1)
+    w, covered = edge_weight(uv, fade), sums > threshold
+    wx, wz = np.minimum(w[1:], w[:-1]), np.minimum(w[:, 1:], w[:, :-1])
+    differ = (wx * (covered[1:] != covered[:-1])).sum() + (wz * (covered[:, 1:] != covered[:, :-1])).sum()
+    return float(differ / max(wx.sum() + wz.sum(), 1e-30))
+
+
 def column_quantiles(sums_a, sums_b, t: float, a_shift, fade: float, count: int = 33) -> np.ndarray:
     """(count,) edge-weighted quantiles 0 .. 1 of the column sums of mix(A, B, t) (``cover.comp``'s
     column_quantiles, which bins the sums into a histogram: within one bin of these): 0 inside the
@@ -34,23 +47,58 @@ def column_quantiles(sums_a, sums_b, t: float, a_shift, fade: float, count: int 
     return np.where(target <= empty, 0.0, out) if total > 0 else np.zeros(count)
 
 
+def column_profile(density_a, density_b, t: float, a_shift, fade: float, quantiles, heights: int | None = None) -> np.ndarray:
+    """``cover.comp``'s profile (intervals, heights, 2) of mix(A, B, t) (``density_a/b`` (nx, ny, nz), A
+    read at ``c + a_shift``, zero past its edge; densities clamped to [0, 1]): each covered column (sum
+    above 1e-6, edge weight ``fade``) adds w × its density at the ``heights`` samples (default ny; the
+    nearest cell) to the rank interval k of ``quantiles`` (:func:`column_quantiles`) its sum lies in;
+    [k, j] = (density per unit column sum in cells, share of the column above sample j), an interval
+    without columns takes the nearest one's (above first); none at all: uniform."""
+    a, b = (np.asarray(d, np.float64) for d in (density_a, density_b))
+    nx, ny, nz = b.shape
+    heights = ny if heights is None else int(heights)
+    shifted_a = np.zeros_like(a)
+    sx, sz = int(a_shift[0]), int(a_shift[2])
+    src_x, src_z = np.arange(nx) + sx, np.arange(nz) + sz
+    okx, okz = (src_x >= 0) & (src_x < nx), (src_z >= 0) & (src_z < nz)
+    shifted_a[np.ix_(okx, np.arange(ny), okz)] = a[np.ix_(src_x[okx], np.arange(ny), src_z[okz])]
+    d = np.clip((1.0 - t) * shifted_a + t * b, 0.0, 1.0)
+    sums = (1.0 - t) * shifted_a.sum(1) + t * b.sum(1)
+    uv = np.stack(np.meshgrid((np.arange(nx) + 0.5) / nx, (np.arange(nz) + 0.5) / nz, indexing="ij"), -1)
+    units = np.round(edge_weight(uv, fade) * 1024.0)                   # cover.comp's fixed point
+    q = np.asarray(quantiles, np.float64)
+    intervals = len(q) - 1
+    rows = np.minimum(((np.arange(heights) + 0.5) * ny / heights).astype(np.int64), ny - 1)
+    take = (sums > 1e-6) & (units > 0)
+    k = np.minimum(np.searchsorted(q, sums[take], side="right") - 1, intervals - 1).clip(0)
+    profile = np.zeros((intervals, heights))
+    np.add.at(profile, k, units[take][:, None] * d.transpose(0, 2, 1)[take][:, rows])
+    total = profile.sum(1)
+    out = np.zeros((intervals, heights, 2))
+    full = np.flatnonzero(total > 0)
+    for i in range(intervals):
+        if not len(full):
+            out[i, :, 0], out[i, :, 1] = 1.0 / ny, 1.0 - (np.arange(heights) + 0.5) / heights
+            continue
+        dist = np.abs(full - i) * 2 + (full < i)                      # nearest, above first on a tie
+        src = full[np.argmin(dist)]
+        p = profile[src]
+        out[i, :, 0] = p * heights / (total[src] * ny)
+        out[i, :, 1] = (p[::-1].cumsum()[::-1] - 0.5 * p) / total[src]
+    return out
+
+
 def field_fbm(xz, octaves, offsets, tile_size: float) -> np.ndarray:
     """The fbm (...,) of ``cloud_far_field/field.glsl`` at world ``xz`` (..., 2), mip 0: ``octaves`` the
-    four downloaded textures (size, size, 4) [x, y, channel] (``OctaveTextures.download``), ``offsets``
-    (4, 2) the drift in tiles; bilinear with repeat, texel i centred at (i + 0.5)/size."""
+    four downloaded textures (size, size, 4) [x, y, channel] (``OctaveTextures.download``), octave k read
+    at its own turned uv (:func:`atmos.plugins.cloud_far_field.pattern.octave_uv`), ``offsets`` (4, 2)
+    each octave's drift in its uv (:func:`.layer.drift`), ``tile_size`` the layer's tile (m,
+    FarFieldLayer.tile_size); bilinear with repeat, texel i centred at (i + 0.5)/size."""
+    from atmos.plugins.cloud_far_field.cover import sample
+    from atmos.plugins.cloud_far_field.pattern import octave_uv
     from atmos.plugins.sky_layer.octaves import WEIGHTS
-    xz = np.asarray(xz, np.float64)
-    fbm = np.zeros(xz.shape[:-1])
-    for w, tex, off in zip(WEIGHTS, octaves, np.asarray(offsets, np.float64)):
-        plane = np.asarray(tex, np.float64)[..., 0]
-        n = plane.shape[0]
-        p = (xz / tile_size + off) * n - 0.5
-        i0 = np.floor(p).astype(np.int64)
-        f = p - i0
-        at = lambda di, dk: plane[(i0[..., 0] + di) % n, (i0[..., 1] + dk) % n]
-        fbm += w * ((1 - f[..., 0]) * (1 - f[..., 1]) * at(0, 0) + f[..., 0] * (1 - f[..., 1]) * at(1, 0)
-                    + (1 - f[..., 0]) * f[..., 1] * at(0, 1) + f[..., 0] * f[..., 1] * at(1, 1))
-    return fbm
+    uv = octave_uv(xz, offsets, tile_size)
+    return sum(w * sample(np.asarray(tex, np.float64)[..., 0], uv[k]) for k, (w, tex) in enumerate(zip(WEIGHTS, octaves)))
 
 
 def field_rank(fbm, quantiles) -> np.ndarray:

@@ -20,8 +20,11 @@ class CloudFarFieldSettings(CheckedSettings):
     that sum, seen along the view's slant (α = 1 − exp(−τ / |dir.y|), capped near the horizon); 0: no far field.
     Its light comes from the cloud medium's own model (``cloud_render/volume.glsl``) with the same
     column (toward the sun along the sun's slant); the ground shadows (:mod:`atmos.plugins.cloud_shadows`)
-    and light shafts take the same column beyond the volume. ``tile_size``: metres
-    one octave-texture repeat covers; ``wind``: None (the default) moves the pattern with the
+    and light shafts take the same column beyond the volume. ``tile_size``: None (the default) sizes the clouds
+    from the volume's: the tile is chosen each frame (followed over a few seconds) so that the far field's
+    cover changes along a line as often per metre as the volume's measured cover does (cover.comp); a
+    number fixes the metres of one tile (:mod:`.pattern`: the octaves repeat every 1–4.2 tiles, each on
+    its own turned axes, so the sum never repeats); ``wind``: None (the default) moves the pattern with the
     simulated clouds (the distance the weather's wind has carried them, ``CloudSets.wind_travel``),
     so volume and far field drift together; an (x, z) tuple drifts it at that many m/s with the App
     clock instead. ``animate`` False holds it still. ``horizon_fade``: it fades in while the view ray's
@@ -31,7 +34,7 @@ class CloudFarFieldSettings(CheckedSettings):
     """
 
     thickness: float = 1.0
-    tile_size: float = 8000.0
+    tile_size: float | None = None
     wind: tuple | None = None
     horizon_fade: float = 0.015
     size: int = 256
@@ -45,7 +48,7 @@ class CloudFarFieldSettings(CheckedSettings):
         o = _OWNER
         self.store(dict(
             thickness=check_num(o, "thickness", self.thickness, 0.0, 1e3),
-            tile_size=check_num(o, "tile_size", self.tile_size, 1.0, 1e7),
+            tile_size=check_num(o, "tile_size", self.tile_size, 1.0, 1e7, optional=True),
             wind=check_vec(o, "wind", self.wind, 2, optional=True),
             horizon_fade=check_num(o, "horizon_fade", self.horizon_fade, 0.0, 1.0, lo_open=True),
             size=check_int(o, "size", self.size, 16, 2048),

@@ -4,19 +4,17 @@ Beyond the simulated volume the march goes on through the layer's altitude band 
 column statistics: a point whose far-field fbm (:mod:`atmos.plugins.cloud_far_field`, the graph
 resource "far_field": the same octaves and drift as the 2D far field and the ground shadows) has rank
 r gets the volume's column sum at rank r (the edge-weighted quantiles ``cover.comp`` measures each
-frame), as a vertical profile of that integral; so it is covered as often and as thick per cover as
-the volume. Float64 reference :mod:`.far_reference`. With it on, the 2D far-field pass declares nothing (culled): the march
+frame) spread over height as the volume's covered columns of that rank are (the profile the same pass
+measures: :attr:`atmos.plugins.cloud_far_field.layer.FarFieldLayer.profile`); so it is covered as often,
+as thick per cover and at the same heights as the volume. Float64 reference :mod:`.far_reference`. With it on, the 2D far-field pass declares nothing (culled): the march
 replaces it (:meth:`atmos.plugins.cloud_far_field.plugin.CloudFarFieldPlugin.drawn_by_march`).
 """
 from __future__ import annotations
 
 import numpy as np
 
-from atmos.plugins.cloud_raymarch.noise import COVERAGE, pixel_angle
+from atmos.plugins.cloud_raymarch.noise import pixel_angle
 
-FAR_BASE, FAR_BASE_SOFT, FAR_TOP_SOFT = 0.1, 0.05, 0.3     # far.glsl's profile (height fractions)
-FAR_MAX = 1.0 - FAR_BASE - 0.5 * FAR_TOP_SOFT              # the tallest profile's column integral
-FAR_BODY = COVERAGE                                        # a far cloud body's density (detail.glsl's K)
 SUN_STEPS = 3                                              # far.glsl's march toward the sun (channels d.yzw)
 MAX_SUN_STEP = 2000.0                                      # m: the longest of those steps
 
@@ -36,18 +34,12 @@ def sun_steps(sun_dir, light_step_m: float, height: float) -> tuple[float, float
     return ds, min(channels, 1.0), ds * vertical / height if height > 0.0 else 0.0    # a layer 0 m thick (floats at 1e30 m)
 
 
-def far_amount(layers: int) -> float:
-    """far.glsl's ``far_amount``: a column sum (cells of density 1) in profile units, 1 / (FAR_BODY · the
-    layer's height in cells)."""
-    return 1.0 / (FAR_BODY * max(int(layers), 1))
-
-
-def far_uniforms(march, far, layout, view, sun_dir) -> dict:
+def far_uniforms(march, far, layout, view, sun_dir, tile_size: float) -> dict:
     """The far field's march uniforms: ``march`` RaymarchCloudSettings, ``far`` CloudFarFieldSettings,
-    ``layout`` the march's layer layout, ``view`` the SceneView, ``sun_dir`` unit toward the sun."""
+    ``layout`` the march's layer layout, ``view`` the SceneView, ``sun_dir`` unit toward the sun,
+    ``tile_size`` the far field's tile as drawn (FarFieldLayer.tile_size)."""
     base, height = float(layout.lo[1]), float(layout.hi[1] - layout.lo[1])
     pixel = pixel_angle(view)
     return {"far_distance": float(march.far_distance), "far_growth": float(march.far_step_growth),
-            "far_lod_scale": float(far.size / far.tile_size * pixel), "far_band": (base, height),
-            "far_body": float(FAR_BODY), "far_amount": far_amount(layout.shape[1]),
-            "far_sun": sun_steps(sun_dir, float(far.light_step * far.tile_size), height)}
+            "far_lod_scale": float(far.size / tile_size * pixel), "far_band": (base, height),
+            "far_sun": sun_steps(sun_dir, float(far.light_step * tile_size), height)}

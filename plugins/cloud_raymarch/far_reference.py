@@ -6,55 +6,60 @@ from __future__ import annotations
 import numpy as np
 
 from atmos.plugins.cloud_far_field.reference import column_at_rank, field_fbm, field_rank
-from atmos.plugins.cloud_raymarch.far import FAR_BASE, FAR_BASE_SOFT, FAR_BODY, FAR_MAX, FAR_TOP_SOFT, SUN_STEPS, sun_steps
+from atmos.plugins.cloud_raymarch.far import SUN_STEPS, sun_steps
 from atmos.plugins.cloud_raymarch.reference import integrate, rays
 from atmos.plugins.cloud_render.light import sun_light, unit_direction
 from atmos.shading.medium import source_reference
 
 
-def column(I) -> tuple[np.ndarray, np.ndarray]:
-    """far.glsl's far_column: (top, density factor) of a column ``I`` (profile units)."""
-    I = np.asarray(I, np.float64)
-    x = np.where(I >= 0.5 * FAR_TOP_SOFT, I + 0.5 * FAR_TOP_SOFT, np.sqrt(2.0 * FAR_TOP_SOFT * np.maximum(I, 0.0)))
-    return np.where(I > FAR_MAX, 1.0, FAR_BASE + x), np.maximum(I / FAR_MAX, 1.0)
+def sample_profile(profile, rank, h) -> np.ndarray:
+    """far.glsl's textureLod(far_profile, (rank, h)): ``profile`` (intervals, heights, 2)
+    (FarFieldLayer.read_profile) bilinear, texel (k, j) centred at ((k + 0.5)/intervals, (j + 0.5)/heights),
+    clamped to the edge; returns (..., 2) (R, G)."""
+    table = np.asarray(profile, np.float64)
+    n, m = table.shape[:2]
+    rank, h = np.broadcast_arrays(np.asarray(rank, np.float64), np.asarray(h, np.float64))
 
+    def axis(x, size):
+        p = np.clip(x * size - 0.5, 0.0, size - 1.0)
+        i0 = np.minimum(np.floor(p).astype(np.int64), max(size - 2, 0))
+        return i0, np.minimum(i0 + 1, size - 1), (p - i0)[..., None]
 
-def profile(h, I) -> np.ndarray:
-    """far.glsl's far_profile: the vertical profile at height fraction ``h`` of a column ``I``."""
-    h, I = np.asarray(h, np.float64), np.asarray(I, np.float64)
-    top, factor = column(I)
-    p = factor * np.clip((h - FAR_BASE) / FAR_BASE_SOFT + 0.5, 0, 1) * np.clip((top - h) / FAR_TOP_SOFT, 0, 1)
-    return np.where(I > 0.0, p, 0.0)
-
-
-def above(h, top) -> np.ndarray:
-    """The profile's integral from ``h`` to ``top`` (far.glsl's far_above)."""
-    x = np.maximum(np.asarray(top, np.float64) - h, 0.0)
-    return np.where(x >= FAR_TOP_SOFT, x - 0.5 * FAR_TOP_SOFT, x * x / (2.0 * FAR_TOP_SOFT))
+    (k0, k1, fk), (j0, j1, fj) = axis(rank, n), axis(h, m)
+    low = (1 - fk) * table[k0, j0] + fk * table[k1, j0]
+    high = (1 - fk) * table[k0, j1] + fk * table[k1, j1]
+    return (1 - fj) * low + fj * high
 
 
 class FarField:
-    """The far field's columns I (profile units) as a function of world xz at mip 0: the fbm
+    """The far field as a function of world xz at mip 0: the fbm
     (:func:`atmos.plugins.cloud_far_field.reference.field_fbm` of ``octaves``, ``offsets``,
-    ``tile_size``) ranked among the layer's ``quantiles`` (level 0), the volume's column sum at that
-    rank (``columns``: its QUANTILES column-sum quantiles in cells, FarFieldLayer.read_cover) times
-    ``amount`` (far.py far_amount); ``light_step_m`` the channels' spacing toward the sun (m)."""
+    ``tile_size``) ranked among the layer's ``quantiles`` (level 0); a point of rank r holds the
+    volume's column sum at r (``columns``: its QUANTILES column-sum quantiles in cells,
+    FarFieldLayer.read_cover) spread over height by ``profile`` (FarFieldLayer.read_profile);
+    ``light_step_m`` the channels' spacing toward the sun (m)."""
 
-    def __init__(self, light_step_m: float, *, octaves, offsets, tile_size: float, quantiles, columns, amount: float):
-        self.light_step_m, self.amount = float(light_step_m), float(amount)
+    def __init__(self, light_step_m: float, *, octaves, offsets, tile_size: float, quantiles, columns, profile):
+        self.light_step_m = float(light_step_m)
         self.field = dict(octaves=octaves, offsets=offsets, tile_size=tile_size)
         self.quantiles, self.columns = np.asarray(quantiles, np.float64), np.asarray(columns, np.float64)
+        self.profile = np.asarray(profile, np.float64)
 
-    def column(self, xz) -> np.ndarray:
-        rank = field_rank(field_fbm(xz, **self.field), self.quantiles)
-        return self.amount * column_at_rank(rank, self.columns)
+    def rank(self, xz) -> np.ndarray:
+        return field_rank(field_fbm(xz, **self.field), self.quantiles)
+
+    def density(self, rank, h) -> np.ndarray:
+        """far.glsl's far_density: the column sum at ``rank`` × the profile's R at height fraction ``h``."""
+        h = np.asarray(h, np.float64)
+        d = column_at_rank(rank, self.columns) * sample_profile(self.profile, rank, h)[..., 0]
+        return np.where((h >= 0.0) & (h <= 1.0), d, 0.0)
 
     def channels(self, xz, sun_dir) -> np.ndarray:
-        """(..., 4): the column at xz and 1..3 light steps toward the sun (the baked channels)."""
+        """(..., 4): the rank at xz and 1..3 light steps toward the sun (the baked channels)."""
         s = np.asarray(sun_dir, np.float64)[[0, 2]]
         n = np.linalg.norm(s)
         shift = s / n * self.light_step_m if n > 1e-6 else np.zeros(2)
-        return np.stack([self.column(np.asarray(xz, np.float64) + k * shift) for k in range(4)], -1)
+        return np.stack([self.rank(np.asarray(xz, np.float64) + k * shift) for k in range(4)], -1)
 
 
 def far_source(field: FarField, medium, settings, p, dirs, band, sun) -> np.ndarray:
@@ -67,11 +72,11 @@ def far_source(field: FarField, medium, settings, p, dirs, band, sun) -> np.ndar
     for k in range(SUN_STEPS):
         x = (k + 0.5) * per_step
         i = min(int(x), 2)
-        depth += profile(h + (k + 0.5) * rise, c[:, i] + (c[:, i + 1] - c[:, i]) * (x - i))
-    T = np.exp(-medium.sigma_t * FAR_BODY * ds * depth)
-    (top, factor), hb = column(c[:, 0]), np.maximum(h, FAR_BASE)
-    k = medium.sigma_t * FAR_BODY * band[1] * factor
-    up, down = k * above(hb, top), k * (above(FAR_BASE, top) - above(hb, top))
+        depth += field.density(c[:, i] + (c[:, i + 1] - c[:, i]) * (x - i), h + (k + 0.5) * rise)
+    T = np.exp(-medium.sigma_t * ds * depth)
+    column = medium.sigma_t * medium.cell_size[1] * column_at_rank(c[:, 0], field.columns)
+    above = sample_profile(field.profile, c[:, 0], np.clip(h, 0.0, 1.0))[..., 1]
+    up, down = column * above, column * (1.0 - above)
     sun_color, ambient = sun_light(sun)
     return source_reference(medium, settings, T, up, down, dirs @ sun_dir, dirs[:, 1], sun_color, ambient, sun_dir)
 
@@ -92,7 +97,7 @@ def far_march_reference(field: FarField, medium, settings, band, camera, sun, si
     step_base = settings.step * float(np.min(medium.cell_size))
 
     def sample(i, p):
-        rho = FAR_BODY * profile((p[:, 1] - band[0]) / band[1], field.column(p[:, [0, 2]]))
+        rho = field.density(field.rank(p[:, [0, 2]]), (p[:, 1] - band[0]) / band[1])
         return rho, far_source(field, medium, settings, p, dirs[i], band, sun)
 
     return integrate(pos, dirs, enter, leave, settings.steps, step_base, settings.far_step_growth,

@@ -27,7 +27,7 @@ from atmos.plugins.cloud_far_field.layer import FAR_FIELD
 from atmos.plugins.cloud_far_field.plugin import CloudFarFieldPlugin
 from atmos.plugins.cloud_raymarch.far import far_uniforms
 from atmos.plugins.cloud_raymarch.noise import pixel_angle
-from atmos.plugins.cloud_raymarch.settings import REFERENCE, RaymarchCloudSettings
+from atmos.plugins.cloud_raymarch.settings import REFERENCE, SUN_GROWTH, SUN_SPACING, RaymarchCloudSettings
 from atmos.plugins.cloud_raymarch.temporal import TemporalClouds, jitter
 from atmos.plugins.cloud_render.binding import bind_volume, clamp_sampler, unbind_volume
 from atmos.plugins.cloud_render.light import unit_direction
@@ -40,7 +40,6 @@ LOW_COLOR = "cloud_raymarch_color"
 LOW_DISTANCE = "cloud_raymarch_distance"
 LOW_DEPTH = "cloud_raymarch_depth"
 SKIP_UNIT, DEPTH_UNIT = 4, 9              # (5..8: the far field's octaves, field.glsl)
-SUN_SPACING = 0.5        # cells between the sun_steps detail samples (a billow is ~2 cells across)
 
 
 def skip_map(max_maps: np.ndarray) -> np.ndarray:
@@ -163,7 +162,7 @@ class RaymarchPass(RenderPass):
         s = self.plugin.settings
         return self.gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="cloud_raymarch/march.frag",
                                 defines={"DETAIL_OCTAVES": s.detail_octaves,
-                                         "SUN_STEPS": s.sun_steps if s.detail_octaves else 0,
+                                         "SUN_STEPS": s.sun_steps,
                                          "FAR_FIELD": int(far)})
 
     def _skip_texture(self, sim: CloudSets):
@@ -197,7 +196,7 @@ class RaymarchPass(RenderPass):
                 "skip_cells": skip_cells, "max_skips": int(sum(grid)) + 3, "factor": s.resolution,
                 "sample_offset": tuple(offset), "frame_size": tuple(int(v) for v in view.size),
                 "jitter": int(s.jitter),
-                "sun_march": tuple(float(v) for v in sun * SUN_SPACING * cell.min()),
+                "sun_march": tuple(float(v) for v in sun * SUN_SPACING * cell.min()), "sun_growth": SUN_GROWTH,
                 "pixel_angle": pixel_angle(view)}
 
     def execute(self, frame: PassContext) -> None:
@@ -219,7 +218,7 @@ class RaymarchPass(RenderPass):
         for name, value in self._uniforms(frame, sim, offset).items():
             if name in p:                   # a compiler may drop a uniform a variant does not use
                 p[name].value = value
-        bind_volume(p, sim, self.sampler, view.sun, s.octaves)
+        bind_volume(p, sim, self.sampler, view.sun, s.octaves, s.ms_diffusion)
         if s.empty_space_skipping:
             self._skip_texture(sim).use(SKIP_UNIT)
         else:                               # nothing uploaded; the shader reads no skip map
@@ -249,7 +248,7 @@ class RaymarchPass(RenderPass):
         layer = frame.resource(FAR_FIELD)
         layer.prepare(view, sim)
         layer.use(p, view, sim)
-        values = far_uniforms(s, layer.settings, sim.layout(s.base_altitude), view, unit_direction(view.sun))
+        values = far_uniforms(s, layer.settings, sim.layout(s.base_altitude), view, unit_direction(view.sun), layer.tile_size)
         for name, value in values.items():
             if name in p:
                 p[name].value = value

@@ -3,15 +3,18 @@
 fall): the same segments (``step_base + step_growth · s``, s from the near plane or the layer's box
 to its far side or the scene), the density trilinear between cell centres (clamp to edge), the
 light J of :func:`atmos.shading.medium.source_reference` with the column depths of
-:func:`atmos.plugins.cloud_render.reference.column_depth` (``edge_fade`` 0: neither fades)."""
+:func:`atmos.plugins.cloud_render.reference.column_depth` and the set's diffusion field
+(``edge_fade`` 0: neither fades)."""
 from __future__ import annotations
 
 import numpy as np
 
 from atmos.camera import view_basis
+from atmos.plugins.cloud_raymarch.settings import SUN_GROWTH, SUN_SPACING
 from atmos.plugins.cloud_render.light import sun_light, unit_direction
 from atmos.plugins.cloud_render.reference import column_depth
-from atmos.shading.medium import source_reference
+from atmos.shading.diffusion import diffusion_radiance
+from atmos.shading.medium import mean_cosine, source_reference
 from atmos.shading.reference import multilinear
 
 
@@ -24,11 +27,11 @@ def rays(camera, size) -> tuple[np.ndarray, np.ndarray]:
     return ray / length[..., None], float(camera.near) * length
 
 
-def march_reference(density, transmittance, medium, settings, layout, camera, sun, size, scene=None) -> dict:
+def march_reference(density, transmittance, medium, settings, layout, camera, sun, size, scene=None, field=None) -> dict:
     """``density`` (nx, ny, nz) and ``transmittance`` (the shading volume, its own shape) of one set;
     ``medium``: the CloudSettings; ``settings``: the RaymarchCloudSettings (steps, step, step_growth,
     min_transmittance, ms_*); ``layout``: the CloudLayout; ``scene``: distance to the scene (h, w), None
-    for sky. Returns ``light`` (h, w, 3), ``alpha`` (h, w) and ``distance`` (h, w): a·distance."""
+    for sky; ``field``: the set's diffusion field (its own shape, 4), None: none. Returns ``light`` (h, w, 3), ``alpha`` (h, w) and ``distance`` (h, w): a·distance."""
     d = np.asarray(density, np.float64)
     trans_volume = np.asarray(transmittance, np.float64)
     shape, tshape = np.array(d.shape, np.float64), np.array(trans_volume.shape, np.float64)
@@ -48,13 +51,16 @@ def march_reference(density, transmittance, medium, settings, layout, camera, su
     sun_color, ambient = sun_light(sun)
     sun_dir = unit_direction(sun)
     column_tau = medium.sigma_t * cell[1]
+    g = mean_cosine(medium.phase_g, medium.phase_g2, medium.phase_w)
 
     def sample(i, p):
         uvw = (p - lo) / extent
-        T = multilinear(trans_volume, uvw * tshape - 0.5)
+        T = sun_transmittance(d, trans_volume, medium.sigma_t, lo, extent, SUN_SPACING * cell.min(),
+                              settings.sun_steps, sun_dir, p)
         up, down = column_depth(d, uvw, column_tau, trans_volume.shape)
+        L = None if field is None else diffusion_radiance(field, uvw, dirs[i], g)
         return multilinear(d, uvw * shape - 0.5), source_reference(
-            medium, settings, T, up, down, dirs[i] @ sun_dir, dirs[i][:, 1], sun_color, ambient, sun_dir)
+            medium, settings, T, up, down, dirs[i] @ sun_dir, dirs[i][:, 1], sun_color, ambient, sun_dir, L)
 
     return integrate(pos, dirs, enter, leave, settings.steps, step_base, settings.step_growth,
                      settings.min_transmittance, medium.sigma_t, sample, (h, w))
@@ -85,3 +91,29 @@ def integrate(pos, dirs, enter, leave, steps, step_base, growth, min_transmittan
     h, w = shape
     return {"light": light.reshape(h, w, 3), "alpha": (1.0 - trans).reshape(h, w),
             "distance": weighted.reshape(h, w)}
+
+
+def sun_transmittance(density, transmittance, sigma_t, lo, extent, step, steps, sun_dir, p) -> np.ndarray:
+    """march.frag's sun_transmittance at world points ``p`` (n, 3): ``steps`` steps toward ``sun_dir``
+    (unit), the first ``step`` m long and each next SUN_GROWTH times the last, the trilinear ``density``
+    at each step's midpoint (0 from the first midpoint outside the box on) times the step, then the
+    shading volume ``transmittance`` (trilinear) where they end (1 outside the box); ``steps`` 0: the
+    shading volume's T at p."""
+    d, tv = np.asarray(density, np.float64), np.asarray(transmittance, np.float64)
+    shape, tshape = np.array(d.shape, np.float64), np.array(tv.shape, np.float64)
+
+    def inside(uvw):
+        return np.all((uvw >= 0.0) & (uvw <= 1.0), axis=-1)
+
+    tau, at, h = np.zeros(len(p)), 0.0, float(step)
+    live = np.ones(len(p), bool)
+    for _ in range(steps):
+        uvw = (p + sun_dir * (at + 0.5 * h) - lo) / extent
+        live &= inside(uvw)
+        tau += np.where(live, h * multilinear(d, uvw * shape - 0.5), 0.0)
+        at, h = at + h, h * SUN_GROWTH
+    end = (p + sun_dir * at - lo) / extent
+    far = multilinear(tv, end * tshape - 0.5)
+    if steps > 0:
+        far = np.where(live & inside(end), far, 1.0)
+    return np.exp(-sigma_t * tau) * far

@@ -12,24 +12,38 @@ per full-res pixel (``shaders/cloud_raymarch/temporal.frag``):
   moves with the terrain instead of staying put as sky would — the flight demo's 2-pixel stripes); clamped to the box of the current 3×3 low-res neighbourhood (``history_clamp``), the
   history first corrected by this frame's samples (the upsample's weights times fresh − history at
   each sample, reprojected with this pixel's motion: history and fresh samples agree, no 2-pixel
-  pattern while moving), the clamp and the correction loosened below ``CLAMP_MOTION`` pixels of motion where the block's fresh sample matches the
-  history there (``CHANGE_TOLERANCE``), so that a still camera over still clouds keeps every fresh
-  sample and converges to the full-res march in r² frames, while clouds that move are clamped; rejected, falling back to the depth-aware upsample
+  pattern while moving), the clamp and the correction loosened to 0 below ``CLAMP_MOTION`` pixels of
+  motion, so that a still camera over still clouds keeps every fresh sample and converges to the
+  full-res march in r² frames, while clouds that move are clamped; rejected, falling back to the depth-aware upsample
   of this frame's samples (``cloud_render/upsample.glsl``, shared with OffscreenClouds' composite), when its point was off screen or the scene behind the pixel changed
-  (``DEPTH_TOLERANCE``: an object moved in front, or away), or, under a still camera, where the
-block's fresh sample differs from the history by more than ``CHANGE_TOLERANCE`` (clouds drifting:
-all of it from the tolerance, none below half; the stale history is worse than the upsample at
-0.1–2 px/frame of drift); and mixed toward the upsample the faster
+  (``DEPTH_TOLERANCE``: an object moved in front, or away); and mixed toward the upsample the faster
   the pixel moves (weight 1 − motion / ``motion_limit``, motion in full-res pixels per frame).
+* under a camera still for r² frames (:func:`detects_change`: every pixel's last sample is then
+  real, and marched with this camera) the history stays where the clouds evolve in place and is
+  tested where they drift. The history also keeps each pixel's last marched sample (a fourth target;
+  the upsample where the scene behind it changed), and drift is told from evolution by matching
+  (``shaders/cloud_raymarch/drift.frag``, a low-res pass; twin :func:`.temporal_reference.drift_flags`):
+  each low-res texel compares this frame's 3×3 samples with the samples marched at the same pixels r²
+  frames ago, unshifted and shifted by one texel (r px) each way. Where a shift explains the change
+  better than none (by ``DRIFT_GAIN`` of it, the change above ``DRIFT_FLOOR``), or the samples changed
+  by more than ``DRIFT_MEAN`` on average or one by more than ``DRIFT_CHANGE`` (a drift too fast for
+  the shifts), the clouds moved: within one texel the block's fresh sample is compared with the
+  history there, rejected (the upsample) where they differ by more than ``CHANGE_TOLERANCE`` (all of
+  it from the tolerance, none below half; at 0.5–2 px/frame of drift stale history is worse than the
+  upsample). Elsewhere the history stays: evolving clouds (sunset, bench_cloud_stability.py) change
+  about half their samples by more than 2 % in r² frames, and the upsample there would be both wrong
+  and flickering. Testing the history against itself everywhere fed on itself: a rejected block held
+  the upsample, whose own error read as a change the next frame (7× the clouds' own change).
 
 The output (premultiplied colour RGBA16F, (a·distance, a) RG32F as in :mod:`atmos.composition`) is
 the next frame's history; the pass blends it onto "color" (and "cloud_distance"). The numpy float64
 reference is :mod:`.temporal_reference`.
 
 Knobs and their cost (the resolve itself is one fullscreen pass: 1 fresh + 4 bilinear + 9
-neighbourhood fetches of the low-res targets, 2 × 4 bilinear history fetches, 2 depth fetches, each
-pixel, plus 4 × 2 × 4 for the correction while moving: 1.43× the resolve without it, 640×360 r 2 on
-llvmpipe; 28 bytes of history per pixel, twice):
+neighbourhood fetches of the low-res targets, 2 × 4 bilinear history fetches, 2 depth fetches, 1
+last-sample fetch each pixel, plus 4 × 2 × 4 for the correction while moving: 1.43× the resolve
+without it, 640×360 r 2 on llvmpipe; under a still camera also 9 drift-flag fetches, after the
+low-res drift pass: 25 + 9 × 9 fetches per low-res texel; 36 bytes of history per pixel, twice):
 
 * ``reprojection`` (the plugin's): off → no history (the upsample alone, which blurs at r > 1);
   on → r² frames to converge when still, a ghost after fast motion bounded by the clamp.
@@ -53,7 +67,11 @@ RESOLUTIONS = (1, 2, 4)
 HISTORY_CLAMP = 1.0        # default clamp weight of moving history (0..1)
 MOTION_LIMIT = 16.0        # default pixels of motion per frame at which history is dropped
 CLAMP_MOTION = 1.0         # pixels of motion per frame below which the clamp is loosened linearly to 0 ...
-CHANGE_TOLERANCE = 0.02    # ... unless this frame's sample differs from the history by more (alpha, relative rgb)
+CHANGE_TOLERANCE = 0.02    # ... unless, where clouds drift, this frame's sample differs from the history by more
+DRIFT_GAIN = 0.3           # still camera: the share of the r²-frame change a one-texel shift must explain to be drift ...
+DRIFT_FLOOR = 0.1          # ... of a mean change (alpha, relative rgb) over the 3×3 samples above this ...
+DRIFT_MEAN = 0.15          # ... or the mean change that is drift whatever the shift explains ...
+DRIFT_CHANGE = 0.4         # ... as is this change of one sample
 DEPTH_TOLERANCE = 0.1      # relative change of the scene distance behind a pixel that rejects its history
 CUT_DISTANCE = 100.0       # m the camera moves in one frame that make a camera cut (history reset) ...
 CUT_TURN = math.radians(30.0)   # ... or radians its view direction turns
@@ -93,8 +111,8 @@ def low_size(size, r: int) -> tuple[int, int]:
 
 
 def detects_change(still_frames: int, r: int) -> bool:
-    """Whether the resolve compares fresh samples with the history (``CHANGE_TOLERANCE``): once the
-    camera has been still for r² frames, every pixel holds a sample, so a difference is the clouds'."""
+    """Whether the resolve tells drifting clouds from evolving ones (the drift pass): once the camera
+    has been still for r² frames, every pixel holds a sample marched with it, so a change is the clouds'."""
     return still_frames >= r * r
 
 
@@ -124,13 +142,14 @@ class TemporalClouds:
     def __init__(self, gpu):
         self.gpu = gpu
         self.frame_index = 0
-        self._sets: list | None = None     # [(fbo, color, distance, scene)] × 2
+        self._sets: list | None = None     # [(fbo, color, distance, scene, last sample)] × 2
+        self._drift = None                 # (fbo, texture): the low-res drift flags
         self._key = None                   # (size, r) the history was made for
         self._current = 0                  # which set holds the last output
         self._valid = False
         self._prev = None                  # (camera_state, CameraMatrices, position) of the last resolve
         self.still_frames = 0              # resolves in a row with the camera of the one before
-        self._vao = None
+        self._vaos: dict = {}              # program -> its empty vertex array
 
     # -- per frame -----------------------------------------------------------------------------
     def offset(self, r: int) -> tuple[int, int]:
@@ -189,11 +208,14 @@ class TemporalClouds:
         self._set(p, "edge", EDGE if depth is not None and low_depth is not None else 1e30)
         valid = self._valid and self._prev is not None and not self.is_cut(camera, self._prev[2], self._prev[3])
         self._set(p, "history_valid", valid)
+        detect = valid and state == self._prev[0] and detects_change(self.still_frames + 1, r)
+        if detect:
+            self._flag_drift(low_color, prev, r, (int(ox), int(oy)), depth, matrices, camera)
         if valid:
             prev_state, prev_matrices, prev_position, _ = self._prev
             proj, view = prev_matrices.projection, prev_matrices.view
             self._set(p, "still", state == prev_state)
-            self._set(p, "detect_change", detects_change(self.still_frames + 1, r) if state == prev_state else False)
+            self._set(p, "detect_change", detect)
             p["prev_proj"].write(gl_matrix(proj[[0, 1, 3], :3] @ view[:3, :3]))
             self._set(p, "cam_delta", tuple(float(c) for c in np.asarray(camera.position) - prev_position))
             self._set(p, "history_clamp", float(history_clamp))
@@ -203,18 +225,42 @@ class TemporalClouds:
         if depth is not None:
             depth.use(5)
         (low_depth if low_depth is not None else low_color).use(6)     # unit 6 read only at edge < 1e30
-        ctx = self.gpu.ctx
+        prev[4].use(7)
+        self._drift[1].use(8)                                          # read only when detect_change
         write[0].use()
-        ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST | moderngl.CULL_FACE)
-        if self._vao is None or self._vao[1] is not p:
-            self._vao = (self.gpu.track(ctx.vertex_array(p, [])), p)
-        self._vao[0].render(moderngl.TRIANGLES, vertices=3)
+        self._draw(p)
         self._current = 1 - self._current
         self.still_frames = self.still_frames + 1 if valid and state == self._prev[0] else 0
         self._valid = True
         self._prev = (state, matrices, np.array(camera.position, np.float64), forward_of(camera))
         self.frame_index += 1
         return write[1], write[2]
+
+    def _flag_drift(self, low_color, prev, r: int, offset, depth, matrices, camera) -> None:
+        """The low-res drift flags of this frame's samples against the last ones in the history set
+        ``prev`` (``drift.frag``); ``depth`` (or None: sky) tells where the scene changed."""
+        p = self.gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="cloud_raymarch/drift.frag")
+        self._set(p, "r", r)
+        self._set(p, "offset", offset)
+        self._set(p, "has_depth", depth is not None)
+        self._set(p, "near", float(camera.near))
+        self._set(p, "far", float(camera.far))
+        if "view_basis" in p:
+            p["view_basis"].write(matrices.gl("view_basis"))
+        low_color.use(0)
+        prev[4].use(1)
+        if depth is not None:
+            depth.use(2)
+        prev[3].use(3)
+        self._drift[0].use()
+        self._draw(p)
+
+    def _draw(self, p) -> None:
+        ctx = self.gpu.ctx
+        ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST | moderngl.CULL_FACE)
+        if p not in self._vaos:
+            self._vaos[p] = self.gpu.track(ctx.vertex_array(p, []))
+        self._vaos[p].render(moderngl.TRIANGLES, vertices=3)
 
     @staticmethod
     def _set(program, name, value):
@@ -229,7 +275,7 @@ class TemporalClouds:
         self._sets = []
         for _ in range(2):
             textures = [ctx.texture(size, 4, dtype="f2"), ctx.texture(size, 2, dtype="f4"),
-                        ctx.texture(size, 1, dtype="f4")]
+                        ctx.texture(size, 1, dtype="f4"), ctx.texture(size, 4, dtype="f2")]
             for tex in textures:
                 tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
                 tex.repeat_x = tex.repeat_y = False
@@ -237,33 +283,42 @@ class TemporalClouds:
             fbo.use()                      # clear() re-binds the framebuffer bound before it: this one
             fbo.clear(0.0, 0.0, 0.0, 0.0)
             self._sets.append(tuple(self.gpu.track(o) for o in (fbo, *textures)))
+        flags = ctx.texture(low_size(size, r), 1, dtype="f1")
+        flags.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        fbo = ctx.framebuffer([flags])
+        fbo.use()
+        fbo.clear(0.0, 0.0, 0.0, 0.0)
+        self._drift = tuple(self.gpu.track(o) for o in (fbo, flags))
         self._key, self._current, self._valid = (size, r), 0, False
 
     def _free(self) -> None:
-        if self._sets and any(self.gpu.ctx.fbo is objects[0] for objects in self._sets):
+        held = [*(self._sets or ()), *((self._drift,) if self._drift else ())]
+        if any(self.gpu.ctx.fbo is objects[0] for objects in held):
             self.gpu.target.use()          # never leave a released framebuffer bound
-        for objects in self._sets or ():
+        for objects in held:
             for obj in objects:
                 obj.release()
-        self._sets, self._key, self._valid = None, None, False
+        self._sets, self._drift, self._key, self._valid = None, None, None, False
 
     def release(self) -> None:
         """Free the history (the next resolve makes it again); the program is the context's."""
         self._free()
-        if self._vao is not None:
-            self._vao[0].release()
-            self._vao = None
+        for vao in self._vaos.values():
+            vao.release()
+        self._vaos = {}
 
-    def read_history(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def read_history(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """The last output as float64 arrays, GL row order (row 0 at the bottom): colour (h, w, 4),
-        distance (h, w, 2), scene distance (h, w) (−1: sky). For tests and debugging (a GPU read)."""
+        distance (h, w, 2), scene distance (h, w) (−1: sky), each pixel's last sample (h, w, 4). For
+        tests and debugging (a GPU read)."""
         if self._sets is None:
             raise ValueError("TemporalClouds.read_history: nothing resolved yet (or released)")
         (w, h), _ = self._key
-        _, color, distance, scene = self._sets[self._current]
+        _, color, distance, scene, last = self._sets[self._current]
         out = [np.frombuffer(t.read(), dt).reshape(h, w, n).astype(np.float64)
-               for t, dt, n in ((color, np.float16, 4), (distance, np.float32, 2), (scene, np.float32, 1))]
-        return out[0], out[1], out[2][..., 0]
+               for t, dt, n in ((color, np.float16, 4), (distance, np.float32, 2), (scene, np.float32, 1),
+                                (last, np.float16, 4))]
+        return out[0], out[1], out[2][..., 0], out[3]
 
     @property
     def allocated(self) -> bool:

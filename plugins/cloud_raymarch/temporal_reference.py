@@ -14,7 +14,8 @@ from atmos.camera import Camera, view_basis
 from atmos.plugins.cloud_render.offscreen import EDGE
 from atmos.plugins.cloud_render.offscreen_reference import inv_depth, upsample_weights
 
-from .temporal import ALPHA_EPS, TemporalClouds, forward_of, CHANGE_TOLERANCE, CLAMP_MOTION, DEPTH_TOLERANCE, HISTORY_CLAMP, MOTION_LIMIT, camera_state, detects_change
+from .temporal import (ALPHA_EPS, CHANGE_TOLERANCE, CLAMP_MOTION, DEPTH_TOLERANCE, DRIFT_CHANGE, DRIFT_FLOOR, DRIFT_GAIN, DRIFT_MEAN, HISTORY_CLAMP,
+                       MOTION_LIMIT, TemporalClouds, camera_state, detects_change, forward_of)
 
 
 def bilinear(image: np.ndarray, px: np.ndarray, py: np.ndarray) -> np.ndarray:
@@ -50,16 +51,59 @@ def _rays(camera, aspect: float, size) -> np.ndarray:
     return ndc @ view_basis(camera, aspect).T
 
 
+def _change(a: np.ndarray, b: np.ndarray, scale: np.ndarray) -> np.ndarray:
+    """The change measure of colours (..., 4): alpha, and rgb relative to ``scale``."""
+    return np.maximum(np.abs(a[..., 3] - b[..., 3]), np.abs(a[..., :3] - b[..., :3]).max(axis=-1) / scale)
+
+
+def _around(a: np.ndarray, i: int, j: int) -> np.ndarray:
+    """``a`` (lh, lw, ...) at texel (x + i, y + j), clamped to the edge."""
+    lh, lw = a.shape[:2]
+    y, x = np.mgrid[0:lh, 0:lw]
+    return a[np.clip(y + j, 0, lh - 1), np.clip(x + i, 0, lw - 1)]
+
+
+def drift_flags(low_color: np.ndarray, last_sample: np.ndarray, r: int, offset, same=None) -> np.ndarray:
+    """``shaders/cloud_raymarch/drift.frag``: per low-res texel (lh, lw), whether this frame's 3×3
+    samples around it moved since they were last marched (``last_sample``, full-res (h, w, 4): each
+    pixel's last sample, r² frames old at this frame's pixels): a one-texel shift explains
+    ``DRIFT_GAIN`` of their change (above ``DRIFT_FLOOR`` each on average), or they changed by more
+    than ``DRIFT_MEAN`` on average or one by more than ``DRIFT_CHANGE``; ``same`` (h, w): where the scene behind a pixel is the history's (None:
+    everywhere), a sample elsewhere takes no part."""
+    h, w = last_sample.shape[:2]
+    lh, lw = low_color.shape[:2]
+    ox, oy = offset
+    rows, cols = np.minimum(np.arange(lh) * r + oy, h - 1), np.minimum(np.arange(lw) * r + ox, w - 1)
+    before = last_sample[rows][:, cols]
+    part = np.ones((lh, lw), bool) if same is None else same[rows][:, cols]
+    scale = np.maximum(np.max([_around(low_color[..., :3].max(axis=-1), i, j) for j in range(-2, 3)
+                               for i in range(-2, 3)], axis=0), 1e-3)
+    costs, largest = [], None
+    for uy in (-1, 0, 1):
+        for ux in (-1, 0, 1):
+            shifted = _around(before, ux, uy)
+            # texel m of the patch is clamped first, then shifted (and clamped again), as the shader does
+            changes = [_change(_around(low_color, i, j), _around(shifted, i, j), scale) * _around(part, i, j)
+                       for j in (-1, 0, 1) for i in (-1, 0, 1)]
+            costs.append(sum(changes))
+            if ux == uy == 0:
+                still, largest = costs[-1], np.max(changes, axis=0)
+    best = np.min([c for k, c in enumerate(costs) if k != 4], axis=0)
+    gain = (still - np.minimum(best, still)) / np.maximum(still, 1e-6)
+    return ((gain > DRIFT_GAIN) & (still > 9 * DRIFT_FLOOR)) | (still > 9 * DRIFT_MEAN) | (largest > DRIFT_CHANGE)
+
+
 def resolve_reference(history, low_color, low_distance, depth, size, r: int, offset, camera, prev, aspect: float,
                       history_clamp: float = HISTORY_CLAMP, motion_limit: float = MOTION_LIMIT,
                       detect_change: bool = False, low_depth=None):
     """One resolve at full-res ``size`` (w, h). ``history``: None (no valid history) or (color (h, w, 4),
-    distance (h, w, 2), scene distance (h, w)) of the previous frame; ``low_color`` (lh, lw, 4),
+    distance (h, w, 2), scene distance (h, w), each pixel's last sample (h, w, 4)) of the previous frame; ``low_color`` (lh, lw, 4),
     ``low_distance`` (lh, lw, 2): this frame's samples at full-res pixels (i·r + ox, j·r + oy);
     ``depth``: the window-space scene depth (h, w) or None; ``prev``: (camera, aspect) of the
     history's frame; ``detect_change``: :func:`.temporal.detects_change` of the frames the camera
     has been still; ``low_depth``: the window depth each sample's ray saw (lh, lw), with ``depth``
-    making the upsample depth-aware. Returns (color, distance, scene distance): the frame and the next history."""
+    making the upsample depth-aware. Returns (color, distance, scene distance, last sample): the frame
+    and the next history."""
     lh, lw = low_color.shape[:2]
     w, h = size
     ox, oy = offset
@@ -80,7 +124,7 @@ def resolve_reference(history, low_color, low_distance, depth, size, r: int, off
                       for j in (-1, 0, 1) for i in (-1, 0, 1)])
     lo, hi = neigh.min(axis=0), neigh.max(axis=0)
 
-    out = up
+    out, last = up, up[..., :4]
     if history is not None:
         hist = np.concatenate([history[0], history[1]], axis=-1)
         prev_camera, prev_aspect = prev
@@ -94,19 +138,24 @@ def resolve_reference(history, low_color, low_distance, depth, size, r: int, off
         nx = np.clip(np.floor(qx + 0.5), 0, w - 1).astype(np.int64)
         ny = np.clip(np.floor(qy + 0.5), 0, h - 1).astype(np.int64)
         prev_scene = history[2][ny, nx]
+        last = history[3][ny, nx]
         rays = _rays(camera, aspect, size)
         dirs = rays / np.linalg.norm(rays, axis=-1, keepdims=True)
         point = np.asarray(camera.position) + dirs * np.maximum(scene, 0)[..., None]
         expected = np.where(scene < 0, -1.0, np.linalg.norm(point - np.asarray(prev_camera.position), axis=-1))
         same = (expected < 0) == (prev_scene < 0)
         same &= (expected < 0) | (np.abs(prev_scene - expected) <= DEPTH_TOLERANCE * expected)
-        # has the image changed where it was marched? the nearest sample against the history there
+        last = np.where((inside & same)[..., None], last, up[..., :4])     # no last sample of this scene: the upsample
+        # a still camera: where the clouds drift, has the image changed where it was marched? (the
+        # nearest sample against the history there); where they evolve in place the history stays
+        drifting = np.zeros((h, w))
+        if detect_change:
+            flags = drift_flags(low_color, history[3], r, offset, same=same).astype(np.float64)
+            drifting = np.max([_around(flags, i, j)[cy, cx] for j in (-1, 0, 1) for i in (-1, 0, 1)], axis=0)
         fx = np.clip(np.floor(cx * r + ox + (qx - x) + 0.5), 0, w - 1).astype(np.int64)
         fy = np.clip(np.floor(cy * r + oy + (qy - y) + 0.5), 0, h - 1).astype(np.int64)
         predicted, now = history[0][fy, fx], low_color[cy, cx]
-        scale = np.maximum(hi[..., :3].max(axis=-1), 1e-3)
-        change = np.maximum(np.abs(now[..., 3] - predicted[..., 3]),
-                            np.abs(now[..., :3] - predicted[..., :3]).max(axis=-1) / scale) * detect_change
+        change = drifting * _change(now, predicted, np.maximum(hi[..., :3].max(axis=-1), 1e-3))
         moved = np.maximum(np.minimum(motion / CLAMP_MOTION, 1.0), np.minimum(change / CHANGE_TOLERANCE, 1.0))[..., None]
         # the history corrected by this frame's samples: (fresh - history at the sample, moved like this pixel)
         correction = sum(weight[..., None] * (both[ty, tx] - bilinear(hist, tx * r + ox + (qx - x), ty * r + oy + (qy - y)))
@@ -122,7 +171,8 @@ def resolve_reference(history, low_color, low_distance, depth, size, r: int, off
     fi, fj = ((x - ox) // r).astype(np.int64), ((y - oy) // r).astype(np.int64)
     fresh_value = np.concatenate([low_color, low_distance], axis=-1)[np.clip(fj, 0, lh - 1), np.clip(fi, 0, lw - 1)]
     out = np.where(fresh[..., None], fresh_value, out)
-    return out[..., :4], out[..., 4:], scene
+    last = np.where(fresh[..., None], fresh_value[..., :4], last)
+    return out[..., :4], out[..., 4:], scene, last
 
 
 def _reproject(hist_distance, camera, prev_camera, prev_aspect, aspect, size, scene):
@@ -171,10 +221,10 @@ class ReferenceHistory:
             self.history, self.r = None, r
         still = self.history is not None and camera_state(camera, aspect) == camera_state(*self.prev)
         self.still_frames = self.still_frames + 1 if still else 0
-        color, distance, scene = resolve_reference(self.history, low_color, low_distance, depth, self.size, r,
+        color, distance, scene, last = resolve_reference(self.history, low_color, low_distance, depth, self.size, r,
                                                    offset, camera, self.prev, aspect, **knobs,
                                                    detect_change=detects_change(self.still_frames, r))
-        self.history = (color, distance, scene)
+        self.history = (color, distance, scene, last)
         self.prev = (_copy(camera), aspect)
         return color, distance
 

@@ -7,8 +7,9 @@ from atmos.lighting import Sun
 from atmos.plugins.cloud_render.light import DEFAULT_OCTAVES, light_uniforms
 from atmos.plugins.clouds.sets import CloudSets
 from atmos.shading.columns import COLUMNS
+from atmos.shading.diffusion import DIFFUSION
 
-UNITS = (0, 1, 2, 3, 10, 11)   # density, transmittance, columns (each a, b)
+UNITS = (0, 1, 2, 3, 10, 11, 16, 17)   # density, transmittance, columns, diffusion field (each a, b)
 
 
 def clamp_sampler(ctx: moderngl.Context):
@@ -16,11 +17,12 @@ def clamp_sampler(ctx: moderngl.Context):
     return ctx.sampler(filter=(moderngl.LINEAR, moderngl.LINEAR), repeat_x=False, repeat_y=False, repeat_z=False)
 
 
-def bind_volume(program, sim, sampler, sun: Sun | None, octaves=DEFAULT_OCTAVES) -> float:
+def bind_volume(program, sim, sampler, sun: Sun | None, octaves=DEFAULT_OCTAVES, diffusion: float = 0.0) -> float:
     """Bind mix(A, B, t)'s textures (``sim``: the frame's CloudSets, or the CloudSimulation) to units
     0..3 (density, transmittance) and 10, 11 (the light volume's columns) with ``sampler`` and set ``t``, ``a_shift`` (A drawn where it was computed), ``has_shading``
     and the light (:func:`light_uniforms` of the simulation's medium, the sun and the
-    multiple-scattering ``octaves``); returns t. Call
+    multiple-scattering ``octaves``), and 16, 17 (the diffusion field, weight ``diffusion``; 0 where the
+    sets have no field); returns t. Call
     :func:`unbind_volume` when the draw is done."""
     a, b, t = sim.view()
     shading = "transmittance" in a
@@ -31,13 +33,16 @@ def bind_volume(program, sim, sampler, sun: Sun | None, octaves=DEFAULT_OCTAVES)
     b[light].use(3)
     a[COLUMNS].use(10)
     b[COLUMNS].use(11)
+    field = DIFFUSION in a and DIFFUSION in b
+    a[DIFFUSION if field else COLUMNS].use(16)         # without a field: a placeholder, unread
+    b[DIFFUSION if field else COLUMNS].use(17)
     for unit in UNITS:
         sampler.use(unit)
     program["t"].value = float(t)
     if "a_shift" in program:
         program["a_shift"].value = (sim if isinstance(sim, CloudSets) else sim.sets()).a_shift
     values = {"has_shading": int(shading), "edge_fade": float(sim.settings.edge_fade),
-              **light_uniforms(sim.settings, sun, octaves)}
+              **light_uniforms(sim.settings, sun, octaves, diffusion if field else 0.0)}
     for name, value in values.items():
         if name in program:
             program[name].value = value

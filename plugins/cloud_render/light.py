@@ -12,6 +12,7 @@ from atmos.shading.medium import environment
 
 DEFAULT_AMBIENT = (0.35, 0.47, 0.65)
 DEFAULT_OCTAVES = (0.2, 0.85, 0.85)       # Wrenninge's a, b, c, fitted to the path tracer (bench_cloud_light --fit)
+DEFAULT_DIFFUSION = 0.4                   # the diffusion field's weight beta (fitted beside the octaves, README "Cloud light")
 
 
 @dataclass(frozen=True)
@@ -19,11 +20,16 @@ class CloudLightSettings(CheckedSettings):
     """The multiple-scattering octaves both cloud renderers share (the sprites' CloudRenderSettings
     and the march's RaymarchCloudSettings inherit them): ``ms_attenuation``, ``ms_contribution``,
     ``ms_eccentricity`` = Wrenninge's a, b, c in [0, 1] (the defaults are fitted to the path tracer,
-    ``benchmarks/bench_cloud_light.py --fit``). A subclass's ``__post_init__`` stores
+    ``benchmarks/bench_cloud_light.py --fit``). ``ms_diffusion`` (0..2): the weight beta of the diffusion
+    field beside them (:mod:`atmos.shading.diffusion`: J += sun_source beta max(sun_y, 0) (1 - cos^2)^4
+    max(phi - 3 g F.ray, 0) / 4pi, cos = ray . sun); 0.5 was fitted on the bench's two volumes in four
+    views (gate cost -32 % in the float64 twin); 0 turns the term off (the field is still computed
+    where the cloud chain shades). A subclass's ``__post_init__`` stores
     :meth:`light_checks` beside its own checks (alone, the class checks just these)."""
     ms_attenuation: float = DEFAULT_OCTAVES[0]
     ms_contribution: float = DEFAULT_OCTAVES[1]
     ms_eccentricity: float = DEFAULT_OCTAVES[2]
+    ms_diffusion: float = DEFAULT_DIFFUSION
 
     def __post_init__(self):
         self.store(self.light_checks())
@@ -31,8 +37,9 @@ class CloudLightSettings(CheckedSettings):
     def light_checks(self) -> dict:
         """The checked octave fields, named after the concrete settings class."""
         o = type(self).__name__
-        return {name: check_num(o, name, getattr(self, name), 0.0, 1.0)
-                for name in ("ms_attenuation", "ms_contribution", "ms_eccentricity")}
+        return {**{name: check_num(o, name, getattr(self, name), 0.0, 1.0)
+                   for name in ("ms_attenuation", "ms_contribution", "ms_eccentricity")},
+                "ms_diffusion": check_num(o, "ms_diffusion", self.ms_diffusion, 0.0, 2.0)}
 
     @property
     def octaves(self) -> tuple:
@@ -60,9 +67,9 @@ def unit_direction(sun: Sun | None) -> np.ndarray:
     return d / n if n > 0 and np.isfinite(n) else np.array([0.0, -1.0, 0.0])
 
 
-def light_uniforms(cloud_settings, sun: Sun | None, octaves=DEFAULT_OCTAVES) -> dict:
-    """The light uniforms of ``volume.glsl`` for a ``CloudSettings`` medium, the ``Sun`` and the
-    multiple-scattering octaves (a, b, c)."""
+def light_uniforms(cloud_settings, sun: Sun | None, octaves=DEFAULT_OCTAVES, diffusion: float = 0.0) -> dict:
+    """The light uniforms of ``volume.glsl`` for a ``CloudSettings`` medium, the ``Sun``, the
+    multiple-scattering octaves (a, b, c) and the diffusion field's weight."""
     color, ambient = sun_light(sun)
     direction = unit_direction(sun)
     e, sky, ground = environment(cloud_settings, color, ambient, direction)
@@ -73,4 +80,5 @@ def light_uniforms(cloud_settings, sun: Sun | None, octaves=DEFAULT_OCTAVES) -> 
             "sun_dir": tuple(float(v) for v in direction),
             "phase_lobes": (float(s.phase_g), float(s.phase_g2), float(s.phase_w)),
             "ms_octaves": tuple(float(v) for v in octaves),
-            "column_tau": float(s.sigma_t * s.cell_size[1])}
+            "column_tau": float(s.sigma_t * s.cell_size[1]),
+            "ms_diffusion": float(diffusion)}

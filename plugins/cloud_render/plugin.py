@@ -63,8 +63,8 @@ class CloudRenderSettings(CloudLightSettings):
     pass's ``setup`` every frame, so a change resizes the off-screen targets on the next frame).
     ``lod_pixels``: level of detail — columns where a block of 2^L cells spans at most this many
     target pixels are drawn one sprite per block (L ≤ 2, :mod:`.segments`); None: every cell.
-    ``ms_attenuation``, ``ms_contribution``, ``ms_eccentricity``: the multiple-scattering octaves,
-    inherited from :class:`~atmos.plugins.cloud_render.light.CloudLightSettings` (shared with the
+    ``ms_attenuation``, ``ms_contribution``, ``ms_eccentricity``: the multiple-scattering octaves, and
+    ``ms_diffusion`` the diffusion field's weight beside them, inherited from :class:`~atmos.plugins.cloud_render.light.CloudLightSettings` (shared with the
     ray-marched clouds). ``enabled`` False declares nothing (the pass is culled, allocates nothing).
     """
     base_altitude: float | None = None
@@ -265,7 +265,7 @@ class CloudSpritePass(RenderPass):
         frame.blend_over()
         ctx.enable(moderngl.DEPTH_TEST | moderngl.PROGRAM_POINT_SIZE)
         ctx.depth_func = "<="          # a tiny near plane rounds far depths to 1.0: still in front of the sky
-        bind_volume(p, sim, self.sampler, view.sun, settings.octaves)
+        bind_volume(p, sim, self.sampler, view.sun, settings.octaves, settings.ms_diffusion)
         try:
             self._draw(segments, layout.group)
         finally:

@@ -6,7 +6,8 @@ the wind and by the volume's own motion) → smoothing (``smoothing_slices`` z r
 maps (the same z ranges; the tiny max maps are copied into a pixel buffer once per step and read
 when the set is first drawn, frames later: no stall) → columns (the light volume's density integrals
 up and down, :mod:`atmos.shading.columns`, the same number of z ranges) → shading (inverse
-shear-warp transmittance toward the sun, a few light-space slices per job slice; optional). The frame scheduler runs
+shear-warp transmittance toward the sun, a few light-space slices per job slice; optional) → with the
+shading, the diffusion field (:mod:`atmos.shading.diffusion`: CG iterations over 8 job slices). The frame scheduler runs
 a few slices per frame into set C while the renderer draws sets A and B interpolated; nothing but
 the max maps comes back to the CPU.
 """
@@ -29,6 +30,7 @@ from atmos.plugins.clouds.layout import CloudLayout
 from atmos.plugins.clouds.sets import CloudSets
 from atmos.plugins.clouds.smoothing import FORMATS, WEIGHTS, Smoother, slice_range
 from atmos.shading.columns import COLUMNS, ColumnShader, ColumnTask, column_desc
+from atmos.shading.diffusion import DIFFUSION, DiffusionSolver, DiffusionTask, diffusion_desc, field_medium
 from atmos.shading.grid import check_scale, shading_shape
 from atmos.shading.medium import cell_sigma
 from atmos.shading.scattering import Scattering
@@ -165,6 +167,7 @@ class CloudSimulation:
     (empty-space skipping); a set's ``["density"]`` is the smoothed density,
     ``["transmittance"]`` (with shading) the transmittance toward the sun at the shading scale,
     ``["columns"]`` the light volume's column integrals (:mod:`atmos.shading.columns`) at that scale,
+    ``["diffusion"]`` (with shading) the diffusion field (:mod:`atmos.shading.diffusion`),
     and ``maps_of(set).sums`` the top-view sums (layer 0 all heights, then one per height band).
     """
 
@@ -180,7 +183,7 @@ class CloudSimulation:
         self.rng = np.random.default_rng(seed)
         self.gpu = gpu
         self.sun = sun or (lambda: np.array([0.3, 0.35, -0.88]))
-        self.shader = None
+        self.shader = self.diffusion = None
         s = self.settings
         made = []
         try:
@@ -195,6 +198,9 @@ class CloudSimulation:
                 descs["transmittance"] = TextureDesc(shading_shape(shape, s.shading_scale), 1, "f2")
                 self.shader = ShearWarpShader(gpu, shape, s.shading_scale)
                 made.append(self.shader)
+                descs[DIFFUSION] = diffusion_desc(shape, s.shading_scale)
+                self.diffusion = DiffusionSolver(gpu, shape, s.shading_scale)
+                made.append(self.diffusion)
             self.triple = TripleSet(gpu, descs)
             made.append(self.triple)
             self._maps = {id(t): DensityMaps(gpu, shape, s.band_height, s.group_size) for t in self.triple.sets}
@@ -221,6 +227,7 @@ class CloudSimulation:
         if s.shading:                  # sigma and scattering read when each step's shading begins
             tasks.append(ShadingTask(self.shader, self.sun_in_cells, lambda: self.settings.shading_sigma(self.sun()),
                                        slices_per_run=s.shading_slices_per_run))
+            tasks.append(DiffusionTask(self.diffusion, lambda: field_medium(self.settings, self.sun())))
         self.job = SlicedJob("clouds", tasks, self.triple)
 
     # -- tasks -------------------------------------------------------------------------------
@@ -316,7 +323,8 @@ class CloudSimulation:
         return float((sums > self.settings.cover_threshold).mean())
 
     def release(self) -> None:
-        for obj in (self.region, self.automaton, self.smoother, self.triple, self.shader, *self._maps.values()):
+        for obj in (self.region, self.automaton, self.smoother, self.triple, self.shader, self.diffusion,
+                    *self._maps.values()):
             if obj is not None:
                 obj.release()
         self._maps.clear()

@@ -2,8 +2,8 @@
 
 The volume ``[x, y, z]`` is uploaded once into one texture set shown as both A and B (t = 0) and
 placed by :mod:`atmos.plugins.clouds.layout` at the current :class:`VolumeOrigin`; its density maps
-and light-volume columns are computed once, its transmittance toward the sun again whenever the sun's direction or the
-medium changes (checked each frame, when the graph asks for ``"cloud_sets"``).
+and light-volume columns are computed once, its transmittance toward the sun and its diffusion field
+(:mod:`atmos.shading.diffusion`) again whenever the sun's direction or the medium changes (checked each frame, when the graph asks for ``"cloud_sets"``).
 """
 from __future__ import annotations
 
@@ -15,6 +15,7 @@ from atmos.plugins.clouds.density_maps import DensityMaps
 from atmos.plugins.clouds.sets import CloudSets
 from atmos.shading import grid
 from atmos.shading.columns import COLUMNS, ColumnShader, column_desc
+from atmos.shading.diffusion import DIFFUSION, DiffusionSolver, diffusion_desc, field_medium
 from atmos.shading.shear_warp import ShearWarpShader
 
 
@@ -29,8 +30,9 @@ class StaticClouds:
         descs = {"density": TextureDesc(self.shape, 1, "f4"), COLUMNS: column_desc(self.shape, s.shading_scale)}
         if s.shading:
             descs["transmittance"] = TextureDesc(grid.shading_shape(self.shape, s.shading_scale), 1, "f2")
+            descs[DIFFUSION] = diffusion_desc(self.shape, s.shading_scale)
         self.set = TextureSet.create(gpu, descs, "static")
-        self.shader = self.maps = None
+        self.shader = self.maps = self.diffusion = None
         try:
             self.set["density"].write(np.ascontiguousarray(volume.transpose(2, 1, 0)).tobytes())
             self.maps = DensityMaps(gpu, self.shape, s.band_height, s.group_size)
@@ -39,6 +41,7 @@ class StaticClouds:
             ColumnShader(gpu, self.shape, s.shading_scale).run(self.set["density"], self.set[COLUMNS])
             if s.shading:
                 self.shader = ShearWarpShader(gpu, self.shape, s.shading_scale)
+                self.diffusion = DiffusionSolver(gpu, self.shape, s.shading_scale)
         except Exception:
             self.release()
             raise
@@ -48,12 +51,15 @@ class StaticClouds:
         if self.shader is None:
             return
         sun = np.asarray(self.sun(), np.float64)
-        key = (tuple(sun), self.settings.sigma_t, self.settings.scattering, tuple(self.settings.cell_size))
+        s = self.settings
+        key = (tuple(sun), s.sigma_t, s.scattering, tuple(s.cell_size), s.albedo, s.phase_g, s.phase_g2, s.phase_w)
         if key == self._shaded:
             return
         self.shader.begin(self.set["density"], sun / np.asarray(self.settings.cell_size, float),
                           self.settings.shading_sigma(sun), target=self.set["transmittance"])
         self.shader.run_all()
+        self.diffusion.solve(self.set["density"], self.set["transmittance"], self.set[DIFFUSION],
+                             *field_medium(s, sun))
         self._shaded = key
 
     def sets(self) -> CloudSets:
@@ -75,7 +81,7 @@ class StaticClouds:
         return self.sets().layout(base_altitude, cell_size, pad)
 
     def release(self) -> None:
-        for obj in (self.shader, self.maps, self.set):
+        for obj in (self.shader, self.diffusion, self.maps, self.set):
             if obj is not None:
                 obj.release()
-        self.shader = self.maps = self.set = None
+        self.shader = self.diffusion = self.maps = self.set = None

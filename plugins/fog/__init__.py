@@ -47,6 +47,14 @@ class FogPlugin(Plugin):
         """The App's SkyPlugin's settings (``color_from="sky"``), None without one."""
         return None if self._sky is None else self._sky.settings
 
+    def horizon(self, view):
+        """This frame's horizon table of ``color_from="sky"`` (:mod:`.sky_color`: the App's sky seen
+        from the camera's altitude, at the SceneView ``view``'s sun), None with a fixed colour."""
+        if self.settings.color_from != "sky":
+            return None
+        from atmos.plugins.fog.sky_color import horizon_colors
+        return horizon_colors(view.sun, self.sky_settings(), altitude=max(float(view.camera.position[1]), 0.0))
+
     def cleanup(self, app) -> None:
         if self.composition is not None:
             self.composition.readers.discard("fog")

@@ -11,7 +11,7 @@ from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.graph.frame import BLEND_TRANSMITTANCE, blend
 from atmos.plugins.fog.noise import NoiseVolumes, octave_key
 from atmos.plugins.fog.settings import MODES
-from atmos.plugins.fog.sky_color import SAMPLES, horizon_colors
+from atmos.plugins.fog.sky_color import SAMPLES
 from atmos.render_core import COLOR, DEPTH
 
 FRAGMENT = "fog/fog.frag"
@@ -120,8 +120,7 @@ class FogPass(RenderPass):
         if self.volumes is not None:
             self.volumes.use(3)
         set_camera_uniforms(prog, view.camera, view.aspect)
-        horizon = horizon_colors(view.sun, self.plugin.sky_settings()) if settings.color_from == "sky" else None
-        set_fog_uniforms(prog, settings, view.time + settings.time_offset, horizon)
+        set_fog_uniforms(prog, settings, view.time + settings.time_offset, self.plugin.horizon(view))
         frame.fullscreen(prog)
 
     def release(self) -> None:

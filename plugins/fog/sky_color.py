@@ -3,8 +3,9 @@
 Far terrain, meshes and clouds fade toward the sky they stand against, not toward one fixed grey:
 the in-scattered colour of a pixel is ``fog_color ⊙ H(azimuth of its view ray)``, where ``H`` is the
 sky's radiance just above the horizon (``ELEVATION``) at ``SAMPLES`` azimuths round the horizon,
-interpolated linearly (periodic). ``H`` comes from the Preetham sky of the App's SkyPlugin (its
-turbidity and scale, :func:`atmos.plugins.sky.reference.sky_radiance`) at this frame's sun, or,
+interpolated linearly (periodic). ``H`` comes from the App's SkyPlugin at this frame's sun: the
+Preetham sky (its turbidity and scale, :func:`atmos.plugins.sky.reference.sky_radiance`) or the
+physical one (its atmosphere, from the camera's altitude), or,
 without a SkyPlugin, is the Sun's ambient colour in every direction. Azimuth as in
 :meth:`atmos.lighting.Sun.from_angles`: ``atan2(x, -z)``, 0 toward -z, increasing toward +x.
 """
@@ -25,11 +26,17 @@ def horizon_directions(n: int = SAMPLES) -> np.ndarray:
     return np.stack([np.sin(a) * c, np.full(n, math.sin(ELEVATION)), -np.cos(a) * c], -1)
 
 
-def horizon_colors(sun, sky_settings=None, n: int = SAMPLES) -> np.ndarray:
+def horizon_colors(sun, sky_settings=None, n: int = SAMPLES, altitude: float = 0.0) -> np.ndarray:
     """(n, 3) float64 linear radiance of the horizon sky for ``sun`` (an :class:`atmos.Sun`):
-    ``sky_settings`` (a SkySettings) gives the Preetham sky; None: the Sun's ambient everywhere."""
+    ``sky_settings`` (a SkySettings) gives its sky, Preetham or physical (seen from the camera's
+    ``altitude`` in m: :func:`atmos.plugins.sky.sun_light.horizon_radiance`); None: the Sun's
+    ambient everywhere."""
     if sky_settings is None:
         return np.tile(np.asarray(sun.ambient, np.float64), (n, 1))
+    if sky_settings.model == "physical":
+        from atmos.plugins.sky.sun_light import horizon_radiance
+        return horizon_radiance(horizon_directions(n), sun.direction, altitude, sky_settings.atmosphere,
+                                sky_settings.night)
     from atmos.plugins.sky.reference import sky_radiance
     return sky_radiance(horizon_directions(n), np.asarray(sun.direction, np.float64),
                         sky_settings.turbidity, sky_settings.scale, sky_settings.night)

@@ -106,10 +106,8 @@ class MarchedShafts:
     def fog_uniforms(frame: PassContext, program, fog, settings) -> None:
         """The fog's factor and colour (as its own pass sets them) and its clouds' distance (unit 3)."""
         from atmos.plugins.fog.post import set_fog_uniforms
-        from atmos.plugins.fog.sky_color import horizon_colors
         view, fs = frame.view, fog.settings
-        horizon = horizon_colors(view.sun, fog.sky_settings()) if fs.color_from == "sky" else None
-        set_fog_uniforms(program, fs, view.time + fs.time_offset, horizon)
+        set_fog_uniforms(program, fs, view.time + fs.time_offset, fog.horizon(view))
         clouds = frame.declares(CLOUD_DISTANCE)
         if clouds:
             frame.resource(CLOUD_DISTANCE).use(3)

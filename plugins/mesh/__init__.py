@@ -91,7 +91,6 @@ class MeshPass(OpaquePass):
         gpu = frame.gpu
         self.frame += 1
         self.begin(frame)
-        self.program["sky_ambient"].value = tuple(float(v) for v in frame.view.sun.ambient)
         for mesh, data in self.plugin.instances.items():
             _, _, inst, vao, _, vertices = self._buffers(gpu, mesh, len(data))
             inst.write(data.tobytes())

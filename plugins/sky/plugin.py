@@ -1,41 +1,146 @@
-"""SkyPlugin and its pass: the Preetham sky with sun disc, night and stars as the scene's background."""
+"""SkyPlugin and its passes: the Preetham or the physical sky with sun disc, night and stars as the
+scene's background; with the physical sky, its LUTs and the Sun's light from the same model."""
 from __future__ import annotations
 
-from atmos.camera import set_camera_uniforms
-from atmos.graph import FullscreenPass, PassContext
+import numpy as np
+
+from atmos.camera import Camera, set_camera_uniforms
+from atmos.graph import FullscreenPass, PassContext, RenderPass
+from atmos.lighting import Sun
 from atmos.plugin import Plugin
+from atmos.plugins.sky import sun_light
+from atmos.plugins.sky.atmosphere import camera_radius, medium
+from atmos.plugins.sky.luts import SKY_VIEW_UNIT, AtmosphereLuts, atmosphere_defines, set_atmosphere_uniforms
 from atmos.plugins.sky.settings import SkySettings
 from atmos.plugins.sky.shader import set_sky_uniforms, sky_defines
 from atmos.render_core import DEPTH, where_nothing_was_drawn
 
+SKY_LUTS = "sky_luts"       # the imported AtmosphereLuts of the physical sky
+
+
+def camera_altitude(camera) -> float:
+    """The camera's height above the ground plane (y = 0), at least 0."""
+    return max(float(np.asarray(camera.position, np.float64)[1]), 0.0)
+
+
+class SkyLutsPass(RenderPass):
+    """Phase sky, before the sky pass: brings the physical sky's LUTs up to date (transmittance and
+    multiple scattering when the atmosphere changes, the sky view when the sun's height or the
+    camera's altitude does). Declares nothing with the Preetham model: culled."""
+    name = "sky_luts"
+    phase = "sky"
+
+    def __init__(self, plugin):
+        self.plugin = plugin
+
+    def setup(self, builder) -> None:
+        if self.plugin.settings.model != "physical":
+            self.plugin._release_luts()          # back to Preetham: the LUTs go
+            return
+        builder.read(SKY_LUTS)
+        builder.write(SKY_LUTS)
+
+    def execute(self, frame: PassContext) -> None:
+        view = frame.view
+        frame.resource(SKY_LUTS).update(self.plugin.settings.atmosphere, camera_altitude(view.camera),
+                                        float(view.sun.direction[1]))
+
 
 class SkyPass(FullscreenPass):
     """Writes the sky into every pixel of ``color`` where nothing was drawn (depth 1; later passes draw
-    over it), from the Sun resource."""
+    over it), from the Sun resource: Preetham's formula, or the physical sky's sky-view LUT."""
     name = "sky"
     phase = "sky"
-    fragment = "sky/sky.frag"
     vertex = "lib/fullscreen_far.vert"
     reads = (DEPTH,)
 
+    @property
+    def physical(self) -> bool:
+        return self.plugin.settings.model == "physical"
+
+    @property
+    def fragment(self) -> str:
+        return "sky/physical.frag" if self.physical else "sky/sky.frag"
+
     def defines(self) -> dict:
-        return sky_defines()
+        return {**sky_defines(), **atmosphere_defines()} if self.physical else sky_defines()
+
+    def setup(self, builder) -> None:
+        super().setup(builder)
+        if self.physical:
+            builder.read(SKY_LUTS)
 
     def execute(self, frame: PassContext) -> None:
         view, p = frame.view, self.program
         where_nothing_was_drawn(frame)
         camera = view.camera
+        settings = self.plugin.settings
         set_camera_uniforms(p, camera, view.aspect)      # view_basis
-        set_sky_uniforms(p, self.plugin.settings, view.sun.direction, view.sun.color, view.time,
+        set_sky_uniforms(p, settings, view.sun.direction, view.sun.color, view.time,
                          camera.fov_y / max(1, view.size[1]))
+        if self.physical:
+            frame.resource(SKY_LUTS).use()
+            set_atmosphere_uniforms(p, settings.atmosphere)
+            p["sky_view"].value = SKY_VIEW_UNIT
+            p["view_r"].value = camera_radius(medium(settings.atmosphere), camera_altitude(camera))
         frame.fullscreen(p)
 
 
 class SkyPlugin(Plugin):
-    """The Preetham analytic sky (pass "sky"): ``SkyPlugin(settings=None, **fields)`` with
-    :class:`SkySettings`; ``configure(**changes)`` changes any of them live (next frame)."""
+    """The sky (passes "sky_luts" and "sky"): ``SkyPlugin(settings=None, **fields)`` with
+    :class:`SkySettings`, e.g. ``SkyPlugin(model="physical")``; ``configure(**changes)`` changes any
+    of them live (next frame), the atmosphere field by field (``configure(atmosphere={"mie_g": 0.7})``).
+
+    With ``model="physical"`` the system ``sky_light`` (after DaylightPlugin's ``daylight``) writes
+    ``Sun.color`` and ``Sun.ambient`` from the same atmosphere (:mod:`atmos.plugins.sky.sun_light`),
+    and a FogPlugin's ``color_from="sky"`` takes its horizon from it
+    (:func:`atmos.plugins.fog.sky_color.horizon_colors`)."""
 
     settings_class = SkySettings
 
+    def __init__(self, settings: SkySettings | None = None, **fields):
+        super().__init__(settings, **fields)
+        self.luts: AtmosphereLuts | None = None
+        self.gpu = None
+
     def build(self, app) -> None:
+        self.gpu = app.gpu
+        app.graph.add_pass(SkyLutsPass(self))
         app.graph.add_pass(SkyPass(self))
+        app.graph.import_resource(SKY_LUTS, self._luts)
+
+    def finish(self, app) -> None:
+        labels = {s.label for s in app.schedule.systems}
+        for stage, after in (("update", "daylight"), ("startup", "daylight_start")):
+            app.add_system(self.sun_light, stage, label=f"sky_light{'_start' if stage == 'startup' else ''}",
+                           after=(after,) if after in labels else ())
+
+    def cleanup(self, app) -> None:
+        self._release_luts()
+
+    def _luts(self) -> AtmosphereLuts:
+        """The imported "sky_luts" (resolved only in frames that draw the physical sky): made on the
+        first such frame, released when the model goes back to Preetham."""
+        if self.luts is None:
+            self.luts = AtmosphereLuts(self.gpu)
+        return self.luts
+
+    def _release_luts(self) -> None:
+        if self.luts is not None:
+            self.luts.release()
+            self.luts = None
+
+    def sun_light(self, app) -> None:
+        """System: with the physical sky, the Sun's colour and ambient for its direction and the
+        camera's altitude (nothing with the Preetham model)."""
+        s = self.settings
+        if s.model != "physical":
+            return
+        sun = app.get_resource(Sun)
+        if sun is None:
+            sun = Sun()
+            app.insert_resource(sun)
+        camera = app.get_resource(Camera)
+        altitude = camera_altitude(camera) if camera is not None else 0.0
+        sun.color = tuple(sun_light.sun_color(sun.direction, altitude, s.atmosphere))
+        sun.ambient = tuple(sun_light.sky_ambient(sun.direction, altitude, s.atmosphere, s.night))

@@ -8,7 +8,8 @@ toward the horizon glow, lit through the lower air), ``day`` fades the Preetham 
 (the sun's height, sin elevation, from ``DAY_FADE[1]`` down to ``DAY_FADE[0]``) and ``below`` dims
 views under the horizon toward ``GROUND_DIM`` over view heights 0..-``BELOW_FADE``.
 ``sky_color`` adds the sun disc and its glare (:func:`sun_disc`, measured as the chord |v − s| so
-the GPU needs no inverse trigonometry there) and the stars of :mod:`atmos.plugins.sky.stars`.
+the GPU needs no inverse trigonometry there) and the stars of :mod:`atmos.plugins.sky.stars`
+(:func:`extras`, shared with the physical sky: :func:`physical_sky_color`).
 """
 from __future__ import annotations
 
@@ -79,7 +80,27 @@ def sky_color(view_dir, sun_dir, sun_color, settings: SkySettings | None = None,
     p = settings or SkySettings()
     v = unit_vectors(view_dir, "view_dir")
     s = unit_vectors(sun_dir, "sun_dir").reshape(3)
+    return sky_radiance(v, s, p.turbidity, p.scale, p.night) + extras(v, s, sun_color, p, time, pixel_angle)
+
+
+def extras(v, s, sun_color, p: SkySettings, time: float, pixel_angle: float) -> np.ndarray:
+    """(..., 3) what both skies draw over their radiance (``shaders/sky/extras.glsl``): the sun disc
+    and glare and (if ``p.stars``) the stars, dimmed below the horizon; unit ``v`` (..., 3), ``s`` (3,)."""
     extra = sun_disc(v, s, sun_color, p.sun_size_deg, p.sun_gain, p.sun_glare, pixel_angle)
     if p.stars:
         extra = extra + star_field(v, s[1], time, pixel_angle, p.star_density, p.star_brightness, p.twinkle)
-    return sky_radiance(v, s, p.turbidity, p.scale, p.night) + extra * below_horizon(v[..., 1])[..., None]
+    return extra * below_horizon(v[..., 1])[..., None]
+
+
+def physical_sky_color(view_dir, sun_dir, sun_color, sky_view_lut, altitude: float = 0.0,
+                       settings: SkySettings | None = None, time: float = 0.0, pixel_angle: float = 0.0) -> np.ndarray:
+    """(..., 3) what the physical sky pass (``shaders/sky/physical.frag``) writes: the sky-view LUT
+    ``sky_view_lut`` (from :func:`atmos.plugins.sky.atmosphere.sky_view_lut`, or read back from the
+    GPU) along ``view_dir``, ``night`` × (1 − :func:`daylight`), and the :func:`extras`."""
+    from atmos.plugins.sky.atmosphere import sample_sky_view
+    p = settings or SkySettings(model="physical")
+    v = unit_vectors(view_dir, "view_dir")
+    s = unit_vectors(sun_dir, "sun_dir").reshape(3)
+    rgb = sample_sky_view(p.atmosphere, sky_view_lut, altitude, v, s)
+    rgb = rgb + np.asarray(p.night, np.float64) * (1.0 - daylight(s[1]))
+    return rgb + extras(v, s, sun_color, p, time, pixel_angle)

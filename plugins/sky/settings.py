@@ -3,17 +3,24 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from atmos.checks import CheckedSettings, check_bool, check_num, check_vec
+from atmos.checks import CheckedSettings, check_bool, check_choice, check_num, check_vec
 from atmos.lighting import NIGHT_SKY
+from atmos.plugins.sky.atmosphere_settings import AtmosphereSettings
 from atmos.plugins.sky.preetham import TURBIDITY_RANGE, check_turbidity
 
 _OWNER = "SkySettings"
+MODELS = ("preetham", "physical")
 
 
 @dataclass(frozen=True)
 class SkySettings(CheckedSettings):
-    """Look of the sky: haze, brightness in the HDR pipeline, sun disc, night and stars.
+    """Look of the sky: the model, haze, brightness in the HDR pipeline, sun disc, night and stars.
 
+    ``model``: ``"preetham"`` (the analytic sky; ``turbidity`` and ``scale`` set it, the Sun's colour
+    and ambient stay what DaylightPlugin or the game write) or ``"physical"`` (Hillaire 2020: a
+    Rayleigh, Mie and ozone atmosphere, ``atmosphere`` an :class:`AtmosphereSettings`; the sky plugin
+    then writes the Sun's colour and ambient from the same model every frame, see
+    :mod:`atmos.plugins.sky.sun_light`). The sun disc, night and stars are the same for both.
     ``scale``: HDR units per kcd/m² of Preetham luminance (0.03 puts a clear noon zenith near 0.25,
     beside the sun colour ≈ 1 of ``sky_light``); ``sun_size_deg``: angular radius of the disc
     (the real sun's: 0.2665°, 0.53° across); ``sun_gain``: radiance at the disc's centre per unit of
@@ -23,6 +30,8 @@ class SkySettings(CheckedSettings):
     a star; ``star_brightness``: HDR radiance of the brightest star; ``twinkle``: 0 steady .. 1 full.
     """
 
+    model: str = "preetham"
+    atmosphere: AtmosphereSettings = AtmosphereSettings()
     turbidity: float = 2.5
     scale: float = 0.03
     sun_size_deg: float = 0.2665
@@ -36,12 +45,15 @@ class SkySettings(CheckedSettings):
 
     def __post_init__(self):
         o = _OWNER
+        if not isinstance(self.atmosphere, AtmosphereSettings):
+            raise ValueError(f"{o}.atmosphere must be an AtmosphereSettings, got {type(self.atmosphere).__name__}")
         try:
             turbidity = check_turbidity(self.turbidity)
         except ValueError:
             raise ValueError(f"{o}.turbidity must be a number in {list(TURBIDITY_RANGE)} "
                              f"(2 clear .. 10 hazy), got {self.turbidity!r}") from None
         checked = dict(
+            model=check_choice(o, "model", self.model, MODELS),
             turbidity=turbidity,
             stars=check_bool(o, "stars", self.stars),
             scale=check_num(o, "scale", self.scale, 0.0, 1e3, lo_open=True),

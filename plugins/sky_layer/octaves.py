@@ -47,8 +47,10 @@ class OctaveTextures:
         self.baked_for: tuple | None = None    # (texture settings, light shift) of the last bake
         self._program = None
 
-    def bake(self, settings: SkyLayerSettings, sun_dir) -> None:
-        """Fill the textures for ``settings`` and the sun direction (re-allocating on a size change)."""
+    def bake(self, settings: SkyLayerSettings, sun_dir, frequencies=None, shift_maps=None) -> None:
+        """Fill the textures for ``settings`` and the sun direction (re-allocating on a size change).
+        ``frequencies`` (4,): cells across each texture (default base_frequency·2^k); ``shift_maps``
+        (4, 2, 2): each texture's light shift is shift_maps[k] @ the sun's (default: the same for all)."""
         ctx = self.gpu.ctx
         if self._program is None:
             self._program = self.gpu.program(compute_shader="sky_layer/octave.comp")
@@ -63,7 +65,9 @@ class OctaveTextures:
         prog["light_shift"].value = tuple(shift)
         groups = math.ceil(settings.size / 8)
         for k, tex in enumerate(self.textures):
-            prog["frequency"].value = float(settings.base_frequency * 2 ** k)
+            prog["frequency"].value = float(settings.base_frequency * 2 ** k if frequencies is None else frequencies[k])
+            if shift_maps is not None:
+                prog["light_shift"].value = tuple(np.asarray(shift_maps[k], np.float64) @ shift)
             prog["key"].value = octave_key(settings.seed, k)
             tex.bind_to_image(0, read=False, write=True)
             prog.run(groups, groups)

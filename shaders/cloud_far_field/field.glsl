@@ -1,5 +1,6 @@
 // The far field's cloud pattern as a function of world (x, z) (float64 reference:
-// atmos/plugins/cloud_far_field/reference.py): four scrolling tileable octaves give fbm;
+// atmos/plugins/cloud_far_field/reference.py): four scrolling tileable octaves, each turned and with
+// its own period, give fbm;
 // far_field_rank(xz, lod) is the fraction of the layer whose fbm lies below this point's (per mip level:
 // cover.py level_table, a blurred pattern ranked by its own quantiles), and far_quantile(r) the volume's
 // column sum at that rank (column_quantiles, cover.comp), so the far field is clouded as often, and as
@@ -13,8 +14,9 @@ layout(binding = 7) uniform sampler2D octave2;
 layout(binding = 8) uniform sampler2D octave3;
 layout(std430, binding = 0) readonly buffer Cover { float cover; float column_quantiles[33]; };
 uniform vec2 field_origin;         // a world xz near the view (the camera's)
-uniform vec2 field_origin_uv;      // it in tiles, wrapped to [0, 1) (float64 on the CPU)
-uniform vec2 field_offsets[4];     // drift of each octave (tiles, wrapped)
+uniform vec2 field_offsets[4];     // each octave's uv there, drift included (wrapped, float64 on the CPU)
+uniform mat2 field_turns[4];       // world tiles -> octave k's uv: its turn / its period (cloud_far_field/pattern.py)
+uniform vec4 field_lod_shift;      // log2 of each octave's period in tiles (its texels are that much larger)
 #define FIELD_LEVELS 8
 uniform float field_quantiles[FIELD_LEVELS * 33]; // cover.level_table: 33 per level
 uniform float field_first_level;                  // the mip level of table row 0
@@ -43,13 +45,16 @@ float far_quantile(float r) {
     return mix(column_quantiles[k], column_quantiles[k + 1], x - float(k));
 }
 
-// The four octaves' fbm at world (x, z) = xz (four light-march channels); lod: mip level.
+// The four octaves' fbm at world (x, z) = xz (four light-march channels); lod: mip level of a texture
+// repeating once per tile (octave k, repeating every 2^field_lod_shift[k] tiles, reads that much finer).
+// Each octave turned and repeating at its own period: the sum repeats nowhere (pattern.py).
 vec4 field_fbm(vec2 xz, float lod) {
-    vec2 uv = field_origin_uv + (xz - field_origin) / field_tile_size;
-    return SKY_LAYER_WEIGHTS.x * textureLod(octave0, uv + field_offsets[0], lod)
-         + SKY_LAYER_WEIGHTS.y * textureLod(octave1, uv + field_offsets[1], lod)
-         + SKY_LAYER_WEIGHTS.z * textureLod(octave2, uv + field_offsets[2], lod)
-         + SKY_LAYER_WEIGHTS.w * textureLod(octave3, uv + field_offsets[3], lod);
+    vec2 p = (xz - field_origin) / field_tile_size;
+    vec4 l = max(vec4(lod) - field_lod_shift, 0.0);
+    return SKY_LAYER_WEIGHTS.x * textureLod(octave0, field_offsets[0] + field_turns[0] * p, l.x)
+         + SKY_LAYER_WEIGHTS.y * textureLod(octave1, field_offsets[1] + field_turns[1] * p, l.y)
+         + SKY_LAYER_WEIGHTS.z * textureLod(octave2, field_offsets[2] + field_turns[2] * p, l.z)
+         + SKY_LAYER_WEIGHTS.w * textureLod(octave3, field_offsets[3] + field_turns[3] * p, l.w);
 }
 
 // The table row (and the share of the next) that mip level lod reads.

@@ -45,7 +45,8 @@ uniform int factor;            // resolution divisor r
 uniform ivec2 sample_offset;   // the frame's jitter offset o in [0, r)^2
 uniform ivec2 frame_size;      // full-res pixels
 uniform int jitter;            // 1: per-pixel first-sample offset, fixed in time; 0: midpoints
-uniform vec3 sun_march;        // toward the sun, times the sun-march sample spacing (m)
+uniform vec3 sun_march;        // toward the sun, times the sun march's first step (m)
+uniform float sun_growth;      // each sun-march step is this many times the last
 uniform float far_distance;    // FAR_FIELD: the march ends this far from the camera (m)
 uniform float far_growth;      // FAR_FIELD: the step's growth per metre of distance in the far field
 uniform float pixel_angle;     // a full-res pixel's angle (rad): its width per metre of distance
@@ -58,20 +59,29 @@ float sample_jitter(vec2 pixel) {
     return fract(52.9829189 * fract(dot(pixel, vec2(0.06711056, 0.00583715))));
 }
 
-// The factor the detail changes the sun transmittance by: exp(-sigma_t * optical depth of the
-// eroded-minus-smooth density over SUN_STEPS samples toward the sun).
-float sun_detail(vec3 p, vec3 extent, float footprint) {
+// Transmittance toward the sun from p (uvw: its texture coordinates): SUN_STEPS steps toward the
+// sun, the first sun_march long, each next sun_growth times the last, one sample of the actual
+// density (trilinear, eroded by the detail; 0 outside the box) at each step's midpoint, continued by
+// the shading volume's T from where they end (1 outside the box). The shading volume holds T at its
+// cell centres; trilinear between centres an e-fold apart it is 12 % too bright midway (0.68 for
+// 0.61), at any depth, and it blurs the lit surface over a cell (a low sun crosses a dense cloud's
+// cells lengthwise: dark bodies came out grey, rims weak); the march resolves the surface and the
+// first cells behind it. SUN_STEPS 0: the shading volume's T at p.
+float sun_transmittance(vec3 p, vec3 uvw, vec3 extent, float footprint) {
 #if SUN_STEPS > 0
-    float sum = 0.0;
-    for (int k = 0; k < SUN_STEPS; ++k) {
-        vec3 q = p + sun_march * (float(k) + 0.5);
-        vec3 uvw = (q - layer_min) / extent;
-        float d = cloud_density(uvw);
-        sum += detail_density(d, q, footprint) - d;
+    float tau = 0.0, at = 0.0, h = length(sun_march);
+    vec3 toward = sun_march / h;
+    for (int k = 0; k < SUN_STEPS; ++k, at += h, h *= sun_growth) {
+        vec3 q = p + toward * (at + 0.5 * h);
+        vec3 s = (q - layer_min) / extent;
+        if (any(lessThan(s, vec3(0.0))) || any(greaterThan(s, vec3(1.0)))) return exp(-sigma_t * tau);
+        tau += h * detail_density(cloud_density(s), q, footprint);
     }
-    return exp(-sigma_t * sum * length(sun_march));
+    vec3 e = (p + toward * at - layer_min) / extent;
+    bool inside = all(greaterThanEqual(e, vec3(0.0))) && all(lessThanEqual(e, vec3(1.0)));
+    return exp(-sigma_t * tau) * (inside ? cloud_transmittance(e) : 1.0);
 #else
-    return 1.0;
+    return cloud_transmittance(uvw);
 #endif
 }
 
@@ -172,8 +182,8 @@ void main() {
             if (far_zone) {
                 fw = far_weight((p.xz - layer_min.xz) / extent.xz);
                 if (fw > 0.0) {
-                    fc = far_cover(p.xz, sp);
-                    df = fw * far_body * far_profile(fh, fc.x);
+                    fc = far_ranks(p.xz, sp);
+                    df = fw * far_density(fc.x, fh);
                 }
             }
 #endif
@@ -184,7 +194,7 @@ void main() {
             float w = trans * a;
             vec3 J = vec3(0.0);
             if (dv > 0.0) {
-                float T = min(cloud_transmittance(uvw) * sun_detail(p, extent, footprint), 1.0);
+                float T = min(sun_transmittance(p, uvw, extent, footprint), 1.0);
                 J = cloud_source_with(uvw, dir, ny, T);
             }
 #if FAR_FIELD

@@ -12,6 +12,8 @@ layout(binding = 3) uniform sampler2D hist_distance;
 layout(binding = 4) uniform sampler2D hist_scene;     // its scene distance (m), -1 = sky
 layout(binding = 5) uniform sampler2D scene_depth;    // this frame's depth (when has_depth)
 layout(binding = 6) uniform sampler2D low_depth;      // the scene depth each sample's ray saw (edge < 1e30)
+layout(binding = 7) uniform sampler2D hist_sample;    // each pixel's last marched sample (carried for drift.frag)
+layout(binding = 8) uniform sampler2D drift;          // low-res: 1 where this frame's samples moved (drift.frag; detect_change)
 
 uniform mat3 view_basis;      // this frame's rays (lib/view_ray.glsl)
 uniform float near, far;
@@ -21,7 +23,7 @@ uniform bool has_depth;
 uniform float edge;           // the depth-aware upsample's edge (offscreen.EDGE; 1e30: bilinear)
 uniform bool history_valid;
 uniform bool still;           // the camera did not change: the history is at this very pixel
-uniform bool detect_change;   // still for r² frames: every pixel holds a sample, a change is the clouds'
+uniform bool detect_change;   // still for r² frames: every pixel's last sample is real, a change is the clouds'
 
 uniform mat3 prev_proj;       // v (m, relative to the previous camera) -> (clip x, clip y, clip w) then
 uniform vec3 cam_delta;       // this camera's position - the previous one's
@@ -36,6 +38,7 @@ const float CHANGE_TOLERANCE = 0.02;
 layout(location = 0) out vec4 out_color;
 layout(location = 1) out vec4 out_distance;
 layout(location = 2) out vec4 out_scene;
+layout(location = 3) out vec4 out_sample;
 
 // Bilinear sample of a colour and a distance texture at texel-centre coordinates p, clamped to the edge
 // (done by hand: the same weights as the reference, whatever the texture's filter).
@@ -77,6 +80,7 @@ void main() {
         ivec2 q = min(rel / r, textureSize(low_color, 0) - 1);
         out_color = texelFetch(low_color, q, 0);
         out_distance = vec4(texelFetch(low_distance, q, 0).rg, 0.0, 1.0);
+        out_sample = out_color;
         return;
     }
     // this frame's samples upsampled, and the box of the 3x3 low-res texels around the pixel
@@ -92,6 +96,7 @@ void main() {
         d += weights[k] * texelFetch(low_distance, taps[k], 0).rg;
     }
     if (!history_valid) {
+        out_sample = c;
         out_color = c;
         out_distance = vec4(d, 0.0, 1.0);
         return;
@@ -124,20 +129,29 @@ void main() {
     float motion = length(q - vec2(pix));
     vec4 hc; vec2 hd;
     bilinear2(hist_color, hist_distance, q, hc, hd);
+    ivec2 nearest = clamp(ivec2(floor(q + 0.5)), ivec2(0), ivec2(size) - 1);
+    out_sample = texelFetch(hist_sample, nearest, 0);
 
     // disocclusion: the scene behind the pixel is not the one the history saw there
-    float prev_scene = texelFetch(hist_scene, clamp(ivec2(floor(q + 0.5)), ivec2(0), ivec2(size) - 1), 0).r;
+    float prev_scene = texelFetch(hist_scene, nearest, 0).r;
     float expected = scene < 0.0 ? -1.0 : length(cam_delta + dir * scene);
     bool same = (expected < 0.0) == (prev_scene < 0.0)
              && (expected < 0.0 || abs(prev_scene - expected) <= DEPTH_TOLERANCE * expected);
+    if (!(inside && same)) out_sample = c;      // no last sample of this scene here: the upsample stands in
 
-    // has the image changed where it was marched? this frame's nearest sample against the history there
+    // a still camera, every pixel's last sample real: where the clouds around the pixel drift (the
+    // drift pass), has the image changed where it was marched? this frame's nearest sample against the
+    // history there. Where they change in place (evolving), the history stays.
+    float drifting = 0.0;
+    if (detect_change)
+        for (int k = 0; k < 9; ++k)
+            drifting = max(drifting, texelFetch(drift, clamp(centre + ivec2(k % 3 - 1, k / 3 - 1), ivec2(0), last), 0).r);
     vec2 qf = vec2(centre * r + offset) + (q - vec2(pix));
     vec4 predicted = texelFetch(hist_color, clamp(ivec2(floor(qf + 0.5)), ivec2(0), ivec2(size) - 1), 0);
     vec4 now = texelFetch(low_color, centre, 0);
     vec3 drgb = abs(now.rgb - predicted.rgb);
-    float change = !detect_change ? 0.0 : max(abs(now.a - predicted.a),
-                       max(drgb.r, max(drgb.g, drgb.b)) / max(max(hi_c.r, max(hi_c.g, hi_c.b)), 1e-3));
+    float change = drifting * max(abs(now.a - predicted.a),
+                                  max(drgb.r, max(drgb.g, drgb.b)) / max(max(hi_c.r, max(hi_c.g, hi_c.b)), 1e-3));
     float moved = max(min(motion / CLAMP_MOTION, 1.0), min(change / CHANGE_TOLERANCE, 1.0));
     // correct the history by this frame's samples: their bilinear blend of (fresh - history at the
     // sample, moved like this pixel), with the upsample's depth-aware weights, so history and fresh
@@ -155,8 +169,8 @@ void main() {
     float clamp_w = history_clamp * moved;
     hc = mix(hc, clamp(hc, lo_c, hi_c), clamp_w);
     hd = mix(hd, clamp(hd, lo_d, hi_d), clamp_w);
-    // clouds that drift under a still camera: the history is stale where its sample changed, the
-    // upsample of this frame's samples is nearer (all of it from CHANGE_TOLERANCE, none below half)
+    // drifting clouds: the history is stale where its sample changed, the upsample of this frame's
+    // samples is nearer (all of it from CHANGE_TOLERANCE, none below half)
     float trust = 1.0 - clamp(2.0 * change / CHANGE_TOLERANCE - 1.0, 0.0, 1.0);
     float keep = (inside && same) ? trust * clamp(1.0 - motion / motion_limit, 0.0, 1.0) : 0.0;
     out_color = (1.0 - keep) * c + keep * hc;                 // not mix(): exact at keep = 1

@@ -17,6 +17,7 @@ uniform vec3 camera_right;
 uniform vec3 camera_up;
 flat in vec4 v_octaves;
 flat in vec3 v_ambient;
+flat in vec4 v_field;          // the diffusion field at the sprite's centre (volume.glsl cloud_diffusion)
 flat in vec3 v_center;
 flat in float v_radius;
 flat in float v_tau;
@@ -36,6 +37,6 @@ void main() {
     float a = (1.0 - exp(-v_tau * profile)) * v_coverage * soft;
     vec2 q = pc * (v_radius * v_stretch);          // the point's side spans stretch × diameter (sprite.vert)
     vec3 ray = normalize(v_center + q.x * camera_right + q.y * camera_up - camera_pos);
-    frag = vec4((sun_part(v_octaves, dot(ray, sun_dir)) + v_ambient) * a, a);
+    frag = vec4((sun_part(v_octaves, dot(ray, sun_dir)) + diffusion_light(v_field, ray) + v_ambient) * a, a);
     frag_distance = vec4(a * length(v_center - camera_pos), a, 0.0, a);   // blends by its own alpha
 }

@@ -28,6 +28,7 @@ uniform vec3 camera_up;
 uniform float tau_scale;       // sigma_t × cell volume: the optical depth a unit of summed density spreads over the screen (m²)
 flat out vec4 v_octaves;      // b^i T^(a^i): the sun's light per octave (volume.glsl)
 flat out vec3 v_ambient;      // sky and ground light at the sprite, dimmed by the columns above and below
+flat out vec4 v_field;        // the diffusion field (phi, F) at the sprite's centre (0 when its weight is 0)
 flat out vec3 v_center;       // world centre and radius: the fragment's view ray for the phase function
 flat out float v_radius;
 flat out float v_tau;
@@ -147,6 +148,7 @@ void main() {
     }
     v_octaves = octaves / 8.0;
     v_ambient = ambient_source(up, down, ray.y);
+    v_field = ms_diffusion > 0.0 ? cloud_diffusion(uvw) : vec4(0.0);
     v_center = world;
     v_radius = 0.5 * diameter;
     // depth-tested at its front (the centre pulled a radius toward the camera, x and y unmoved): a

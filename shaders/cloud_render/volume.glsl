@@ -4,13 +4,17 @@
 //                              + (sky_source + ground_source) + (sky_source - ground_source) h,
 // m_0 = 1, m_i = 1 - exp(-(1 - g_mean)(tau_up + tau_down)) (the column's transport optical depth),
 // h = clamp(u + g_mean ray_y exp(-(tau_up + tau_down) / 2z), -1, 1), u = (tau_down - tau_up) / (tau_up + tau_down + 2z),
-// z = 2 / (3 (1 - g_mean)): the diffusion profile between a slab's lit faces (see medium.py).
+// z = 2 / (3 (1 - g_mean)): the diffusion profile between a slab's lit faces (see medium.py);
+// plus the diffusion field's term (diffusion_part) where the set has one.
 layout(binding = 0) uniform sampler3D density_a;
 layout(binding = 1) uniform sampler3D density_b;
 layout(binding = 2) uniform sampler3D trans_a;       // at the shading scale; same texture coordinates
 layout(binding = 3) uniform sampler3D trans_b;
 layout(binding = 10) uniform sampler3D columns_a;     // the light volume's columns (up, down), shading scale
 layout(binding = 11) uniform sampler3D columns_b;
+layout(binding = 16) uniform sampler3D diffusion_a;   // the diffusion field (phi, F), its own grid
+layout(binding = 17) uniform sampler3D diffusion_b;   // (12, 13: the march's detail noise; 14, 15: far field)
+uniform float ms_diffusion;    // its weight beta (CloudLightSettings.ms_diffusion); 0: no field bound
 uniform float t;
 uniform ivec3 a_shift;         // cells from B's cell to A's at the same world point (CloudSets.a_shift)
 uniform int has_shading;       // 0: no transmittance textures, T = 1
@@ -72,6 +76,26 @@ vec3 ambient_source(float tau_up, float tau_down, float ray_y) {
 
 #include "lib/phase.glsl"
 
+// The diffusion field (atmos/shading/diffusion.py): (phi, F) of the sun's scattered fluence for unit
+// irradiance, mix(A, B, t) like the density.
+vec4 cloud_diffusion(vec3 uvw) {
+    return mix(textureLod(diffusion_a, a_uvw(uvw), 0.0), textureLod(diffusion_b, uvw, 0.0), t);
+}
+
+// The field's share of J beside the octaves for a field value f = (phi, F): sun_source beta
+// max(sun_y, 0) (1 - c^2)^4 max(phi - 3 g_mean F.ray, 0) / 4pi (c = dot(ray, sun_dir);
+// diffusion.diffusion_weight, diffusion_radiance).
+vec3 diffusion_light(vec4 f, vec3 ray_dir) {
+    if (ms_diffusion <= 0.0) return vec3(0.0);
+    float c = dot(ray_dir, sun_dir), s2 = max(1.0 - c * c, 0.0), s4 = s2 * s2;
+    float L = max(f.x - 3.0 * mean_cosine() * dot(f.yzw, ray_dir), 0.0) / (4.0 * PI);
+    return sun_source * (ms_diffusion * max(sun_dir.y, 0.0) * s4 * s4 * L);
+}
+
+vec3 diffusion_part(vec3 uvw, vec3 ray_dir) {
+    return ms_diffusion <= 0.0 ? vec3(0.0) : diffusion_light(cloud_diffusion(uvw), ray_dir);
+}
+
 // sun_source * sum_i w_i p(cos; c^i g): the sun's part of J for a view ray with dot(ray, sun_dir) = c.
 vec3 sun_part(vec4 w, float c) {
     float e = 1.0, sum = 0.0;
@@ -86,7 +110,8 @@ vec3 sun_part(vec4 w, float c) {
 // for the callers).
 vec3 cloud_source_with(vec3 uvw, vec3 ray_dir, float ny, float T) {
     vec2 c = cloud_columns(uvw);
-    return sun_part(octave_weights(T, c.x + c.y), dot(ray_dir, sun_dir)) + ambient_source(c.x, c.y, ray_dir.y);
+    return sun_part(octave_weights(T, c.x + c.y), dot(ray_dir, sun_dir)) + diffusion_part(uvw, ray_dir)
+         + ambient_source(c.x, c.y, ray_dir.y);
 }
 
 // J at uvw for a view ray along ray_dir (world, unit): the shading volume's sun transmittance.

@@ -1,11 +1,12 @@
 #version 430
-// Ground: anti-aliased checker in albedo, Lambert sun light plus sky ambient, distance haze.
+// Ground: anti-aliased checker in albedo, Lambert sun light plus the Sun's sky ambient, distance haze.
 // Alpha 1: opaque, hides the sky (color.a is the sky occlusion, atmos/render_core.py).
 in vec3 v_world;
 out vec4 frag;
 uniform vec3 camera_pos;
 uniform vec3 sun_dir;
 uniform vec3 sun_color;
+uniform vec3 sky_ambient;
 uniform vec3 albedo;
 uniform float tile;
 
@@ -16,7 +17,7 @@ void main() {
     float checker = 0.5 - 0.5 * i.x * i.y;
     vec3 base = albedo * mix(0.8, 1.1, checker);
     vec3 s = normalize(sun_dir);
-    vec3 light = sun_color * max(s.y, 0.0) + vec3(0.25, 0.3, 0.4) * smoothstep(-0.2, 0.2, s.y) + 0.02;
+    vec3 light = sun_color * max(s.y, 0.0) + sky_ambient;
     float dist = length(v_world - camera_pos);
     vec3 haze = vec3(0.7, 0.8, 0.95) * smoothstep(-0.2, 0.2, s.y);
     frag = vec4(mix(base * light, haze, 1.0 - exp(-dist * 0.0015)), 1.0);

@@ -1,11 +1,13 @@
 #version 430
-// Terrain: grass on flat ground, rock on slopes, lighter tops; Lambert sun light plus sky ambient.
+// Terrain: grass on flat ground, rock on slopes, lighter tops; Lambert sun light plus the Sun's sky ambient
+// (weighted toward upward normals, as the meshes are: plugins/mesh/reference.py).
 // Alpha 1: opaque, hides the sky (color.a is the sky occlusion, atmos/render_core.py).
 in vec3 v_world;
 in vec3 v_normal;
 out vec4 frag;
 uniform vec3 sun_dir;
 uniform vec3 sun_color;
+uniform vec3 sky_ambient;
 uniform float relief;
 
 void main() {
@@ -16,7 +18,6 @@ void main() {
     vec3 rock = vec3(0.36, 0.32, 0.28);
     vec3 base = mix(grass, rock, smoothstep(0.12, 0.35, slope));
     base = mix(base, vec3(0.55, 0.55, 0.5), smoothstep(0.75, 1.0, v_world.y / max(relief, 1e-3)));
-    float day = smoothstep(-0.2, 0.2, s.y);
-    vec3 light = sun_color * max(dot(n, s), 0.0) + vec3(0.25, 0.3, 0.4) * day * (0.6 + 0.4 * n.y) + 0.02;
+    vec3 light = sun_color * max(dot(n, s), 0.0) + sky_ambient * (0.6 + 0.4 * n.y);
     frag = vec4(base * light, 1.0);
 }

@@ -1,0 +1,96 @@
+"""The Sun's colour and ambient and the fog's horizon colours from the physical sky (float64, CPU).
+
+With ``SkySettings.model = "physical"`` the sky plugin's system ``sky_light`` (update and startup
+stages, ordered after DaylightPlugin's ``daylight``/``daylight_start`` by label when those exist)
+writes, for the Sun's direction and the camera's altitude:
+
+- ``Sun.color`` = the sun's colour after its path through the atmosphere to the camera
+  (:func:`atmos.plugins.sky.atmosphere.sun_radiance`, one transmittance lookup a frame);
+- ``Sun.ambient`` = the sky's irradiance on an upward surface / π from the same model
+  (:func:`atmos.plugins.sky.atmosphere.ambient`), plus the sky's ``night`` term as the pass draws it.
+
+The ambient and the horizon table depend only on the sun's elevation and the camera's altitude (the
+sky is symmetric about the sun's vertical): both are computed at nodes ``ELEVATION_STEP`` apart in
+sun elevation and at altitudes ``(k · ALTITUDE_ROOT_STEP)²`` m, each node once per settings, and
+interpolated bilinearly between them.
+"""
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+
+import numpy as np
+
+from atmos.plugins.sky import atmosphere as ref
+from atmos.plugins.sky.atmosphere_settings import AtmosphereSettings
+from atmos.plugins.sky.reference import daylight
+
+ELEVATION_STEP = 0.5            # degrees of sun elevation between nodes
+ALTITUDE_ROOT_STEP = 10.0       # nodes at altitudes (10 k)² m: 0, 100, 400, 900 ... 40 000 m at k = 20
+HORIZON_AZIMUTHS = 33           # horizon radiance nodes over 0..π from the sun's azimuth
+
+
+def _sun_at(elevation_deg: float) -> np.ndarray:
+    e = math.radians(elevation_deg)
+    return np.array([math.cos(e), math.sin(e), 0.0])
+
+
+@lru_cache(maxsize=4096)
+def _ambient_node(settings: AtmosphereSettings, i_elevation: int, k_altitude: int) -> np.ndarray:
+    return ref.ambient(_sun_at(i_elevation * ELEVATION_STEP), (k_altitude * ALTITUDE_ROOT_STEP) ** 2, settings)
+
+
+@lru_cache(maxsize=4096)
+def _horizon_node(settings: AtmosphereSettings, i_elevation: int, k_altitude: int, elevation: float) -> np.ndarray:
+    """(HORIZON_AZIMUTHS, 3) radiance at ``elevation`` rad above the horizon, azimuths 0..π from the sun."""
+    a = np.linspace(0.0, math.pi, HORIZON_AZIMUTHS)
+    c = math.cos(elevation)
+    dirs = np.stack([np.cos(a) * c, np.full_like(a, math.sin(elevation)), np.sin(a) * c], axis=-1)
+    return ref.sky_radiance(dirs, _sun_at(i_elevation * ELEVATION_STEP), (k_altitude * ALTITUDE_ROOT_STEP) ** 2, settings)
+
+
+def _nodes(sun_y: float, altitude: float):
+    """[(weight, elevation node, altitude node)] of the bilinear interpolation."""
+    e = math.degrees(math.asin(min(max(sun_y, -1.0), 1.0))) / ELEVATION_STEP
+    k = math.sqrt(max(altitude, 0.0)) / ALTITUDE_ROOT_STEP
+    e0, k0 = math.floor(e), math.floor(k)
+    fe, fk = e - e0, k - k0
+    return [(w, i, j) for w, i, j in (((1 - fe) * (1 - fk), e0, k0), (fe * (1 - fk), e0 + 1, k0),
+                                      ((1 - fe) * fk, e0, k0 + 1), (fe * fk, e0 + 1, k0 + 1)) if w > 0]
+
+
+def _clamped(i: int) -> int:
+    limit = round(90.0 / ELEVATION_STEP)
+    return min(max(i, -limit), limit)
+
+
+def sun_color(sun_dir, altitude: float, settings: AtmosphereSettings) -> np.ndarray:
+    """(3,) ``Sun.color``: the sun's colour seen from ``altitude`` m."""
+    return ref.sun_radiance(sun_dir, altitude, settings)
+
+
+def sky_ambient(sun_dir, altitude: float, settings: AtmosphereSettings, night=(0.0, 0.0, 0.0)) -> np.ndarray:
+    """(3,) ``Sun.ambient``: the sky's irradiance / π (interpolated between nodes) plus ``night`` × the
+    pass's night weight."""
+    s = ref.unit(sun_dir)
+    total = sum(w * _ambient_node(settings, _clamped(i), j) for w, i, j in _nodes(s[1], altitude))
+    return total + np.asarray(night, np.float64) * (1.0 - float(daylight(s[1])))
+
+
+def horizon_radiance(directions, sun_dir, altitude: float, settings: AtmosphereSettings,
+                     night=(0.0, 0.0, 0.0)) -> np.ndarray:
+    """(n, 3) the physical sky's radiance along ``directions`` (n, 3), all at one elevation (the fog's
+    horizon ring), from the nodes: interpolated over the sun's elevation, the altitude and the
+    azimuth from the sun; plus the night term as the pass draws it."""
+    d = np.asarray(directions, np.float64)
+    s = ref.unit(sun_dir)
+    elevation = float(np.arcsin(np.clip(d[0, 1], -1.0, 1.0)))
+    _, cos_az, _, _ = ref.view_angles(d, s)
+    x = np.arccos(np.clip(cos_az, -1.0, 1.0)) / math.pi * (HORIZON_AZIMUTHS - 1)
+    i0 = np.minimum(np.floor(x).astype(int), HORIZON_AZIMUTHS - 2)
+    f = (x - i0)[:, None]
+    total = 0.0
+    for w, i, j in _nodes(s[1], altitude):
+        table = _horizon_node(settings, _clamped(i), j, elevation)
+        total = total + w * ((1 - f) * table[i0] + f * table[i0 + 1])
+    return total + np.asarray(night, np.float64) * (1.0 - float(daylight(s[1])))

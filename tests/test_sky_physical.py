@@ -1,0 +1,357 @@
+"""The physical sky (SkySettings.model = "physical", Hillaire 2020): the float64 reference on analytic
+cases, the GPU LUTs and pass against it, the Sun's light from the same model, settings, culling and
+composition with the fog and the clouds."""
+import math
+
+import numpy as np
+import pytest
+
+from atmos.app import App
+from atmos.camera import Camera, view_basis
+from atmos.defaults import DefaultPlugins
+from atmos.lighting import Sun
+from atmos.plugins.daylight import DaylightPlugin
+from atmos.plugins.fog import FogPlugin
+from atmos.plugins.fog.sky_color import horizon_directions
+from atmos.plugins.ground import GroundPlugin
+from atmos.plugins.sky import AtmosphereSettings, SkyPlugin, SkySettings, physical_sky_color
+from atmos.plugins.sky import atmosphere as ref
+from atmos.plugins.sky import sun_light
+from atmos.plugins.sky.luts import AtmosphereLuts
+
+THIN = 1e-5     # coefficients × this: the optically thin limit
+
+
+def rayleigh_only(scale=1.0, **fields) -> AtmosphereSettings:
+    base = AtmosphereSettings()
+    values = dict(rayleigh_scattering=tuple(scale * c for c in base.rayleigh_scattering),
+                  mie_scattering=(0.0,) * 3, mie_absorption=(0.0,) * 3, ozone_absorption=(0.0,) * 3)
+    return AtmosphereSettings(**{**values, **fields})
+
+
+def sun_at(elevation_deg, azimuth_deg=0.0) -> np.ndarray:
+    return Sun.from_angles(elevation_deg, azimuth_deg).direction
+
+
+# -- the reference on analytic cases ------------------------------------------------------------------
+
+def test_zenith_transmittance_of_exponential_and_tent_profiles_is_analytic():
+    s = rayleigh_only(mie_scattering=(2e-6,) * 3, mie_absorption=(1e-6,) * 3, ozone_absorption=(1e-6, 2e-6, 3e-6))
+    m = ref.medium(s)
+    top = s.atmosphere_height
+    want = (m["ray"] * s.rayleigh_scale_height * (1 - math.exp(-top / s.rayleigh_scale_height))
+            + m["mie_t"] * s.mie_scale_height * (1 - math.exp(-top / s.mie_scale_height))
+            + m["ozone"] * 0.5 * s.ozone_width)                       # the tent's area
+    exact = ref.optical_depth(m, m["rg"], 1.0, top, 4000)
+    assert np.allclose(exact, want, rtol=1e-5)
+    lut = ref.transmittance_lut(s)                                    # 40 steps, read at (ground, zenith)
+    u, v = ref.transmittance_uv(m, m["rg"], 1.0)
+    assert np.allclose(np.exp(-ref.bilinear(lut, u, v)), np.exp(-want), rtol=2e-3)
+    # a horizontal ray from the ground: the LUT's edge texel is the longest path it holds
+    assert (ref.transmittance_to_sun(m, lut, m["rg"] + 1.0, 0.0) < np.exp(-want) ** 20).all()
+
+
+def test_single_scattering_in_the_thin_limit_is_the_column_times_the_phase():
+    s = rayleigh_only(THIN, multiple_scattering=0.0, ground_albedo=(0.0,) * 3)
+    m = ref.medium(s)
+    h, top = s.rayleigh_scale_height, s.atmosphere_height
+    for elevation in (80.0, 30.0, 5.0):
+        sun = sun_at(elevation)
+        nu = sun[1]                                                   # looking straight up
+        want = m["sun"] * m["ray"] * h * (1 - math.exp(-top / h)) * ref.rayleigh_phase(nu)
+        got = ref.sky_radiance(np.array([[0.0, 1.0, 0.0]]), sun, 0.0, s, steps=64)[0]
+        assert np.allclose(got, want, rtol=1e-3), elevation
+
+
+def test_without_absorption_scattered_and_escaping_light_add_up_to_one():
+    """Energy: in a purely scattering atmosphere with no ground, every photon along a ray is either
+    scattered (the transfer ∫σs T dt) or gets through (T) — exactly, step by step."""
+    s = rayleigh_only(30.0, mie_scattering=(2e-5,) * 3, ground_albedo=(0.0,) * 3)
+    m = ref.medium(s)
+    tlut = ref.transmittance_lut(s)
+    mu = np.linspace(-1, 1, 41)
+    r = np.full(mu.shape, m["rg"] + 3000.0)
+    _, transfer = ref.integrate(m, tlut, r, mu, 0.3, 0.1, 24, isotropic=True)
+    ground = ref.hits_ground(m["rg"], r, mu)
+    t = np.where(ground, ref.distance_to_ground(m["rg"], r, mu), ref.distance_to_top(m["rt"], r, mu))
+    escaping = np.exp(-sum(ref.coefficients(m, np.sqrt(r**2 + tm**2 + 2 * r * mu * tm))[2] * dt[..., None]
+                           for tm, dt in segments(t, 24)))
+    assert np.allclose(transfer + escaping, 1.0, atol=1e-12)
+    # and the multiple-scattering sum is the geometric series of that transfer: Ψ = L2 / (1 − f)
+    ms = ref.multiscattering_lut(s, tlut, size=4)
+    assert np.isfinite(ms).all() and (ms >= 0).all()
+
+
+def segments(t, steps):
+    for i in range(steps):
+        t0, t1 = t * (i / steps) ** 2, t * ((i + 1) / steps) ** 2
+        yield 0.5 * (t0 + t1), t1 - t0
+
+
+def test_lut_mappings_invert():
+    m = ref.medium(AtmosphereSettings())
+    u, v = np.meshgrid(ref.texel_centres(64), ref.texel_centres(16))
+    r, mu = ref.transmittance_params(m, u, v)
+    u2, v2 = ref.transmittance_uv(m, r, mu)
+    assert np.allclose(u2, u, atol=1e-7) and np.allclose(v2, v, atol=1e-7)
+    for altitude in (0.0, 1500.0, 20000.0):
+        rr = ref.camera_radius(m, altitude)
+        mu, cos_az = ref.sky_view_params(m, rr, u, v)
+        u3, v3 = ref.sky_view_uv(m, rr, mu, cos_az)
+        assert np.allclose(u3, u, atol=1e-7) and np.allclose(v3, v, atol=1e-6)
+
+
+# -- the GPU against the reference ----------------------------------------------------------------------
+
+def random_atmosphere(rng) -> AtmosphereSettings:
+    b = AtmosphereSettings()
+    k = lambda: rng.uniform(0.3, 3.0)     # noqa: E731
+    return AtmosphereSettings(rayleigh_scattering=tuple(k() * c for c in b.rayleigh_scattering),
+                              mie_scattering=(k() * 4e-6,) * 3, mie_absorption=tuple(rng.uniform(0, 1e-6, 3)),
+                              ozone_absorption=tuple(k() * c for c in b.ozone_absorption),
+                              rayleigh_scale_height=rng.uniform(5000, 12000), mie_scale_height=rng.uniform(500, 3000),
+                              mie_g=rng.uniform(0.5, 0.9), ground_albedo=tuple(rng.uniform(0, 1, 3)),
+                              atmosphere_height=rng.uniform(60e3, 120e3), multiple_scattering=rng.uniform(0, 1))
+
+
+def test_gpu_luts_match_the_float64_reference_on_random_atmospheres(gpu, ctx, rng):
+    luts = AtmosphereLuts(gpu)
+    try:
+        for _ in range(2):
+            s = random_atmosphere(rng)
+            altitude, sun_y = rng.uniform(0, 20000), rng.uniform(-0.3, 1.0)
+            luts.update(s, altitude, sun_y)
+            tlut = ref.transmittance_lut(s)
+            mslut = ref.multiscattering_lut(s, tlut)
+            sv = ref.sky_view_lut(s, tlut, mslut, altitude, sun_y)
+            for name, want, atol in (("transmittance", tlut, 1e-4), ("multiscattering", mslut, 1e-4 * mslut.max()),
+                                     ("sky_view", sv, 1e-3 * sv.max())):    # (float32 at a grazing sun)
+                got = luts.read(name)
+                assert np.isfinite(got).all(), name
+                err = np.abs(got - want) - 2e-3 * np.abs(want)
+                assert err.max() <= atol, (name, s, altitude, sun_y, np.abs(got - want).max())
+    finally:
+        luts.release()
+
+
+def physical_app(gpu, *plugins, sun=None, altitude=2.0, **sky):
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), SkyPlugin(model="physical", **sky), *plugins)
+    if sun is not None:
+        app.insert_resource(Sun(direction=sun))
+    app.startup()
+    app.resource(Camera).position = np.array([0.0, altitude, 0.0])
+    return app
+
+
+def test_the_physical_sky_pass_matches_the_reference_in_every_pixel(gpu, ctx, rng):
+    size = (48, 32)
+    for altitude, elevation in ((2.0, rng.uniform(1, 15)), (rng.uniform(500, 20000), rng.uniform(-5, 60))):
+        sun = sun_at(elevation, rng.uniform(0, 360))
+        app = physical_app(gpu, sun=sun, altitude=altitude, stars=False)
+        cam = app.resource(Camera)
+        cam.yaw, cam.pitch = math.atan2(sun[0], -sun[2]) + rng.uniform(-0.5, 0.5), rng.uniform(-0.3, 0.6)
+        gpu.resize(size)
+        got = app.read_linear()[::-1, :, :3]                        # row 0 at the bottom, as pixel_dirs
+        sky = next(p for p in app.plugins if isinstance(p, SkyPlugin))
+        x, y = np.meshgrid((np.arange(size[0]) + 0.5) / size[0] * 2 - 1, (np.arange(size[1]) + 0.5) / size[1] * 2 - 1)
+        dirs = np.stack([x, y, np.ones_like(x)], -1) @ view_basis(cam, size[0] / size[1]).T
+        dirs /= np.linalg.norm(dirs, axis=-1, keepdims=True)
+        s = app.resource(Sun)
+        want = physical_sky_color(dirs, s.direction, s.color, sky.luts.read("sky_view").astype(np.float64), altitude,
+                                  sky.settings, pixel_angle=cam.fov_y / size[1])
+        assert np.isfinite(got).all()
+        # at the horizon the latitude mapping's square root is singular: float32 moves the LUT row
+        # there by a fraction of a texel (ground to sky): those rows are left out
+        m = ref.medium(sky.settings.atmosphere)
+        mu, cos_az, _, _ = ref.view_angles(dirs, s.direction)
+        _, v = ref.sky_view_uv(m, ref.camera_radius(m, altitude), mu, cos_az)
+        ok = np.abs(v - 0.5) > 1.5 / ref.SKY_VIEW_SIZE[1]
+        assert ok.mean() > 0.7
+        err = np.abs(got - want)[ok]
+        assert (err <= 2e-3 * np.abs(want[ok]) + 2e-4 * want.max()).all(), err.max()
+        # and the LUT read in the pass is the directly ray-marched sky within its resolution
+        direct = ref.sky_radiance(dirs, s.direction, altitude, sky.settings.atmosphere)
+        sampled = ref.sample_sky_view(sky.settings.atmosphere, sky.luts.read("sky_view").astype(np.float64),
+                                      altitude, dirs, s.direction)
+        above = dirs[..., 1] > 0.02
+        assert np.median(np.abs(sampled - direct)[above] / direct[above]) < 0.01
+        app.close()
+    gpu.resize((256, 144))
+
+
+# -- the Sun's light from the same model ----------------------------------------------------------------
+
+def test_sun_colour_and_ambient_are_continuous_finite_and_the_reference():
+    s = AtmosphereSettings()
+    for altitude in (0.0, 20000.0):
+        elevations = np.concatenate([[-90.0, -30.0], np.arange(-6.0, 6.01, 0.25), [30.0, 90.0]])
+        color = np.array([sun_light.sun_color(sun_at(e), altitude, s) for e in elevations])
+        amb = np.array([sun_light.sky_ambient(sun_at(e), altitude, s) for e in elevations])
+        assert np.isfinite(color).all() and np.isfinite(amb).all() and (color >= 0).all() and (amb >= 0).all()
+        near = slice(2, -2)                                         # the 0.25° steps round the horizon
+        fine = np.array([sun_light.sun_color(sun_at(e), altitude, s) for e in np.arange(-6.0, 6.01, 0.05)])
+        steps = np.abs(np.diff(color[near], axis=0)).max()
+        assert np.abs(np.diff(fine, axis=0)).max() < 0.35 * steps, "the sun's colour has no jump (5× finer, 5× smaller steps)"
+        assert np.abs(np.diff(amb[near], axis=0)).max() < 0.05 * amb[near].max(), "no jump in the ambient"
+        dip = math.degrees(math.acos(s.planet_radius / (s.planet_radius + altitude)))   # the horizon's depression
+        assert (color[elevations < -dip - 0.5] == 0).all() and (color[elevations > -dip + 0.5] > 0).all()
+        for e in (-3.0, 0.3, 7.7, 45.2):                            # interpolated nodes vs the direct integral
+            direct = ref.ambient(sun_at(e), altitude, s)
+            assert np.allclose(sun_light.sky_ambient(sun_at(e), altitude, s), direct, rtol=0.05, atol=1e-4)
+    noon = sun_light.sun_color(sun_at(68.4), 0.0, s)
+    from atmos.lighting import sky_light
+    assert np.allclose(noon, sky_light(sun_at(68.4))[0], rtol=0.01), "calibrated: a noon sun as before"
+    low = sun_light.sun_color(sun_at(2.0), 0.0, s)
+    assert low[0] > 3 * low[1] > 9 * low[2], "a low sun is red"
+    high = sun_light.sun_color(sun_at(2.0), 20000.0, s)
+    assert (high > low).all(), "above most of the air it is brighter and whiter"
+
+
+def test_frames_stay_finite_at_the_extremes(gpu, ctx):
+    gpu.resize((32, 24))
+    for altitude in (0.0, 20000.0):
+        for elevation in (-90.0, 0.0, 90.0):
+            app = physical_app(gpu, GroundPlugin(), sun=sun_at(elevation, 30.0), altitude=altitude)
+            app.resource(Camera).pitch = 0.1
+            app.run_frames(1, 1 / 30)
+            img = app.read_linear()
+            sun = app.resource(Sun)
+            assert np.isfinite(img).all() and np.isfinite(sun.color).all() and np.isfinite(sun.ambient).all()
+            app.close()
+    gpu.resize((256, 144))
+
+
+def test_the_sun_light_follows_daylight_by_label_whatever_the_plugin_order(gpu, ctx):
+    for order in (0, 1):
+        daylight = DaylightPlugin(hours=19.3)
+        sky = SkyPlugin(model="physical")
+        plugins = [daylight, sky] if order else [sky, daylight]
+        app = App(gpu).add_plugins(DefaultPlugins(overlay=False), *plugins)
+        app.startup()
+        app.resource(Camera).position = np.array([0.0, 300.0, 0.0])
+        app.update(1 / 30)
+        sun = app.resource(Sun)
+        assert np.allclose(sun.color, sun_light.sun_color(sun.direction, 300.0, sky.settings.atmosphere))
+        labels = [s.label for s in app.schedule.build()["update"]]
+        assert labels.index("daylight") < labels.index("sky_light")
+        declared = {s.label: s.after for s in app.schedule.systems}
+        assert declared["sky_light"] == ("daylight",) and declared["sky_light_start"] == ("daylight_start",)
+        app.close()
+
+
+# -- settings, culling, allocation ----------------------------------------------------------------------
+
+def test_settings_errors_name_the_field():
+    for kwargs, match in ((dict(model="bruneton"), "SkySettings.model must be one of 'preetham', 'physical'"),
+                          (dict(atmosphere=3), "SkySettings.atmosphere must be an AtmosphereSettings")):
+        with pytest.raises(ValueError, match=match):
+            SkySettings(**kwargs)
+    for kwargs, match in ((dict(mie_g=1.0), "AtmosphereSettings.mie_g"),
+                          (dict(ground_albedo=(0.5, 1.5, 0.5)), r"AtmosphereSettings.ground_albedo must be 3 numbers in \[0, 1\]"),
+                          (dict(rayleigh_scattering=(5.8, 13.6, 33.1)), "AtmosphereSettings.rayleigh_scattering must be 3 coefficients"),
+                          (dict(planet_radius=float("nan")), "AtmosphereSettings.planet_radius")):
+        with pytest.raises(ValueError, match=match):
+            AtmosphereSettings(**kwargs)
+    plugin = SkyPlugin(model="physical")
+    with pytest.raises(ValueError, match="unknown AtmosphereSettings setting"):
+        plugin.configure(atmosphere={"nosuch": 1})
+    with pytest.raises(ValueError, match="AtmosphereSettings.mie_g"):
+        plugin.configure(turbidity=3.0, atmosphere={"mie_g": 2.0})
+    assert plugin.settings.turbidity == SkySettings().turbidity, "nothing half-applied"
+    assert plugin.configure(atmosphere={"mie_g": 0.7}).atmosphere.mie_g == 0.7
+
+
+def test_luts_only_with_the_physical_model_and_recomputed_only_when_inputs_change(fresh_gpu):
+    gpu = fresh_gpu
+    sky = SkyPlugin()
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), sky, GroundPlugin())
+    app.insert_resource(Sun(direction=sun_at(20.0)))
+    app.run_frames(2, 1 / 30)
+    assert "sky_luts" in app.graph.compile().culled and sky.luts is None, "Preetham: no LUT pass, no textures"
+    sky.configure(model="physical")
+    app.run_frames(1, 1 / 30)
+    luts = sky.luts
+    assert luts is not None and luts.builds == [1, 1, 1] and "sky_luts" not in app.graph.compile().culled
+    app.run_frames(2, 1 / 30)
+    assert luts.builds == [1, 1, 1], "nothing changed: nothing recomputed"
+    app.resource(Sun).direction = sun_at(20.0, 120.0)
+    app.run_frames(1, 1 / 30)
+    assert luts.builds == [1, 1, 1], "the sun's azimuth alone changes no LUT"
+    app.resource(Sun).direction = sun_at(20.01, 120.0)
+    app.run_frames(1, 1 / 30)
+    assert luts.builds == [1, 1, 1], "nor a move of the sun within SUN_TOLERANCE"
+    app.resource(Sun).direction = sun_at(19.0)
+    app.run_frames(1, 1 / 30)
+    assert luts.builds == [1, 1, 2], "the sun's height: the sky view only"
+    app.resource(Camera).position = np.array([0.0, 800.0, 0.0])
+    app.run_frames(1, 1 / 30)
+    assert luts.builds == [1, 1, 3], "the camera's altitude: the sky view only"
+    sky.configure(atmosphere={"mie_g": 0.6})
+    app.run_frames(1, 1 / 30)
+    assert luts.builds == [2, 2, 4], "the atmosphere: everything"
+    sky.configure(model="preetham")
+    app.run_frames(1, 1 / 30)
+    assert sky.luts is None and not luts.textures, "back to Preetham: the LUTs are released"
+    app.close()
+
+
+# -- composition ----------------------------------------------------------------------------------------
+
+def test_fog_colour_follows_the_physical_sky(gpu, ctx):
+    sun = sun_at(3.0, 40.0)
+    app = physical_app(gpu, GroundPlugin(), FogPlugin(mode="exp", density=1e-3, color_from="sky", sky="keep",
+                                                      fog_color=(1.0, 1.0, 1.0)), sun=sun, altitude=150.0, stars=False)
+    app.run_frames(1, 1 / 30)
+    fog = next(p for p in app.plugins if isinstance(p, FogPlugin))
+    sky = next(p for p in app.plugins if isinstance(p, SkyPlugin))
+    from atmos.scene_view import SceneView
+    view = SceneView(camera=app.resource(Camera), sun=app.resource(Sun), clock=app.clock, size=gpu.size)
+    table = fog.horizon(view)
+    dirs = horizon_directions(len(table))
+    direct = ref.sky_radiance(dirs, sun, 150.0, sky.settings.atmosphere)
+    assert np.allclose(table, direct, rtol=0.05), "the fog's horizon is the physical sky's"
+    drawn = ref.sample_sky_view(sky.settings.atmosphere, sky.luts.read("sky_view").astype(np.float64), 150.0, dirs, sun)
+    assert np.allclose(table, drawn, rtol=0.05), "... and what the sky pass draws there"
+    toward, away = table[np.argmax(dirs @ sun)], table[np.argmin(dirs @ sun)]
+    assert toward[0] > 3 * away[0] and toward[0] > toward[2], "orange toward the low sun"
+    app.close()
+
+
+def test_clouds_are_lit_by_the_physical_sun_colour():
+    from atmos.plugins.cloud_render.light import light_uniforms
+    from atmos.plugins.clouds import CloudSettings
+    sun = Sun(direction=sun_at(2.0))
+    s = AtmosphereSettings()
+    sun.color = tuple(sun_light.sun_color(sun.direction, 900.0, s))
+    sun.ambient = tuple(sun_light.sky_ambient(sun.direction, 900.0, s))
+    source = np.array(light_uniforms(CloudSettings(), sun)["sun_source"])
+    ratio = source / np.asarray(sun.color)
+    assert np.allclose(ratio, ratio[0], rtol=1e-5), "the clouds' sun is Sun.color, scaled"
+    assert source[0] > 3 * source[2], "sunset clouds get the reddened sun"
+
+
+# -- the Monte-Carlo check and the demos ------------------------------------------------------------------
+
+def test_the_path_tracer_first_order_is_the_single_scattering_model():
+    """The independent check's own check: the tracer stopped after one scattering event equals the
+    model's single scattering (no LUT, no Ψms) within its noise; all orders add light."""
+    from atmos.plugins.sky.atmosphere_paths import trace
+    single = AtmosphereSettings(multiple_scattering=0.0)
+    sun = sun_at(20.0)
+    for view in (np.array([0.0, 1.0, 0.0]), sun_at(5.0, 150.0)):
+        mc, err = trace(view, sun, 0.0, single, paths=3000, seed=3, max_orders=1)
+        model = ref.sky_radiance(view[None], sun, 0.0, single, steps=64)[0]
+        assert (np.abs(mc - model) < 4 * err + 0.01 * model).all(), (mc, err, model)
+        more, _ = trace(view, sun, 0.0, single, paths=3000, seed=3)
+        assert (more > mc).all()
+
+
+def test_the_demos_take_the_sky_model(gpu, ctx, capsys):
+    from atmos.cli import main
+    from atmos.demo_registry import SKY_MODELS, DemoSettings
+    from atmos.plugins.sky import MODELS
+    assert SKY_MODELS == MODELS
+    with pytest.raises(ValueError, match="DemoSettings.sky must be one of 'preetham', 'physical'"):
+        DemoSettings(sky="bruneton")
+    assert main(["graph", "sky_day", "--sky", "physical"]) == 0
+    assert "2. sky_luts" in capsys.readouterr().out, "the LUT pass runs before the sky pass"
