@@ -106,10 +106,11 @@ def test_bad_solver_input_is_refused(gpu, ctx):
         DiffusionSolver(gpu, (6, 4, 6), tolerance=0.0)
 
 
-def test_every_shaded_texture_set_carries_its_field_and_unshaded_ones_none(gpu, ctx):
+def test_every_shaded_texture_set_a_renderer_reads_carries_its_field_and_unshaded_ones_none(gpu, ctx):
     weather = params((16, 8, 16))
-    app = App(gpu).add_plugins(CloudsPlugin(CloudSettings(smoothing_slices=2, group_size=(8, 8)),
-                                            weather=weather, seed=3))
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False),
+                               CloudsPlugin(CloudSettings(smoothing_slices=2, group_size=(8, 8)), weather=weather, seed=3),
+                               sprites := CloudRenderPlugin())
     app.startup()
     sim = next(p for p in app.plugins if isinstance(p, CloudsPlugin)).simulation
     for _ in range(25):
@@ -125,19 +126,51 @@ def test_every_shaded_texture_set_carries_its_field_and_unshaded_ones_none(gpu, 
                                   mean_cosine(s.phase_g, s.phase_g2, s.phase_w), T, sim.sun())
         got = read_field(texture_set[DIFFUSION])
         np.testing.assert_allclose(got, ref, rtol=2 ** -10, atol=2e-3 * ref[..., 0].max())
+    sprites.configure(ms_diffusion=0.0)         # no reader: the next steps solve nothing and hold no field
+    for _ in range(3):
+        sim.job.run_step()
+    assert all(DIFFUSION not in texture_set for texture_set in sim.triple.sets)
+    sprites.configure(ms_diffusion=0.4)
+    for _ in range(2):
+        sim.job.run_step()
+    assert all(DIFFUSION in texture_set for texture_set in sim.view()[:2])
     app.close()
     app = App(gpu).add_plugins(DefaultPlugins(overlay=False),
                                CloudsPlugin(CloudSettings(shading=False, group_size=(8, 8)), weather=weather),
                                sprites := CloudRenderPlugin(), march := RaymarchCloudsPlugin(enabled=False))
     app.startup()
     sim = next(p for p in app.plugins if isinstance(p, CloudsPlugin)).simulation
-    assert DIFFUSION not in sim.view()[0] and sim.diffusion is None
+    assert DIFFUSION not in sim.view()[0] and sim.field is None
     for on, off in ((sprites, march), (march, sprites)):          # both draw without a field, weight unused
         off.configure(enabled=False)
         on.configure(enabled=True)
         app.run_frames(2, 1 / 30)
         assert np.isfinite(app.read_linear()).all()
     app.close()
+
+
+def test_a_scene_no_renderer_reads_the_field_of_solves_none(gpu, ctx):
+    """The solve is the chain's costliest task: no cloud renderer, or one disabled, and no step runs it."""
+    weather = params((16, 8, 16))
+    for extra in ((), (RaymarchCloudsPlugin(enabled=False),), (CloudRenderPlugin(ms_diffusion=0.0),)):
+        app = App(gpu).add_plugins(DefaultPlugins(overlay=False), *extra,
+                                   CloudsPlugin(CloudSettings(smoothing_slices=2, group_size=(8, 8)), weather=weather))
+        app.startup()
+        sim = next(p for p in app.plugins if isinstance(p, CloudsPlugin)).simulation
+        app.run_frames(30, 1 / 30)
+        assert sim.job.step >= 3
+        assert "diffusion" not in sim.job.stats.task_ms, extra
+        assert sim.field.solver is None and all(DIFFUSION not in t for t in sim.triple.sets)
+        app.close()
+    density = np.zeros((8, 4, 8), np.float32)
+    density[2:6, 1:3, 2:6] = 1.0
+    for weight in (0.0, 0.4):                     # static clouds: the same demand
+        app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudRenderPlugin(ms_diffusion=weight),
+                                   CloudsPlugin(density=density))
+        app.run_frames(2, 1 / 30)
+        sim = next(p for p in app.plugins if isinstance(p, CloudsPlugin)).simulation
+        assert (DIFFUSION in sim.set) == (weight > 0) and (sim.diffusion is not None) == (weight > 0)
+        app.close()
 
 
 @pytest.mark.parametrize("cls", [CloudRenderPlugin, RaymarchCloudsPlugin])

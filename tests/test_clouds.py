@@ -41,6 +41,21 @@ def test_sliced_frames_equal_whole_steps_and_readers_never_see_c(gpu, ctx):
     sliced_app.close()
 
 
+def test_warm_up_gives_the_sets_of_whole_steps(gpu, ctx):
+    """The warm-up's early steps run the weather and automaton alone: A and B hold what whole steps give."""
+    whole_app, whole = clouds_app(gpu, params())
+    warm_app, warm = clouds_app(gpu, params(), warmup_steps=5)
+    for _ in range(5):
+        whole.job.run_step()
+    assert warm.job.step == 2
+    for x, y in zip(whole.view()[:2], warm.view()[:2]):
+        assert np.array_equal(read_volume(x["density"]), read_volume(y["density"]))
+        assert read_volume(x["density"]).any()
+    assert whole.sets().wind_travel == warm.sets().wind_travel
+    whole_app.close()
+    warm_app.close()
+
+
 def test_density_matches_the_automaton_and_max_maps_never_skip_density(gpu, ctx):
     app, sim = clouds_app(gpu, params())
     for _ in range(25):

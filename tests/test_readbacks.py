@@ -2,6 +2,8 @@
 
 The thesis design brings only the tiny max maps back, once per simulation step; atmos copies them
 into a pixel buffer when the step computes them and reads that buffer when the set is first drawn.
+The far field's cover measure (which sizes its tile) comes back the same way: copied on the GPU when
+a step's sets are first drawn, read when the next step's are.
 The render graph's timer queries are read RING - 1 frames after they were issued. Nothing else
 (textures, framebuffers, glFinish) may wait for the GPU in a frame.
 """
@@ -15,7 +17,8 @@ from atmos.graph.timing import RING
 from atmos.plugins.clouds import CloudSimulation, DensityMaps, reference
 from atmos.runner import build_app
 
-ALLOWED = {("Query.elapsed", "atmos/graph/timing.py"), ("Buffer.read", "plugins/clouds/density_maps.py")}
+MAPS, FAR = ("Buffer.read", "plugins/clouds/density_maps.py"), ("Buffer.read", "plugins/cloud_far_field/layer.py")
+ALLOWED = {("Query.elapsed", "atmos/graph/timing.py"), MAPS, FAR}
 
 
 def test_a_running_sunset_reads_back_only_late_timer_queries_and_the_max_maps_once_per_step():
@@ -32,10 +35,13 @@ def test_a_running_sunset_reads_back_only_late_timer_queries_and_the_max_maps_on
         counts = meter.readback_counts()
         where = {(call, place.rsplit(":", 1)[0]) for call, place in counts}
         assert where <= ALLOWED, f"readbacks beyond late timer queries and the max maps: {sorted(where - ALLOWED)}"
-        by_call = {call: sum(n for (c, _), n in counts.items() if c == call) for call, _ in ALLOWED}
-        assert by_call["Query.elapsed"] == kept * frames, "one late timer-query read per kept pass and frame"
+        by_place = {key: sum(n for (c, place), n in counts.items() if (c, place.rsplit(":", 1)[0]) == key)
+                    for key in ALLOWED}
+        assert by_place[("Query.elapsed", "atmos/graph/timing.py")] == kept * frames, \
+            "one late timer-query read per kept pass and frame"
         assert steps >= 2, "the window must span simulation steps"
-        assert abs(by_call["Buffer.read"] - steps) <= 1, "the max maps come back once per step"
+        assert abs(by_place[MAPS] - steps) <= 1, "the max maps come back once per step"
+        assert abs(by_place[FAR] - steps) <= 1, "the far field's measure comes back once per step"
         assert meter.calls["Texture3D.read"] == meter.calls["TextureArray.read"] == 0
         assert meter.calls["Context.finish"] == 0
     finally:

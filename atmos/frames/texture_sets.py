@@ -41,6 +41,19 @@ class TextureSet:
     def __contains__(self, name: object) -> bool:
         return name in self.textures
 
+    def ensure(self, gpu, name: str, desc: TextureDesc):
+        """The texture ``name``, made (zero-filled) from ``desc`` if the set has none yet: a texture
+        only some steps need (released again with :meth:`drop`)."""
+        if name not in self.textures:
+            self.textures[name] = make_texture(gpu, desc)
+        return self.textures[name]
+
+    def drop(self, name: str) -> None:
+        """Release and remove the texture ``name`` if the set has one."""
+        texture = self.textures.pop(name, None)
+        if texture is not None:
+            texture.release()
+
     def __iter__(self) -> Iterator[str]:
         return iter(self.textures)
 

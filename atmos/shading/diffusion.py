@@ -36,6 +36,7 @@ from atmos.shading.shear_warp import check_volume_texture, groups, program
 FLOOR = 1e-3               # 1/m: transport extinction floor (empty cells still conduct, finitely)
 TOLERANCE = 1e-4           # relative residual |b - A phi| / |b| the GPU solve stops at
 ITERATIONS = 300           # CG iterations per solve at most (the bench's grids converge in ~100, 32^3 in ~150)
+WARM_ITERATIONS = 150      # at most, started from the last step's field (sunset's 64x8x64 grid: 70-80; cold 90)
 FIELD_CELLS = 32768        # the field's grid: the shading grid, halved per axis until it has at most this many cells
 DIFFUSION = "diffusion"    # the texture set's name for the field (rgba16f: phi, F)
 SIGMA_MAX = 1e3            # 1/m: extinction cap (shaders/shading/diffusion.comp has the same)
@@ -284,17 +285,40 @@ class DiffusionSolver:
 
 
 class DiffusionTask(SliceTask):
-    """The cloud chain's field task, after the shading: ``slices`` job slices of set C (assembly and
-    the first iterations, more iterations, the last also writes ``set[DIFFUSION]``), ``iterations`` in
-    all. ``medium`` is a zero-argument callable giving (sigma_t, albedo, g, cell, sun_dir), read when a
-    step's field begins; the solve starts from the previous set's phi (warm)."""
+    """The cloud chain's field task, after the shading, in the steps whose :meth:`plan` found it
+    ``wanted()`` (a renderer reads it: :class:`~atmos.plugins.clouds.field_demand.FieldDemand`):
+    ``slices`` job slices of set C (assembly and the first iterations, more iterations, the last also
+    writes ``set[DIFFUSION]``), ``iterations`` in all. Other steps run no slice and leave C without a
+    field; the solver and a set's field texture are made on the first step that wants them.
+    ``medium`` is a zero-argument callable giving (sigma_t, albedo, g, cell, sun_dir), read when a
+    step's field begins; the solve starts from the last solve's phi (warm: at most ``warm_iterations``;
+    converged iterations cost a GPU nothing, but a software rasterizer a dispatch each)."""
 
-    def __init__(self, solver: DiffusionSolver, medium, slices: int = 8, iterations: int = ITERATIONS,
-                 density: str = "density", transmittance: str = "transmittance", name: str = "diffusion"):
-        self.solver, self.medium = solver, medium
-        self.total = check_int("DiffusionTask", "iterations", iterations, 1, 100000)
+    def __init__(self, gpu: GpuContext, shape, scale: int, medium, wanted=lambda: True, slices: int = 8,
+                 iterations: int = ITERATIONS, warm_iterations: int = WARM_ITERATIONS, density: str = "density",
+                 transmittance: str = "transmittance", name: str = "diffusion"):
+        self.gpu, self.shape, self.scale = gpu, tuple(shape), grid.check_scale(scale)
+        self.medium, self.wanted = medium, wanted
+        self.cold = check_int("DiffusionTask", "iterations", iterations, 1, 100000)
+        self.warm = min(self.cold, check_int("DiffusionTask", "warm_iterations", warm_iterations, 1, 100000))
+        self.total = self.cold             # this step's iterations
         self.density, self.transmittance = density, transmittance
-        super().__init__(name, check_int("DiffusionTask", "slices", slices, 1, 1000), self._run)
+        self.solver: DiffusionSolver | None = None
+        self.active = False            # whether the step in progress solves the field
+        n = check_int("DiffusionTask", "slices", slices, 1, 1000)
+        super().__init__(name, lambda: n if self.active else 0, self._run)
+
+    def plan(self, target) -> None:
+        """At the start of a step into ``target`` (before its slices are counted): solve it if wanted,
+        else take the set's field away (no renderer reads a stale one)."""
+        self.active = bool(self.wanted())
+        if not self.active:
+            target.drop(DIFFUSION)
+            return
+        self.total = self.warm if self.solver is not None else self.cold
+        if self.solver is None:
+            self.solver = DiffusionSolver(self.gpu, self.shape, self.scale)
+        target.ensure(self.gpu, DIFFUSION, diffusion_desc(self.shape, self.scale))
 
     def _run(self, index: int, job) -> None:
         target = job.target
@@ -304,6 +328,11 @@ class DiffusionTask(SliceTask):
         self.solver.iterate(self.total * (index + 1) // n - self.total * index // n)
         if index == n - 1:
             self.solver.write(target[DIFFUSION])
+
+    def release(self) -> None:
+        if self.solver is not None:
+            self.solver.release()
+            self.solver = None
 
 
 def field_medium(cloud_settings, sun_dir) -> tuple:

@@ -3,7 +3,8 @@
 The far field's clouds are a function of world (x, z): the four octave textures, each at its own
 turned uv (:mod:`.pattern`, drift included), each point taking the volume's column sum at its rank
 (:mod:`.cover`). The tile they are drawn at, :attr:`FarFieldLayer.tile_size`, is the setting's or
-(None) sized so that their cover changes per metre as often as the volume's (:meth:`update_tile`). The far-field
+(None) sized so that their cover changes per metre as often as the volume's (:meth:`update_tile`, from a
+measure read back once per simulation step, a step after it was taken: no frame waits for it). The far-field
 pass draws them; the ground shadows (:mod:`atmos.plugins.cloud_shadows`) darken the ground under them
 with the same function (``shaders/cloud_far_field/field.glsl``). The plugin imports this object as the
 graph resource ``"far_field"``; each pass that uses it calls :meth:`prepare` (re-bakes the octaves
@@ -66,6 +67,9 @@ class FarFieldLayer:
         self.gpu, self.plugin = gpu, plugin
         self.octaves = OctaveTextures(gpu)
         self.cover = gpu.track(gpu.ctx.buffer(reserve=4 * (2 + QUANTILES)))   # cover, column_quantiles, transitions
+        self._staged = gpu.track(gpu.ctx.buffer(reserve=self.cover.size))      # a copy of one step's measure
+        self._staged_for = None              # the set B whose measure is staged (held: never a reused id)
+        self._target = None                  # the matched tile the drawn one follows (m)
         self.tile_size = float(self.plugin.settings.tile_size or 8000.0)    # metres per tile as drawn (update_tile)
         self._tile_time = None               # App time of the last update_tile
         self._matched = False                # tile_size follows a measure (else the first one sets it)
@@ -86,18 +90,15 @@ class FarFieldLayer:
         sun_dir = light_uniforms(sim.settings, view.sun)["sun_dir"]
         if self.octaves.needs_bake(params, sun_dir, REBAKE_TOLERANCE):
             self.octaves.bake(params, sun_dir, octave_frequencies(params.base_frequency), rotations())
-        first = self._tile_time is None
-        if not first:
-            self.update_tile(sim, float(view.time))     # from the last frame's measure: no wait on this one
         self.measure_cover(sim)
-        if first:
-            self.update_tile(sim, float(view.time))
+        self.update_tile(sim, float(view.time))
 
     def update_tile(self, sim: CloudSets, time: float) -> None:
         """:attr:`tile_size` from the last measure: ``settings.tile_size`` when set, else the tile at which
         the far field's cover changes along a line as often per metre as the volume's (cover.comp's
-        transitions per cell / the cell size; :func:`.cover.matched_tile_size`), followed with the time
-        constant TILE_TIME (the pattern zooms slowly, never jumps; a first measure is taken at once)."""
+        transitions per cell / the cell size; :func:`.cover.matched_tile_size`; :meth:`_step_measure`),
+        followed with the time constant TILE_TIME (the pattern zooms slowly, never jumps; a first measure
+        is taken at once)."""
         params = self.settings
         dt = time - self._tile_time if self._tile_time is not None else 0.0
         self._tile_time = time
@@ -105,15 +106,29 @@ class FarFieldLayer:
             self._matched = False
             self.tile_size = float(params.tile_size)
             return
-        cover, transitions = self.read_transitions()
-        cell = float(np.mean(np.asarray(sim.settings.cell_size, np.float64)[[0, 2]]))
-        target = matched_tile_size(pattern_crossings(params.base_frequency, params.seed, params.size), cover,
-                                   transitions / cell)
-        if target is None:
+        measured = self._step_measure(sim)
+        if measured is not None:
+            cover, transitions = measured
+            cell = float(np.mean(np.asarray(sim.settings.cell_size, np.float64)[[0, 2]]))
+            self._target = matched_tile_size(pattern_crossings(params.base_frequency, params.seed, params.size),
+                                             cover, transitions / cell)
+        if self._target is None:
             return
         k = min(1.0, max(dt, 0.0) / TILE_TIME) if self._matched else 1.0
-        self.tile_size *= (target / self.tile_size) ** k
+        self.tile_size *= (self._target / self.tile_size) ** k
         self._matched = True
+
+    def _step_measure(self, sim: CloudSets) -> tuple[float, float] | None:
+        """(cover, transitions per cell) once per simulation step, else None: when a step's sets are first
+        drawn, the staged copy of the last step's measure is read (frames old: no wait) and this frame's
+        is copied on the GPU into its place. The very first measure is read at once (start-up)."""
+        if sim.b is self._staged_for:
+            return None
+        first = self._staged_for is None
+        measured = None if first else _transitions(self._staged)
+        self.gpu.ctx.copy_buffer(self._staged, self.cover)
+        self._staged_for = sim.b
+        return _transitions(self._staged) if first else measured
 
     def measure_cover(self, sim: CloudSets, profile: bool | None = None) -> None:
         """The simulation's edge-weighted cover and column-sum quantiles into the buffer the shaders
@@ -162,9 +177,9 @@ class FarFieldLayer:
         return float(values[0]), values[1:1 + QUANTILES]
 
     def read_transitions(self) -> tuple[float, float]:
-        """(cover, the cover's transitions per cell along a line) as last measured (a small GPU → CPU copy)."""
-        values = np.frombuffer(self.cover.read(), np.float32).astype(np.float64)
-        return float(values[0]), float(values[1 + QUANTILES])
+        """(cover, the cover's transitions per cell along a line) as last measured (a GPU → CPU copy: tests
+        and tools)."""
+        return _transitions(self.cover)
 
     def use(self, program, view, sim: CloudSets) -> None:
         """Bind the textures (units 5..8), the cover (storage buffer 0) and set field.glsl's uniforms."""
@@ -195,9 +210,16 @@ class FarFieldLayer:
         if self.octaves is not None:
             self.octaves.release()
             self.octaves = None
-        if self.cover is not None:
-            self.cover.release()
-            self.cover = None
+        for buffer in (self.cover, self._staged):
+            if buffer is not None:
+                buffer.release()
+        self.cover = self._staged = self._staged_for = None
         if self.profile is not None:
             self.profile.release()
             self.profile = None
+
+
+def _transitions(buffer) -> tuple[float, float]:
+    """(cover, transitions per cell) of a cover.comp measure in ``buffer``."""
+    values = np.frombuffer(buffer.read(), np.float32).astype(np.float64)
+    return float(values[0]), float(values[1 + QUANTILES])

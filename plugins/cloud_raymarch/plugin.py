@@ -32,6 +32,7 @@ from atmos.plugins.cloud_raymarch.temporal import TemporalClouds, jitter
 from atmos.plugins.cloud_render.binding import bind_volume, clamp_sampler, unbind_volume
 from atmos.plugins.cloud_render.light import unit_direction
 from atmos.plugins.cloud_render.offscreen import OffscreenClouds, low_size
+from atmos.plugins.clouds.field_demand import field_demand
 from atmos.plugins.clouds.sets import CLOUD_SETS, CLOUD_VOLUME, CloudSets
 from atmos.plugins.clouds.simulation import CloudSimulation
 from atmos.render_core import COLOR, DEPTH
@@ -71,7 +72,7 @@ class RaymarchCloudsPlugin(Plugin):
 
     def __init__(self, settings: RaymarchCloudSettings | None = None, **fields):
         super().__init__(settings, **fields)
-        self.gpu = self.composition = self.far = None
+        self.gpu = self.composition = self.far = self.demand = None
         self.simulated = False
 
     @classmethod
@@ -88,6 +89,12 @@ class RaymarchCloudsPlugin(Plugin):
         self.composition = composition(app)
         self.composition.writers.add(RaymarchPass.name)     # the fog gets the clouds' own distance
         app.graph.add_pass(RaymarchPass(self))
+        self.demand = field_demand(app)
+        self.demand.weights[RaymarchPass.name] = self.field_weight
+
+    def field_weight(self) -> float:
+        """The diffusion field's weight this renderer reads it with (0 when disabled)."""
+        return self.settings.ms_diffusion if self.settings.enabled else 0.0
 
     def finish(self, app) -> None:
         self.simulated = app.get_resource(CloudSimulation) is not None     # weather-driven, not static
@@ -102,6 +109,8 @@ class RaymarchCloudsPlugin(Plugin):
         return bool(s.enabled and s.far_field and self.far is not None and self.far.settings.enabled)
 
     def cleanup(self, app) -> None:
+        if self.demand is not None:
+            self.demand.weights.pop(RaymarchPass.name, None)
         if self.composition is not None:
             self.composition.writers.discard(RaymarchPass.name)
         if self.far is not None:

@@ -44,6 +44,7 @@ from atmos.plugins.cloud_render.light import CloudLightSettings
 from atmos.plugins.cloud_render.offscreen import MAX_DOWNSAMPLE, OffscreenClouds, low_size
 from atmos.plugins.clouds.layout import CloudLayout
 from atmos.plugins.cloud_render.segments import MAX_LEVEL, SegmentStats, select_segments, unpack
+from atmos.plugins.clouds.field_demand import field_demand
 from atmos.plugins.clouds.sets import CLOUD_SETS, CLOUD_VOLUME, CloudSets
 from atmos.render_core import COLOR, DEPTH
 
@@ -105,7 +106,7 @@ class CloudRenderPlugin(Plugin):
     def __init__(self, settings: CloudRenderSettings | None = None, **fields):
         super().__init__(settings, **fields)
         self.stats = SegmentStats()
-        self.gpu = None
+        self.gpu = self.demand = None
 
     def build(self, app) -> None:
         if app.graph is None:
@@ -114,8 +115,16 @@ class CloudRenderPlugin(Plugin):
         self.composition = composition(app)
         self.composition.writers.add("cloud_render")     # the sprites give the fog their own distance
         app.graph.add_pass(CloudSpritePass(self))
+        self.demand = field_demand(app)
+        self.demand.weights["cloud_render"] = self.field_weight
+
+    def field_weight(self) -> float:
+        """The diffusion field's weight this renderer reads it with (0 when disabled)."""
+        return self.settings.ms_diffusion if self.settings.enabled else 0.0
 
     def cleanup(self, app) -> None:
+        if self.demand is not None:
+            self.demand.weights.pop("cloud_render", None)
         comp = getattr(self, "composition", None)
         if comp is not None:
             comp.writers.discard("cloud_render")

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 from atmos.lighting import Sun
 from atmos.plugin import Plugin
+from atmos.plugins.clouds.field_demand import field_demand
 from atmos.plugins.clouds.sets import CLOUD_SETS
 from atmos.plugins.clouds.simulation import CloudSettings, CloudSimulation
 from atmos.checks import check_int
@@ -52,11 +53,11 @@ class CloudsPlugin(Plugin):
         def sun():
             return (app.get_resource(Sun) or default_sun).direction
         if self.density is not None:
-            self.simulation = StaticClouds(app.gpu, self.density, self.settings, origin, sun)
+            self.simulation = StaticClouds(app.gpu, self.density, self.settings, origin, sun, field_demand(app))
             app.insert_resource(origin)
             app.graph.import_resource(CLOUD_SETS, self.simulation.sets)
             return
-        self.simulation = CloudSimulation(app.gpu, app.world, self.settings, self.seed, origin, sun)
+        self.simulation = CloudSimulation(app.gpu, app.world, self.settings, self.seed, origin, sun, field_demand(app))
         app.insert_resource(origin)
         app.insert_resource(self.simulation)
         app.graph.import_resource(CLOUD_SETS, self.simulation.sets)
@@ -66,9 +67,7 @@ class CloudsPlugin(Plugin):
     def _warm_up(self, app) -> None:
         """Fill sets A and B (and ``warmup_steps`` more steps) before the first frame; at start-up,
         not in ``build``, so building a scene (``atmos graph``) runs no simulation."""
-        self.simulation.job.prime()
-        for _ in range(self.warmup_steps):
-            self.simulation.job.run_step()
+        self.simulation.warm_up(self.warmup_steps)
 
     def cleanup(self, app) -> None:
         if self.simulation is not None:

@@ -7,7 +7,8 @@ maps (the same z ranges; the tiny max maps are copied into a pixel buffer once p
 when the set is first drawn, frames later: no stall) → columns (the light volume's density integrals
 up and down, :mod:`atmos.shading.columns`, the same number of z ranges) → shading (inverse
 shear-warp transmittance toward the sun, a few light-space slices per job slice; optional) → with the
-shading, the diffusion field (:mod:`atmos.shading.diffusion`: CG iterations over 8 job slices). The frame scheduler runs
+shading, the diffusion field in the steps a renderer reads it (:mod:`atmos.shading.diffusion`: CG iterations
+over 8 job slices; :mod:`~atmos.plugins.clouds.field_demand`). The frame scheduler runs
 a few slices per frame into set C while the renderer draws sets A and B interpolated; nothing but
 the max maps comes back to the CPU.
 """
@@ -30,7 +31,8 @@ from atmos.plugins.clouds.layout import CloudLayout
 from atmos.plugins.clouds.sets import CloudSets
 from atmos.plugins.clouds.smoothing import FORMATS, WEIGHTS, Smoother, slice_range
 from atmos.shading.columns import COLUMNS, ColumnShader, ColumnTask, column_desc
-from atmos.shading.diffusion import DIFFUSION, DiffusionSolver, DiffusionTask, diffusion_desc, field_medium
+from atmos.shading.diffusion import DiffusionTask, field_medium
+from atmos.plugins.clouds.field_demand import FieldDemand
 from atmos.shading.grid import check_scale, shading_shape
 from atmos.shading.medium import cell_sigma
 from atmos.shading.scattering import Scattering
@@ -167,12 +169,13 @@ class CloudSimulation:
     (empty-space skipping); a set's ``["density"]`` is the smoothed density,
     ``["transmittance"]`` (with shading) the transmittance toward the sun at the shading scale,
     ``["columns"]`` the light volume's column integrals (:mod:`atmos.shading.columns`) at that scale,
-    ``["diffusion"]`` (with shading) the diffusion field (:mod:`atmos.shading.diffusion`),
+    ``["diffusion"]`` (with shading, in the sets of steps where ``demand`` wanted it) the diffusion
+    field (:mod:`atmos.shading.diffusion`),
     and ``maps_of(set).sums`` the top-view sums (layer 0 all heights, then one per height band).
     """
 
     def __init__(self, gpu, world, settings: CloudSettings | None = None, seed: int = 0,
-                 origin: VolumeOrigin | None = None, sun=None):
+                 origin: VolumeOrigin | None = None, sun=None, demand: FieldDemand | None = None):
         if settings is not None and not isinstance(settings, CloudSettings):
             raise ValueError(f"CloudSimulation settings must be a CloudSettings, got {type(settings).__name__}")
         self.settings = settings or CloudSettings()      # read live: CloudsPlugin.configure replaces it
@@ -183,7 +186,7 @@ class CloudSimulation:
         self.rng = np.random.default_rng(seed)
         self.gpu = gpu
         self.sun = sun or (lambda: np.array([0.3, 0.35, -0.88]))
-        self.shader = self.diffusion = None
+        self.shader = self.field = None
         s = self.settings
         made = []
         try:
@@ -198,9 +201,6 @@ class CloudSimulation:
                 descs["transmittance"] = TextureDesc(shading_shape(shape, s.shading_scale), 1, "f2")
                 self.shader = ShearWarpShader(gpu, shape, s.shading_scale)
                 made.append(self.shader)
-                descs[DIFFUSION] = diffusion_desc(shape, s.shading_scale)
-                self.diffusion = DiffusionSolver(gpu, shape, s.shading_scale)
-                made.append(self.diffusion)
             self.triple = TripleSet(gpu, descs)
             made.append(self.triple)
             self._maps = {id(t): DensityMaps(gpu, shape, s.band_height, s.group_size) for t in self.triple.sets}
@@ -227,20 +227,42 @@ class CloudSimulation:
         if s.shading:                  # sigma and scattering read when each step's shading begins
             tasks.append(ShadingTask(self.shader, self.sun_in_cells, lambda: self.settings.shading_sigma(self.sun()),
                                        slices_per_run=s.shading_slices_per_run))
-            tasks.append(DiffusionTask(self.diffusion, lambda: field_medium(self.settings, self.sun())))
-        self.job = SlicedJob("clouds", tasks, self.triple)
+            demand = demand or FieldDemand()
+            self.field = DiffusionTask(gpu, shape, s.shading_scale, lambda: field_medium(self.settings, self.sun()),
+                                       demand.wanted)
+            tasks.append(self.field)
+        self.job = SlicedJob("clouds", tasks, self.triple, begin=self._begin_step)
+
+    def _begin_step(self, step: int) -> None:
+        if self.field is not None:
+            self.field.plan(self.triple.c)
 
     # -- tasks -------------------------------------------------------------------------------
-    def _region_slice(self, index: int, job) -> None:
-        origin = self.origin.as_tuple()
-        self._placement[id(job.target)] = self._step_origin = origin
+    def warm_up(self, steps: int = 0) -> None:
+        """Before the first frame: ``steps`` steps of the weather and the automaton alone (no set would
+        show their smoothing, maps, light or field), then whole steps until sets A and B hold results
+        (:meth:`SlicedJob.prime`): the same clouds as ``steps`` more whole steps, at a fraction of the cost."""
+        for _ in range(steps):
+            self._weather_step()
+            self._automaton_step()
+        self.job.prime()
+
+    def _weather_step(self) -> None:
+        origin = self._step_origin = self.origin.as_tuple()
         s = self.settings
         step_weather(self.world, s.weather, self.rng, s.step_seconds, origin)
         self.region.render(ellipsoid_array(self.world, origin))
         self.region.probabilities(s.weather)
 
-    def _automaton_slice(self, index: int, job) -> None:
+    def _automaton_step(self) -> None:
         self.automaton.step_with_texture(self.region.prob_texture, shift=self._next_shift())
+
+    def _region_slice(self, index: int, job) -> None:
+        self._weather_step()
+        self._placement[id(job.target)] = self._step_origin
+
+    def _automaton_slice(self, index: int, job) -> None:
+        self._automaton_step()
         self._travel[id(job.target)] = self._blown - self._drift      # the wind's part of the whole-cell shifts
 
     def _smoothing_slice(self, index: int, job) -> None:
@@ -323,7 +345,7 @@ class CloudSimulation:
         return float((sums > self.settings.cover_threshold).mean())
 
     def release(self) -> None:
-        for obj in (self.region, self.automaton, self.smoother, self.triple, self.shader, self.diffusion,
+        for obj in (self.region, self.automaton, self.smoother, self.triple, self.shader, self.field,
                     *self._maps.values()):
             if obj is not None:
                 obj.release()

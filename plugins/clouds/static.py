@@ -2,8 +2,10 @@
 
 The volume ``[x, y, z]`` is uploaded once into one texture set shown as both A and B (t = 0) and
 placed by :mod:`atmos.plugins.clouds.layout` at the current :class:`VolumeOrigin`; its density maps
-and light-volume columns are computed once, its transmittance toward the sun and its diffusion field
-(:mod:`atmos.shading.diffusion`) again whenever the sun's direction or the medium changes (checked each frame, when the graph asks for ``"cloud_sets"``).
+and light-volume columns are computed once, its transmittance toward the sun and (while a renderer reads
+it: :mod:`~atmos.plugins.clouds.field_demand`) its diffusion field (:mod:`atmos.shading.diffusion`) again
+whenever the sun's direction, the medium or the demand changes (checked each frame, when the graph asks
+for ``"cloud_sets"``).
 """
 from __future__ import annotations
 
@@ -15,6 +17,7 @@ from atmos.plugins.clouds.density_maps import DensityMaps
 from atmos.plugins.clouds.sets import CloudSets
 from atmos.shading import grid
 from atmos.shading.columns import COLUMNS, ColumnShader, column_desc
+from atmos.plugins.clouds.field_demand import FieldDemand
 from atmos.shading.diffusion import DIFFUSION, DiffusionSolver, diffusion_desc, field_medium
 from atmos.shading.shear_warp import ShearWarpShader
 
@@ -22,15 +25,15 @@ from atmos.shading.shear_warp import ShearWarpShader
 class StaticClouds:
     """Answers ``sets()``, ``view()``, ``max_maps()``, ``layout()`` like a CloudSimulation."""
 
-    def __init__(self, gpu, density, settings, origin, sun):
+    def __init__(self, gpu, density, settings, origin, sun, demand: FieldDemand | None = None):
         volume = grid.check_density(density)
         self.shape = tuple(volume.shape)
-        self.settings, self.origin, self.sun = settings, origin, sun
+        self.gpu, self.settings, self.origin, self.sun = gpu, settings, origin, sun
+        self.demand = demand or FieldDemand()
         s = settings
         descs = {"density": TextureDesc(self.shape, 1, "f4"), COLUMNS: column_desc(self.shape, s.shading_scale)}
         if s.shading:
             descs["transmittance"] = TextureDesc(grid.shading_shape(self.shape, s.shading_scale), 1, "f2")
-            descs[DIFFUSION] = diffusion_desc(self.shape, s.shading_scale)
         self.set = TextureSet.create(gpu, descs, "static")
         self.shader = self.maps = self.diffusion = None
         try:
@@ -41,7 +44,6 @@ class StaticClouds:
             ColumnShader(gpu, self.shape, s.shading_scale).run(self.set["density"], self.set[COLUMNS])
             if s.shading:
                 self.shader = ShearWarpShader(gpu, self.shape, s.shading_scale)
-                self.diffusion = DiffusionSolver(gpu, self.shape, s.shading_scale)
         except Exception:
             self.release()
             raise
@@ -52,14 +54,21 @@ class StaticClouds:
             return
         sun = np.asarray(self.sun(), np.float64)
         s = self.settings
-        key = (tuple(sun), s.sigma_t, s.scattering, tuple(s.cell_size), s.albedo, s.phase_g, s.phase_g2, s.phase_w)
+        wanted = self.demand.wanted()
+        key = (tuple(sun), s.sigma_t, s.scattering, tuple(s.cell_size), s.albedo, s.phase_g, s.phase_g2, s.phase_w,
+               wanted)
         if key == self._shaded:
             return
         self.shader.begin(self.set["density"], sun / np.asarray(self.settings.cell_size, float),
                           self.settings.shading_sigma(sun), target=self.set["transmittance"])
         self.shader.run_all()
-        self.diffusion.solve(self.set["density"], self.set["transmittance"], self.set[DIFFUSION],
-                             *field_medium(s, sun))
+        if wanted:
+            if self.diffusion is None:
+                self.diffusion = DiffusionSolver(self.gpu, self.shape, s.shading_scale)
+            field = self.set.ensure(self.gpu, DIFFUSION, diffusion_desc(self.shape, s.shading_scale))
+            self.diffusion.solve(self.set["density"], self.set["transmittance"], field, *field_medium(s, sun))
+        else:
+            self.set.drop(DIFFUSION)
         self._shaded = key
 
     def sets(self) -> CloudSets:
