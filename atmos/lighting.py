@@ -29,7 +29,15 @@ _SUN_CHECKS = {
     "direction": lambda v: _read_only(check_sun_dir(v, "Sun.direction")),
     "color": lambda v: check_vec("Sun", "color", v, 3, "non-negative"),
     "ambient": lambda v: check_vec("Sun", "ambient", v, 3, "non-negative"),
+    "color_by_altitude": lambda v: _check_path(v),
 }
+
+
+def _check_path(value):
+    if value is not None and not callable(value):
+        raise ValueError("Sun.color_by_altitude must be None or a callable (direction, altitude_m) -> RGB, "
+                         f"got {value!r}")
+    return value
 
 
 @dataclass(slots=True)
@@ -37,10 +45,24 @@ class Sun:
     """``direction`` points from the scene toward the sun (kept at unit length, read-only: assign a
     new one); ``color`` is its radiance (zero at night); ``ambient`` is the sky's diffuse light (linear
     RGB, non-negative). Every assignment is checked (a ValueError names ``Sun.field``). DaylightPlugin
-    drives all three."""
+    drives all three. ``color`` is the sun seen from the camera; ``color_by_altitude`` (set by a sky
+    model that knows the air's path, the physical sky; None: ``color`` everywhere) gives it at another
+    altitude, through :meth:`color_at`: clouds 2 km up see a less reddened sun, and still see it after
+    the ground's sunset."""
     direction: np.ndarray = field(default_factory=lambda: np.array([0.3, 0.35, -0.88]))
     color: tuple = (1.0, 0.95, 0.85)
     ambient: tuple = (0.35, 0.47, 0.65)
+    color_by_altitude: object = None
+
+    def color_at(self, altitude: float) -> np.ndarray:
+        """(3,) the sun's colour at ``altitude`` m: ``color_by_altitude(direction, altitude)``, or ``color``
+        without one."""
+        if self.color_by_altitude is None:
+            return np.asarray(self.color, np.float64)
+        color = np.asarray(self.color_by_altitude(self.direction, float(altitude)), np.float64)
+        if color.shape != (3,) or not np.all(np.isfinite(color)) or color.min() < 0:
+            raise ValueError(f"Sun.color_by_altitude must return 3 non-negative finite numbers, got {color!r}")
+        return color
 
     def __setattr__(self, name: str, value) -> None:
         check = _SUN_CHECKS.get(name)

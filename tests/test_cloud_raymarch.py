@@ -60,8 +60,13 @@ def linear(app):
     return app.read_linear()[::-1].astype(np.float64)
 
 
-def test_the_march_matches_its_float64_reference(gpu, ctx):
-    app = scene(gpu, volume(), empty_space_skipping=False, min_transmittance=0.0, steps=96, step_growth=0.002)
+# a sky that gives the sun's colour by altitude: the clouds take it at their layer's middle (460 m here)
+BY_ALTITUDE = Sun(DAY.direction, DAY.color, color_by_altitude=lambda d, h: (h / 500.0, 0.6, 0.3))
+
+
+@pytest.mark.parametrize("sun", [DAY, BY_ALTITUDE], ids=["day", "by_altitude"])
+def test_the_march_matches_its_float64_reference(gpu, ctx, sun):
+    app = scene(gpu, volume(), sun, empty_space_skipping=False, min_transmittance=0.0, steps=96, step_growth=0.002)
     cam = aim(app, (80.0, 470.0, -150.0))
     image = linear(app)
     plugin = next(p for p in app.plugins if isinstance(p, CloudsPlugin))
@@ -70,7 +75,7 @@ def test_the_march_matches_its_float64_reference(gpu, ctx):
     tshape = sim.a["transmittance"].size
     trans = trans.reshape(tshape[2], tshape[1], tshape[0]).transpose(2, 1, 0)
     settings = next(p for p in app.plugins if isinstance(p, RaymarchCloudsPlugin)).settings
-    ref = march_reference(volume(), trans, sim.settings, settings, sim.layout(), cam, DAY, gpu.size,
+    ref = march_reference(volume(), trans, sim.settings, settings, sim.layout(), cam, sun, gpu.size,
                           field=read_field(sim.a[DIFFUSION]))
     assert settings.ms_diffusion > 0 and read_field(sim.a[DIFFUSION])[..., 0].max() > 0.1, "the field must be in it"
     assert ref["alpha"].max() > 0.9 and (ref["alpha"] > 0.01).mean() > 0.05, "the view must see the clouds"

@@ -330,6 +330,58 @@ def test_clouds_are_lit_by_the_physical_sun_colour():
     assert source[0] > 3 * source[2], "sunset clouds get the reddened sun"
 
 
+def test_clouds_above_keep_the_sun_after_the_grounds_sunset(gpu, ctx):
+    """The physical sky gives the sun's colour by altitude: at -0.8 deg the ground has lost the sun, a layer
+    1.5 km up has not (the horizon dips 1.2 deg there); by day the layer sees it through less air.
+    The clouds take it at their layer's middle; the Preetham model gives none, and switching back drops it."""
+    from atmos.plugins.cloud_render import CloudRenderPlugin
+    from atmos.plugins.cloud_render.light import light_uniforms
+    from atmos.plugins.clouds import CloudSettings, CloudsPlugin
+    s = AtmosphereSettings()
+    low = Sun(direction=sun_at(-0.8))
+    assert np.all(sun_light.sun_color(low.direction, 0.0, s) == 0.0)
+    high = sun_light.sun_color(low.direction, 1500.0, s)
+    assert high[0] > 0.05 and high[0] > 3 * high[2], high
+    day = sun_at(20.0)
+    assert np.all(sun_light.sun_color(day, 2000.0, s) > sun_light.sun_color(day, 0.0, s))
+
+    density = np.zeros((8, 4, 8), np.float32)
+    density[1:7, 1:3, 1:7] = 1.0
+    settings = CloudSettings(cell_size=(60.0, 50.0, 60.0), base_altitude=1500.0, group_size=(4, 4))
+    plugin = SkyPlugin(model="physical")
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), plugin, CloudsPlugin(settings, density=density),
+                               CloudRenderPlugin())
+    app.insert_resource(Sun(direction=sun_at(-0.8, 45.0)))
+    app.startup()
+    cam = app.resource(Camera)
+    cam.position = np.array([-300.0, 2.0, -300.0])
+    cam.look_at(np.array([240.0, 1600.0, 240.0]))
+    app.run_frames(1)
+    sun = app.resource(Sun)
+    assert np.all(np.asarray(sun.color) == 0.0) and sun.color_by_altitude is not None
+    lit = np.asarray(light_uniforms(settings, sun, altitude=1600.0)["sun_source"])
+    assert lit[0] > 0.1 and np.all(np.asarray(light_uniforms(settings, sun)["sun_source"]) == 0.0)
+    image = app.read_linear()
+    clouds = image[..., 3] > 0.5
+    assert clouds.mean() > 0.02, "the view must see the clouds"
+    red_lit = image[clouds, 0].mean()
+    plugin.configure(model="preetham")    # no colour by altitude: the clouds get the ground's (none), sky light only
+    app.run_frames(1)
+    assert app.resource(Sun).color_by_altitude is None
+    unlit = app.read_linear()[clouds, 0].mean()
+    assert red_lit > 1.5 * unlit, (red_lit, unlit)
+    app.close()
+
+
+def test_a_sun_colour_by_altitude_is_checked():
+    with pytest.raises(ValueError, match="Sun.color_by_altitude must be None or a callable"):
+        Sun(color_by_altitude=(1.0, 0.5, 0.2))
+    sun = Sun(color_by_altitude=lambda d, h: (1.0, float("nan"), 0.0))
+    with pytest.raises(ValueError, match="Sun.color_by_altitude must return 3 non-negative finite numbers"):
+        sun.color_at(100.0)
+    assert np.array_equal(Sun(color=(0.5, 0.4, 0.3)).color_at(5000.0), [0.5, 0.4, 0.3])
+
+
 # -- the Monte-Carlo check and the demos ------------------------------------------------------------------
 
 def test_the_path_tracer_first_order_is_the_single_scattering_model():

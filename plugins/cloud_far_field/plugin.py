@@ -46,7 +46,7 @@ class CloudFarFieldPass(FullscreenPass):
         layer.use(p, view, sim)
         frame.resource(DEPTH).use(9)
         set_camera_uniforms(p, view.camera, view.aspect)
-        values = dict(light_uniforms(sim.settings, view.sun),
+        values = dict(light_uniforms(sim.settings, view.sun, altitude=layout.middle_altitude),
                       footprint_min=tuple(layout.lo[[0, 2]]), footprint_size=tuple(layout.hi[[0, 2]] - layout.lo[[0, 2]]),
                       edge_fade=float(sim.settings.edge_fade),
                       lod_scale=float(params.size / layer.tile_size * 2.0 * np.tan(view.camera.fov_y / 2)

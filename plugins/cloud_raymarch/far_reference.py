@@ -77,7 +77,7 @@ def far_source(field: FarField, medium, settings, p, dirs, band, sun) -> np.ndar
     column = medium.sigma_t * medium.cell_size[1] * column_at_rank(c[:, 0], field.columns)
     above = sample_profile(field.profile, c[:, 0], np.clip(h, 0.0, 1.0))[..., 1]
     up, down = column * above, column * (1.0 - above)
-    sun_color, ambient = sun_light(sun)
+    sun_color, ambient = sun_light(sun, band[0] + 0.5 * band[1])
     return source_reference(medium, settings, T, up, down, dirs @ sun_dir, dirs[:, 1], sun_color, ambient, sun_dir)
 
 

@@ -48,7 +48,7 @@ def march_reference(density, transmittance, medium, settings, layout, camera, su
     if scene is not None:
         leave = np.minimum(leave, np.asarray(scene, np.float64).reshape(-1))
     step_base = settings.step * cell.min()
-    sun_color, ambient = sun_light(sun)
+    sun_color, ambient = sun_light(sun, layout.middle_altitude)
     sun_dir = unit_direction(sun)
     column_tau = medium.sigma_t * cell[1]
     g = mean_cosine(medium.phase_g, medium.phase_g2, medium.phase_w)

@@ -47,10 +47,15 @@ class CloudLightSettings(CheckedSettings):
         return self.ms_attenuation, self.ms_contribution, self.ms_eccentricity
 
 
-def sun_light(sun: Sun | None) -> tuple[tuple, tuple]:
-    """(sun colour, ambient) as float tuples; the sun colour fades to 0 across the horizon
-    (direction y from −0.01 to 0.01), so a sun below it leaves ambient light only."""
+def sun_light(sun: Sun | None, altitude: float | None = None) -> tuple[tuple, tuple]:
+    """(sun colour, ambient) as float tuples. With an ``altitude`` (m) and a sky that gives the sun's
+    colour by altitude (``Sun.color_by_altitude``), the colour there (the planet's shadow included: a
+    cloud layer keeps its sun after the ground's sunset); else ``Sun.color``, faded to 0 across the
+    horizon (direction y from −0.01 to 0.01), so a sun below it leaves ambient light only."""
     sun = sun or Sun()
+    if altitude is not None and sun.color_by_altitude is not None:
+        ambient = tuple(float(c) for c in getattr(sun, "ambient", DEFAULT_AMBIENT))
+        return tuple(float(c) for c in sun.color_at(altitude)), ambient
     direction = np.asarray(sun.direction, np.float64)
     norm = np.linalg.norm(direction)
     y = direction[1] / norm if norm > 0 and np.isfinite(norm) else -1.0
@@ -67,10 +72,12 @@ def unit_direction(sun: Sun | None) -> np.ndarray:
     return d / n if n > 0 and np.isfinite(n) else np.array([0.0, -1.0, 0.0])
 
 
-def light_uniforms(cloud_settings, sun: Sun | None, octaves=DEFAULT_OCTAVES, diffusion: float = 0.0) -> dict:
+def light_uniforms(cloud_settings, sun: Sun | None, octaves=DEFAULT_OCTAVES, diffusion: float = 0.0,
+                   altitude: float | None = None) -> dict:
     """The light uniforms of ``volume.glsl`` for a ``CloudSettings`` medium, the ``Sun``, the
-    multiple-scattering octaves (a, b, c) and the diffusion field's weight."""
-    color, ambient = sun_light(sun)
+    multiple-scattering octaves (a, b, c), the diffusion field's weight and the altitude (m) the
+    clouds take the sun's colour at (:func:`sun_light`; None: the camera's)."""
+    color, ambient = sun_light(sun, altitude)
     direction = unit_direction(sun)
     e, sky, ground = environment(cloud_settings, color, ambient, direction)
     s = cloud_settings

@@ -30,6 +30,11 @@ class CloudLayout:
         return np.array([self.origin_xz[0] * self.cell[0], self.base, self.origin_xz[1] * self.cell[2]])
 
     @property
+    def middle_altitude(self) -> float:
+        """World y of the layer's middle (where the cloud light takes the sun's colour: ``Sun.color_at``)."""
+        return float(self.base + 0.5 * self.shape[1] * self.cell[1])
+
+    @property
     def hi(self) -> np.ndarray:
         return self.lo + np.asarray(self.shape, float) * np.asarray(self.cell, float)
 

@@ -93,6 +93,7 @@ class SkyPlugin(Plugin):
 
     With ``model="physical"`` the system ``sky_light`` (after DaylightPlugin's ``daylight``) writes
     ``Sun.color`` and ``Sun.ambient`` from the same atmosphere (:mod:`atmos.plugins.sky.sun_light`),
+    and ``Sun.color_by_altitude`` (the sun's colour at any altitude: the clouds take it at theirs),
     and a FogPlugin's ``color_from="sky"`` takes its horizon from it
     (:func:`atmos.plugins.fog.sky_color.horizon_colors`)."""
 
@@ -117,6 +118,7 @@ class SkyPlugin(Plugin):
 
     def cleanup(self, app) -> None:
         self._release_luts()
+        self._drop_sun_path(app.get_resource(Sun))
 
     def _luts(self) -> AtmosphereLuts:
         """The imported "sky_luts" (resolved only in frames that draw the physical sky): made on the
@@ -132,11 +134,12 @@ class SkyPlugin(Plugin):
 
     def sun_light(self, app) -> None:
         """System: with the physical sky, the Sun's colour and ambient for its direction and the
-        camera's altitude (nothing with the Preetham model)."""
+        camera's altitude, and its colour by altitude (nothing with the Preetham model)."""
         s = self.settings
-        if s.model != "physical":
-            return
         sun = app.get_resource(Sun)
+        if s.model != "physical":
+            self._drop_sun_path(sun)
+            return
         if sun is None:
             sun = Sun()
             app.insert_resource(sun)
@@ -144,3 +147,12 @@ class SkyPlugin(Plugin):
         altitude = camera_altitude(camera) if camera is not None else 0.0
         sun.color = tuple(sun_light.sun_color(sun.direction, altitude, s.atmosphere))
         sun.ambient = tuple(sun_light.sky_ambient(sun.direction, altitude, s.atmosphere, s.night))
+        sun.color_by_altitude = self.sun_color_at
+
+    def sun_color_at(self, direction, altitude: float) -> np.ndarray:
+        """``Sun.color_by_altitude`` of the physical sky: the sun's colour at ``altitude`` m."""
+        return sun_light.sun_color(direction, altitude, self.settings.atmosphere)
+
+    def _drop_sun_path(self, sun: Sun | None) -> None:
+        if sun is not None and sun.color_by_altitude == self.sun_color_at:
+            sun.color_by_altitude = None

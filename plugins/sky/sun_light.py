@@ -5,7 +5,8 @@ stages, ordered after DaylightPlugin's ``daylight``/``daylight_start`` by label 
 writes, for the Sun's direction and the camera's altitude:
 
 - ``Sun.color`` = the sun's colour after its path through the atmosphere to the camera
-  (:func:`atmos.plugins.sky.atmosphere.sun_radiance`, one transmittance lookup a frame);
+  (:func:`atmos.plugins.sky.atmosphere.sun_radiance`, one transmittance lookup a frame), and
+  ``Sun.color_by_altitude`` the same at any altitude (the cloud layers take it at theirs);
 - ``Sun.ambient`` = the sky's irradiance on an upward surface / π from the same model
   (:func:`atmos.plugins.sky.atmosphere.ambient`), plus the sky's ``night`` term as the pass draws it.
 
@@ -65,8 +66,15 @@ def _clamped(i: int) -> int:
 
 
 def sun_color(sun_dir, altitude: float, settings: AtmosphereSettings) -> np.ndarray:
-    """(3,) ``Sun.color``: the sun's colour seen from ``altitude`` m."""
-    return ref.sun_radiance(sun_dir, altitude, settings)
+    """(3,) ``Sun.color``: the sun's colour seen from ``altitude`` m (remembered for the last few
+    directions and altitudes: the camera's and the cloud layers' are asked every frame)."""
+    return _sun_color(tuple(float(v) for v in np.asarray(sun_dir, np.float64).reshape(3)), float(altitude),
+                      settings).copy()
+
+
+@lru_cache(maxsize=16)
+def _sun_color(sun_dir: tuple, altitude: float, settings: AtmosphereSettings) -> np.ndarray:
+    return ref.sun_radiance(np.array(sun_dir), altitude, settings)
 
 
 def sky_ambient(sun_dir, altitude: float, settings: AtmosphereSettings, night=(0.0, 0.0, 0.0)) -> np.ndarray:
