@@ -82,9 +82,9 @@ def _clouds_option(command) -> None:
     command.add_argument("--clouds", choices=CLOUD_RENDERERS, default="sprites",
                          help="cloud renderer of the cloud scenes (sunset, flight, weather): point sprites "
                               "or the ray march (default sprites; key C flips it in a window)")
-    command.add_argument("--sky", choices=SKY_MODELS, default="preetham",
+    command.add_argument("--sky", choices=SKY_MODELS, default="physical",
                          help="sky model of the demos with a sky: the Preetham analytic sky or the physical "
-                              "atmosphere after Hillaire 2020, which also lights the sun and ambient (default preetham)")
+                              "atmosphere after Hillaire 2020, which also lights the sun and ambient (default physical)")
 
 
 def cmd_info(args) -> int:

@@ -19,7 +19,7 @@ class DemoSettings:
     frames: int | None = None     # None: until the window closes (headless: the demo's DEFAULT_FRAMES)
     headless: bool = False
     clouds: str = "sprites"       # the cloud scenes' renderer: point sprites or the ray march (key C flips it)
-    sky: str = "preetham"         # the sky's model in the demos with a sky (SkySettings.model)
+    sky: str = "physical"         # the sky's model in the demos with a sky (SkySettings.model)
 
     def __post_init__(self):
         check_choice("DemoSettings", "clouds", self.clouds, CLOUD_RENDERERS)

@@ -185,7 +185,7 @@ def run_window(name, settings: DemoSettings, title: str | None = None) -> None:
 
 def run(game, *, size: tuple[int, int] = (960, 540), title: str | None = None, headless: bool | None = None,
         frames: int | None = None, out: str | None = None, seed: int = 0, clouds: str = "sprites",
-        sky: str = "preetham", progress: bool = False) -> dict | None:
+        sky: str = "physical", progress: bool = False) -> dict | None:
     """Run a game: ``game`` is ``build(app, settings)`` (a function, a module that defines it, a path
     to a ``.py`` file, or a demo name). The App is made for you on a window's context (the window must
     exist before the GL context, so atmos makes both), or on a headless one when ``headless`` is True,

@@ -1,4 +1,4 @@
-"""sky_day: a day–night cycle of the sky (Preetham, or ``--sky physical``) over the ground plane, facing the sun."""
+"""sky_day: a day–night cycle of the sky (the physical sky, or ``--sky preetham``) over the ground plane, facing the sun."""
 import math
 
 import numpy as np
@@ -11,7 +11,7 @@ from atmos.plugins.daylight import DaylightPlugin
 from atmos.plugins.ground import GroundPlugin
 from atmos.plugins.sky import SkyPlugin
 
-TITLE = "Preetham analytic sky through a day–night cycle: sunset, twinkling stars, sunrise, noon"
+TITLE = "the sky through a day–night cycle: sunset, Earth's shadow, twinkling stars, sunrise, noon"
 DEFAULT_FRAMES = 360
 HOURS_PER_SECOND = 2.5       # in full daylight or deep night; 5x slower with the sun near the horizon
 
