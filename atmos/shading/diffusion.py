@@ -36,7 +36,7 @@ from atmos.shading.shear_warp import check_volume_texture, groups, program
 FLOOR = 1e-3               # 1/m: transport extinction floor (empty cells still conduct, finitely)
 TOLERANCE = 1e-4           # relative residual |b - A phi| / |b| the GPU solve stops at
 ITERATIONS = 300           # CG iterations per solve at most (the bench's grids converge in ~100, 32^3 in ~150)
-WARM_ITERATIONS = 150      # at most, started from the last step's field (sunset's 64x8x64 grid: 70-80; cold 90)
+WARM_ITERATIONS = 150      # at most, started from the last step's field (bench_cloud_field: sunset's 64x8x64 grid 75, cold 100)
 FIELD_CELLS = 32768        # the field's grid: the shading grid, halved per axis until it has at most this many cells
 DIFFUSION = "diffusion"    # the texture set's name for the field (rgba16f: phi, F)
 SIGMA_MAX = 1e3            # 1/m: extinction cap (shaders/shading/diffusion.comp has the same)
@@ -291,8 +291,8 @@ class DiffusionTask(SliceTask):
     writes ``set[DIFFUSION]``), ``iterations`` in all. Other steps run no slice and leave C without a
     field; the solver and a set's field texture are made on the first step that wants them.
     ``medium`` is a zero-argument callable giving (sigma_t, albedo, g, cell, sun_dir), read when a
-    step's field begins; the solve starts from the last solve's phi (warm: at most ``warm_iterations``;
-    converged iterations cost a GPU nothing, but a software rasterizer a dispatch each)."""
+    step's field begins; the solve starts from the last solve's phi (warm: at most ``warm_iterations``,
+    fewer dispatches once converged; ``benchmarks/bench_cloud_field.py``)."""
 
     def __init__(self, gpu: GpuContext, shape, scale: int, medium, wanted=lambda: True, slices: int = 8,
                  iterations: int = ITERATIONS, warm_iterations: int = WARM_ITERATIONS, density: str = "density",
