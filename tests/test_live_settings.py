@@ -188,6 +188,14 @@ def freeze_frame_times(app, plugin):
     plugin.times.record = lambda: None
 
 
+def physical_ground(**changes):
+    """The physical sky (and ``changes``), the camera turned down onto the ground: the aerial perspective's view."""
+    def hook(app, plugin):
+        plugin.configure(model="physical", **changes)
+        app.resource(Camera).pitch = -0.12
+    return hook
+
+
 def configure_first(**changes):
     def hook(app, plugin):
         plugin.configure(**changes)
@@ -260,13 +268,15 @@ SPECS = {
         look((0.0, 50.0, 130.0), target=(0.0, 0.0, 0.0)),
         dict(size=128.0, cells=12, relief=60.0)),
     "sky": Spec(
-        lambda: [DefaultPlugins(overlay=False), SkyPlugin(star_density=0.5)], SkyPlugin,
+        lambda: [DefaultPlugins(overlay=False), SkyPlugin(star_density=0.5), GroundPlugin()], SkyPlugin,
         look((0.0, 2.0, 0.0), yaw=math.radians(200.0), pitch=0.45),
         dict(turbidity=8.0, scale=0.08, sun_size_deg=4.0, sun_gain=200.0, sun_glare=0.5, night=(0.2, 0.1, 0.3), stars=False,
-             star_density=0.9, star_brightness=40.0, twinkle=1.0, model="physical", **PHYSICAL_CHANGES),
+             star_density=0.9, star_brightness=40.0, twinkle=1.0, model="physical", aerial_perspective=True,
+             aerial_steps=1, **PHYSICAL_CHANGES),
         before={"sun_gain": configure_first(sun_size_deg=4.0), "night": set_sun(NIGHT), "stars": set_sun(NIGHT), "star_density": set_sun(NIGHT),
                 "star_brightness": set_sun(NIGHT), "twinkle": set_sun(NIGHT),
-                **{name: configure_first(model="physical") for name in PHYSICAL_CHANGES}}),
+                **{name: configure_first(model="physical") for name in PHYSICAL_CHANGES},
+                "aerial_perspective": physical_ground(), "aerial_steps": physical_ground(aerial_perspective=True)}),
     "sky_layer": Spec(
         lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), SkyLayerPlugin(size=32)], SkyLayerPlugin,
         look((123.0, 3.0, -77.0), yaw=0.3, pitch=0.6),

@@ -179,6 +179,82 @@ def test_the_physical_sky_pass_matches_the_reference_in_every_pixel(gpu, ctx, rn
     gpu.resize((256, 144))
 
 
+def ground_frames(gpu, size, altitude, sun, yaw, pitch, **sky):
+    """read_linear (row 0 at the bottom) of a physical sky over the ground plane, aerial perspective off
+    and on, the view directions, and the app (open)."""
+    app = physical_app(gpu, GroundPlugin(half_size=5e5), sun=sun, altitude=altitude, stars=False, **sky)
+    cam = app.resource(Camera)
+    cam.yaw, cam.pitch, cam.near, cam.far = yaw, pitch, 1.0, 1e6
+    gpu.resize(size)
+    plugin = next(p for p in app.plugins if isinstance(p, SkyPlugin))
+    plain = app.read_linear()[::-1].astype(np.float64)
+    plugin.configure(aerial_perspective=True)
+    hazed = app.read_linear()[::-1].astype(np.float64)
+    x, y = np.meshgrid((np.arange(size[0]) + 0.5) / size[0] * 2 - 1, (np.arange(size[1]) + 0.5) / size[1] * 2 - 1)
+    rays = np.stack([x, y, np.ones_like(x)], -1) @ view_basis(cam, size[0] / size[1]).T
+    return plain, hazed, rays, app
+
+
+def test_aerial_perspective_matches_the_float64_march_over_the_ground(gpu, ctx, rng):
+    """C -> L + T C over the ground plane at its distance (the float64 march through the same atmosphere);
+    sky pixels untouched; distant ground turns toward the horizon sky; culled and allocating nothing off."""
+    size = (48, 32)
+    for altitude, elevation in ((rng.uniform(2, 50), rng.uniform(2, 20)), (rng.uniform(800, 6000), rng.uniform(-1, 50))):
+        sun = sun_at(elevation, rng.uniform(0, 360))
+        plain, hazed, rays, app = ground_frames(gpu, size, altitude, sun, math.atan2(sun[0], -sun[2]) + rng.uniform(-1, 1),
+                                                rng.uniform(-0.5, -0.05))
+        plugin = next(p for p in app.plugins if isinstance(p, SkyPlugin))
+        assert "aerial_perspective" in app.graph.compile().kept
+        dirs = rays / np.linalg.norm(rays, axis=-1, keepdims=True)
+        distance = altitude / np.maximum(-dirs[..., 1], 1e-6)
+        ground = (dirs[..., 1] < -0.01) & (distance < 4e5)          # the plane reaches 5e5 m
+        assert ground.mean() > 0.3 and (~ground).any()
+        tlut, mslut = ref.luts(plugin.settings.atmosphere)
+        light, trans = ref.aerial_perspective(plugin.settings.atmosphere, tlut, mslut, altitude, dirs, sun, distance,
+                                              plugin.settings.aerial_steps)
+        want = light + trans.mean(-1, keepdims=True) * plain[..., :3]
+        err = np.abs(hazed[..., :3] - want)
+        close = ground & (distance < 2e4)   # beyond, a 24-bit depth buffer's distance is off by up to ~1 %
+        assert close.mean() > 0.2
+        # the GPU's LUTs are within 2e-3 of the float64 ones; the colour target is float16
+        assert (err[close] <= 1e-2 * np.abs(want[close]) + 3e-4 * want[ground].max()).all(), err[close].max()
+        assert (err[ground] <= 5e-2 * np.abs(want[ground])).all(), (err[ground] / np.abs(want[ground])).max()
+        sky = dirs[..., 1] > 0.01
+        assert np.array_equal(hazed[sky], plain[sky]), "the sky already holds the whole ray"
+        far = ground & (distance > 20e3)
+        if far.any():      # far ground is mostly air light: closer to the sky just above the horizon than to the ground
+            assert (trans.mean(-1)[far] < 0.8).all()
+        app.close()
+    app = physical_app(gpu, GroundPlugin())
+    assert "aerial_perspective" not in app.graph.compile().kept
+    next(p for p in app.plugins if isinstance(p, SkyPlugin)).configure(model="preetham", aerial_perspective=True)
+    app.run_frames(1)
+    assert "aerial_perspective" not in app.graph.compile().kept, "the Preetham sky has no atmosphere to march"
+    app.close()
+    gpu.resize((256, 144))
+
+
+def test_aerial_perspective_hazes_clouds_by_their_own_distance_and_follows_fog(gpu, ctx):
+    """With clouds and fog: the pass reads the clouds' distance and runs after the fog; finite frames."""
+    from atmos.plugins.cloud_render import CloudRenderPlugin
+    from atmos.plugins.clouds import CloudSettings, CloudsPlugin
+    density = np.zeros((8, 4, 8), np.float32)
+    density[1:7, 1:3, 1:7] = 1.0
+    settings = CloudSettings(cell_size=(400.0, 100.0, 400.0), base_altitude=1500.0, group_size=(4, 4))
+    app = physical_app(gpu, GroundPlugin(), CloudsPlugin(settings, density=density), CloudRenderPlugin(),
+                       FogPlugin(density=1e-4), sun=sun_at(8.0, 20.0), aerial_perspective=True)
+    cam = app.resource(Camera)
+    cam.position = np.array([-2000.0, 300.0, -2000.0])
+    cam.look_at(np.array([1600.0, 1600.0, 1600.0]))
+    cam.far = 1e6
+    app.run_frames(1)
+    kept = app.graph.compile().kept
+    assert kept.index("aerial_perspective") > kept.index("fog") > kept.index("cloud_render")
+    image = app.read_linear()
+    assert np.isfinite(image).all() and image[..., 3].max() > 0.5
+    app.close()
+
+
 # -- the Sun's light from the same model ----------------------------------------------------------------
 
 def test_sun_colour_and_ambient_are_continuous_finite_and_the_reference():

@@ -213,22 +213,17 @@ def clamp_radius(m: dict, r):
     return np.clip(np.asarray(r, np.float64), m["rg"] + RADIUS_EPS, m["rt"] - RADIUS_EPS)
 
 
-def integrate(m: dict, tlut: np.ndarray, r, mu, mu_s, nu, steps: int, mslut: np.ndarray | None = None,
-              isotropic: bool = False):
-    """(radiance (..., 3), transfer f (..., 3)) along rays from radius ``r``: in-scattered sunlight
-    plus the sunlit ground where the ray ends on it (per unit sun irradiance when ``isotropic``,
-    the multiple-scattering LUT's pass: isotropic phase, no Ψ; else × the sun's illuminance with the
-    real phases and ``mslut``'s Ψ). ``f`` = ∫ σs T dt, the multiple-scattering LUT's transfer."""
-    r = clamp_radius(m, r)
-    mu, mu_s, nu = (np.broadcast_to(np.asarray(a, np.float64), r.shape) for a in (mu, mu_s, nu))
-    ground = hits_ground(m["rg"], r, mu)
-    t_max = np.where(ground, distance_to_ground(m["rg"], r, mu), distance_to_top(m["rt"], r, mu))
+def march(m: dict, tlut: np.ndarray, r, mu, mu_s, nu, t_max, steps: int, mslut: np.ndarray | None = None,
+          isotropic: bool = False):
+    """(radiance (..., 3) per unit sun, transfer (..., 3), throughput (..., 3)) over the first ``t_max``
+    metres of rays from radius ``r``: in-scattered sunlight (``isotropic``: the multiple-scattering
+    LUT's pass, isotropic phase, no Ψ; else the real phases and ``mslut``'s Ψ), ``f`` = ∫ σs T dt and the
+    rays' transmittance. ``shaders/sky/atmosphere.glsl`` atm_march is the same."""
+    mu, mu_s, nu, t_max = (np.broadcast_to(np.asarray(a, np.float64), r.shape) for a in (mu, mu_s, nu, t_max))
     if isotropic:
         phase_r = phase_m = np.full(r.shape, 1.0 / (4.0 * math.pi))
-        sun = np.ones(3)
     else:
         phase_r, phase_m = rayleigh_phase(nu), hg_phase(m["g"], nu)
-        sun = m["sun"]
     radiance = np.zeros(r.shape + (3,))
     transfer = np.zeros(r.shape + (3,))
     throughput = np.ones(r.shape + (3,))
@@ -242,16 +237,46 @@ def integrate(m: dict, tlut: np.ndarray, r, mu, mu_s, nu, steps: int, mslut: np.
         spread = np.where(ext > 0, (1.0 - seg) / np.where(ext > 0, ext, 1.0), dt)   # ∫ e^(−σt s) ds over dt
         lit = transmittance_to_sun(m, tlut, ri, mus_i)
         source = lit * (s_ray * phase_r[..., None] + s_mie * phase_m[..., None])
-        if mslut is not None and m["ms"] > 0:
+        if not isotropic and mslut is not None and m["ms"] > 0:
             u, v = ms_uv(m, ri, mus_i, mslut.shape[0])
             source = source + m["ms"] * bilinear(mslut, u, v) * (s_ray + s_mie)
         radiance += throughput * source * spread
         transfer += throughput * (s_ray + s_mie) * spread
         throughput = throughput * seg
+    return radiance, transfer, throughput
+
+
+def integrate(m: dict, tlut: np.ndarray, r, mu, mu_s, nu, steps: int, mslut: np.ndarray | None = None,
+              isotropic: bool = False):
+    """(radiance (..., 3), transfer f (..., 3)) along rays from radius ``r`` to the top or the ground:
+    :func:`march` plus the sunlit ground where the ray ends on it (per unit sun irradiance when
+    ``isotropic``, the multiple-scattering LUT's pass; else × the sun's illuminance). ``f`` = ∫ σs T dt,
+    the multiple-scattering LUT's transfer."""
+    r = clamp_radius(m, r)
+    mu, mu_s, nu = (np.broadcast_to(np.asarray(a, np.float64), r.shape) for a in (mu, mu_s, nu))
+    ground = hits_ground(m["rg"], r, mu)
+    t_max = np.where(ground, distance_to_ground(m["rg"], r, mu), distance_to_top(m["rt"], r, mu))
+    radiance, transfer, throughput = march(m, tlut, r, mu, mu_s, nu, t_max, steps, mslut, isotropic)
     mu_g = np.clip((r * mu_s + t_max * nu) / m["rg"], -1.0, 1.0)
     lit = transmittance_to_sun(m, tlut, np.full(r.shape, m["rg"] + RADIUS_EPS), mu_g) * np.maximum(mu_g, 0.0)[..., None]
     radiance += np.where(ground[..., None], throughput * lit * m["albedo"] / math.pi, 0.0)
-    return radiance * sun, transfer
+    return radiance * (1.0 if isotropic else m["sun"]), transfer
+
+
+def aerial_perspective(settings: AtmosphereSettings, tlut, mslut, altitude: float, view_dirs, sun_dir, distance,
+                       steps: int) -> tuple[np.ndarray, np.ndarray]:
+    """(in-scattered radiance (..., 3), transmittance (..., 3)) over the first ``distance`` m (...,) of
+    unit ``view_dirs`` (..., 3) from ``altitude``, capped at the atmosphere's end: what a surface that far
+    away gets in front of it (``shaders/sky/atmosphere.glsl`` atm_aerial)."""
+    m = medium(settings)
+    d = np.asarray(view_dirs, np.float64)
+    s = unit(sun_dir)
+    r = clamp_radius(m, np.full(d.shape[:-1], camera_radius(m, altitude)))
+    mu, nu = d[..., 1], d @ s
+    end = np.where(hits_ground(m["rg"], r, mu), distance_to_ground(m["rg"], r, mu), distance_to_top(m["rt"], r, mu))
+    radiance, _, throughput = march(m, tlut, r, mu, np.full(r.shape, s[1]), nu,
+                                    np.minimum(np.asarray(distance, np.float64), end), steps, mslut)
+    return radiance * m["sun"], throughput
 
 
 # --- multiple scattering -----------------------------------------------------------------------------

@@ -23,6 +23,9 @@ SUN_TOLERANCE = 5e-4          # the sky view is remade when the sun's height (y)
 ALTITUDE_TOLERANCE = (1.0, 0.01)   # ... or the camera's altitude by more than max(1 m, 1 %)
 
 
+SKY_LUTS = "sky_luts"       # the imported AtmosphereLuts of the physical sky (a graph resource)
+
+
 @lru_cache(maxsize=1)
 def atmosphere_defines() -> dict:
     """The reference's sizes and step counts as defines (one source of truth)."""

@@ -10,12 +10,13 @@ from atmos.lighting import Sun
 from atmos.plugin import Plugin
 from atmos.plugins.sky import sun_light
 from atmos.plugins.sky.atmosphere import camera_radius, medium
-from atmos.plugins.sky.luts import SKY_VIEW_UNIT, AtmosphereLuts, atmosphere_defines, set_atmosphere_uniforms
+from atmos.composition import composition
+from atmos.plugins.sky.aerial import AERIAL, AerialPerspectivePass, active
+from atmos.plugins.sky.luts import SKY_LUTS, SKY_VIEW_UNIT, AtmosphereLuts, atmosphere_defines, set_atmosphere_uniforms
 from atmos.plugins.sky.settings import SkySettings
 from atmos.plugins.sky.shader import set_sky_uniforms, sky_defines
 from atmos.render_core import DEPTH, where_nothing_was_drawn
 
-SKY_LUTS = "sky_luts"       # the imported AtmosphereLuts of the physical sky
 
 
 def camera_altitude(camera) -> float:
@@ -102,13 +103,31 @@ class SkyPlugin(Plugin):
     def __init__(self, settings: SkySettings | None = None, **fields):
         super().__init__(settings, **fields)
         self.luts: AtmosphereLuts | None = None
-        self.gpu = None
+        self.gpu = self.graph = self.composition = None
 
     def build(self, app) -> None:
         self.gpu = app.gpu
+        self.graph = app.graph
+        self.composition = composition(app)
         app.graph.add_pass(SkyLutsPass(self))
         app.graph.add_pass(SkyPass(self))
+        app.graph.add_pass(AerialPerspectivePass(self))
         app.graph.import_resource(SKY_LUTS, self._luts)
+        self._read_distance()
+
+    def configure(self, **changes) -> SkySettings:
+        settings = super().configure(**changes)
+        self._read_distance()
+        return settings
+
+    def _read_distance(self) -> None:
+        """The aerial perspective reads the clouds' own distance (atmos.composition) while it is on."""
+        if self.composition is None:
+            return
+        if active(self.settings):
+            self.composition.readers.add(AERIAL)
+        else:
+            self.composition.readers.discard(AERIAL)
 
     def finish(self, app) -> None:
         labels = {s.label for s in app.schedule.systems}
@@ -118,6 +137,8 @@ class SkyPlugin(Plugin):
 
     def cleanup(self, app) -> None:
         self._release_luts()
+        if self.composition is not None:
+            self.composition.readers.discard(AERIAL)
         self._drop_sun_path(app.get_resource(Sun))
 
     def _luts(self) -> AtmosphereLuts:

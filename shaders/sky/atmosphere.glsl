@@ -70,16 +70,16 @@ vec2 atm_ms_uv(float r, float mu_s) {
 float atm_rayleigh_phase(float nu) { return 3.0 / (16.0 * ATM_PI) * (1.0 + nu * nu); }
 float atm_hg_phase(float g, float nu) { return (1.0 - g * g) / (4.0 * ATM_PI * pow(1.0 + g * g - 2.0 * g * nu, 1.5)); }
 
-// Radiance along the ray from radius r (zenith cosine mu; sun at mu_s, nu = cos view·sun), `steps`
-// quadratically spaced segments; `isotropic`: the multiple-scattering LUT's pass (unit sun, isotropic
-// phase, no Ψ). `transfer`: ∫ σs T dt.
-vec3 atm_integrate(float r, float mu, float mu_s, float nu, int steps, bool isotropic, out vec3 transfer) {
-    r = atm_clamp_radius(r);
-    bool ground = atm_hits_ground(r, mu);
-    float t_max = ground ? atm_distance_to_ground(r, mu) : atm_distance_to_top(r, mu);
+// In-scattered radiance (per unit sun: times atm_sun for the real sun) along the first t_max metres of
+// the ray from radius r (zenith cosine mu; sun at mu_s, nu = cos view·sun), `steps` quadratically spaced
+// segments; `isotropic`: the multiple-scattering LUT's pass (isotropic phase, no Ψ). `transfer`:
+// ∫ σs T dt; `throughput`: the ray's transmittance over t_max.
+vec3 atm_march(float r, float mu, float mu_s, float nu, float t_max, int steps, bool isotropic,
+               out vec3 transfer, out vec3 throughput) {
     float pr = isotropic ? 0.25 / ATM_PI : atm_rayleigh_phase(nu);
     float pm = isotropic ? 0.25 / ATM_PI : atm_hg_phase(atm_g, nu);
-    vec3 radiance = vec3(0.0), throughput = vec3(1.0);
+    vec3 radiance = vec3(0.0);
+    throughput = vec3(1.0);
     transfer = vec3(0.0);
     for (int i = 0; i < steps; i++) {
         float a = float(i) / float(steps), b = float(i + 1) / float(steps);
@@ -99,11 +99,32 @@ vec3 atm_integrate(float r, float mu, float mu_s, float nu, int steps, bool isot
         transfer += throughput * (s_ray + s_mie) * spread;
         throughput *= seg;
     }
+    return radiance;
+}
+
+// Radiance along the whole ray from radius r to the top of the atmosphere or the ground (whose sunlit
+// albedo it adds): atm_march to the end; `transfer` as there.
+vec3 atm_integrate(float r, float mu, float mu_s, float nu, int steps, bool isotropic, out vec3 transfer) {
+    r = atm_clamp_radius(r);
+    bool ground = atm_hits_ground(r, mu);
+    float t_max = ground ? atm_distance_to_ground(r, mu) : atm_distance_to_top(r, mu);
+    vec3 throughput;
+    vec3 radiance = atm_march(r, mu, mu_s, nu, t_max, steps, isotropic, transfer, throughput);
     if (ground) {
         float mu_g = clamp((r * mu_s + t_max * nu) / atm_rg, -1.0, 1.0);
         radiance += throughput * atm_transmittance_to_sun(atm_rg + ATM_RADIUS_EPS, mu_g) * max(mu_g, 0.0) * atm_albedo / ATM_PI;
     }
     return radiance * (isotropic ? vec3(1.0) : atm_sun);
+}
+
+// Aerial perspective: the sunlight scattered toward the camera over the first `distance` metres of the
+// ray (capped at the atmosphere's end), and the ray's transmittance over them (Hillaire 2020 sec. 5.5,
+// marched per pixel instead of a froxel volume).
+vec3 atm_aerial(float r, float mu, float mu_s, float nu, float distance, int steps, out vec3 transmittance) {
+    r = atm_clamp_radius(r);
+    float end = atm_hits_ground(r, mu) ? atm_distance_to_ground(r, mu) : atm_distance_to_top(r, mu);
+    vec3 transfer;
+    return atm_march(r, mu, mu_s, nu, min(distance, end), steps, false, transfer, transmittance) * atm_sun;
 }
 
 // Sky-view LUT: (u, v) <-> (view mu, cos azimuth from the sun) seen from radius r.
