@@ -285,15 +285,19 @@ def test_sun_colour_and_ambient_are_continuous_finite_and_the_reference():
 
 def test_frames_stay_finite_at_the_extremes(gpu, ctx):
     gpu.resize((32, 24))
-    for altitude in (0.0, 20000.0):
+    for altitude in (0.0, 20000.0, 2e5):                   # 200 km: above the atmosphere
         for elevation in (-90.0, 0.0, 90.0):
-            app = physical_app(gpu, GroundPlugin(), sun=sun_at(elevation, 30.0), altitude=altitude)
-            app.resource(Camera).pitch = 0.1
-            app.run_frames(1, 1 / 30)
-            img = app.read_linear()
-            sun = app.resource(Sun)
-            assert np.isfinite(img).all() and np.isfinite(sun.color).all() and np.isfinite(sun.ambient).all()
-            app.close()
+            for pitch in (0.1, -1.5):                           # the aerial perspective over the ground straight down
+                app = physical_app(gpu, GroundPlugin(half_size=1e6), sun=sun_at(elevation, 30.0), altitude=altitude,
+                                   aerial_perspective=pitch < 0)
+                cam = app.resource(Camera)
+                cam.pitch, cam.far = pitch, 1e7
+                app.run_frames(1, 1 / 30)
+                img = app.read_linear()
+                sun = app.resource(Sun)
+                assert np.isfinite(img).all() and np.isfinite(sun.color).all() and np.isfinite(sun.ambient).all()
+                assert np.isfinite(sun.color_at(altitude + 1000.0)).all()
+                app.close()
     gpu.resize((256, 144))
 
 
