@@ -67,3 +67,47 @@ def test_cloud_shadows_show_as_darker_rays_in_the_fog(fog_gpu):
     assert sides > 0.02 and sides > 3.0 * centre, f"shadowed air darker ({sides:.3f}) than the lit gap ({centre:.3f})"
     inscatter = (alone - attenuated).mean(-1)          # (1 − f) C_fog: never more is taken away
     assert (dark <= inscatter + 4e-3).all()
+
+
+def aerial_frame(gpu, density, shafts: bool, aerial: bool = True) -> np.ndarray:
+    """The gap view under the physical sky, its aerial perspective on (or off), with or without shafts."""
+    from atmos.plugins.sky import SkyPlugin
+    extra = [LightShaftsPlugin(steps=48, max_distance=3000.0)] if shafts else []
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), SkyPlugin(model="physical", stars=False,
+                                                                         aerial_perspective=aerial), GroundPlugin(),
+                               CloudsPlugin(CloudSettings(cell_size=CELL, base_altitude=BASE, shading=False,
+                                                          sigma_t=0.05), density=density), *extra)
+    app.insert_resource(Sun(np.array([0.0, 1.0, 0.25])))
+    app.startup()
+    cam = app.resource(Camera)
+    cam.position = np.array([320.0, 60.0, 20.0])
+    cam.yaw, cam.pitch, cam.far = math.pi, 0.25, 5000.0
+    try:
+        app.run_frames(1)
+        kept = app.graph.compile().kept
+        assert ("aerial_perspective" in kept) == aerial and ("light_shafts" in kept) == shafts
+        return app.read_linear()[..., :3].astype(np.float64)
+    finally:
+        app.close()
+
+
+def test_with_the_skys_aerial_perspective_shafts_only_take_its_light_away_in_cloud_shadow(fog_gpu):
+    """SHAFT_AERIAL: no fog, the physical sky's aerial perspective owns the air's light; the shafts add
+    none of their own (nothing changes without clouds) and take away only what the clouds shadow,
+    never more than the aerial perspective put in."""
+    empty = np.zeros((32, 4, 32), np.float32)
+    alone, both = aerial_frame(fog_gpu, empty, False), aerial_frame(fog_gpu, empty, True)
+    assert np.abs(both - alone).max() < 2e-3 * max(alone.max(), 1.0), "the air's in-scatter is not counted twice"
+    volume = columns_volume()
+    alone, both = aerial_frame(fog_gpu, volume, False), aerial_frame(fog_gpu, volume, True)
+    plain = aerial_frame(fog_gpu, volume, False, aerial=False)
+    dark = (alone - both).mean(-1)
+    lost = dark.mean(axis=0)
+    w = lost.size
+    centre = lost[int(0.45 * w):int(0.55 * w)].mean()
+    sides = np.concatenate([lost[int(0.02 * w):int(0.2 * w)], lost[int(0.8 * w):int(0.98 * w)]]).mean()
+    assert np.isfinite(both).all() and dark.min() > -2e-3, "the shafts only take light away"
+    assert sides > 3.0 * centre and sides > 2e-3, (sides, centre)
+    put_in = (alone - plain).mean(-1)               # the aerial perspective's light on the scene (the sky holds
+    scene = put_in > 1e-4                           # its own: there the shafts take from the sky view's air)
+    assert scene.mean() > 0.2 and (dark[scene] <= put_in[scene] + 2e-3).all(), "never more than it put in"

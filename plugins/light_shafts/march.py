@@ -38,11 +38,15 @@ class MarchedShafts:
         self.gpu = gpu
         self.offscreen = OffscreenClouds(gpu, SHAFT_COLOR, SHAFT_DEPTH)
 
-    def program(self, far_field: bool, fog=None):
+    def program(self, far_field: bool, fog=None, aerial=None):
         """The march, with the far field's shadows beyond the volume (column.glsl's CLOUD_FAR_FIELD) or
         without; ``fog`` (FogSettings): the variant that shadows the fog's in-scatter (SHAFT_FOG; its
-        turbulence evaluated procedurally, the fog's noise volumes are not bound here)."""
+        turbulence evaluated procedurally, the fog's noise volumes are not bound here); ``aerial``
+        (the SkyPlugin): the variant that shadows the sky's aerial perspective (SHAFT_AERIAL)."""
         defines = {"CLOUD_FAR_FIELD": 1} if far_field else {}
+        if aerial is not None:
+            from atmos.plugins.sky.luts import atmosphere_defines
+            defines.update(SHAFT_AERIAL=1, **atmosphere_defines())
         if fog is not None:
             from atmos.plugins.fog.settings import MODES
             from atmos.plugins.fog.sky_color import SAMPLES
@@ -52,9 +56,12 @@ class MarchedShafts:
                                 fragment_shader="light_shafts/march.frag")
 
     @staticmethod
-    def declare(builder: PassBuilder, size, factor: int, clouds: bool, far_field: bool = False, fog=None) -> None:
+    def declare(builder: PassBuilder, size, factor: int, clouds: bool, far_field: bool = False, fog=None,
+                aerial=None) -> None:
         """``far_field``: the graph imports a CloudFarFieldPlugin's layer; the rays see its shadows too.
-        ``fog``: the App's FogPlugin; its clouds' own distance is read when the fog reads one."""
+        ``fog``: the App's FogPlugin; its clouds' own distance is read when the fog reads one.
+        ``aerial``: the SkyPlugin whose aerial perspective the march shadows (its LUTs are read, and the
+        clouds' own distance when its pass reads one)."""
         OffscreenClouds.declare(builder, size, factor, color=SHAFT_COLOR, depth=SHAFT_DEPTH)
         builder.read(DEPTH)
         builder.read(COLOR)
@@ -65,8 +72,13 @@ class MarchedShafts:
                 builder.read(FAR_FIELD)
         if fog is not None and fog.composition is not None and fog.composition.distance:
             builder.read(CLOUD_DISTANCE)
+        if aerial is not None:
+            from atmos.plugins.sky.luts import SKY_LUTS
+            builder.read(SKY_LUTS)
+            if aerial.composition.distance:
+                builder.read(CLOUD_DISTANCE)
 
-    def execute(self, frame: PassContext, settings, clouds: bool, fog=None) -> None:
+    def execute(self, frame: PassContext, settings, clouds: bool, fog=None, aerial=None) -> None:
         view = frame.view
         irradiance = march_irradiance(view.sun, settings)
         if irradiance is None:
@@ -76,7 +88,7 @@ class MarchedShafts:
         frame.reset_state()
         frame.framebuffer(color=[SHAFT_COLOR]).use()
         far_field = clouds and frame.declares(FAR_FIELD)
-        p = self.program(far_field, fog.settings if fog is not None else None)
+        p = self.program(far_field, fog.settings if fog is not None else None, aerial)
         frame.resource(SHAFT_DEPTH).use(2)
         if clouds:
             sim: CloudSets = frame.resource(CLOUD_SETS)
@@ -96,6 +108,8 @@ class MarchedShafts:
                       frame_size=tuple(float(v) for v in view.size))
         if fog is not None:
             self.fog_uniforms(frame, p, fog, settings)
+        if aerial is not None:
+            self.aerial_uniforms(frame, p, aerial)
         for name, value in values.items():
             if name in p:
                 p[name].value = value
@@ -108,8 +122,22 @@ class MarchedShafts:
         from atmos.plugins.fog.post import set_fog_uniforms
         view, fs = frame.view, fog.settings
         set_fog_uniforms(program, fs, view.time + fs.time_offset, fog.horizon(view))
-        clouds = frame.declares(CLOUD_DISTANCE)
-        if clouds:
-            frame.resource(CLOUD_DISTANCE).use(3)
-        program["fog_clouds"].value = int(clouds)
+        bind_cloud_distance(frame, program)
         program["fog_sun_share"].value = settings.fog_sun_share
+
+    @staticmethod
+    def aerial_uniforms(frame: PassContext, program, sky) -> None:
+        """The sky's atmosphere (its LUTs bound, the camera's radius) and the clouds' distance (unit 3)."""
+        from atmos.plugins.sky.luts import SKY_LUTS, set_atmosphere_uniforms, view_radius
+        frame.resource(SKY_LUTS).use()
+        set_atmosphere_uniforms(program, sky.settings.atmosphere)
+        program["view_r"].value = view_radius(sky.settings.atmosphere, frame.view.camera)
+        bind_cloud_distance(frame, program)
+
+
+def bind_cloud_distance(frame: PassContext, program) -> None:
+    """The clouds' own distance at unit 3 when the pass declared it (``has_cloud_distance``)."""
+    clouds = frame.declares(CLOUD_DISTANCE)
+    if clouds:
+        frame.resource(CLOUD_DISTANCE).use(3)
+    program["has_cloud_distance"].value = int(clouds)

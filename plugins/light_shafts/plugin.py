@@ -53,7 +53,7 @@ class LightShaftsPass(RenderPass):
         d = self.plugin.settings.downsample
         if self.plugin.settings.mode == "march":
             MarchedShafts.declare(builder, (w, h), d, self.clouds(), self.plugin.graph.imports(FAR_FIELD),
-                                  self.plugin.fog)
+                                  self.plugin.fog, self.plugin.aerial())
             return
         desc = TextureDesc((math.ceil(w / d), math.ceil(h / d)), components=4, dtype="f2")
         builder.create(MASK, desc)
@@ -72,7 +72,7 @@ class LightShaftsPass(RenderPass):
     def execute(self, frame: PassContext) -> None:
         view, gpu, params = frame.view, frame.gpu, self.plugin.settings
         if params.mode == "march":
-            self.marched.execute(frame, params, frame.declares(CLOUD_SETS), self.plugin.fog)
+            self.marched.execute(frame, params, frame.declares(CLOUD_SETS), self.plugin.fog, self.plugin.aerial())
             return
         w, h = view.size
         where = screen_sun(view.camera, view.aspect, view.sun.direction, params)
@@ -116,6 +116,7 @@ class LightShaftsPlugin(Plugin):
         super().__init__(settings, **fields)
         self.gpu = self.graph = None
         self.fog = None                 # the App's FogPlugin (finish), whose in-scatter the march shadows
+        self.sky = None                 # the App's SkyPlugin (finish): its aerial perspective, when on
 
     def build(self, app) -> None:
         if app.graph is None:
@@ -125,4 +126,12 @@ class LightShaftsPlugin(Plugin):
 
     def finish(self, app) -> None:
         from atmos.plugins.fog import FogPlugin
+        from atmos.plugins.sky import SkyPlugin
         self.fog = next((p for p in app.plugins if isinstance(p, FogPlugin)), None)
+        self.sky = next((p for p in app.plugins if isinstance(p, SkyPlugin)), None)
+
+    def aerial(self):
+        """The SkyPlugin when its aerial perspective owns the air's light and no fog does (the march then
+        takes away that in-scatter in cloud shadow); else None."""
+        from atmos.plugins.sky.aerial import active
+        return self.sky if self.fog is None and self.sky is not None and active(self.sky.settings) else None

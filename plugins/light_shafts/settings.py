@@ -31,7 +31,10 @@ class LightShaftSettings(CheckedSettings):
     air's in-scattering (its colour already holds it): the shafts then add no light and no extinction
     of their own but take away the share ``fog_sun_share`` (the part of the fog's colour that is
     sunlight; the rest is sky light, which cloud shadow leaves) of the fog's in-scatter along each ray
-    where the clouds shadow the air, so the haze is counted once (``shaders/light_shafts/march.frag``). ``horizon_fade`` fades it with the sun's
+    where the clouds shadow the air, so the haze is counted once (``shaders/light_shafts/march.frag``).
+    Without a fog but with the physical sky's aerial perspective (``SkySettings.aerial_perspective``)
+    the atmosphere owns it: the shafts take away its single-scattered sunlight where the clouds shadow
+    the air (the same atmosphere and LUTs; ``phase_*`` and ``scattering`` are then unused). ``horizon_fade`` fades it with the sun's
     height; ``samples`` … ``ceiling``, ``radius``, ``front_fade``, ``edge_fade`` are the screen mode's.
 
     Screen:

@@ -15,8 +15,7 @@ from atmos.composition import CLOUD_DISTANCE
 from atmos.graph import FullscreenPass, PassContext
 from atmos.camera import set_camera_uniforms
 from atmos.lighting import unit_sun
-from atmos.plugins.sky.atmosphere import camera_radius, medium
-from atmos.plugins.sky.luts import SKY_LUTS, atmosphere_defines, set_atmosphere_uniforms
+from atmos.plugins.sky.luts import SKY_LUTS, atmosphere_defines, set_atmosphere_uniforms, view_radius
 
 COLOR, DEPTH = "color", "depth"
 AERIAL = "aerial_perspective"
@@ -68,5 +67,5 @@ class AerialPerspectivePass(FullscreenPass):
         set_atmosphere_uniforms(p, settings.atmosphere)
         sun = unit_sun(view.sun.direction)
         p["sun_dir"].value = tuple(float(v) for v in sun)
-        p["view_r"].value = camera_radius(medium(settings.atmosphere), max(float(view.camera.position[1]), 0.0))
+        p["view_r"].value = view_radius(settings.atmosphere, view.camera)
         frame.fullscreen(p)

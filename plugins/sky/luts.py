@@ -26,6 +26,11 @@ ALTITUDE_TOLERANCE = (1.0, 0.01)   # ... or the camera's altitude by more than m
 SKY_LUTS = "sky_luts"       # the imported AtmosphereLuts of the physical sky (a graph resource)
 
 
+def view_radius(settings: AtmosphereSettings, camera) -> float:
+    """The camera's radius from the planet's centre (its height above y = 0, at least 0; ``view_r``)."""
+    return ref.camera_radius(ref.medium(settings), max(float(np.asarray(camera.position, np.float64)[1]), 0.0))
+
+
 @lru_cache(maxsize=1)
 def atmosphere_defines() -> dict:
     """The reference's sizes and step counts as defines (one source of truth)."""

@@ -9,10 +9,10 @@ from atmos.graph import FullscreenPass, PassContext, RenderPass
 from atmos.lighting import Sun
 from atmos.plugin import Plugin
 from atmos.plugins.sky import sun_light
-from atmos.plugins.sky.atmosphere import camera_radius, medium
 from atmos.composition import composition
 from atmos.plugins.sky.aerial import AERIAL, AerialPerspectivePass, active
-from atmos.plugins.sky.luts import SKY_LUTS, SKY_VIEW_UNIT, AtmosphereLuts, atmosphere_defines, set_atmosphere_uniforms
+from atmos.plugins.sky.luts import (SKY_LUTS, SKY_VIEW_UNIT, AtmosphereLuts, atmosphere_defines, set_atmosphere_uniforms,
+                                    view_radius)
 from atmos.plugins.sky.settings import SkySettings
 from atmos.plugins.sky.shader import set_sky_uniforms, sky_defines
 from atmos.render_core import DEPTH, where_nothing_was_drawn
@@ -83,7 +83,7 @@ class SkyPass(FullscreenPass):
             frame.resource(SKY_LUTS).use()
             set_atmosphere_uniforms(p, settings.atmosphere)
             p["sky_view"].value = SKY_VIEW_UNIT
-            p["view_r"].value = camera_radius(medium(settings.atmosphere), camera_altitude(camera))
+            p["view_r"].value = view_radius(settings.atmosphere, camera)
         frame.fullscreen(p)
 
 

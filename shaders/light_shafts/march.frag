@@ -13,7 +13,12 @@
 // f = fog/factor.glsl (at the fog's end point: the sum of [f(s_i) - f(s_i+1)] telescopes to the fog's own
 // 1 - f), V = exp(-tau_sun) the sun's visibility through the clouds, w the share of the fog in front of
 // s_i (a cloud in front, "cloud_distance": a before it, 1 - a behind; sky="keep" sky: none). It never
-// exceeds the fog's in-scatter. plugins/light_shafts/reference.py fog_shadow is the same in numpy.
+// exceeds the fog's in-scatter (tests/test_light_shafts_fog.py).
+// SHAFT_AERIAL 1 (no fog; the sky's aerial perspective owns the air's light, sky/aerial.frag): the same,
+// for the atmosphere's single-scattered sunlight, lost where the clouds shadow the air,
+//   L = -sum_i w(s_i) T(s_i) E_sun(p_i) [s_ray(p_i) p_R(cos) + s_mie(p_i) p_M(cos)] (1 - V(s_i)) ds,  T = 1,
+// T(s) ~ exp(-ext(p) s) the air's transmittance from the eye, E_sun = atm_sun × its transmittance to the
+// sun (sky/atmosphere.glsl); w as above with the scene's distance (the clouds hazed at their own).
 #include "lib/view_ray.glsl"
 #include "lib/hash.glsl"
 #include "lib/phase.glsl"
@@ -33,13 +38,19 @@ uniform int has_clouds;
 uniform int factor;
 uniform vec2 frame_size;
 out vec4 frag;
+#if SHAFT_FOG || SHAFT_AERIAL
+uniform int has_cloud_distance;   // 1: cloud_distance is bound (unit 3)
+layout(binding = 3) uniform sampler2D cloud_distance;
+#endif
 #if SHAFT_FOG
 #include "fog/factor.glsl"
 #include "fog/color.glsl"
 uniform int fog_sky_keep;
 uniform float fog_sun_share;   // LightShaftSettings.fog_sun_share
-uniform int fog_clouds;        // 1: cloud_distance is bound (unit 3)
-layout(binding = 3) uniform sampler2D cloud_distance;
+#endif
+#if SHAFT_AERIAL
+#include "sky/atmosphere.glsl"
+uniform float view_r;          // the camera's radius from the planet's centre
 #endif
 
 // Per-texel start offset in [0, 1): lowbias32 of x + 65536 y (atmos.hashing.lowbias32), 24 bits.
@@ -61,7 +72,7 @@ void main() {
     float z = texelFetch(low_depth, q, 0).r;
     float behind = z < 1.0 ? d : (fog_sky_keep == 0 ? far * length(ray)
                  : (dir.y < 0.0 && camera_pos.y > 0.0 ? camera_pos.y / max(-dir.y, 1e-6) : 0.0));
-    vec2 cloud = fog_clouds != 0 ? texture(cloud_distance, uv).rg : vec2(0.0);
+    vec2 cloud = has_cloud_distance != 0 ? texture(cloud_distance, uv).rg : vec2(0.0);
     float a = clamp(cloud.y, 0.0, 1.0);
     float dc = a > 0.0 ? max(cloud.x / cloud.y, 0.0) : 0.0;
     float reach = max(behind, a > 0.0 ? dc : 0.0);
@@ -80,6 +91,30 @@ void main() {
         f0 = f1;
     }
     frag = vec4(-fog_sun_share * in_color(dir) * lost, 1.0);
+    return;
+#endif
+#if SHAFT_AERIAL
+    vec2 own = has_cloud_distance != 0 ? texture(cloud_distance, uv).rg : vec2(0.0);
+    float ca = clamp(own.y, 0.0, 1.0);
+    float cd = ca > 0.0 ? max(own.x / own.y, 0.0) : 0.0;
+    float reach_air = max(d, ca > 0.0 ? min(cd, max_distance) : 0.0);
+    float r = atm_clamp_radius(view_r), nu = dot(dir, sun_dir);
+    float pr = atm_rayleigh_phase(nu), pm = atm_hg_phase(atm_g, nu);
+    float dsa = reach_air / float(steps);
+    vec3 shadowed = vec3(0.0);
+    for (int i = 0; i < steps; ++i) {
+        float s = (float(i) + j) * dsa;
+        float w = (s < cd ? ca : 0.0) + (s < d ? 1.0 - ca : 0.0);
+        float tau = has_clouds != 0 ? sun_optical_depth(camera_pos + dir * s, sun_dir) : 0.0;
+        if (w <= 0.0 || tau <= 0.0) continue;
+        float ri = sqrt(max(r * r + s * s + 2.0 * r * dir.y * s, 0.0));
+        float mus_i = clamp((r * sun_dir.y + s * nu) / max(ri, 1.0), -1.0, 1.0);
+        vec3 s_ray, s_mie;
+        vec3 ext = atm_coefficients(ri, s_ray, s_mie);
+        shadowed += w * exp(-ext * s) * atm_transmittance_to_sun(ri, mus_i) * (s_ray * pr + s_mie * pm)
+                    * (1.0 - exp(-tau));
+    }
+    frag = vec4(-shadowed * dsa * atm_sun, 1.0);
     return;
 #endif
     float ds = d / float(steps);
