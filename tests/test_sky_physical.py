@@ -199,25 +199,28 @@ def test_aerial_perspective_matches_the_float64_march_over_the_ground(gpu, ctx, 
     """C -> L + T C over the ground plane at its distance (the float64 march through the same atmosphere);
     sky pixels untouched; distant ground turns toward the horizon sky; culled and allocating nothing off."""
     size = (48, 32)
-    for altitude, elevation in ((rng.uniform(2, 50), rng.uniform(2, 20)), (rng.uniform(800, 6000), rng.uniform(-1, 50))):
+    cases = ((rng.uniform(2, 50), rng.uniform(2, 20), rng.uniform(-0.5, -0.05)),      # near the ground, and high up
+             (rng.uniform(800, 6000), rng.uniform(-1, 50), rng.uniform(-0.45, -0.2)))  # near ground and some sky in view
+    for altitude, elevation, pitch in cases:
         sun = sun_at(elevation, rng.uniform(0, 360))
         plain, hazed, rays, app = ground_frames(gpu, size, altitude, sun, math.atan2(sun[0], -sun[2]) + rng.uniform(-1, 1),
-                                                rng.uniform(-0.5, -0.05))
+                                                pitch)
         plugin = next(p for p in app.plugins if isinstance(p, SkyPlugin))
         assert "aerial_perspective" in app.graph.compile().kept
         dirs = rays / np.linalg.norm(rays, axis=-1, keepdims=True)
         distance = altitude / np.maximum(-dirs[..., 1], 1e-6)
         ground = (dirs[..., 1] < -0.01) & (distance < 4e5)          # the plane reaches 5e5 m
         assert ground.mean() > 0.3 and (~ground).any()
-        tlut, mslut = ref.luts(plugin.settings.atmosphere)
+        # the GPU's own LUTs (tested against float64 above): this checks the march, not the tables
+        tlut, mslut = (plugin.luts.read(name).astype(np.float64) for name in ("transmittance", "multiscattering"))
         light, trans = ref.aerial_perspective(plugin.settings.atmosphere, tlut, mslut, altitude, dirs, sun, distance,
                                               plugin.settings.aerial_steps)
         want = light + trans.mean(-1, keepdims=True) * plain[..., :3]
         err = np.abs(hazed[..., :3] - want)
         close = ground & (distance < 2e4)   # beyond, a 24-bit depth buffer's distance is off by up to ~1 %
-        assert close.mean() > 0.2
-        # the GPU's LUTs are within 2e-3 of the float64 ones; the colour target is float16
-        assert (err[close] <= 1e-2 * np.abs(want[close]) + 3e-4 * want[ground].max()).all(), err[close].max()
+        assert close.mean() > 0.1
+        # float32 against float64, the depth buffer's distance and a float16 colour target: 0.4 % seen
+        assert (err[close] <= 8e-3 * np.abs(want[close]) + 3e-4 * want[ground].max()).all(), err[close].max()
         assert (err[ground] <= 5e-2 * np.abs(want[ground])).all(), (err[ground] / np.abs(want[ground])).max()
         sky = dirs[..., 1] > 0.01
         assert np.array_equal(hazed[sky], plain[sky]), "the sky already holds the whole ray"

@@ -30,7 +30,7 @@ class SkySettings(CheckedSettings):
     a star; ``star_brightness``: HDR radiance of the brightest star; ``twinkle``: 0 steady .. 1 full.
     ``aerial_perspective`` (the physical model only): the air between the camera and the scene hazes it
     with the sky's own light (:mod:`atmos.plugins.sky.aerial`), marched in ``aerial_steps`` segments (8:
-    within 2.5e-3 of a 96-step float64 march from 10 km up, 7e-4 near the ground; benchmarks/bench_sky.py).
+    within 8e-4 of a 96-step float64 march from 10 km up, 6e-4 near the ground; benchmarks/bench_sky.py).
     """
 
     model: str = "preetham"
