@@ -25,19 +25,19 @@ def _read_only(direction: np.ndarray) -> np.ndarray:
     return direction
 
 
-_SUN_CHECKS = {
-    "direction": lambda v: _read_only(check_sun_dir(v, "Sun.direction")),
-    "color": lambda v: check_vec("Sun", "color", v, 3, "non-negative"),
-    "ambient": lambda v: check_vec("Sun", "ambient", v, 3, "non-negative"),
-    "color_by_altitude": lambda v: _check_path(v),
-}
-
-
 def _check_path(value):
     if value is not None and not callable(value):
         raise ValueError("Sun.color_by_altitude must be None or a callable (direction, altitude_m) -> RGB, "
                          f"got {value!r}")
     return value
+
+
+_SUN_CHECKS = {
+    "direction": lambda v: _read_only(check_sun_dir(v, "Sun.direction")),
+    "color": lambda v: check_vec("Sun", "color", v, 3, "non-negative"),
+    "ambient": lambda v: check_vec("Sun", "ambient", v, 3, "non-negative"),
+    "color_by_altitude": _check_path,
+}
 
 
 @dataclass(slots=True)

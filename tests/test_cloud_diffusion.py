@@ -169,7 +169,7 @@ def test_a_scene_no_renderer_reads_the_field_of_solves_none(gpu, ctx):
                                    CloudsPlugin(density=density))
         app.run_frames(2, 1 / 30)
         sim = next(p for p in app.plugins if isinstance(p, CloudsPlugin)).simulation
-        assert (DIFFUSION in sim.set) == (weight > 0) and (sim.diffusion is not None) == (weight > 0)
+        assert (DIFFUSION in sim.set) == (weight > 0) and (sim.field.solver is not None) == (weight > 0)
         app.close()
 
 

@@ -289,7 +289,8 @@ class DiffusionTask(SliceTask):
     ``wanted()`` (a renderer reads it: :class:`~atmos.plugins.clouds.field_demand.FieldDemand`):
     ``slices`` job slices of set C (assembly and the first iterations, more iterations, the last also
     writes ``set[DIFFUSION]``), ``iterations`` in all. Other steps run no slice and leave C without a
-    field; the solver and a set's field texture are made on the first step that wants them.
+    field; the solver and a set's field texture are made on the first step that wants them. A set shaded
+    outside a sliced job (static clouds) takes its whole field at once with :meth:`solve`.
     ``medium`` is a zero-argument callable giving (sigma_t, albedo, g, cell, sun_dir), read when a
     step's field begins; the solve starts from the last solve's phi (warm: at most ``warm_iterations``,
     fewer dispatches once converged; ``benchmarks/bench_cloud_field.py``)."""
@@ -320,11 +321,20 @@ class DiffusionTask(SliceTask):
             self.solver = DiffusionSolver(self.gpu, self.shape, self.scale)
         target.ensure(self.gpu, DIFFUSION, diffusion_desc(self.shape, self.scale))
 
+    def solve(self, target) -> None:
+        """:meth:`plan` and, if wanted, every slice of ``target``'s field now."""
+        self.plan(target)
+        if self.active:
+            n = self.count()
+            for index in range(n):
+                self._slice(index, n, target)
+
     def _run(self, index: int, job) -> None:
-        target = job.target
+        self._slice(index, job.slices, job.target)
+
+    def _slice(self, index: int, n: int, target) -> None:
         if index == 0:
             self.solver.begin(target[self.density], target[self.transmittance], *self.medium())
-        n = job.slices
         self.solver.iterate(self.total * (index + 1) // n - self.total * index // n)
         if index == n - 1:
             self.solver.write(target[DIFFUSION])

@@ -90,11 +90,7 @@ class RaymarchCloudsPlugin(Plugin):
         self.composition.writers.add(RaymarchPass.name)     # the fog gets the clouds' own distance
         app.graph.add_pass(RaymarchPass(self))
         self.demand = field_demand(app)
-        self.demand.weights[RaymarchPass.name] = self.field_weight
-
-    def field_weight(self) -> float:
-        """The diffusion field's weight this renderer reads it with (0 when disabled)."""
-        return self.settings.ms_diffusion if self.settings.enabled else 0.0
+        self.demand.readers.add(self)
 
     def finish(self, app) -> None:
         self.simulated = app.get_resource(CloudSimulation) is not None     # weather-driven, not static
@@ -110,7 +106,7 @@ class RaymarchCloudsPlugin(Plugin):
 
     def cleanup(self, app) -> None:
         if self.demand is not None:
-            self.demand.weights.pop(RaymarchPass.name, None)
+            self.demand.readers.discard(self)
         if self.composition is not None:
             self.composition.writers.discard(RaymarchPass.name)
         if self.far is not None:
@@ -190,9 +186,8 @@ class RaymarchPass(RenderPass):
             self._skip_key = key
         return self.skip
 
-    def _uniforms(self, frame: PassContext, sim: CloudSets, offset) -> dict:
+    def _uniforms(self, frame: PassContext, sim: CloudSets, layout, offset) -> dict:
         s, view = self.plugin.settings, frame.view
-        layout = sim.layout(s.base_altitude)
         cell = np.asarray(layout.cell, np.float64)
         maps = sim.maps_of(sim.view()[0])
         skip_cells = (float(layout.group[0]), float(maps.band_height), float(layout.group[1]))
@@ -224,11 +219,11 @@ class RaymarchPass(RenderPass):
             frame.gpu.ctx.enable(moderngl.DEPTH_TEST)
             frame.gpu.ctx.depth_func = "1"  # always: the shader writes the scene depth it saw
         set_camera_uniforms(p, view.camera, view.aspect)
-        for name, value in self._uniforms(frame, sim, offset).items():
+        layout = sim.layout(s.base_altitude)
+        for name, value in self._uniforms(frame, sim, layout, offset).items():
             if name in p:                   # a compiler may drop a uniform a variant does not use
                 p[name].value = value
-        altitude = sim.layout(s.base_altitude).middle_altitude
-        bind_volume(p, sim, self.sampler, view.sun, s.octaves, s.ms_diffusion, altitude)
+        bind_volume(p, sim, self.sampler, view.sun, s.octaves, s.ms_diffusion, layout.middle_altitude)
         if s.empty_space_skipping:
             self._skip_texture(sim).use(SKIP_UNIT)
         else:                               # nothing uploaded; the shader reads no skip map

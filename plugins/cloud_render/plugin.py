@@ -116,15 +116,11 @@ class CloudRenderPlugin(Plugin):
         self.composition.writers.add("cloud_render")     # the sprites give the fog their own distance
         app.graph.add_pass(CloudSpritePass(self))
         self.demand = field_demand(app)
-        self.demand.weights["cloud_render"] = self.field_weight
-
-    def field_weight(self) -> float:
-        """The diffusion field's weight this renderer reads it with (0 when disabled)."""
-        return self.settings.ms_diffusion if self.settings.enabled else 0.0
+        self.demand.readers.add(self)
 
     def cleanup(self, app) -> None:
         if self.demand is not None:
-            self.demand.weights.pop("cloud_render", None)
+            self.demand.readers.discard(self)
         comp = getattr(self, "composition", None)
         if comp is not None:
             comp.writers.discard("cloud_render")

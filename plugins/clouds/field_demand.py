@@ -1,8 +1,8 @@
 """Which cloud renderers read the diffusion field, so the cloud chain solves it only for them.
 
 The field (:mod:`atmos.shading.diffusion`) is the chain's costliest task. A renderer that reads it
-adds a zero-argument callable giving its weight (``ms_diffusion``, 0 when disabled) to the App
-resource :class:`FieldDemand` in ``build`` and takes it out in ``cleanup``; the simulation asks
+(its settings have ``enabled`` and ``ms_diffusion``, the field's weight) adds itself to ``readers`` of
+the App resource :class:`FieldDemand` in ``build`` and takes itself out in ``cleanup``; the simulation asks
 :meth:`FieldDemand.wanted` when each step begins (static clouds: when they are shaded). A scene
 whose renderers give the field no weight (none added, ``enabled=False`` or ``ms_diffusion=0``)
 solves nothing and allocates no field texture. The plugins meet there in any order, as in
@@ -15,12 +15,12 @@ from dataclasses import dataclass, field
 
 @dataclass
 class FieldDemand:
-    """App resource: reader name → zero-argument callable giving the weight it reads the field with."""
-    weights: dict = field(default_factory=dict)
+    """App resource: the renderer plugins that read the field."""
+    readers: set = field(default_factory=set)
 
     def wanted(self) -> bool:
-        """True when some reader gives the field a weight above 0."""
-        return any(float(weight()) > 0 for weight in self.weights.values())
+        """True when an enabled reader gives the field a weight (``ms_diffusion``) above 0."""
+        return any(r.settings.enabled and r.settings.ms_diffusion > 0 for r in self.readers)
 
 
 def field_demand(app) -> FieldDemand:

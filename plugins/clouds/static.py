@@ -18,7 +18,7 @@ from atmos.plugins.clouds.sets import CloudSets
 from atmos.shading import grid
 from atmos.shading.columns import COLUMNS, ColumnShader, column_desc
 from atmos.plugins.clouds.field_demand import FieldDemand
-from atmos.shading.diffusion import DIFFUSION, DiffusionSolver, diffusion_desc, field_medium
+from atmos.shading.diffusion import DiffusionTask, field_medium
 from atmos.shading.shear_warp import ShearWarpShader
 
 
@@ -28,14 +28,14 @@ class StaticClouds:
     def __init__(self, gpu, density, settings, origin, sun, demand: FieldDemand | None = None):
         volume = grid.check_density(density)
         self.shape = tuple(volume.shape)
-        self.gpu, self.settings, self.origin, self.sun = gpu, settings, origin, sun
+        self.settings, self.origin, self.sun = settings, origin, sun
         self.demand = demand or FieldDemand()
         s = settings
         descs = {"density": TextureDesc(self.shape, 1, "f4"), COLUMNS: column_desc(self.shape, s.shading_scale)}
         if s.shading:
             descs["transmittance"] = TextureDesc(grid.shading_shape(self.shape, s.shading_scale), 1, "f2")
         self.set = TextureSet.create(gpu, descs, "static")
-        self.shader = self.maps = self.diffusion = None
+        self.shader = self.maps = self.field = None
         try:
             self.set["density"].write(np.ascontiguousarray(volume.transpose(2, 1, 0)).tobytes())
             self.maps = DensityMaps(gpu, self.shape, s.band_height, s.group_size)
@@ -44,6 +44,8 @@ class StaticClouds:
             ColumnShader(gpu, self.shape, s.shading_scale).run(self.set["density"], self.set[COLUMNS])
             if s.shading:
                 self.shader = ShearWarpShader(gpu, self.shape, s.shading_scale)
+                self.field = DiffusionTask(gpu, self.shape, s.shading_scale,
+                                           lambda: field_medium(self.settings, self.sun()), self.demand.wanted)
         except Exception:
             self.release()
             raise
@@ -62,13 +64,7 @@ class StaticClouds:
         self.shader.begin(self.set["density"], sun / np.asarray(self.settings.cell_size, float),
                           self.settings.shading_sigma(sun), target=self.set["transmittance"])
         self.shader.run_all()
-        if wanted:
-            if self.diffusion is None:
-                self.diffusion = DiffusionSolver(self.gpu, self.shape, s.shading_scale)
-            field = self.set.ensure(self.gpu, DIFFUSION, diffusion_desc(self.shape, s.shading_scale))
-            self.diffusion.solve(self.set["density"], self.set["transmittance"], field, *field_medium(s, sun))
-        else:
-            self.set.drop(DIFFUSION)
+        self.field.solve(self.set)
         self._shaded = key
 
     def sets(self) -> CloudSets:
@@ -90,7 +86,7 @@ class StaticClouds:
         return self.sets().layout(base_altitude, cell_size, pad)
 
     def release(self) -> None:
-        for obj in (self.shader, self.diffusion, self.maps, self.set):
+        for obj in (self.shader, self.field, self.maps, self.set):
             if obj is not None:
                 obj.release()
-        self.shader = self.diffusion = self.maps = self.set = None
+        self.shader = self.field = self.maps = self.set = None

@@ -14,6 +14,7 @@ from atmos.plugins.cloud_far_field.layer import FAR_FIELD
 from atmos.plugins.cloud_render.offscreen import OffscreenClouds
 from atmos.plugins.cloud_shadows.plugin import column_uniforms
 from atmos.plugins.clouds.sets import CLOUD_SETS, CloudSets
+from atmos.plugins.sky.luts import SKY_LUTS, atmosphere_defines, set_atmosphere_uniforms, view_radius
 from atmos.render_core import COLOR, DEPTH
 
 SHAFT_COLOR = "light_shafts_march"     # low-res (in-scattered light, transmittance)
@@ -45,7 +46,6 @@ class MarchedShafts:
         (the SkyPlugin): the variant that shadows the sky's aerial perspective (SHAFT_AERIAL)."""
         defines = {"CLOUD_FAR_FIELD": 1} if far_field else {}
         if aerial is not None:
-            from atmos.plugins.sky.luts import atmosphere_defines
             defines.update(SHAFT_AERIAL=1, **atmosphere_defines())
         if fog is not None:
             from atmos.plugins.fog.settings import MODES
@@ -73,7 +73,6 @@ class MarchedShafts:
         if fog is not None and fog.composition is not None and fog.composition.distance:
             builder.read(CLOUD_DISTANCE)
         if aerial is not None:
-            from atmos.plugins.sky.luts import SKY_LUTS
             builder.read(SKY_LUTS)
             if aerial.composition.distance:
                 builder.read(CLOUD_DISTANCE)
@@ -128,7 +127,6 @@ class MarchedShafts:
     @staticmethod
     def aerial_uniforms(frame: PassContext, program, sky) -> None:
         """The sky's atmosphere (its LUTs bound, the camera's radius) and the clouds' distance (unit 3)."""
-        from atmos.plugins.sky.luts import SKY_LUTS, set_atmosphere_uniforms, view_radius
         frame.resource(SKY_LUTS).use()
         set_atmosphere_uniforms(program, sky.settings.atmosphere)
         program["view_r"].value = view_radius(sky.settings.atmosphere, frame.view.camera)

@@ -11,6 +11,8 @@ from atmos.plugins.clouds.sets import CLOUD_SETS
 from atmos.plugins.light_shafts.march import MarchedShafts
 from atmos.plugins.light_shafts.settings import LightShaftSettings
 from atmos.plugins.light_shafts.screen_sun import screen_sun
+from atmos.plugins.sky import SkyPlugin
+from atmos.plugins.sky.aerial import active
 from atmos.render_core import COLOR, DEPTH
 
 MASK = "light_shafts_mask"
@@ -126,12 +128,10 @@ class LightShaftsPlugin(Plugin):
 
     def finish(self, app) -> None:
         from atmos.plugins.fog import FogPlugin
-        from atmos.plugins.sky import SkyPlugin
         self.fog = next((p for p in app.plugins if isinstance(p, FogPlugin)), None)
         self.sky = next((p for p in app.plugins if isinstance(p, SkyPlugin)), None)
 
     def aerial(self):
         """The SkyPlugin when its aerial perspective owns the air's light and no fog does (the march then
         takes away that in-scatter in cloud shadow); else None."""
-        from atmos.plugins.sky.aerial import active
         return self.sky if self.fog is None and self.sky is not None and active(self.sky.settings) else None

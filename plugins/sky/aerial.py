@@ -16,8 +16,8 @@ from atmos.graph import FullscreenPass, PassContext
 from atmos.camera import set_camera_uniforms
 from atmos.lighting import unit_sun
 from atmos.plugins.sky.luts import SKY_LUTS, atmosphere_defines, set_atmosphere_uniforms, view_radius
+from atmos.render_core import COLOR, DEPTH
 
-COLOR, DEPTH = "color", "depth"
 AERIAL = "aerial_perspective"
 
 

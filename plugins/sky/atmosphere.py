@@ -102,6 +102,12 @@ def distance_to_ground(rg: float, r, mu):
     return np.maximum(-r * mu - np.sqrt(np.maximum(_discriminant(rg, r, mu), 0.0)), 0.0)
 
 
+def ray_end(m: dict, r, mu):
+    """(ends on the ground, distance to that end or to the top of the atmosphere) of rays from ``r``."""
+    ground = hits_ground(m["rg"], r, mu)
+    return ground, np.where(ground, distance_to_ground(m["rg"], r, mu), distance_to_top(m["rt"], r, mu))
+
+
 def horizon_mu(rg: float, r):
     """cos of the zenith angle of the ray tangent to the ground from radius ``r``."""
     r = np.asarray(r, np.float64)
@@ -254,8 +260,7 @@ def integrate(m: dict, tlut: np.ndarray, r, mu, mu_s, nu, steps: int, mslut: np.
     the multiple-scattering LUT's transfer."""
     r = clamp_radius(m, r)
     mu, mu_s, nu = (np.broadcast_to(np.asarray(a, np.float64), r.shape) for a in (mu, mu_s, nu))
-    ground = hits_ground(m["rg"], r, mu)
-    t_max = np.where(ground, distance_to_ground(m["rg"], r, mu), distance_to_top(m["rt"], r, mu))
+    ground, t_max = ray_end(m, r, mu)
     radiance, transfer, throughput = march(m, tlut, r, mu, mu_s, nu, t_max, steps, mslut, isotropic)
     mu_g = np.clip((r * mu_s + t_max * nu) / m["rg"], -1.0, 1.0)
     lit = transmittance_to_sun(m, tlut, np.full(r.shape, m["rg"] + RADIUS_EPS), mu_g) * np.maximum(mu_g, 0.0)[..., None]
@@ -273,7 +278,7 @@ def aerial_perspective(settings: AtmosphereSettings, tlut, mslut, altitude: floa
     s = unit(sun_dir)
     r = clamp_radius(m, np.full(d.shape[:-1], camera_radius(m, altitude)))
     mu, nu = d[..., 1], d @ s
-    end = np.where(hits_ground(m["rg"], r, mu), distance_to_ground(m["rg"], r, mu), distance_to_top(m["rt"], r, mu))
+    _, end = ray_end(m, r, mu)
     radiance, _, throughput = march(m, tlut, r, mu, np.full(r.shape, s[1]), nu,
                                     np.minimum(np.asarray(distance, np.float64), end), steps, mslut)
     return radiance * m["sun"], throughput

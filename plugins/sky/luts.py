@@ -26,9 +26,14 @@ ALTITUDE_TOLERANCE = (1.0, 0.01)   # ... or the camera's altitude by more than m
 SKY_LUTS = "sky_luts"       # the imported AtmosphereLuts of the physical sky (a graph resource)
 
 
+def camera_altitude(camera) -> float:
+    """The camera's height above the ground plane (y = 0), at least 0."""
+    return max(float(np.asarray(camera.position, np.float64)[1]), 0.0)
+
+
 def view_radius(settings: AtmosphereSettings, camera) -> float:
-    """The camera's radius from the planet's centre (its height above y = 0, at least 0; ``view_r``)."""
-    return ref.camera_radius(ref.medium(settings), max(float(np.asarray(camera.position, np.float64)[1]), 0.0))
+    """The camera's radius from the planet's centre (``view_r`` of the shaders)."""
+    return ref.camera_radius(ref.medium(settings), camera_altitude(camera))
 
 
 @lru_cache(maxsize=1)

@@ -5,23 +5,17 @@ from __future__ import annotations
 import numpy as np
 
 from atmos.camera import Camera, set_camera_uniforms
+from atmos.composition import composition
 from atmos.graph import FullscreenPass, PassContext, RenderPass
 from atmos.lighting import Sun
 from atmos.plugin import Plugin
 from atmos.plugins.sky import sun_light
-from atmos.composition import composition
 from atmos.plugins.sky.aerial import AERIAL, AerialPerspectivePass, active
-from atmos.plugins.sky.luts import (SKY_LUTS, SKY_VIEW_UNIT, AtmosphereLuts, atmosphere_defines, set_atmosphere_uniforms,
-                                    view_radius)
+from atmos.plugins.sky.luts import (SKY_LUTS, SKY_VIEW_UNIT, AtmosphereLuts, atmosphere_defines, camera_altitude,
+                                    set_atmosphere_uniforms, view_radius)
 from atmos.plugins.sky.settings import SkySettings
 from atmos.plugins.sky.shader import set_sky_uniforms, sky_defines
 from atmos.render_core import DEPTH, where_nothing_was_drawn
-
-
-
-def camera_altitude(camera) -> float:
-    """The camera's height above the ground plane (y = 0), at least 0."""
-    return max(float(np.asarray(camera.position, np.float64)[1]), 0.0)
 
 
 class SkyLutsPass(RenderPass):

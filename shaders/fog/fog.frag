@@ -11,6 +11,7 @@ out vec4 frag;
 #include "fog/factor.glsl"
 uniform int fog_sky_keep;    // 1: sky pixels are left to the sky
 #if FOG_CLOUDS
+#include "lib/cloud_distance.glsl"
 layout(binding = 2) uniform sampler2D cloud_distance;
 #endif
 #include "fog/color.glsl"
@@ -59,12 +60,8 @@ void main() {
 #endif
     float f = sky && fog_sky_keep != 0 ? 1.0 : fog_factor(d, world);
 #if FOG_CLOUDS
-    vec2 cloud = texelFetch(cloud_distance, ivec2(gl_FragCoord.xy), 0).rg;
-    float a = clamp(cloud.y, 0.0, 1.0);
-    if (a > 0.0) {
-        float dc = max(cloud.x / cloud.y, 0.0);
-        f = a * fog_factor(dc, eye + dir * dc) + (1.0 - a) * f;
-    }
+    vec2 cloud = cloud_cover_distance(texelFetch(cloud_distance, ivec2(gl_FragCoord.xy), 0).rg);
+    if (cloud.x > 0.0) f = cloud.x * fog_factor(cloud.y, eye + dir * cloud.y) + (1.0 - cloud.x) * f;
 #endif
     frag = vec4(in_color(dir) * (1.0 - f), f);
 }

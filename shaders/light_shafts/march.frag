@@ -39,6 +39,7 @@ uniform int factor;
 uniform vec2 frame_size;
 out vec4 frag;
 #if SHAFT_FOG || SHAFT_AERIAL
+#include "lib/cloud_distance.glsl"
 uniform int has_cloud_distance;   // 1: cloud_distance is bound (unit 3)
 layout(binding = 3) uniform sampler2D cloud_distance;
 #endif
@@ -66,15 +67,16 @@ void main() {
     float d = min(view_ray_distance(uv, texelFetch(low_depth, q, 0).r, view_basis, near, far, max_distance),
                   max_distance);
     float j = jitter(q);
+#if SHAFT_FOG || SHAFT_AERIAL
+    vec2 cloud = cloud_cover_distance(has_cloud_distance != 0 ? texture(cloud_distance, uv).rg : vec2(0.0));
+    float a = cloud.x, dc = cloud.y;            // the clouds' coverage and own distance
+#endif
 #if SHAFT_FOG
     // the fog's own distance: the scene's, the sky's far plane, or (keep) none above the horizon and
     // the ground plane's below it (fog.frag)
     float z = texelFetch(low_depth, q, 0).r;
     float behind = z < 1.0 ? d : (fog_sky_keep == 0 ? far * length(ray)
                  : (dir.y < 0.0 && camera_pos.y > 0.0 ? camera_pos.y / max(-dir.y, 1e-6) : 0.0));
-    vec2 cloud = has_cloud_distance != 0 ? texture(cloud_distance, uv).rg : vec2(0.0);
-    float a = clamp(cloud.y, 0.0, 1.0);
-    float dc = a > 0.0 ? max(cloud.x / cloud.y, 0.0) : 0.0;
     float reach = max(behind, a > 0.0 ? dc : 0.0);
     vec3 end = camera_pos + dir * reach;
     float dm = min(reach, max_distance);
@@ -94,24 +96,20 @@ void main() {
     return;
 #endif
 #if SHAFT_AERIAL
-    vec2 own = has_cloud_distance != 0 ? texture(cloud_distance, uv).rg : vec2(0.0);
-    float ca = clamp(own.y, 0.0, 1.0);
-    float cd = ca > 0.0 ? max(own.x / own.y, 0.0) : 0.0;
-    float reach_air = max(d, ca > 0.0 ? min(cd, max_distance) : 0.0);
+    float reach_air = max(d, a > 0.0 ? min(dc, max_distance) : 0.0);
     float r = atm_clamp_radius(view_r), nu = dot(dir, sun_dir);
     float pr = atm_rayleigh_phase(nu), pm = atm_hg_phase(atm_g, nu);
     float dsa = reach_air / float(steps);
     vec3 shadowed = vec3(0.0);
     for (int i = 0; i < steps; ++i) {
         float s = (float(i) + j) * dsa;
-        float w = (s < cd ? ca : 0.0) + (s < d ? 1.0 - ca : 0.0);
+        float w = (s < dc ? a : 0.0) + (s < d ? 1.0 - a : 0.0);
         float tau = has_clouds != 0 ? sun_optical_depth(camera_pos + dir * s, sun_dir) : 0.0;
         if (w <= 0.0 || tau <= 0.0) continue;
-        float ri = sqrt(max(r * r + s * s + 2.0 * r * dir.y * s, 0.0));
-        float mus_i = clamp((r * sun_dir.y + s * nu) / max(ri, 1.0), -1.0, 1.0);
+        vec2 at = atm_point(r, dir.y, sun_dir.y, nu, s);
         vec3 s_ray, s_mie;
-        vec3 ext = atm_coefficients(ri, s_ray, s_mie);
-        shadowed += w * exp(-ext * s) * atm_transmittance_to_sun(ri, mus_i) * (s_ray * pr + s_mie * pm)
+        vec3 ext = atm_coefficients(at.x, s_ray, s_mie);
+        shadowed += w * exp(-ext * s) * atm_transmittance_to_sun(at.x, at.y) * (s_ray * pr + s_mie * pm)
                     * (1.0 - exp(-tau));
     }
     frag = vec4(-shadowed * dsa * atm_sun, 1.0);

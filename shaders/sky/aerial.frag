@@ -11,6 +11,7 @@ in vec2 v_uv;
 out vec4 frag;
 layout(binding = 0) uniform sampler2D scene_depth;
 #if AERIAL_CLOUDS
+#include "lib/cloud_distance.glsl"
 layout(binding = 2) uniform sampler2D cloud_distance;
 #endif
 uniform mat3 view_basis;       // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
@@ -33,9 +34,8 @@ void main() {
     vec3 dir = normalize(ray);
     vec4 ap = z >= 1.0 ? vec4(0.0, 0.0, 0.0, 1.0) : aerial(dir, view_depth(z, near, far) * length(ray));
 #if AERIAL_CLOUDS
-    vec2 cloud = texelFetch(cloud_distance, ivec2(gl_FragCoord.xy), 0).rg;
-    float a = clamp(cloud.y, 0.0, 1.0);
-    if (a > 0.0) ap = a * aerial(dir, max(cloud.x / cloud.y, 0.0)) + (1.0 - a) * ap;
+    vec2 cloud = cloud_cover_distance(texelFetch(cloud_distance, ivec2(gl_FragCoord.xy), 0).rg);
+    if (cloud.x > 0.0) ap = cloud.x * aerial(dir, cloud.y) + (1.0 - cloud.x) * ap;
 #endif
     frag = ap;
 }

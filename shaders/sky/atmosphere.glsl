@@ -35,6 +35,7 @@ float atm_discriminant(float radius, float r, float mu) { return (radius - r) * 
 float atm_distance_to_top(float r, float mu) { return max(-r * mu + sqrt(max(atm_discriminant(atm_rt, r, mu), 0.0)), 0.0); }
 float atm_distance_to_ground(float r, float mu) { return max(-r * mu - sqrt(max(atm_discriminant(atm_rg, r, mu), 0.0)), 0.0); }
 bool atm_hits_ground(float r, float mu) { return mu < 0.0 && atm_discriminant(atm_rg, r, mu) >= 0.0; }
+float atm_ray_end(float r, float mu) { return atm_hits_ground(r, mu) ? atm_distance_to_ground(r, mu) : atm_distance_to_top(r, mu); }
 float atm_horizon_mu(float r) { return -sqrt(max((r - atm_rg) * (r + atm_rg), 0.0)) / r; }
 float atm_clamp_radius(float r) { return clamp(r, atm_rg + ATM_RADIUS_EPS, atm_rt - ATM_RADIUS_EPS); }
 
@@ -67,6 +68,13 @@ vec2 atm_ms_uv(float r, float mu_s) {
                 atm_to_sub_uv(clamp((r - atm_rg) / (atm_rt - atm_rg), 0.0, 1.0), n));
 }
 
+// The point t metres along the ray from radius r (zenith cosine mu; sun at mu_s, nu = cos view·sun):
+// its radius and the sun's zenith cosine there.
+vec2 atm_point(float r, float mu, float mu_s, float nu, float t) {
+    float ri = sqrt(max(r * r + t * t + 2.0 * r * mu * t, 0.0));
+    return vec2(ri, clamp((r * mu_s + t * nu) / max(ri, 1.0), -1.0, 1.0));
+}
+
 float atm_rayleigh_phase(float nu) { return 3.0 / (16.0 * ATM_PI) * (1.0 + nu * nu); }
 float atm_hg_phase(float g, float nu) { return (1.0 - g * g) / (4.0 * ATM_PI * pow(1.0 + g * g - 2.0 * g * nu, 1.5)); }
 
@@ -85,8 +93,8 @@ vec3 atm_march(float r, float mu, float mu_s, float nu, float t_max, int steps, 
         float a = float(i) / float(steps), b = float(i + 1) / float(steps);
         float t0 = t_max * a * a, t1 = t_max * b * b;
         float t = 0.5 * (t0 + t1), dt = t1 - t0;
-        float ri = sqrt(max(r * r + t * t + 2.0 * r * mu * t, 0.0));
-        float mus_i = clamp((r * mu_s + t * nu) / max(ri, 1.0), -1.0, 1.0);
+        vec2 at = atm_point(r, mu, mu_s, nu, t);
+        float ri = at.x, mus_i = at.y;
         vec3 s_ray, s_mie;
         vec3 ext = atm_coefficients(ri, s_ray, s_mie);
         vec3 seg = exp(-ext * dt);
@@ -107,7 +115,7 @@ vec3 atm_march(float r, float mu, float mu_s, float nu, float t_max, int steps, 
 vec3 atm_integrate(float r, float mu, float mu_s, float nu, int steps, bool isotropic, out vec3 transfer) {
     r = atm_clamp_radius(r);
     bool ground = atm_hits_ground(r, mu);
-    float t_max = ground ? atm_distance_to_ground(r, mu) : atm_distance_to_top(r, mu);
+    float t_max = atm_ray_end(r, mu);
     vec3 throughput;
     vec3 radiance = atm_march(r, mu, mu_s, nu, t_max, steps, isotropic, transfer, throughput);
     if (ground) {
@@ -122,9 +130,8 @@ vec3 atm_integrate(float r, float mu, float mu_s, float nu, int steps, bool isot
 // marched per pixel instead of a froxel volume).
 vec3 atm_aerial(float r, float mu, float mu_s, float nu, float distance, int steps, out vec3 transmittance) {
     r = atm_clamp_radius(r);
-    float end = atm_hits_ground(r, mu) ? atm_distance_to_ground(r, mu) : atm_distance_to_top(r, mu);
     vec3 transfer;
-    return atm_march(r, mu, mu_s, nu, min(distance, end), steps, false, transfer, transmittance) * atm_sun;
+    return atm_march(r, mu, mu_s, nu, min(distance, atm_ray_end(r, mu)), steps, false, transfer, transmittance) * atm_sun;
 }
 
 // Sky-view LUT: (u, v) <-> (view mu, cos azimuth from the sun) seen from radius r.
