@@ -5,7 +5,7 @@ import argparse
 import os
 import sys
 
-from atmos.demo_registry import CLOUD_RENDERERS, DEFAULT_DEMO, SKY_MODELS, DemoSettings, list_demos, load_demo
+from atmos.demo_registry import CLOUD_RENDERERS, DEFAULT_DEMO, HAZES, SKY_MODELS, DemoSettings, list_demos, load_demo
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -85,6 +85,10 @@ def _clouds_option(command) -> None:
     command.add_argument("--sky", choices=SKY_MODELS, default="physical",
                          help="sky model of the demos with a sky: the Preetham analytic sky or the physical "
                               "atmosphere after Hillaire 2020, which also lights the sun and ambient (default physical)")
+    command.add_argument("--haze", choices=HAZES, default="fog",
+                         help="distance haze of the hazy demos (sunset, flight): an exponential fog toward the "
+                              "sky's colour, or the physical sky's aerial perspective, Earth's own air (needs "
+                              "--sky physical; default fog)")
 
 
 def cmd_info(args) -> int:
@@ -129,7 +133,7 @@ def _play(args, game, stem: str) -> int:
     if problem is not None:
         print(f"atmos: {problem}; rendering headless", file=sys.stderr)
     settings = DemoSettings(size=args.size, seed=args.seed, frames=args.frames, clouds=args.clouds, sky=args.sky,
-                            headless=args.headless or args.out is not None or problem is not None)   # as atmos.run
+                            haze=args.haze, headless=args.headless or args.out is not None or problem is not None)   # as atmos.run
     if settings.headless:
         out = args.out if args.out is not None else f"out/{stem}.mp4"
         result = run_headless(game, settings, out, progress=not args.quiet)
@@ -147,7 +151,8 @@ def cmd_graph(args, top) -> int:
     except ValueError as error:
         top.error(str(error))
     gpu = create_headless((320, 180))
-    app = build_app(args.name, DemoSettings(size=gpu.size, headless=True, clouds=args.clouds, sky=args.sky), gpu, start=False)
+    app = build_app(args.name, DemoSettings(size=gpu.size, headless=True, clouds=args.clouds, sky=args.sky,
+                                                 haze=args.haze), gpu, start=False)
     try:
         print(app.graph.to_dot() if args.dot else app.graph.dump())
     finally:
@@ -165,6 +170,8 @@ def main(argv: list[str] | None = None) -> int:
     from atmos.output import OutputError
     top = parser()
     args = top.parse_args(argv)
+    if getattr(args, "haze", None) == "air" and args.sky != "physical":
+        top.error("--haze air is the physical sky's aerial perspective: it needs --sky physical")
     commands = {"info": lambda: cmd_info(args), "demo": lambda: cmd_demo(args, top), "run": lambda: cmd_run(args, top),
                 "graph": lambda: cmd_graph(args, top)}
     if args.command not in commands:

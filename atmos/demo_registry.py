@@ -10,6 +10,7 @@ from atmos.checks import check_choice
 DEFAULT_DEMO = "sunset"
 CLOUD_RENDERERS = ("sprites", "march")
 SKY_MODELS = ("preetham", "physical")      # atmos.plugins.sky.MODELS (kept here so the CLI imports no plugin)
+HAZES = ("fog", "air")      # the hazy demos' distance haze: a FogPlugin toward the sky, or the physical sky's aerial perspective
 
 
 @dataclass
@@ -20,10 +21,15 @@ class DemoSettings:
     headless: bool = False
     clouds: str = "sprites"       # the cloud scenes' renderer: point sprites or the ray march (key C flips it)
     sky: str = "physical"         # the sky's model in the demos with a sky (SkySettings.model)
+    haze: str = "fog"             # sunset's and flight's haze: "fog" (FogPlugin toward the sky) or "air" (aerial perspective)
 
     def __post_init__(self):
         check_choice("DemoSettings", "clouds", self.clouds, CLOUD_RENDERERS)
         check_choice("DemoSettings", "sky", self.sky, SKY_MODELS)
+        check_choice("DemoSettings", "haze", self.haze, HAZES)
+        if self.haze == "air" and self.sky != "physical":
+            raise ValueError(f"DemoSettings.haze 'air' is the physical sky's aerial perspective: it needs "
+                             f"sky='physical', got sky={self.sky!r} (or take haze='fog')")
 
 
 def list_demos() -> dict[str, str]:

@@ -6,7 +6,7 @@ import os
 import sys
 
 from atmos.app import App
-from atmos.demo_registry import CLOUD_RENDERERS, SKY_MODELS, DemoSettings, load_demo
+from atmos.demo_registry import CLOUD_RENDERERS, HAZES, SKY_MODELS, DemoSettings, load_demo
 from atmos.gpu import create_headless
 
 _FILES: dict = {}      # game files loaded so far, by resolved path: each runs once per process
@@ -185,7 +185,7 @@ def run_window(name, settings: DemoSettings, title: str | None = None) -> None:
 
 def run(game, *, size: tuple[int, int] = (960, 540), title: str | None = None, headless: bool | None = None,
         frames: int | None = None, out: str | None = None, seed: int = 0, clouds: str = "sprites",
-        sky: str = "physical", progress: bool = False) -> dict | None:
+        sky: str = "physical", haze: str = "fog", progress: bool = False) -> dict | None:
     """Run a game: ``game`` is ``build(app, settings)`` (a function, a module that defines it, a path
     to a ``.py`` file, or a demo name). The App is made for you on a window's context (the window must
     exist before the GL context, so atmos makes both), or on a headless one when ``headless`` is True,
@@ -194,7 +194,8 @@ def run(game, *, size: tuple[int, int] = (960, 540), title: str | None = None, h
     ``settings`` (:class:`atmos.DemoSettings`) carries ``size``, ``seed``, ``frames``, ``headless`` and
     ``clouds``: the cloud renderer a cloud scene uses, "sprites" (point sprites) or "march" (the ray
     march), like ``atmos demo --clouds`` (the demos ``sunset``, ``flight`` and ``weather`` read it);
-    ``sky``: "preetham" or "physical", like ``atmos demo --sky`` (the demos with a sky read it).
+    ``sky``: "preetham" or "physical", like ``atmos demo --sky`` (the demos with a sky read it);
+    ``haze``: "fog" or "air" (the physical sky's aerial perspective), like ``atmos demo --haze``.
     Headless: ``frames`` frames (default the game's ``DEFAULT_FRAMES`` or 90) at 1/30 s, written to
     ``out`` (``.mp4``, ``.gif``, ``.png`` or a folder) if given; returns what was written. Windowed:
     until the window closes (or ``frames`` frames); returns None."""
@@ -204,12 +205,16 @@ def run(game, *, size: tuple[int, int] = (960, 540), title: str | None = None, h
     size = check_frame_size(size, None, "atmos.run size")
     clouds = check_choice("atmos.run", "clouds", clouds, CLOUD_RENDERERS)
     sky = check_choice("atmos.run", "sky", sky, SKY_MODELS)
+    haze = check_choice("atmos.run", "haze", haze, HAZES)
+    if haze == "air" and sky != "physical":
+        raise ValueError(f"atmos.run haze='air' is the physical sky's aerial perspective: it needs sky='physical', "
+                         f"got sky={sky!r}")
     if headless is None:
         problem = display_problem()
         headless = problem is not None
         if problem is not None:
             print(f"atmos: {problem}; rendering headless" + (f" into {out}" if out else ""), file=sys.stderr)
-    settings = DemoSettings(size=size, seed=seed, frames=frames, clouds=clouds, sky=sky,
+    settings = DemoSettings(size=size, seed=seed, frames=frames, clouds=clouds, sky=sky, haze=haze,
                             headless=bool(headless) or out is not None)
     if settings.headless:
         return run_headless(game, settings, out, progress=progress)

@@ -101,6 +101,8 @@ def test_headless_demo_writes_files(tmp_path, capsys, suffix):
     (["demo", "--clouds", "voxels"], "argument --clouds: invalid choice: 'voxels' (choose from"),
     (["run", "demos/glider.py", "--clouds", "cubes"], "invalid choice: 'cubes'"),
     (["graph", "sunset", "--clouds", "both"], "argument --clouds: invalid choice: 'both' (choose from"),
+    (["demo", "--haze", "smoke"], "argument --haze: invalid choice: 'smoke' (choose from"),
+    (["graph", "sunset", "--sky", "preetham", "--haze", "air"], "--haze air is the physical sky's aerial perspective"),
 ])
 def test_bad_arguments_get_clear_messages(capsys, argv, message):
     with pytest.raises(SystemExit) as info:

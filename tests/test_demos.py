@@ -51,6 +51,32 @@ def test_cloud_demos_render_with_the_ray_march_and_key_c_switches_the_renderer(n
         gpu.release()
 
 
+@pytest.mark.parametrize("name", ["sunset", "flight"])
+def test_hazy_demos_take_the_air_instead_of_the_fog(name):
+    """``haze="air"``: the physical sky's aerial perspective hazes terrain and clouds, no fog pass runs
+    (the two would count the air's light twice); the frame differs from the fog's and is not blank."""
+    gpu = create_headless((96, 54))
+    images = {}
+    try:
+        for haze in ("fog", "air"):
+            app = build_app(name, DemoSettings(size=gpu.size, headless=True, frames=2, haze=haze), gpu)
+            app.run_frames(2, 1 / 30)
+            images[haze] = gpu.read_pixels().astype(float)
+            assert gpu.ctx.error == "GL_NO_ERROR"
+            passes = kept(app)
+            assert ("aerial_perspective" in passes) == (haze == "air")
+            assert ("fog" in passes) == (haze == "fog")
+            app.close()
+    finally:
+        gpu.release()
+    assert images["air"].max() > 20 and images["air"].std() > 3, f"{name} with the air renders a blank image"
+    assert abs(images["air"] - images["fog"]).mean() > 1.0, "the haze changes the image"
+
+
 def test_demo_settings_name_the_cloud_renderers():
     with pytest.raises(ValueError, match="DemoSettings.clouds must be one of 'sprites', 'march', got 'voxels'"):
         DemoSettings(clouds="voxels")
+    with pytest.raises(ValueError, match="DemoSettings.haze must be one of 'fog', 'air', got 'smoke'"):
+        DemoSettings(haze="smoke")
+    with pytest.raises(ValueError, match="haze 'air' is the physical sky's aerial perspective: it needs sky='physical'"):
+        DemoSettings(sky="preetham", haze="air")
