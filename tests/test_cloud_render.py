@@ -137,7 +137,7 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale,
 
     src, _ = load_source("cloud_render/sprite.vert")
     names = ["gl_Position", "gl_PointSize", "v_octaves", "v_ambient", "v_center", "v_radius", "v_tau", "v_coverage",
-             "v_conic", "v_falloff", "v_stretch"]
+             "v_conic", "v_falloff", "v_stretch", "v_slope"]
     prog = ctx.program(vertex_shader=src, varyings=names)
     sampler = clamp_sampler(ctx)
     sun = app.resource(Sun)
@@ -154,9 +154,9 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale,
             blocks = (layout.group[0] * sx >> level) * (layout.group[1] * sz >> level)
             inst = ctx.buffer(mine.tobytes())
             vao = ctx.vertex_array(prog, [(inst, "4i/i", "in_segment")])
-            out = ctx.buffer(np.full(len(mine) * blocks * 23, np.nan, np.float32).tobytes())
+            out = ctx.buffer(np.full(len(mine) * blocks * 26, np.nan, np.float32).tobytes())
             vao.transform(out, moderngl.POINTS, vertices=blocks, instances=len(mine))
-            parts.append(np.frombuffer(out.read(), np.float32).reshape(-1, 23).astype(np.float64))
+            parts.append(np.frombuffer(out.read(), np.float32).reshape(-1, 26).astype(np.float64))
             for obj in (vao, out, inst):
                 obj.release()
         unbind_volume(sampler)
@@ -196,6 +196,10 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale,
     np.testing.assert_allclose(got[:, 18:21], ref["conic"], rtol=1e-4, atol=1e-4 * np.abs(ref["conic"]).max())
     np.testing.assert_allclose(got[:, 21], ref["falloff"], rtol=1e-4)
     np.testing.assert_allclose(got[:, 22], ref["stretch"], rtol=1e-4)   # float32 perspective terms
+    # log T's slope across the sprite and its half variance: a float32 log of 8 taps, through the footprint
+    slope_tol = 1e-3 if shading_scale == 1 else 2e-2
+    np.testing.assert_allclose(got[:, 23:26], ref["slope"], rtol=slope_tol, atol=slope_tol * np.abs(ref["slope"]).max())
+    assert np.abs(ref["slope"][vis, :2]).max() > 0.1, "T varies across the sprites"
     assert ref["stretch"][vis].max() > 1.05, "off-axis sprites: the perspective's Jacobian stretches them"
     if abs(cam.forward()[1]) < 0.6:               # seen from the side, the 20 × 15 m cells' footprints are ellipses
         assert np.abs(ref["conic"][vis][:, 0] / ref["conic"][vis][:, 2] - 1).max() > 0.1, "elliptical footprints"

@@ -4,7 +4,7 @@ Given the densities and transmittances of sets A and B (``[x, y, z]`` arrays, th
 its own shading resolution), the segments and the uniforms, it returns what every
 (instance, vertex) outputs, instance-major like the GPU: the clip position (``CULLED`` for empty
 blocks and blocks past the edge), point size, the light (octave weights of the sun's transmittance
-averaged over 8 samples spread like the block's mass, the sky and ground light dimmed by the columns
+averaged over 8 samples spread like the block's mass, log T's slope across the sprite fitted to them, the sky and ground light dimmed by the columns
 above and below, the light volume's columns (:mod:`atmos.shading.columns`): :mod:`atmos.shading.medium`), the world centre of mass and radius, centre optical depth and coverage; :func:`soft_fade` is the fragment's fade
 against the scene depth.
 """
@@ -24,6 +24,8 @@ CULLED = np.array([0.0, 0.0, 2.0, 1.0])
 
 
 HAT_SPREAD = 1.0 / 9.0   # sprite.vert: light samples at the centre of mass ± sqrt(variance + 1/9) cells
+MIN_T = 1e-30            # sprite.vert: log T's floor
+MAX_SLOPE = 8.0          # sprite.vert: log T's change per half side at most
 
 
 def toward(k, n: int, c: float, s: int):
@@ -124,7 +126,7 @@ def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, 
     grid = None if trans_a is None else np.shape(trans_a)
     (up_a, down_a), (up_b, down_b) = (column_depth(d, w, light["column_tau"], grid) for d, w in ((a64, uvw_a), (b64, uvw)))
     up, down = (1.0 - t) * up_a + t * up_b, (1.0 - t) * down_a + t * down_b
-    octaves = np.zeros((len(c), 4))
+    octaves, slope = np.zeros((len(c), 4)), np.zeros((len(c), 3))
     for side in np.stack(np.meshgrid(*[(-1.0, 1.0)] * 3, indexing="ij"), -1).reshape(-1, 3):
         tap = center + side * spread
         if trans_a is None:
@@ -134,6 +136,7 @@ def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, 
             T = trilinear(np.asarray(trans_a, np.float64), (tap + shift) / shape * tex - 0.5) * (1 - t) + \
                 trilinear(np.asarray(trans_b, np.float64), tap / shape * tex - 0.5) * t
         octaves += octave_weights(T, up + down, a_ms, b_ms, g_mean) / 8.0
+        slope += side * np.log(np.maximum(T, MIN_T))[:, None]
     world = np.asarray(u["layer_min"]) + center * np.asarray(u["cell_size"])
     ray = world - np.asarray(u["camera_pos"], np.float64)
     h = ambient_profile(up, down, g_mean, ray[:, 1] / np.linalg.norm(ray, axis=1))[:, None]
@@ -144,6 +147,11 @@ def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, 
     axis_x, axis_y, stretch = screen_axes(ray, u["camera_right"], u["camera_up"], u["near"])
     conic, k, det = footprint(cells_var, u["cell_size"], 0.5 * diameter, axis_x, axis_y)
     px = stretch * diameter * u["pixel_scale"] / np.maximum(clip[:, 3], 1e-6)
+    g = slope / (8.0 * spread * np.asarray(u["cell_size"], np.float64))      # log T's gradient, 1/m
+    h = np.clip((stretch * 0.5 * diameter)[:, None] * np.stack([g @ u["camera_right"], g @ u["camera_up"]], -1),
+                -MAX_SLOPE, MAX_SLOPE)
+    cov = np.stack([conic[:, 2], -conic[:, 1], conic[:, 0]], -1) * det[:, None]      # xx, xy, yy in half sides
+    half_var = 0.5 * (cov[:, 0] * h[:, 0] ** 2 + 2.0 * cov[:, 1] * h[:, 0] * h[:, 1] + cov[:, 2] * h[:, 1] ** 2)
     near, far = u["near"], u["far"]                 # depth-tested at its front: the centre a radius nearer
     front = np.maximum(clip[:, 3] - 0.5 * diameter, near)
     ndc = np.minimum((far + near) / (far - near) - 2.0 * far * near / ((far - near) * front), 1.0)
@@ -151,6 +159,7 @@ def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, 
     return {"position": np.where(visible[:, None], clip, CULLED),
             "size": np.where(visible, np.clip(px, 1.0, u["max_point_size"]), 1.0),
             "octaves": np.where(visible[:, None], octaves, 0.0),
+            "slope": np.where(visible[:, None], np.concatenate([h, half_var[:, None]], 1), 0.0),
             "ambient": np.where(visible[:, None], ambient, 0.0),
             "center": np.where(visible[:, None], world, 0.0),
             "radius": np.where(visible, 0.5 * diameter, 0.0),

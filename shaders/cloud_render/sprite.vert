@@ -27,6 +27,7 @@ uniform vec3 camera_right;     // the sprite's screen axes (the fragment shader'
 uniform vec3 camera_up;
 uniform float tau_scale;       // sigma_t × cell volume: the optical depth a unit of summed density spreads over the screen (m²)
 flat out vec4 v_octaves;      // b^i T^(a^i): the sun's light per octave (volume.glsl)
+flat out vec3 v_slope;        // log T's slope h across the sprite (per unit pc) and h^T cov h / 2
 flat out vec3 v_ambient;      // sky and ground light at the sprite, dimmed by the columns above and below
 flat out vec4 v_field;        // the diffusion field (phi, F) at the sprite's centre (0 when its weight is 0)
 flat out vec3 v_center;       // world centre and radius: the fragment's view ray for the phase function
@@ -49,6 +50,8 @@ const float MAX_OFF_AXIS = 4.0;         // |x/z|, |y/z| of the Jacobian's m (76�
 // the hat is exactly the average of two samples at ±1/3 cell, so 8 samples at the block's centre of
 // mass ± sqrt(variance of its cells + 1/9) cells (exact for one cell, the mass's spread for a block).
 const float HAT_SPREAD = 1.0 / 9.0;
+const float MIN_T = 1e-30;              // log T's floor
+const float MAX_SLOPE = 8.0;            // |log T change| per half side at most: e^8 across a sprite
 
 // The block drawn k-th of n (size s) along an axis with the camera c cells from the group's start:
 // each side of the camera walked toward it, the side whose innermost block is farther first.
@@ -73,6 +76,7 @@ void main() {
         : ivec2(toward(gl_VertexID % n.x, n.x, cam.x, s), toward(gl_VertexID / n.x, n.y, cam.y, s));
     ivec3 cell = ivec3(origin.x + block.x * s, in_segment.y * s, origin.y + block.y * s);
     v_octaves = vec4(0.0);
+    v_slope = vec3(0.0);
     v_ambient = vec3(0.0);
     v_center = vec3(0.0);
     v_radius = 0.0;
@@ -142,10 +146,19 @@ void main() {
     vec2 col = cloud_columns(uvw);
     float up = col.x, down = col.y;
     vec4 octaves = vec4(0.0);
+    vec3 slope = vec3(0.0);                        // sum of side × log T over the taps
     for (int i = 0; i < 8; ++i) {
         vec3 side = vec3((i & 1) == 0 ? -1.0 : 1.0, (i & 2) == 0 ? -1.0 : 1.0, (i & 4) == 0 ? -1.0 : 1.0);
-        octaves += octave_weights(cloud_transmittance(uvw + side * spread / vec3(volume_shape)), up + down);
+        float T = cloud_transmittance(uvw + side * spread / vec3(volume_shape));
+        octaves += octave_weights(T, up + down);
+        slope += side * log(max(T, MIN_T));
     }
+    // log T's gradient (1/m) fitted to the taps, on the sprite's screen axes per unit of point coordinate
+    // (sprite.frag's pc: a half side stretch × radius long): the sun's light varies across the sprite as
+    // T does, exp(a^i (h.pc - h^T cov h / 2)) per octave, a mean of 1 over the footprint's Gaussian
+    vec3 g = slope / (8.0 * spread * cell_size);
+    vec2 h = clamp(stretch * 0.5 * diameter * vec2(dot(g, camera_right), dot(g, camera_up)), -MAX_SLOPE, MAX_SLOPE);
+    v_slope = vec3(h, 0.5 * dot(h, vec2(cov.x * h.x + cov.y * h.y, cov.y * h.x + cov.z * h.y)));
     v_octaves = octaves / 8.0;
     v_ambient = ambient_source(up, down, ray.y);
     v_field = ms_diffusion > 0.0 ? cloud_diffusion(uvw) : vec4(0.0);
