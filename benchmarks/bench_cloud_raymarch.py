@@ -36,7 +36,6 @@ depend on (the shading modules' source included).
 from __future__ import annotations
 
 import argparse
-import hashlib
 import math
 import statistics
 import sys
@@ -51,7 +50,6 @@ sys.path.insert(0, str(HERE))
 import bench_cloud_light as light  # noqa: E402  (its volumes, views, references and metrics)
 
 from atmos import create_headless  # noqa: E402
-from atmos.camera import Camera  # noqa: E402
 from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin  # noqa: E402
 from atmos.plugins.cloud_raymarch.settings import REFERENCE  # noqa: E402
 from atmos.plugins.cloud_render import CloudRenderPlugin  # noqa: E402
@@ -75,7 +73,7 @@ ROWS = {    # label: march fields over DEFAULT (None: the default sprites, downs
 QUICK_ROWS = ("sprites 1/2", "march 64 r1", "march r2 reproj", "march r2 upsample", "march r2 oct 2")
 NO_DETAIL = "march r2 reproj"          # what the octave rows are compared with
 CONVERGE = 4                           # frames past r² before a reprojected image is read
-NEAR = 0.6                             # parts 3, 4: the side view this much closer (the cloud fills more)
+NEAR = 0.6 / light.FRAMING            # parts 3, 4: the side view 0.6 x the old bench distance (the cloud fills more)
 LOG: list[str] = []
 
 
@@ -120,26 +118,6 @@ class MarchScene:
         self.app.close()
 
 
-def reference(ms: MarchScene, vname, view, cam, sun, samples):
-    """The path-traced image and its standard error, cached in out/cache/ by all they depend on."""
-    s = ms.scene
-    key = hashlib.sha1(repr((vname, view, light.SIZE, samples, repr(s.settings), s.density.tobytes(),
-                             tuple(cam.position), cam.yaw, cam.pitch, cam.roll, cam.fov_y,
-                             tuple(sun.direction), tuple(sun.ambient), getattr(sun, "color", None),
-                             [p.read_bytes() for p in sorted((ROOT / "atmos" / "shading").glob("*.py"))],
-                             (ROOT / "plugins" / "cloud_render" / "light.py").read_bytes())).encode()).hexdigest()[:16]
-    path = OUT / "cache" / f"raymarch_ref_{key}.npz"
-    if path.exists():
-        with np.load(path) as f:
-            return f["ref"], f["err"], float(f["seconds"])
-    ref, err, seconds = s.reference(cam, sun, samples, None)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(".tmp.npz")
-    np.savez(tmp, ref=ref, err=err, seconds=seconds)
-    tmp.replace(path)
-    return ref, err, seconds
-
-
 def change(image, base):
     """(image-sum change, rel. RMS difference over the base's cloud pixels) of ``image`` vs ``base``."""
     return light.errors(image, np.asarray(base, np.float64)[..., :3])
@@ -160,7 +138,7 @@ def error_vs_time(gpu, rows, volumes, view_names, samples):
             if view not in view_names:
                 continue
             cam, sun = s.look(pos, target, elevation)
-            ref, err, seconds = reference(ms, vname, view, cam, sun, samples)
+            ref, err, seconds = light.cached_reference(s, cam, sun, samples)
             noise_sum, noise_rmse = light.tracer_noise(ref, err)
             say(f"{view:11s} {'path tracer':18s} ±{100 * noise_sum:5.1f}% {100 * noise_rmse:8.1f}% "
                 f"{'':10s} {1e3 * seconds:9.0f}  (its standard error; ms of the whole trace)")
