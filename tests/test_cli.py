@@ -67,6 +67,13 @@ def test_graph_of_the_cloud_demo_with_the_ray_march(capsys):
     assert "- cloud_render " in culled and ". cloud_render " not in kept, "the sprites are off (culled)"
 
 
+def test_graph_of_the_hazy_demo_with_the_air(capsys):
+    code, out, _ = run(capsys, "graph", "sunset", "--haze", "air")
+    assert code == 0
+    kept, culled = out.split("culled:")[0], out.split("culled:")[1].split("resources:")[0]
+    assert ". aerial_perspective " in kept and ". fog " not in kept, "the air instead of the haze fog"
+
+
 def test_headless_demo_frames_are_not_blank_and_move(tmp_path, capsys):
     code, out, _ = run(capsys, "demo", "testbed", "--headless", "--frames", "24", "--size", "160x90",
                        "--out", str(tmp_path), "--quiet")
