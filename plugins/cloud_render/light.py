@@ -19,12 +19,13 @@ DEFAULT_DIFFUSION = 0.4                   # the diffusion field's weight beta (f
 class CloudLightSettings(CheckedSettings):
     """The multiple-scattering octaves both cloud renderers share (the sprites' CloudRenderSettings
     and the march's RaymarchCloudSettings inherit them): ``ms_attenuation``, ``ms_contribution``,
-    ``ms_eccentricity`` = Wrenninge's a, b, c in [0, 1] (the defaults are fitted to the path tracer,
-    ``benchmarks/bench_cloud_light.py --fit``). ``ms_diffusion`` (0..2): the weight beta of the diffusion
+    ``ms_eccentricity`` = Wrenninge's a, b, c in [0, 1] (the defaults are fitted to the path tracer;
+    ``benchmarks/bench_cloud_light.py --fit``'s search on today's framing scores them 1.44, its best
+    1.41: README "Cloud light"). ``ms_diffusion`` (0..2): the weight beta of the diffusion
     field beside them (:mod:`atmos.shading.diffusion`: J += sun_source beta max(sun_y, 0) (1 - cos^2)^4
-    max(phi - 3 g F.ray, 0) / 4pi, cos = ray . sun); 0.5 was fitted on the bench's two volumes in four
-    views (gate cost -32 % in the float64 twin); 0 turns the term off (the field is still computed
-    where the cloud chain shades). A subclass's ``__post_init__`` stores
+    max(phi - 3 g F.ray, 0) / 4pi, cos = ray . sun); 0.4 was fitted on the bench's two volumes in four
+    views (gate cost -32 % in the float64 twin); 0 turns the term off (and, with no other reader,
+    the field's solve: ``plugins/clouds/field_demand.py``). A subclass's ``__post_init__`` stores
     :meth:`light_checks` beside its own checks (alone, the class checks just these)."""
     ms_attenuation: float = DEFAULT_OCTAVES[0]
     ms_contribution: float = DEFAULT_OCTAVES[1]
