@@ -5,7 +5,8 @@ import argparse
 import os
 import sys
 
-from atmos.demo_registry import CLOUD_RENDERERS, DEFAULT_DEMO, HAZES, SKY_MODELS, DemoSettings, list_demos, load_demo
+from atmos.demo_registry import (CLOUD_RENDERERS, DEFAULT_DEMO, HAZES, SKY_MODELS, DemoSettings, haze_conflict,
+                                 list_demos, load_demo)
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -170,8 +171,9 @@ def main(argv: list[str] | None = None) -> int:
     from atmos.output import OutputError
     top = parser()
     args = top.parse_args(argv)
-    if getattr(args, "haze", None) == "air" and args.sky != "physical":
-        top.error("--haze air is the physical sky's aerial perspective: it needs --sky physical")
+    conflict = haze_conflict(getattr(args, "haze", "fog"), getattr(args, "sky", "physical"))
+    if conflict:
+        top.error(f"--haze air is {conflict} (--sky physical)")
     commands = {"info": lambda: cmd_info(args), "demo": lambda: cmd_demo(args, top), "run": lambda: cmd_run(args, top),
                 "graph": lambda: cmd_graph(args, top)}
     if args.command not in commands:

@@ -13,6 +13,14 @@ SKY_MODELS = ("preetham", "physical")      # atmos.plugins.sky.MODELS (kept here
 HAZES = ("fog", "air")      # the hazy demos' distance haze: a FogPlugin toward the sky, or the physical sky's aerial perspective
 
 
+def haze_conflict(haze: str, sky: str) -> str | None:
+    """Why ``haze`` cannot go with ``sky`` (the end of a message; None: it can). The one rule that
+    DemoSettings, ``atmos.run`` and the CLI state in their own words."""
+    if haze == "air" and sky != "physical":
+        return f"the physical sky's aerial perspective: it needs sky='physical', got sky={sky!r}"
+    return None
+
+
 @dataclass
 class DemoSettings:
     size: tuple[int, int] = (960, 540)
@@ -27,9 +35,9 @@ class DemoSettings:
         check_choice("DemoSettings", "clouds", self.clouds, CLOUD_RENDERERS)
         check_choice("DemoSettings", "sky", self.sky, SKY_MODELS)
         check_choice("DemoSettings", "haze", self.haze, HAZES)
-        if self.haze == "air" and self.sky != "physical":
-            raise ValueError(f"DemoSettings.haze 'air' is the physical sky's aerial perspective: it needs "
-                             f"sky='physical', got sky={self.sky!r} (or take haze='fog')")
+        conflict = haze_conflict(self.haze, self.sky)
+        if conflict:
+            raise ValueError(f"DemoSettings.haze 'air' is {conflict} (or take haze='fog')")
 
 
 def list_demos() -> dict[str, str]:

@@ -6,7 +6,7 @@ import os
 import sys
 
 from atmos.app import App
-from atmos.demo_registry import CLOUD_RENDERERS, HAZES, SKY_MODELS, DemoSettings, load_demo
+from atmos.demo_registry import CLOUD_RENDERERS, HAZES, SKY_MODELS, DemoSettings, haze_conflict, load_demo
 from atmos.gpu import create_headless
 
 _FILES: dict = {}      # game files loaded so far, by resolved path: each runs once per process
@@ -206,9 +206,9 @@ def run(game, *, size: tuple[int, int] = (960, 540), title: str | None = None, h
     clouds = check_choice("atmos.run", "clouds", clouds, CLOUD_RENDERERS)
     sky = check_choice("atmos.run", "sky", sky, SKY_MODELS)
     haze = check_choice("atmos.run", "haze", haze, HAZES)
-    if haze == "air" and sky != "physical":
-        raise ValueError(f"atmos.run haze='air' is the physical sky's aerial perspective: it needs sky='physical', "
-                         f"got sky={sky!r}")
+    conflict = haze_conflict(haze, sky)
+    if conflict:
+        raise ValueError(f"atmos.run haze='air' is {conflict}")
     if headless is None:
         problem = display_problem()
         headless = problem is not None

@@ -39,7 +39,7 @@ from atmos.lighting import Sun
 from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
 from atmos.plugins.cloud_raymarch.settings import REFERENCE
 from atmos.plugins.cloud_render import CloudRenderPlugin
-from atmos.plugins.cloud_render.light import sun_light
+from atmos.plugins.cloud_render.light import DEFAULT_DIFFUSION, DEFAULT_OCTAVES, sun_light
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
 from atmos.shading.medium import environment
 from atmos.shading.path_tracer import trace
@@ -190,6 +190,11 @@ def errors(image, ref):
     return bias, rmse
 
 
+def less_noise(rmse: float, noise: float) -> float:
+    """A rel. RMSE less the tracer's own (independent errors add in quadrature)."""
+    return math.sqrt(max(rmse ** 2 - noise ** 2, 0.0))
+
+
 def tracer_noise(ref, err):
     """The reference's own standard error: of its image sum (relative) and its rel. RMSE floor."""
     mask = ref.sum(-1) > 1e-3 * ref.sum(-1).max()
@@ -256,7 +261,7 @@ def sprite_pass_cost(rounds=5, frames=9):
 
 
 FIT_FIELDS = OCTAVE_FIELDS + ("ms_diffusion",)
-FIT_START = (0.2, 0.85, 0.85, 0.4)          # the defaults before this search
+FIT_START = (*DEFAULT_OCTAVES, DEFAULT_DIFFUSION)     # the renderers' defaults
 FIT_STEPS = (0.1, 0.1, 0.1, 0.2)
 FIT_LIMITS = ((0.0, 1.0), (0.0, 1.0), (0.0, 1.0), (0.0, 2.0))
 
@@ -276,13 +281,13 @@ def fit(gpu, samples, start=FIT_START, rounds=8):
             ref, err, _ = cached_reference(scene, cam, sun, samples)
             cases.append((scene, (pos, target, elevation), ref, tracer_noise(ref, err)[1], f"{vname}/{view}"))
 
-    def worst(values):
+    def score(values):
         errs = []
         for scene, look, ref, noise, _ in cases:
             scene.look(*look)
             scene.mode(dict(downsample=2, **dict(zip(FIT_FIELDS, values))), None)
             bias, rmse = errors(scene.app.read_linear(), ref)
-            errs.append((bias, math.sqrt(max(rmse ** 2 - noise ** 2, 0.0))))
+            errs.append((bias, less_noise(rmse, noise)))
         return sum(max(abs(b) / 0.10, r / 0.15) ** 8 for b, r in errs) ** 0.125, errs
 
     def show(values, result):
@@ -290,7 +295,7 @@ def fit(gpu, samples, start=FIT_START, rounds=8):
             f"{c[4]} {100 * b:+.1f}/{100 * r:.1f}%" for (b, r), c in zip(result[1], cases)), flush=True)
 
     values, steps = list(start), list(FIT_STEPS)
-    best = worst(values)
+    best = score(values)
     show(values, best)
     for _ in range(rounds):
         gained = False
@@ -298,7 +303,7 @@ def fit(gpu, samples, start=FIT_START, rounds=8):
             for sign in (-1.0, 1.0):
                 trial = list(values)
                 trial[i] = min(max(trial[i] + sign * steps[i], lo), hi)
-                result = None if trial == values else worst(trial)
+                result = None if trial == values else score(trial)
                 if result is not None and result[0] < best[0]:
                     values, best, gained = trial, result, True
                     show(values, best)
@@ -392,7 +397,7 @@ def main(argv=None):
                 ms = scene.frame_ms()
                 table[m][view] = (bias, rmse, ms)
                 row.append(image)
-                clean = math.sqrt(max(rmse ** 2 - noise_rmse ** 2, 0.0))     # independent errors add in quadrature
+                clean = less_noise(rmse, noise_rmse)
                 print(f"{'':11s} {m:16s} {100 * bias:+6.1f}% {100 * rmse:8.1f}% {ms:9.2f} {100 * clean:22.1f}%")
             images.append(row)
         tag = f"{vname}{'_single' if single else ''}"

@@ -159,7 +159,7 @@ def error_vs_time(gpu, rows, volumes, view_names, samples):
                         f"  (change vs octaves 0, not error)")
                     continue
                 bias, rmse = light.errors(image, ref)
-                clean = math.sqrt(max(rmse ** 2 - noise_rmse ** 2, 0.0))
+                clean = light.less_noise(rmse, noise_rmse)
                 results[(vname, view, label)] = dict(bias=bias, rmse=rmse, clean=clean, ms=frame_ms)
                 base = results.get((vname, view, "sprites 1/2"))
                 ratio = frame_ms / base["ms"] if base else float("nan")
