@@ -9,7 +9,8 @@ from atmos.camera import Camera
 from atmos.demo_registry import DemoSettings
 from atmos.gpu import create_headless
 from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
-from atmos.plugins.cloud_far_field.reference import column_profile, column_quantiles, volume_cover
+from atmos.plugins.cloud_far_field.layer import profile_heights
+from atmos.plugins.cloud_far_field.reference import column_profile, column_quantiles, light_by_rank, volume_cover
 from atmos.plugins.clouds import CloudSimulation, CloudsPlugin
 from atmos.plugins.clouds.edge import edge_weight
 from atmos.plugins.clouds.smoothing import read_volume
@@ -120,6 +121,63 @@ def test_the_profile_by_rank_is_the_volumes_vertical_shape(gpu, ctx, shape, base
             assert abs(centre.mean() - base) < abs(centre.mean() - 0.5) or base == 0.5
             spread = np.sqrt((got[..., 0] * (heights - centre[:, None]) ** 2).sum(1) / got[..., 0].sum(1))
             assert spread[-1] > 1.5 * spread[-16], spread              # thicker columns, taller clouds
+    finally:
+        app.close()
+
+
+@pytest.mark.parametrize("clouds", [True, False])
+def test_the_light_by_rank_is_the_volumes_own_light(gpu, ctx, clouds):
+    """light_by_rank.comp (RankLight) against its float64 reference on a fresh random volume: per rank
+    interval the octaves' mean sun transmittances and the diffusion field's mean (phi, F), seen from
+    above and from below, and the field per height bin; the sun lower than the cloud tops shades the
+    bases. No cloud at all: T = 1, the field 0, nothing NaN."""
+    from atmos import App, DefaultPlugins
+    from atmos.lighting import Sun
+    from atmos.plugins.cloud_render import CloudRenderPlugin
+    from atmos.plugins.clouds import CloudSettings
+    from atmos.shading.diffusion import DIFFUSION, read_field
+    rng = np.random.default_rng()
+    shape = (16, 12, 16)
+    d = np.zeros(shape, np.float32)
+    if clouds:
+        x, y, z = np.meshgrid(*[np.arange(k) + 0.5 for k in shape], indexing="ij")
+        for _ in range(6):
+            c, r = rng.uniform([2, 3, 2], [14, 9, 14]), rng.uniform(2.0, 5.0)
+            d = np.maximum(d, np.clip(1.0 - ((x - c[0]) ** 2 + ((y - c[1]) * 1.5) ** 2 + (z - c[2]) ** 2) / r ** 2, 0, 1))
+    medium = CloudSettings(cell_size=(40.0, 30.0, 40.0), base_altitude=400.0, group_size=(4, 4), smoothing_slices=1,
+                           sigma_t=0.03, edge_fade=0.2)
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(medium, density=d),
+                               CloudRenderPlugin(ms_diffusion=1.0), CloudFarFieldPlugin(size=64))
+    app.insert_resource(Sun.from_angles(float(rng.uniform(15.0, 60.0)), float(rng.uniform(0.0, 360.0))))
+    try:
+        app.startup()
+        app.render()
+        far = next(p for p in app.plugins if isinstance(p, CloudFarFieldPlugin))
+        sets = next(p for p in app.plugins if isinstance(p, CloudsPlugin)).simulation.sets()
+        got = far.layer.light.read()
+        assert set(got) == {"sun", "field", "field_profile"}, "the renderer gives the field a weight: measured"
+        _, quantiles = far.layer.read_cover()
+        want = light_by_rank(*(sets.maps_of(s).read_sums()[0] for s in (sets.a, sets.b)),
+                             *(read_volume(s["density"]) for s in (sets.a, sets.b)), sets.t, sets.a_shift, 0.2, quantiles,
+                             heights=profile_heights(shape[1]), attenuation=far.light_settings().ms_attenuation,
+                             column_tau=0.03 * 30.0, trans_a=read_volume(sets.a["transmittance"]),
+                             trans_b=read_volume(sets.b["transmittance"]), field_a=read_field(sets.a[DIFFUSION]),
+                             field_b=read_field(sets.b[DIFFUSION]))
+        for name in ("sun", "field", "field_profile"):
+            assert got[name].shape == want[name].shape and np.isfinite(got[name]).all(), name
+            scale = max(np.abs(want[name]).max(), 1e-3)
+            err = np.abs(got[name] - want[name])
+            assert err.max() < 5e-3 * scale, (name, err.max(), scale, np.unravel_index(err.argmax(), err.shape),
+                                              got[name][np.unravel_index(err.argmax(), err.shape)[:2]],
+                                              want[name][np.unravel_index(err.argmax(), err.shape)[:2]])
+        if clouds:
+            covered = quantiles[:-1] > 1e-6
+            assert covered.sum() >= 4 and got["field"][..., 0].max() > 0.05, "the volume scatters light"
+            above, below = got["sun"][covered, 0, 0], got["sun"][covered, 1, 0]
+            assert below.mean() < above.mean() - 0.05, f"the bases are in the clouds' own shadow: {above} vs {below}"
+            assert np.all((got["sun"] >= 0) & (got["sun"] <= 1))
+        else:
+            assert np.all(got["sun"] == 1.0) and np.all(got["field"] == 0.0)
     finally:
         app.close()
 

@@ -67,12 +67,17 @@ def field_reference(app) -> FarField:
     _, columns = layer.read_cover()
     return FarField(params.light_step * layer.tile_size,
                     octaves=[layer.octaves.download(k) for k in range(4)], offsets=drift(params, sim, 0.0, layer.tile_size),
-                    tile_size=layer.tile_size, quantiles=quantiles, columns=columns, profile=layer.read_profile())
+                    tile_size=layer.tile_size, quantiles=quantiles, columns=columns, profile=layer.read_profile(),
+                    field_profile=layer.light.read().get("field_profile"))
 
 
-def test_the_far_field_march_matches_its_float64_reference(gpu, ctx):
-    app = scene(gpu, steps=256)
-    cam = aim(app, (-2500.0, BASE + 900.0, 200.0), yaw=-np.pi / 2, pitch=-0.3)   # outside, above, looking away
+@pytest.mark.parametrize("yaw, fields", [(-np.pi / 2, {}), (0.0, dict(ms_diffusion=2.0))])
+def test_the_far_field_march_matches_its_float64_reference(gpu, ctx, yaw, fields):
+    """Outside the volume, above it, looking away from it. Yaw 0 looks across the sun, where the far
+    field's light from the volume's diffusion field by rank (RankLight) is half the image: the reference
+    without it is far off (the test can fail)."""
+    app = scene(gpu, steps=256, **fields)
+    cam = aim(app, (-2500.0, BASE + 900.0, 200.0), yaw=yaw, pitch=-0.3)
     image = app.read_linear()[::-1].astype(np.float64)
     shape = of(app, CloudFarFieldPlugin).layer.read_profile()[-1, :, 0]
     assert np.allclose(shape, PROFILE / PROFILE.sum(), atol=1e-3), "the far field's profile is the volume's"
@@ -88,6 +93,13 @@ def test_the_far_field_march_matches_its_float64_reference(gpu, ctx):
     assert rmse < 0.03, f"colour off the reference: relative RMSE {rmse:.4f}"
     off = np.abs(image[..., 3] - alpha)
     assert np.percentile(off, 99) < 0.01 and off.mean() < 0.003, f"coverage off the reference: {off.max():.4f}"
+    if fields:
+        far = field_reference(app)
+        assert far.field_profile is not None, "the sets carry a diffusion field"
+        far.field_profile = None
+        without = far_march_reference(far, sim.settings, of(app, RaymarchCloudsPlugin).settings, band, cam, DAY,
+                                      gpu.size)["light"]
+        assert np.sqrt(np.mean((image[..., :3] - without) ** 2)) / np.sqrt(np.mean(without ** 2)) > 0.3
     app.close()
 
 

@@ -107,6 +107,12 @@ def next_step_reads(name):
     return observe
 
 
+def light_channels(app, plugin):
+    """The far field's baked light-march channels (the ray march's far field marches the sun through
+    them; the 2D layer takes the volume's light by rank instead)."""
+    return np.asarray(plugin.layer.octaves.download(0), np.float64)[..., 1:]
+
+
 def shading_extinction(app, plugin):
     """The extinction the next step's shading task latches."""
     task = next(s for s in plugin.simulation.job.tasks if isinstance(s, ShadingTask))
@@ -360,7 +366,7 @@ SPECS = {
         look((320.0, 60.0, 320.0), yaw=0.3, pitch=0.15, far=60000.0),     # the horizon beyond the volume
         dict(thickness=0.5, tile_size=1000.0, wind=(500.0, 0.0), horizon_fade=0.9,
              size=16, base_frequency=9, seed=7, light_step=0.2, animate=False, enabled=False),
-        before={"animate": configure_first(wind=(500.0, 0.0))}),
+        before={"animate": configure_first(wind=(500.0, 0.0))}, observe={"light_step": light_channels}),
 }
 
 

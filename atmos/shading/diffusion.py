@@ -172,15 +172,19 @@ def diffusion_radiance(field_volume, uvw, dirs, g: float) -> np.ndarray:
     (..., 3, unit, toward the eye's travel): trilinear (clamp to edge) like the renderers' fetch."""
     f = np.asarray(field_volume, np.float64)
     p = np.asarray(uvw, np.float64) * np.array(f.shape[:3]) - 0.5
-    v = np.stack([multilinear(f[..., k], p) for k in range(4)], -1)
+    return field_radiance(np.stack([multilinear(f[..., k], p) for k in range(4)], -1), dirs, g)
+
+
+def field_radiance(values, dirs, g: float) -> np.ndarray:
+    """max(phi - 3 g F.d, 0) / 4pi of field values ``values`` (..., 4) = (phi, F) for view rays ``dirs``."""
+    v = np.asarray(values, np.float64)
     return np.maximum(v[..., 0] - 3 * g * (v[..., 1:] * np.asarray(dirs)).sum(-1), 0.0) / (4 * math.pi)
 
 
-def diffusion_weight(beta: float, sun_dir, cos_view) -> np.ndarray:
-    """beta max(sun_y, 0) (1 - cos^2)^4: the fitted weight of the field's radiance (cos = view . sun)."""
-    s = np.asarray(sun_dir, np.float64) / np.linalg.norm(sun_dir)
+def diffusion_weight(beta: float, cos_view) -> np.ndarray:
+    """beta (1 - cos^2)^4: the fitted weight of the field's radiance (cos = view . sun)."""
     c = np.asarray(cos_view, np.float64)
-    return beta * max(s[1], 0.0) * (1.0 - c * c) ** 4
+    return beta * (1.0 - c * c) ** 4
 
 
 def diffusion_desc(shape, scale: int) -> TextureDesc:

@@ -111,7 +111,7 @@ def source_reference(settings, render, T, tau_up, tau_down, cos, ray_y, sun_colo
               for i in range(OCTAVES))
     if diffusion is not None:
         from atmos.shading.diffusion import diffusion_weight
-        sun = sun + diffusion_weight(render.ms_diffusion, sun_dir, cos) * np.asarray(diffusion, np.float64)
+        sun = sun + diffusion_weight(render.ms_diffusion, cos) * np.asarray(diffusion, np.float64)
     h = ambient_profile(tau_up, tau_down, g_mean, ray_y)[..., None]
     amb = 0.5 * (l_sky + l_ground) + 0.5 * h * (l_sky - l_ground)
     return settings.albedo * (sun[..., None] * e + amb)

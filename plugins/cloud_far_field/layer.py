@@ -10,7 +10,8 @@ with the same function (``shaders/cloud_far_field/field.glsl``). The plugin impo
 graph resource ``"far_field"``; each pass that uses it calls :meth:`prepare` (re-bakes the octaves
 when the sun turned, measures the cover) and :meth:`use`. The same measure gives the volume's vertical
 shape by rank (:attr:`FarFieldLayer.profile`, :meth:`read_profile`), which the ray march's volumetric
-far field takes its density from.
+far field takes its density from; a second dispatch its light by rank (:attr:`FarFieldLayer.light`,
+:mod:`.rank_light`), which both far fields light their columns with.
 """
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ import numpy as np
 
 from atmos.plugins.cloud_far_field.cover import QUANTILES, level_table, matched_tile_size, pattern_crossings
 from atmos.plugins.cloud_far_field.pattern import PERIODS, octave_frequencies, octave_offsets, rotations
+from atmos.plugins.cloud_far_field.rank_light import RankLight
 from atmos.plugins.cloud_render.light import light_uniforms
 from atmos.plugins.clouds.sets import CloudSets
 from atmos.plugins.sky_layer.octaves import OctaveTextures
@@ -74,6 +76,7 @@ class FarFieldLayer:
         self._tile_time = None               # App time of the last update_tile
         self._matched = False                # tile_size follows a measure (else the first one sets it)
         self.profile = None                  # (INTERVALS, heights) rg32f: the volume's shape by rank (cover.comp)
+        self.light = RankLight(gpu)          # the volume's light by rank (light_by_rank.comp)
         self._prepared = None                # the SceneView of the frame prepared last (held: never a reused id)
 
     @property
@@ -81,8 +84,9 @@ class FarFieldLayer:
         return self.plugin.settings
 
     def prepare(self, view, sim: CloudSets) -> None:
-        """Bake (when needed) and measure the cover (one small dispatch), once per frame: every user
-        (the far-field pass or the march, the shadows, the shafts) calls it, the first one does it."""
+        """Bake (when needed), measure the cover and the light by rank (two small dispatches), once per
+        frame: every user (the far-field pass or the march, the shadows, the shafts) calls it, the first
+        one does it."""
         if view is self._prepared:
             return
         self._prepared = view
@@ -91,6 +95,7 @@ class FarFieldLayer:
         if self.octaves.needs_bake(params, sun_dir, REBAKE_TOLERANCE):
             self.octaves.bake(params, sun_dir, octave_frequencies(params.base_frequency), rotations())
         self.measure_cover(sim)
+        self.light.measure(sim, self.cover, self.plugin.light_settings().ms_attenuation, profile_heights(sim.shape[1]))
         self.update_tile(sim, float(view.time))
 
     def update_tile(self, sim: CloudSets, time: float) -> None:
@@ -188,6 +193,7 @@ class FarFieldLayer:
         self.cover.bind_to_storage_buffer(0)
         if "far_profile" in program and self.profile is not None:
             self.profile.use(PROFILE_UNIT)
+        self.light.use(program)
         time = float(view.time) if params.animate else 0.0
         layout = sim.layout()
         camera = np.asarray(view.camera.position, np.float64)
@@ -217,6 +223,9 @@ class FarFieldLayer:
         if self.profile is not None:
             self.profile.release()
             self.profile = None
+        if self.light is not None:
+            self.light.release()
+            self.light = None
 
 
 def _transitions(buffer) -> tuple[float, float]:

@@ -9,7 +9,8 @@ from atmos.graph import FullscreenPass, PassContext
 from atmos.plugin import Plugin
 from atmos.plugins.cloud_far_field.layer import FAR_FIELD, FarFieldLayer
 from atmos.plugins.cloud_far_field.settings import CloudFarFieldSettings
-from atmos.plugins.cloud_render.light import light_uniforms
+from atmos.plugins.cloud_render.light import CloudLightSettings, light_uniforms
+from atmos.plugins.clouds.field_demand import field_demand
 from atmos.plugins.clouds.sets import CLOUD_SETS, CloudSets
 from atmos.render_core import COLOR, DEPTH
 
@@ -46,7 +47,9 @@ class CloudFarFieldPass(FullscreenPass):
         layer.use(p, view, sim)
         frame.resource(DEPTH).use(9)
         set_camera_uniforms(p, view.camera, view.aspect)
-        values = dict(light_uniforms(sim.settings, view.sun, altitude=layout.middle_altitude),
+        light = self.plugin.light_settings()       # the renderer's octaves; its field's weight where measured
+        diffusion = light.ms_diffusion if layer.light.has_field else 0.0
+        values = dict(light_uniforms(sim.settings, view.sun, light.octaves, diffusion, layout.middle_altitude),
                       footprint_min=tuple(layout.lo[[0, 2]]), footprint_size=tuple(layout.hi[[0, 2]] - layout.lo[[0, 2]]),
                       edge_fade=float(sim.settings.edge_fade),
                       lod_scale=float(params.size / layer.tile_size * 2.0 * np.tan(view.camera.fov_y / 2)
@@ -73,6 +76,7 @@ class CloudFarFieldPlugin(Plugin):
         self.composition = composition(app)
         self.composition.writers.add("cloud_far_field")   # the fog gets the layer's own distance
         self.layer = FarFieldLayer(app.gpu, self)          # also read by the ground shadows
+        self.demand = field_demand(app)                    # the cloud renderers (light_settings)
         self.marchers = set()       # renderers that may march the far field themselves (drawn_by_march)
         app.graph.import_resource(FAR_FIELD, self.layer)
         self.pass_ = CloudFarFieldPass(self)
@@ -85,6 +89,11 @@ class CloudFarFieldPlugin(Plugin):
         comp = getattr(self, "composition", None)
         if comp is not None:
             comp.writers.discard("cloud_far_field")
+
+    def light_settings(self) -> CloudLightSettings:
+        """The octaves and field weight the far field is lit with: the cloud renderer's (FieldDemand.light;
+        the defaults without one), so the far clouds continue the volume's light."""
+        return self.demand.light() or CloudLightSettings()
 
     def drawn_by_march(self) -> bool:
         """Whether a cloud renderer marches the far field itself this frame (a registered renderer's

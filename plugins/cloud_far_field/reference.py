@@ -1,4 +1,5 @@
-"""numpy float64 reference of the far field's GPU cover measure (``cloud_far_field/cover.comp``)."""
+"""numpy float64 references of the far field's GPU measures (``cloud_far_field/cover.comp``,
+``cloud_far_field/light_by_rank.comp``) and of its pattern."""
 from __future__ import annotations
 
 import numpy as np
@@ -85,6 +86,80 @@ def column_profile(density_a, density_b, t: float, a_shift, fade: float, quantil
         p = profile[src]
         out[i, :, 0] = p * heights / (total[src] * ny)
         out[i, :, 1] = (p[::-1].cumsum()[::-1] - 0.5 * p) / total[src]
+    return out
+
+
+def light_by_rank(sums_a, sums_b, density_a, density_b, t: float, a_shift, fade: float, quantiles, *, heights: int,
+                  attenuation: float, column_tau: float, trans_a=None, trans_b=None, field_a=None, field_b=None,
+                  bins: int = 16) -> dict:
+    """``light_by_rank.comp`` of mix(A, B, t) (A read at ``c + a_shift``, zero past its edge; ``sums_a/b``
+    (nx, nz) column sums, ``density_a/b`` (nx, ny, nz), the optional sun transmittance ``trans_a/b`` and
+    diffusion field ``field_a/b`` (x, y, z, 4) on their own grids, each read at the texel nearest a density
+    cell's centre, clamped): per rank interval of ``quantiles`` the edge-weighted mean over its covered
+    columns of each column's mean (T, T^a, T^a², T^a³) and (phi, F) at its ``heights`` samples, weighted
+    by density × the vertical transmittance to the column's top (row 0) or base (row 1); and per height
+    bin (of min(heights, bins)) the columns' density-weighted (phi, F). Returns dict sun (32, 2, 4) and,
+    with a field, field (32, 2, 4), field_profile (32, bins, 4); filled as the shader fills them."""
+    def mixed(a, b, cells):
+        """mix(A, B, t) of grid a, b (x, y, z, ...) at the texels nearest density ``cells`` (n, 3)."""
+        out = []
+        for grid, shift in ((np.asarray(a, np.float64), np.array([a_shift[0], 0, a_shift[2]])), (np.asarray(b, np.float64), 0)):
+            m = np.array(grid.shape[:3])
+            i = np.clip(((cells + shift + 0.5) / n * m).astype(np.int64), 0, m - 1)
+            out.append(grid[i[:, 0], i[:, 1], i[:, 2]])
+        return (1.0 - t) * out[0] + t * out[1]
+
+    n = np.array(np.shape(density_b))
+    nx, ny, nz = n
+    sums = (1.0 - t) * shifted(np.asarray(sums_a, np.float64), a_shift) + t * np.asarray(sums_b, np.float64)
+    uv = np.stack(np.meshgrid((np.arange(nx) + 0.5) / nx, (np.arange(nz) + 0.5) / nz, indexing="ij"), -1)
+    units = np.round(edge_weight(uv, fade) * 1024.0)
+    q = np.asarray(quantiles, np.float64)
+    rows = np.minimum(((np.arange(heights) + 0.5) * ny / heights).astype(np.int64), ny - 1)
+    bins = min(int(heights), int(bins))
+    in_bin = np.arange(heights) * bins // heights
+    field = field_a is not None and field_b is not None
+    weight, sun_sum, field_sum = np.zeros((32, 2)), np.zeros((32, 2, 4)), np.zeros((32, 2, 4))
+    bin_weight, bin_sum = np.zeros((32, bins)), np.zeros((32, bins, 4))
+    for x, z in zip(*np.nonzero((sums > 1e-6) & (units > 0))):
+        k = min(max(int(np.searchsorted(q, sums[x, z], side="right")) - 1, 0), 31)
+        cells = np.stack([np.full(heights, x), rows, np.full(heights, z)], -1)
+        d = np.clip(mixed(density_a, density_b, cells), 0.0, 1.0)
+        tau = column_tau * units[x, z] / 1024.0 * ny / heights * d
+        below = np.cumsum(tau)
+        seen = d[:, None] * np.stack([np.exp(-(below[-1] - below + 0.5 * tau)), np.exp(-(below - 0.5 * tau))], -1)
+        T = np.ones(heights) if trans_a is None else np.clip(mixed(trans_a, trans_b, cells), 0.0, 1.0)
+        sun = np.stack([T ** (attenuation ** i) for i in range(4)], -1)
+        v = np.zeros((heights, 4))
+        if field:
+            f = mixed(field_a, field_b, cells)
+            phi = np.clip(f[:, 0], 0.0, 8.0)
+            v = np.concatenate([phi[:, None], np.clip(f[:, 1:], -phi[:, None], phi[:, None])], -1)
+            dw, dv = np.zeros(bins), np.zeros((bins, 4))
+            np.add.at(dw, in_bin, d)
+            np.add.at(dv, in_bin, d[:, None] * v)
+            has = dw > 0
+            bin_weight[k, has] += units[x, z]
+            bin_sum[k, has] += units[x, z] * dv[has] / dw[has, None]
+        s = seen.sum(0)
+        for view in np.flatnonzero(s > 0):
+            weight[k, view] += units[x, z]
+            sun_sum[k, view] += units[x, z] * (seen[:, view, None] * sun).sum(0) / s[view]
+            field_sum[k, view] += units[x, z] * (seen[:, view, None] * v).sum(0) / s[view]
+    filled = np.flatnonzero(weight[:, 0] > 0)
+    out = {"sun": np.ones((32, 2, 4))}
+    if field:
+        out.update(field=np.zeros((32, 2, 4)), field_profile=np.zeros((32, bins, 4)))
+    for i in range(32):
+        if not len(filled):
+            continue
+        k = filled[np.argmin(np.abs(filled - i) * 2 + (filled < i))]      # nearest, above first on a tie
+        w = weight[k][:, None]
+        out["sun"][i] = np.where(w > 0, sun_sum[k] / np.maximum(w, 1e-300), 1.0)
+        if field:
+            out["field"][i] = np.where(w > 0, field_sum[k] / np.maximum(w, 1e-300), 0.0)
+            b = bin_weight[k][:, None]
+            out["field_profile"][i] = np.where(b > 0, bin_sum[k] / np.maximum(b, 1e-300), out["field"][i, 0])
     return out
 
 

@@ -18,8 +18,9 @@ class CloudFarFieldSettings(CheckedSettings):
     point whose fbm has rank r in the layer gets the volume's column sum at the same rank (its
     edge-weighted column-sum quantiles), vertical optical depth τ = thickness · sigma_t · cell height ·
     that sum, seen along the view's slant (α = 1 − exp(−τ / |dir.y|), capped near the horizon); 0: no far field.
-    Its light comes from the cloud medium's own model (``cloud_render/volume.glsl``) with the same
-    column (toward the sun along the sun's slant); the ground shadows (:mod:`atmos.plugins.cloud_shadows`)
+    Its light comes from the cloud medium's own model (``cloud_render/volume.glsl``) with the volume's own
+    light at the same rank (:mod:`.rank_light`: its columns' sun transmittances and diffusion field, and
+    the drawing renderer's octaves); the ground shadows (:mod:`atmos.plugins.cloud_shadows`)
     and light shafts take the same column beyond the volume. ``tile_size``: None (the default) sizes the clouds
     from the volume's: the tile is chosen each frame (followed over a few seconds) so that the far field's
     cover changes along a line as often per metre as the volume's measured cover does (cover.comp); a
@@ -29,7 +30,9 @@ class CloudFarFieldSettings(CheckedSettings):
     so volume and far field drift together; an (x, z) tuple drifts it at that many m/s with the App
     clock instead. ``animate`` False holds it still. ``horizon_fade``: it fades in while the view ray's
     height rises from 0 to this (sin of the elevation). ``size``, ``base_frequency``, ``seed``,
-    ``light_step``: the octave textures (:class:`atmos.plugins.sky_layer.octaves.OctaveTextures`).
+    ``light_step``: the octave textures (:class:`atmos.plugins.sky_layer.octaves.OctaveTextures`;
+    ``light_step``: the spacing of their light-march channels, which the ray march's volumetric far
+    field marches the sun through).
     ``enabled`` False draws nothing.
     """
 

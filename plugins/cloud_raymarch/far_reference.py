@@ -9,13 +9,14 @@ from atmos.plugins.cloud_far_field.reference import column_at_rank, field_fbm, f
 from atmos.plugins.cloud_raymarch.far import SUN_STEPS, sun_steps
 from atmos.plugins.cloud_raymarch.reference import integrate, rays
 from atmos.plugins.cloud_render.light import sun_light, unit_direction
-from atmos.shading.medium import source_reference
+from atmos.shading.diffusion import field_radiance
+from atmos.shading.medium import mean_cosine, source_reference
 
 
 def sample_profile(profile, rank, h) -> np.ndarray:
-    """far.glsl's textureLod(far_profile, (rank, h)): ``profile`` (intervals, heights, 2)
-    (FarFieldLayer.read_profile) bilinear, texel (k, j) centred at ((k + 0.5)/intervals, (j + 0.5)/heights),
-    clamped to the edge; returns (..., 2) (R, G)."""
+    """far.glsl's textureLod(far_profile, (rank, h)): ``profile`` (intervals, heights, channels)
+    (FarFieldLayer.read_profile: (R, G); RankLight's field_profile: (phi, F)) bilinear, texel (k, j)
+    centred at ((k + 0.5)/intervals, (j + 0.5)/heights), clamped to the edge; returns (..., channels)."""
     table = np.asarray(profile, np.float64)
     n, m = table.shape[:2]
     rank, h = np.broadcast_arrays(np.asarray(rank, np.float64), np.asarray(h, np.float64))
@@ -37,13 +38,16 @@ class FarField:
     ``tile_size``) ranked among the layer's ``quantiles`` (level 0); a point of rank r holds the
     volume's column sum at r (``columns``: its QUANTILES column-sum quantiles in cells,
     FarFieldLayer.read_cover) spread over height by ``profile`` (FarFieldLayer.read_profile);
-    ``light_step_m`` the channels' spacing toward the sun (m)."""
+    ``light_step_m`` the channels' spacing toward the sun (m); ``field_profile``: the diffusion field's
+    mean (phi, F) by rank and height (RankLight.read()["field_profile"]; None: no field)."""
 
-    def __init__(self, light_step_m: float, *, octaves, offsets, tile_size: float, quantiles, columns, profile):
+    def __init__(self, light_step_m: float, *, octaves, offsets, tile_size: float, quantiles, columns, profile,
+                 field_profile=None):
         self.light_step_m = float(light_step_m)
         self.field = dict(octaves=octaves, offsets=offsets, tile_size=tile_size)
         self.quantiles, self.columns = np.asarray(quantiles, np.float64), np.asarray(columns, np.float64)
         self.profile = np.asarray(profile, np.float64)
+        self.field_profile = None if field_profile is None else np.asarray(field_profile, np.float64)
 
     def rank(self, xz) -> np.ndarray:
         return field_rank(field_fbm(xz, **self.field), self.quantiles)
@@ -78,7 +82,12 @@ def far_source(field: FarField, medium, settings, p, dirs, band, sun) -> np.ndar
     above = sample_profile(field.profile, c[:, 0], np.clip(h, 0.0, 1.0))[..., 1]
     up, down = column * above, column * (1.0 - above)
     sun_color, ambient = sun_light(sun, band[0] + 0.5 * band[1])
-    return source_reference(medium, settings, T, up, down, dirs @ sun_dir, dirs[:, 1], sun_color, ambient, sun_dir)
+    diffusion = None
+    if field.field_profile is not None and settings.ms_diffusion > 0:       # the volume's field at this rank
+        values = sample_profile(field.field_profile, c[:, 0], np.clip(h, 0.0, 1.0))
+        diffusion = field_radiance(values, dirs, mean_cosine(medium.phase_g, medium.phase_g2, medium.phase_w))
+    return source_reference(medium, settings, T, up, down, dirs @ sun_dir, dirs[:, 1], sun_color, ambient, sun_dir,
+                            diffusion)
 
 
 def far_march_reference(field: FarField, medium, settings, band, camera, sun, size) -> dict:

@@ -11,21 +11,21 @@ from atmos.lighting import Sun
 from atmos.shading.medium import environment
 
 DEFAULT_AMBIENT = (0.35, 0.47, 0.65)
-DEFAULT_OCTAVES = (0.2, 0.85, 0.85)       # Wrenninge's a, b, c, fitted to the path tracer (bench_cloud_light --fit)
-DEFAULT_DIFFUSION = 0.4                   # the diffusion field's weight beta (fitted beside the octaves, README "Cloud light")
+DEFAULT_OCTAVES = (0.44, 0.86, 0.9)       # Wrenninge's a, b, c, fitted to the path tracer (bench_cloud_light --fit)
+DEFAULT_DIFFUSION = 1.0                   # the diffusion field's weight beta, fitted with them (README "Cloud light")
 
 
 @dataclass(frozen=True)
 class CloudLightSettings(CheckedSettings):
     """The multiple-scattering octaves both cloud renderers share (the sprites' CloudRenderSettings
     and the march's RaymarchCloudSettings inherit them): ``ms_attenuation``, ``ms_contribution``,
-    ``ms_eccentricity`` = Wrenninge's a, b, c in [0, 1] (the defaults are fitted to the path tracer;
-    ``benchmarks/bench_cloud_light.py --fit``'s search on today's framing scores them 1.44, its best
-    1.41: README "Cloud light"). ``ms_diffusion`` (0..2): the weight beta of the diffusion
-    field beside them (:mod:`atmos.shading.diffusion`: J += sun_source beta max(sun_y, 0) (1 - cos^2)^4
-    max(phi - 3 g F.ray, 0) / 4pi, cos = ray . sun); 0.4 was fitted on the bench's two volumes in four
-    views (gate cost -32 % in the float64 twin); 0 turns the term off (and, with no other reader,
-    the field's solve: ``plugins/clouds/field_demand.py``). A subclass's ``__post_init__`` stores
+    ``ms_eccentricity`` = Wrenninge's a, b, c in [0, 1]; ``ms_diffusion`` (0..2): the weight beta of
+    the diffusion field beside them (:mod:`atmos.shading.diffusion`: J += sun_source beta (1 - cos^2)^4
+    max(phi - 3 g F.ray, 0) / 4pi, cos = ray . sun); 0 turns the term off (and, with no other reader,
+    the field's solve: ``plugins/clouds/field_demand.py``). The defaults are the search
+    ``benchmarks/bench_cloud_light.py --fit`` found against the path tracer on the bench's two volumes
+    in four views (score 1.21; README "Cloud light"). The 2D far field is lit with the drawing
+    renderer's settings (``CloudFarFieldPlugin.light_settings``). A subclass's ``__post_init__`` stores
     :meth:`light_checks` beside its own checks (alone, the class checks just these)."""
     ms_attenuation: float = DEFAULT_OCTAVES[0]
     ms_contribution: float = DEFAULT_OCTAVES[1]

@@ -22,6 +22,14 @@ class FieldDemand:
         """True when an enabled reader gives the field a weight (``ms_diffusion``) above 0."""
         return any(r.settings.enabled and r.settings.ms_diffusion > 0 for r in self.readers)
 
+    def light(self):
+        """The light settings (a CloudLightSettings: octaves, ``ms_diffusion``) of the renderer that draws
+        the clouds, for passes that light clouds without being a renderer (the 2D far field): an enabled
+        reader's (the one giving the field the most weight), else any reader's; None: no renderer."""
+        readers = sorted(self.readers, key=lambda r: (bool(r.settings.enabled), float(r.settings.ms_diffusion),
+                                                      type(r).__name__))
+        return readers[-1].settings if readers else None
+
 
 def field_demand(app) -> FieldDemand:
     """The App's :class:`FieldDemand` (made on first use)."""

@@ -20,25 +20,15 @@
 #ifndef PROFILE
 #define PROFILE 0
 #endif
-#include "clouds/edge.glsl"
+#include "cloud_far_field/columns.glsl"
 layout(local_size_x = 256) in;
-layout(binding = 0) uniform sampler2DArray sums_a;
-layout(binding = 1) uniform sampler2DArray sums_b;
 #if PROFILE
-layout(binding = 14) uniform sampler3D density_a;   // the sets' density (units no renderer binds)
-layout(binding = 15) uniform sampler3D density_b;
 layout(rg32f, binding = 0) writeonly uniform image2D column_profile;   // (32 intervals, P heights)
 #endif
 layout(std430, binding = 0) writeonly buffer Cover { float cover; float column_quantiles[33]; float transitions; };
-uniform float t;
-uniform ivec2 a_shift;
 uniform float threshold;
-uniform float edge_fade;
 uniform float max_sum;         // the histogram's range: the layer's height in cells
 const int BINS = 256;
-const float WEIGHT_UNIT = 1024.0;   // fixed point of the edge weights in the histogram
-const float EMPTY = 1e-6;           // a column sum at or below this is empty
-const int INTERVALS = 32;           // rank intervals of the profile (between the 33 quantiles)
 const int MAX_HEIGHTS = 64;         // most height samples P (FarFieldLayer sizes the image)
 const float DENSITY_UNIT = 16.0;    // fixed point of density x weight units (density clamped to 1)
 shared vec2 partial[256];
@@ -48,22 +38,6 @@ shared float quantile[33];
 #if PROFILE
 shared uint profile[INTERVALS * MAX_HEIGHTS];
 shared float total[INTERVALS];
-#endif
-
-// Column p's sum of mix(A, B, t) (A read at p + a_shift, empty past its edge).
-float column_sum(ivec2 p, ivec2 n) {
-    ivec2 pa = p + a_shift;
-    float a = any(lessThan(pa, ivec2(0))) || any(greaterThanEqual(pa, n)) ? 0.0 : texelFetch(sums_a, ivec3(pa, 0), 0).r;
-    return mix(a, texelFetch(sums_b, ivec3(p, 0), 0).r, t);
-}
-
-#if PROFILE
-// Cell c's density of mix(A, B, t), clamped to [0, 1].
-float column_density(ivec3 c, ivec3 n) {
-    ivec3 ca = c + ivec3(a_shift.x, 0, a_shift.y);
-    float a = any(lessThan(ca, ivec3(0))) || any(greaterThanEqual(ca, n)) ? 0.0 : texelFetch(density_a, ca, 0).r;
-    return clamp(mix(a, texelFetch(density_b, c, 0).r, t), 0.0, 1.0);
-}
 #endif
 
 void main() {
@@ -126,17 +100,11 @@ void main() {
     for (int c = int(i); c < n.x * n.y; c += 256) {
         ivec2 p = ivec2(c % n.x, c / n.x);
         float s = column_sum(p, n);
-        uint units = uint(round(cloud_edge_weight((vec2(p) + 0.5) / vec2(n), edge_fade) * WEIGHT_UNIT));
+        uint units = column_units(p, n);
         if (s <= EMPTY || units == 0u) continue;
-        int lo = 0, hi = 32;                // the interval [q_lo, q_lo+1] holding s
-        for (int k = 0; k < 5; ++k) {
-            int mid = (lo + hi) / 2;
-            if (quantile[mid] <= s) lo = mid; else hi = mid;
-        }
-        int k = min(lo, INTERVALS - 1);
+        int k = rank_interval(quantile, s);
         for (int j = 0; j < heights; ++j) {
-            int y = min(int((float(j) + 0.5) * float(size.y) / float(heights)), size.y - 1);
-            float d = column_density(ivec3(p.x, y, p.y), size);
+            float d = column_density(ivec3(p.x, sample_row(j, heights, size.y), p.y), size);
             atomicAdd(profile[k * MAX_HEIGHTS + j], uint(round(d * DENSITY_UNIT * float(units))));
         }
     }

@@ -2,16 +2,20 @@
 // The cloud field beyond the simulated volume (float64 reference: atmos/plugins/cloud_far_field/
 // reference.py). The view ray meets the layer's middle plane y = field_mid_height at the view depth s;
 // where that is in front of the scene, r = far_field_rank there (field.glsl: the fraction of the
-// layer's fbm below the point's, per light-march channel) and the column takes the volume's own
+// layer's fbm below the point's) and the column takes the volume's own
 // column sum at the same rank (far_quantile: column_quantiles, cover.comp), so it is as thick per
 // cover as the volume, from the medium, with no hand-set opacity:
-//   tau = thickness * column_tau * far_quantile(r)   (column_tau = sigma_t * cell height; four channels)
-//   alpha = (1 - exp(-tau.x / max(|dir.y|, MIN_SLANT))) * (1 - edge weight at the hit) * smoothstep(0, horizon_fade, |ray.y|)
+//   tau = thickness * column_tau * far_quantile(r)   (column_tau = sigma_t * cell height)
+//   alpha = (1 - exp(-tau / max(|dir.y|, MIN_SLANT))) * (1 - edge weight at the hit) * smoothstep(0, horizon_fade, |ray.y|)
 // (the view crosses the column along its slant, capped at the horizon), lit by the cloud medium's own
-// model (cloud_render/volume.glsl): from the column's middle the sun's ray climbs half the column over
-// a path 1/sun_dir.y times longer (capped like the view), through the mean of the four channels:
-// sun transmittance exp(-0.5 mean(tau) / max(sun_dir.y, MIN_SLANT)); sky light with tau.x half above,
-// half below. Premultiplied (blend_over).
+// model (cloud_render/volume.glsl) with the volume's own light at the same rank (RankLight,
+// light_by_rank.comp; as seen from above when the view looks down, else from below): the octaves' sun
+// transmittances (T, T^a, T^a^2, T^a^3) of the volume's columns of rank r, to the power `thickness`
+// (optical depths scale with it), times the relief of the layer toward the sun, exp(-a^i relief) with
+// relief = 0.5 (mean(tau of the four light-march channels) - tau) / max(sun_dir.y, MIN_SLANT) (the
+// channels: the rank 0..3 light steps toward the sun; 0 on average), and, where the sets carry a
+// diffusion field, its light from their mean (phi, F); sky light with tau half above, half below.
+// Premultiplied (blend_over).
 // frag_distance: (alpha * distance to the hit, alpha), "cloud_distance" when attached (atmos/composition.py).
 #include "lib/view_ray.glsl"
 #include "cloud_far_field/field.glsl"
@@ -29,6 +33,8 @@ uniform vec2 footprint_size;
 uniform float thickness;
 uniform float horizon_fade;
 const float MIN_SLANT = 0.1;     // the horizon's slant cap (about 6 degrees)
+layout(binding = 18) uniform sampler2D far_sun_by_rank;   // RankLight.sun: (rank, seen from above | below) -> T^(a^i)
+layout(binding = 19) uniform sampler2D far_field_light;   // RankLight.field: (rank, seen from above | below) -> (phi, F)
 uniform float lod_scale;       // texels per metre × a pixel's angle (rad): the mip level from the footprint,
                                // not from screen derivatives (the same under any camera roll)
 
@@ -50,13 +56,17 @@ void main() {
     float lod = log2(max(lod_scale * length(hit - camera_pos) / max(abs(dir.y), 1e-3), 1e-6));
     vec4 r = far_field_rank(hit.xz, lod);
     vec4 col = thickness * column_tau * vec4(far_quantile(r.x), far_quantile(r.y), far_quantile(r.z), far_quantile(r.w));
-    // (the sky layer's own amount, max(d - SKY_LAYER_RAY, 0) / 4, is a quarter of the vertical depth
-    // even for a grazing sun: its tops lit 1.5-2x brighter than the volume's from above at sunset)
-    float amount = 0.5 * dot(col, vec4(0.25)) / max(sun_dir.y, MIN_SLANT);
     float tau = col.x;
     float alpha = (1.0 - exp(-tau / max(abs(dir.y), MIN_SLANT))) * fade;
-    vec3 light = sun_part(octave_weights(exp(-amount), tau), dot(dir, sun_dir))
-               + ambient_source(0.5 * tau, 0.5 * tau, dir.y);
+    vec2 at = vec2(r.x, dir.y < 0.0 ? 0.25 : 0.75);        // row 0: seen from above, 1: from below
+    // relief: the sun's extra optical depth through the channels toward it over a column as thick all
+    // round (0 on average): lit edges facing the sun, shaded ones behind
+    float relief = 0.5 * (dot(col, vec4(0.25)) - tau) / max(sun_dir.y, MIN_SLANT);
+    float a = ms_octaves.x;
+    vec4 sun = min(pow(max(textureLod(far_sun_by_rank, at, 0.0), 0.0), vec4(thickness))
+                   * exp(-relief * vec4(1.0, a, a * a, a * a * a)), 1.0);
+    vec3 light = sun_part(octave_weights_of(sun, tau), dot(dir, sun_dir)) + ambient_source(0.5 * tau, 0.5 * tau, dir.y)
+               + (ms_diffusion > 0.0 ? diffusion_light(textureLod(far_field_light, at, 0.0), dir) : vec3(0.0));
     frag = vec4(light * alpha, alpha);
     frag_distance = vec4(alpha * length(hit - camera_pos), alpha, 0.0, alpha);
 }

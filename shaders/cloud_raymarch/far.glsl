@@ -12,7 +12,9 @@
 // which the march then erodes with the detail noise like the volume's density. Light (volume.glsl's
 // model): the sun transmittance from a three-step march toward the sun through the same density, the
 // rank at each step from the light-march channels (baked light_step tiles apart toward the sun: no
-// extra fetch); the sky light from the column above and below: column_tau * far_quantile(r) * (G, 1 - G).
+// extra fetch); the sky light from the column above and below: column_tau * far_quantile(r) * (G, 1 - G);
+// with a diffusion field, its light (diffusion_light) from the field's mean (phi, F) over the volume's
+// columns of rank r at height h (far_field_light_profile: light_by_rank.comp's field_profile).
 // Requires volume.glsl (sun_part, octave_weights, ambient_source, sun_dir, column_tau) included first.
 #include "cloud_far_field/field.glsl"
 
@@ -20,6 +22,7 @@ uniform float far_lod_scale;      // octave texels per metre x a full-res pixel'
 uniform vec2 far_band;            // (base y, height) of the layer (m)
 uniform vec3 far_sun;             // (step toward the sun (m), channels per step, layer fraction per step)
 layout(binding = 14) uniform sampler2D far_profile;   // FarFieldLayer.profile: (rank, h) -> (R, G), clamped
+layout(binding = 20) uniform sampler2D far_field_light_profile;   // RankLight.field_profile: (rank, h) -> (phi, F)
 
 // The ranks at xz and at the three light-march channels; s: distance (m).
 vec4 far_ranks(vec2 xz, float s) {
@@ -53,5 +56,7 @@ vec3 far_source(vec4 c, float h, vec3 dir, float sigma_t) {
     float T = exp(-sigma_t * far_sun.x * depth);
     float column = column_tau * far_quantile(c.x), above = textureLod(far_profile, vec2(c.x, clamp(h, 0.0, 1.0)), 0.0).g;
     float up = column * above, down = column * (1.0 - above);
-    return sun_part(octave_weights(T, up + down), dot(dir, sun_dir)) + ambient_source(up, down, dir.y);
+    vec3 field = ms_diffusion > 0.0
+               ? diffusion_light(textureLod(far_field_light_profile, vec2(c.x, clamp(h, 0.0, 1.0)), 0.0), dir) : vec3(0.0);
+    return sun_part(octave_weights(T, up + down), dot(dir, sun_dir)) + ambient_source(up, down, dir.y) + field;
 }

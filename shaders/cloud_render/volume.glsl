@@ -56,11 +56,18 @@ float mean_cosine() {
     return (1.0 - phase_lobes.z) * phase_lobes.x + phase_lobes.z * phase_lobes.y;
 }
 
+// Octave weights b^i Ta_i from the octaves' transmittances Ta = (T, T^a, T^a^2, T^a^3) (the 2D far field
+// passes the volume's means by rank), the scattered ones times m as below.
+vec4 octave_weights_of(vec4 Ta, float tau_column) {
+    float b = ms_octaves.y, m = 1.0 - exp(-(1.0 - mean_cosine()) * tau_column);
+    return Ta * vec4(1.0, m * b, m * b * b, m * b * b * b);
+}
+
 // Octave weights b^i T^(a^i), i = 0..3, the scattered ones (i >= 1) times the chance
 // 1 - exp(-(1 - g_mean) tau_column) that light was turned aside in the column through the point.
 vec4 octave_weights(float T, float tau_column) {
-    float a = ms_octaves.x, b = ms_octaves.y, m = 1.0 - exp(-(1.0 - mean_cosine()) * tau_column);
-    return vec4(T, m * b * pow(T, a), m * b * b * pow(T, a * a), m * b * b * b * pow(T, a * a * a));
+    float a = ms_octaves.x;
+    return octave_weights_of(vec4(T, pow(T, a), pow(T, a * a), pow(T, a * a * a)), tau_column);
 }
 
 // Sky and ground light toward the eye along ray_y (the view ray's y): their mean plus half their
@@ -83,13 +90,13 @@ vec4 cloud_diffusion(vec3 uvw) {
 }
 
 // The field's share of J beside the octaves for a field value f = (phi, F): sun_source beta
-// max(sun_y, 0) (1 - c^2)^4 max(phi - 3 g_mean F.ray, 0) / 4pi (c = dot(ray, sun_dir);
+// (1 - c^2)^4 max(phi - 3 g_mean F.ray, 0) / 4pi (c = dot(ray, sun_dir);
 // diffusion.diffusion_weight, diffusion_radiance).
 vec3 diffusion_light(vec4 f, vec3 ray_dir) {
     if (ms_diffusion <= 0.0) return vec3(0.0);
     float c = dot(ray_dir, sun_dir), s2 = max(1.0 - c * c, 0.0), s4 = s2 * s2;
     float L = max(f.x - 3.0 * mean_cosine() * dot(f.yzw, ray_dir), 0.0) / (4.0 * PI);
-    return sun_source * (ms_diffusion * max(sun_dir.y, 0.0) * s4 * s4 * L);
+    return sun_source * (ms_diffusion * s4 * s4 * L);
 }
 
 vec3 diffusion_part(vec3 uvw, vec3 ray_dir) {

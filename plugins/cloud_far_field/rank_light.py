@@ -1,0 +1,123 @@
+"""RankLight: the volume's own light by column rank, which the far fields light their columns with.
+
+The far field gives a point of rank r the volume's column sum at r (:mod:`.cover`); this measure gives
+it the light of the volume's columns of that rank too (``shaders/cloud_far_field/light_by_rank.comp``,
+float64 reference :func:`atmos.plugins.cloud_far_field.reference.light_by_rank`): the mean sun
+transmittances of the octaves (T, T^a, T^a², T^a³) and, where the sets carry a diffusion field, its mean
+(phi, F), each as seen from above and from below; and the field per height bin for the ray march's
+volumetric far field. So the far field is as bright per cover as the volume at every sun, not a guess
+from a slanted column. Two small dispatches per frame after the cover (:meth:`FarFieldLayer.prepare`).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from atmos.shading.diffusion import DIFFUSION
+
+SUN_UNIT = 18                    # sun_by_rank for the shaders that declare far_sun_by_rank (2D)
+FIELD_UNIT = 19                  # field_column for those that declare far_field_light (2D)
+FIELD_PROFILE_UNIT = 20          # field_profile for those that declare far_field_light_profile (2D)
+READ_UNITS = {"density": (14, 15), "transmittance": (2, 3), DIFFUSION: (16, 17)}   # light_by_rank.comp's inputs
+INTERVALS = 32
+FIELD_BINS = 16                  # light_by_rank.comp's most height bins of the field
+SUMS = INTERVALS * 2 * 9 + INTERVALS * FIELD_BINS * 5      # its Sums buffer (uint32): the slots, the bins
+GROUP = 256                      # its work group (columns per group in STAGE 0)
+
+
+class RankLight:
+    """The textures of one measure (GL objects of one GpuContext): ``sun`` (INTERVALS, 2) rgba32f, and
+    with a field ``field`` (INTERVALS, 2) and ``field_profile`` (INTERVALS, bins) rgba32f."""
+
+    def __init__(self, gpu):
+        self.gpu = gpu
+        self.sun = self.field = self.field_profile = self.sums = None
+        self.has_field = False           # the last measure took a diffusion field
+
+    def measure(self, sim, cover_buffer, attenuation: float, heights: int) -> None:
+        """Measure mix(A, B, t) of ``sim`` (the frame's CloudSets) ranked by the quantiles in
+        ``cover_buffer`` (cover.comp's, already written), the octaves' ``attenuation`` a, at ``heights``
+        samples per column: one invocation per column, then one work group for the means."""
+        self.has_field = DIFFUSION in sim.a and DIFFUSION in sim.b
+        shading = "transmittance" in sim.a and "transmittance" in sim.b
+        bins = min(int(heights), FIELD_BINS) if self.has_field else 1
+        self._allocate(bins)
+        sim.maps_of(sim.a).sums.use(0)
+        sim.maps_of(sim.b).sums.use(1)
+        for name, (unit_a, unit_b) in READ_UNITS.items():
+            if name in sim.a and name in sim.b:
+                sim.a[name].use(unit_a)
+                sim.b[name].use(unit_b)
+        medium = sim.settings
+        values = dict(t=float(sim.t), a_shift=(sim.a_shift[0], sim.a_shift[2]), edge_fade=float(medium.edge_fade),
+                      heights=int(heights), bins=bins, has_shading=int(shading), attenuation=float(attenuation),
+                      column_tau=float(medium.sigma_t * medium.cell_size[1]))
+        cover_buffer.bind_to_storage_buffer(0)
+        self.sums.bind_to_storage_buffer(1)
+        columns = int(np.prod(np.asarray(sim.shape)[[0, 2]]))
+        for stage, groups in ((0, -(-columns // GROUP)), (1, 1)):
+            c = self.gpu.program(compute_shader="cloud_far_field/light_by_rank.comp",
+                                 defines={"FIELD": int(self.has_field), "STAGE": stage})
+            for name, value in values.items():
+                if name in c:
+                    c[name].value = value
+            if stage == 1:
+                self.sun.bind_to_image(0, read=False, write=True)
+                if self.has_field:
+                    self.field.bind_to_image(1, read=False, write=True)
+                    self.field_profile.bind_to_image(2, read=False, write=True)
+            c.run(groups)
+            self.gpu.ctx.memory_barrier()
+
+    def _allocate(self, bins: int) -> None:
+        if self.sun is None:
+            self.sun = self._texture(2)
+            self.sums = self.gpu.track(self.gpu.ctx.buffer(bytes(4 * SUMS)))    # zero; STAGE 1 clears it
+        if self.has_field and (self.field_profile is None or self.field_profile.size != (INTERVALS, bins)):
+            self._release_field()
+            self.field, self.field_profile = self._texture(2), self._texture(bins)
+
+    def _texture(self, rows: int):
+        texture = self.gpu.track(self.gpu.ctx.texture((INTERVALS, rows), 4, dtype="f4"))
+        texture.repeat_x = texture.repeat_y = False         # clamp: ranks 0 and 1, base and top
+        return texture
+
+    def use(self, program) -> None:
+        """Bind the textures the program declares (far_sun_by_rank, far_field_light, far_field_light_profile)."""
+        field = self.has_field
+        for name, texture, unit in (("far_sun_by_rank", self.sun, SUN_UNIT),
+                                    ("far_field_light", self.field if field else None, FIELD_UNIT),
+                                    ("far_field_light_profile", self.field_profile if field else None, FIELD_PROFILE_UNIT)):
+            if name in program and texture is not None:
+                texture.use(unit)
+
+    def read(self) -> dict:
+        """The last measure as float64 arrays (a GPU → CPU copy: tests and tools): ``sun`` (INTERVALS, 2, 4)
+        [k, v] = the mean (T, T^a, T^a², T^a³) of rank interval k seen from above (v = 0) and below (1);
+        with a field also ``field`` (INTERVALS, 2, 4) the mean (phi, F) likewise and ``field_profile``
+        (INTERVALS, bins, 4) per height bin."""
+        if self.sun is None:
+            raise RuntimeError("RankLight.read: nothing measured yet (FarFieldLayer.prepare measures it)")
+        self.gpu.ctx.memory_barrier()
+        out = {"sun": _read(self.sun)}
+        if self.has_field:
+            out.update(field=_read(self.field), field_profile=_read(self.field_profile))
+        return out
+
+    def _release_field(self) -> None:
+        for texture in (self.field, self.field_profile):
+            if texture is not None:
+                texture.release()
+        self.field = self.field_profile = None
+
+    def release(self) -> None:
+        self._release_field()
+        for resource in (self.sun, self.sums):
+            if resource is not None:
+                resource.release()
+        self.sun = self.sums = None
+
+
+def _read(texture) -> np.ndarray:
+    """(width, height, 4) float64 of an rgba32f texture: [k, row]."""
+    w, h = texture.size
+    return np.frombuffer(texture.read(), np.float32).reshape(h, w, 4).transpose(1, 0, 2).astype(np.float64)
