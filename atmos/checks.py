@@ -157,16 +157,20 @@ def is_int(value) -> bool:
     return isinstance(value, (numbers.Integral, np.integer)) and not isinstance(value, (bool, np.bool_))
 
 
-def check_shape(shape, name: str = "shape") -> tuple[int, int, int]:
-    """``(nx, ny, nz)`` as ints; ValueError naming ``name`` unless three positive ints."""
+def check_shape(shape, name: str = "shape", hi: int | None = None, optional: bool = False) -> tuple[int, int, int] | None:
+    """``(nx, ny, nz)`` as ints; ValueError naming ``name`` unless three positive ints (each at most
+    ``hi`` when given); ``optional``: None passes."""
     owner, _, field = name.rpartition(".")
-    _declare(owner, field, "shape")
+    _declare(owner, field, "shape", hi=hi, optional=optional)
+    if optional and shape is None:
+        return None
     try:
-        values = tuple(shape)
+        values = None if isinstance(shape, (str, bytes)) else tuple(shape)
     except TypeError:
         values = None
-    if values is None or len(values) != 3 or not all(is_int(n) and n >= 1 for n in values):
-        raise ValueError(f"{name} must be three positive ints (nx, ny, nz), got {shape!r}")
+    if values is None or len(values) != 3 or not all(is_int(n) and 1 <= n <= (hi or n) for n in values):
+        allowed = "positive ints" if hi is None else f"ints in [1, {hi}]"
+        raise ValueError(f"{name} must be {'None or ' if optional else ''}three {allowed} (nx, ny, nz), got {shape!r}")
     return tuple(int(n) for n in values)
 
 

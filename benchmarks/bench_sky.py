@@ -10,7 +10,8 @@
    alternating runs.
 3. The aerial perspective (``SkySettings.aerial_perspective``): its error against a 96-step float64 march
    (on the GPU's LUTs) of the same atmosphere (relative RMSE over the ground out to 40 km, camera 500 m up, sun 8°) vs
-   ``aerial_steps``, beside the pass's GPU ms (timer queries) and the sky pass's.
+   ``aerial_steps`` with every pixel marching, and vs ``aerial_froxels`` at 8 steps (the froxel volume),
+   beside the pass's GPU ms (timer queries) and the sky pass's.
 
     .venv/bin/python benchmarks/bench_sky.py [--paths 20000] [--size 640x360] [--frames 30] [--skip-accuracy]
 """
@@ -118,9 +119,13 @@ def cost(size, frames: int, rounds: int = 3) -> None:
           f"one sky view {np.median(views):.2f}")
 
 
-def aerial(size, frames: int, steps=(1, 2, 4, 8, 12, 24, 48)) -> None:
+FROXELS = ((16, 16, 16), (32, 32, 32), (32, 32, 64), (64, 64, 64), (128, 72, 64))
+
+
+def aerial(size, frames: int, steps=(1, 2, 4, 8, 12, 24, 48), froxels=FROXELS) -> None:
     """Per view (camera altitude, pitch): the aerial perspective's relative RMSE over the ground (out to
-    40 km) against a 96-step float64 march, and the GPU ms of the pass and of the sky pass, per step count."""
+    40 km) against a 96-step float64 march, and the GPU ms of the pass and of the sky pass, per step count
+    with every pixel marching, then per froxel volume at 8 steps."""
     from atmos import App, Camera, DefaultPlugins, Sun, create_headless
     from atmos.camera import view_basis
     from atmos.plugins.ground import GroundPlugin
@@ -145,9 +150,9 @@ def aerial(size, frames: int, steps=(1, 2, 4, 8, 12, 24, 48)) -> None:
         truth = light + trans.mean(-1, keepdims=True) * plain[ground]
         print(f"\naerial perspective at {size[0]}×{size[1]}, camera {altitude:.0f} m, pitch {pitch}, sun 8°, "
               f"ground to 40 km (the pass changes it by {np.sqrt(((truth - plain[ground]) ** 2).mean() / (truth ** 2).mean()):.1%}):")
-        print(f"{'steps':>6} {'rel RMSE':>9} {'pass GPU ms':>12} {'sky pass ms':>12}")
-        for n in steps:
-            sky.configure(aerial_perspective=True, aerial_steps=n)
+        print(f"{'froxels':>13} {'steps':>6} {'rel RMSE':>9} {'pass GPU ms':>12} {'sky pass ms':>12}")
+        for volume, n in [(None, n) for n in steps] + [(f, 8) for f in froxels]:
+            sky.configure(aerial_perspective=True, aerial_steps=n, aerial_froxels=volume)
             got = app.read_linear()[::-1].astype(np.float64)[..., :3][ground]
             rmse = np.sqrt(((got - truth) ** 2).mean() / (truth ** 2).mean())
             ms = {}
@@ -155,7 +160,8 @@ def aerial(size, frames: int, steps=(1, 2, 4, 8, 12, 24, 48)) -> None:
                 app.update(0.0)
                 for name, (gpu_ms, _) in app.graph.timings.items():
                     ms.setdefault(name, []).append(gpu_ms)
-            print(f"{n:>6} {rmse:9.2e} {np.median(ms['aerial_perspective']):12.3f} {np.median(ms['sky']):12.3f}")
+            label = "per pixel" if volume is None else "x".join(map(str, volume))
+            print(f"{label:>13} {n:>6} {rmse:9.2e} {np.median(ms['aerial_perspective']):12.3f} {np.median(ms['sky']):12.3f}")
         app.close()
     gpu.release()
 

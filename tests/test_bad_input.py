@@ -95,6 +95,8 @@ def bad_values(rule: Rule | None) -> list[tuple[str, object]]:
     elif kind == "shape":
         cases += [("zero", (0, 1, 1)), ("negative", (-1, 4, 4)), ("short", (4, 4)), ("float", (1.5, 4, 4)),
                   ("string", "abc")]
+        if rule.hi is not None:
+            cases.append(("above", (int(rule.hi) + 1, 4, 4)))
     else:
         raise AssertionError(f"no bad values for rules of kind {kind!r}: add them here")
     return cases

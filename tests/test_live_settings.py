@@ -278,11 +278,13 @@ SPECS = {
         look((0.0, 2.0, 0.0), yaw=math.radians(200.0), pitch=0.45),
         dict(turbidity=8.0, scale=0.08, sun_size_deg=4.0, sun_gain=200.0, sun_glare=0.5, night=(0.2, 0.1, 0.3), stars=False,
              star_density=0.9, star_brightness=40.0, twinkle=1.0, model="physical", aerial_perspective=True,
-             aerial_steps=1, **PHYSICAL_CHANGES),
+             aerial_steps=1, aerial_froxels=(4, 4, 2), **PHYSICAL_CHANGES),
         before={"sun_gain": configure_first(sun_size_deg=4.0), "night": set_sun(NIGHT), "stars": set_sun(NIGHT), "star_density": set_sun(NIGHT),
                 "star_brightness": set_sun(NIGHT), "twinkle": set_sun(NIGHT),
                 **{name: configure_first(model="physical") for name in PHYSICAL_CHANGES},
-                "aerial_perspective": physical_ground(), "aerial_steps": physical_ground(aerial_perspective=True)}),
+                "aerial_perspective": physical_ground(),
+                "aerial_steps": physical_ground(aerial_perspective=True, aerial_froxels=None),   # the per-pixel march's
+                "aerial_froxels": physical_ground(aerial_perspective=True)}),
     "sky_layer": Spec(
         lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), SkyLayerPlugin(size=32)], SkyLayerPlugin,
         look((123.0, 3.0, -77.0), yaw=0.3, pitch=0.6),

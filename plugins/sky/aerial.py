@@ -8,17 +8,42 @@ sky's own atmosphere and LUTs (``shaders/sky/aerial.frag``; float64:
 its orange at sunset, with no fog colour to choose. Clouds that give the media passes their own distance
 (:mod:`atmos.composition`) are hazed by it. It runs after the other media passes (local fog lies in
 front of the surfaces it covers; the atmosphere spans the whole ray). Culled with Preetham or off.
+
+With ``SkySettings.aerial_froxels`` (default (32, 32, 64)) the pass first fills the transient
+"aerial_volume", a froxel volume: each froxel column's ray marched slice by slice (slices squared out
+to :func:`volume_range`; ``shaders/sky/aerial_volume.comp``), and every pixel reads it trilinearly
+instead of marching; None marches every pixel in ``aerial_steps`` (``benchmarks/bench_sky.py`` measures
+both against a 96-step float64 march).
 """
 from __future__ import annotations
 
+import math
+
+import moderngl
+import numpy as np
+
 from atmos.composition import CLOUD_DISTANCE
-from atmos.graph import FullscreenPass, PassContext
-from atmos.camera import set_camera_uniforms
+from atmos.graph import FullscreenPass, PassContext, TextureDesc
+from atmos.camera import set_camera_uniforms, view_basis
 from atmos.lighting import unit_sun
 from atmos.plugins.sky.luts import SKY_LUTS, atmosphere_defines, set_atmosphere_uniforms, view_radius
 from atmos.render_core import COLOR, DEPTH
 
 AERIAL = "aerial_perspective"
+AERIAL_VOLUME = "aerial_volume"          # the froxel volume (a transient of this pass)
+VOLUME_UNIT = 3                          # aerial.frag samples it here
+GROUP = 8                                # aerial_volume.comp's work group: 8 x 8 froxel columns
+
+
+def volume_range(camera, aspect: float, settings) -> float:
+    """m: the froxel volume's reach, the farthest a pixel's surface can be (the far plane along the
+    frame's corner ray), at most the longest ray through the atmosphere that can end on the ground
+    (to the horizon and on to the top of the atmosphere); longer rays (far clouds) march themselves."""
+    corner = float(np.linalg.norm(view_basis(camera, aspect) @ np.array([1.0, 1.0, 1.0])))
+    rg, rt = settings.planet_radius, settings.top_radius
+    r = min(max(rg + float(camera.position[1]), rg), rt)
+    atmosphere = math.sqrt(max(r * r - rg * rg, 0.0)) + math.sqrt(rt * rt - rg * rg)
+    return min(float(camera.far) * corner, atmosphere)
 
 
 def active(settings) -> bool:
@@ -42,11 +67,16 @@ class AerialPerspectivePass(FullscreenPass):
 
     def defines(self) -> dict:
         return {**atmosphere_defines(), "AERIAL_STEPS": self.plugin.settings.aerial_steps,
-                "AERIAL_CLOUDS": int(self.clouds())}
+                "AERIAL_CLOUDS": int(self.clouds()), "AERIAL_VOLUME": int(self.froxels() is not None)}
+
+    def froxels(self):
+        return self.plugin.settings.aerial_froxels
 
     def setup(self, builder) -> None:
         if not active(self.plugin.settings):
             return                              # declares nothing: culled, nothing allocated
+        if self.froxels() is not None:
+            builder.create(AERIAL_VOLUME, TextureDesc(tuple(self.froxels()), components=4, dtype="f4"))
         builder.read(DEPTH)
         builder.read(COLOR)                     # blends onto it
         builder.write(COLOR)
@@ -54,18 +84,53 @@ class AerialPerspectivePass(FullscreenPass):
         if self.clouds():
             builder.read(CLOUD_DISTANCE)
 
+    def prepare(self, gpu) -> None:
+        super().prepare(gpu)
+        self.sampler = gpu.ctx.sampler(filter=(moderngl.LINEAR, moderngl.LINEAR), repeat_x=False, repeat_y=False,
+                                       repeat_z=False)
+
+    def release(self) -> None:
+        sampler = getattr(self, "sampler", None)
+        if sampler is not None:
+            sampler.release()
+            self.sampler = None
+        super().release()
+
     def execute(self, frame: PassContext) -> None:
         view, p = frame.view, self.program
         settings = self.plugin.settings
+        frame.resource(SKY_LUTS).use()
+        values = dict(sun_dir=tuple(float(v) for v in unit_sun(view.sun.direction)),
+                      view_r=view_radius(settings.atmosphere, view.camera),
+                      aerial_range=volume_range(view.camera, view.aspect, settings.atmosphere))
+        volume = frame.resource(AERIAL_VOLUME) if frame.declares(AERIAL_VOLUME) else None
+        if volume is not None:
+            self._fill(volume, view, values)
+            volume.use(VOLUME_UNIT)
+            self.sampler.use(VOLUME_UNIT)
         frame.framebuffer(color=[COLOR]).use()
         frame.blend_transmittance()
         frame.resource(DEPTH).use(0)
         if frame.declares(CLOUD_DISTANCE):
             frame.resource(CLOUD_DISTANCE).use(2)
-        frame.resource(SKY_LUTS).use()
         set_camera_uniforms(p, view.camera, view.aspect)
         set_atmosphere_uniforms(p, settings.atmosphere)
-        sun = unit_sun(view.sun.direction)
-        p["sun_dir"].value = tuple(float(v) for v in sun)
-        p["view_r"].value = view_radius(settings.atmosphere, view.camera)
+        for name, value in values.items():
+            if name in p:
+                p[name].value = value
         frame.fullscreen(p)
+        if volume is not None:
+            self.sampler.clear(VOLUME_UNIT)
+
+    def _fill(self, volume, view, values) -> None:
+        """The froxel volume: one invocation per froxel column, marching through the slices (aerial_volume.comp)."""
+        c = self.gpu.program(compute_shader="sky/aerial_volume.comp", defines=self.defines())
+        set_camera_uniforms(c, view.camera, view.aspect)
+        set_atmosphere_uniforms(c, self.plugin.settings.atmosphere)
+        for name, value in values.items():
+            if name in c:
+                c[name].value = value
+        volume.bind_to_image(0, read=False, write=True)
+        w, h, _ = volume.size
+        c.run(-(-w // GROUP), -(-h // GROUP), 1)
+        self.gpu.ctx.memory_barrier()

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from atmos.checks import CheckedSettings, check_bool, check_choice, check_int, check_num, check_vec
+from atmos.checks import CheckedSettings, check_bool, check_choice, check_int, check_num, check_shape, check_vec
 from atmos.lighting import NIGHT_SKY
 from atmos.plugins.sky.atmosphere_settings import AtmosphereSettings
 from atmos.plugins.sky.preetham import TURBIDITY_RANGE, check_turbidity
@@ -29,8 +29,11 @@ class SkySettings(CheckedSettings):
     once the sun is well below the horizon; ``star_density``: fraction of star-grid cells holding
     a star; ``star_brightness``: HDR radiance of the brightest star; ``twinkle``: 0 steady .. 1 full.
     ``aerial_perspective`` (the physical model only): the air between the camera and the scene hazes it
-    with the sky's own light (:mod:`atmos.plugins.sky.aerial`), marched in ``aerial_steps`` segments (8:
-    within 8e-4 of a 96-step float64 march from 10 km up, 6e-4 near the ground; benchmarks/bench_sky.py).
+    with the sky's own light (:mod:`atmos.plugins.sky.aerial`), from a froxel volume of ``aerial_froxels``
+    (width, height, slices; each 1..256) that the pixels read trilinearly, each froxel column's ray
+    marched slice by slice out to the far plane; None: every pixel marches its own ray in
+    ``aerial_steps`` segments (8: within 8e-4 of a 96-step float64 march from 10 km up, 6e-4 near the
+    ground; benchmarks/bench_sky.py), as do rays beyond the volume (far clouds).
     """
 
     model: str = "preetham"
@@ -47,6 +50,7 @@ class SkySettings(CheckedSettings):
     twinkle: float = 0.4
     aerial_perspective: bool = False
     aerial_steps: int = 8
+    aerial_froxels: tuple | None = (32, 32, 64)
 
     def __post_init__(self):
         o = _OWNER
@@ -71,5 +75,6 @@ class SkySettings(CheckedSettings):
             twinkle=check_num(o, "twinkle", self.twinkle, 0.0, 1.0),
             aerial_perspective=check_bool(o, "aerial_perspective", self.aerial_perspective),
             aerial_steps=check_int(o, "aerial_steps", self.aerial_steps, 1, 256),
+            aerial_froxels=check_shape(self.aerial_froxels, f"{o}.aerial_froxels", hi=256, optional=True),
         )
         self.store(checked)

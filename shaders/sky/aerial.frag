@@ -6,7 +6,10 @@
 // of the RGB transmittance (Hillaire's grey transmittance), so the target becomes L + T·C. Sky pixels
 // (depth 1) already hold the whole ray: left alone. AERIAL_CLOUDS 1: "cloud_distance" (premultiplied
 // (a·d, a), atmos/composition.py) gives the clouds their own distance: a·AP(d_cloud) + (1 - a)·AP(d).
-// float64 reference: plugins/sky/atmosphere.py aerial_perspective.
+// AERIAL_VOLUME 1 (SkySettings.aerial_froxels): AP(d) is rebuilt from the froxel volume
+// (sky/aerial_volume.comp: the air's colour and extinction, read trilinearly at (uv, the slice of d,
+// sky/aerial_slices.glsl)); a ray longer than its range (far clouds), or whose froxels straddle the
+// horizon, marches itself. float64 reference: plugins/sky/atmosphere.py aerial_perspective.
 in vec2 v_uv;
 out vec4 frag;
 layout(binding = 0) uniform sampler2D scene_depth;
@@ -27,15 +30,48 @@ vec4 aerial(vec3 dir, float distance) {
     vec3 light = atm_aerial(view_r, dir.y, sun_dir.y, dot(dir, sun_dir), distance, AERIAL_STEPS, transmittance);
     return vec4(light, dot(transmittance, vec3(1.0 / 3.0)));
 }
+#if AERIAL_VOLUME
+#include "sky/aerial_slices.glsl"
+layout(binding = 3) uniform sampler3D aerial_volume;
+uniform float aerial_range;    // m: the volume's last slice (plugins/sky/aerial.py volume_range)
+#endif
+
+#if AERIAL_VOLUME
+// Whether the four froxel columns the pixel reads from all end on the ground, or all leave the air
+// through its top: across the horizon their air differs (a ray into the thin air above it, one down
+// through the densest), and the pixels there march their own rays.
+bool froxels_agree() {
+    vec2 n = vec2(textureSize(aerial_volume, 0).xy);
+    vec2 c0 = (floor(v_uv * n - 0.5) + 0.5) / n, c1 = c0 + 1.0 / n;
+    float r = atm_clamp_radius(view_r);
+    bool g = atm_hits_ground(r, view_ray_dir(c0, view_basis).y);
+    return g == atm_hits_ground(r, view_ray_dir(vec2(c1.x, c0.y), view_basis).y)
+        && g == atm_hits_ground(r, view_ray_dir(vec2(c0.x, c1.y), view_basis).y)
+        && g == atm_hits_ground(r, view_ray_dir(c1, view_basis).y);
+}
+#endif
+
+// The aerial perspective of the pixel's ray out to `distance`.
+vec4 aerial_at(vec3 dir, float distance) {
+#if AERIAL_VOLUME
+    if (distance <= aerial_range && froxels_agree()) {  // the air's colour and extinction (aerial_volume.comp)
+        float w = aerial_slice_w(distance, aerial_range), first = 0.5 / float(textureSize(aerial_volume, 0).z);
+        vec4 air = textureLod(aerial_volume, vec3(v_uv, max(w, first)), 0.0);
+        float T = exp(-air.a * max(distance, 0.0));
+        return vec4(air.rgb * (1.0 - T), T);
+    }
+#endif
+    return aerial(dir, distance);
+}
 
 void main() {
     float z = texelFetch(scene_depth, ivec2(gl_FragCoord.xy), 0).r;
     vec3 ray = view_ray(v_uv, view_basis);
     vec3 dir = normalize(ray);
-    vec4 ap = z >= 1.0 ? vec4(0.0, 0.0, 0.0, 1.0) : aerial(dir, view_depth(z, near, far) * length(ray));
+    vec4 ap = z >= 1.0 ? vec4(0.0, 0.0, 0.0, 1.0) : aerial_at(dir, view_depth(z, near, far) * length(ray));
 #if AERIAL_CLOUDS
     vec2 cloud = cloud_cover_distance(texelFetch(cloud_distance, ivec2(gl_FragCoord.xy), 0).rg);
-    if (cloud.x > 0.0) ap = cloud.x * aerial(dir, cloud.y) + (1.0 - cloud.x) * ap;
+    if (cloud.x > 0.0) ap = cloud.x * aerial_at(dir, cloud.y) + (1.0 - cloud.x) * ap;
 #endif
     frag = ap;
 }

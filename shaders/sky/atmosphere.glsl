@@ -78,34 +78,42 @@ vec2 atm_point(float r, float mu, float mu_s, float nu, float t) {
 float atm_rayleigh_phase(float nu) { return 3.0 / (16.0 * ATM_PI) * (1.0 + nu * nu); }
 float atm_hg_phase(float g, float nu) { return (1.0 - g * g) / (4.0 * ATM_PI * pow(1.0 + g * g - 2.0 * g * nu, 1.5)); }
 
+// One segment [t0, t1] of a ray from radius r (zenith cosine mu; sun at mu_s, nu = cos view·sun), sampled
+// at its middle (the medium's coefficients there, the sun's transmittance, the multiple-scattering LUT
+// unless `isotropic`): adds its in-scattered radiance and transfer (∫ σs T dt) seen through `throughput`,
+// then dims `throughput` by the segment. atm_march's step; sky/aerial_volume.comp marches slice by slice.
+void atm_segment(float r, float mu, float mu_s, float nu, float t0, float t1, bool isotropic,
+                 inout vec3 radiance, inout vec3 transfer, inout vec3 throughput) {
+    float pr = isotropic ? 0.25 / ATM_PI : atm_rayleigh_phase(nu);
+    float pm = isotropic ? 0.25 / ATM_PI : atm_hg_phase(atm_g, nu);
+    float t = 0.5 * (t0 + t1), dt = t1 - t0;
+    vec2 at = atm_point(r, mu, mu_s, nu, t);
+    float ri = at.x, mus_i = at.y;
+    vec3 s_ray, s_mie;
+    vec3 ext = atm_coefficients(ri, s_ray, s_mie);
+    vec3 seg = exp(-ext * dt);
+    vec3 spread = vec3(ext.x > 0.0 ? (1.0 - seg.x) / ext.x : dt, ext.y > 0.0 ? (1.0 - seg.y) / ext.y : dt,
+                       ext.z > 0.0 ? (1.0 - seg.z) / ext.z : dt);
+    vec3 source = atm_transmittance_to_sun(ri, mus_i) * (s_ray * pr + s_mie * pm);
+    if (!isotropic && atm_ms > 0.0)
+        source += atm_ms * texture(atm_multiscattering, atm_ms_uv(ri, mus_i)).rgb * (s_ray + s_mie);
+    radiance += throughput * source * spread;
+    transfer += throughput * (s_ray + s_mie) * spread;
+    throughput *= seg;
+}
+
 // In-scattered radiance (per unit sun: times atm_sun for the real sun) along the first t_max metres of
 // the ray from radius r (zenith cosine mu; sun at mu_s, nu = cos view·sun), `steps` quadratically spaced
 // segments; `isotropic`: the multiple-scattering LUT's pass (isotropic phase, no Ψ). `transfer`:
 // ∫ σs T dt; `throughput`: the ray's transmittance over t_max.
 vec3 atm_march(float r, float mu, float mu_s, float nu, float t_max, int steps, bool isotropic,
                out vec3 transfer, out vec3 throughput) {
-    float pr = isotropic ? 0.25 / ATM_PI : atm_rayleigh_phase(nu);
-    float pm = isotropic ? 0.25 / ATM_PI : atm_hg_phase(atm_g, nu);
     vec3 radiance = vec3(0.0);
     throughput = vec3(1.0);
     transfer = vec3(0.0);
     for (int i = 0; i < steps; i++) {
         float a = float(i) / float(steps), b = float(i + 1) / float(steps);
-        float t0 = t_max * a * a, t1 = t_max * b * b;
-        float t = 0.5 * (t0 + t1), dt = t1 - t0;
-        vec2 at = atm_point(r, mu, mu_s, nu, t);
-        float ri = at.x, mus_i = at.y;
-        vec3 s_ray, s_mie;
-        vec3 ext = atm_coefficients(ri, s_ray, s_mie);
-        vec3 seg = exp(-ext * dt);
-        vec3 spread = vec3(ext.x > 0.0 ? (1.0 - seg.x) / ext.x : dt, ext.y > 0.0 ? (1.0 - seg.y) / ext.y : dt,
-                           ext.z > 0.0 ? (1.0 - seg.z) / ext.z : dt);
-        vec3 source = atm_transmittance_to_sun(ri, mus_i) * (s_ray * pr + s_mie * pm);
-        if (!isotropic && atm_ms > 0.0)
-            source += atm_ms * texture(atm_multiscattering, atm_ms_uv(ri, mus_i)).rgb * (s_ray + s_mie);
-        radiance += throughput * source * spread;
-        transfer += throughput * (s_ray + s_mie) * spread;
-        throughput *= seg;
+        atm_segment(r, mu, mu_s, nu, t_max * a * a, t_max * b * b, isotropic, radiance, transfer, throughput);
     }
     return radiance;
 }
