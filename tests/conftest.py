@@ -28,9 +28,10 @@ def ctx(gpu):
 
 @pytest.fixture
 def rng(request):
-    """A fresh random generator per test; the seed is printed so a failure can be replayed."""
+    """A fresh random generator per test; the seed is printed so a failure can be replayed
+    (``ATMOS_TEST_SEED=<seed> pytest <the test>``)."""
     import numpy as np
-    seed = int.from_bytes(os.urandom(4), "little")
+    seed = int(os.environ.get("ATMOS_TEST_SEED") or int.from_bytes(os.urandom(4), "little"))
     print(f"rng seed {seed}")
     return np.random.default_rng(seed)
 

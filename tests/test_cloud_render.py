@@ -189,13 +189,21 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale,
     assert ref["ambient"][vis].std() > 1e-3, "the columns above and below dim the sky and ground light"
     np.testing.assert_allclose(got[:, 12:15], ref["center"], rtol=1e-5, atol=1e-3)
     np.testing.assert_allclose(got[:, 15], ref["radius"], rtol=2e-5)
-    np.testing.assert_allclose(got[:, 16], ref["tau"], rtol=5e-5)   # a float32 sum over the footprint (2.06e-5 seen)
     # the near-plane fade (w - near) / diameter: float32 clip w, ~1e-4 m at 1 km
     np.testing.assert_allclose(got[:, 17], ref["coverage"], rtol=2e-5, atol=5e-6)
+    # the screen-space terms of a sprite touching the near plane (fade below 1 %) lose float32 digits to
+    # the perspective there (seed 1491649024: one 60 m sprite at fade 7e-4, tau 1.0e-4, conic 6e-4 and
+    # stretch 1.7e-4 off)
+    clear = ref["coverage"] > 1e-2
+    np.testing.assert_allclose(got[clear, 16], ref["tau"][clear], rtol=5e-5)   # a float32 sum over the footprint (2.06e-5 seen)
+    np.testing.assert_allclose(got[:, 16], ref["tau"], rtol=1e-3)
     # the mass's footprint on the screen axes: an ellipse on these non-cubic cells (float32 conic)
-    np.testing.assert_allclose(got[:, 18:21], ref["conic"], rtol=1e-4, atol=1e-4 * np.abs(ref["conic"]).max())
-    np.testing.assert_allclose(got[:, 21], ref["falloff"], rtol=1e-4)
-    np.testing.assert_allclose(got[:, 22], ref["stretch"], rtol=1e-4)   # float32 perspective terms
+    scale = np.abs(ref["conic"]).max()
+    np.testing.assert_allclose(got[clear, 18:21], ref["conic"][clear], rtol=1e-4, atol=1e-4 * scale)
+    np.testing.assert_allclose(got[:, 18:21], ref["conic"], rtol=3e-3, atol=1e-4 * scale)
+    for column, name in ((21, "falloff"), (22, "stretch")):            # float32 perspective terms
+        np.testing.assert_allclose(got[clear, column], ref[name][clear], rtol=1e-4)
+        np.testing.assert_allclose(got[:, column], ref[name], rtol=3e-3)
     # log T's slope across the sprite and its half variance: a float32 log of 8 taps, through the footprint
     slope_tol = 1e-3 if shading_scale == 1 else 2e-2
     np.testing.assert_allclose(got[:, 23:26], ref["slope"], rtol=slope_tol, atol=slope_tol * np.abs(ref["slope"]).max())

@@ -12,13 +12,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from atmos.plugins.cloud_far_field.cover import QUANTILES
 from atmos.shading.diffusion import DIFFUSION
 
 SUN_UNIT = 18                    # sun_by_rank for the shaders that declare far_sun_by_rank (2D)
 FIELD_UNIT = 19                  # field_column for those that declare far_field_light (2D)
 FIELD_PROFILE_UNIT = 20          # field_profile for those that declare far_field_light_profile (2D)
 READ_UNITS = {"density": (14, 15), "transmittance": (2, 3), DIFFUSION: (16, 17)}   # light_by_rank.comp's inputs
-INTERVALS = 32
+INTERVALS = QUANTILES - 1        # the rank intervals (columns.glsl INTERVALS)
 FIELD_BINS = 16                  # light_by_rank.comp's most height bins of the field
 SUMS = INTERVALS * 2 * 9 + INTERVALS * FIELD_BINS * 5      # its Sums buffer (uint32): the slots, the bins
 GROUP = 256                      # its work group (columns per group in STAGE 0)
