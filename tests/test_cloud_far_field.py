@@ -1,6 +1,7 @@
 """Clouds to the horizon: the volume's edge fade, the far field's cover, and the sunset horizon by pixels."""
 import dataclasses
 import math
+import types
 
 import numpy as np
 import pytest
@@ -170,6 +171,10 @@ def test_the_light_by_rank_is_the_volumes_own_light(gpu, ctx, clouds):
             assert err.max() < 5e-3 * scale, (name, err.max(), scale, np.unravel_index(err.argmax(), err.shape),
                                               got[name][np.unravel_index(err.argmax(), err.shape)[:2]],
                                               want[name][np.unravel_index(err.argmax(), err.shape)[:2]])
+        far.configure(enabled=False)          # the ground shadows alone still prepare the layer
+        far.layer.light.release()
+        far.layer.prepare(types.SimpleNamespace(sun=app.resource(Sun), time=0.0), sets)
+        assert far.layer.light.sun is None, "no far field drawn: its light is not measured"
         if clouds:
             covered = quantiles[:-1] > 1e-6
             assert covered.sum() >= 4 and got["field"][..., 0].max() > 0.05, "the volume scatters light"

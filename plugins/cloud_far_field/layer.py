@@ -84,9 +84,9 @@ class FarFieldLayer:
         return self.plugin.settings
 
     def prepare(self, view, sim: CloudSets) -> None:
-        """Bake (when needed), measure the cover and the light by rank (two small dispatches), once per
-        frame: every user (the far-field pass or the march, the shadows, the shafts) calls it, the first
-        one does it."""
+        """Bake (when needed), measure the cover and, while a far field is drawn, the light by rank (small
+        dispatches), once per frame: every user (the far-field pass or the march, the shadows, the
+        shafts) calls it, the first one does it."""
         if view is self._prepared:
             return
         self._prepared = view
@@ -95,7 +95,9 @@ class FarFieldLayer:
         if self.octaves.needs_bake(params, sun_dir, REBAKE_TOLERANCE):
             self.octaves.bake(params, sun_dir, octave_frequencies(params.base_frequency), rotations())
         self.measure_cover(sim)
-        self.light.measure(sim, self.cover, self.plugin.light_settings().ms_attenuation, profile_heights(sim.shape[1]))
+        if self.plugin.drawn_by_march() or params.enabled:      # a far field is drawn (not just shadows)
+            self.light.measure(sim, self.cover, self.plugin.light_settings().ms_attenuation,
+                               profile_heights(sim.shape[1]))
         self.update_tile(sim, float(view.time))
 
     def update_tile(self, sim: CloudSets, time: float) -> None:
