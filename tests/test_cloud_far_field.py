@@ -275,3 +275,51 @@ def test_the_far_fields_clouds_change_as_often_per_metre_as_the_volumes(gpu, ctx
         assert abs(np.mean(rates) / volume_rate - 1.0) < 0.15, (np.mean(rates), volume_rate, tile)
     finally:
         app.close()
+
+
+@pytest.mark.parametrize("shape", [(1, 1, 1), (192, 8, 192)])
+def test_the_light_by_rank_of_a_one_cell_and_a_wide_uniform_deck_is_finite(gpu, ctx, shape):
+    """Extremes of light_by_rank.comp: one cell (against the float64 twin), and a deck of 36,864 equal
+    columns that all fall in one rank interval (the fixed-point sums sized so that none overflows): T
+    within [0, 1], the field finite, and the deck's mean T seen from above and below its columns' own
+    (every column weighs its samples alike, so the mean over all columns of each row's T, weighted)."""
+    from atmos import App, DefaultPlugins
+    from atmos.plugins.cloud_render import CloudRenderPlugin
+    from atmos.plugins.clouds import CloudSettings
+    from atmos.shading.diffusion import DIFFUSION, read_field
+    d = np.ones(shape, np.float32)
+    medium = CloudSettings(cell_size=(40.0, 30.0, 40.0), base_altitude=400.0, group_size=(1, 1) if shape[0] == 1 else (8, 8),
+                           smoothing_slices=1, sigma_t=0.03, edge_fade=0.0)
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(medium, density=d),
+                               CloudRenderPlugin(ms_diffusion=1.0), CloudFarFieldPlugin(size=32))
+    try:
+        app.startup()
+        app.render()
+        far = next(p for p in app.plugins if isinstance(p, CloudFarFieldPlugin))
+        sets = next(p for p in app.plugins if isinstance(p, CloudsPlugin)).simulation.sets()
+        got = far.layer.light.read()
+        for name, values in got.items():
+            assert np.isfinite(values).all(), name
+        assert np.all((got["sun"] >= 0.0) & (got["sun"] <= 1.0))
+        assert got["field"][..., 0].max() > 0.0, "the cloud scatters light"
+        T = read_volume(sets.b["transmittance"]).astype(np.float64)
+        if shape == (1, 1, 1):
+            _, quantiles = far.layer.read_cover()
+            want = light_by_rank(*(sets.maps_of(s).read_sums()[0] for s in (sets.a, sets.b)),
+                                 *(read_volume(s["density"]) for s in (sets.a, sets.b)), sets.t, sets.a_shift, 0.0,
+                                 quantiles, heights=1, attenuation=far.light_settings().ms_attenuation,
+                                 column_tau=0.03 * 30.0, trans_a=read_volume(sets.a["transmittance"]), trans_b=T,
+                                 field_a=read_field(sets.a[DIFFUSION]), field_b=read_field(sets.b[DIFFUSION]))
+            for name in ("sun", "field"):
+                assert np.abs(got[name] - want[name]).max() < 5e-3 * max(np.abs(want[name]).max(), 1e-3), name
+        else:
+            assert T.shape == shape and sets.t in (0.0, 1.0)
+            tau = 0.03 * 30.0 * np.ones(shape[1])                      # each row's optical depth, density 1
+            below = np.cumsum(tau)
+            for view, seen in enumerate((np.exp(-(below[-1] - below + 0.5 * tau)), np.exp(-(below - 0.5 * tau)))):
+                rows = T.mean(axis=(0, 2))                                # every column alike: the rows' mean T
+                want = (seen * rows).sum() / seen.sum()
+                assert abs(got["sun"][-1, view, 0] - want) < 2e-3, (view, got["sun"][-1, view, 0], want)
+            assert got["sun"][-1, 1, 0] < got["sun"][-1, 0, 0]
+    finally:
+        app.close()
