@@ -14,7 +14,8 @@ from atmos.gpu.shaders import load_source
 from atmos.lighting import Sun
 from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
 from atmos.plugins.cloud_render import CloudLayout, CloudRenderPlugin, select_segments, sun_light
-from atmos.plugins.cloud_render.binding import bind_volume, clamp_sampler, unbind_volume
+from atmos.gpu import clamp_sampler
+from atmos.plugins.cloud_render.binding import bind_volume, unbind_volume
 from atmos.plugins.cloud_render.light import light_uniforms
 from atmos.plugins.cloud_render.example import example_weather
 from atmos.plugins.cloud_render.plugin import sprite_uniforms
@@ -184,7 +185,13 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale,
     # the light samples sit between texels, and GPUs (llvmpipe too) filter with 8-bit sub-texel weights:
     # up to ~0.3 % of a value apart; a coarser shading volume (scale > 1) interpolates further still
     light_tol = 2e-5 if shading_scale == 1 else 5e-3
-    np.testing.assert_allclose(got[:, 5:9], ref["octaves"], atol=light_tol, rtol=3e-3)
+    # deep in shadow (T < 1e-6) those weights leave T itself percents off between texels orders of magnitude
+    # apart, and octave i takes T^(a^i): a^i times that (seed 3730811875: T 7 % off, octave 3 0.57 % at a 0.44)
+    deep = ref["octaves"][:, 0] < 1e-6
+    a = renderer.settings.ms_attenuation
+    np.testing.assert_allclose(got[~deep, 5:9], ref["octaves"][~deep], atol=light_tol, rtol=3e-3)
+    off = np.abs(got[deep, 5:9] - ref["octaves"][deep])
+    assert (off <= light_tol + (3e-3 + 0.1 * a ** np.arange(4)) * np.abs(ref["octaves"][deep])).all(), off.max()
     np.testing.assert_allclose(got[:, 9:12], ref["ambient"], atol=light_tol, rtol=3e-3)
     assert ref["ambient"][vis].std() > 1e-3, "the columns above and below dim the sky and ground light"
     np.testing.assert_allclose(got[:, 12:15], ref["center"], rtol=1e-5, atol=1e-3)
