@@ -126,17 +126,53 @@ def test_the_profile_by_rank_is_the_volumes_vertical_shape(gpu, ctx, shape, base
         app.close()
 
 
+LIGHT_MEDIUM = dict(cell_size=(40.0, 30.0, 40.0), base_altitude=400.0, smoothing_slices=1, sigma_t=0.03)
+
+
+def light_scene(gpu, density, edge_fade: float, group=(4, 4), far_size: int = 64, sun=None):
+    """A static volume drawn by the sprites (the diffusion field on) with a far field, rendered once:
+    (app, the CloudFarFieldPlugin, the frame's CloudSets). The caller closes the app."""
+    from atmos import App, DefaultPlugins
+    from atmos.plugins.cloud_render import CloudRenderPlugin
+    from atmos.plugins.clouds import CloudSettings
+    medium = CloudSettings(group_size=group, edge_fade=edge_fade, **LIGHT_MEDIUM)
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(medium, density=density),
+                               CloudRenderPlugin(ms_diffusion=1.0), CloudFarFieldPlugin(size=far_size))
+    if sun is not None:
+        app.insert_resource(sun)
+    app.startup()
+    app.render()
+    far = next(p for p in app.plugins if isinstance(p, CloudFarFieldPlugin))
+    return app, far, next(p for p in app.plugins if isinstance(p, CloudsPlugin)).simulation.sets()
+
+
+def light_reference(far, sets) -> dict:
+    """light_by_rank (float64) of the sets' textures as the GPU holds them, ranked by its quantiles."""
+    from atmos.plugins.cloud_render.light import cell_tau
+    from atmos.shading.diffusion import DIFFUSION, read_field
+    _, quantiles = far.layer.read_cover()
+    a, b = sets.a, sets.b
+    return light_by_rank(*(sets.maps_of(s).read_sums()[0] for s in (a, b)), *(read_volume(s["density"]) for s in (a, b)),
+                         sets.t, sets.a_shift, sets.settings.edge_fade, quantiles, heights=profile_heights(sets.shape[1]),
+                         attenuation=far.light_settings().ms_attenuation, column_tau=cell_tau(sets.settings),
+                         trans_a=read_volume(a["transmittance"]), trans_b=read_volume(b["transmittance"]),
+                         field_a=read_field(a[DIFFUSION]), field_b=read_field(b[DIFFUSION]))
+
+
+def assert_light_matches(got, want, names) -> None:
+    for name in names:
+        assert got[name].shape == want[name].shape and np.isfinite(got[name]).all(), name
+        err = np.abs(got[name] - want[name]).max()
+        assert err < 5e-3 * max(np.abs(want[name]).max(), 1e-3), (name, err)
+
+
 @pytest.mark.parametrize("clouds", [True, False])
 def test_the_light_by_rank_is_the_volumes_own_light(gpu, ctx, rng, clouds):
     """light_by_rank.comp (RankLight) against its float64 reference on a fresh random volume: per rank
     interval the octaves' mean sun transmittances and the diffusion field's mean (phi, F), seen from
     above and from below, and the field per height bin; the sun lower than the cloud tops shades the
     bases. No cloud at all: T = 1, the field 0, nothing NaN."""
-    from atmos import App, DefaultPlugins
     from atmos.lighting import Sun
-    from atmos.plugins.cloud_render import CloudRenderPlugin
-    from atmos.plugins.clouds import CloudSettings
-    from atmos.shading.diffusion import DIFFUSION, read_field
     shape = (16, 12, 16)
     d = np.zeros(shape, np.float32)
     if clouds:
@@ -144,37 +180,18 @@ def test_the_light_by_rank_is_the_volumes_own_light(gpu, ctx, rng, clouds):
         for _ in range(6):
             c, r = rng.uniform([2, 3, 2], [14, 9, 14]), rng.uniform(2.0, 5.0)
             d = np.maximum(d, np.clip(1.0 - ((x - c[0]) ** 2 + ((y - c[1]) * 1.5) ** 2 + (z - c[2]) ** 2) / r ** 2, 0, 1))
-    medium = CloudSettings(cell_size=(40.0, 30.0, 40.0), base_altitude=400.0, group_size=(4, 4), smoothing_slices=1,
-                           sigma_t=0.03, edge_fade=0.2)
-    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(medium, density=d),
-                               CloudRenderPlugin(ms_diffusion=1.0), CloudFarFieldPlugin(size=64))
-    app.insert_resource(Sun.from_angles(float(rng.uniform(15.0, 60.0)), float(rng.uniform(0.0, 360.0))))
+    sun = Sun.from_angles(float(rng.uniform(15.0, 60.0)), float(rng.uniform(0.0, 360.0)))
+    app, far, sets = light_scene(gpu, d, 0.2, sun=sun)
     try:
-        app.startup()
-        app.render()
-        far = next(p for p in app.plugins if isinstance(p, CloudFarFieldPlugin))
-        sets = next(p for p in app.plugins if isinstance(p, CloudsPlugin)).simulation.sets()
         got = far.layer.light.read()
         assert set(got) == {"sun", "field", "field_profile"}, "the renderer gives the field a weight: measured"
-        _, quantiles = far.layer.read_cover()
-        want = light_by_rank(*(sets.maps_of(s).read_sums()[0] for s in (sets.a, sets.b)),
-                             *(read_volume(s["density"]) for s in (sets.a, sets.b)), sets.t, sets.a_shift, 0.2, quantiles,
-                             heights=profile_heights(shape[1]), attenuation=far.light_settings().ms_attenuation,
-                             column_tau=0.03 * 30.0, trans_a=read_volume(sets.a["transmittance"]),
-                             trans_b=read_volume(sets.b["transmittance"]), field_a=read_field(sets.a[DIFFUSION]),
-                             field_b=read_field(sets.b[DIFFUSION]))
-        for name in ("sun", "field", "field_profile"):
-            assert got[name].shape == want[name].shape and np.isfinite(got[name]).all(), name
-            scale = max(np.abs(want[name]).max(), 1e-3)
-            err = np.abs(got[name] - want[name])
-            assert err.max() < 5e-3 * scale, (name, err.max(), scale, np.unravel_index(err.argmax(), err.shape),
-                                              got[name][np.unravel_index(err.argmax(), err.shape)[:2]],
-                                              want[name][np.unravel_index(err.argmax(), err.shape)[:2]])
+        assert_light_matches(got, light_reference(far, sets), ("sun", "field", "field_profile"))
         far.configure(enabled=False)          # the ground shadows alone still prepare the layer
         far.layer.light.release()
-        far.layer.prepare(types.SimpleNamespace(sun=app.resource(Sun), time=0.0), sets)
+        far.layer.prepare(types.SimpleNamespace(sun=sun, time=0.0), sets)
         assert far.layer.light.sun is None, "no far field drawn: its light is not measured"
         if clouds:
+            _, quantiles = far.layer.read_cover()
             covered = quantiles[:-1] > 1e-6
             assert covered.sum() >= 4 and got["field"][..., 0].max() > 0.05, "the volume scatters light"
             above, below = got["sun"][covered, 0, 0], got["sun"][covered, 1, 0]
@@ -282,20 +299,9 @@ def test_the_light_by_rank_of_a_one_cell_and_a_wide_uniform_deck_is_finite(gpu, 
     columns that all fall in one rank interval (the fixed-point sums sized so that none overflows): T
     within [0, 1], the field finite, and the deck's mean T seen from above and below its columns' own
     (every column weighs its samples alike, so the mean over all columns of each row's T, weighted)."""
-    from atmos import App, DefaultPlugins
-    from atmos.plugins.cloud_render import CloudRenderPlugin
-    from atmos.plugins.clouds import CloudSettings
-    from atmos.shading.diffusion import DIFFUSION, read_field
-    d = np.ones(shape, np.float32)
-    medium = CloudSettings(cell_size=(40.0, 30.0, 40.0), base_altitude=400.0, group_size=(1, 1) if shape[0] == 1 else (8, 8),
-                           smoothing_slices=1, sigma_t=0.03, edge_fade=0.0)
-    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(medium, density=d),
-                               CloudRenderPlugin(ms_diffusion=1.0), CloudFarFieldPlugin(size=32))
+    app, far, sets = light_scene(gpu, np.ones(shape, np.float32), 0.0, group=(1, 1) if shape[0] == 1 else (8, 8),
+                                 far_size=32)
     try:
-        app.startup()
-        app.render()
-        far = next(p for p in app.plugins if isinstance(p, CloudFarFieldPlugin))
-        sets = next(p for p in app.plugins if isinstance(p, CloudsPlugin)).simulation.sets()
         got = far.layer.light.read()
         for name, values in got.items():
             assert np.isfinite(values).all(), name
@@ -303,20 +309,13 @@ def test_the_light_by_rank_of_a_one_cell_and_a_wide_uniform_deck_is_finite(gpu, 
         assert got["field"][..., 0].max() > 0.0, "the cloud scatters light"
         T = read_volume(sets.b["transmittance"]).astype(np.float64)
         if shape == (1, 1, 1):
-            _, quantiles = far.layer.read_cover()
-            want = light_by_rank(*(sets.maps_of(s).read_sums()[0] for s in (sets.a, sets.b)),
-                                 *(read_volume(s["density"]) for s in (sets.a, sets.b)), sets.t, sets.a_shift, 0.0,
-                                 quantiles, heights=1, attenuation=far.light_settings().ms_attenuation,
-                                 column_tau=0.03 * 30.0, trans_a=read_volume(sets.a["transmittance"]), trans_b=T,
-                                 field_a=read_field(sets.a[DIFFUSION]), field_b=read_field(sets.b[DIFFUSION]))
-            for name in ("sun", "field"):
-                assert np.abs(got[name] - want[name]).max() < 5e-3 * max(np.abs(want[name]).max(), 1e-3), name
+            assert_light_matches(got, light_reference(far, sets), ("sun", "field"))
         else:
             assert T.shape == shape and sets.t in (0.0, 1.0)
             tau = 0.03 * 30.0 * np.ones(shape[1])                      # each row's optical depth, density 1
             below = np.cumsum(tau)
+            rows = T.mean(axis=(0, 2))                                    # every column alike: the rows' mean T
             for view, seen in enumerate((np.exp(-(below[-1] - below + 0.5 * tau)), np.exp(-(below - 0.5 * tau)))):
-                rows = T.mean(axis=(0, 2))                                # every column alike: the rows' mean T
                 want = (seen * rows).sum() / seen.sum()
                 assert abs(got["sun"][-1, view, 0] - want) < 2e-3, (view, got["sun"][-1, view, 0], want)
             assert got["sun"][-1, 1, 0] < got["sun"][-1, 0, 0]

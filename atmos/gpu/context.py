@@ -64,6 +64,11 @@ def window_framebuffer(ctx: moderngl.Context, size: tuple[int, int]) -> moderngl
     return screen
 
 
+def clamp_sampler(ctx: moderngl.Context):
+    """Linear, clamp-to-edge: a texture's outer half texels hold the edge value, never wrap around."""
+    return ctx.sampler(filter=(moderngl.LINEAR, moderngl.LINEAR), repeat_x=False, repeat_y=False, repeat_z=False)
+
+
 def create_headless(size: tuple[int, int] = (640, 360), backend: str = "egl") -> "GpuContext":
     """A standalone context (EGL by default) that renders into an offscreen framebuffer of ``size``."""
     check_frame_size(size)

@@ -17,19 +17,18 @@ from __future__ import annotations
 
 import numpy as np
 
+from atmos.plugins.cloud_far_field.columns import rank_texture, read_rank_texture, use_columns
 from atmos.plugins.cloud_far_field.cover import QUANTILES, level_table, matched_tile_size, pattern_crossings
 from atmos.plugins.cloud_far_field.pattern import PERIODS, octave_frequencies, octave_offsets, rotations
 from atmos.plugins.cloud_far_field.rank_light import RankLight
-from atmos.plugins.cloud_render.light import light_uniforms
+from atmos.plugins.cloud_render.light import cell_tau, light_uniforms
 from atmos.plugins.clouds.sets import CloudSets
 from atmos.plugins.sky_layer.octaves import OctaveTextures
 
 FAR_FIELD = "far_field"          # the imported graph resource
 REBAKE_TOLERANCE = 0.05          # re-bake the octaves when the sun moved the light step by this fraction
 OCTAVE_UNIT = 5                  # texture units 5..8 (field.glsl)
-DENSITY_UNIT = 14                # cover.comp reads the sets' density at units 14, 15 (3D; no renderer binds them)
 PROFILE_UNIT = 14                # the profile texture for the shaders that declare far_profile (2D)
-INTERVALS = QUANTILES - 1        # the profile's rank intervals (between the quantiles)
 MAX_HEIGHTS = 64                 # cover.comp's most height samples
 TILE_TIME = 5.0                  # s: the matched tile follows a change of the volume's with this time constant
 
@@ -58,8 +57,7 @@ def drift(settings, sets: CloudSets, time: float, tile_size: float) -> np.ndarra
 def column_tau(settings, sets: CloudSets) -> float:
     """field.glsl's field_column_tau: optical depth per cell of a column sum, ``thickness · sigma_t ·
     cell height`` (the column far.frag draws and the ground shadows take beyond the volume)."""
-    medium = sets.settings
-    return float(settings.thickness * medium.sigma_t * medium.cell_size[1])
+    return float(settings.thickness) * cell_tau(sets.settings)
 
 
 class FarFieldLayer:
@@ -145,27 +143,20 @@ class FarFieldLayer:
         (:meth:`read_profile`)."""
         profile = self.plugin.drawn_by_march() if profile is None else bool(profile)
         c = self.gpu.program(compute_shader="cloud_far_field/cover.comp", defines={"PROFILE": int(profile)})
-        sim.maps_of(sim.a).sums.use(0)
-        sim.maps_of(sim.b).sums.use(1)
+        use_columns(c, sim, density=profile)
         if profile:
-            sim.a["density"].use(DENSITY_UNIT)
-            sim.b["density"].use(DENSITY_UNIT + 1)
             self._profile_texture(profile_heights(sim.shape[1])).bind_to_image(0, read=False, write=True)
-        c["t"].value = float(sim.t)
-        c["a_shift"].value = sim.a_shift[0], sim.a_shift[2]
         c["threshold"].value = float(sim.settings.cover_threshold)
-        c["edge_fade"].value = float(sim.settings.edge_fade)
         c["max_sum"].value = float(sim.shape[1])
         self.cover.bind_to_storage_buffer(0)
         c.run(1)
         self.gpu.ctx.memory_barrier()
 
     def _profile_texture(self, heights: int):
-        if self.profile is None or self.profile.size != (INTERVALS, heights):
+        if self.profile is None or self.profile.size[1] != heights:
             if self.profile is not None:
                 self.profile.release()
-            self.profile = self.gpu.track(self.gpu.ctx.texture((INTERVALS, heights), 2, dtype="f4"))
-            self.profile.repeat_x = self.profile.repeat_y = False      # clamp: ranks 0 and 1, base and top
+            self.profile = rank_texture(self.gpu, heights, 2)
         return self.profile
 
     def read_profile(self) -> np.ndarray:
@@ -175,8 +166,7 @@ class FarFieldLayer:
             raise RuntimeError("FarFieldLayer.read_profile: no profile measured yet; it is measured while a ray "
                                "march draws the far field, or by measure_cover(sim, profile=True)")
         self.gpu.ctx.memory_barrier()
-        w, h = self.profile.size
-        return np.frombuffer(self.profile.read(), np.float32).reshape(h, w, 2).transpose(1, 0, 2).astype(np.float64)
+        return read_rank_texture(self.profile)
 
     def read_cover(self) -> tuple[float, np.ndarray]:
         """(cover, (QUANTILES,) column-sum quantiles) as last measured (a GPU → CPU copy: tests and tools)."""

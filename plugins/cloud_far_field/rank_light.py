@@ -10,16 +10,14 @@ from a slanted column. Two small dispatches per frame after the cover (:meth:`Fa
 """
 from __future__ import annotations
 
-import numpy as np
-
-from atmos.plugins.cloud_far_field.cover import QUANTILES
+from atmos.plugins.cloud_far_field.columns import INTERVALS, rank_texture, read_rank_texture, use_columns
+from atmos.plugins.cloud_render.light import cell_tau
 from atmos.shading.diffusion import DIFFUSION
 
 SUN_UNIT = 18                    # sun_by_rank for the shaders that declare far_sun_by_rank (2D)
 FIELD_UNIT = 19                  # field_column for those that declare far_field_light (2D)
 FIELD_PROFILE_UNIT = 20          # field_profile for those that declare far_field_light_profile (2D)
-READ_UNITS = {"density": (14, 15), "transmittance": (2, 3), DIFFUSION: (16, 17)}   # light_by_rank.comp's inputs
-INTERVALS = QUANTILES - 1        # the rank intervals (columns.glsl INTERVALS)
+READ_UNITS = {"transmittance": (2, 3), DIFFUSION: (16, 17)}   # light_by_rank.comp's inputs beside columns.glsl's
 FIELD_BINS = 16                  # light_by_rank.comp's most height bins of the field
 SUMS = INTERVALS * 2 * 9 + INTERVALS * FIELD_BINS * 5      # its Sums buffer (uint32): the slots, the bins
 GROUP = 256                      # its work group (columns per group in STAGE 0)
@@ -42,22 +40,19 @@ class RankLight:
         shading = "transmittance" in sim.a and "transmittance" in sim.b
         bins = min(int(heights), FIELD_BINS) if self.has_field else 1
         self._allocate(bins)
-        sim.maps_of(sim.a).sums.use(0)
-        sim.maps_of(sim.b).sums.use(1)
         for name, (unit_a, unit_b) in READ_UNITS.items():
             if name in sim.a and name in sim.b:
                 sim.a[name].use(unit_a)
                 sim.b[name].use(unit_b)
-        medium = sim.settings
-        values = dict(t=float(sim.t), a_shift=(sim.a_shift[0], sim.a_shift[2]), edge_fade=float(medium.edge_fade),
-                      heights=int(heights), bins=bins, has_shading=int(shading), attenuation=float(attenuation),
-                      column_tau=float(medium.sigma_t * medium.cell_size[1]))
+        values = dict(heights=int(heights), bins=bins, has_shading=int(shading), attenuation=float(attenuation),
+                      column_tau=cell_tau(sim.settings))
         cover_buffer.bind_to_storage_buffer(0)
         self.sums.bind_to_storage_buffer(1)
-        columns = int(np.prod(np.asarray(sim.shape)[[0, 2]]))
+        columns = sim.shape[0] * sim.shape[2]
         for stage, groups in ((0, -(-columns // GROUP)), (1, 1)):
             c = self.gpu.program(compute_shader="cloud_far_field/light_by_rank.comp",
                                  defines={"FIELD": int(self.has_field), "STAGE": stage})
+            use_columns(c, sim)
             for name, value in values.items():
                 if name in c:
                     c[name].value = value
@@ -71,16 +66,11 @@ class RankLight:
 
     def _allocate(self, bins: int) -> None:
         if self.sun is None:
-            self.sun = self._texture(2)
+            self.sun = rank_texture(self.gpu, 2, 4)
             self.sums = self.gpu.track(self.gpu.ctx.buffer(bytes(4 * SUMS)))    # zero; STAGE 1 clears it
-        if self.has_field and (self.field_profile is None or self.field_profile.size != (INTERVALS, bins)):
+        if self.has_field and (self.field_profile is None or self.field_profile.size[1] != bins):
             self._release_field()
-            self.field, self.field_profile = self._texture(2), self._texture(bins)
-
-    def _texture(self, rows: int):
-        texture = self.gpu.track(self.gpu.ctx.texture((INTERVALS, rows), 4, dtype="f4"))
-        texture.repeat_x = texture.repeat_y = False         # clamp: ranks 0 and 1, base and top
-        return texture
+            self.field, self.field_profile = rank_texture(self.gpu, 2, 4), rank_texture(self.gpu, bins, 4)
 
     def use(self, program) -> None:
         """Bind the textures the program declares (far_sun_by_rank, far_field_light, far_field_light_profile)."""
@@ -99,9 +89,9 @@ class RankLight:
         if self.sun is None:
             raise RuntimeError("RankLight.read: nothing measured yet (FarFieldLayer.prepare measures it)")
         self.gpu.ctx.memory_barrier()
-        out = {"sun": _read(self.sun)}
+        out = {"sun": read_rank_texture(self.sun)}
         if self.has_field:
-            out.update(field=_read(self.field), field_profile=_read(self.field_profile))
+            out.update(field=read_rank_texture(self.field), field_profile=read_rank_texture(self.field_profile))
         return out
 
     def _release_field(self) -> None:
@@ -116,9 +106,3 @@ class RankLight:
             if resource is not None:
                 resource.release()
         self.sun = self.sums = None
-
-
-def _read(texture) -> np.ndarray:
-    """(width, height, 4) float64 of an rgba32f texture: [k, row]."""
-    w, h = texture.size
-    return np.frombuffer(texture.read(), np.float32).reshape(h, w, 4).transpose(1, 0, 2).astype(np.float64)

@@ -48,6 +48,18 @@ def column_quantiles(sums_a, sums_b, t: float, a_shift, fade: float, count: int 
     return np.where(target <= empty, 0.0, out) if total > 0 else np.zeros(count)
 
 
+def shifted_volume(volume, a_shift) -> np.ndarray:
+    """``volume`` (nx, ny, nz) read at ``[i + a_shift.x, j, k + a_shift.z]``, zero past its edge (set A on
+    B's grid, as columns.glsl's column_density reads it)."""
+    a = np.asarray(volume, np.float64)
+    nx, ny, nz = a.shape
+    out = np.zeros_like(a)
+    src_x, src_z = np.arange(nx) + int(a_shift[0]), np.arange(nz) + int(a_shift[2])
+    okx, okz = (src_x >= 0) & (src_x < nx), (src_z >= 0) & (src_z < nz)
+    out[np.ix_(okx, np.arange(ny), okz)] = a[np.ix_(src_x[okx], np.arange(ny), src_z[okz])]
+    return out
+
+
 def column_profile(density_a, density_b, t: float, a_shift, fade: float, quantiles, heights: int | None = None) -> np.ndarray:
     """``cover.comp``'s profile (intervals, heights, 2) of mix(A, B, t) (``density_a/b`` (nx, ny, nz), A
     read at ``c + a_shift``, zero past its edge; densities clamped to [0, 1]): each covered column (sum
@@ -55,14 +67,9 @@ def column_profile(density_a, density_b, t: float, a_shift, fade: float, quantil
     nearest cell) to the rank interval k of ``quantiles`` (:func:`column_quantiles`) its sum lies in;
     [k, j] = (density per unit column sum in cells, share of the column above sample j), an interval
     without columns takes the nearest one's (above first); none at all: uniform."""
-    a, b = (np.asarray(d, np.float64) for d in (density_a, density_b))
+    shifted_a, b = shifted_volume(density_a, a_shift), np.asarray(density_b, np.float64)
     nx, ny, nz = b.shape
     heights = ny if heights is None else int(heights)
-    shifted_a = np.zeros_like(a)
-    sx, sz = int(a_shift[0]), int(a_shift[2])
-    src_x, src_z = np.arange(nx) + sx, np.arange(nz) + sz
-    okx, okz = (src_x >= 0) & (src_x < nx), (src_z >= 0) & (src_z < nz)
-    shifted_a[np.ix_(okx, np.arange(ny), okz)] = a[np.ix_(src_x[okx], np.arange(ny), src_z[okz])]
     d = np.clip((1.0 - t) * shifted_a + t * b, 0.0, 1.0)
     sums = (1.0 - t) * shifted_a.sum(1) + t * b.sum(1)
     uv = np.stack(np.meshgrid((np.arange(nx) + 0.5) / nx, (np.arange(nz) + 0.5) / nz, indexing="ij"), -1)
@@ -92,8 +99,8 @@ def column_profile(density_a, density_b, t: float, a_shift, fade: float, quantil
 def light_by_rank(sums_a, sums_b, density_a, density_b, t: float, a_shift, fade: float, quantiles, *, heights: int,
                   attenuation: float, column_tau: float, trans_a=None, trans_b=None, field_a=None, field_b=None,
                   bins: int = 16) -> dict:
-    """``light_by_rank.comp`` of mix(A, B, t) (A read at ``c + a_shift``, zero past its edge; ``sums_a/b``
-    (nx, nz) column sums, ``density_a/b`` (nx, ny, nz), the optional sun transmittance ``trans_a/b`` and
+    """``light_by_rank.comp`` of mix(A, B, t) (A read at ``c + a_shift``: ``sums_a/b`` (nx, nz) column sums
+    and ``density_a/b`` (nx, ny, nz) zero past its edge; the optional sun transmittance ``trans_a/b`` and
     diffusion field ``field_a/b`` (x, y, z, 4) on their own grids, each read at the texel nearest a density
     cell's centre, clamped): per rank interval of ``quantiles`` the edge-weighted mean over its covered
     columns of each column's mean (T, T^a, T^a², T^a³) and (phi, F) at its ``heights`` samples, weighted
@@ -101,7 +108,8 @@ def light_by_rank(sums_a, sums_b, density_a, density_b, t: float, a_shift, fade:
     bin (of min(heights, bins)) the columns' density-weighted (phi, F). Returns dict sun (32, 2, 4) and,
     with a field, field (32, 2, 4), field_profile (32, bins, 4); filled as the shader fills them."""
     def mixed(a, b, cells):
-        """mix(A, B, t) of grid a, b (x, y, z, ...) at the texels nearest density ``cells`` (n, 3)."""
+        """mix(A, B, t) of grids a, b (x, y, z, ...) at their texels nearest density ``cells`` (n, 3)
+        (A's at the cells + a_shift), each index clamped to its grid."""
         out = []
         for grid, shift in ((np.asarray(a, np.float64), np.array([a_shift[0], 0, a_shift[2]])), (np.asarray(b, np.float64), 0)):
             m = np.array(grid.shape[:3])
@@ -111,6 +119,7 @@ def light_by_rank(sums_a, sums_b, density_a, density_b, t: float, a_shift, fade:
 
     n = np.array(np.shape(density_b))
     nx, ny, nz = n
+    density = (1.0 - t) * shifted_volume(density_a, a_shift) + t * np.asarray(density_b, np.float64)
     sums = (1.0 - t) * shifted(np.asarray(sums_a, np.float64), a_shift) + t * np.asarray(sums_b, np.float64)
     uv = np.stack(np.meshgrid((np.arange(nx) + 0.5) / nx, (np.arange(nz) + 0.5) / nz, indexing="ij"), -1)
     units = np.round(edge_weight(uv, fade) * 1024.0)
@@ -124,7 +133,7 @@ def light_by_rank(sums_a, sums_b, density_a, density_b, t: float, a_shift, fade:
     for x, z in zip(*np.nonzero((sums > 1e-6) & (units > 0))):
         k = min(max(int(np.searchsorted(q, sums[x, z], side="right")) - 1, 0), 31)
         cells = np.stack([np.full(heights, x), rows, np.full(heights, z)], -1)
-        d = np.clip(mixed(density_a, density_b, cells), 0.0, 1.0)
+        d = np.clip(density[x, rows, z], 0.0, 1.0)
         tau = column_tau * units[x, z] / 1024.0 * ny / heights * d
         below = np.cumsum(tau)
         seen = d[:, None] * np.stack([np.exp(-(below[-1] - below + 0.5 * tau)), np.exp(-(below - 0.5 * tau))], -1)

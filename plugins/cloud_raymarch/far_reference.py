@@ -8,7 +8,7 @@ import numpy as np
 from atmos.plugins.cloud_far_field.reference import column_at_rank, field_fbm, field_rank
 from atmos.plugins.cloud_raymarch.far import SUN_STEPS, sun_steps
 from atmos.plugins.cloud_raymarch.reference import integrate, rays
-from atmos.plugins.cloud_render.light import sun_light, unit_direction
+from atmos.plugins.cloud_render.light import cell_tau, sun_light, unit_direction
 from atmos.shading.diffusion import field_radiance
 from atmos.shading.medium import mean_cosine, source_reference
 
@@ -78,7 +78,7 @@ def far_source(field: FarField, medium, settings, p, dirs, band, sun) -> np.ndar
         i = min(int(x), 2)
         depth += field.density(c[:, i] + (c[:, i + 1] - c[:, i]) * (x - i), h + (k + 0.5) * rise)
     T = np.exp(-medium.sigma_t * ds * depth)
-    column = medium.sigma_t * medium.cell_size[1] * column_at_rank(c[:, 0], field.columns)
+    column = cell_tau(medium) * column_at_rank(c[:, 0], field.columns)
     above = sample_profile(field.profile, c[:, 0], np.clip(h, 0.0, 1.0))[..., 1]
     up, down = column * above, column * (1.0 - above)
     sun_color, ambient = sun_light(sun, band[0] + 0.5 * band[1])

@@ -29,7 +29,8 @@ from atmos.plugins.cloud_raymarch.far import far_uniforms
 from atmos.plugins.cloud_raymarch.noise import pixel_angle
 from atmos.plugins.cloud_raymarch.settings import REFERENCE, SUN_GROWTH, SUN_SPACING, RaymarchCloudSettings
 from atmos.plugins.cloud_raymarch.temporal import TemporalClouds, jitter
-from atmos.plugins.cloud_render.binding import bind_volume, clamp_sampler, unbind_volume
+from atmos.gpu import clamp_sampler
+from atmos.plugins.cloud_render.binding import bind_volume, unbind_volume
 from atmos.plugins.cloud_render.light import unit_direction
 from atmos.plugins.cloud_render.offscreen import OffscreenClouds, low_size
 from atmos.plugins.clouds.field_demand import field_demand

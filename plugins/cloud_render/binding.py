@@ -1,8 +1,6 @@
 """Binding the simulation's A/B textures and the light model to a program (``cloud_render/volume.glsl``)."""
 from __future__ import annotations
 
-import moderngl
-
 from atmos.lighting import Sun
 from atmos.plugins.cloud_render.light import DEFAULT_OCTAVES, light_uniforms
 from atmos.plugins.clouds.sets import CloudSets
@@ -10,11 +8,6 @@ from atmos.shading.columns import COLUMNS
 from atmos.shading.diffusion import DIFFUSION
 
 UNITS = (0, 1, 2, 3, 10, 11, 16, 17)   # density, transmittance, columns, diffusion field (each a, b)
-
-
-def clamp_sampler(ctx: moderngl.Context):
-    """Linear, clamp-to-edge: the volume's outer half cells hold the edge value, never wrap around."""
-    return ctx.sampler(filter=(moderngl.LINEAR, moderngl.LINEAR), repeat_x=False, repeat_y=False, repeat_z=False)
 
 
 def bind_volume(program, sim, sampler, sun: Sun | None, octaves=DEFAULT_OCTAVES, diffusion: float = 0.0,

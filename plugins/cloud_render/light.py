@@ -73,6 +73,12 @@ def unit_direction(sun: Sun | None) -> np.ndarray:
     return d / n if n > 0 and np.isfinite(n) else np.array([0.0, -1.0, 0.0])
 
 
+def cell_tau(cloud_settings) -> float:
+    """sigma_t × cell height: the optical depth of one cell of density 1, vertically (volume.glsl's
+    column_tau; the far field's columns per summed cell)."""
+    return float(cloud_settings.sigma_t * cloud_settings.cell_size[1])
+
+
 def light_uniforms(cloud_settings, sun: Sun | None, octaves=DEFAULT_OCTAVES, diffusion: float = 0.0,
                    altitude: float | None = None) -> dict:
     """The light uniforms of ``volume.glsl`` for a ``CloudSettings`` medium, the ``Sun``, the
@@ -88,5 +94,5 @@ def light_uniforms(cloud_settings, sun: Sun | None, octaves=DEFAULT_OCTAVES, dif
             "sun_dir": tuple(float(v) for v in direction),
             "phase_lobes": (float(s.phase_g), float(s.phase_g2), float(s.phase_w)),
             "ms_octaves": tuple(float(v) for v in octaves),
-            "column_tau": float(s.sigma_t * s.cell_size[1]),
+            "column_tau": cell_tau(s),
             "ms_diffusion": float(diffusion)}

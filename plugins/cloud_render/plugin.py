@@ -42,7 +42,8 @@ from atmos.checks import check_bool, check_int, check_num
 from atmos.composition import CLOUD_DISTANCE, composition
 from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.plugin import Plugin
-from atmos.plugins.cloud_render.binding import bind_volume, clamp_sampler, unbind_volume
+from atmos.gpu import clamp_sampler
+from atmos.plugins.cloud_render.binding import bind_volume, unbind_volume
 from atmos.plugins.cloud_render.light import CloudLightSettings
 from atmos.plugins.cloud_render.offscreen import MAX_DOWNSAMPLE, OffscreenClouds, low_size
 from atmos.plugins.clouds.layout import CloudLayout

@@ -19,12 +19,12 @@ from __future__ import annotations
 
 import math
 
-import moderngl
 import numpy as np
 
-from atmos.composition import CLOUD_DISTANCE
-from atmos.graph import FullscreenPass, PassContext, TextureDesc
 from atmos.camera import set_camera_uniforms, view_basis
+from atmos.composition import CLOUD_DISTANCE
+from atmos.gpu import clamp_sampler
+from atmos.graph import FullscreenPass, PassContext, TextureDesc
 from atmos.lighting import unit_sun
 from atmos.plugins.sky.luts import SKY_LUTS, atmosphere_defines, set_atmosphere_uniforms, view_radius
 from atmos.render_core import COLOR, DEPTH
@@ -86,8 +86,7 @@ class AerialPerspectivePass(FullscreenPass):
 
     def prepare(self, gpu) -> None:
         super().prepare(gpu)
-        self.sampler = gpu.ctx.sampler(filter=(moderngl.LINEAR, moderngl.LINEAR), repeat_x=False, repeat_y=False,
-                                       repeat_z=False)
+        self.sampler = clamp_sampler(gpu.ctx)
 
     def release(self) -> None:
         sampler = getattr(self, "sampler", None)
@@ -124,7 +123,7 @@ class AerialPerspectivePass(FullscreenPass):
 
     def _fill(self, volume, view, values) -> None:
         """The froxel volume: one invocation per froxel column, marching through the slices (aerial_volume.comp)."""
-        c = self.gpu.program(compute_shader="sky/aerial_volume.comp", defines=self.defines())
+        c = self.gpu.program(compute_shader="sky/aerial_volume.comp", defines=atmosphere_defines())
         set_camera_uniforms(c, view.camera, view.aspect)
         set_atmosphere_uniforms(c, self.plugin.settings.atmosphere)
         for name, value in values.items():

@@ -62,9 +62,8 @@ void main() {
     // relief: the sun's extra optical depth through the channels toward it over a column as thick all
     // round (0 on average): lit edges facing the sun, shaded ones behind
     float relief = 0.5 * (dot(col, vec4(0.25)) - tau) / max(sun_dir.y, MIN_SLANT);
-    float a = ms_octaves.x;
-    vec4 sun = min(pow(max(textureLod(far_sun_by_rank, at, 0.0), 0.0), vec4(thickness))
-                   * exp(-relief * vec4(1.0, a, a * a, a * a * a)), 1.0);
+    vec4 sun = min(pow(max(textureLod(far_sun_by_rank, at, 0.0), 0.0), vec4(thickness)) * exp(-relief * octave_exponents()),
+                   1.0);
     vec3 light = sun_part(octave_weights_of(sun, tau), dot(dir, sun_dir)) + ambient_source(0.5 * tau, 0.5 * tau, dir.y)
                + (ms_diffusion > 0.0 ? diffusion_light(textureLod(far_field_light, at, 0.0), dir) : vec3(0.0));
     frag = vec4(light * alpha, alpha);

@@ -56,6 +56,12 @@ float mean_cosine() {
     return (1.0 - phase_lobes.z) * phase_lobes.x + phase_lobes.z * phase_lobes.y;
 }
 
+// The octaves' exponents of T: (1, a, a^2, a^3).
+vec4 octave_exponents() {
+    float a = ms_octaves.x;
+    return vec4(1.0, a, a * a, a * a * a);
+}
+
 // Octave weights b^i Ta_i from the octaves' transmittances Ta = (T, T^a, T^a^2, T^a^3) (the 2D far field
 // passes the volume's means by rank), the scattered ones times m as below.
 vec4 octave_weights_of(vec4 Ta, float tau_column) {
@@ -66,8 +72,7 @@ vec4 octave_weights_of(vec4 Ta, float tau_column) {
 // Octave weights b^i T^(a^i), i = 0..3, the scattered ones (i >= 1) times the chance
 // 1 - exp(-(1 - g_mean) tau_column) that light was turned aside in the column through the point.
 vec4 octave_weights(float T, float tau_column) {
-    float a = ms_octaves.x;
-    return octave_weights_of(vec4(T, pow(T, a), pow(T, a * a), pow(T, a * a * a)), tau_column);
+    return octave_weights_of(vec4(T, pow(vec3(T), octave_exponents().yzw)), tau_column);
 }
 
 // Sky and ground light toward the eye along ray_y (the view ray's y): their mean plus half their

@@ -28,10 +28,11 @@ void main() {
     vec3 dir = view_ray_dir((vec2(c) + 0.5) / vec2(size.xy), view_basis);
     float r = atm_clamp_radius(view_r), end = atm_ray_end(r, dir.y), nu = dot(dir, sun_dir);
     vec3 radiance = vec3(0.0), transfer = vec3(0.0), throughput = vec3(1.0);
+    vec2 phases = atm_phases(nu, false);
     float t = 0.0;
     for (int z = 0; z < size.z; ++z) {
         float d = min(aerial_slice_distance((float(z) + 0.5) / float(size.z), aerial_range), end);
-        if (d > t) atm_segment(r, dir.y, sun_dir.y, nu, t, d, false, radiance, transfer, throughput);
+        if (d > t) atm_segment(r, dir.y, sun_dir.y, nu, t, d, phases, false, radiance, transfer, throughput);
         t = max(t, d);
         float T = dot(throughput, vec3(1.0 / 3.0)), opacity = 1.0 - T;
         vec3 light = radiance * atm_sun;

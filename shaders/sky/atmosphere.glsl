@@ -78,14 +78,20 @@ vec2 atm_point(float r, float mu, float mu_s, float nu, float t) {
 float atm_rayleigh_phase(float nu) { return 3.0 / (16.0 * ATM_PI) * (1.0 + nu * nu); }
 float atm_hg_phase(float g, float nu) { return (1.0 - g * g) / (4.0 * ATM_PI * pow(1.0 + g * g - 2.0 * g * nu, 1.5)); }
 
-// One segment [t0, t1] of a ray from radius r (zenith cosine mu; sun at mu_s, nu = cos view·sun), sampled
-// at its middle (the medium's coefficients there, the sun's transmittance, the multiple-scattering LUT
-// unless `isotropic`): adds its in-scattered radiance and transfer (∫ σs T dt) seen through `throughput`,
-// then dims `throughput` by the segment. atm_march's step; sky/aerial_volume.comp marches slice by slice.
-void atm_segment(float r, float mu, float mu_s, float nu, float t0, float t1, bool isotropic,
+// The (Rayleigh, Mie) phase of a ray with nu = cos view·sun; `isotropic`: the multiple-scattering LUT's
+// pass (isotropic phase, no Ψ). Once per ray: atm_segment takes it.
+vec2 atm_phases(float nu, bool isotropic) {
+    return isotropic ? vec2(0.25 / ATM_PI) : vec2(atm_rayleigh_phase(nu), atm_hg_phase(atm_g, nu));
+}
+
+// One segment [t0, t1] of a ray from radius r (zenith cosine mu; sun at mu_s, nu = cos view·sun; `phases`
+// its atm_phases), sampled at its middle (the medium's coefficients there, the sun's transmittance, the
+// multiple-scattering LUT unless `isotropic`): adds its in-scattered radiance and transfer (∫ σs T dt)
+// seen through `throughput`, then dims `throughput` by the segment. atm_march's step;
+// sky/aerial_volume.comp marches slice by slice.
+void atm_segment(float r, float mu, float mu_s, float nu, float t0, float t1, vec2 phases, bool isotropic,
                  inout vec3 radiance, inout vec3 transfer, inout vec3 throughput) {
-    float pr = isotropic ? 0.25 / ATM_PI : atm_rayleigh_phase(nu);
-    float pm = isotropic ? 0.25 / ATM_PI : atm_hg_phase(atm_g, nu);
+    float pr = phases.x, pm = phases.y;
     float t = 0.5 * (t0 + t1), dt = t1 - t0;
     vec2 at = atm_point(r, mu, mu_s, nu, t);
     float ri = at.x, mus_i = at.y;
@@ -111,9 +117,10 @@ vec3 atm_march(float r, float mu, float mu_s, float nu, float t_max, int steps, 
     vec3 radiance = vec3(0.0);
     throughput = vec3(1.0);
     transfer = vec3(0.0);
+    vec2 phases = atm_phases(nu, isotropic);
     for (int i = 0; i < steps; i++) {
         float a = float(i) / float(steps), b = float(i + 1) / float(steps);
-        atm_segment(r, mu, mu_s, nu, t_max * a * a, t_max * b * b, isotropic, radiance, transfer, throughput);
+        atm_segment(r, mu, mu_s, nu, t_max * a * a, t_max * b * b, phases, isotropic, radiance, transfer, throughput);
     }
     return radiance;
 }
