@@ -1,6 +1,6 @@
 """The ray-marched clouds (issue 15) measured in one run, beside the sprites:
 
-1. **Error vs time** against the path tracer (bench_cloud_light's two static volumes, five views,
+1. **Error vs time** against the path tracer (bench_cloud_light's two static volumes, six views,
    references and error metrics): the march at steps 32–256 (full resolution), resolution 1/2/4 with
    and without reprojection (with it, the image after r² + 4 frames of a still camera), detail
    octaves 1–3 — their "truth" is another cloud, so those rows give the change vs octaves 0, not the
