@@ -10,7 +10,8 @@ from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
 from atmos.plugins.cloud_render import CloudRenderPlugin
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin, read_volume
 from atmos.shading.diffusion import (DIFFUSION, TOLERANCE, DiffusionSolver, apply, diffusion_desc,
-                                     diffusion_reference, diffusion_system, field_shape, read_field, resample, solve_cg)
+                                     diffusion_reference, diffusion_system, diffusion_weight, field_radiance, field_shape,
+                                     read_field, resample, solve_cg)
 from atmos.shading.grid import shading_shape
 from atmos.shading.shear_warp import upload_volume
 from tests.test_clouds import params
@@ -91,6 +92,24 @@ def test_the_gpu_solve_needs_its_iterations_and_starts_warm_from_the_last(gpu, c
     cold, res_cold = gpu_field(gpu, d, T2, iterations=12, solver=DiffusionSolver(gpu, d.shape))
     warm, res_warm = gpu_field(gpu, d, T2, iterations=12, solver=solver, warm=True)
     assert res_warm < 0.2 * res_cold
+
+
+def test_the_field_lights_a_lit_surface_seen_with_the_sun_behind():
+    """Against the flux (a view with the sun behind it, cos -1) the truncated P1 radiance phi - 3 g F.d is
+    negative at a lit surface, where F runs with the sun's light; the field then gives -cos phi / 4pi,
+    the diffuse light the surface sends back (bench_cloud_light "sun behind": the cumulus was -17.8 %
+    dark without it). Toward the sun the P1 term is larger and stands; the weight fades the field
+    toward the sun only."""
+    sun, g, phi = np.array([0.0, 0.6, 0.8]), 0.735, 2.0
+    field = np.concatenate([[phi], -0.9 * phi * sun])           # |F| near phi, along the sun's light
+    behind, toward, side = -sun, sun, np.array([1.0, 0.0, 0.0])
+    assert phi - 3 * g * field[1:] @ behind < 0.0
+    got = field_radiance(np.stack([field] * 3), np.stack([behind, toward, side]), g, sun)
+    np.testing.assert_allclose(got, np.array([phi, phi * (1 + 3 * g * 0.9), phi]) / (4 * np.pi), rtol=1e-12)
+    half = field_radiance(field, -np.array([0.0, 1.0, 0.0]), g, sun)          # cos -0.6: 0.6 phi at least
+    assert half == pytest.approx(max(phi - 3 * g * field[1:] @ [0.0, -1.0, 0.0], 0.6 * phi) / (4 * np.pi))
+    np.testing.assert_allclose(diffusion_weight(1.5, np.array([-1.0, -0.5, 0.0, 0.5, 1.0])),
+                               [1.5, 1.5, 1.5, 1.5 * 0.75 ** 4, 0.0], rtol=1e-12)
 
 
 def test_bad_solver_input_is_refused(gpu, ctx):

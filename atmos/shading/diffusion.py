@@ -10,7 +10,9 @@ light travels). Finite volumes, cell-centred: harmonic face conductances A / (h 
 boundaries (no light enters from outside, ``A k / (2k + 1)``, k = 2D / h), the first-moment source as a
 face flux 3 D_face Q1. The result (phi, F): collided fluence phi and flux F = -D grad phi + 3 D Q1
 (``numpy.gradient``'s differences), |F| clamped to phi. The renderers' radiance from it toward a
-view ray d is max(phi - 3 g F.d, 0) / 4pi.
+view ray d is max(phi - 3 g F.d, -cos phi, 0) / 4pi (cos = d . sun): against the sun never below -cos of
+its isotropic part (the truncated P1 fell to 0 against the flux at a lit surface, and a view from above
+with the sun behind saw no diffuse backscatter: cumulus -17.8 % before, bench_cloud_light "sun behind").
 
 :func:`diffusion_reference` solves the system in float64 by Jacobi-preconditioned conjugate
 gradients (:func:`solve_cg`, the algorithm ``shaders/shading/diffusion.comp`` runs in float32, two
@@ -167,23 +169,27 @@ def resample(volume, shape) -> np.ndarray:
     return multilinear(v, p)
 
 
-def diffusion_radiance(field_volume, uvw, dirs, g: float) -> np.ndarray:
-    """max(phi - 3 g F.d, 0) / 4pi at texture coordinates ``uvw`` (..., 3) for view rays ``dirs``
+def diffusion_radiance(field_volume, uvw, dirs, g: float, sun_dir) -> np.ndarray:
+    """:func:`field_radiance` at texture coordinates ``uvw`` (..., 3) for view rays ``dirs``
     (..., 3, unit, toward the eye's travel): trilinear (clamp to edge) like the renderers' fetch."""
     f = np.asarray(field_volume, np.float64)
     p = np.asarray(uvw, np.float64) * np.array(f.shape[:3]) - 0.5
-    return field_radiance(np.stack([multilinear(f[..., k], p) for k in range(4)], -1), dirs, g)
+    return field_radiance(np.stack([multilinear(f[..., k], p) for k in range(4)], -1), dirs, g, sun_dir)
 
 
-def field_radiance(values, dirs, g: float) -> np.ndarray:
-    """max(phi - 3 g F.d, 0) / 4pi of field values ``values`` (..., 4) = (phi, F) for view rays ``dirs``."""
-    v = np.asarray(values, np.float64)
-    return np.maximum(v[..., 0] - 3 * g * (v[..., 1:] * np.asarray(dirs)).sum(-1), 0.0) / (4 * math.pi)
+def field_radiance(values, dirs, g: float, sun_dir) -> np.ndarray:
+    """max(phi - 3 g F.d, -cos phi, 0) / 4pi of field values ``values`` (..., 4) = (phi, F) for view rays
+    ``dirs`` (unit; cos = d . ``sun_dir``, unit, toward the sun)."""
+    v, d = np.asarray(values, np.float64), np.asarray(dirs, np.float64)
+    c = (d * np.asarray(sun_dir, np.float64)).sum(-1)
+    p1 = v[..., 0] - 3 * g * (v[..., 1:] * d).sum(-1)
+    return np.maximum(np.maximum(p1, -c * v[..., 0]), 0.0) / (4 * math.pi)
 
 
 def diffusion_weight(beta: float, cos_view) -> np.ndarray:
-    """beta (1 - cos^2)^4: the fitted weight of the field's radiance (cos = view . sun)."""
-    c = np.asarray(cos_view, np.float64)
+    """beta (1 - max(cos, 0)^2)^4: the fitted weight of the field's radiance (cos = view . sun), fading
+    it toward the sun only (there the octaves' forward lobes are the light)."""
+    c = np.maximum(np.asarray(cos_view, np.float64), 0.0)
     return beta * (1.0 - c * c) ** 4
 
 

@@ -58,7 +58,7 @@ def march_reference(density, transmittance, medium, settings, layout, camera, su
         T = sun_transmittance(d, trans_volume, medium.sigma_t, lo, extent, SUN_SPACING * cell.min(),
                               settings.sun_steps, sun_dir, p)
         up, down = column_depth(d, uvw, column_tau, trans_volume.shape)
-        L = None if field is None else diffusion_radiance(field, uvw, dirs[i], g)
+        L = None if field is None else diffusion_radiance(field, uvw, dirs[i], g, sun_dir)
         return multilinear(d, uvw * shape - 0.5), source_reference(
             medium, settings, T, up, down, dirs[i] @ sun_dir, dirs[i][:, 1], sun_color, ambient, sun_dir, L)
 

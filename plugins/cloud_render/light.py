@@ -20,8 +20,8 @@ class CloudLightSettings(CheckedSettings):
     """The multiple-scattering octaves both cloud renderers share (the sprites' CloudRenderSettings
     and the march's RaymarchCloudSettings inherit them): ``ms_attenuation``, ``ms_contribution``,
     ``ms_eccentricity`` = Wrenninge's a, b, c in [0, 1]; ``ms_diffusion`` (0..2): the weight beta of
-    the diffusion field beside them (:mod:`atmos.shading.diffusion`: J += sun_source beta (1 - cos^2)^4
-    max(phi - 3 g F.ray, 0) / 4pi, cos = ray . sun); 0 turns the term off (and, with no other reader,
+    the diffusion field beside them (:mod:`atmos.shading.diffusion`: J += sun_source beta (1 - max(cos,
+    0)^2)^4 max(phi - 3 g F.ray, -cos phi, 0) / 4pi, cos = ray . sun); 0 turns the term off (and, with no other reader,
     the field's solve: ``plugins/clouds/field_demand.py``). The defaults are the search
     ``benchmarks/bench_cloud_light.py --fit`` found against the path tracer on the bench's two volumes
     in four views (score 1.21; README "Cloud light"). The 2D far field is lit with the drawing

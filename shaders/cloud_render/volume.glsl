@@ -95,12 +95,14 @@ vec4 cloud_diffusion(vec3 uvw) {
 }
 
 // The field's share of J beside the octaves for a field value f = (phi, F): sun_source beta
-// (1 - c^2)^4 max(phi - 3 g_mean F.ray, 0) / 4pi (c = dot(ray, sun_dir);
-// diffusion.diffusion_weight, diffusion_radiance).
+// (1 - max(c, 0)^2)^4 max(phi - 3 g_mean F.ray, -c phi, 0) / 4pi (c = dot(ray, sun_dir);
+// diffusion.diffusion_weight, field_radiance): faded toward the sun only (the octaves' forward lobes
+// are the light there), and against the sun never below -c of its isotropic part (the diffuse light a
+// lit surface sends back, where the truncated P1 fell to 0 against the flux).
 vec3 diffusion_light(vec4 f, vec3 ray_dir) {
     if (ms_diffusion <= 0.0) return vec3(0.0);
-    float c = dot(ray_dir, sun_dir), s2 = max(1.0 - c * c, 0.0), s4 = s2 * s2;
-    float L = max(f.x - 3.0 * mean_cosine() * dot(f.yzw, ray_dir), 0.0) / (4.0 * PI);
+    float c = dot(ray_dir, sun_dir), s2 = 1.0 - max(c, 0.0) * max(c, 0.0), s4 = s2 * s2;
+    float L = max(max(f.x - 3.0 * mean_cosine() * dot(f.yzw, ray_dir), -c * f.x), 0.0) / (4.0 * PI);
     return sun_source * (ms_diffusion * s4 * s4 * L);
 }
 
