@@ -125,7 +125,10 @@ def test_gpu_luts_match_the_float64_reference_on_random_atmospheres(gpu, ctx, rn
             mslut = ref.multiscattering_lut(s, tlut)
             sv = ref.sky_view_lut(s, tlut, mslut, altitude, sun_y)
             for name, want, atol in (("transmittance", tlut, 1e-4), ("multiscattering", mslut, 1e-4 * mslut.max()),
-                                     ("sky_view", sv, 1e-3 * sv.max())):    # (float32 at a grazing sun)
+                                     ("sky_view", sv, 1e-3 * sv.max() + 1e-7)):
+                # (float32 at a grazing sun; and deep in twilight, where the whole sky is ~1e-6 of a unit
+                # sun's day (~0.1), float32 exp of the long paths' optical depth is off by ~1 % of that
+                # max: seed 1515813457, sun_y -0.29 at 7 km, 1.7e-8 of 1.5e-6)
                 got = luts.read(name)
                 assert np.isfinite(got).all(), name
                 err = np.abs(got - want) - 2e-3 * np.abs(want)
