@@ -24,7 +24,8 @@ class CloudLightSettings(CheckedSettings):
     0)^2)^4 max(phi - 3 g F.ray, -cos phi, 0) / 4pi, cos = ray . sun); 0 turns the term off (and, with no other reader,
     the field's solve: ``plugins/clouds/field_demand.py``). The defaults are the search
     ``benchmarks/bench_cloud_light.py --fit`` found against the path tracer on the bench's two volumes
-    in four views (score 1.21; README "Cloud light"). The 2D far field is lit with the drawing
+    in the goal's four views, scoring the sprites alone (1.21; both renderers, as it scores now: 1.29;
+    README "Cloud light"). The 2D far field is lit with the drawing
     renderer's settings (``CloudFarFieldPlugin.light_settings``). A subclass's ``__post_init__`` stores
     :meth:`light_checks` beside its own checks (alone, the class checks just these)."""
     ms_attenuation: float = DEFAULT_OCTAVES[0]

@@ -101,7 +101,7 @@ vec4 cloud_diffusion(vec3 uvw) {
 // lit surface sends back, where the truncated P1 fell to 0 against the flux).
 vec3 diffusion_light(vec4 f, vec3 ray_dir) {
     if (ms_diffusion <= 0.0) return vec3(0.0);
-    float c = dot(ray_dir, sun_dir), s2 = 1.0 - max(c, 0.0) * max(c, 0.0), s4 = s2 * s2;
+    float c = dot(ray_dir, sun_dir), toward = max(c, 0.0), s2 = 1.0 - toward * toward, s4 = s2 * s2;
     float L = max(max(f.x - 3.0 * mean_cosine() * dot(f.yzw, ray_dir), -c * f.x), 0.0) / (4.0 * PI);
     return sun_source * (ms_diffusion * s4 * s4 * L);
 }
