@@ -6,9 +6,9 @@ and the ray march (``RaymarchCloudsPlugin.reference()`` at several step lengths)
 :func:`atmos.shading.path_tracer.trace` of the same medium and light (``medium.environment``), all
 orders (``--max-order 1``: single scattering only, against the renderers with
 ``ms_contribution = 0``; sky and ground light are then off too). Six views: side, from below,
-toward the sun (20°), grazing sun (3°) (the goal's four), and outside the goal and the fit: toward a
-low sun (10°, a sunset's silver lining) and from above with the sun behind the camera (40°: the
-backscatter a flight over the clouds sees). Per view and mode: image-sum bias, relative RMSE (over pixels the
+toward the sun (20°), grazing sun (3°) (the goal's four), and outside the goal: toward a
+low sun (10°, a sunset's silver lining; in the fit) and from above with the sun behind the camera
+(40°: the backscatter a flight over the clouds sees; held out). Per view and mode: image-sum bias, relative RMSE (over pixels the
 reference sees cloud in) and the frame's ms (median, ``ctx.finish`` around each frame); the tracer's
 own standard error of the image sum and of the RMSE is printed beside it. Plot:
 out/bench_cloud_light.png (rel. RMSE vs ms per view; the other volumes and --max-order 1 get
@@ -272,12 +272,12 @@ FIT_LIMITS = ((0.0, 1.0), (0.0, 1.0), (0.0, 1.0), (0.0, 2.0))
 
 
 FIT_MODES = ("sprites 1/2", "march 1 cell")      # both renderers at real-time settings
-FIT_VIEWS = ("side", "below", "toward sun", "grazing")   # the goal's; the low sun and sun behind are held out
+FIT_VIEWS = ("side", "below", "toward sun", "grazing", "toward low sun")   # the goal's and the low sun; the sun behind is held out
 
 
 def fit(gpu, samples, start=FIT_START, rounds=8):
     """Coordinate search of (ms_attenuation, ms_contribution, ms_eccentricity, ms_diffusion) for both
-    renderers (FIT_MODES) against all-order references of every volume in the goal's views (FIT_VIEWS): each round
+    renderers (FIT_MODES) against all-order references of every volume in FIT_VIEWS: each round
     tries a step down and up per field and keeps the first that lowers the score: per view the larger
     of |bias| / 10 % and rel. RMSE less tracer noise / 15 % (1: the goal), over the views their 8-norm
     (nearly the worst, but a tie goes to the better rest), halving the steps after a round with no gain.

@@ -58,11 +58,11 @@ def test_a_moving_volume_changes_the_picture_without_spikes(gpu, ctx):
           f"moving: median {np.median(moving):.3f} max {moving.max():.3f}")
     assert np.median(still) > 0.01, "the clouds evolve"
     # drawn at the current origin instead, the field jumped a cell whenever the origin moved:
-    # the moving volume's largest change was several times the still one's. The diffusion field's
-    # share of the light moves with its set's solve: since it lights the backscatter (0425f7b) the
-    # largest moving change is 0.611 levels against the still 0.274 (0.564 before; with the field off
-    # both are 0.492, at start-up), hence 2.5x
-    assert moving.max() < 2.5 * still.max() + 0.05
+    # the moving volume's largest change was several times the still one's. The largest moving change
+    # is one frame (43) where a cloud's silhouette moves with the volume: 0.611 levels when the field
+    # began to light the backscatter (0425f7b; 0.564 before), 0.518 with the Poisson octaves, whose
+    # still volume changes less (its largest 0.274 -> 0.182), hence 3x
+    assert moving.max() < 3.0 * still.max() + 0.05
     assert np.median(moving) < 2.0 * np.median(still) + 0.02
 
 

@@ -4,7 +4,7 @@ the shading grid (halved per axis while it has more than :data:`FIELD_CELLS` cel
 
 Per field cell (size ``cell`` metres, density ``rho``): sigma_t = sigma_t rho, scattering ss = albedo
 sigma_t, absorption sa = (1 - albedo) sigma_t, transport extinction max(sa + ss (1 - g), FLOOR), D = 1 /
-(3 transport extinction); the once-scattered source Q0 = ss T (T: the shading volume's transmittance
+(3 transport extinction), air partly a vacuum (:func:`emptiness`); the once-scattered source Q0 = ss T (T: the shading volume's transmittance
 toward the sun, unit irradiance) and its first moment Q1 = g ss T s (s = -sun_dir, the direction the
 light travels). Finite volumes, cell-centred: harmonic face conductances A / (h / 2D0 + h / 2D1), Marshak
 boundaries (no light enters from outside, ``A k / (2k + 1)``, k = 2D / h), the first-moment source as a
@@ -42,6 +42,16 @@ WARM_ITERATIONS = 150      # at most, started from the last step's field (bench_
 FIELD_CELLS = 32768        # the field's grid: the shading grid, halved per axis until it has at most this many cells
 DIFFUSION = "diffusion"    # the texture set's name for the field (rgba16f: phi, F)
 SIGMA_MAX = 1e3            # 1/m: extinction cap (shaders/shading/diffusion.comp has the same)
+AIR_DEPTH = 1.0            # a cell's optical thickness sigma_t h below which it is partly air (:func:`emptiness`)
+
+
+def emptiness(st, cell):
+    """(e, h): a cell's emptiness e = clamp(1 - st h / AIR_DEPTH, 0, 1)^2 at extinction ``st`` (1/m) and
+    the cells' mean size h (the cube root of their volume, metres). The system adds e / h of transport
+    extinction and 3 e / 4h of absorption (the light that escapes): in air the diffusion length is then
+    2h/3 and the flux into it phi/2, a vacuum (Marshak) boundary wherever the cloud's surface lies in the box."""
+    h = float(np.prod(np.broadcast_to(np.asarray(cell, np.float64), (3,)))) ** (1.0 / 3.0)
+    return np.clip(1.0 - np.asarray(st, np.float64) * h / AIR_DEPTH, 0.0, 1.0) ** 2, h
 
 
 def diffusion_system(density, cell, sigma_t: float, albedo: float, g: float, T, sun_dir) -> dict:
@@ -57,12 +67,13 @@ def diffusion_system(density, cell, sigma_t: float, albedo: float, g: float, T, 
     cell = np.broadcast_to(np.asarray(cell, np.float64), (3,))
     st = np.minimum(sigma_t * np.maximum(np.nan_to_num(rho), 0.0), SIGMA_MAX)
     ss, sa = albedo * st, (1.0 - albedo) * st
-    D = 1.0 / (3.0 * np.maximum(sa + ss * (1.0 - g), FLOOR))
+    e, hm = emptiness(st, cell)
+    D = 1.0 / (3.0 * np.maximum(sa + ss * (1.0 - g) + e / hm, FLOOR))
     T = np.clip(np.nan_to_num(T), 0.0, 1.0)
     s = -np.asarray(sun_dir, np.float64) / np.linalg.norm(sun_dir)
     q = g * ss * T
     V = cell.prod()
-    diag, rhs = sa * V, ss * T * V
+    diag, rhs = (sa + 0.75 * e / hm) * V, ss * T * V
     faces = []
     for a in range(3):
         A, h = V / cell[a], cell[a]
@@ -184,13 +195,6 @@ def field_radiance(values, dirs, g: float, sun_dir) -> np.ndarray:
     c = (d * np.asarray(sun_dir, np.float64)).sum(-1)
     p1 = v[..., 0] - 3 * g * (v[..., 1:] * d).sum(-1)
     return np.maximum(np.maximum(p1, -c * v[..., 0]), 0.0) / (4 * math.pi)
-
-
-def diffusion_weight(beta: float, cos_view) -> np.ndarray:
-    """beta (1 - max(cos, 0)^2)^4: the fitted weight of the field's radiance (cos = view . sun), fading
-    it toward the sun only (there the octaves' forward lobes are the light)."""
-    c = np.maximum(np.asarray(cos_view, np.float64), 0.0)
-    return beta * (1.0 - c * c) ** 4
 
 
 def diffusion_desc(shape, scale: int) -> TextureDesc:

@@ -15,15 +15,19 @@ below a Lambertian ``ground_albedo`` lit by both, radiance ``ground_albedo * (E 
 + L_sky)``. :func:`environment` gives the three; :mod:`atmos.shading.path_tracer` renders exactly
 this scene (all orders), the real-time renderers approximate it (``cloud_render/volume.glsl``):
 
-    source per unit extinction J = albedo * (E * sum_i m_i b^i p(cos; c^i g) T^(a^i)
+    source per unit extinction J = albedo * (E * (sum_i b^i p(cos; c^i g) P_i(T) + beta L_field)
                                              + (L_sky + L_ground) / 2 + h (L_sky - L_ground) / 2)
 
-with ``T`` the transmittance toward the sun, ``p`` the phase at the angle between the view ray and
-the sun (per pixel), octaves ``i < 4`` after Wrenninge (a: ``ms_attenuation``, b:
-``ms_contribution``, c: ``ms_eccentricity``) of which the scattered ones (``m_0 = 1``, ``m_i =
-1 - exp(-(1 - g_mean)(tau_up + tau_down))``) scale with the chance that light was turned aside in
-the column through the point: its transport optical depth (``g_mean`` the phase's mean cosine; a
-forward lobe turns little light aside, so a thin cloud seen from below is mostly single scattering).
+with ``T`` the transmittance toward the sun and ``p`` the phase at the angle between the view ray and
+the sun (per pixel). The sun's light splits in two. What stays forward: octaves ``i < 4`` after
+Wrenninge (b: ``ms_contribution``, c: ``ms_eccentricity``), each over the light that reached the point
+forward-scattered ``i`` times on its way (:func:`octave_transmittances`): the count is Poisson with
+mean ``x = (1 - a) tau`` (``tau = -ln T``; a: ``ms_attenuation``, the share of scatterings that turn
+light aside, near ``1 - g_mean``), so ``P = (T, T x, T x²/2, T^a - those)``, the last all higher counts.
+Light only forward-scattered once has a path behind it: the thin lit rim of a cloud holds little of it
+(its "powder" darkening), and deep in the cloud it falls as ``T^a``. What is turned aside: the
+diffusion field (:mod:`atmos.shading.diffusion`, weight beta: ``ms_diffusion``), a P1 solve of the
+scattered fluence whose radiance ``L_field`` is diffuse and runs with the flux.
 ``tau_up``/``tau_down`` (straight up and down to the volume's faces) come from the light volume's
 columns, computed once per texture set (:mod:`atmos.shading.columns`).
 Sky and ground light: the diffusion solution between a slab's two lit faces, ``u = (tau_down −
@@ -32,8 +36,8 @@ tau_up) / (tau_up + tau_down + 2 z)`` with the extrapolation length ``z = 2 / (3
 and ground at albedo 1, gives exactly ``J = L`` at any depth), plus where the column is thin the
 phase's forward share ``g_mean ray_y`` (looking up at a thin base sees sky light scattered forward):
 ``h = clamp(u + g_mean ray_y exp(−(tau_up + tau_down) / 2 z), −1, 1)``. No fitted constant dims it;
-the octaves are fitted to the path tracer (``benchmarks/bench_cloud_light.py --fit``) over both
-volumes and all four views.
+a, b, c and beta are fitted to the path tracer (``benchmarks/bench_cloud_light.py --fit``) over both
+volumes, both renderers and five views.
 """
 from __future__ import annotations
 
@@ -79,11 +83,20 @@ def mean_cosine(g: float, g2: float, w: float) -> float:
     return (1.0 - w) * g + w * g2
 
 
-def octave_weights(T, tau_column, a: float, b: float, g_mean: float) -> np.ndarray:
-    """(..., 4): ``m_i b^i T^(a^i)`` of the module docstring (``tau_column = tau_up + tau_down``)."""
-    T = np.asarray(T, np.float64)
-    m = 1.0 - np.exp(-(1.0 - g_mean) * np.asarray(tau_column, np.float64))
-    return np.stack([(1.0 if i == 0 else m) * b ** i * T ** (a ** i) for i in range(OCTAVES)], -1)
+def octave_transmittances(T, a: float) -> np.ndarray:
+    """(..., 4): the octaves' sun transmittances P_i of the module docstring at transmittance ``T``:
+    light that reached the point forward-scattered k times on its way, k Poisson with mean
+    x = (1 - a) tau (tau = -ln T; ``a`` the share of scatterings that turn light aside), (T, T x, T x²/2)
+    for k = 0, 1, 2 and the rest of T^a (all k) for the higher counts (``shaders/lib/octaves.glsl``)."""
+    T = np.clip(np.asarray(T, np.float64), 0.0, 1.0)
+    x = -(1.0 - a) * np.log(np.maximum(T, 1e-30))
+    low = [T, T * x, 0.5 * T * x * x]
+    return np.stack([*low, np.maximum(T ** a - sum(low), 0.0)], -1)
+
+
+def octave_weights(T, a: float, b: float) -> np.ndarray:
+    """(..., 4): ``b^i P_i(T)`` of the module docstring."""
+    return octave_transmittances(T, a) * b ** np.arange(OCTAVES)
 
 
 def ambient_profile(tau_up, tau_down, g_mean: float, ray_y) -> np.ndarray:
@@ -106,12 +119,11 @@ def source_reference(settings, render, T, tau_up, tau_down, cos, ray_y, sun_colo
     tau_up, tau_down = np.asarray(tau_up, np.float64), np.asarray(tau_down, np.float64)
     a, b, c = render.ms_attenuation, render.ms_contribution, render.ms_eccentricity
     g_mean = mean_cosine(settings.phase_g, settings.phase_g2, settings.phase_w)
-    w = octave_weights(T, tau_up + tau_down, a, b, g_mean)
+    w = octave_weights(T, a, b)
     sun = sum(w[..., i] * phase(cos, settings.phase_g * c ** i, settings.phase_g2 * c ** i, settings.phase_w)
               for i in range(OCTAVES))
     if diffusion is not None:
-        from atmos.shading.diffusion import diffusion_weight
-        sun = sun + diffusion_weight(render.ms_diffusion, cos) * np.asarray(diffusion, np.float64)
+        sun = sun + render.ms_diffusion * np.asarray(diffusion, np.float64)
     h = ambient_profile(tau_up, tau_down, g_mean, ray_y)[..., None]
     amb = 0.5 * (l_sky + l_ground) + 0.5 * h * (l_sky - l_ground)
     return settings.albedo * (sun[..., None] * e + amb)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from atmos.plugins.clouds.edge import edge_weight
+from atmos.shading.medium import octave_transmittances
 from atmos.plugins.cloud_shadows.reference import shifted
 
 
@@ -103,7 +104,7 @@ def light_by_rank(sums_a, sums_b, density_a, density_b, t: float, a_shift, fade:
     and ``density_a/b`` (nx, ny, nz) zero past its edge; the optional sun transmittance ``trans_a/b`` and
     diffusion field ``field_a/b`` (x, y, z, 4) on their own grids, each read at the texel nearest a density
     cell's centre, clamped): per rank interval of ``quantiles`` the edge-weighted mean over its covered
-    columns of each column's mean (T, T^a, T^a², T^a³) and (phi, F) at its ``heights`` samples, weighted
+    columns of each column's mean octave transmittances (medium.octave_transmittances) and (phi, F) at its ``heights`` samples, weighted
     by density × the vertical transmittance to the column's top (row 0) or base (row 1); and per height
     bin (of min(heights, bins)) the columns' density-weighted (phi, F). Returns dict sun (32, 2, 4) and,
     with a field, field (32, 2, 4), field_profile (32, bins, 4); filled as the shader fills them."""
@@ -138,7 +139,7 @@ def light_by_rank(sums_a, sums_b, density_a, density_b, t: float, a_shift, fade:
         below = np.cumsum(tau)
         seen = d[:, None] * np.stack([np.exp(-(below[-1] - below + 0.5 * tau)), np.exp(-(below - 0.5 * tau))], -1)
         T = np.ones(heights) if trans_a is None else np.clip(mixed(trans_a, trans_b, cells), 0.0, 1.0)
-        sun = np.stack([T ** (attenuation ** i) for i in range(4)], -1)
+        sun = octave_transmittances(T, attenuation)
         v = np.zeros((heights, 4))
         if field:
             f = mixed(field_a, field_b, cells)

@@ -11,21 +11,22 @@ from atmos.lighting import Sun
 from atmos.shading.medium import environment
 
 DEFAULT_AMBIENT = (0.35, 0.47, 0.65)
-DEFAULT_OCTAVES = (0.44, 0.86, 0.9)       # Wrenninge's a, b, c, fitted to the path tracer (bench_cloud_light --fit)
-DEFAULT_DIFFUSION = 1.0                   # the diffusion field's weight beta, fitted with them (README "Cloud light")
+DEFAULT_OCTAVES = (0.25, 0.9525, 0.875)   # a, b, c of the octaves, fitted to the path tracer (bench_cloud_light --fit)
+DEFAULT_DIFFUSION = 0.575                 # the diffusion field's weight beta, fitted with them (README "Cloud light")
 
 
 @dataclass(frozen=True)
 class CloudLightSettings(CheckedSettings):
     """The multiple-scattering octaves both cloud renderers share (the sprites' CloudRenderSettings
-    and the march's RaymarchCloudSettings inherit them): ``ms_attenuation``, ``ms_contribution``,
-    ``ms_eccentricity`` = Wrenninge's a, b, c in [0, 1]; ``ms_diffusion`` (0..2): the weight beta of
-    the diffusion field beside them (:mod:`atmos.shading.diffusion`: J += sun_source beta (1 - max(cos,
-    0)^2)^4 max(phi - 3 g F.ray, -cos phi, 0) / 4pi, cos = ray . sun); 0 turns the term off (and, with no other reader,
-    the field's solve: ``plugins/clouds/field_demand.py``). The defaults are the search
-    ``benchmarks/bench_cloud_light.py --fit`` found against the path tracer on the bench's two volumes
-    in the goal's four views, scoring the sprites alone (1.21; both renderers, as it scores now: 1.29;
-    README "Cloud light"). The 2D far field is lit with the drawing
+    and the march's RaymarchCloudSettings inherit them): ``ms_attenuation`` a (the share of scatterings
+    that turn light aside: the octaves' Poisson mean (1 - a) tau), ``ms_contribution`` b (octave i's
+    weight b^i), ``ms_eccentricity`` c (its lobes c^i g), each in [0, 1] (:mod:`atmos.shading.medium`);
+    ``ms_diffusion`` (0..2): the weight beta of the diffusion field, the light turned aside
+    (:mod:`atmos.shading.diffusion`: J += sun_source beta max(phi - 3 g F.ray, -cos phi, 0) / 4pi, cos =
+    ray . sun); 0 turns the term off (and, with no other reader, the field's solve:
+    ``plugins/clouds/field_demand.py``). The defaults are the search ``benchmarks/bench_cloud_light.py
+    --fit`` found against the path tracer on the bench's two volumes, scoring both renderers in the
+    goal's four views and a low sun (README "Cloud light"). The 2D far field is lit with the drawing
     renderer's settings (``CloudFarFieldPlugin.light_settings``). A subclass's ``__post_init__`` stores
     :meth:`light_checks` beside its own checks (alone, the class checks just these)."""
     ms_attenuation: float = DEFAULT_OCTAVES[0]

@@ -135,7 +135,7 @@ def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, 
             tex = np.array(np.shape(trans_a))
             T = trilinear(np.asarray(trans_a, np.float64), (tap + shift) / shape * tex - 0.5) * (1 - t) + \
                 trilinear(np.asarray(trans_b, np.float64), tap / shape * tex - 0.5) * t
-        octaves += octave_weights(T, up + down, a_ms, b_ms, g_mean) / 8.0
+        octaves += octave_weights(T, a_ms, b_ms) / 8.0
         slope += side * np.log(np.maximum(T, MIN_T))[:, None]
     world = np.asarray(u["layer_min"]) + center * np.asarray(u["cell_size"])
     ray = world - np.asarray(u["camera_pos"], np.float64)

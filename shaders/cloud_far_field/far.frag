@@ -64,7 +64,7 @@ void main() {
     float relief = 0.5 * (dot(col, vec4(0.25)) - tau) / max(sun_dir.y, MIN_SLANT);
     vec4 sun = min(pow(max(textureLod(far_sun_by_rank, at, 0.0), 0.0), vec4(thickness)) * exp(-relief * octave_exponents()),
                    1.0);
-    vec3 light = sun_part(octave_weights_of(sun, tau), dot(dir, sun_dir)) + ambient_source(0.5 * tau, 0.5 * tau, dir.y)
+    vec3 light = sun_part(octave_weights_of(sun), dot(dir, sun_dir)) + ambient_source(0.5 * tau, 0.5 * tau, dir.y)
                + (ms_diffusion > 0.0 ? diffusion_light(textureLod(far_field_light, at, 0.0), dir) : vec3(0.0));
     frag = vec4(light * alpha, alpha);
     frag_distance = vec4(alpha * length(hit - camera_pos), alpha, 0.0, alpha);

@@ -6,9 +6,9 @@
 // vertical transmittance exp(-tau) to the column's top (seen from above) or to its base (seen from
 // below; tau: column_tau x w x the sampled densities, half its own sample's); interval k's result is the
 // mean of its columns' means weighted by w:
-//   sun_by_rank (k, v):   (T, T^a, T^a^2, T^a^3) (T: the sun transmittance of the shading volume, nearest
-//                         texel; 1 without one), v = 0 seen from above, 1 from below: the octaves'
-//                         transmittances (volume.glsl octave_weights_of) of the volume's columns of that
+//   sun_by_rank (k, v):   the octaves' transmittances (lib/octaves.glsl) of T (the sun transmittance of the
+//                         shading volume, nearest texel; 1 without one), v = 0 seen from above, 1 from
+//                         below: those (volume.glsl octave_weights_of) of the volume's columns of that
 //                         rank, which the 2D far field (far.frag) lights its columns with;
 // and with FIELD (the sets carry a diffusion field, atmos/shading/diffusion.py):
 //   field_column (k, v):  the field's (phi, F) likewise (nearest field cell);
@@ -28,6 +28,7 @@
 #define STAGE 0
 #endif
 #include "cloud_far_field/columns.glsl"
+#include "lib/octaves.glsl"
 layout(local_size_x = 256) in;
 layout(binding = 2) uniform sampler3D trans_a;       // the sun transmittance, shading scale (if has_shading)
 layout(binding = 3) uniform sampler3D trans_b;
@@ -88,7 +89,7 @@ void add_column(ivec2 p, ivec2 n, int k, uint units, float unit) {
             below += tau;
             if (d <= 0.0) continue;
             float T = has_shading == 0 ? 1.0 : clamp(NEAREST(trans_a, trans_b, cell, size).r, 0.0, 1.0);
-            vec4 Ta = vec4(T, pow(T, attenuation), pow(T, attenuation * attenuation), pow(T, attenuation * attenuation * attenuation));
+            vec4 Ta = octave_transmittances(T, attenuation);
 #if FIELD
             vec4 f = NEAREST(diffusion_a, diffusion_b, cell, size);
             float phi = clamp(f.x, 0.0, FIELD_MAX);

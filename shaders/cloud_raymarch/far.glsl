@@ -58,5 +58,5 @@ vec3 far_source(vec4 c, float h, vec3 dir, float sigma_t) {
     float up = column * above, down = column * (1.0 - above);
     vec3 field = ms_diffusion > 0.0
                ? diffusion_light(textureLod(far_field_light_profile, vec2(c.x, clamp(h, 0.0, 1.0)), 0.0), dir) : vec3(0.0);
-    return sun_part(octave_weights(T, up + down), dot(dir, sun_dir)) + ambient_source(up, down, dir.y) + field;
+    return sun_part(octave_weights(T), dot(dir, sun_dir)) + ambient_source(up, down, dir.y) + field;
 }

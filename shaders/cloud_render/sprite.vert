@@ -150,7 +150,7 @@ void main() {
     for (int i = 0; i < 8; ++i) {
         vec3 side = vec3((i & 1) == 0 ? -1.0 : 1.0, (i & 2) == 0 ? -1.0 : 1.0, (i & 4) == 0 ? -1.0 : 1.0);
         float T = cloud_transmittance(uvw + side * spread / vec3(volume_shape));
-        octaves += octave_weights(T, up + down);
+        octaves += octave_weights(T);
         slope += side * log(max(T, MIN_T));
     }
     // log T's gradient (1/m) fitted to the taps, on the sprite's screen axes per unit of point coordinate

@@ -1,11 +1,12 @@
 // The cloud volume as the renderers see it: density and transmittance toward the sun, each
 // mix(A, B, t) of the two latest completed steps, and the light model of atmos/shading/medium.py:
-// source per unit extinction J = sun_source * sum_i m_i b^i p(cos; c^i g) T^(a^i)
+// source per unit extinction J = sun_source * sum_i b^i p(cos; c^i g) P_i(T)
 //                              + (sky_source + ground_source) + (sky_source - ground_source) h,
-// m_0 = 1, m_i = 1 - exp(-(1 - g_mean)(tau_up + tau_down)) (the column's transport optical depth),
-// h = clamp(u + g_mean ray_y exp(-(tau_up + tau_down) / 2z), -1, 1), u = (tau_down - tau_up) / (tau_up + tau_down + 2z),
-// z = 2 / (3 (1 - g_mean)): the diffusion profile between a slab's lit faces (see medium.py);
-// plus the diffusion field's term (diffusion_part) where the set has one.
+// P_i: the octaves' transmittances (lib/octaves.glsl: light forward-scattered i times on its way, the
+// last all higher counts), h = clamp(u + g_mean ray_y exp(-(tau_up + tau_down) / 2z), -1, 1),
+// u = (tau_down - tau_up) / (tau_up + tau_down + 2z), z = 2 / (3 (1 - g_mean)): the diffusion profile
+// between a slab's lit faces (see medium.py); plus the diffusion field's term (diffusion_part) where the
+// set has one: the light turned aside (diffuse), where the octaves carry what stays forward.
 layout(binding = 0) uniform sampler3D density_a;
 layout(binding = 1) uniform sampler3D density_b;
 layout(binding = 2) uniform sampler3D trans_a;       // at the shading scale; same texture coordinates
@@ -56,23 +57,25 @@ float mean_cosine() {
     return (1.0 - phase_lobes.z) * phase_lobes.x + phase_lobes.z * phase_lobes.y;
 }
 
-// The octaves' exponents of T: (1, a, a^2, a^3).
+#include "lib/octaves.glsl"
+
+// How fast each octave's transmittance falls with the sun's optical depth, as T^e: (1, 1, 1, a) (exact
+// for the first and last deep in the cloud); the sprites' spread across a sprite and the 2D far field's
+// thickness and relief scale them so.
 vec4 octave_exponents() {
-    float a = ms_octaves.x;
-    return vec4(1.0, a, a * a, a * a * a);
+    return vec4(1.0, 1.0, 1.0, ms_octaves.x);
 }
 
-// Octave weights b^i Ta_i from the octaves' transmittances Ta = (T, T^a, T^a^2, T^a^3) (the 2D far field
-// passes the volume's means by rank), the scattered ones times m as below.
-vec4 octave_weights_of(vec4 Ta, float tau_column) {
-    float b = ms_octaves.y, m = 1.0 - exp(-(1.0 - mean_cosine()) * tau_column);
-    return Ta * vec4(1.0, m * b, m * b * b, m * b * b * b);
+// Octave weights b^i P_i from the octaves' transmittances P (the 2D far field passes the volume's means
+// by rank).
+vec4 octave_weights_of(vec4 P) {
+    float b = ms_octaves.y;
+    return P * vec4(1.0, b, b * b, b * b * b);
 }
 
-// Octave weights b^i T^(a^i), i = 0..3, the scattered ones (i >= 1) times the chance
-// 1 - exp(-(1 - g_mean) tau_column) that light was turned aside in the column through the point.
-vec4 octave_weights(float T, float tau_column) {
-    return octave_weights_of(vec4(T, pow(vec3(T), octave_exponents().yzw)), tau_column);
+// Octave weights b^i P_i(T) at sun transmittance T.
+vec4 octave_weights(float T) {
+    return octave_weights_of(octave_transmittances(T, ms_octaves.x));
 }
 
 // Sky and ground light toward the eye along ray_y (the view ray's y): their mean plus half their
@@ -95,15 +98,14 @@ vec4 cloud_diffusion(vec3 uvw) {
 }
 
 // The field's share of J beside the octaves for a field value f = (phi, F): sun_source beta
-// (1 - max(c, 0)^2)^4 max(phi - 3 g_mean F.ray, -c phi, 0) / 4pi (c = dot(ray, sun_dir);
-// diffusion.diffusion_weight, field_radiance): faded toward the sun only (the octaves' forward lobes
-// are the light there), and against the sun never below -c of its isotropic part (the diffuse light a
-// lit surface sends back, where the truncated P1 fell to 0 against the flux).
+// max(phi - 3 g_mean F.ray, -c phi, 0) / 4pi (c = dot(ray, sun_dir); diffusion.field_radiance): against
+// the sun never below -c of its isotropic part (the diffuse light a lit surface sends back, where the
+// truncated P1 fell to 0 against the flux).
 vec3 diffusion_light(vec4 f, vec3 ray_dir) {
     if (ms_diffusion <= 0.0) return vec3(0.0);
-    float c = dot(ray_dir, sun_dir), toward = max(c, 0.0), s2 = 1.0 - toward * toward, s4 = s2 * s2;
+    float c = dot(ray_dir, sun_dir);
     float L = max(max(f.x - 3.0 * mean_cosine() * dot(f.yzw, ray_dir), -c * f.x), 0.0) / (4.0 * PI);
-    return sun_source * (ms_diffusion * s4 * s4 * L);
+    return sun_source * (ms_diffusion * L);
 }
 
 vec3 diffusion_part(vec3 uvw, vec3 ray_dir) {
@@ -124,7 +126,7 @@ vec3 sun_part(vec4 w, float c) {
 // for the callers).
 vec3 cloud_source_with(vec3 uvw, vec3 ray_dir, float ny, float T) {
     vec2 c = cloud_columns(uvw);
-    return sun_part(octave_weights(T, c.x + c.y), dot(ray_dir, sun_dir)) + diffusion_part(uvw, ray_dir)
+    return sun_part(octave_weights(T), dot(ray_dir, sun_dir)) + diffusion_part(uvw, ray_dir)
          + ambient_source(c.x, c.y, ray_dir.y);
 }
 

@@ -27,6 +27,7 @@ layout(std430, binding = 2) buffer Args { uint args[3]; };   // stages 2 and 3 r
 layout(rgba16f, binding = 0) uniform writeonly image3D target;
 const float FLOOR = 1e-3;
 const float SIGMA_MAX = 1e3;  // diffusion.SIGMA_MAX
+const float AIR_DEPTH = 1.0;  // diffusion.AIR_DEPTH
 const int X = 0, R = 1, Z = 2, P = 3, AP = 4, DIAG = 5, RHS = 6, GX = 7, GY = 8, GZ = 9, DC = 10, QC = 11;
 shared vec3 red[256];
 shared vec4 sums;
@@ -78,13 +79,18 @@ float extinction(ivec3 c) {
     float rho = shading_trilinear(fine, fine_size, (vec3(c) + 0.5) * h - 0.5);
     return min(sigma_t * max(rho, 0.0), SIGMA_MAX);
 }
-float diffusivity(float st) { return 1.0 / (3.0 * max(st * (1.0 - albedo) + albedo * st * (1.0 - g), FLOOR)); }
+// Air is a vacuum around the cloud (diffusion.emptiness): e / h more transport extinction, 3 e / 4h escape.
+float cell_mean() { return pow(cell.x * cell.y * cell.z, 1.0 / 3.0); }
+float emptiness(float st) { float e = clamp(1.0 - st * cell_mean() / AIR_DEPTH, 0.0, 1.0); return e * e; }
+float diffusivity(float st) {
+    return 1.0 / (3.0 * max(st * (1.0 - albedo) + albedo * st * (1.0 - g) + emptiness(st) / cell_mean(), FLOOR));
+}
 float first_moment(ivec3 c, float st) { return g * albedo * st * transmittance(c); }
 
 void assemble(ivec3 c, int i) {
     float st = extinction(c), D = diffusivity(st), q = first_moment(c, st);
     float V = cell.x * cell.y * cell.z;
-    float diag = (1.0 - albedo) * st * V;
+    float diag = ((1.0 - albedo) * st + 0.75 * emptiness(st) / cell_mean()) * V;
     float rhs = albedo * st * transmittance(c) * V;
     float Gp[3];
     for (int a = 0; a < 3; ++a) {
