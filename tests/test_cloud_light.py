@@ -222,3 +222,31 @@ def test_sky_light_is_exact_in_a_white_furnace_and_follows_the_columns():
     np.testing.assert_allclose(middle, 0.5 * sky)                      # deep inside: the faces' mean
     assert (sky_part(0.01, 0.0, 1.0) > 1.6 * sky_part(0.01, 0.0, 0.0)).all(), "thin base from below: forward share"
     assert np.isfinite(sky_part(1e30, 1e30)).all() and np.isfinite(sky_part(0.0, 0.0, 1.0)).all()
+
+
+def test_the_octaves_count_forward_scatterings_on_the_way_in(rng):
+    """atmos.shading.medium.octave_transmittances (the twin of shaders/lib/octaves.glsl, checked on the
+    GPU through the renderers' J tests): light that reached a point forward-scattered k times, k Poisson
+    with mean (1 - a) tau, against the Poisson probabilities written out; the last octave is every higher
+    count, so the four sum to T^a; a lit rim (T -> 1) holds no multiple scattering, and any T in [0, 1]
+    (0 and 1 included) gives finite values in [0, 1]."""
+    import math
+
+    from atmos.shading.medium import octave_transmittances
+    a = rng.uniform(0.05, 0.95)
+    tau = np.concatenate([[0.0, 1e-6, 50.0, 1e4], rng.exponential(3.0, 200)])
+    T = np.exp(-tau)
+    P = octave_transmittances(T, a)
+    x = (1.0 - a) * tau
+    def poisson(k):         # T x^k / k!, in logs (x reaches ~10^4)
+        with np.errstate(divide="ignore"):
+            return np.exp(-tau) if k == 0 else np.exp(k * np.log(x) - math.lgamma(k + 1) - tau)
+    for k in range(3):
+        np.testing.assert_allclose(P[:, k], poisson(k), rtol=1e-9, atol=1e-300)
+    higher = sum(poisson(k) for k in range(3, 400))          # the rest of the series (x <= 0.95 * 50 but the 1e4)
+    np.testing.assert_allclose(P[:, 3], higher, rtol=1e-6, atol=1e-12)
+    np.testing.assert_allclose(P.sum(-1), T ** a, rtol=1e-9)
+    assert np.all(np.isfinite(P)) and P.min() >= 0.0 and P.max() <= 1.0
+    rim = octave_transmittances(np.array([1.0, 1.0 - 1e-9]), a)
+    assert rim[:, 1:].max() < 1e-8 and rim[0, 0] == 1.0
+    assert np.isfinite(octave_transmittances(np.array([0.0, 1e-300]), a)).all()
