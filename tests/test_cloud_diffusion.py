@@ -112,17 +112,27 @@ def test_air_around_a_cloud_is_a_vacuum_not_a_conductor():
 
 def test_the_field_lights_a_lit_surface_seen_with_the_sun_behind():
     """Against the flux (a view with the sun behind it, cos -1) the truncated P1 radiance phi - 3 g F.d is
-    negative at a lit surface, where F runs with the sun's light; the field then gives -cos phi / 4pi,
-    the diffuse light the surface sends back (bench_cloud_light "sun behind": the cumulus was -17.8 %
-    dark without it). Toward the sun the P1 term is larger and stands."""
+    negative at a lit surface, where F runs with the sun's light; the field then gives -cos 2 H phi / 4pi:
+    the light a lit surface sends back fills only its outward hemisphere (phi / 2pi) and the phase takes
+    its share H of it outward (bench_cloud_light "sun behind": the cumulus was -17.8 % dark with no floor,
+    -9.1 % with -cos phi, +2.0 % now). Toward the sun the P1 term is larger and stands. H is checked
+    against a quadrature of the lobes."""
+    from atmos.shading.medium import hemisphere_share, hg
+    lobes = (0.85, -0.3, 0.1)
+    mu = (np.arange(200000) + 0.5) / 200000                       # midpoint rule over the hemisphere
+    quad = 2 * np.pi * np.mean((1 - lobes[2]) * hg(mu, lobes[0]) + lobes[2] * hg(mu, lobes[1]))
+    share = hemisphere_share(*lobes)
+    assert share == pytest.approx(quad, rel=1e-6) and 0.85 < share < 0.95
+    assert hemisphere_share(0.0, 0.0, 0.0) == pytest.approx(0.5) and hemisphere_share(1e-5, 0.0, 0.0) == pytest.approx(0.5, abs=1e-5)
     sun, g, phi = np.array([0.0, 0.6, 0.8]), 0.735, 2.0
     field = np.concatenate([[phi], -0.9 * phi * sun])           # |F| near phi, along the sun's light
     behind, toward, side = -sun, sun, np.array([1.0, 0.0, 0.0])
     assert phi - 3 * g * field[1:] @ behind < 0.0
-    got = field_radiance(np.stack([field] * 3), np.stack([behind, toward, side]), g, sun)
-    np.testing.assert_allclose(got, np.array([phi, phi * (1 + 3 * g * 0.9), phi]) / (4 * np.pi), rtol=1e-12)
-    half = field_radiance(field, -np.array([0.0, 1.0, 0.0]), g, sun)          # cos -0.6: 0.6 phi at least
-    assert half == pytest.approx(max(phi - 3 * g * field[1:] @ [0.0, -1.0, 0.0], 0.6 * phi) / (4 * np.pi))
+    got = field_radiance(np.stack([field] * 3), np.stack([behind, toward, side]), lobes, sun)
+    want = np.array([2 * share * phi, phi * (1 + 3 * g * 0.9), phi]) / (4 * np.pi)
+    np.testing.assert_allclose(got, want, rtol=1e-12)
+    half = field_radiance(field, -np.array([0.0, 1.0, 0.0]), lobes, sun)          # cos -0.6
+    assert half == pytest.approx(max(phi - 3 * g * field[1:] @ [0.0, -1.0, 0.0], 0.6 * 2 * share * phi) / (4 * np.pi))
 
 
 def test_bad_solver_input_is_refused(gpu, ctx):

@@ -78,6 +78,14 @@ def environment(settings, sun_color, sky, sun_dir) -> tuple[np.ndarray, np.ndarr
     return e, l_sky, settings.ground_albedo * (e * up / math.pi + l_sky)
 
 
+def hemisphere_share(g: float, g2: float, w: float) -> float:
+    """The two-lobe phase's share of the light scattered into a direction d that came from the
+    hemisphere about d: per HG lobe (1 - g²) / 2g (1 / (1 - g) - 1 / sqrt(1 + g²)) (1/2 at g = 0)."""
+    def lobe(g):
+        return 0.5 + 0.375 * g if abs(g) < 1e-4 else (1 - g * g) / (2 * g) * (1 / (1 - g) - 1 / math.sqrt(1 + g * g))
+    return (1.0 - w) * lobe(g) + w * lobe(g2)
+
+
 def mean_cosine(g: float, g2: float, w: float) -> float:
     """The two-lobe phase function's mean cosine ``(1 - w) g + w g2``."""
     return (1.0 - w) * g + w * g2

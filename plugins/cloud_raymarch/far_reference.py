@@ -10,7 +10,7 @@ from atmos.plugins.cloud_raymarch.far import SUN_STEPS, sun_steps
 from atmos.plugins.cloud_raymarch.reference import integrate, rays
 from atmos.plugins.cloud_render.light import cell_tau, sun_light, unit_direction
 from atmos.shading.diffusion import field_radiance
-from atmos.shading.medium import mean_cosine, source_reference
+from atmos.shading.medium import source_reference
 
 
 def sample_profile(profile, rank, h) -> np.ndarray:
@@ -85,7 +85,7 @@ def far_source(field: FarField, medium, settings, p, dirs, band, sun) -> np.ndar
     diffusion = None
     if field.field_profile is not None and settings.ms_diffusion > 0:       # the volume's field at this rank
         values = sample_profile(field.field_profile, c[:, 0], np.clip(h, 0.0, 1.0))
-        diffusion = field_radiance(values, dirs, mean_cosine(medium.phase_g, medium.phase_g2, medium.phase_w), sun_dir)
+        diffusion = field_radiance(values, dirs, (medium.phase_g, medium.phase_g2, medium.phase_w), sun_dir)
     return source_reference(medium, settings, T, up, down, dirs @ sun_dir, dirs[:, 1], sun_color, ambient, sun_dir,
                             diffusion)
 

@@ -14,7 +14,7 @@ from atmos.plugins.cloud_raymarch.settings import SUN_GROWTH, SUN_SPACING
 from atmos.plugins.cloud_render.light import sun_light, unit_direction
 from atmos.plugins.cloud_render.reference import column_depth
 from atmos.shading.diffusion import diffusion_radiance
-from atmos.shading.medium import mean_cosine, source_reference
+from atmos.shading.medium import source_reference
 from atmos.shading.reference import multilinear
 
 
@@ -51,14 +51,14 @@ def march_reference(density, transmittance, medium, settings, layout, camera, su
     sun_color, ambient = sun_light(sun, layout.middle_altitude)
     sun_dir = unit_direction(sun)
     column_tau = medium.sigma_t * cell[1]
-    g = mean_cosine(medium.phase_g, medium.phase_g2, medium.phase_w)
+    lobes = (medium.phase_g, medium.phase_g2, medium.phase_w)
 
     def sample(i, p):
         uvw = (p - lo) / extent
         T = sun_transmittance(d, trans_volume, medium.sigma_t, lo, extent, SUN_SPACING * cell.min(),
                               settings.sun_steps, sun_dir, p)
         up, down = column_depth(d, uvw, column_tau, trans_volume.shape)
-        L = None if field is None else diffusion_radiance(field, uvw, dirs[i], g, sun_dir)
+        L = None if field is None else diffusion_radiance(field, uvw, dirs[i], lobes, sun_dir)
         return multilinear(d, uvw * shape - 0.5), source_reference(
             medium, settings, T, up, down, dirs[i] @ sun_dir, dirs[i][:, 1], sun_color, ambient, sun_dir, L)
 

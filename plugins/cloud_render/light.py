@@ -22,7 +22,7 @@ class CloudLightSettings(CheckedSettings):
     that turn light aside: the octaves' Poisson mean (1 - a) tau), ``ms_contribution`` b (octave i's
     weight b^i), ``ms_eccentricity`` c (its lobes c^i g), each in [0, 1] (:mod:`atmos.shading.medium`);
     ``ms_diffusion`` (0..2): the weight beta of the diffusion field, the light turned aside
-    (:mod:`atmos.shading.diffusion`: J += sun_source beta max(phi - 3 g F.ray, -cos phi, 0) / 4pi, cos =
+    (:mod:`atmos.shading.diffusion`: J += sun_source beta max(phi - 3 g F.ray, -cos 2 H phi, 0) / 4pi, cos =
     ray . sun); 0 turns the term off (and, with no other reader, the field's solve:
     ``plugins/clouds/field_demand.py``). The defaults are the search ``benchmarks/bench_cloud_light.py
     --fit`` found against the path tracer on the bench's two volumes, scoring both renderers in the

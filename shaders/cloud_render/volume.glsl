@@ -98,13 +98,15 @@ vec4 cloud_diffusion(vec3 uvw) {
 }
 
 // The field's share of J beside the octaves for a field value f = (phi, F): sun_source beta
-// max(phi - 3 g_mean F.ray, -c phi, 0) / 4pi (c = dot(ray, sun_dir); diffusion.field_radiance): against
-// the sun never below -c of its isotropic part (the diffuse light a lit surface sends back, where the
-// truncated P1 fell to 0 against the flux).
+// max(phi - 3 g_mean F.ray, -c 2 H phi, 0) / 4pi (c = dot(ray, sun_dir); diffusion.field_radiance).
+// Against the sun the truncated P1 falls to 0 at a lit surface, where F runs with the sun's light; the
+// light a lit surface sends back fills only the outward hemisphere there (phi / 2pi, twice the
+// isotropic part), and scattering toward the outside takes the phase's share H of that hemisphere
+// (hemisphere_share: 0.90 at the defaults), so J is never below -c 2 H phi / 4pi.
 vec3 diffusion_light(vec4 f, vec3 ray_dir) {
     if (ms_diffusion <= 0.0) return vec3(0.0);
-    float c = dot(ray_dir, sun_dir);
-    float L = max(max(f.x - 3.0 * mean_cosine() * dot(f.yzw, ray_dir), -c * f.x), 0.0) / (4.0 * PI);
+    float c = dot(ray_dir, sun_dir), back = -c * 2.0 * hemisphere_share(phase_lobes);
+    float L = max(max(f.x - 3.0 * mean_cosine() * dot(f.yzw, ray_dir), back * f.x), 0.0) / (4.0 * PI);
     return sun_source * (ms_diffusion * L);
 }
 
