@@ -3,7 +3,7 @@
 The far field gives a point of rank r the volume's column sum at r (:mod:`.cover`); this measure gives
 it the light of the volume's columns of that rank too (``shaders/cloud_far_field/light_by_rank.comp``,
 float64 reference :func:`atmos.plugins.cloud_far_field.reference.light_by_rank`): the mean sun
-transmittances of the octaves (T, T^a, T^a², T^a³) and, where the sets carry a diffusion field, its mean
+transmittances of the octaves (``medium.octave_transmittances``) and, where the sets carry a diffusion field, its mean
 (phi, F), each as seen from above and from below; and the field per height bin for the ray march's
 volumetric far field. So the far field is as bright per cover as the volume at every sun, not a guess
 from a slanted column. Two small dispatches per frame after the cover (:meth:`FarFieldLayer.prepare`).
@@ -83,7 +83,7 @@ class RankLight:
 
     def read(self) -> dict:
         """The last measure as float64 arrays (a GPU → CPU copy: tests and tools): ``sun`` (INTERVALS, 2, 4)
-        [k, v] = the mean (T, T^a, T^a², T^a³) of rank interval k seen from above (v = 0) and below (1);
+        [k, v] = the mean octave transmittances of rank interval k seen from above (v = 0) and below (1);
         with a field also ``field`` (INTERVALS, 2, 4) the mean (phi, F) likewise and ``field_profile``
         (INTERVALS, bins, 4) per height bin."""
         if self.sun is None:

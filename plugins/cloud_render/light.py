@@ -8,7 +8,7 @@ import numpy as np
 
 from atmos.checks import CheckedSettings, check_num
 from atmos.lighting import Sun
-from atmos.shading.medium import environment
+from atmos.shading.medium import environment, hemisphere_share
 
 DEFAULT_AMBIENT = (0.35, 0.47, 0.65)
 DEFAULT_OCTAVES = (0.25, 0.9525, 0.875)   # a, b, c of the octaves, fitted to the path tracer (bench_cloud_light --fit)
@@ -95,6 +95,7 @@ def light_uniforms(cloud_settings, sun: Sun | None, octaves=DEFAULT_OCTAVES, dif
             "ground_source": tuple(float(v) for v in 0.5 * s.albedo * ground),
             "sun_dir": tuple(float(v) for v in direction),
             "phase_lobes": (float(s.phase_g), float(s.phase_g2), float(s.phase_w)),
+            "outward_share": float(hemisphere_share(s.phase_g, s.phase_g2, s.phase_w)),
             "ms_octaves": tuple(float(v) for v in octaves),
             "column_tau": cell_tau(s),
             "ms_diffusion": float(diffusion)}

@@ -10,8 +10,9 @@
 // (the view crosses the column along its slant, capped at the horizon), lit by the cloud medium's own
 // model (cloud_render/volume.glsl) with the volume's own light at the same rank (RankLight,
 // light_by_rank.comp; as seen from above when the view looks down, else from below): the octaves' sun
-// transmittances (T, T^a, T^a^2, T^a^3) of the volume's columns of rank r, to the power `thickness`
-// (optical depths scale with it), times the relief of the layer toward the sun, exp(-a^i relief) with
+// transmittances (lib/octaves.glsl) of the volume's columns of rank r, to the power `thickness`
+// (optical depths scale with it), times the relief of the layer toward the sun, exp(-e_i relief) (e:
+// volume.glsl octave_exponents, how fast each falls with optical depth) with
 // relief = 0.5 (mean(tau of the four light-march channels) - tau) / max(sun_dir.y, MIN_SLANT) (the
 // channels: the rank 0..3 light steps toward the sun; 0 on average), and, where the sets carry a
 // diffusion field, its light from their mean (phi, F); sky light with tau half above, half below.
@@ -33,7 +34,7 @@ uniform vec2 footprint_size;
 uniform float thickness;
 uniform float horizon_fade;
 const float MIN_SLANT = 0.1;     // the horizon's slant cap (about 6 degrees)
-layout(binding = 18) uniform sampler2D far_sun_by_rank;   // RankLight.sun: (rank, seen from above | below) -> T^(a^i)
+layout(binding = 18) uniform sampler2D far_sun_by_rank;   // RankLight.sun: (rank, seen from above | below) -> the octaves' transmittances
 layout(binding = 19) uniform sampler2D far_field_light;   // RankLight.field: (rank, seen from above | below) -> (phi, F)
 uniform float lod_scale;       // texels per metre × a pixel's angle (rad): the mip level from the footprint,
                                // not from screen derivatives (the same under any camera roll)

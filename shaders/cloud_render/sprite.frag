@@ -38,7 +38,7 @@ void main() {
     float a = (1.0 - exp(-v_tau * profile)) * v_coverage * soft;
     vec2 q = pc * (v_radius * v_stretch);          // the point's side spans stretch × diameter (sprite.vert)
     vec3 ray = normalize(v_center + q.x * camera_right + q.y * camera_up - camera_pos);
-    vec4 ai = octave_exponents();                                        // octave i: exp(a^i (h.pc - a^i var))
+    vec4 ai = octave_exponents();                                        // octave i: exp(e_i (h.pc - e_i var))
     vec4 across = exp(clamp(ai * (dot(v_slope.xy, pc) - ai * v_slope.z), -40.0, 40.0));
     frag = vec4((sun_part(v_octaves * across, dot(ray, sun_dir)) + diffusion_light(v_field, ray) + v_ambient) * a, a);
     frag_distance = vec4(a * length(v_center - camera_pos), a, 0.0, a);   // blends by its own alpha

@@ -26,7 +26,7 @@ uniform float far;
 uniform vec3 camera_right;     // the sprite's screen axes (the fragment shader's too)
 uniform vec3 camera_up;
 uniform float tau_scale;       // sigma_t × cell volume: the optical depth a unit of summed density spreads over the screen (m²)
-flat out vec4 v_octaves;      // b^i T^(a^i): the sun's light per octave (volume.glsl)
+flat out vec4 v_octaves;      // b^i P_i(T): the sun's light per octave (volume.glsl octave_weights)
 flat out vec3 v_slope;        // log T's slope h across the sprite (per unit pc) and h^T cov h / 2
 flat out vec3 v_ambient;      // sky and ground light at the sprite, dimmed by the columns above and below
 flat out vec4 v_field;        // the diffusion field (phi, F) at the sprite's centre (0 when its weight is 0)
@@ -155,7 +155,7 @@ void main() {
     }
     // log T's gradient (1/m) fitted to the taps, on the sprite's screen axes per unit of point coordinate
     // (sprite.frag's pc: a half side stretch × radius long): the sun's light varies across the sprite as
-    // T does, exp(a^i (h.pc - h^T cov h / 2)) per octave, a mean of 1 over the footprint's Gaussian
+    // T does, exp(e_i (h.pc - e_i h^T cov h / 2)) per octave (e = octave_exponents()), a mean of 1 over the footprint's Gaussian
     vec3 g = slope / (8.0 * spread * cell_size);
     vec2 h = clamp(stretch * 0.5 * diameter * vec2(dot(g, camera_right), dot(g, camera_up)), -MAX_SLOPE, MAX_SLOPE);
     v_slope = vec3(h, 0.5 * dot(h, vec2(cov.x * h.x + cov.y * h.y, cov.y * h.x + cov.z * h.y)));

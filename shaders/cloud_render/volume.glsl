@@ -24,6 +24,7 @@ uniform vec3 sky_source;       // albedo * sky radiance / 2
 uniform vec3 ground_source;    // albedo * ground radiance / 2
 uniform vec3 sun_dir;          // toward the sun, unit
 uniform vec3 phase_lobes;      // g, g2, w
+uniform float outward_share;   // the phase's share H of the hemisphere about a direction (medium.hemisphere_share)
 uniform vec3 ms_octaves;       // a (attenuation), b (contribution), c (eccentricity)
 uniform float column_tau;      // sigma_t * cell height: optical depth of one cell of density 1, vertically
 uniform float edge_fade;       // CloudSettings.edge_fade: density fades to 0 toward the inscribed circle
@@ -102,10 +103,10 @@ vec4 cloud_diffusion(vec3 uvw) {
 // Against the sun the truncated P1 falls to 0 at a lit surface, where F runs with the sun's light; the
 // light a lit surface sends back fills only the outward hemisphere there (phi / 2pi, twice the
 // isotropic part), and scattering toward the outside takes the phase's share H of that hemisphere
-// (hemisphere_share: 0.90 at the defaults), so J is never below -c 2 H phi / 4pi.
+// (outward_share: 0.90 at the defaults), so J is never below -c 2 H phi / 4pi.
 vec3 diffusion_light(vec4 f, vec3 ray_dir) {
     if (ms_diffusion <= 0.0) return vec3(0.0);
-    float c = dot(ray_dir, sun_dir), back = -c * 2.0 * hemisphere_share(phase_lobes);
+    float c = dot(ray_dir, sun_dir), back = -c * 2.0 * outward_share;
     float L = max(max(f.x - 3.0 * mean_cosine() * dot(f.yzw, ray_dir), back * f.x), 0.0) / (4.0 * PI);
     return sun_source * (ms_diffusion * L);
 }
