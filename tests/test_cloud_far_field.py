@@ -170,8 +170,8 @@ def assert_light_matches(got, want, names) -> None:
 def test_the_light_by_rank_is_the_volumes_own_light(gpu, ctx, rng, clouds):
     """light_by_rank.comp (RankLight) against its float64 reference on a fresh random volume: per rank
     interval the octaves' mean sun transmittances and the diffusion field's mean (phi, F), seen from
-    above and from below, and the field per height bin; the sun lower than the cloud tops shades the
-    bases. No cloud at all: T = 1, the field 0, nothing NaN."""
+    above and from below, both per height bin, and the clouds' thickness; the sun lower than the cloud
+    tops shades the bases. No cloud at all: T = 1, the field 0, the thickness the layer's, nothing NaN."""
     from atmos.lighting import Sun
     shape = (16, 12, 16)
     d = np.zeros(shape, np.float32)
@@ -184,8 +184,8 @@ def test_the_light_by_rank_is_the_volumes_own_light(gpu, ctx, rng, clouds):
     app, far, sets = light_scene(gpu, d, 0.2, sun=sun)
     try:
         got = far.layer.light.read()
-        assert set(got) == {"sun", "field", "field_profile"}, "the renderer gives the field a weight: measured"
-        assert_light_matches(got, light_reference(far, sets), ("sun", "field", "field_profile"))
+        assert set(got) == {"sun", "thickness", "sun_profile", "field", "field_profile"}, "the renderer gives the field a weight: measured"
+        assert_light_matches(got, light_reference(far, sets), ("sun", "thickness", "sun_profile", "field", "field_profile"))
         far.configure(enabled=False)          # the ground shadows alone still prepare the layer
         far.layer.light.release()
         far.layer.prepare(types.SimpleNamespace(sun=sun, time=0.0), sets)
@@ -197,8 +197,12 @@ def test_the_light_by_rank_is_the_volumes_own_light(gpu, ctx, rng, clouds):
             above, below = got["sun"][covered, 0, 0], got["sun"][covered, 1, 0]
             assert below.mean() < above.mean(), f"the bases are in the clouds' own shadow: {above} vs {below}"
             assert np.all((got["sun"] >= 0) & (got["sun"] <= 1))
+            profile = got["sun_profile"][covered, :, 0]
+            assert np.ptp(profile, axis=1).max() > 0.05 and np.all((profile >= 0) & (profile <= 1)), "it varies by height"
+            assert np.all((got["thickness"] > 0) & (got["thickness"] <= 1)) and got["thickness"][covered].min() < 0.9
         else:
-            assert np.all(got["sun"] == 1.0) and np.all(got["field"] == 0.0)
+            assert np.all(got["sun"] == 1.0) and np.all(got["sun_profile"] == 1.0) and np.all(got["field"] == 0.0)
+            assert np.all(got["thickness"] == 1.0)
     finally:
         app.close()
 
@@ -221,6 +225,49 @@ def far_scene(gpu, **far):
 def correlation(a, b) -> float:
     a, b = a - a.mean(), b - b.mean()
     return float((a * b).mean() / max(a.std() * b.std(), 1e-12))
+
+
+@pytest.mark.parametrize("pitch", [0.25, 0.7])
+def test_the_far_fields_opacity_matches_float64(gpu, ctx, pitch):
+    """far.frag's alpha outside the volume (mip 0: a 64-texel, 20 km tile) against far_field_alpha: the
+    mean column optical depth at the middle plane's hit and a third of the clouds' height (RankLight's
+    thickness at the median covered rank) above and below it along the ray, over the slant, times the
+    horizon fade; without the two slanted samples it is far off (the test can fail)."""
+    from atmos.plugins.cloud_far_field.cover import fbm_quantiles
+    from atmos.plugins.cloud_far_field.layer import column_tau, drift
+    from atmos.plugins.cloud_far_field.reference import far_field_alpha
+    from atmos.plugins.cloud_raymarch.reference import rays
+    app = far_scene(gpu, size=64, tile_size=20000.0, animate=False)
+    try:
+        far = next(p for p in app.plugins if isinstance(p, CloudFarFieldPlugin))
+        sets = next(p for p in app.plugins if isinstance(p, CloudsPlugin)).simulation.sets()
+        cam = app.resource(Camera)
+        cam.position, cam.yaw, cam.pitch = np.array([-3000.0, 200.0, 300.0]), -math.pi / 2, pitch   # looking away
+        cam.near, cam.far = 1.0, 40000.0
+        alpha = app.read_linear()[::-1, :, 3].astype(np.float64)
+        layer, params = far.layer, far.settings
+        layout = sets.layout()
+        cover, columns = layer.read_cover()
+        thickness = layer.light.read()["thickness"]
+        height = (layout.hi[1] - layout.lo[1]) * np.interp(1.0 - 0.5 * cover, (np.arange(32) + 0.5) / 32, thickness)
+        dirs, _ = rays(cam, gpu.size)
+        s = (0.5 * (layout.lo[1] + layout.hi[1]) - cam.position[1]) / dirs[..., 1]
+        xz = cam.position[[0, 2]] + s[..., None] * dirs[..., [0, 2]]
+        fade = np.clip(np.abs(dirs[..., 1]) / params.horizon_fade, 0.0, 1.0)
+        fade = fade * fade * (3.0 - 2.0 * fade)
+        args = ([layer.octaves.download(k) for k in range(4)], drift(params, sets, 0.0, layer.tile_size), layer.tile_size,
+                fbm_quantiles(params.base_frequency, params.seed, params.size), columns, column_tau(params, sets))
+        fade = np.where(s > 0.0, fade, 0.0)                 # below the plane: none
+        want = far_field_alpha(xz, dirs, height, *args) * fade
+        flat = far_field_alpha(xz, dirs, 0.0, *args) * fade
+        texels = params.size / layer.tile_size * 2.0 * math.tan(cam.fov_y / 2) / gpu.size[1] * s / np.abs(dirs[..., 1])
+        mip0 = (s > 0.0) & (texels < 1.0)                   # far.frag's footprint: mip 0 (nearer the horizon coarser)
+        assert mip0.mean() > 0.3 and 0.2 < (want[mip0] > 0.05).mean() < 0.95, "the view holds far clouds and gaps"
+        err = np.abs(alpha - want)[mip0]
+        assert np.percentile(err, 99) < 0.02 and err.mean() < 0.004, (err.mean(), np.percentile(err, 99))
+        assert np.abs(alpha - flat)[mip0].mean() > 5 * err.mean(), "the clouds' sides are drawn"
+    finally:
+        app.close()
 
 
 def test_the_far_fields_cover_repeats_at_no_tile_lag(gpu, ctx):

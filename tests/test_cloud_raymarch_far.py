@@ -65,10 +65,9 @@ def field_reference(app) -> FarField:
     sim = of(app, CloudsPlugin).simulation.sets()
     quantiles = level_table(params.base_frequency, params.seed, params.size)[0][0]
     _, columns = layer.read_cover()
-    return FarField(params.light_step * layer.tile_size,
-                    octaves=[layer.octaves.download(k) for k in range(4)], offsets=drift(params, sim, 0.0, layer.tile_size),
+    return FarField(octaves=[layer.octaves.download(k) for k in range(4)], offsets=drift(params, sim, 0.0, layer.tile_size),
                     tile_size=layer.tile_size, quantiles=quantiles, columns=columns, profile=layer.read_profile(),
-                    field_profile=layer.light.read().get("field_profile"))
+                    sun_profile=layer.light.read()["sun_profile"], field_profile=layer.light.read().get("field_profile"))
 
 
 @pytest.mark.parametrize("yaw, fields", [(-np.pi / 2, {}), (0.0, dict(ms_diffusion=2.0))])

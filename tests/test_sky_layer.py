@@ -36,6 +36,10 @@ def test_gpu_octaves_match_reference_and_every_texel_is_written(gpu, ctx, rng):
             assert np.abs(got - want).max() < 2e-4 * 2 ** k, f"octave {k}: {np.abs(got - want).max()}"
             assert got.std() > 0.03
         assert octaves.bakes == 2
+        steps = (0.0, 2.0, -2.0, 0.5)               # the far field's relief channels: toward and away from the sun
+        octaves.bake(params, sun, steps=steps)
+        want = reference.octave_texture(48, params.base_frequency, reference.octave_key(params.seed, 0), shift, steps)
+        assert np.abs(octaves.download(0) - want).max() < 2e-4
     finally:
         octaves.release()
 

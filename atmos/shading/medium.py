@@ -117,8 +117,9 @@ def ambient_profile(tau_up, tau_down, g_mean: float, ray_y) -> np.ndarray:
 
 
 def source_reference(settings, render, T, tau_up, tau_down, cos, ray_y, sun_color, sky, sun_dir,
-                     diffusion=None) -> np.ndarray:
-    """float64 (n, 3): J of the module docstring at points with transmittance ``T``, column optical
+                     diffusion=None, *, octaves=None) -> np.ndarray:
+    """float64 (n, 3): J of the module docstring at points with transmittance ``T`` (or, given
+    ``octaves`` (n, 4), those as the octaves' sun transmittances: the far fields' by rank), column optical
     depths ``tau_up``/``tau_down``, view/sun cosine ``cos`` and view ray y ``ray_y`` (``render``:
     the CloudRenderSettings or RaymarchCloudSettings); ``diffusion``: the diffusion field's radiance
     there (:func:`atmos.shading.diffusion.diffusion_radiance`, unit irradiance), added with the weight
@@ -127,7 +128,7 @@ def source_reference(settings, render, T, tau_up, tau_down, cos, ray_y, sun_colo
     tau_up, tau_down = np.asarray(tau_up, np.float64), np.asarray(tau_down, np.float64)
     a, b, c = render.ms_attenuation, render.ms_contribution, render.ms_eccentricity
     g_mean = mean_cosine(settings.phase_g, settings.phase_g2, settings.phase_w)
-    w = octave_weights(T, a, b)
+    w = octave_weights(T, a, b) if octaves is None else np.asarray(octaves, np.float64) * b ** np.arange(OCTAVES)
     sun = sum(w[..., i] * phase(cos, settings.phase_g * c ** i, settings.phase_g2 * c ** i, settings.phase_w)
               for i in range(OCTAVES))
     if diffusion is not None:

@@ -19,7 +19,7 @@ import numpy as np
 
 from atmos.plugins.cloud_far_field.columns import rank_texture, read_rank_texture, use_columns
 from atmos.plugins.cloud_far_field.cover import QUANTILES, level_table, matched_tile_size, pattern_crossings
-from atmos.plugins.cloud_far_field.pattern import PERIODS, octave_frequencies, octave_offsets, rotations
+from atmos.plugins.cloud_far_field.pattern import CHANNEL_STEPS, PERIODS, octave_frequencies, octave_offsets, rotations
 from atmos.plugins.cloud_far_field.rank_light import RankLight
 from atmos.plugins.cloud_render.light import cell_tau, light_uniforms
 from atmos.plugins.clouds.sets import CloudSets
@@ -91,7 +91,7 @@ class FarFieldLayer:
         params = self.settings
         sun_dir = light_uniforms(sim.settings, view.sun)["sun_dir"]
         if self.octaves.needs_bake(params, sun_dir, REBAKE_TOLERANCE):
-            self.octaves.bake(params, sun_dir, octave_frequencies(params.base_frequency), rotations())
+            self.octaves.bake(params, sun_dir, octave_frequencies(params.base_frequency), rotations(), CHANNEL_STEPS)
         self.measure_cover(sim)
         if self.plugin.drawn_by_march() or params.enabled:      # a far field is drawn (not just shadows)
             self.light.measure(sim, self.cover, self.plugin.light_settings().ms_attenuation,

@@ -6,9 +6,11 @@ sampled at ``uv_k = R(TURNS[k]) · xz / (tile_size · PERIODS[k]) + offset_k``: 
 axes turned by ``TURNS[k]``. The periods are powers of the golden ratio (6.9, 4.2, 2.6 and 1 tiles: a
 texture keeps 6–9 texels per cell at 256 texels and base frequency 4) and the turns multiples of the
 golden angle, so no lag repeats two octaves at once (with one period and no turn, the dominant octave
-and with it the whole pattern repeated every tile: rows of the same clouds to the horizon). The light
-march channels (channel c is the noise c light steps toward the sun) are baked along each octave's
-own turned axis (``OctaveTextures.bake`` with ``rotations()`` as its shift maps), so they stay toward the sun in the world.
+and with it the whole pattern repeated every tile: rows of the same clouds to the horizon). The
+channels (CHANNEL_STEPS: the point, RELIEF_STEPS light steps toward the sun and as many away, the
+point again) are baked along each octave's own turned axis (``OctaveTextures.bake`` with
+``rotations()`` as its shift maps), so they stay toward the sun in the world: one fetch gives a
+point's rank and the slope of the clouds across it along the sun (field.glsl far_relief).
 """
 from __future__ import annotations
 
@@ -17,6 +19,8 @@ import numpy as np
 GOLDEN = 0.5 * (1.0 + 5.0 ** 0.5)
 TURNS = np.arange(4) * np.pi * (3.0 - 5.0 ** 0.5)          # k golden angles (rad)
 PERIODS = GOLDEN ** np.array([4.0, 3.0, 2.0, 0.0])          # φ⁴, φ³, φ², 1 tiles: the coarse octaves repeat least
+RELIEF_STEPS = 2.0                                          # light steps to the relief's samples, each way
+CHANNEL_STEPS = (0.0, RELIEF_STEPS, -RELIEF_STEPS, 0.0)     # the baked channels' light steps toward the sun
 
 
 def rotations() -> np.ndarray:

@@ -105,9 +105,11 @@ def light_by_rank(sums_a, sums_b, density_a, density_b, t: float, a_shift, fade:
     diffusion field ``field_a/b`` (x, y, z, 4) on their own grids, each read at the texel nearest a density
     cell's centre, clamped): per rank interval of ``quantiles`` the edge-weighted mean over its covered
     columns of each column's mean octave transmittances (medium.octave_transmittances) and (phi, F) at its ``heights`` samples, weighted
-    by density × the vertical transmittance to the column's top (row 0) or base (row 1); and per height
-    bin (of min(heights, bins)) the columns' density-weighted (phi, F). Returns dict sun (32, 2, 4) and,
-    with a field, field (32, 2, 4), field_profile (32, bins, 4); filled as the shader fills them."""
+    by density × the vertical transmittance to the column's top (row 0) or base (row 1); per height
+    bin (of min(heights, bins)) the columns' density-weighted octave transmittances and (phi, F); and the edge-weighted mean of each
+    column's thickness, sqrt(12 var + 1 / heights²) of its density's height (as a layer fraction, at most
+    1: a uniform slab's). Returns dict sun (32, 2, 4), thickness (32,), sun_profile (32, bins, 4) and, with
+    a field, field (32, 2, 4), field_profile (32, bins, 4); filled as the shader fills them."""
     def mixed(a, b, cells):
         """mix(A, B, t) of grids a, b (x, y, z, ...) at their texels nearest density ``cells`` (n, 3)
         (A's at the cells + a_shift), each index clamped to its grid."""
@@ -130,7 +132,9 @@ def light_by_rank(sums_a, sums_b, density_a, density_b, t: float, a_shift, fade:
     in_bin = np.arange(heights) * bins // heights
     field = field_a is not None and field_b is not None
     weight, sun_sum, field_sum = np.zeros((32, 2)), np.zeros((32, 2, 4)), np.zeros((32, 2, 4))
-    bin_weight, bin_sum = np.zeros((32, bins)), np.zeros((32, bins, 4))
+    thickness_sum = np.zeros(32)
+    y = (rows + 0.5) / ny
+    bin_weight, bin_sum, bin_sun = np.zeros((32, bins)), np.zeros((32, bins, 4)), np.zeros((32, bins, 4))
     for x, z in zip(*np.nonzero((sums > 1e-6) & (units > 0))):
         k = min(max(int(np.searchsorted(q, sums[x, z], side="right")) - 1, 0), 31)
         cells = np.stack([np.full(heights, x), rows, np.full(heights, z)], -1)
@@ -145,19 +149,25 @@ def light_by_rank(sums_a, sums_b, density_a, density_b, t: float, a_shift, fade:
             f = mixed(field_a, field_b, cells)
             phi = np.clip(f[:, 0], 0.0, 8.0)
             v = np.concatenate([phi[:, None], np.clip(f[:, 1:], -phi[:, None], phi[:, None])], -1)
-            dw, dv = np.zeros(bins), np.zeros((bins, 4))
-            np.add.at(dw, in_bin, d)
-            np.add.at(dv, in_bin, d[:, None] * v)
-            has = dw > 0
-            bin_weight[k, has] += units[x, z]
-            bin_sum[k, has] += units[x, z] * dv[has] / dw[has, None]
+        dw, dv, dsun = np.zeros(bins), np.zeros((bins, 4)), np.zeros((bins, 4))
+        np.add.at(dw, in_bin, d)
+        np.add.at(dv, in_bin, d[:, None] * v)
+        np.add.at(dsun, in_bin, d[:, None] * sun)
+        has = dw > 0
+        bin_weight[k, has] += units[x, z]
+        bin_sum[k, has] += units[x, z] * dv[has] / dw[has, None]
+        bin_sun[k, has] += units[x, z] * dsun[has] / dw[has, None]
         s = seen.sum(0)
+        mass = max(d.sum(), 1e-30)
+        mean = (d * y).sum() / mass
+        thickness = min(np.sqrt(max(12.0 * ((d * y * y).sum() / mass - mean ** 2), 0.0) + 1.0 / heights ** 2), 1.0)
+        thickness_sum[k] += units[x, z] * thickness if s[0] > 0 else 0.0
         for view in np.flatnonzero(s > 0):
             weight[k, view] += units[x, z]
             sun_sum[k, view] += units[x, z] * (seen[:, view, None] * sun).sum(0) / s[view]
             field_sum[k, view] += units[x, z] * (seen[:, view, None] * v).sum(0) / s[view]
     filled = np.flatnonzero(weight[:, 0] > 0)
-    out = {"sun": np.ones((32, 2, 4))}
+    out = {"sun": np.ones((32, 2, 4)), "thickness": np.ones(32), "sun_profile": np.ones((32, bins, 4))}
     if field:
         out.update(field=np.zeros((32, 2, 4)), field_profile=np.zeros((32, bins, 4)))
     for i in range(32):
@@ -166,24 +176,27 @@ def light_by_rank(sums_a, sums_b, density_a, density_b, t: float, a_shift, fade:
         k = filled[np.argmin(np.abs(filled - i) * 2 + (filled < i))]      # nearest, above first on a tie
         w = weight[k][:, None]
         out["sun"][i] = np.where(w > 0, sun_sum[k] / np.maximum(w, 1e-300), 1.0)
+        out["thickness"][i] = thickness_sum[k] / weight[k, 0] if weight[k, 0] > 0 else 1.0
+        b = bin_weight[k][:, None]
+        out["sun_profile"][i] = np.where(b > 0, bin_sun[k] / np.maximum(b, 1e-300), out["sun"][i, 0])
         if field:
             out["field"][i] = np.where(w > 0, field_sum[k] / np.maximum(w, 1e-300), 0.0)
-            b = bin_weight[k][:, None]
             out["field_profile"][i] = np.where(b > 0, bin_sum[k] / np.maximum(b, 1e-300), out["field"][i, 0])
     return out
 
 
-def field_fbm(xz, octaves, offsets, tile_size: float) -> np.ndarray:
+def field_fbm(xz, octaves, offsets, tile_size: float, channel: int = 0) -> np.ndarray:
     """The fbm (...,) of ``cloud_far_field/field.glsl`` at world ``xz`` (..., 2), mip 0: ``octaves`` the
     four downloaded textures (size, size, 4) [x, y, channel] (``OctaveTextures.download``), octave k read
     at its own turned uv (:func:`atmos.plugins.cloud_far_field.pattern.octave_uv`), ``offsets`` (4, 2)
     each octave's drift in its uv (:func:`.layer.drift`), ``tile_size`` the layer's tile (m,
-    FarFieldLayer.tile_size); bilinear with repeat, texel i centred at (i + 0.5)/size."""
+    FarFieldLayer.tile_size); bilinear with repeat, texel i centred at (i + 0.5)/size; ``channel``: the
+    channel read (pattern.CHANNEL_STEPS: the point, the relief's samples toward and away from the sun)."""
     from atmos.plugins.cloud_far_field.cover import sample
     from atmos.plugins.cloud_far_field.pattern import octave_uv
     from atmos.plugins.sky_layer.octaves import WEIGHTS
     uv = octave_uv(xz, offsets, tile_size)
-    return sum(w * sample(np.asarray(tex, np.float64)[..., 0], uv[k]) for k, (w, tex) in enumerate(zip(WEIGHTS, octaves)))
+    return sum(w * sample(np.asarray(tex, np.float64)[..., channel], uv[k]) for k, (w, tex) in enumerate(zip(WEIGHTS, octaves)))
 
 
 def field_rank(fbm, quantiles) -> np.ndarray:
@@ -200,16 +213,37 @@ def column_at_rank(rank, columns) -> np.ndarray:
     return np.interp(np.clip(rank, 0.0, 1.0), np.linspace(0.0, 1.0, len(c)), c)
 
 
+def far_relief(ranks, columns, tau_cell: float, sun_y: float, min_slant: float) -> np.ndarray:
+    """field.glsl's far_relief (...,): 3/16 of the difference between the column optical depths
+    (``tau_cell`` × :func:`column_at_rank` of ``columns``) at the relief's samples toward the sun and away
+    from it (``ranks`` (..., 4): the channels, pattern.CHANNEL_STEPS) over max(``sun_y``, ``min_slant``)."""
+    r = np.asarray(ranks, np.float64)
+    return 0.1875 * tau_cell * (column_at_rank(r[..., 1], columns) - column_at_rank(r[..., 2], columns)) / max(sun_y, min_slant)
+
+
+def relief_light(s, d) -> np.ndarray:
+    """field.glsl's relief_light: the octaves' sun transmittances ``s`` moved by the relief's optical
+    depths ``d`` toward 0 (d > 0) or 1, at most as far as the nearer bound (odd in d: no light added)."""
+    s = np.asarray(s, np.float64)
+    return s - np.minimum(s, 1.0 - s) * np.tanh(np.clip(d, -10.0, 10.0))
+
+
 MIN_SLANT = 0.1     # far.frag's horizon cap on the slant
 
 
-def far_field_alpha(xz, dir_y, octaves, offsets, tile_size: float, quantiles, columns, column_tau: float,
-                    thickness: float = 1.0) -> np.ndarray:
-    """far.frag's opacity (...,) at world ``xz`` (..., 2) seen with view direction height ``dir_y``, mip 0,
-    before the edge and horizon fades: vertical optical depth thickness · column_tau (sigma_t · cell
-    height) · the volume's column sum at the point's rank, along the slant 1 / max(|dir_y|, MIN_SLANT)."""
-    tau = far_optical_depth(xz, octaves, offsets, tile_size, quantiles, columns, float(thickness) * float(column_tau))
-    return 1.0 - np.exp(-tau / np.maximum(np.abs(dir_y), MIN_SLANT))
+def far_field_alpha(xz, dirs, height: float, octaves, offsets, tile_size: float, quantiles, columns,
+                    column_tau: float, thickness: float = 1.0) -> np.ndarray:
+    """far.frag's opacity (...,) where the view ``dirs`` (..., 3, unit) meet the middle plane at world
+    ``xz`` (..., 2), mip 0, before the edge, horizon and scene fades: the mean vertical optical depth
+    thickness · column_tau (sigma_t · cell height) · the volume's column sum at the rank of the hit and of
+    the points a third of the clouds' ``height`` (m) above and below it along the ray, seen along the
+    slant 1 / max(|dir_y|, MIN_SLANT)."""
+    dirs = np.asarray(dirs, np.float64)
+    slant = np.maximum(np.abs(dirs[..., 1]), MIN_SLANT)
+    across = dirs[..., [0, 2]] * (float(height) / 3.0 / slant)[..., None]
+    tau = sum(far_optical_depth(np.asarray(xz, np.float64) + k * across, octaves, offsets, tile_size, quantiles, columns,
+                                float(thickness) * float(column_tau)) for k in (-1, 0, 1)) / 3.0
+    return 1.0 - np.exp(-tau / slant)
 
 
 def far_optical_depth(xz, octaves, offsets, tile_size: float, quantiles, columns, column_tau: float) -> np.ndarray:

@@ -31,8 +31,8 @@ class CloudFarFieldSettings(CheckedSettings):
     clock instead. ``animate`` False holds it still. ``horizon_fade``: it fades in while the view ray's
     height rises from 0 to this (sin of the elevation). ``size``, ``base_frequency``, ``seed``,
     ``light_step``: the octave textures (:class:`atmos.plugins.sky_layer.octaves.OctaveTextures`;
-    ``light_step``: the spacing of their light-march channels, which the ray march's volumetric far
-    field marches the sun through).
+    ``light_step`` (tiles): the relief's samples lie 2 of these toward the sun and away from it
+    (:mod:`.pattern` CHANNEL_STEPS): the lit sides of far clouds face the sun; 0: no relief).
     ``enabled`` False draws nothing.
     """
 

@@ -5,12 +5,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.plugins.cloud_far_field.reference import column_at_rank, field_fbm, field_rank
-from atmos.plugins.cloud_raymarch.far import SUN_STEPS, sun_steps
+from atmos.plugins.cloud_far_field.reference import (MIN_SLANT, column_at_rank, far_relief, field_fbm, field_rank,
+                                                      relief_light)
 from atmos.plugins.cloud_raymarch.reference import integrate, rays
 from atmos.plugins.cloud_render.light import cell_tau, sun_light, unit_direction
 from atmos.shading.diffusion import field_radiance
-from atmos.shading.medium import source_reference
+from atmos.shading.medium import OCTAVES, source_reference
 
 
 def sample_profile(profile, rank, h) -> np.ndarray:
@@ -37,20 +37,21 @@ class FarField:
     (:func:`atmos.plugins.cloud_far_field.reference.field_fbm` of ``octaves``, ``offsets``,
     ``tile_size``) ranked among the layer's ``quantiles`` (level 0); a point of rank r holds the
     volume's column sum at r (``columns``: its QUANTILES column-sum quantiles in cells,
-    FarFieldLayer.read_cover) spread over height by ``profile`` (FarFieldLayer.read_profile);
-    ``light_step_m`` the channels' spacing toward the sun (m); ``field_profile``: the diffusion field's
-    mean (phi, F) by rank and height (RankLight.read()["field_profile"]; None: no field)."""
+    FarFieldLayer.read_cover) spread over height by ``profile`` (FarFieldLayer.read_profile), its
+    channels (the relief's samples) read from the textures' own; ``sun_profile``: the volume's mean octave
+    sun transmittances by rank and height (RankLight.read()["sun_profile"]); ``field_profile``: the
+    diffusion field's mean (phi, F) likewise (RankLight.read()["field_profile"]; None: no field)."""
 
-    def __init__(self, light_step_m: float, *, octaves, offsets, tile_size: float, quantiles, columns, profile,
+    def __init__(self, *, octaves, offsets, tile_size: float, quantiles, columns, profile, sun_profile,
                  field_profile=None):
-        self.light_step_m = float(light_step_m)
         self.field = dict(octaves=octaves, offsets=offsets, tile_size=tile_size)
         self.quantiles, self.columns = np.asarray(quantiles, np.float64), np.asarray(columns, np.float64)
         self.profile = np.asarray(profile, np.float64)
+        self.sun_profile = np.asarray(sun_profile, np.float64)
         self.field_profile = None if field_profile is None else np.asarray(field_profile, np.float64)
 
-    def rank(self, xz) -> np.ndarray:
-        return field_rank(field_fbm(xz, **self.field), self.quantiles)
+    def rank(self, xz, channel: int = 0) -> np.ndarray:
+        return field_rank(field_fbm(xz, **self.field, channel=channel), self.quantiles)
 
     def density(self, rank, h) -> np.ndarray:
         """far.glsl's far_density: the column sum at ``rank`` × the profile's R at height fraction ``h``."""
@@ -58,36 +59,30 @@ class FarField:
         d = column_at_rank(rank, self.columns) * sample_profile(self.profile, rank, h)[..., 0]
         return np.where((h >= 0.0) & (h <= 1.0), d, 0.0)
 
-    def channels(self, xz, sun_dir) -> np.ndarray:
-        """(..., 4): the rank at xz and 1..3 light steps toward the sun (the baked channels)."""
-        s = np.asarray(sun_dir, np.float64)[[0, 2]]
-        n = np.linalg.norm(s)
-        shift = s / n * self.light_step_m if n > 1e-6 else np.zeros(2)
-        return np.stack([self.rank(np.asarray(xz, np.float64) + k * shift) for k in range(4)], -1)
+    def channels(self, xz) -> np.ndarray:
+        """(..., 4): far_ranks, the ranks of the four baked channels at xz (pattern.CHANNEL_STEPS)."""
+        return np.stack([self.rank(xz, k) for k in range(4)], -1)
 
 
 def far_source(field: FarField, medium, settings, p, dirs, band, sun) -> np.ndarray:
     """J (n, 3) at points ``p`` (n, 3) for view directions ``dirs``; ``band`` (base y, height)."""
     sun_dir = unit_direction(sun)
-    c = field.channels(p[:, [0, 2]], sun_dir)
-    h = (p[:, 1] - band[0]) / band[1]
-    ds, per_step, rise = sun_steps(sun_dir, field.light_step_m, band[1])
-    depth = np.zeros(len(p))
-    for k in range(SUN_STEPS):
-        x = (k + 0.5) * per_step
-        i = min(int(x), 2)
-        depth += field.density(c[:, i] + (c[:, i + 1] - c[:, i]) * (x - i), h + (k + 0.5) * rise)
-    T = np.exp(-medium.sigma_t * ds * depth)
+    c = field.channels(p[:, [0, 2]])
+    h01 = np.clip((p[:, 1] - band[0]) / band[1], 0.0, 1.0)
+    exponents = np.ones(OCTAVES)
+    exponents[-1] = settings.ms_attenuation                         # volume.glsl's octave_exponents
+    relief = far_relief(c, field.columns, cell_tau(medium), float(sun_dir[1]), MIN_SLANT)
+    octaves = relief_light(sample_profile(field.sun_profile, c[:, 0], h01), relief[:, None] * exponents)
     column = cell_tau(medium) * column_at_rank(c[:, 0], field.columns)
-    above = sample_profile(field.profile, c[:, 0], np.clip(h, 0.0, 1.0))[..., 1]
+    above = sample_profile(field.profile, c[:, 0], h01)[..., 1]
     up, down = column * above, column * (1.0 - above)
     sun_color, ambient = sun_light(sun, band[0] + 0.5 * band[1])
     diffusion = None
     if field.field_profile is not None and settings.ms_diffusion > 0:       # the volume's field at this rank
-        values = sample_profile(field.field_profile, c[:, 0], np.clip(h, 0.0, 1.0))
+        values = sample_profile(field.field_profile, c[:, 0], h01)
         diffusion = field_radiance(values, dirs, (medium.phase_g, medium.phase_g2, medium.phase_w), sun_dir)
-    return source_reference(medium, settings, T, up, down, dirs @ sun_dir, dirs[:, 1], sun_color, ambient, sun_dir,
-                            diffusion)
+    return source_reference(medium, settings, None, up, down, dirs @ sun_dir, dirs[:, 1], sun_color, ambient, sun_dir,
+                            diffusion, octaves=octaves)
 
 
 def far_march_reference(field: FarField, medium, settings, band, camera, sun, size) -> dict:

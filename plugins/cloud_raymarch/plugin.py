@@ -254,7 +254,7 @@ class RaymarchPass(RenderPass):
         layer = frame.resource(FAR_FIELD)
         layer.prepare(view, sim)
         layer.use(p, view, sim)
-        values = far_uniforms(s, layer.settings, sim.layout(s.base_altitude), view, unit_direction(view.sun), layer.tile_size)
+        values = far_uniforms(s, layer.settings, sim.layout(s.base_altitude), view, layer.tile_size)
         for name, value in values.items():
             if name in p:
                 p[name].value = value

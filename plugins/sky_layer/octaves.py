@@ -38,7 +38,8 @@ OCTAVES = 4
 
 class OctaveTextures:
     """Four RGBA float textures (repeat, mipmapped); octave k has base_frequency·2^k cells per tile and
-    channel c its noise c light-march steps toward the sun. :meth:`bake` (re)computes them."""
+    channel c its noise ``steps[c]`` light steps toward the sun (:meth:`bake`; the sky layer's light
+    march: c steps). :meth:`bake` (re)computes them."""
 
     def __init__(self, gpu):
         self.gpu = gpu
@@ -47,10 +48,12 @@ class OctaveTextures:
         self.baked_for: tuple | None = None    # (texture settings, light shift) of the last bake
         self._program = None
 
-    def bake(self, settings: SkyLayerSettings, sun_dir, frequencies=None, shift_maps=None) -> None:
+    def bake(self, settings: SkyLayerSettings, sun_dir, frequencies=None, shift_maps=None,
+             steps=(0.0, 1.0, 2.0, 3.0)) -> None:
         """Fill the textures for ``settings`` and the sun direction (re-allocating on a size change).
         ``frequencies`` (4,): cells across each texture (default base_frequency·2^k); ``shift_maps``
-        (4, 2, 2): each texture's light shift is shift_maps[k] @ the sun's (default: the same for all)."""
+        (4, 2, 2): each texture's light shift is shift_maps[k] @ the sun's (default: the same for all);
+        ``steps`` (4,): the light steps toward the sun each channel holds the noise at."""
         ctx = self.gpu.ctx
         if self._program is None:
             self._program = self.gpu.program(compute_shader="sky_layer/octave.comp")
@@ -63,6 +66,7 @@ class OctaveTextures:
         shift = light_shift(sun_dir, settings.light_step)
         prog = self._program
         prog["light_shift"].value = tuple(shift)
+        prog["channel_steps"].value = tuple(float(v) for v in steps)
         groups = math.ceil(settings.size / 8)
         for k, tex in enumerate(self.textures):
             prog["frequency"].value = float(settings.base_frequency * 2 ** k if frequencies is None else frequencies[k])

@@ -8,12 +8,12 @@ from atmos.plugins.sky_layer.octaves import WEIGHTS, light_shift, octave_key, ti
 RAY = np.array([0.0, 0.2, 0.4, 0.6])
 
 
-def octave_texture(size: int, frequency: float, k, light_shift) -> np.ndarray:
-    """(size, size, 4) indexed [x, y, channel]: channel c sampled at texel/size + c·light_shift."""
+def octave_texture(size: int, frequency: float, k, light_shift, steps=(0, 1, 2, 3)) -> np.ndarray:
+    """(size, size, 4) indexed [x, y, channel]: channel c sampled at texel/size + steps[c]·light_shift."""
     i = np.arange(size) / size
     uv = np.stack(np.meshgrid(i, i, indexing="ij"), axis=-1)
     shift = np.asarray(light_shift, np.float64)
-    return np.stack([tile_noise(uv + c * shift, frequency, k) for c in range(4)], axis=-1)
+    return np.stack([tile_noise(uv + c * shift, frequency, k) for c in np.asarray(steps, np.float64)], axis=-1)
 
 
 def fbm(samples) -> np.ndarray:

@@ -2,20 +2,19 @@
 // The cloud field beyond the simulated volume (float64 reference: atmos/plugins/cloud_far_field/
 // reference.py). The view ray meets the layer's middle plane y = field_mid_height at the view depth s;
 // where that is in front of the scene, r = far_field_rank there (field.glsl: the fraction of the
-// layer's fbm below the point's) and the column takes the volume's own
-// column sum at the same rank (far_quantile: column_quantiles, cover.comp), so it is as thick per
-// cover as the volume, from the medium, with no hand-set opacity:
-//   tau = thickness * column_tau * far_quantile(r)   (column_tau = sigma_t * cell height)
+// layer's fbm below the point's) and the column takes the volume's own column sum at the same rank
+// (far_quantile: column_quantiles, cover.comp), so it is as thick per cover as the volume, from the
+// medium, with no hand-set opacity. The ray crosses the clouds' height h (RankLight's thickness at the
+// median covered rank) along its slant, so the columns a third of h above and below the plane count too:
+//   tau = thickness * column_tau * mean of far_quantile(r) at the three   (column_tau = sigma_t * cell height)
 //   alpha = (1 - exp(-tau / max(|dir.y|, MIN_SLANT))) * (1 - edge weight at the hit) * smoothstep(0, horizon_fade, |ray.y|)
-// (the view crosses the column along its slant, capped at the horizon), lit by the cloud medium's own
+// (a 3D field covers more of the sky at a slant: its clouds' sides), lit by the cloud medium's own
 // model (cloud_render/volume.glsl) with the volume's own light at the same rank (RankLight,
 // light_by_rank.comp; as seen from above when the view looks down, else from below): the octaves' sun
 // transmittances (lib/octaves.glsl) of the volume's columns of rank r, to the power `thickness`
-// (optical depths scale with it), times the relief of the layer toward the sun, exp(-e_i relief) (e:
-// volume.glsl octave_exponents, how fast each falls with optical depth) with
-// relief = 0.5 (mean(tau of the four light-march channels) - tau) / max(sun_dir.y, MIN_SLANT) (the
-// channels: the rank 0..3 light steps toward the sun; 0 on average), and, where the sets carry a
-// diffusion field, its light from their mean (phi, F); sky light with tau half above, half below.
+// (optical depths scale with it), moved by the relief toward the sun (field.glsl far_relief,
+// relief_light: lit edges facing the sun, shaded ones behind, no light added), and, where the sets
+// carry a diffusion field, its light from their mean (phi, F); sky light with tau half above, half below.
 // Premultiplied (blend_over).
 // frag_distance: (alpha * distance to the hit, alpha), "cloud_distance" when attached (atmos/composition.py).
 #include "lib/view_ray.glsl"
@@ -33,8 +32,10 @@ uniform vec2 footprint_min;    // the volume's footprint (world xz)
 uniform vec2 footprint_size;
 uniform float thickness;
 uniform float horizon_fade;
+uniform float layer_height;    // the volume's layer (m)
 const float MIN_SLANT = 0.1;     // the horizon's slant cap (about 6 degrees)
 layout(binding = 18) uniform sampler2D far_sun_by_rank;   // RankLight.sun: (rank, seen from above | below) -> the octaves' transmittances
+layout(binding = 21) uniform sampler2D far_thickness_by_rank;   // RankLight.thickness: rank -> the clouds' height / layer_height
 layout(binding = 19) uniform sampler2D far_field_light;   // RankLight.field: (rank, seen from above | below) -> (phi, F)
 uniform float lod_scale;       // texels per metre × a pixel's angle (rad): the mip level from the footprint,
                                // not from screen derivatives (the same under any camera roll)
@@ -56,15 +57,20 @@ void main() {
     if (fade <= 0.0) return;
     float lod = log2(max(lod_scale * length(hit - camera_pos) / max(abs(dir.y), 1e-3), 1e-6));
     vec4 r = far_field_rank(hit.xz, lod);
-    vec4 col = thickness * column_tau * vec4(far_quantile(r.x), far_quantile(r.y), far_quantile(r.z), far_quantile(r.w));
-    float tau = col.x;
+    float here = thickness * column_tau * far_quantile(r.x);
+    // the ray crosses the clouds' height along a slant: the columns it passes a third of that height
+    // above and below the middle plane count as much as the middle's (a cloud's sides are seen too); the
+    // height, the thickness of the volume's median covered column's rank interval (RankLight)
+    float height = layer_height * textureLod(far_thickness_by_rank, vec2(1.0 - 0.5 * cover, 0.5), 0.0).r;
+    vec2 across = dir.xz * (height / 3.0) / max(abs(dir.y), MIN_SLANT);
+    float tau = (here + thickness * column_tau * (far_quantile(far_field_rank_here(hit.xz - across, lod))
+                                                   + far_quantile(far_field_rank_here(hit.xz + across, lod)))) / 3.0;
     float alpha = (1.0 - exp(-tau / max(abs(dir.y), MIN_SLANT))) * fade;
     vec2 at = vec2(r.x, dir.y < 0.0 ? 0.25 : 0.75);        // row 0: seen from above, 1: from below
-    // relief: the sun's extra optical depth through the channels toward it over a column as thick all
-    // round (0 on average): lit edges facing the sun, shaded ones behind
-    float relief = 0.5 * (dot(col, vec4(0.25)) - tau) / max(sun_dir.y, MIN_SLANT);
-    vec4 sun = min(pow(max(textureLod(far_sun_by_rank, at, 0.0), 0.0), vec4(thickness)) * exp(-relief * octave_exponents()),
-                   1.0);
+    // the sun's light moved by the relief: lit edges facing the sun, shaded ones behind, none added
+    float relief = far_relief(r, thickness * column_tau, sun_dir.y, MIN_SLANT);
+    vec4 sun = relief_light(clamp(pow(max(textureLod(far_sun_by_rank, at, 0.0), 0.0), vec4(thickness)), 0.0, 1.0),
+                            relief * octave_exponents());
     vec3 light = sun_part(octave_weights_of(sun), dot(dir, sun_dir)) + ambient_source(0.5 * tau, 0.5 * tau, dir.y)
                + (ms_diffusion > 0.0 ? diffusion_light(textureLod(far_field_light, at, 0.0), dir) : vec3(0.0));
     frag = vec4(light * alpha, alpha);

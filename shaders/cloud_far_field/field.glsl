@@ -45,7 +45,8 @@ float far_quantile(float r) {
     return mix(column_quantiles[k], column_quantiles[k + 1], x - float(k));
 }
 
-// The four octaves' fbm at world (x, z) = xz (four light-march channels); lod: mip level of a texture
+// The four octaves' fbm at world (x, z) = xz, per channel (pattern.py CHANNEL_STEPS: the point, the
+// relief's samples toward the sun and away from it, the point again); lod: mip level of a texture
 // repeating once per tile (octave k, repeating every 2^field_lod_shift[k] tiles, reads that much finer).
 // Each octave turned and repeating at its own period: the sum repeats nowhere (pattern.py).
 vec4 field_fbm(vec2 xz, float lod) {
@@ -71,4 +72,34 @@ vec4 far_field_rank(vec2 xz, float lod) {
     vec4 r;
     for (int k = 0; k < 4; ++k) r[k] = mix(field_rank(fbm[k], m0), field_rank(fbm[k], m0 + 1), t);
     return r;
+}
+
+// far_field_rank's first channel alone (the point's own rank; the others not ranked).
+float far_field_rank_here(vec2 xz, float lod) {
+    vec2 p = (xz - field_origin) / field_tile_size;
+    vec4 l = max(vec4(lod) - field_lod_shift, 0.0);
+    float fbm = SKY_LAYER_WEIGHTS.x * textureLod(octave0, field_offsets[0] + field_turns[0] * p, l.x).x
+              + SKY_LAYER_WEIGHTS.y * textureLod(octave1, field_offsets[1] + field_turns[1] * p, l.y).x
+              + SKY_LAYER_WEIGHTS.z * textureLod(octave2, field_offsets[2] + field_turns[2] * p, l.z).x
+              + SKY_LAYER_WEIGHTS.w * textureLod(octave3, field_offsets[3] + field_turns[3] * p, l.w).x;
+    float m = field_level(lod);
+    int m0 = min(int(m), FIELD_LEVELS - 2);
+    return mix(field_rank(fbm, m0), field_rank(fbm, m0 + 1), m - float(m0));
+}
+
+// The relief at a point of ranks r (far_field_rank): the sun's extra optical depth through the layer's
+// slope there, from the columns the relief's samples toward the sun and away from it hold (tau_cell:
+// optical depth per summed cell): 3/16 of their difference (for a steady slope as much as the
+// one-sided form it replaced, 3/8 of (mean over 1..3 steps toward the sun - here)) over the sun's
+// height sin (capped at min_slant). 0 where the clouds are as thick both ways; as often up as down.
+float far_relief(vec4 r, float tau_cell, float sun_y, float min_slant) {
+    return 0.1875 * tau_cell * (far_quantile(r.y) - far_quantile(r.z)) / max(sun_y, min_slant);
+}
+
+// The octaves' sun transmittances s (the volume's own mean at the point's rank: RankLight) moved by the
+// relief's optical depths d toward 0 (d > 0: more cloud toward the sun than away) or 1, at most as far
+// as the nearer bound: odd in d, so a relief as often up as down leaves the mean light at s (lit sides
+// facing the sun, shaded ones behind, and no light added).
+vec4 relief_light(vec4 s, vec4 d) {
+    return s - min(s, 1.0 - s) * tanh(clamp(d, -10.0, 10.0));      // clamped: tanh's exp overflows past ~44
 }

@@ -10,11 +10,16 @@
 //                         shading volume, nearest texel; 1 without one), v = 0 seen from above, 1 from
 //                         below: those (volume.glsl octave_weights_of) of the volume's columns of that
 //                         rank, which the 2D far field (far.frag) lights its columns with;
+//   sun_profile (k, q):  per height bin q of Q (sample j in bin j Q / P) the columns' density-weighted
+//                         mean octave transmittances there (no transmittance weight), which the ray
+//                         march's volumetric far field (cloud_raymarch/far.glsl) lights its density with;
+//   thickness (k):       the clouds' height as a fraction of the layer: per column sqrt(12 var + 1/P^2) of
+//                         its density's height (var in layer fractions; a uniform slab's thickness), mean
+//                         over the interval's columns weighted by w: the span the 2D far field's slanted
+//                         views cross (far.frag);
 // and with FIELD (the sets carry a diffusion field, atmos/shading/diffusion.py):
 //   field_column (k, v):  the field's (phi, F) likewise (nearest field cell);
-//   field_profile (k, q): per height bin q of Q (sample j in bin j Q / P) the columns' density-weighted
-//                         mean (phi, F) there (no transmittance weight), for the ray march's volumetric far
-//                         field (cloud_raymarch/far.glsl).
+//   field_profile (k, q): likewise the field's mean (phi, F) per height bin, for the same.
 // A bin without density takes its interval's mean from above; an interval without columns the nearest
 // one's (above first); none at all: T = 1, the field 0. phi is clamped to [0, FIELD_MAX], |F| to phi.
 // Two dispatches (RankLight.measure): STAGE 0, one invocation per column, sums each work group's columns
@@ -36,6 +41,8 @@ layout(binding = 16) uniform sampler3D diffusion_a;  // the diffusion field (phi
 layout(binding = 17) uniform sampler3D diffusion_b;
 #if STAGE == 1
 layout(rgba32f, binding = 0) writeonly uniform image2D sun_by_rank;     // (32 intervals, 2)
+layout(r32f, binding = 3) writeonly uniform image2D thickness_by_rank;  // (32 intervals, 1)
+layout(rgba32f, binding = 4) writeonly uniform image2D sun_profile;     // (32 intervals, Q bins)
 #if FIELD
 layout(rgba32f, binding = 1) writeonly uniform image2D field_column;    // (32 intervals, 2)
 layout(rgba32f, binding = 2) writeonly uniform image2D field_profile;   // (32 intervals, Q bins)
@@ -43,14 +50,14 @@ layout(rgba32f, binding = 2) writeonly uniform image2D field_profile;   // (32 i
 #endif
 const float FIELD_MAX = 8.0;        // phi clamped to this (unit irradiance; a cloud's stays below 4)
 const int FIELD_BINS = 16;          // most height bins Q
-const int SLOT = 9;                 // a column slot: weight, 4 sun transmittances, phi, F + phi (3)
-const int BIN = 5;                  // a height bin: weight, phi, F + phi (3)
+const int SLOT = 10;                // a column slot: weight, 4 sun transmittances, phi, F + phi (3), thickness
+const int BIN = 9;                  // a height bin: weight, phi, F + phi (3), 4 sun transmittances
 const int BINS_AT = INTERVALS * 2 * SLOT;              // the bins' sums follow the columns' (k, view) slots
 const int TOTAL = BINS_AT + INTERVALS * FIELD_BINS * BIN;
 layout(std430, binding = 0) readonly buffer Cover { float cover; float column_quantiles[33]; };
 layout(std430, binding = 1) coherent buffer Sums { uint sums[TOTAL]; };   // zero between frames
 uniform int heights;           // P: height samples per column
-uniform int bins;              // Q: height bins of the field (1 without one)
+uniform int bins;              // Q: height bins of the profiles
 uniform int has_shading;       // 0: T = 1
 uniform float attenuation;     // the octaves' a (CloudLightSettings.ms_attenuation)
 uniform float column_tau;      // sigma_t x cell height: optical depth of a cell of density 1, vertically
@@ -76,18 +83,21 @@ void add_column(ivec2 p, ivec2 n, int k, uint units, float unit) {
     ivec3 size = textureSize(density_b, 0);
     float w = float(units) / WEIGHT_UNIT, sample_tau = column_tau * w * float(size.y) / float(heights);
     float total = 0.0, below = 0.0;              // the column's optical depth, and below the sample
+    vec3 moments = vec3(0.0);                    // the density's sum, and its first two height moments
     for (int j = 0; j < heights; ++j)
         total += sample_tau * column_density(ivec3(p.x, sample_row(j, heights, size.y), p.y), size);
     float weight[2] = float[2](0.0, 0.0);        // the column's sums seen from above, from below
     vec4 sun[2] = vec4[2](vec4(0.0), vec4(0.0)), field[2] = vec4[2](vec4(0.0), vec4(0.0));
     for (int b = 0; b < bins; ++b) {             // bin b holds the samples j with j bins / heights = b
         float bin_weight = 0.0;
-        vec4 bin_field = vec4(0.0);
+        vec4 bin_field = vec4(0.0), bin_sun = vec4(0.0);
         for (int j = (b * heights + bins - 1) / bins; j < ((b + 1) * heights + bins - 1) / bins; ++j) {
             ivec3 cell = ivec3(p.x, sample_row(j, heights, size.y), p.y);
             float d = column_density(cell, size), tau = sample_tau * d;
             below += tau;
             if (d <= 0.0) continue;
+            float y = (float(cell.y) + 0.5) / float(size.y);
+            moments += d * vec3(1.0, y, y * y);
             float T = has_shading == 0 ? 1.0 : clamp(NEAREST(trans_a, trans_b, cell, size).r, 0.0, 1.0);
             vec4 Ta = octave_transmittances(T, attenuation);
 #if FIELD
@@ -99,6 +109,7 @@ void add_column(ivec2 p, ivec2 n, int k, uint units, float unit) {
 #endif
             bin_weight += d;
             bin_field += d * v;
+            bin_sun += d * Ta;
             float seen[2] = float[2](exp(-(total - below + 0.5 * tau)), exp(-(below - 0.5 * tau)));
             for (int view = 0; view < 2; ++view) {
                 weight[view] += d * seen[view];
@@ -106,19 +117,25 @@ void add_column(ivec2 p, ivec2 n, int k, uint units, float unit) {
                 field[view] += d * seen[view] * v;
             }
         }
-#if FIELD
         if (bin_weight > 0.0) {                 // the column's mean in this bin, weighted by its edge weight
             uint at = uint(BINS_AT + (k * FIELD_BINS + b) * BIN);
             atomicAdd(local[at], units);
-            for (int c = 0; c < 4; ++c)
+            for (int c = 0; c < 4; ++c) {
+#if FIELD
                 atomicAdd(local[at + 1u + uint(c)], uint(round(float(units) * unit * bin_field[c] / bin_weight)));
-        }
 #endif
+                atomicAdd(local[at + 5u + uint(c)], uint(round(float(units) * unit * bin_sun[c] / bin_weight)));
+            }
+        }
     }
+    float mean = moments.y / max(moments.x, 1e-30);
+    float thickness = min(sqrt(max(12.0 * (moments.z / max(moments.x, 1e-30) - mean * mean), 0.0)
+                               + 1.0 / float(heights * heights)), 1.0);
     for (int view = 0; view < 2; ++view) {      // the column's means, weighted by its edge weight
         if (!(weight[view] > 0.0)) continue;
         uint at = uint((k * 2 + view) * SLOT);
         atomicAdd(local[at], units);
+        atomicAdd(local[at + 9u], uint(round(float(units) * unit * thickness)));
         for (int c = 0; c < 4; ++c) atomicAdd(local[at + 1u + uint(c)], uint(round(float(units) * unit * sun[view][c] / weight[view])));
         for (int c = 0; c < 4; ++c) atomicAdd(local[at + 5u + uint(c)], uint(round(float(units) * unit * field[view][c] / weight[view])));
     }
@@ -166,6 +183,8 @@ void main() {
         if (int(i) + d < INTERVALS && local[(int(i) + d) * 2 * SLOT] > 0u) k = int(i) + d;
         else if (int(i) - d >= 0 && local[(int(i) - d) * 2 * SLOT] > 0u) k = int(i) - d;
     }
+    float weight = k < 0 ? 0.0 : float(local[k * 2 * SLOT]) * unit;
+    imageStore(thickness_by_rank, ivec2(int(i), 0), vec4(weight > 0.0 ? float(local[k * 2 * SLOT + 9]) / weight : 1.0));
     for (int view = 0; view < 2; ++view) {
         int s = k * 2 + view;
         imageStore(sun_by_rank, ivec2(int(i), view), k < 0 ? vec4(1.0) : slot_mean(s, 1, vec4(1.0), unit));
@@ -174,18 +193,22 @@ void main() {
         imageStore(field_column, ivec2(int(i), view), vec4(field.x, field.yzw - field.x));
 #endif
     }
-#if FIELD
-    vec4 top = k < 0 ? vec4(0.0) : slot_mean(2 * k, 5, vec4(0.0), unit);
+    vec4 top = k < 0 ? vec4(0.0) : slot_mean(2 * k, 5, vec4(0.0), unit);      // (phi, F + phi) seen from above
+    vec4 top_sun = k < 0 ? vec4(1.0) : slot_mean(2 * k, 1, vec4(1.0), unit);
     for (int b = 0; b < bins; ++b) {
-        vec4 v = top;                       // (phi, F + phi)
+        vec4 v = top, sun = top_sun;
         if (k >= 0) {
             uint at = uint(BINS_AT + (k * FIELD_BINS + b) * BIN);
             float w = float(local[at]) * unit;
-            if (w > 0.0)
+            if (w > 0.0) {
                 v = vec4(float(local[at + 1u]), float(local[at + 2u]), float(local[at + 3u]), float(local[at + 4u])) / w;
+                sun = vec4(float(local[at + 5u]), float(local[at + 6u]), float(local[at + 7u]), float(local[at + 8u])) / w;
+            }
         }
+        imageStore(sun_profile, ivec2(int(i), b), sun);
+#if FIELD
         imageStore(field_profile, ivec2(int(i), b), vec4(v.x, v.yzw - v.x));
-    }
 #endif
+    }
 }
 #endif

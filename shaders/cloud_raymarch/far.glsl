@@ -10,21 +10,25 @@
 // the volume:
 //   density(r, h) = far_quantile(r) * far_profile(r, h).R       (h: height fraction, 0 base, 1 top)
 // which the march then erodes with the detail noise like the volume's density. Light (volume.glsl's
-// model): the sun transmittance from a three-step march toward the sun through the same density, the
-// rank at each step from the light-march channels (baked light_step tiles apart toward the sun: no
-// extra fetch); the sky light from the column above and below: column_tau * far_quantile(r) * (G, 1 - G);
+// model): the octaves' sun transmittances are the volume's own mean at the point's rank and height
+// (far_sun_profile: light_by_rank.comp's sun_profile), so far clouds shade each other as much as the
+// volume's do at any sun (a short march of their own saw 85 m of a 4.6 deg sun's path: sunset's far
+// clouds 1.7x too bright toward the sun); moved by the relief as the 2D far field's (field.glsl
+// far_relief, relief_light: from the same fetch's channels, lit sides facing the sun, none added);
+// the sky light from the column above and below: column_tau * far_quantile(r) * (G, 1 - G);
 // with a diffusion field, its light (diffusion_light) from the field's mean (phi, F) over the volume's
 // columns of rank r at height h (far_field_light_profile: light_by_rank.comp's field_profile).
-// Requires volume.glsl (sun_part, octave_weights, ambient_source, sun_dir, column_tau) included first.
+// Requires volume.glsl (sun_part, octave_weights_of, octave_exponents, ambient_source, sun_dir, column_tau)
+// included first.
 #include "cloud_far_field/field.glsl"
 
 uniform float far_lod_scale;      // octave texels per metre x a full-res pixel's angle (rad)
 uniform vec2 far_band;            // (base y, height) of the layer (m)
-uniform vec3 far_sun;             // (step toward the sun (m), channels per step, layer fraction per step)
 layout(binding = 14) uniform sampler2D far_profile;   // FarFieldLayer.profile: (rank, h) -> (R, G), clamped
 layout(binding = 20) uniform sampler2D far_field_light_profile;   // RankLight.field_profile: (rank, h) -> (phi, F)
+layout(binding = 22) uniform sampler2D far_sun_profile;   // RankLight.sun_profile: (rank, h) -> the octaves' transmittances
 
-// The ranks at xz and at the three light-march channels; s: distance (m).
+// The ranks at xz and at the relief's samples (field.glsl's channels); s: distance (m).
 vec4 far_ranks(vec2 xz, float s) {
     return far_field_rank(xz, log2(max(far_lod_scale * s, 1e-6)));
 }
@@ -39,24 +43,17 @@ float far_density(float r, float h) {
     return far_quantile(r) * textureLod(far_profile, vec2(r, h), 0.0).r;
 }
 
-// The rank at a fractional channel position x in [0, 3) of the light-march channels c.
-float far_channel(vec4 c, float x) {
-    int i = min(int(x), 2);
-    return mix(c[i], c[i + 1], x - float(i));
-}
+const float FAR_MIN_SLANT = 0.1;   // the relief's cap on the sun's slant (far.frag's MIN_SLANT)
 
-// J (per unit extinction) of far-field density with ranks c (channels) at height fraction h, seen along
-// dir; sigma_t: extinction (1/m) at density 1.
-vec3 far_source(vec4 c, float h, vec3 dir, float sigma_t) {
-    float depth = 0.0;
-    for (int k = 0; k < 3; ++k) {
-        float x = (float(k) + 0.5) * far_sun.y;
-        depth += far_density(far_channel(c, x), h + (float(k) + 0.5) * far_sun.z);
-    }
-    float T = exp(-sigma_t * far_sun.x * depth);
-    float column = column_tau * far_quantile(c.x), above = textureLod(far_profile, vec2(c.x, clamp(h, 0.0, 1.0)), 0.0).g;
+// J (per unit extinction) of far-field density with ranks c (far_ranks) at height fraction h, seen along
+// dir.
+vec3 far_source(vec4 c, float h, vec3 dir) {
+    vec2 at = vec2(c.x, clamp(h, 0.0, 1.0));
+    vec4 sun = relief_light(textureLod(far_sun_profile, at, 0.0),
+                            far_relief(c, column_tau, sun_dir.y, FAR_MIN_SLANT) * octave_exponents());
+    float column = column_tau * far_quantile(c.x), above = textureLod(far_profile, at, 0.0).g;
     float up = column * above, down = column * (1.0 - above);
     vec3 field = ms_diffusion > 0.0
-               ? diffusion_light(textureLod(far_field_light_profile, vec2(c.x, clamp(h, 0.0, 1.0)), 0.0), dir) : vec3(0.0);
-    return sun_part(octave_weights(T), dot(dir, sun_dir)) + ambient_source(up, down, dir.y) + field;
+               ? diffusion_light(textureLod(far_field_light_profile, at, 0.0), dir) : vec3(0.0);
+    return sun_part(octave_weights_of(sun), dot(dir, sun_dir)) + ambient_source(up, down, dir.y) + field;
 }

@@ -198,7 +198,7 @@ void main() {
                 J = cloud_source_with(uvw, dir, ny, T);
             }
 #if FAR_FIELD
-            if (df > 0.0) J = mix(J, far_source(fc, fh, dir, sigma_t), df / (dv + df));
+            if (df > 0.0) J = mix(J, far_source(fc, fh, dir), df / (dv + df));
 #endif
             light += w * J;
             weighted += w * sp;

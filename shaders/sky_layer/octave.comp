@@ -1,8 +1,9 @@
 #version 430
 // One seamlessly tiling octave of the 2D cloud layer (dynamic-2d-clouds-iq.txt): 4D value noise on two
 // circles, u -> (cos, sin)(2πu) and v -> (cos, sin)(2πv) of radius frequency/2π, so the texture repeats
-// with period 1 and has `frequency` noise cells across. Channel c holds the noise c light-march steps
-// toward the sun (uv + c * light_shift): one fetch gives all four samples.
+// with period 1 and has `frequency` noise cells across. Channel c holds the noise channel_steps[c]
+// light steps toward the sun (uv + channel_steps[c] * light_shift): one fetch gives all four samples
+// (the sky layer's light march: 0, 1, 2, 3; the far field's relief: OctaveTextures.bake's steps).
 #include "lib/hash.glsl"
 #include "lib/value_noise.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -10,6 +11,7 @@ layout(binding = 0, rgba32f) uniform writeonly image2D octave;
 uniform float frequency;
 uniform uint key;
 uniform vec2 light_shift;
+uniform vec4 channel_steps;
 
 const float TAU = 6.283185307179586;
 
@@ -25,6 +27,6 @@ void main() {
     vec2 uv = vec2(cell) / vec2(size);
     float radius = frequency / TAU;
     vec4 v;
-    for (int c = 0; c < 4; ++c) v[c] = tile_noise(uv + float(c) * light_shift, radius);
+    for (int c = 0; c < 4; ++c) v[c] = tile_noise(uv + channel_steps[c] * light_shift, radius);
     imageStore(octave, cell, v);
 }
