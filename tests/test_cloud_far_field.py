@@ -230,10 +230,10 @@ def correlation(a, b) -> float:
 @pytest.mark.parametrize("pitch", [0.25, 0.7])
 def test_the_far_fields_opacity_matches_float64(gpu, ctx, pitch):
     """far.frag's alpha outside the volume (mip 0: a 64-texel, 20 km tile) against far_field_alpha: the
-    mean column optical depth at the middle plane's hit and a third of the clouds' height (RankLight's
-    thickness at the median covered rank) above and below it along the ray, over the slant, times the
-    horizon fade; without the two slanted samples it is far off (the test can fail)."""
-    from atmos.plugins.cloud_far_field.cover import fbm_quantiles
+    column optical depth at the middle plane's hit, at the rank and scale slant_rank gives for clouds of
+    the measured height (RankLight's thickness at the median covered rank) at the ray's slant, over the
+    slant, times the horizon fade; as a flat layer (height 0) it is far off (the test can fail)."""
+    from atmos.plugins.cloud_far_field.cover import fbm_quantiles, pattern_crossings
     from atmos.plugins.cloud_far_field.layer import column_tau, drift
     from atmos.plugins.cloud_far_field.reference import far_field_alpha
     from atmos.plugins.cloud_raymarch.reference import rays
@@ -256,7 +256,8 @@ def test_the_far_fields_opacity_matches_float64(gpu, ctx, pitch):
         fade = np.clip(np.abs(dirs[..., 1]) / params.horizon_fade, 0.0, 1.0)
         fade = fade * fade * (3.0 - 2.0 * fade)
         args = ([layer.octaves.download(k) for k in range(4)], drift(params, sets, 0.0, layer.tile_size), layer.tile_size,
-                fbm_quantiles(params.base_frequency, params.seed, params.size), columns, column_tau(params, sets))
+                fbm_quantiles(params.base_frequency, params.seed, params.size), columns, column_tau(params, sets), cover,
+                pattern_crossings(params.base_frequency, params.seed, params.size))
         fade = np.where(s > 0.0, fade, 0.0)                 # below the plane: none
         want = far_field_alpha(xz, dirs, height, *args) * fade
         flat = far_field_alpha(xz, dirs, 0.0, *args) * fade
@@ -265,7 +266,7 @@ def test_the_far_fields_opacity_matches_float64(gpu, ctx, pitch):
         assert mip0.mean() > 0.3 and 0.2 < (want[mip0] > 0.05).mean() < 0.95, "the view holds far clouds and gaps"
         err = np.abs(alpha - want)[mip0]
         assert np.percentile(err, 99) < 0.02 and err.mean() < 0.004, (err.mean(), np.percentile(err, 99))
-        assert np.abs(alpha - flat)[mip0].mean() > 5 * err.mean(), "the clouds' sides are drawn"
+        assert np.abs(alpha - flat)[mip0].mean() > 5 * err.mean(), "the clouds' sides are seen"
     finally:
         app.close()
 

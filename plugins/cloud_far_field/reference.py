@@ -231,18 +231,37 @@ def relief_light(s, d) -> np.ndarray:
 MIN_SLANT = 0.1     # far.frag's horizon cap on the slant
 
 
+def slant_rank(rank, height: float, cot, cover: float, crossings, tile_size: float) -> tuple[np.ndarray, np.ndarray]:
+    """far.frag's slant_rank: (rank, optical depth factor) of points of ``rank`` (...,) of a layer of
+    clouds ``height`` (m) high seen with cot(elevation) ``cot`` (...,): the pattern crosses its cover n
+    times per metre (``crossings`` per tile at quantile 1 − cover, :func:`.cover.pattern_crossings`); a
+    cloud as a spheroid of radii a = cover / n across and b = height / 2 up widens by 2 (√(a² + b²
+    cot²) − a) along the view, and with exponential gaps of mean 2 (1 − cover) / n the layer covers
+    c' = 1 − (1 − c) exp(−widening / gap); ranks above 1 − c' spread over 1 − c .. 1, the optical depth
+    × c / c'."""
+    rank, cot = np.broadcast_arrays(np.asarray(rank, np.float64), np.asarray(cot, np.float64))
+    c = float(np.clip(cover, 0.0, 1.0))
+    n = float(np.interp(1.0 - c, np.linspace(0.0, 1.0, len(crossings)), crossings)) / float(tile_size)
+    if not (0.0 < c < 1.0 and n > 0.0 and height > 0.0):
+        return rank, np.ones_like(rank)
+    a, b = c / n, 0.5 * float(height)
+    widen = 2.0 * (np.sqrt(a * a + b * b * cot * cot) - a)
+    c2 = 1.0 - (1.0 - c) * np.exp(-widen * n / (2.0 * (1.0 - c)))
+    return 1.0 - c + (rank - (1.0 - c2)) * c / c2, c / c2
+
+
 def far_field_alpha(xz, dirs, height: float, octaves, offsets, tile_size: float, quantiles, columns,
-                    column_tau: float, thickness: float = 1.0) -> np.ndarray:
+                    column_tau: float, cover: float, crossings, thickness: float = 1.0) -> np.ndarray:
     """far.frag's opacity (...,) where the view ``dirs`` (..., 3, unit) meet the middle plane at world
-    ``xz`` (..., 2), mip 0, before the edge, horizon and scene fades: the mean vertical optical depth
-    thickness · column_tau (sigma_t · cell height) · the volume's column sum at the rank of the hit and of
-    the points a third of the clouds' ``height`` (m) above and below it along the ray, seen along the
-    slant 1 / max(|dir_y|, MIN_SLANT)."""
+    ``xz`` (..., 2), mip 0, before the edge, horizon and scene fades: thickness · column_tau (sigma_t ·
+    cell height) · the volume's column sum at the point's rank, both as :func:`slant_rank` gives them
+    for clouds ``height`` (m) high at the ray's slant (``cover``, ``crossings``: the layer's), seen along
+    the slant 1 / max(|dir_y|, MIN_SLANT)."""
     dirs = np.asarray(dirs, np.float64)
     slant = np.maximum(np.abs(dirs[..., 1]), MIN_SLANT)
-    across = dirs[..., [0, 2]] * (float(height) / 3.0 / slant)[..., None]
-    tau = sum(far_optical_depth(np.asarray(xz, np.float64) + k * across, octaves, offsets, tile_size, quantiles, columns,
-                                float(thickness) * float(column_tau)) for k in (-1, 0, 1)) / 3.0
+    rank = field_rank(field_fbm(xz, octaves, offsets, tile_size), quantiles)
+    rank, factor = slant_rank(rank, height, np.linalg.norm(dirs[..., [0, 2]], axis=-1) / slant, cover, crossings, tile_size)
+    tau = float(thickness) * float(column_tau) * factor * column_at_rank(rank, columns)
     return 1.0 - np.exp(-tau / slant)
 
 

@@ -33,12 +33,34 @@ uniform vec2 footprint_size;
 uniform float thickness;
 uniform float horizon_fade;
 uniform float layer_height;    // the volume's layer (m)
+uniform float field_crossings[33];   // cover.pattern_crossings: the pattern's crossings of quantile k per tile
 const float MIN_SLANT = 0.1;     // the horizon's slant cap (about 6 degrees)
 layout(binding = 18) uniform sampler2D far_sun_by_rank;   // RankLight.sun: (rank, seen from above | below) -> the octaves' transmittances
 layout(binding = 21) uniform sampler2D far_thickness_by_rank;   // RankLight.thickness: rank -> the clouds' height / layer_height
 layout(binding = 19) uniform sampler2D far_field_light;   // RankLight.field: (rank, seen from above | below) -> (phi, F)
 uniform float lod_scale;       // texels per metre × a pixel's angle (rad): the mip level from the footprint,
                                // not from screen derivatives (the same under any camera roll)
+
+// (rank, optical depth factor) of a point of rank r of a layer of clouds `height` (m) high seen with
+// the view's cot(elevation) `cot`. Along a line the pattern changes cover n times per metre
+// (field_crossings at the cover's quantile, per tile): chords of mean length 2c / n, gaps 2 (1 - c) / n,
+// taken as exponential. A cloud as a spheroid of those radii (a = c / n across, b = height / 2 up) seen
+// at that slant throws a shadow on the middle plane sqrt(a^2 + b^2 cot^2) long (half), so each cloud
+// widens by S = 2 (sqrt(a^2 + b^2 cot^2) - a) along the view, and the layer covers
+// c' = 1 - (1 - c) exp(-S / gap) of it; the ranks above 1 - c' are spread over the covered ones
+// (1 - c .. 1) and the optical depth scaled by c / c': the mean optical depth along the ray stays the
+// layer's (a 3D layer's clouds show their sides; toward the horizon the gaps close).
+vec2 slant_rank(float r, float height, float cot) {
+    float c = clamp(cover, 0.0, 1.0);
+    float x = clamp(1.0 - c, 0.0, 1.0) * 32.0;
+    int k = min(int(x), 31);
+    float n = mix(field_crossings[k], field_crossings[k + 1], x - float(k)) / field_tile_size;
+    if (!(c > 0.0 && c < 1.0 && n > 0.0 && height > 0.0)) return vec2(r, 1.0);
+    float a = c / n, b = 0.5 * height;
+    float widen = 2.0 * (sqrt(a * a + b * b * cot * cot) - a);
+    float c2 = 1.0 - (1.0 - c) * exp(-widen * n / (2.0 * (1.0 - c)));
+    return vec2(1.0 - c + (r - (1.0 - c2)) * c / c2, c / c2);
+}
 
 void main() {
     frag = vec4(0.0);
@@ -57,16 +79,13 @@ void main() {
     if (fade <= 0.0) return;
     float lod = log2(max(lod_scale * length(hit - camera_pos) / max(abs(dir.y), 1e-3), 1e-6));
     vec4 r = far_field_rank(hit.xz, lod);
-    float here = thickness * column_tau * far_quantile(r.x);
-    // the ray crosses the clouds' height along a slant: the columns it passes a third of that height
-    // above and below the middle plane count as much as the middle's (a cloud's sides are seen too); the
-    // height, the thickness of the volume's median covered column's rank interval (RankLight)
+    // the clouds' height h: RankLight's thickness at the median covered rank; seen at a slant their
+    // sides widen the layer's cover (slant_rank)
     float height = layer_height * textureLod(far_thickness_by_rank, vec2(1.0 - 0.5 * cover, 0.5), 0.0).r;
-    vec2 across = dir.xz * (height / 3.0) / max(abs(dir.y), MIN_SLANT);
-    float tau = (here + thickness * column_tau * (far_quantile(far_field_rank_here(hit.xz - across, lod))
-                                                   + far_quantile(far_field_rank_here(hit.xz + across, lod)))) / 3.0;
+    vec2 slanted = slant_rank(r.x, height, length(dir.xz) / max(abs(dir.y), MIN_SLANT));
+    float tau = thickness * column_tau * slanted.y * far_quantile(slanted.x);
     float alpha = (1.0 - exp(-tau / max(abs(dir.y), MIN_SLANT))) * fade;
-    vec2 at = vec2(r.x, dir.y < 0.0 ? 0.25 : 0.75);        // row 0: seen from above, 1: from below
+    vec2 at = vec2(slanted.x, dir.y < 0.0 ? 0.25 : 0.75);  // row 0: seen from above, 1: from below
     // the sun's light moved by the relief: lit edges facing the sun, shaded ones behind, none added
     float relief = far_relief(r, thickness * column_tau, sun_dir.y, MIN_SLANT);
     vec4 sun = relief_light(clamp(pow(max(textureLod(far_sun_by_rank, at, 0.0), 0.0), vec4(thickness)), 0.0, 1.0),

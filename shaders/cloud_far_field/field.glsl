@@ -74,19 +74,6 @@ vec4 far_field_rank(vec2 xz, float lod) {
     return r;
 }
 
-// far_field_rank's first channel alone (the point's own rank; the others not ranked).
-float far_field_rank_here(vec2 xz, float lod) {
-    vec2 p = (xz - field_origin) / field_tile_size;
-    vec4 l = max(vec4(lod) - field_lod_shift, 0.0);
-    float fbm = SKY_LAYER_WEIGHTS.x * textureLod(octave0, field_offsets[0] + field_turns[0] * p, l.x).x
-              + SKY_LAYER_WEIGHTS.y * textureLod(octave1, field_offsets[1] + field_turns[1] * p, l.y).x
-              + SKY_LAYER_WEIGHTS.z * textureLod(octave2, field_offsets[2] + field_turns[2] * p, l.z).x
-              + SKY_LAYER_WEIGHTS.w * textureLod(octave3, field_offsets[3] + field_turns[3] * p, l.w).x;
-    float m = field_level(lod);
-    int m0 = min(int(m), FIELD_LEVELS - 2);
-    return mix(field_rank(fbm, m0), field_rank(fbm, m0 + 1), m - float(m0));
-}
-
 // The relief at a point of ranks r (far_field_rank): the sun's extra optical depth through the layer's
 // slope there, from the columns the relief's samples toward the sun and away from it hold (tau_cell:
 // optical depth per summed cell): 3/16 of their difference (for a steady slope as much as the
