@@ -19,6 +19,7 @@ from __future__ import annotations
 import moderngl
 import numpy as np
 
+from atmos.blue_noise import blue_noise
 from atmos.camera import set_camera_uniforms
 from atmos.composition import CLOUD_DISTANCE, composition, distance_desc
 from atmos.graph import PassBuilder, PassContext, RenderPass, TextureDesc
@@ -42,6 +43,7 @@ LOW_COLOR = "cloud_raymarch_color"
 LOW_DISTANCE = "cloud_raymarch_distance"
 LOW_DEPTH = "cloud_raymarch_depth"
 SKIP_UNIT, DEPTH_UNIT = 4, 9              # (5..8: the far field's octaves, field.glsl)
+BLUE_NOISE_UNIT = 23                       # march.frag's first-sample jitter (10..22: volume.glsl, the far field)
 
 
 def skip_map(max_maps: np.ndarray) -> np.ndarray:
@@ -134,7 +136,7 @@ class RaymarchPass(RenderPass):
 
     def __init__(self, plugin: RaymarchCloudsPlugin):
         self.plugin = plugin
-        self.gpu = self.sampler = self.offscreen = self.skip = self.temporal = self.noise = None
+        self.gpu = self.sampler = self.offscreen = self.skip = self.temporal = self.noise = self.jitter = None
         self._skip_key = None
         self.frame_index = 0
 
@@ -230,6 +232,8 @@ class RaymarchPass(RenderPass):
         else:                               # nothing uploaded; the shader reads no skip map
             self._release_skip()
         frame.resource(DEPTH).use(DEPTH_UNIT)
+        if s.jitter:
+            self._jitter_texture().use(BLUE_NOISE_UNIT)
         if far:
             self._bind_far(frame, p, sim)
         if s.detail_octaves:
@@ -293,6 +297,14 @@ class RaymarchPass(RenderPass):
         frame.fullscreen(self.gpu.program(vertex_shader="lib/fullscreen.vert",
                                           fragment_shader="cloud_raymarch/blend.frag"))
 
+    def _jitter_texture(self):
+        """The blue-noise tile march.frag offsets each pixel's first sample by (made on first use)."""
+        if self.jitter is None:
+            tile = blue_noise()
+            self.jitter = self.gpu.ctx.texture(tile.shape[::-1], 1, tile.tobytes(), dtype="f4")
+            self.jitter.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        return self.jitter
+
     def _release_skip(self) -> None:
         if self.skip is not None:
             self.skip.release()
@@ -305,3 +317,6 @@ class RaymarchPass(RenderPass):
             self.sampler.release()
         self.sampler = self.noise = None     # the noise textures belong to the context's cache
         self._release_skip()
+        if self.jitter is not None:
+            self.jitter.release()
+            self.jitter = None

@@ -36,8 +36,8 @@ class RaymarchCloudSettings(CloudLightSettings):
     where it cannot skip, saves most samples of a sparse sky; the image changes only by where the
     steps fall). ``min_transmittance``: stop a ray once this little light from behind gets through
     (0..0.5; 0 marches to the layer's end; the pixel's alpha is short by at most that much).
-    ``jitter``: offset each pixel's first sample by an interleaved-gradient noise of the pixel, fixed
-    in time (turns step banding into fine spatial noise that does not flicker); False: midpoint samples,
+    ``jitter``: offset each pixel's first sample by a tiled blue noise of the pixel (:mod:`atmos.blue_noise`),
+    fixed in time (turns step banding into fine spatial noise that does not flicker); False: midpoint samples,
     reproducible (tests). ``resolution``: march one pixel of every r × r block (1, 2 or 4; 2 costs a
     quarter of the samples, the frame's jitter moves the marched pixel inside the block).
     ``reprojection``: resolve the low-res samples with the temporal history (r² frames to converge

@@ -51,12 +51,15 @@ uniform float far_distance;    // FAR_FIELD: the march ends this far from the ca
 uniform float far_growth;      // FAR_FIELD: the step's growth per metre of distance in the far field
 uniform float pixel_angle;     // a full-res pixel's angle (rad): its width per metre of distance
 
-// Jimenez's interleaved gradient noise of the full-res pixel, the same every frame: the temporal
+// The blue noise (atmos/blue_noise.py) of the full-res pixel, tiled, the same every frame: the temporal
 // resolve keeps each pixel's latest sample (it does not average), so an offset that moved per frame
-// only flickered (1.1 levels per frame at resolution 1, 5x the clouds' own change in sunset).
+// only flickered (1.1 levels per frame at resolution 1, 5x the clouds' own change in sunset); and
+// interleaved gradient noise, a set of diagonal lines, showed as a woven hatching under the history
+// a moving camera reprojects.
+layout(binding = 23) uniform sampler2D blue_noise;
 float sample_jitter(vec2 pixel) {
     if (jitter == 0) return 0.5;
-    return fract(52.9829189 * fract(dot(pixel, vec2(0.06711056, 0.00583715))));
+    return texelFetch(blue_noise, ivec2(pixel) % textureSize(blue_noise, 0), 0).r;
 }
 
 // Transmittance toward the sun from p (uvw: its texture coordinates): SUN_STEPS steps toward the
