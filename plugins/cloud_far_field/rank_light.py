@@ -5,8 +5,8 @@ it the light of the volume's columns of that rank too (``shaders/cloud_far_field
 float64 reference :func:`atmos.plugins.cloud_far_field.reference.light_by_rank`): the mean sun
 transmittances of the octaves (``medium.octave_transmittances``) and, where the sets carry a diffusion field, its mean
 (phi, F), each as seen from above and from below; both per height bin for the ray march's
-volumetric far field; and the clouds' thickness (the height their density spans), which sets how far
-the 2D far field's slanted views reach across the layer. So the far field is as bright per cover as the volume at every sun, not a guess
+volumetric far field; and the clouds' thickness (the height their density spans), how high the 2D
+far field's clouds stand when seen at a slant (``far.frag`` slant_rank). So the far field is as bright per cover as the volume at every sun, not a guess
 from a slanted column. Two small dispatches per frame after the cover (:meth:`FarFieldLayer.prepare`).
 """
 from __future__ import annotations

@@ -15,8 +15,8 @@
 //                         march's volumetric far field (cloud_raymarch/far.glsl) lights its density with;
 //   thickness (k):       the clouds' height as a fraction of the layer: per column sqrt(12 var + 1/P^2) of
 //                         its density's height (var in layer fractions; a uniform slab's thickness), mean
-//                         over the interval's columns weighted by w: the span the 2D far field's slanted
-//                         views cross (far.frag);
+//                         over the interval's columns weighted by w: how high the 2D far field's clouds
+//                         stand when seen at a slant (far.frag slant_rank);
 // and with FIELD (the sets carry a diffusion field, atmos/shading/diffusion.py):
 //   field_column (k, v):  the field's (phi, F) likewise (nearest field cell);
 //   field_profile (k, q): likewise the field's mean (phi, F) per height bin, for the same.
