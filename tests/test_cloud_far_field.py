@@ -346,7 +346,9 @@ def test_the_light_by_rank_of_a_one_cell_and_a_wide_uniform_deck_is_finite(gpu, 
     """Extremes of light_by_rank.comp: one cell (against the float64 twin), and a deck of 36,864 equal
     columns that all fall in one rank interval (the fixed-point sums sized so that none overflows): T
     within [0, 1], the field finite, and the deck's mean T seen from above and below its columns' own
-    (every column weighs its samples alike, so the mean over all columns of each row's T, weighted)."""
+    (every column weighs its samples alike, so the mean over all columns of each row's T, weighted);
+    the deck's clouds as high as the layer; the far field drawn over the whole sky from a grazing sun
+    to one below the horizon, finite (a cover of 1: nothing to widen at a slant)."""
     app, far, sets = light_scene(gpu, np.ones(shape, np.float32), 0.0, group=(1, 1) if shape[0] == 1 else (8, 8),
                                  far_size=32)
     try:
@@ -356,8 +358,9 @@ def test_the_light_by_rank_of_a_one_cell_and_a_wide_uniform_deck_is_finite(gpu, 
         assert np.all((got["sun"] >= 0.0) & (got["sun"] <= 1.0))
         assert got["field"][..., 0].max() > 0.0, "the cloud scatters light"
         T = read_volume(sets.b["transmittance"]).astype(np.float64)
+        assert np.all((got["sun_profile"] >= 0.0) & (got["sun_profile"] <= 1.0)) and got["thickness"].max() <= 1.0
         if shape == (1, 1, 1):
-            assert_light_matches(got, light_reference(far, sets), ("sun", "field"))
+            assert_light_matches(got, light_reference(far, sets), ("sun", "thickness", "sun_profile", "field"))
         else:
             assert T.shape == shape and sets.t in (0.0, 1.0)
             tau = 0.03 * 30.0 * np.ones(shape[1])                      # each row's optical depth, density 1
@@ -367,5 +370,14 @@ def test_the_light_by_rank_of_a_one_cell_and_a_wide_uniform_deck_is_finite(gpu, 
                 want = (seen * rows).sum() / seen.sum()
                 assert abs(got["sun"][-1, view, 0] - want) < 2e-3, (view, got["sun"][-1, view, 0], want)
             assert got["sun"][-1, 1, 0] < got["sun"][-1, 0, 0]
+            assert abs(got["thickness"][-1] - 1.0) < 1e-3, got["thickness"][-1]
+            from atmos.lighting import Sun
+            cam = app.resource(Camera)
+            cam.position, cam.yaw, cam.pitch = np.array([0.0, 100.0, 0.0]), 0.4, 0.05
+            for elevation in (0.5, 0.0, -3.0):
+                app.insert_resource(Sun.from_angles(elevation, 80.0))
+                app.render()
+                image = app.read_linear()
+                assert np.isfinite(image).all(), elevation
     finally:
         app.close()

@@ -184,7 +184,8 @@ void main() {
         else if (int(i) - d >= 0 && local[(int(i) - d) * 2 * SLOT] > 0u) k = int(i) - d;
     }
     float weight = k < 0 ? 0.0 : float(local[k * 2 * SLOT]) * unit;
-    imageStore(thickness_by_rank, ivec2(int(i), 0), vec4(weight > 0.0 ? float(local[k * 2 * SLOT + 9]) / weight : 1.0));
+    // (at most 1: the fixed point's rounding can lift the mean of a deck of whole-layer columns above it)
+    imageStore(thickness_by_rank, ivec2(int(i), 0), vec4(weight > 0.0 ? min(float(local[k * 2 * SLOT + 9]) / weight, 1.0) : 1.0));
     for (int view = 0; view < 2; ++view) {
         int s = k * 2 + view;
         imageStore(sun_by_rank, ivec2(int(i), view), k < 0 ? vec4(1.0) : slot_mean(s, 1, vec4(1.0), unit));
