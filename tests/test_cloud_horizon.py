@@ -202,6 +202,21 @@ def cloud_change(app, img):
 SEEDS = range(6)              # realisations of the far field's pattern the outside band is averaged over
 
 
+def across_the_border(app, look, metric, seeds=SEEDS) -> tuple[float, float]:
+    """(the far field just outside the volume: the OUTSIDE band's mean over ``seeds`` of its pattern,
+    the volume seen at the same elevations: ``behind``) for the view ``look`` and per-pixel ``metric``."""
+    far = plugin(app, CloudFarFieldPlugin)
+    default = far.settings.seed
+    outside = []
+    try:
+        for seed in seeds:
+            far.configure(seed=seed)
+            outside.append(bands(*panorama(app, look, metric))[1])
+    finally:
+        far.configure(seed=default)
+    return float(np.mean(outside)), bands(*panorama(app, behind(look), metric, far=False))[1]
+
+
 @pytest.mark.parametrize("demo, view, clouds", [
     ("sunset", "ground", "sprites"), ("sunset", "above", "sprites"), ("sunset", "ground", "march"),
     ("sunset", "above", "march"), ("flight", "ground", "sprites"), ("flight", "above", "sprites"),
@@ -218,18 +233,8 @@ def test_clouds_have_no_step_at_the_volume_edge(scenes, demo, view, clouds):
     its volumetric one."""
     app = scene(scenes, demo, clouds)
     look, metric = (ground_view, coverage) if view == "ground" else (above_view, cloud_change)
-    far = plugin(app, CloudFarFieldPlugin)
-    default = far.settings.seed
     border, elsewhere = seam_outliers(*panorama(app, look, metric))
-    outside = []
-    try:
-        for seed in SEEDS:
-            far.configure(seed=seed)
-            outside.append(bands(*panorama(app, look, metric))[1])
-    finally:
-        far.configure(seed=default)
-    outside = float(np.mean(outside))
-    _, volume = bands(*panorama(app, behind(look), metric, far=False))
+    outside, volume = across_the_border(app, look, metric)
     assert volume > 0.01, f"{demo}: the volume is seen ({volume:.3f})"
     assert abs(outside - volume) < TOLERANCE * volume, f"{demo} {view}: far field {outside:.3f} vs the volume {volume:.3f}"
     assert border < OUTLIER_FACTOR * elsewhere, f"{demo} {view}: column outlier {border:.1f} at the border vs {elsewhere:.1f} elsewhere"
@@ -345,8 +350,9 @@ def far_alone_vs_volume(app, seeds=range(4)) -> dict:
     return {name: tuple(np.mean(v, axis=0)) for name, v in out.items()}
 
 
-if __name__ == "__main__":      # the radial profiles (mean of each band of r) the tests check; then the
-    gpu = create_headless(SIZE)  # far field alone vs the volume over four seeds (README, "Cloud renderers")
+if __name__ == "__main__":      # the radial profiles (mean of each band of r); the step the test checks (the far
+    gpu = create_headless(SIZE)  # field over 8 seeds vs the volume at the same elevations); the far field alone vs
+    # the volume over four seeds in the band well inside (README, "Cloud renderers")
     edges = np.array([0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2, 1.35, 1.5, 1.8])
     for demo in ("sunset", "flight"):
         for clouds in ("sprites", "march"):
@@ -357,6 +363,9 @@ if __name__ == "__main__":      # the radial profiles (mean of each band of r) t
                     v, r, ok = panorama(app, look, metric, far=far)
                     prof = [v[ok & (r > lo) & (r < hi)].mean() for lo, hi in zip(edges[:-1], edges[1:])]
                     print(demo, clouds, view, "far" if far else "nofar", " ".join(f"{p:.3f}" for p in prof))
+                outside, volume = across_the_border(app, look, metric, range(8))
+                print(demo, clouds, view, f"across the border: far field {outside:.3f} (8 seeds), the volume at the same "
+                                          f"elevations {volume:.3f} ({outside / volume:.2f}x)")
             for view, (volume, alone) in far_alone_vs_volume(app).items():
                 print(demo, clouds, view, f"coverage: volume {volume:.3f}, far field alone {alone:.3f} ({alone / volume:.2f}x)")
             app.close()
