@@ -5,15 +5,19 @@ Gaussian (``sigma`` pixels, wrapped) measures how crowded each pixel's neighbour
 start is relaxed until its tightest cluster is its largest void, then pixels are ranked by removing
 the tightest clusters (down from the start's count) and adding into the largest voids (up to the
 whole tile). Value ``(rank + 0.5) / size²``: every value once, uniform, and any threshold of it is
-evenly spread. The ray march offsets its first sample by it (``shaders/cloud_raymarch/march.frag``):
-interleaved gradient noise, its predecessor, is a set of diagonal lines, which a moving camera's
-reprojected history drew as a woven hatching.
+evenly spread. The cloud march and the light shafts' march offset their first samples by it
+(:func:`blue_noise_texture`, unit BLUE_NOISE_UNIT, ``texelFetch(blue_noise, pixel % size)``):
+interleaved gradient noise, the cloud march's before, is a set of diagonal lines, which a moving
+camera's reprojected history drew as a woven hatching; the shafts' white noise clumped.
 """
 from __future__ import annotations
 
 from functools import lru_cache
 
+import moderngl
 import numpy as np
+
+BLUE_NOISE_UNIT = 23     # the texture unit the marches read it at (below: volume.glsl, the far field, sky LUTs)
 
 
 def _kernel(size: int, sigma: float) -> np.ndarray:
@@ -54,3 +58,12 @@ def blue_noise(size: int = 64, sigma: float = 1.5, seed: int = 0) -> np.ndarray:
         ones[void] = True
         energy += shifted(void)
     return ((rank + 0.5) / n).reshape(size, size).astype(np.float32)
+
+
+def blue_noise_texture(ctx):
+    """A new r32f texture of :func:`blue_noise` on the moderngl context ``ctx`` (texel (x, y) =
+    tile[y, x], nearest); the pass that made it releases it."""
+    tile = blue_noise()
+    texture = ctx.texture(tile.shape[::-1], 1, tile.tobytes(), dtype="f4")
+    texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+    return texture

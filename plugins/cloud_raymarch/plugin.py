@@ -19,7 +19,7 @@ from __future__ import annotations
 import moderngl
 import numpy as np
 
-from atmos.blue_noise import blue_noise
+from atmos.blue_noise import BLUE_NOISE_UNIT, blue_noise_texture
 from atmos.camera import set_camera_uniforms
 from atmos.composition import CLOUD_DISTANCE, composition, distance_desc
 from atmos.graph import PassBuilder, PassContext, RenderPass, TextureDesc
@@ -43,7 +43,6 @@ LOW_COLOR = "cloud_raymarch_color"
 LOW_DISTANCE = "cloud_raymarch_distance"
 LOW_DEPTH = "cloud_raymarch_depth"
 SKIP_UNIT, DEPTH_UNIT = 4, 9              # (5..8: the far field's octaves, field.glsl)
-BLUE_NOISE_UNIT = 23                       # march.frag's first-sample jitter (10..22: volume.glsl, the far field)
 
 
 def skip_map(max_maps: np.ndarray) -> np.ndarray:
@@ -233,7 +232,9 @@ class RaymarchPass(RenderPass):
             self._release_skip()
         frame.resource(DEPTH).use(DEPTH_UNIT)
         if s.jitter:
-            self._jitter_texture().use(BLUE_NOISE_UNIT)
+            if self.jitter is None:
+                self.jitter = blue_noise_texture(self.gpu.ctx)
+            self.jitter.use(BLUE_NOISE_UNIT)
         if far:
             self._bind_far(frame, p, sim)
         if s.detail_octaves:
@@ -296,14 +297,6 @@ class RaymarchPass(RenderPass):
         frame.blend_over()
         frame.fullscreen(self.gpu.program(vertex_shader="lib/fullscreen.vert",
                                           fragment_shader="cloud_raymarch/blend.frag"))
-
-    def _jitter_texture(self):
-        """The blue-noise tile march.frag offsets each pixel's first sample by (made on first use)."""
-        if self.jitter is None:
-            tile = blue_noise()
-            self.jitter = self.gpu.ctx.texture(tile.shape[::-1], 1, tile.tobytes(), dtype="f4")
-            self.jitter.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        return self.jitter
 
     def _release_skip(self) -> None:
         if self.skip is not None:

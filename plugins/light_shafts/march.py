@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from atmos.blue_noise import BLUE_NOISE_UNIT, blue_noise_texture
 from atmos.camera import set_camera_uniforms
 from atmos.composition import CLOUD_DISTANCE
 from atmos.graph import PassBuilder, PassContext
@@ -38,6 +39,12 @@ class MarchedShafts:
     def __init__(self, gpu):
         self.gpu = gpu
         self.offscreen = OffscreenClouds(gpu, SHAFT_COLOR, SHAFT_DEPTH)
+        self.jitter = None                  # the blue-noise tile of the rays' start offsets (first use)
+
+    def release(self) -> None:
+        if self.jitter is not None:
+            self.jitter.release()
+            self.jitter = None
 
     def program(self, far_field: bool, fog=None, aerial=None):
         """The march, with the far field's shadows beyond the volume (column.glsl's CLOUD_FAR_FIELD) or
@@ -89,6 +96,9 @@ class MarchedShafts:
         far_field = clouds and frame.declares(FAR_FIELD)
         p = self.program(far_field, fog.settings if fog is not None else None, aerial)
         frame.resource(SHAFT_DEPTH).use(2)
+        if self.jitter is None:
+            self.jitter = blue_noise_texture(self.gpu.ctx)
+        self.jitter.use(BLUE_NOISE_UNIT)
         if clouds:
             sim: CloudSets = frame.resource(CLOUD_SETS)
             a, b, _ = sim.view()

@@ -71,6 +71,10 @@ class LightShaftsPass(RenderPass):
         self.composite = gpu.program(vertex_shader=fullscreen, fragment_shader="light_shafts/composite.frag")
         self.marched = MarchedShafts(gpu)
 
+    def release(self) -> None:
+        if self.marched is not None:
+            self.marched.release()
+
     def execute(self, frame: PassContext) -> None:
         view, gpu, params = frame.view, frame.gpu, self.plugin.settings
         if params.mode == "march":

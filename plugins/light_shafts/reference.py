@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.hashing import lowbias32
+from atmos.blue_noise import blue_noise
 from atmos.plugins.cloud_shadows.reference import zero_border_bilinear
 from atmos.shading.medium import phase
 
@@ -56,9 +56,10 @@ def radial_blur(mask, sun_uv, settings, strength: float = 1.0) -> np.ndarray:
 
 
 def march_jitter(w: int, h: int) -> np.ndarray:
-    """(h, w) start offsets in [0, 1) of the marched shafts' low-res texels (shaders/light_shafts/march.frag)."""
-    x, y = np.meshgrid(np.arange(w, dtype=np.uint64), np.arange(h, dtype=np.uint64))
-    return (lowbias32((x + 65536 * y) & 0xFFFFFFFF) >> np.uint32(8)).astype(np.float64) / 16777216.0
+    """(h, w) start offsets in [0, 1) of the marched shafts' low-res texels (shaders/light_shafts/march.frag):
+    the blue-noise tile (atmos.blue_noise), row 0 at the bottom."""
+    tile = blue_noise().astype(np.float64)
+    return np.tile(tile, (-(-h // tile.shape[0]), -(-w // tile.shape[1])))[:h, :w]
 
 
 def march_shafts(low_depth, basis, camera_pos, near: float, far: float, frame_size, factor: int, sun_dir,

@@ -20,7 +20,6 @@
 // T(s) ~ exp(-ext(p) s) the air's transmittance from the eye, E_sun = atm_sun × its transmittance to the
 // sun (sky/atmosphere.glsl); w as above with the scene's distance (the clouds hazed at their own).
 #include "lib/view_ray.glsl"
-#include "lib/hash.glsl"
 #include "lib/phase.glsl"
 #include "cloud_shadows/column.glsl"
 layout(binding = 2) uniform sampler2D low_depth;   // the farthest scene depth of each block
@@ -54,9 +53,10 @@ uniform float fog_sun_share;   // LightShaftSettings.fog_sun_share
 uniform float view_r;          // the camera's radius from the planet's centre
 #endif
 
-// Per-texel start offset in [0, 1): lowbias32 of x + 65536 y (atmos.hashing.lowbias32), 24 bits.
+// Per-texel start offset in [0, 1): the tiled blue noise (atmos/blue_noise.py; white noise clumped).
+layout(binding = 23) uniform sampler2D blue_noise;
 float jitter(ivec2 q) {
-    return float(atmos_lowbias32(uint(q.x) + 65536u * uint(q.y)) >> 8) / 16777216.0;
+    return texelFetch(blue_noise, q % textureSize(blue_noise, 0), 0).r;
 }
 
 void main() {
