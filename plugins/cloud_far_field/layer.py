@@ -201,6 +201,9 @@ class FarFieldLayer:
         program["field_turns"].write(np.transpose(rotations(), (0, 2, 1)).astype("f4").tobytes())   # column-major
         quantiles, first = level_table(params.base_frequency, params.seed, params.size)
         program["field_quantiles"].write(np.asarray(quantiles, "f4").tobytes())
+        if "field_crossings" in program:              # far.frag's slant_rank
+            program["field_crossings"].write(np.asarray(pattern_crossings(params.base_frequency, params.seed, params.size),
+                                                        "f4").tobytes())
         if "field_first_level" in program:
             program["field_first_level"].value = first
 

@@ -7,7 +7,6 @@ from atmos.camera import set_camera_uniforms
 from atmos.composition import CLOUD_DISTANCE, composition
 from atmos.graph import FullscreenPass, PassContext
 from atmos.plugin import Plugin
-from atmos.plugins.cloud_far_field.cover import pattern_crossings
 from atmos.plugins.cloud_far_field.layer import FAR_FIELD, FarFieldLayer
 from atmos.plugins.cloud_far_field.settings import CloudFarFieldSettings
 from atmos.plugins.cloud_render.light import CloudLightSettings, light_uniforms
@@ -60,7 +59,6 @@ class CloudFarFieldPass(FullscreenPass):
         for name, value in values.items():
             if name in p:
                 p[name].value = value
-        p["field_crossings"].write(np.asarray(pattern_crossings(params.base_frequency, params.seed, params.size), "f4").tobytes())
         frame.fullscreen(p)
 
 

@@ -213,12 +213,15 @@ def column_at_rank(rank, columns) -> np.ndarray:
     return np.interp(np.clip(rank, 0.0, 1.0), np.linspace(0.0, 1.0, len(c)), c)
 
 
-def far_relief(ranks, columns, tau_cell: float, sun_y: float, min_slant: float) -> np.ndarray:
+MIN_SLANT = 0.1     # field.glsl's cap on a slant's sin (the view's at the horizon, the sun's)
+
+
+def far_relief(ranks, columns, tau_cell: float, sun_y: float) -> np.ndarray:
     """field.glsl's far_relief (...,): 3/16 of the difference between the column optical depths
     (``tau_cell`` × :func:`column_at_rank` of ``columns``) at the relief's samples toward the sun and away
-    from it (``ranks`` (..., 4): the channels, pattern.CHANNEL_STEPS) over max(``sun_y``, ``min_slant``)."""
+    from it (``ranks`` (..., 4): the channels, pattern.CHANNEL_STEPS) over max(``sun_y``, MIN_SLANT)."""
     r = np.asarray(ranks, np.float64)
-    return 0.1875 * tau_cell * (column_at_rank(r[..., 1], columns) - column_at_rank(r[..., 2], columns)) / max(sun_y, min_slant)
+    return 0.1875 * tau_cell * (column_at_rank(r[..., 1], columns) - column_at_rank(r[..., 2], columns)) / max(sun_y, MIN_SLANT)
 
 
 def relief_light(s, d) -> np.ndarray:
@@ -226,9 +229,6 @@ def relief_light(s, d) -> np.ndarray:
     depths ``d`` toward 0 (d > 0) or 1, at most as far as the nearer bound (odd in d: no light added)."""
     s = np.asarray(s, np.float64)
     return s - np.minimum(s, 1.0 - s) * np.tanh(np.clip(d, -10.0, 10.0))
-
-
-MIN_SLANT = 0.1     # far.frag's horizon cap on the slant
 
 
 def slant_rank(rank, height: float, cot, cover: float, crossings, tile_size: float) -> tuple[np.ndarray, np.ndarray]:

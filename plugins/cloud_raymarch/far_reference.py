@@ -5,8 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.plugins.cloud_far_field.reference import (MIN_SLANT, column_at_rank, far_relief, field_fbm, field_rank,
-                                                      relief_light)
+from atmos.plugins.cloud_far_field.reference import column_at_rank, far_relief, field_fbm, field_rank, relief_light
 from atmos.plugins.cloud_raymarch.reference import integrate, rays
 from atmos.plugins.cloud_render.light import cell_tau, sun_light, unit_direction
 from atmos.shading.diffusion import field_radiance
@@ -71,7 +70,7 @@ def far_source(field: FarField, medium, settings, p, dirs, band, sun) -> np.ndar
     h01 = np.clip((p[:, 1] - band[0]) / band[1], 0.0, 1.0)
     exponents = np.ones(OCTAVES)
     exponents[-1] = settings.ms_attenuation                         # volume.glsl's octave_exponents
-    relief = far_relief(c, field.columns, cell_tau(medium), float(sun_dir[1]), MIN_SLANT)
+    relief = far_relief(c, field.columns, cell_tau(medium), float(sun_dir[1]))
     octaves = relief_light(sample_profile(field.sun_profile, c[:, 0], h01), relief[:, None] * exponents)
     column = cell_tau(medium) * column_at_rank(c[:, 0], field.columns)
     above = sample_profile(field.profile, c[:, 0], h01)[..., 1]

@@ -4,11 +4,11 @@
 // where that is in front of the scene, r = far_field_rank there (field.glsl: the fraction of the
 // layer's fbm below the point's) and the column takes the volume's own column sum at the same rank
 // (far_quantile: column_quantiles, cover.comp), so it is as thick per cover as the volume, from the
-// medium, with no hand-set opacity. The ray crosses the clouds' height h (RankLight's thickness at the
-// median covered rank) along its slant, so the columns a third of h above and below the plane count too:
-//   tau = thickness * column_tau * mean of far_quantile(r) at the three   (column_tau = sigma_t * cell height)
+// medium, with no hand-set opacity; seen at a slant, the layer's clouds (RankLight's thickness at the
+// median covered rank high) show their sides and cover more of the view (slant_rank: rank r', factor f):
+//   tau = thickness * column_tau * f * far_quantile(r')   (column_tau = sigma_t * cell height)
 //   alpha = (1 - exp(-tau / max(|dir.y|, MIN_SLANT))) * (1 - edge weight at the hit) * smoothstep(0, horizon_fade, |ray.y|)
-// (a 3D field covers more of the sky at a slant: its clouds' sides), lit by the cloud medium's own
+// (MIN_SLANT: field.glsl's cap on the slant at the horizon), lit by the cloud medium's own
 // model (cloud_render/volume.glsl) with the volume's own light at the same rank (RankLight,
 // light_by_rank.comp; as seen from above when the view looks down, else from below): the octaves' sun
 // transmittances (lib/octaves.glsl) of the volume's columns of rank r, to the power `thickness`
@@ -33,8 +33,6 @@ uniform vec2 footprint_size;
 uniform float thickness;
 uniform float horizon_fade;
 uniform float layer_height;    // the volume's layer (m)
-uniform float field_crossings[33];   // cover.pattern_crossings: the pattern's crossings of quantile k per tile
-const float MIN_SLANT = 0.1;     // the horizon's slant cap (about 6 degrees)
 layout(binding = 18) uniform sampler2D far_sun_by_rank;   // RankLight.sun: (rank, seen from above | below) -> the octaves' transmittances
 layout(binding = 21) uniform sampler2D far_thickness_by_rank;   // RankLight.thickness: rank -> the clouds' height / layer_height
 layout(binding = 19) uniform sampler2D far_field_light;   // RankLight.field: (rank, seen from above | below) -> (phi, F)
@@ -87,7 +85,7 @@ void main() {
     float alpha = (1.0 - exp(-tau / max(abs(dir.y), MIN_SLANT))) * fade;
     vec2 at = vec2(slanted.x, dir.y < 0.0 ? 0.25 : 0.75);  // row 0: seen from above, 1: from below
     // the sun's light moved by the relief: lit edges facing the sun, shaded ones behind, none added
-    float relief = far_relief(r, thickness * column_tau, sun_dir.y, MIN_SLANT);
+    float relief = far_relief(r, thickness * column_tau, sun_dir.y);
     vec4 sun = relief_light(clamp(pow(max(textureLod(far_sun_by_rank, at, 0.0), 0.0), vec4(thickness)), 0.0, 1.0),
                             relief * octave_exponents());
     vec3 light = sun_part(octave_weights_of(sun), dot(dir, sun_dir)) + ambient_source(0.5 * tau, 0.5 * tau, dir.y)

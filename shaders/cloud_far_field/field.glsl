@@ -23,6 +23,8 @@ uniform float field_first_level;                  // the mip level of table row 
 uniform float field_tile_size;
 uniform float field_mid_height;    // the layer's middle plane (world y)
 uniform float field_column_tau;    // thickness · sigma_t · cell height: optical depth per summed cell
+uniform float field_crossings[33]; // cover.pattern_crossings: the pattern's crossings of quantile k per tile
+const float MIN_SLANT = 0.1;       // the cap on a slant's sin (about 6 degrees): the view's at the horizon, the sun's
 
 // The fraction of level `level`'s fbm at or below f (binary search, linear between the 33 quantiles).
 float field_rank(float f, int level) {
@@ -78,9 +80,9 @@ vec4 far_field_rank(vec2 xz, float lod) {
 // slope there, from the columns the relief's samples toward the sun and away from it hold (tau_cell:
 // optical depth per summed cell): 3/16 of their difference (for a steady slope as much as the
 // one-sided form it replaced, 3/8 of (mean over 1..3 steps toward the sun - here)) over the sun's
-// height sin (capped at min_slant). 0 where the clouds are as thick both ways; as often up as down.
-float far_relief(vec4 r, float tau_cell, float sun_y, float min_slant) {
-    return 0.1875 * tau_cell * (far_quantile(r.y) - far_quantile(r.z)) / max(sun_y, min_slant);
+// height sin (capped at MIN_SLANT). 0 where the clouds are as thick both ways; as often up as down.
+float far_relief(vec4 r, float tau_cell, float sun_y) {
+    return 0.1875 * tau_cell * (far_quantile(r.y) - far_quantile(r.z)) / max(sun_y, MIN_SLANT);
 }
 
 // The octaves' sun transmittances s (the volume's own mean at the point's rank: RankLight) moved by the

@@ -43,14 +43,12 @@ float far_density(float r, float h) {
     return far_quantile(r) * textureLod(far_profile, vec2(r, h), 0.0).r;
 }
 
-const float FAR_MIN_SLANT = 0.1;   // the relief's cap on the sun's slant (far.frag's MIN_SLANT)
-
 // J (per unit extinction) of far-field density with ranks c (far_ranks) at height fraction h, seen along
 // dir.
 vec3 far_source(vec4 c, float h, vec3 dir) {
     vec2 at = vec2(c.x, clamp(h, 0.0, 1.0));
     vec4 sun = relief_light(textureLod(far_sun_profile, at, 0.0),
-                            far_relief(c, column_tau, sun_dir.y, FAR_MIN_SLANT) * octave_exponents());
+                            far_relief(c, column_tau, sun_dir.y) * octave_exponents());
     float column = column_tau * far_quantile(c.x), above = textureLod(far_profile, at, 0.0).g;
     float up = column * above, down = column * (1.0 - above);
     vec3 field = ms_diffusion > 0.0
