@@ -43,16 +43,18 @@ def test_blur_matches_reference_on_small_random_masks(gpu, ctx, rng, where):
     w, h = (int(n) for n in rng.integers(3, 24, 2))
     mask = rng.uniform(0, 4, (h, w, 3)).astype(np.float16).astype(np.float64)
     sun_uv = {"random": rng.uniform(-0.5, 1.5, 2), "centre": (0.5, 0.5), "pixel_centre": (0.5 / w, 1.5 / h),
-              "edge": (1.0, rng.uniform(0, 1)), "outside": (rng.uniform(1.2, 3), rng.uniform(-2, -0.2)),
+              "edge": (1.0, rng.uniform(0, 1)), "outside": (rng.uniform(1.2, 2), rng.uniform(-1, -0.2)),
               "far_outside": (64.0, -64.0)}[where]
-    params = random_params(rng)
+    # outside: at most 2/64 of the screen per tap, less than a texel of the largest mask, so the corner
+    # nearest the sun keeps its first tap on the mask and the comparison is not of two black images
+    params = random_params(rng, **({"samples": 64} if where == "outside" else {}))
     strength = rng.uniform(0.1, 1.0)
     out = gpu_blur(gpu, mask, sun_uv, params, strength)
     assert np.isfinite(out).all(), "every texel written, none NaN"
     expected = reference.radial_blur(mask, sun_uv, params, strength)
     assert np.allclose(out[..., :3], expected, rtol=1e-4, atol=1e-5 * expected.max())
     assert np.all(out[..., 3] == 0.0)
-    assert expected.max() > 0 or where == "far_outside"     # taps may all leave the mask then
+    assert expected.max() > 0 or where == "far_outside"     # all taps may leave the mask there
 
 
 def test_blur_reference_by_hand():
