@@ -170,7 +170,7 @@ def assert_light_matches(got, want, names) -> None:
 def test_the_light_by_rank_is_the_volumes_own_light(gpu, ctx, rng, clouds):
     """light_by_rank.comp (RankLight) against its float64 reference on a fresh random volume: per rank
     interval the octaves' mean sun transmittances and the diffusion field's mean (phi, F), seen from
-    above and from below, both per height bin, and the clouds' thickness; the sun lower than the cloud
+    above and from below, both per height bin, the height that light comes from, and the clouds' thickness; the sun lower than the cloud
     tops shades the bases. No cloud at all: T = 1, the field 0, the thickness the layer's, nothing NaN."""
     from atmos.lighting import Sun
     shape = (16, 12, 16)
@@ -184,8 +184,8 @@ def test_the_light_by_rank_is_the_volumes_own_light(gpu, ctx, rng, clouds):
     app, far, sets = light_scene(gpu, d, 0.2, sun=sun)
     try:
         got = far.layer.light.read()
-        assert set(got) == {"sun", "thickness", "sun_profile", "field", "field_profile"}, "the renderer gives the field a weight: measured"
-        assert_light_matches(got, light_reference(far, sets), ("sun", "thickness", "sun_profile", "field", "field_profile"))
+        assert set(got) == {"sun", "height", "thickness", "sun_profile", "field", "field_profile"}, "the renderer gives the field a weight: measured"
+        assert_light_matches(got, light_reference(far, sets), ("sun", "height", "thickness", "sun_profile", "field", "field_profile"))
         far.configure(enabled=False)          # the ground shadows alone still prepare the layer
         far.layer.light.release()
         far.layer.prepare(types.SimpleNamespace(sun=sun, time=0.0), sets)
@@ -200,9 +200,12 @@ def test_the_light_by_rank_is_the_volumes_own_light(gpu, ctx, rng, clouds):
             profile = got["sun_profile"][covered, :, 0]
             assert np.ptp(profile, axis=1).max() > 0.05 and np.all((profile >= 0) & (profile <= 1)), "it varies by height"
             assert np.all((got["thickness"] > 0) & (got["thickness"] <= 1)) and got["thickness"][covered].min() < 0.9
+            top, base = got["height"][covered, 0], got["height"][covered, 1]
+            assert np.all((top >= base - 1e-6) & (base >= 0) & (top <= 1)) and top.mean() > base.mean() + 0.05, \
+                f"seen from above, the light comes from higher up: {top} vs {base}"
         else:
             assert np.all(got["sun"] == 1.0) and np.all(got["sun_profile"] == 1.0) and np.all(got["field"] == 0.0)
-            assert np.all(got["thickness"] == 1.0)
+            assert np.all(got["thickness"] == 1.0) and np.all(got["height"] == 0.5)
     finally:
         app.close()
 
@@ -360,7 +363,7 @@ def test_the_light_by_rank_of_a_one_cell_and_a_wide_uniform_deck_is_finite(gpu, 
         T = read_volume(sets.b["transmittance"]).astype(np.float64)
         assert np.all((got["sun_profile"] >= 0.0) & (got["sun_profile"] <= 1.0)) and got["thickness"].max() <= 1.0
         if shape == (1, 1, 1):
-            assert_light_matches(got, light_reference(far, sets), ("sun", "thickness", "sun_profile", "field"))
+            assert_light_matches(got, light_reference(far, sets), ("sun", "height", "thickness", "sun_profile", "field"))
         else:
             assert T.shape == shape and sets.t in (0.0, 1.0)
             tau = 0.03 * 30.0 * np.ones(shape[1])                      # each row's optical depth, density 1

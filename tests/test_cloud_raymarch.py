@@ -60,7 +60,7 @@ def linear(app):
     return app.read_linear()[::-1].astype(np.float64)
 
 
-# a sky that gives the sun's colour by altitude: the clouds take it at their layer's middle (460 m here)
+# a sky that gives the sun's colour by altitude: the clouds take it at their heights (400..520 m here)
 BY_ALTITUDE = Sun(DAY.direction, DAY.color, color_by_altitude=lambda d, h: (h / 500.0, 0.6, 0.3))
 
 

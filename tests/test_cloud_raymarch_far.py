@@ -17,6 +17,8 @@ SHAPE = (16, 8, 16)
 CELL = (40.0, 40.0, 40.0)
 BASE = 400.0
 DAY = Sun.from_angles(35.0, 70.0)
+# a sun whose colour changes over the band (400..720 m): the far clouds take it at their heights
+BY_ALTITUDE = Sun(DAY.direction, DAY.color, color_by_altitude=lambda d, h: (1.0, (h - 300.0) / 500.0, ((h - 300.0) / 420.0) ** 2))
 FAR = dict(size=64, tile_size=20000.0, base_frequency=4, animate=False)   # mip 0 out to far_distance
 
 
@@ -70,12 +72,14 @@ def field_reference(app) -> FarField:
                     sun_profile=layer.light.read()["sun_profile"], field_profile=layer.light.read().get("field_profile"))
 
 
-@pytest.mark.parametrize("yaw, fields", [(-np.pi / 2, {}), (0.0, dict(ms_diffusion=2.0))])
-def test_the_far_field_march_matches_its_float64_reference(gpu, ctx, yaw, fields):
+@pytest.mark.parametrize("yaw, fields, sun", [(-np.pi / 2, {}, DAY), (0.0, dict(ms_diffusion=2.0), DAY),
+                                               (-np.pi / 2, {}, BY_ALTITUDE)], ids=["day", "field", "by_altitude"])
+def test_the_far_field_march_matches_its_float64_reference(gpu, ctx, yaw, fields, sun):
     """Outside the volume, above it, looking away from it. Yaw 0 looks across the sun, where the far
     field's light from the volume's diffusion field by rank (RankLight) is half the image: the reference
-    without it is far off (the test can fail)."""
-    app = scene(gpu, steps=256, **fields)
+    without it is far off (the test can fail). A sun whose colour changes with height: each sample takes
+    its own."""
+    app = scene(gpu, sun, steps=256, **fields)
     cam = aim(app, (-2500.0, BASE + 900.0, 200.0), yaw=yaw, pitch=-0.3)
     image = app.read_linear()[::-1].astype(np.float64)
     shape = of(app, CloudFarFieldPlugin).layer.read_profile()[-1, :, 0]
@@ -84,7 +88,7 @@ def test_the_far_field_march_matches_its_float64_reference(gpu, ctx, yaw, fields
     layout = sim.layout()
     band = (float(layout.lo[1]), float(layout.hi[1] - layout.lo[1]))
     ref = far_march_reference(field_reference(app), sim.settings, of(app, RaymarchCloudsPlugin).settings, band,
-                              cam, DAY, gpu.size)
+                              cam, sun, gpu.size)
     alpha = ref["alpha"]
     assert 0.05 < (alpha > 0.05).mean() < 0.95 and alpha.max() > 0.5, "the view must see far clouds and gaps"
     light = ref["light"]

@@ -138,26 +138,29 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale,
 
     src, _ = load_source("cloud_render/sprite.vert")
     names = ["gl_Position", "gl_PointSize", "v_octaves", "v_ambient", "v_center", "v_radius", "v_tau", "v_coverage",
-             "v_conic", "v_falloff", "v_stretch", "v_slope"]
+             "v_conic", "v_falloff", "v_stretch", "v_slope", "v_sun"]
     prog = ctx.program(vertex_shader=src, varyings=names)
     sampler = clamp_sampler(ctx)
     sun = app.resource(Sun)
+    # a sun whose colour changes over the layer's height (as the physical sky's does at sunset): each
+    # sprite takes it at its own height (volume.glsl sun_source_at)
+    sun.color_by_altitude = lambda direction, altitude: (1.0, 0.4 + altitude / 2000.0, (altitude / 1500.0) ** 2)
     parts = []
     try:
         prog["view_proj"].write(np.asarray(vp, np.float32).T.tobytes())
         for name, value in uniforms.items():
             if name in prog:                      # the camera's basis is the fragment shader's
                 prog[name].value = value
-        bind_volume(prog, sim, sampler, sun, renderer.settings.octaves)
+        bind_volume(prog, sim, sampler, sun, renderer.settings.octaves, layer=layout.heights)
         for code in np.unique(segments[:, 3]):
             mine = segments[segments[:, 3] == code]
             _, sx, sz = unpack(code)
             blocks = (layout.group[0] * sx >> level) * (layout.group[1] * sz >> level)
             inst = ctx.buffer(mine.tobytes())
             vao = ctx.vertex_array(prog, [(inst, "4i/i", "in_segment")])
-            out = ctx.buffer(np.full(len(mine) * blocks * 26, np.nan, np.float32).tobytes())
+            out = ctx.buffer(np.full(len(mine) * blocks * 29, np.nan, np.float32).tobytes())
             vao.transform(out, moderngl.POINTS, vertices=blocks, instances=len(mine))
-            parts.append(np.frombuffer(out.read(), np.float32).reshape(-1, 26).astype(np.float64))
+            parts.append(np.frombuffer(out.read(), np.float32).reshape(-1, 29).astype(np.float64))
             for obj in (vao, out, inst):
                 obj.release()
         unbind_volume(sampler)
@@ -170,7 +173,7 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale,
     assert np.isfinite(got).all(), "every output element written"
     trans = [read_volume(s["transmittance"]) for s in (a, b)]
     ref = sprite_vertices(read_volume(a["density"]), read_volume(b["density"]), *trans, t, segments, uniforms,
-                          vp, light_uniforms(sim.settings, sun, renderer.settings.octaves), sim.a_shift)
+                          vp, light_uniforms(sim.settings, sun, renderer.settings.octaves, layer=layout.heights), sim.a_shift)
     vis = ref["visible"]
     assert 0 < vis.sum() < n, "the test needs empty and full cells"
     scale = np.abs(ref["position"]).max(axis=1, keepdims=True)
@@ -215,6 +218,8 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale,
     # log T's slope across the sprite and its half variance: a float32 log of 8 taps, through the footprint
     slope_tol = 1e-3 if shading_scale == 1 else 2e-2
     np.testing.assert_allclose(got[:, 23:26], ref["slope"], rtol=slope_tol, atol=slope_tol * np.abs(ref["slope"]).max())
+    np.testing.assert_allclose(got[:, 26:29], ref["sun"], rtol=1e-5, atol=1e-6)
+    assert np.ptp(ref["sun"][vis, 2]) > 0.1 * ref["sun"][vis, 2].max(), "the sprites see the sun's colour at their heights"
     assert np.abs(ref["slope"][vis, :2]).max() > 0.1, "T varies across the sprites"
     assert ref["stretch"][vis].max() > 1.05, "off-axis sprites: the perspective's Jacobian stretches them"
     if abs(cam.forward()[1]) < 0.6:               # seen from the side, the 20 × 15 m cells' footprints are ellipses

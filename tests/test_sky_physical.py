@@ -441,7 +441,9 @@ def test_clouds_are_lit_by_the_physical_sun_colour():
     s = AtmosphereSettings()
     sun.color = tuple(sun_light.sun_color(sun.direction, 900.0, s))
     sun.ambient = tuple(sun_light.sky_ambient(sun.direction, 900.0, s))
-    source = np.array(light_uniforms(CloudSettings(), sun)["sun_source"])
+    sources = np.array(light_uniforms(CloudSettings(), sun)["sun_sources"])
+    assert np.all(sources == sources[0]), "without a layer, the camera's colour at every height"
+    source = sources[0]
     ratio = source / np.asarray(sun.color)
     assert np.allclose(ratio, ratio[0], rtol=1e-5), "the clouds' sun is Sun.color, scaled"
     assert source[0] > 3 * source[2], "sunset clouds get the reddened sun"
@@ -450,7 +452,7 @@ def test_clouds_are_lit_by_the_physical_sun_colour():
 def test_clouds_above_keep_the_sun_after_the_grounds_sunset(gpu, ctx):
     """The physical sky gives the sun's colour by altitude: at -0.8 deg the ground has lost the sun, a layer
     1.5 km up has not (the horizon dips 1.2 deg there); by day the layer sees it through less air.
-    The clouds take it at their layer's middle; the Preetham model gives none, and switching back drops it."""
+    The clouds take it at their heights; the Preetham model gives none, and switching back drops it."""
     from atmos.plugins.cloud_render import CloudRenderPlugin
     from atmos.plugins.cloud_render.light import light_uniforms
     from atmos.plugins.clouds import CloudSettings, CloudsPlugin
@@ -476,8 +478,8 @@ def test_clouds_above_keep_the_sun_after_the_grounds_sunset(gpu, ctx):
     app.run_frames(1)
     sun = app.resource(Sun)
     assert np.all(np.asarray(sun.color) == 0.0) and sun.color_by_altitude is not None
-    lit = np.asarray(light_uniforms(settings, sun, altitude=1600.0)["sun_source"])
-    assert lit[0] > 0.1 and np.all(np.asarray(light_uniforms(settings, sun)["sun_source"]) == 0.0)
+    lit = np.asarray(light_uniforms(settings, sun, layer=(1500.0, 1700.0))["sun_sources"])
+    assert lit[:, 0].min() > 0.1 and np.all(np.asarray(light_uniforms(settings, sun)["sun_sources"]) == 0.0)
     image = app.read_linear()
     clouds = image[..., 3] > 0.5
     assert clouds.mean() > 0.02, "the view must see the clouds"
@@ -524,3 +526,42 @@ def test_the_demos_take_the_sky_model(gpu, ctx, capsys):
         DemoSettings(sky="bruneton")
     assert main(["graph", "sky_day", "--sky", "physical"]) == 0
     assert "2. sky_luts" in capsys.readouterr().out, "the LUT pass runs before the sky pass"
+
+
+@pytest.mark.parametrize("renderer", ["sprites", "march"])
+def test_at_dusk_the_tops_keep_the_sun_after_the_bases_lose_it(gpu, ctx, renderer, monkeypatch):
+    """A tower of cloud from 900 m to 2.1 km, the sun 1.2 deg below the horizon: the physical sky's sun has
+    all but set for the base (the planet's shadow: 0.6 % of the top's red) and not for the top. Both
+    renderers take the sun's colour at each height (volume.glsl sun_source_at): the top glows red over a
+    base lit by the sky alone. Drawn again with the middle's colour at every height (the model before),
+    the base is brighter and the top darker."""
+    from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
+    from atmos.plugins.cloud_render import CloudRenderPlugin, light
+    from atmos.plugins.clouds import CloudSettings, CloudsPlugin
+
+    def draw():
+        density = np.zeros((8, 24, 8), np.float32)
+        density[1:7, 1:23, 1:7] = 1.0
+        settings = CloudSettings(cell_size=(50.0, 50.0, 50.0), base_altitude=900.0, group_size=(4, 4), sigma_t=0.01)
+        drawing = CloudRenderPlugin() if renderer == "sprites" else RaymarchCloudsPlugin(jitter=False)
+        app = App(gpu).add_plugins(DefaultPlugins(overlay=False), SkyPlugin(model="physical"),
+                                   CloudsPlugin(settings, density=density), drawing)
+        app.insert_resource(Sun(direction=sun_at(-1.2, 60.0)))
+        app.startup()
+        cam = app.resource(Camera)
+        cam.position, cam.far = np.array([200.0, 900.0, -2500.0]), 20000.0
+        cam.look_at(np.array([200.0, 1500.0, 200.0]))
+        app.run_frames(1)
+        image = app.read_linear()
+        app.close()
+        rows = np.flatnonzero((image[..., 3] > 0.5).any(1))
+        assert len(rows) > 10 and np.isfinite(image).all(), "the view must see the tower"
+        third = len(rows) // 3
+        return [float(part[part[..., 3] > 0.5, 0].mean()) for part in (image[rows[:third]], image[rows[-third:]])]
+
+    top, base = draw()
+    middle = light.sun_colors
+    monkeypatch.setattr(light, "sun_colors", lambda sun, layer=None: middle(sun, None if layer is None else (
+        0.5 * (layer[0] + layer[1]),) * 2))
+    flat_top, flat_base = draw()
+    assert top > 1.6 * base and top > 1.1 * flat_top and base < 0.9 * flat_base, (top, base, flat_top, flat_base)

@@ -117,14 +117,17 @@ def ambient_profile(tau_up, tau_down, g_mean: float, ray_y) -> np.ndarray:
 
 
 def source_reference(settings, render, T, tau_up, tau_down, cos, ray_y, sun_color, sky, sun_dir,
-                     diffusion=None, *, octaves=None) -> np.ndarray:
+                     diffusion=None, *, octaves=None, sun_colors=None) -> np.ndarray:
     """float64 (n, 3): J of the module docstring at points with transmittance ``T`` (or, given
     ``octaves`` (n, 4), those as the octaves' sun transmittances: the far fields' by rank), column optical
     depths ``tau_up``/``tau_down``, view/sun cosine ``cos`` and view ray y ``ray_y`` (``render``:
     the CloudRenderSettings or RaymarchCloudSettings); ``diffusion``: the diffusion field's radiance
     there (:func:`atmos.shading.diffusion.diffusion_radiance`, unit irradiance), added with the weight
-    ``render.ms_diffusion`` (None: no field)."""
+    ``render.ms_diffusion`` (None: no field); ``sun_colors`` (n, 3): the sun's colour at each point
+    (None: ``sun_color``, which the ground's light takes in any case)."""
     e, l_sky, l_ground = environment(settings, sun_color, sky, sun_dir)
+    if sun_colors is not None:
+        e = settings.sun_intensity * np.asarray(sun_colors, np.float64)
     tau_up, tau_down = np.asarray(tau_up, np.float64), np.asarray(tau_down, np.float64)
     a, b, c = render.ms_attenuation, render.ms_contribution, render.ms_eccentricity
     g_mean = mean_cosine(settings.phase_g, settings.phase_g2, settings.phase_w)

@@ -49,7 +49,7 @@ class CloudFarFieldPass(FullscreenPass):
         set_camera_uniforms(p, view.camera, view.aspect)
         light = self.plugin.light_settings()       # the renderer's octaves; its field's weight where measured
         diffusion = light.ms_diffusion if layer.light.has_field else 0.0
-        values = dict(light_uniforms(sim.settings, view.sun, light.octaves, diffusion, layout.middle_altitude),
+        values = dict(light_uniforms(sim.settings, view.sun, light.octaves, diffusion, layout.heights),
                       footprint_min=tuple(layout.lo[[0, 2]]), footprint_size=tuple(layout.hi[[0, 2]] - layout.lo[[0, 2]]),
                       edge_fade=float(sim.settings.edge_fade), layer_height=float(layout.hi[1] - layout.lo[1]),
                       lod_scale=float(params.size / layer.tile_size * 2.0 * np.tan(view.camera.fov_y / 2)

@@ -5,7 +5,8 @@ it the light of the volume's columns of that rank too (``shaders/cloud_far_field
 float64 reference :func:`atmos.plugins.cloud_far_field.reference.light_by_rank`): the mean sun
 transmittances of the octaves (``medium.octave_transmittances``) and, where the sets carry a diffusion field, its mean
 (phi, F), each as seen from above and from below; both per height bin for the ray march's
-volumetric far field; and the clouds' thickness (the height their density spans), how high the 2D
+volumetric far field; the height their light comes from (where the 2D far field takes the sun's
+colour); and the clouds' thickness (the height their density spans), how high the 2D
 far field's clouds stand when seen at a slant (``far.frag`` slant_rank). So the far field is as bright per cover as the volume at every sun, not a guess
 from a slanted column. Two small dispatches per frame after the cover (:meth:`FarFieldLayer.prepare`).
 """
@@ -20,20 +21,21 @@ FIELD_UNIT = 19                  # field_column for those that declare far_field
 FIELD_PROFILE_UNIT = 20          # field_profile for those that declare far_field_light_profile (2D)
 THICKNESS_UNIT = 21              # thickness for those that declare far_thickness_by_rank (2D)
 SUN_PROFILE_UNIT = 22            # sun_profile for those that declare far_sun_profile (the march's)
+HEIGHT_UNIT = 24                 # height for those that declare far_height_by_rank (2D)
 READ_UNITS = {"transmittance": (2, 3), DIFFUSION: (16, 17)}   # light_by_rank.comp's inputs beside columns.glsl's
 FIELD_BINS = 16                  # light_by_rank.comp's most height bins (sun_profile, field_profile)
-SUMS = INTERVALS * 2 * 10 + INTERVALS * FIELD_BINS * 9      # its Sums buffer (uint32): the slots, the bins
+SUMS = INTERVALS * 2 * 11 + INTERVALS * FIELD_BINS * 9      # its Sums buffer (uint32): the slots, the bins
 GROUP = 256                      # its work group (columns per group in STAGE 0)
 
 
 class RankLight:
     """The textures of one measure (GL objects of one GpuContext): ``sun`` (INTERVALS, 2) rgba32f,
-    ``thickness`` (INTERVALS, 1) r32f, ``sun_profile`` (INTERVALS, bins) rgba32f, and with a field
+    ``thickness`` (INTERVALS, 1) and ``height`` (INTERVALS, 2) r32f, ``sun_profile`` (INTERVALS, bins) rgba32f, and with a field
     ``field`` (INTERVALS, 2) and ``field_profile`` (INTERVALS, bins) rgba32f."""
 
     def __init__(self, gpu):
         self.gpu = gpu
-        self.sun = self.thickness = self.sun_profile = self.field = self.field_profile = self.sums = None
+        self.sun = self.thickness = self.height = self.sun_profile = self.field = self.field_profile = self.sums = None
         self.has_field = False           # the last measure took a diffusion field
 
     def measure(self, sim, cover_buffer, attenuation: float, heights: int) -> None:
@@ -63,6 +65,7 @@ class RankLight:
             if stage == 1:
                 self.sun.bind_to_image(0, read=False, write=True)
                 self.thickness.bind_to_image(3, read=False, write=True)
+                self.height.bind_to_image(5, read=False, write=True)
                 self.sun_profile.bind_to_image(4, read=False, write=True)
                 if self.has_field:
                     self.field.bind_to_image(1, read=False, write=True)
@@ -73,6 +76,7 @@ class RankLight:
     def _allocate(self, bins: int) -> None:
         if self.sun is None:
             self.sun, self.thickness = rank_texture(self.gpu, 2, 4), rank_texture(self.gpu, 1, 1)
+            self.height = rank_texture(self.gpu, 2, 1)
             self.sums = self.gpu.track(self.gpu.ctx.buffer(bytes(4 * SUMS)))    # zero; STAGE 1 clears it
         if self.sun_profile is None or self.sun_profile.size[1] != bins:
             self._release_profiles()
@@ -81,11 +85,12 @@ class RankLight:
             self.field, self.field_profile = rank_texture(self.gpu, 2, 4), rank_texture(self.gpu, bins, 4)
 
     def use(self, program) -> None:
-        """Bind the textures the program declares (far_sun_by_rank, far_thickness_by_rank, far_sun_profile,
-        far_field_light, far_field_light_profile)."""
+        """Bind the textures the program declares (far_sun_by_rank, far_thickness_by_rank, far_height_by_rank,
+        far_sun_profile, far_field_light, far_field_light_profile)."""
         field = self.has_field
         for name, texture, unit in (("far_sun_by_rank", self.sun, SUN_UNIT),
                                     ("far_thickness_by_rank", self.thickness, THICKNESS_UNIT),
+                                    ("far_height_by_rank", self.height, HEIGHT_UNIT),
                                     ("far_sun_profile", self.sun_profile, SUN_PROFILE_UNIT),
                                     ("far_field_light", self.field if field else None, FIELD_UNIT),
                                     ("far_field_light_profile", self.field_profile if field else None, FIELD_PROFILE_UNIT)):
@@ -95,7 +100,8 @@ class RankLight:
     def read(self) -> dict:
         """The last measure as float64 arrays (a GPU → CPU copy: tests and tools): ``sun`` (INTERVALS, 2, 4)
         [k, v] = the mean octave transmittances of rank interval k seen from above (v = 0) and below (1),
-        ``thickness`` (INTERVALS,) its clouds' mean height as a fraction of the layer, ``sun_profile``
+        ``thickness`` (INTERVALS,) its clouds' mean height as a fraction of the layer, ``height`` (INTERVALS, 2)
+        the mean height fraction its light comes from seen from above and below, ``sun_profile``
         (INTERVALS, bins, 4) the mean octave transmittances per height bin;
         with a field also ``field`` (INTERVALS, 2, 4) the mean (phi, F) likewise and ``field_profile``
         (INTERVALS, bins, 4) per height bin."""
@@ -103,6 +109,7 @@ class RankLight:
             raise RuntimeError("RankLight.read: nothing measured yet (FarFieldLayer.prepare measures it)")
         self.gpu.ctx.memory_barrier()
         out = {"sun": read_rank_texture(self.sun), "thickness": read_rank_texture(self.thickness)[:, 0, 0],
+               "height": read_rank_texture(self.height)[:, :, 0],
                "sun_profile": read_rank_texture(self.sun_profile)}
         if self.has_field:
             out.update(field=read_rank_texture(self.field), field_profile=read_rank_texture(self.field_profile))
@@ -116,7 +123,7 @@ class RankLight:
 
     def release(self) -> None:
         self._release_profiles()
-        for resource in (self.sun, self.thickness, self.sums):
+        for resource in (self.sun, self.thickness, self.height, self.sums):
             if resource is not None:
                 resource.release()
-        self.sun = self.thickness = self.sums = None
+        self.sun = self.thickness = self.height = self.sums = None

@@ -108,7 +108,8 @@ def light_by_rank(sums_a, sums_b, density_a, density_b, t: float, a_shift, fade:
     by density × the vertical transmittance to the column's top (row 0) or base (row 1); per height
     bin (of min(heights, bins)) the columns' density-weighted octave transmittances and (phi, F); and the edge-weighted mean of each
     column's thickness, sqrt(12 var + 1 / heights²) of its density's height (as a layer fraction, at most
-    1: a uniform slab's). Returns dict sun (32, 2, 4), thickness (32,), sun_profile (32, bins, 4) and, with
+    1: a uniform slab's); and the mean height fraction of the samples weighted as the sun's rows are.
+    Returns dict sun (32, 2, 4), height (32, 2), thickness (32,), sun_profile (32, bins, 4) and, with
     a field, field (32, 2, 4), field_profile (32, bins, 4); filled as the shader fills them."""
     def mixed(a, b, cells):
         """mix(A, B, t) of grids a, b (x, y, z, ...) at their texels nearest density ``cells`` (n, 3)
@@ -132,6 +133,7 @@ def light_by_rank(sums_a, sums_b, density_a, density_b, t: float, a_shift, fade:
     in_bin = np.arange(heights) * bins // heights
     field = field_a is not None and field_b is not None
     weight, sun_sum, field_sum = np.zeros((32, 2)), np.zeros((32, 2, 4)), np.zeros((32, 2, 4))
+    height_sum = np.zeros((32, 2))
     thickness_sum = np.zeros(32)
     y = (rows + 0.5) / ny
     bin_weight, bin_sum, bin_sun = np.zeros((32, bins)), np.zeros((32, bins, 4)), np.zeros((32, bins, 4))
@@ -165,9 +167,11 @@ def light_by_rank(sums_a, sums_b, density_a, density_b, t: float, a_shift, fade:
         for view in np.flatnonzero(s > 0):
             weight[k, view] += units[x, z]
             sun_sum[k, view] += units[x, z] * (seen[:, view, None] * sun).sum(0) / s[view]
+            height_sum[k, view] += units[x, z] * (seen[:, view] * y).sum() / s[view]
             field_sum[k, view] += units[x, z] * (seen[:, view, None] * v).sum(0) / s[view]
     filled = np.flatnonzero(weight[:, 0] > 0)
-    out = {"sun": np.ones((32, 2, 4)), "thickness": np.ones(32), "sun_profile": np.ones((32, bins, 4))}
+    out = {"sun": np.ones((32, 2, 4)), "height": np.full((32, 2), 0.5), "thickness": np.ones(32),
+           "sun_profile": np.ones((32, bins, 4))}
     if field:
         out.update(field=np.zeros((32, 2, 4)), field_profile=np.zeros((32, bins, 4)))
     for i in range(32):
@@ -176,6 +180,7 @@ def light_by_rank(sums_a, sums_b, density_a, density_b, t: float, a_shift, fade:
         k = filled[np.argmin(np.abs(filled - i) * 2 + (filled < i))]      # nearest, above first on a tie
         w = weight[k][:, None]
         out["sun"][i] = np.where(w > 0, sun_sum[k] / np.maximum(w, 1e-300), 1.0)
+        out["height"][i] = np.where(w[:, 0] > 0, np.minimum(height_sum[k] / np.maximum(w[:, 0], 1e-300), 1.0), 0.5)
         out["thickness"][i] = thickness_sum[k] / weight[k, 0] if weight[k, 0] > 0 else 1.0
         b = bin_weight[k][:, None]
         out["sun_profile"][i] = np.where(b > 0, bin_sun[k] / np.maximum(b, 1e-300), out["sun"][i, 0])

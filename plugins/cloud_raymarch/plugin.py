@@ -225,7 +225,7 @@ class RaymarchPass(RenderPass):
         for name, value in self._uniforms(frame, sim, layout, offset).items():
             if name in p:                   # a compiler may drop a uniform a variant does not use
                 p[name].value = value
-        bind_volume(p, sim, self.sampler, view.sun, s.octaves, s.ms_diffusion, layout.middle_altitude)
+        bind_volume(p, sim, self.sampler, view.sun, s.octaves, s.ms_diffusion, layout.heights)
         if s.empty_space_skipping:
             self._skip_texture(sim).use(SKIP_UNIT)
         else:                               # nothing uploaded; the shader reads no skip map

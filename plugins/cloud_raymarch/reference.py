@@ -11,7 +11,7 @@ import numpy as np
 
 from atmos.camera import view_basis
 from atmos.plugins.cloud_raymarch.settings import SUN_GROWTH, SUN_SPACING
-from atmos.plugins.cloud_render.light import sun_light, unit_direction
+from atmos.plugins.cloud_render.light import sun_colors, sun_light, sun_source_at, unit_direction
 from atmos.plugins.cloud_render.reference import column_depth
 from atmos.shading.diffusion import diffusion_radiance
 from atmos.shading.medium import source_reference
@@ -49,6 +49,7 @@ def march_reference(density, transmittance, medium, settings, layout, camera, su
         leave = np.minimum(leave, np.asarray(scene, np.float64).reshape(-1))
     step_base = settings.step * cell.min()
     sun_color, ambient = sun_light(sun, layout.middle_altitude)
+    by_height = sun_colors(sun, layout.heights)
     sun_dir = unit_direction(sun)
     column_tau = medium.sigma_t * cell[1]
     lobes = (medium.phase_g, medium.phase_g2, medium.phase_w)
@@ -60,7 +61,8 @@ def march_reference(density, transmittance, medium, settings, layout, camera, su
         up, down = column_depth(d, uvw, column_tau, trans_volume.shape)
         L = None if field is None else diffusion_radiance(field, uvw, dirs[i], lobes, sun_dir)
         return multilinear(d, uvw * shape - 0.5), source_reference(
-            medium, settings, T, up, down, dirs[i] @ sun_dir, dirs[i][:, 1], sun_color, ambient, sun_dir, L)
+            medium, settings, T, up, down, dirs[i] @ sun_dir, dirs[i][:, 1], sun_color, ambient, sun_dir, L,
+            sun_colors=sun_source_at(by_height, uvw[:, 1]))
 
     return integrate(pos, dirs, enter, leave, settings.steps, step_base, settings.step_growth,
                      settings.min_transmittance, medium.sigma_t, sample, (h, w))

@@ -11,12 +11,12 @@ UNITS = (0, 1, 2, 3, 10, 11, 16, 17)   # density, transmittance, columns, diffus
 
 
 def bind_volume(program, sim, sampler, sun: Sun | None, octaves=DEFAULT_OCTAVES, diffusion: float = 0.0,
-                altitude: float | None = None) -> float:
+                layer=None) -> float:
     """Bind mix(A, B, t)'s textures (``sim``: the frame's CloudSets, or the CloudSimulation) to units
     0..3 (density, transmittance) and 10, 11 (the light volume's columns) with ``sampler`` and set ``t``, ``a_shift`` (A drawn where it was computed), ``has_shading``
     and the light (:func:`light_uniforms` of the simulation's medium, the sun and the
     multiple-scattering ``octaves``), and 16, 17 (the diffusion field, weight ``diffusion``; 0 where the
-    sets have no field; the sun's colour taken at ``altitude``, the layer's middle); returns t. Call
+    sets have no field; the sun's colour taken over ``layer``, (base, top) world y); returns t. Call
     :func:`unbind_volume` when the draw is done."""
     a, b, t = sim.view()
     shading = "transmittance" in a
@@ -36,7 +36,7 @@ def bind_volume(program, sim, sampler, sun: Sun | None, octaves=DEFAULT_OCTAVES,
     if "a_shift" in program:
         program["a_shift"].value = (sim if isinstance(sim, CloudSets) else sim.sets()).a_shift
     values = {"has_shading": int(shading), "edge_fade": float(sim.settings.edge_fade),
-              **light_uniforms(sim.settings, sun, octaves, diffusion if field else 0.0, altitude)}
+              **light_uniforms(sim.settings, sun, octaves, diffusion if field else 0.0, layer)}
     for name, value in values.items():
         if name in program:
             program[name].value = value

@@ -1,5 +1,6 @@
 """The light both cloud renderers share (``cloud_render/volume.glsl``; the model is
-:mod:`atmos.shading.medium`): the sun's colour faded across the horizon, and the uniforms of J."""
+:mod:`atmos.shading.medium`): the sun's colour faded across the horizon and over the layer's height,
+and the uniforms of J."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -13,6 +14,7 @@ from atmos.shading.medium import environment, hemisphere_share
 DEFAULT_AMBIENT = (0.35, 0.47, 0.65)
 DEFAULT_OCTAVES = (0.25, 0.9525, 0.875)   # a, b, c of the octaves, fitted to the path tracer (bench_cloud_light --fit)
 DEFAULT_DIFFUSION = 0.575                 # the diffusion field's weight beta, fitted with them (README "Cloud light")
+SUN_HEIGHTS = 8                           # volume.glsl's samples of the sun's colour over the layer, base to top
 
 
 @dataclass(frozen=True)
@@ -69,6 +71,26 @@ def sun_light(sun: Sun | None, altitude: float | None = None) -> tuple[tuple, tu
     return color, ambient
 
 
+def sun_colors(sun: Sun | None, layer=None) -> np.ndarray:
+    """(SUN_HEIGHTS, 3) float64: the sun's colour (:func:`sun_light`) at the heights ``base + k / 7 (top −
+    base)`` of ``layer`` = (base, top) world y (m), what volume.glsl's ``sun_sources`` hold (× albedo ×
+    intensity); ``layer`` None: the camera's colour at every height."""
+    if layer is None:
+        return np.tile(np.asarray(sun_light(sun)[0], np.float64), (SUN_HEIGHTS, 1))
+    base, top = (float(v) for v in layer)
+    return np.array([sun_light(sun, base + k / (SUN_HEIGHTS - 1) * (top - base))[0] for k in range(SUN_HEIGHTS)])
+
+
+def sun_source_at(sources, v) -> np.ndarray:
+    """(..., 3) float64: volume.glsl's ``sun_source_at`` of the (SUN_HEIGHTS, 3) ``sources`` at height
+    fractions ``v`` (...,) of the layer (0 base, 1 top; clamped), linear between the samples."""
+    s = np.asarray(sources, np.float64)
+    x = np.clip(np.asarray(v, np.float64), 0.0, 1.0) * (len(s) - 1)
+    k = np.minimum(x.astype(np.int64), len(s) - 2)
+    f = (x - k)[..., None]
+    return s[k] * (1.0 - f) + s[k + 1] * f
+
+
 def unit_direction(sun: Sun | None) -> np.ndarray:
     d = np.asarray((sun or Sun()).direction, np.float64)
     n = np.linalg.norm(d)
@@ -82,15 +104,17 @@ def cell_tau(cloud_settings) -> float:
 
 
 def light_uniforms(cloud_settings, sun: Sun | None, octaves=DEFAULT_OCTAVES, diffusion: float = 0.0,
-                   altitude: float | None = None) -> dict:
+                   layer=None) -> dict:
     """The light uniforms of ``volume.glsl`` for a ``CloudSettings`` medium, the ``Sun``, the
-    multiple-scattering octaves (a, b, c), the diffusion field's weight and the altitude (m) the
-    clouds take the sun's colour at (:func:`sun_light`; None: the camera's)."""
-    color, ambient = sun_light(sun, altitude)
+    multiple-scattering octaves (a, b, c), the diffusion field's weight and the layer (base, top) world
+    y (m) over which the clouds take the sun's colour (``sun_sources``: :func:`sun_colors`; the ground's
+    light takes the middle's; None: the camera's colour everywhere)."""
+    color, ambient = sun_light(sun, None if layer is None else 0.5 * (float(layer[0]) + float(layer[1])))
     direction = unit_direction(sun)
     e, sky, ground = environment(cloud_settings, color, ambient, direction)
     s = cloud_settings
-    return {"sun_source": tuple(float(v) for v in s.albedo * e),
+    sources = s.albedo * s.sun_intensity * sun_colors(sun, layer)
+    return {"sun_sources": [tuple(float(v) for v in row) for row in sources],
             "sky_source": tuple(float(v) for v in 0.5 * s.albedo * sky),
             "ground_source": tuple(float(v) for v in 0.5 * s.albedo * ground),
             "sun_dir": tuple(float(v) for v in direction),

@@ -274,7 +274,7 @@ class CloudSpritePass(RenderPass):
         frame.blend_over()
         ctx.enable(moderngl.DEPTH_TEST | moderngl.PROGRAM_POINT_SIZE)
         ctx.depth_func = "<="          # a tiny near plane rounds far depths to 1.0: still in front of the sky
-        bind_volume(p, sim, self.sampler, view.sun, settings.octaves, settings.ms_diffusion, layout.middle_altitude)
+        bind_volume(p, sim, self.sampler, view.sun, settings.octaves, settings.ms_diffusion, layout.heights)
         try:
             self._draw(segments, layout.group)
         finally:

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from atmos.plugins.cloud_render.light import sun_source_at
 from atmos.plugins.cloud_render.particle import centre_tau, footprint, screen_axes
 from atmos.plugins.cloud_render.segments import unpack
 from atmos.shading.medium import ambient_profile, mean_cosine, octave_weights
@@ -82,7 +83,7 @@ def shifted(volume: np.ndarray, shift) -> np.ndarray:
 def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, uniforms: dict, view_proj,
                     light: dict, a_shift=(0, 0, 0)) -> dict:
     """Arrays over the vertices of every segment (gi, j, gk, packed level and span), in order: ``position`` (n, 4),
-    ``size``, ``octaves`` (n, 4), ``ambient`` (n, 3), ``center`` (n, 3), ``radius``, ``tau``, ``stretch``, ``coverage``,
+    ``size``, ``octaves`` (n, 4), ``ambient`` (n, 3), ``sun`` (n, 3: the sun's source at its height), ``center`` (n, 3), ``radius``, ``tau``, ``stretch``, ``coverage``,
     ``visible``. ``trans_a``/``trans_b`` None: no shading (T = 1). ``light``: the light uniforms
     (:func:`atmos.plugins.cloud_render.light.light_uniforms`). ``a_shift``: A's cell for B's cell c is
     c + a_shift (zero past A's edge for the cell sums; clamp-to-edge for the sampled light, as the GPU)."""
@@ -161,6 +162,7 @@ def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, 
             "octaves": np.where(visible[:, None], octaves, 0.0),
             "slope": np.where(visible[:, None], np.concatenate([h, half_var[:, None]], 1), 0.0),
             "ambient": np.where(visible[:, None], ambient, 0.0),
+            "sun": np.where(visible[:, None], sun_source_at(light["sun_sources"], uvw[:, 1]), 0.0),
             "center": np.where(visible[:, None], world, 0.0),
             "radius": np.where(visible, 0.5 * diameter, 0.0),
             "tau": np.where(visible, centre_tau(u["tau_scale"] * total, 0.5 * diameter, det, k, stretch), 0.0),

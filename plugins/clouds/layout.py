@@ -31,8 +31,14 @@ class CloudLayout:
 
     @property
     def middle_altitude(self) -> float:
-        """World y of the layer's middle (where the cloud light takes the sun's colour: ``Sun.color_at``)."""
+        """World y of the layer's middle."""
         return float(self.base + 0.5 * self.shape[1] * self.cell[1])
+
+    @property
+    def heights(self) -> tuple[float, float]:
+        """(base, top) world y of the layer, over which the cloud light takes the sun's colour
+        (``Sun.color_at``, :func:`atmos.plugins.cloud_render.light.sun_colors`)."""
+        return float(self.base), float(self.base + self.shape[1] * self.cell[1])
 
     @property
     def hi(self) -> np.ndarray:

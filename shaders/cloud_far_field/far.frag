@@ -11,7 +11,8 @@
 // (MIN_SLANT: field.glsl's cap on the slant at the horizon), lit by the cloud medium's own
 // model (cloud_render/volume.glsl) with the volume's own light at the same rank (RankLight,
 // light_by_rank.comp; as seen from above when the view looks down, else from below): the octaves' sun
-// transmittances (lib/octaves.glsl) of the volume's columns of rank r, to the power `thickness`
+// transmittances (lib/octaves.glsl) of the volume's columns of rank r, to the power `thickness`, under the
+// sun's colour at the height that light comes from (RankLight.height, volume.glsl sun_source_at)
 // (optical depths scale with it), moved by the relief toward the sun (field.glsl far_relief,
 // relief_light: lit edges facing the sun, shaded ones behind, no light added), and, where the sets
 // carry a diffusion field, its light from their mean (phi, F); sky light with tau half above, half below.
@@ -35,6 +36,7 @@ uniform float horizon_fade;
 uniform float layer_height;    // the volume's layer (m)
 layout(binding = 18) uniform sampler2D far_sun_by_rank;   // RankLight.sun: (rank, seen from above | below) -> the octaves' transmittances
 layout(binding = 21) uniform sampler2D far_thickness_by_rank;   // RankLight.thickness: rank -> the clouds' height / layer_height
+layout(binding = 24) uniform sampler2D far_height_by_rank;   // RankLight.height: (rank, seen from above | below) -> where its light comes from
 layout(binding = 19) uniform sampler2D far_field_light;   // RankLight.field: (rank, seen from above | below) -> (phi, F)
 uniform float lod_scale;       // texels per metre × a pixel's angle (rad): the mip level from the footprint,
                                // not from screen derivatives (the same under any camera roll)
@@ -88,8 +90,9 @@ void main() {
     float relief = far_relief(r, thickness * column_tau, sun_dir.y);
     vec4 sun = relief_light(clamp(pow(max(textureLod(far_sun_by_rank, at, 0.0), 0.0), vec4(thickness)), 0.0, 1.0),
                             relief * octave_exponents());
-    vec3 light = sun_part(octave_weights_of(sun), dot(dir, sun_dir)) + ambient_source(0.5 * tau, 0.5 * tau, dir.y)
-               + (ms_diffusion > 0.0 ? diffusion_light(textureLod(far_field_light, at, 0.0), dir) : vec3(0.0));
+    vec3 source = sun_source_at(textureLod(far_height_by_rank, at, 0.0).r);
+    vec3 light = sun_part(octave_weights_of(sun), dot(dir, sun_dir), source) + ambient_source(0.5 * tau, 0.5 * tau, dir.y)
+               + (ms_diffusion > 0.0 ? diffusion_light(textureLod(far_field_light, at, 0.0), dir, source) : vec3(0.0));
     frag = vec4(light * alpha, alpha);
     frag_distance = vec4(alpha * length(hit - camera_pos), alpha, 0.0, alpha);
 }

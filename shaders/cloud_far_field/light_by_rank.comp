@@ -13,6 +13,9 @@
 //   sun_profile (k, q):  per height bin q of Q (sample j in bin j Q / P) the columns' density-weighted
 //                         mean octave transmittances there (no transmittance weight), which the ray
 //                         march's volumetric far field (cloud_raymarch/far.glsl) lights its density with;
+//   height_by_rank (k, v): the height fraction (0 base, 1 top) of the same samples, weighted as sun_by_rank's:
+//                         where the light of the columns seen from above (v = 0) or below (1) comes from,
+//                         at which the 2D far field takes the sun's colour (volume.glsl sun_source_at);
 //   thickness (k):       the clouds' height as a fraction of the layer: per column sqrt(12 var + 1/P^2) of
 //                         its density's height (var in layer fractions; a uniform slab's thickness), mean
 //                         over the interval's columns weighted by w: how high the 2D far field's clouds
@@ -43,6 +46,7 @@ layout(binding = 17) uniform sampler3D diffusion_b;
 layout(rgba32f, binding = 0) writeonly uniform image2D sun_by_rank;     // (32 intervals, 2)
 layout(r32f, binding = 3) writeonly uniform image2D thickness_by_rank;  // (32 intervals, 1)
 layout(rgba32f, binding = 4) writeonly uniform image2D sun_profile;     // (32 intervals, Q bins)
+layout(r32f, binding = 5) writeonly uniform image2D height_by_rank;     // (32 intervals, 2)
 #if FIELD
 layout(rgba32f, binding = 1) writeonly uniform image2D field_column;    // (32 intervals, 2)
 layout(rgba32f, binding = 2) writeonly uniform image2D field_profile;   // (32 intervals, Q bins)
@@ -50,7 +54,7 @@ layout(rgba32f, binding = 2) writeonly uniform image2D field_profile;   // (32 i
 #endif
 const float FIELD_MAX = 8.0;        // phi clamped to this (unit irradiance; a cloud's stays below 4)
 const int FIELD_BINS = 16;          // most height bins Q
-const int SLOT = 10;                // a column slot: weight, 4 sun transmittances, phi, F + phi (3), thickness
+const int SLOT = 11;                // a column slot: weight, 4 sun transmittances, phi, F + phi (3), thickness, height
 const int BIN = 9;                  // a height bin: weight, phi, F + phi (3), 4 sun transmittances
 const int BINS_AT = INTERVALS * 2 * SLOT;              // the bins' sums follow the columns' (k, view) slots
 const int TOTAL = BINS_AT + INTERVALS * FIELD_BINS * BIN;
@@ -87,6 +91,7 @@ void add_column(ivec2 p, ivec2 n, int k, uint units, float unit) {
     for (int j = 0; j < heights; ++j)
         total += sample_tau * column_density(ivec3(p.x, sample_row(j, heights, size.y), p.y), size);
     float weight[2] = float[2](0.0, 0.0);        // the column's sums seen from above, from below
+    float height[2] = float[2](0.0, 0.0);
     vec4 sun[2] = vec4[2](vec4(0.0), vec4(0.0)), field[2] = vec4[2](vec4(0.0), vec4(0.0));
     for (int b = 0; b < bins; ++b) {             // bin b holds the samples j with j bins / heights = b
         float bin_weight = 0.0;
@@ -113,6 +118,7 @@ void add_column(ivec2 p, ivec2 n, int k, uint units, float unit) {
             float seen[2] = float[2](exp(-(total - below + 0.5 * tau)), exp(-(below - 0.5 * tau)));
             for (int view = 0; view < 2; ++view) {
                 weight[view] += d * seen[view];
+                height[view] += d * seen[view] * y;
                 sun[view] += d * seen[view] * Ta;
                 field[view] += d * seen[view] * v;
             }
@@ -136,6 +142,7 @@ void add_column(ivec2 p, ivec2 n, int k, uint units, float unit) {
         uint at = uint((k * 2 + view) * SLOT);
         atomicAdd(local[at], units);
         atomicAdd(local[at + 9u], uint(round(float(units) * unit * thickness)));
+        atomicAdd(local[at + 10u], uint(round(float(units) * unit * height[view] / weight[view])));
         for (int c = 0; c < 4; ++c) atomicAdd(local[at + 1u + uint(c)], uint(round(float(units) * unit * sun[view][c] / weight[view])));
         for (int c = 0; c < 4; ++c) atomicAdd(local[at + 5u + uint(c)], uint(round(float(units) * unit * field[view][c] / weight[view])));
     }
@@ -189,6 +196,8 @@ void main() {
     for (int view = 0; view < 2; ++view) {
         int s = k * 2 + view;
         imageStore(sun_by_rank, ivec2(int(i), view), k < 0 ? vec4(1.0) : slot_mean(s, 1, vec4(1.0), unit));
+        float w = k < 0 ? 0.0 : float(local[s * SLOT]) * unit;
+        imageStore(height_by_rank, ivec2(int(i), view), vec4(w > 0.0 ? min(float(local[s * SLOT + 10]) / w, 1.0) : 0.5));
 #if FIELD
         vec4 field = k < 0 ? vec4(0.0) : slot_mean(s, 5, vec4(0.0), unit);
         imageStore(field_column, ivec2(int(i), view), vec4(field.x, field.yzw - field.x));

@@ -19,6 +19,7 @@ flat in vec4 v_octaves;
 flat in vec3 v_slope;          // log T's slope across the sprite (sprite.vert)
 flat in vec3 v_ambient;
 flat in vec4 v_field;          // the diffusion field at the sprite's centre (volume.glsl cloud_diffusion)
+flat in vec3 v_sun;            // the sun's source at its height (volume.glsl sun_source_at)
 flat in vec3 v_center;
 flat in float v_radius;
 flat in float v_tau;
@@ -40,6 +41,6 @@ void main() {
     vec3 ray = normalize(v_center + q.x * camera_right + q.y * camera_up - camera_pos);
     vec4 ai = octave_exponents();                                        // octave i: exp(e_i (h.pc - e_i var))
     vec4 across = exp(clamp(ai * (dot(v_slope.xy, pc) - ai * v_slope.z), -40.0, 40.0));
-    frag = vec4((sun_part(v_octaves * across, dot(ray, sun_dir)) + diffusion_light(v_field, ray) + v_ambient) * a, a);
+    frag = vec4((sun_part(v_octaves * across, dot(ray, sun_dir), v_sun) + diffusion_light(v_field, ray, v_sun) + v_ambient) * a, a);
     frag_distance = vec4(a * length(v_center - camera_pos), a, 0.0, a);   // blends by its own alpha
 }

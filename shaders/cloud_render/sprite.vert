@@ -30,6 +30,7 @@ flat out vec4 v_octaves;      // b^i P_i(T): the sun's light per octave (volume.
 flat out vec3 v_slope;        // log T's slope h across the sprite (per unit pc) and h^T cov h / 2
 flat out vec3 v_ambient;      // sky and ground light at the sprite, dimmed by the columns above and below
 flat out vec4 v_field;        // the diffusion field (phi, F) at the sprite's centre (0 when its weight is 0)
+flat out vec3 v_sun;          // the sun's source at the sprite's height (volume.glsl sun_source_at)
 flat out vec3 v_center;       // world centre and radius: the fragment's view ray for the phase function
 flat out float v_radius;
 flat out float v_tau;
@@ -78,6 +79,7 @@ void main() {
     v_octaves = vec4(0.0);
     v_slope = vec3(0.0);
     v_ambient = vec3(0.0);
+    v_sun = vec3(0.0);
     v_center = vec3(0.0);
     v_radius = 0.0;
     v_tau = 0.0;
@@ -162,6 +164,7 @@ void main() {
     v_octaves = octaves / 8.0;
     v_ambient = ambient_source(up, down, ray.y);
     v_field = ms_diffusion > 0.0 ? cloud_diffusion(uvw) : vec4(0.0);
+    v_sun = sun_source_at(uvw.y);
     v_center = world;
     v_radius = 0.5 * diameter;
     // depth-tested at its front (the centre pulled a radius toward the camera, x and y unmoved): a

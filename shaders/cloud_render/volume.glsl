@@ -1,6 +1,6 @@
 // The cloud volume as the renderers see it: density and transmittance toward the sun, each
 // mix(A, B, t) of the two latest completed steps, and the light model of atmos/shading/medium.py:
-// source per unit extinction J = sun_source * sum_i b^i p(cos; c^i g) P_i(T)
+// source per unit extinction J = sun_source(y) * sum_i b^i p(cos; c^i g) P_i(T)
 //                              + (sky_source + ground_source) + (sky_source - ground_source) h,
 // P_i: the octaves' transmittances (lib/octaves.glsl: light forward-scattered i times on its way, the
 // last all higher counts), h = clamp(u + g_mean ray_y exp(-(tau_up + tau_down) / 2z), -1, 1),
@@ -19,7 +19,9 @@ uniform float ms_diffusion;    // its weight beta (CloudLightSettings.ms_diffusi
 uniform float t;
 uniform ivec3 a_shift;         // cells from B's cell to A's at the same world point (CloudSets.a_shift)
 uniform int has_shading;       // 0: no transmittance textures, T = 1
-uniform vec3 sun_source;       // albedo * sun irradiance (already 0 with the sun below the horizon)
+const int SUN_HEIGHTS = 8;     // light.py SUN_HEIGHTS
+uniform vec3 sun_sources[SUN_HEIGHTS];  // albedo * sun irradiance at the volume's heights k / 7 (uvw.y, base to
+                               // top): the sun's colour there (already 0 with the sun below the horizon)
 uniform vec3 sky_source;       // albedo * sky radiance / 2
 uniform vec3 ground_source;    // albedo * ground radiance / 2
 uniform vec3 sun_dir;          // toward the sun, unit
@@ -51,6 +53,15 @@ float cloud_transmittance(vec3 uvw) {
 vec2 cloud_columns(vec3 uvw) {
     vec2 c = mix(textureLod(columns_a, a_uvw(uvw), 0.0).rg, textureLod(columns_b, uvw, 0.0).rg, t);
     return column_tau * cloud_edge_weight(uvw.xz, edge_fade) * c;
+}
+
+// albedo * the sun's irradiance at height fraction v of the volume (uvw.y: 0 base, 1 top), linear
+// between the SUN_HEIGHTS samples (light.py sun_source_at): clouds' tops see a less reddened sun than
+// their bases, and keep it after the bases' sunset.
+vec3 sun_source_at(float v) {
+    float x = clamp(v, 0.0, 1.0) * float(SUN_HEIGHTS - 1);
+    int k = min(int(x), SUN_HEIGHTS - 2);
+    return mix(sun_sources[k], sun_sources[k + 1], x - float(k));
 }
 
 // The phase function's mean cosine g_mean = (1 - w) g + w g2.
@@ -98,38 +109,39 @@ vec4 cloud_diffusion(vec3 uvw) {
     return mix(textureLod(diffusion_a, a_uvw(uvw), 0.0), textureLod(diffusion_b, uvw, 0.0), t);
 }
 
-// The field's share of J beside the octaves for a field value f = (phi, F): sun_source beta
+// The field's share of J beside the octaves for a field value f = (phi, F) under the sun's `source`: source beta
 // max(phi - 3 g_mean F.ray, -c 2 H phi, 0) / 4pi (c = dot(ray, sun_dir); diffusion.field_radiance).
 // Against the sun the truncated P1 falls to 0 at a lit surface, where F runs with the sun's light; the
 // light a lit surface sends back fills only the outward hemisphere there (phi / 2pi, twice the
 // isotropic part), and scattering toward the outside takes the phase's share H of that hemisphere
 // (outward_share: 0.90 at the defaults), so J is never below -c 2 H phi / 4pi.
-vec3 diffusion_light(vec4 f, vec3 ray_dir) {
+vec3 diffusion_light(vec4 f, vec3 ray_dir, vec3 source) {
     if (ms_diffusion <= 0.0) return vec3(0.0);
     float c = dot(ray_dir, sun_dir), back = -c * 2.0 * outward_share;
     float L = max(max(f.x - 3.0 * mean_cosine() * dot(f.yzw, ray_dir), back * f.x), 0.0) / (4.0 * PI);
-    return sun_source * (ms_diffusion * L);
+    return source * (ms_diffusion * L);
 }
 
 vec3 diffusion_part(vec3 uvw, vec3 ray_dir) {
-    return ms_diffusion <= 0.0 ? vec3(0.0) : diffusion_light(cloud_diffusion(uvw), ray_dir);
+    return ms_diffusion <= 0.0 ? vec3(0.0) : diffusion_light(cloud_diffusion(uvw), ray_dir, sun_source_at(uvw.y));
 }
 
-// sun_source * sum_i w_i p(cos; c^i g): the sun's part of J for a view ray with dot(ray, sun_dir) = c.
-vec3 sun_part(vec4 w, float c) {
+// source * sum_i w_i p(cos; c^i g): the sun's part of J for a view ray with dot(ray, sun_dir) = c
+// under the sun's `source` (sun_source_at the point's height).
+vec3 sun_part(vec4 w, float c, vec3 source) {
     float e = 1.0, sum = 0.0;
     for (int i = 0; i < 4; ++i) {
         sum += w[i] * mix(hg(c, phase_lobes.x * e), hg(c, phase_lobes.y * e), phase_lobes.z);
         e *= ms_octaves.z;
     }
-    return sun_source * sum;
+    return source * sum;
 }
 
 // J at uvw for a view ray along ray_dir (world, unit), with sun transmittance T (ny: unused, kept
 // for the callers).
 vec3 cloud_source_with(vec3 uvw, vec3 ray_dir, float ny, float T) {
     vec2 c = cloud_columns(uvw);
-    return sun_part(octave_weights(T), dot(ray_dir, sun_dir)) + diffusion_part(uvw, ray_dir)
+    return sun_part(octave_weights(T), dot(ray_dir, sun_dir), sun_source_at(uvw.y)) + diffusion_part(uvw, ray_dir)
          + ambient_source(c.x, c.y, ray_dir.y);
 }
 
