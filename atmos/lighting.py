@@ -27,7 +27,7 @@ def _read_only(direction: np.ndarray) -> np.ndarray:
 
 def _check_path(value):
     if value is not None and not callable(value):
-        raise ValueError("Sun.color_by_altitude must be None or a callable (direction, altitude_m) -> RGB, "
+        raise ValueError("Sun.color_by_altitude must be None or a callable (direction, altitudes_m (n,)) -> RGB (n, 3), "
                          f"got {value!r}")
     return value
 
@@ -46,23 +46,27 @@ class Sun:
     new one); ``color`` is its radiance (zero at night); ``ambient`` is the sky's diffuse light (linear
     RGB, non-negative). Every assignment is checked (a ValueError names ``Sun.field``). DaylightPlugin
     drives all three. ``color`` is the sun seen from the camera; ``color_by_altitude`` (set by a sky
-    model that knows the air's path, the physical sky; None: ``color`` everywhere) gives it at another
-    altitude, through :meth:`color_at`: clouds 2 km up see a less reddened sun, and still see it after
-    the ground's sunset."""
+    model that knows the air's path, the physical sky; None: ``color`` everywhere) gives it at other
+    altitudes, through :meth:`color_at`: clouds 2 km up see a less reddened sun, and still see it after
+    the ground's sunset. It is called as ``color_by_altitude(direction, altitudes)`` with an (n,) array
+    and returns (n, 3) (numpy-vectorised: a cloud layer asks for its heights at once)."""
     direction: np.ndarray = field(default_factory=lambda: np.array([0.3, 0.35, -0.88]))
     color: tuple = (1.0, 0.95, 0.85)
     ambient: tuple = (0.35, 0.47, 0.65)
     color_by_altitude: object = None
 
-    def color_at(self, altitude: float) -> np.ndarray:
-        """(3,) the sun's colour at ``altitude`` m: ``color_by_altitude(direction, altitude)``, or ``color``
-        without one."""
+    def color_at(self, altitude) -> np.ndarray:
+        """(3,) the sun's colour at ``altitude`` m, or (n, 3) at an (n,) array of altitudes:
+        ``color_by_altitude(direction, altitudes)``, or ``color`` without one."""
+        heights = np.asarray(altitude, np.float64)
         if self.color_by_altitude is None:
-            return np.asarray(self.color, np.float64)
-        color = np.asarray(self.color_by_altitude(self.direction, float(altitude)), np.float64)
-        if color.shape != (3,) or not np.all(np.isfinite(color)) or color.min() < 0:
-            raise ValueError(f"Sun.color_by_altitude must return 3 non-negative finite numbers, got {color!r}")
-        return color
+            return np.broadcast_to(np.asarray(self.color, np.float64), heights.shape + (3,)).copy()
+        flat = heights.reshape(-1)
+        color = np.asarray(self.color_by_altitude(self.direction, flat), np.float64)
+        if color.shape != (len(flat), 3) or not np.all(np.isfinite(color)) or color.min() < 0:
+            raise ValueError(f"Sun.color_by_altitude must return ({len(flat)}, 3) non-negative finite numbers "
+                             f"for {len(flat)} altitudes, got {color!r}")
+        return color.reshape(heights.shape + (3,))
 
     def __setattr__(self, name: str, value) -> None:
         check = _SUN_CHECKS.get(name)

@@ -61,7 +61,8 @@ def linear(app):
 
 
 # a sky that gives the sun's colour by altitude: the clouds take it at their heights (400..520 m here)
-BY_ALTITUDE = Sun(DAY.direction, DAY.color, color_by_altitude=lambda d, h: (h / 500.0, 0.6, 0.3))
+BY_ALTITUDE = Sun(DAY.direction, DAY.color, color_by_altitude=lambda d, h: np.stack(
+    [h / 500.0, np.full_like(h, 0.6), np.full_like(h, 0.3)], -1))
 
 
 @pytest.mark.parametrize("sun", [DAY, BY_ALTITUDE], ids=["day", "by_altitude"])

@@ -18,7 +18,8 @@ CELL = (40.0, 40.0, 40.0)
 BASE = 400.0
 DAY = Sun.from_angles(35.0, 70.0)
 # a sun whose colour changes over the band (400..720 m): the far clouds take it at their heights
-BY_ALTITUDE = Sun(DAY.direction, DAY.color, color_by_altitude=lambda d, h: (1.0, (h - 300.0) / 500.0, ((h - 300.0) / 420.0) ** 2))
+BY_ALTITUDE = Sun(DAY.direction, DAY.color, color_by_altitude=lambda d, h: np.stack(
+    [np.ones_like(h), (h - 300.0) / 500.0, ((h - 300.0) / 420.0) ** 2], -1))
 FAR = dict(size=64, tile_size=20000.0, base_frequency=4, animate=False)   # mip 0 out to far_distance
 
 

@@ -144,7 +144,7 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale,
     sun = app.resource(Sun)
     # a sun whose colour changes over the layer's height (as the physical sky's does at sunset): each
     # sprite takes it at its own height (volume.glsl sun_source_at)
-    sun.color_by_altitude = lambda direction, altitude: (1.0, 0.4 + altitude / 2000.0, (altitude / 1500.0) ** 2)
+    sun.color_by_altitude = lambda direction, h: np.stack([np.ones_like(h), 0.4 + h / 2000.0, (h / 1500.0) ** 2], -1)
     parts = []
     try:
         prog["view_proj"].write(np.asarray(vp, np.float32).T.tobytes())

@@ -495,10 +495,14 @@ def test_clouds_above_keep_the_sun_after_the_grounds_sunset(gpu, ctx):
 def test_a_sun_colour_by_altitude_is_checked():
     with pytest.raises(ValueError, match="Sun.color_by_altitude must be None or a callable"):
         Sun(color_by_altitude=(1.0, 0.5, 0.2))
-    sun = Sun(color_by_altitude=lambda d, h: (1.0, float("nan"), 0.0))
-    with pytest.raises(ValueError, match="Sun.color_by_altitude must return 3 non-negative finite numbers"):
+    sun = Sun(color_by_altitude=lambda d, h: np.stack([np.ones_like(h), np.full_like(h, np.nan), 0 * h], -1))
+    with pytest.raises(ValueError, match=r"Sun.color_by_altitude must return \(1, 3\) non-negative finite numbers"):
         sun.color_at(100.0)
+    one_colour = Sun(color_by_altitude=lambda d, h: (1.0, 0.5, 0.2))     # not vectorised over the altitudes
+    with pytest.raises(ValueError, match=r"must return \(8, 3\) non-negative finite numbers for 8 altitudes"):
+        one_colour.color_at(np.linspace(0.0, 700.0, 8))
     assert np.array_equal(Sun(color=(0.5, 0.4, 0.3)).color_at(5000.0), [0.5, 0.4, 0.3])
+    assert Sun(color=(0.5, 0.4, 0.3)).color_at([1.0, 2.0]).shape == (2, 3)
 
 
 # -- the Monte-Carlo check and the demos ------------------------------------------------------------------

@@ -14,7 +14,7 @@ from atmos.shading.medium import environment, hemisphere_share
 DEFAULT_AMBIENT = (0.35, 0.47, 0.65)
 DEFAULT_OCTAVES = (0.25, 0.9525, 0.875)   # a, b, c of the octaves, fitted to the path tracer (bench_cloud_light --fit)
 DEFAULT_DIFFUSION = 0.575                 # the diffusion field's weight beta, fitted with them (README "Cloud light")
-SUN_HEIGHTS = 8                           # volume.glsl's samples of the sun's colour over the layer, base to top
+SUN_HEIGHTS = 5                           # volume.glsl's samples of the sun's colour over the layer, base to top (2: the middle)
 
 
 @dataclass(frozen=True)
@@ -72,13 +72,14 @@ def sun_light(sun: Sun | None, altitude: float | None = None) -> tuple[tuple, tu
 
 
 def sun_colors(sun: Sun | None, layer=None) -> np.ndarray:
-    """(SUN_HEIGHTS, 3) float64: the sun's colour (:func:`sun_light`) at the heights ``base + k / 7 (top −
+    """(SUN_HEIGHTS, 3) float64: the sun's colour (:func:`sun_light`) at the heights ``base + k / 4 (top −
     base)`` of ``layer`` = (base, top) world y (m), what volume.glsl's ``sun_sources`` hold (× albedo ×
     intensity); ``layer`` None: the camera's colour at every height."""
-    if layer is None:
+    sun = sun or Sun()
+    if layer is None or sun.color_by_altitude is None:
         return np.tile(np.asarray(sun_light(sun)[0], np.float64), (SUN_HEIGHTS, 1))
     base, top = (float(v) for v in layer)
-    return np.array([sun_light(sun, base + k / (SUN_HEIGHTS - 1) * (top - base))[0] for k in range(SUN_HEIGHTS)])
+    return sun.color_at(base + np.arange(SUN_HEIGHTS) / (SUN_HEIGHTS - 1) * (top - base))
 
 
 def sun_source_at(sources, v) -> np.ndarray:
@@ -109,11 +110,12 @@ def light_uniforms(cloud_settings, sun: Sun | None, octaves=DEFAULT_OCTAVES, dif
     multiple-scattering octaves (a, b, c), the diffusion field's weight and the layer (base, top) world
     y (m) over which the clouds take the sun's colour (``sun_sources``: :func:`sun_colors`; the ground's
     light takes the middle's; None: the camera's colour everywhere)."""
-    color, ambient = sun_light(sun, None if layer is None else 0.5 * (float(layer[0]) + float(layer[1])))
+    colors = sun_colors(sun, layer)
+    ambient = sun_light(sun)[1]
     direction = unit_direction(sun)
-    e, sky, ground = environment(cloud_settings, color, ambient, direction)
+    e, sky, ground = environment(cloud_settings, colors[SUN_HEIGHTS // 2], ambient, direction)
     s = cloud_settings
-    sources = s.albedo * s.sun_intensity * sun_colors(sun, layer)
+    sources = s.albedo * s.sun_intensity * colors
     return {"sun_sources": [tuple(float(v) for v in row) for row in sources],
             "sky_source": tuple(float(v) for v in 0.5 * s.albedo * sky),
             "ground_source": tuple(float(v) for v in 0.5 * s.albedo * ground),

@@ -408,16 +408,17 @@ def sky_radiance(view_dirs, sun_dir, altitude: float = 0.0, settings: Atmosphere
     return integrate(m, tlut, r, mu, mu_s, nu, steps, mslut)[0]
 
 
-def sun_radiance(sun_dir, altitude: float = 0.0, settings: AtmosphereSettings | None = None) -> np.ndarray:
-    """(3,) the sun's colour at ``altitude``: ``sun_color`` × the transmittance toward it (``SUN_STEPS``
-    midpoint steps) × the share of its disc above the horizon (what ``Sun.color`` becomes with the physical sky)."""
+def sun_radiance(sun_dir, altitude=0.0, settings: AtmosphereSettings | None = None) -> np.ndarray:
+    """(..., 3) the sun's colour at ``altitude`` (m, a number or an array): ``sun_color`` × the
+    transmittance toward it (``SUN_STEPS`` midpoint steps) × the share of its disc above the horizon
+    (what ``Sun.color`` becomes with the physical sky)."""
     settings = settings or AtmosphereSettings()
     m = medium(settings)
     mu_s = float(unit(sun_dir)[1])
-    r = camera_radius(m, altitude)
-    mu = max(mu_s, float(horizon_mu(m["rg"], r)))
+    r = clamp_radius(m, m["rg"] + np.maximum(np.asarray(altitude, np.float64), 0.0))
+    mu = np.maximum(mu_s, horizon_mu(m["rg"], r))
     depth = optical_depth(m, r, mu, distance_to_top(m["rt"], r, mu), SUN_STEPS)
-    return m["color"] * np.exp(-depth) * float(sun_visibility(m["rg"], r, mu_s))
+    return m["color"] * np.exp(-depth) * sun_visibility(m["rg"], r, mu_s)[..., None]
 
 
 SUN_STEPS = 256              # the sun's colour: its one ray integrated directly (no LUT)

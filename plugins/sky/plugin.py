@@ -164,9 +164,9 @@ class SkyPlugin(Plugin):
         sun.ambient = tuple(sun_light.sky_ambient(sun.direction, altitude, s.atmosphere, s.night))
         sun.color_by_altitude = self.sun_color_at
 
-    def sun_color_at(self, direction, altitude: float) -> np.ndarray:
-        """``Sun.color_by_altitude`` of the physical sky: the sun's colour at ``altitude`` m."""
-        return sun_light.sun_color(direction, altitude, self.settings.atmosphere)
+    def sun_color_at(self, direction, altitudes) -> np.ndarray:
+        """``Sun.color_by_altitude`` of the physical sky: (n, 3) the sun's colour at ``altitudes`` (n,) m."""
+        return sun_light.sun_color(direction, altitudes, self.settings.atmosphere)
 
     def _drop_sun_path(self, sun: Sun | None) -> None:
         if sun is not None and sun.color_by_altitude == self.sun_color_at:

@@ -65,16 +65,18 @@ def _clamped(i: int) -> int:
     return min(max(i, -limit), limit)
 
 
-def sun_color(sun_dir, altitude: float, settings: AtmosphereSettings) -> np.ndarray:
-    """(3,) ``Sun.color``: the sun's colour seen from ``altitude`` m (remembered for the last few
-    directions and altitudes: the camera's and the cloud layers' are asked every frame)."""
-    return _sun_color(tuple(float(v) for v in np.asarray(sun_dir, np.float64).reshape(3)), float(altitude),
-                      settings).copy()
+def sun_color(sun_dir, altitude, settings: AtmosphereSettings) -> np.ndarray:
+    """(3,) ``Sun.color``: the sun's colour seen from ``altitude`` m; an array of altitudes (n,) gives
+    (n, 3) in one vectorised pass (``Sun.color_by_altitude``: a cloud layer's heights). Remembered for
+    the last few directions and altitudes: the camera's and the cloud layers' are asked every frame."""
+    heights = np.asarray(altitude, np.float64)
+    direction = tuple(float(v) for v in np.asarray(sun_dir, np.float64).reshape(3))
+    return _sun_color(direction, tuple(heights.reshape(-1).tolist()), settings).reshape(heights.shape + (3,)).copy()
 
 
 @lru_cache(maxsize=16)
-def _sun_color(sun_dir: tuple, altitude: float, settings: AtmosphereSettings) -> np.ndarray:
-    return ref.sun_radiance(np.array(sun_dir), altitude, settings)
+def _sun_color(sun_dir: tuple, altitudes: tuple, settings: AtmosphereSettings) -> np.ndarray:
+    return ref.sun_radiance(np.array(sun_dir), np.array(altitudes), settings)
 
 
 def sky_ambient(sun_dir, altitude: float, settings: AtmosphereSettings, night=(0.0, 0.0, 0.0)) -> np.ndarray:

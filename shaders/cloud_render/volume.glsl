@@ -19,8 +19,8 @@ uniform float ms_diffusion;    // its weight beta (CloudLightSettings.ms_diffusi
 uniform float t;
 uniform ivec3 a_shift;         // cells from B's cell to A's at the same world point (CloudSets.a_shift)
 uniform int has_shading;       // 0: no transmittance textures, T = 1
-const int SUN_HEIGHTS = 8;     // light.py SUN_HEIGHTS
-uniform vec3 sun_sources[SUN_HEIGHTS];  // albedo * sun irradiance at the volume's heights k / 7 (uvw.y, base to
+const int SUN_HEIGHTS = 5;     // light.py SUN_HEIGHTS
+uniform vec3 sun_sources[SUN_HEIGHTS];  // albedo * sun irradiance at the volume's heights k / 4 (uvw.y, base to
                                // top): the sun's colour there (already 0 with the sun below the horizon)
 uniform vec3 sky_source;       // albedo * sky radiance / 2
 uniform vec3 ground_source;    // albedo * ground radiance / 2
