@@ -14,14 +14,28 @@ A pass cannot declare an optional read, so the plugins meet in the App resource
 :class:`ClearDistance` (phase clear, added with the Composition) creates ``"cloud_distance"`` and
 clears it to 0, every layer reads and writes it (the far field, then the sprites over it), and the
 readers read it: a scene without fog allocates no distance target, a fog without clouds reads none.
+
+Local media and the air. A local medium (the fog) blends its (light L, transmittance T) over the colour;
+the aerial perspective, which spans the whole ray, would then add the air's light over the fog as if the
+fog were not there (an opaque fog would still show the air behind it). So the media are mixed instead:
+where a local medium writes (``media_writers``) and the aerial perspective reads (``media_readers``),
+:class:`ClearMedia` creates ``"media_light"`` (RGB, cleared to 0) and ``"media_transmittance"`` (R,
+cleared to 1); each local medium blends its (L, T) onto them as onto the colour (so they hold the local
+media composited), and the aerial perspective mixes the air with them along the ray in proportion
+(:func:`media_mix`, ``shaders/lib/media_mix.glsl``): exact for two homogeneous media, each alone as
+before.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from atmos.graph import RenderPass, TextureDesc
 
 CLOUD_DISTANCE = "cloud_distance"
+MEDIA_LIGHT = "media_light"                    # the local media's in-scattered light, composited (RGB)
+MEDIA_TRANSMITTANCE = "media_transmittance"    # and their transmittance (R)
 
 
 def distance_desc(size) -> TextureDesc:
@@ -29,16 +43,42 @@ def distance_desc(size) -> TextureDesc:
     return TextureDesc(tuple(size), components=2, dtype="f4", filter="nearest")
 
 
+def media_mix(light_a, t_a, light_b, t_b) -> np.ndarray:
+    """float64 (..., 3): the light of two media on one ray, each alone giving (light (..., 3), grey
+    transmittance (...,)), mixed in proportion (their extinctions in one ratio all along the ray):
+    (1 − T_a T_b) / (τ_a + τ_b) · (L_a τ_a / (1 − T_a) + L_b τ_b / (1 − T_b)), τ = −ln T; together they
+    transmit T_a T_b. Either alone (T = 1, L = 0 for the other) gives itself back."""
+    def tau(t):
+        return -np.log(np.clip(np.asarray(t, np.float64), 1e-30, 1.0))
+
+    def per_depth(t, x):            # τ / (1 − T), 1 + τ/2 as τ → 0
+        return np.where(x < 1e-4, 1.0 + 0.5 * x, x / np.maximum(1.0 - np.asarray(t, np.float64), 1e-300))
+
+    ta, tb = tau(t_a), tau(t_b)
+    total = ta + tb
+    share = np.where(total < 1e-4, 1.0 - 0.5 * total, -np.expm1(-total) / np.maximum(total, 1e-300))
+    return share[..., None] * (np.asarray(light_a, np.float64) * per_depth(t_a, ta)[..., None]
+                               + np.asarray(light_b, np.float64) * per_depth(t_b, tb)[..., None])
+
+
 @dataclass
 class Composition:
-    """App resource: which plugins write ``"cloud_distance"`` and which read it (names)."""
+    """App resource: which plugins write ``"cloud_distance"`` and which read it (names); which local
+    media write ``"media_light"``/``"media_transmittance"`` and which passes read them."""
     writers: set = field(default_factory=set)
     readers: set = field(default_factory=set)
+    media_writers: set = field(default_factory=set)
+    media_readers: set = field(default_factory=set)
 
     @property
     def distance(self) -> bool:
         """True when the distance is both written and read: the writer creates it, the readers read it."""
         return bool(self.writers) and bool(self.readers)
+
+    @property
+    def media(self) -> bool:
+        """True when a local medium writes the media targets and a pass reads them."""
+        return bool(self.media_writers) and bool(self.media_readers)
 
 
 class ClearDistance(RenderPass):
@@ -59,12 +99,35 @@ class ClearDistance(RenderPass):
         frame.framebuffer(color=[CLOUD_DISTANCE]).clear(0.0, 0.0, 0.0, 0.0)
 
 
+class ClearMedia(RenderPass):
+    """Pass "media_clear" (phase clear): creates ``"media_light"`` (RGBA float32, cleared to 0) and
+    ``"media_transmittance"`` (R float32, cleared to 1) at the frame's size when the Composition's
+    media are written and read; else declares nothing (culled)."""
+    name = "media_clear"
+    phase = "clear"
+
+    def __init__(self, comp: Composition, gpu):
+        self.comp, self.gpu = comp, gpu
+
+    def setup(self, builder) -> None:
+        if self.comp.media:
+            size = tuple(self.gpu.size)
+            builder.create(MEDIA_LIGHT, TextureDesc(size, components=4, dtype="f4", filter="nearest"))
+            builder.create(MEDIA_TRANSMITTANCE, TextureDesc(size, components=1, dtype="f4", filter="nearest"))
+
+    def execute(self, frame) -> None:
+        frame.framebuffer(color=[MEDIA_LIGHT]).clear(0.0, 0.0, 0.0, 0.0)
+        frame.framebuffer(color=[MEDIA_TRANSMITTANCE]).clear(1.0, 1.0, 1.0, 1.0)
+
+
 def composition(app) -> Composition:
-    """The App's :class:`Composition` (made on first use, with its :class:`ClearDistance` pass)."""
+    """The App's :class:`Composition` (made on first use, with its :class:`ClearDistance` and
+    :class:`ClearMedia` passes)."""
     comp = app.get_resource(Composition)
     if comp is None:
         comp = Composition()
         app.insert_resource(comp)
         if app.graph is not None:
             app.graph.add_pass(ClearDistance(comp, app.gpu))
+            app.graph.add_pass(ClearMedia(comp, app.gpu))
     return comp

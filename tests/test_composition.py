@@ -205,3 +205,24 @@ def test_fog_attenuates_the_far_field_by_its_own_distance(gpu, ctx):
     sky = (a == 0) & (dirs[..., 1] >= 0.0)
     assert np.array_equal(fogged[sky], clear[sky]), "the open sky is kept"
     app.close()
+
+
+def test_media_mix_reduces_to_each_medium_alone_and_never_counts_light_twice(rng):
+    """atmos.composition.media_mix (the float64 twin of lib/media_mix.glsl): the other medium absent
+    (T = 1, no light) gives each back; two media of one colour c are one medium, c (1 - T_a T_b);
+    symmetric; an opaque medium's colour wins over a thin one's; thin media add."""
+    from atmos.composition import media_mix
+    n = 64
+    t_a, t_b = rng.uniform(0.0, 1.0, n), rng.uniform(0.0, 1.0, n)
+    c_a, c_b = rng.uniform(0.0, 2.0, (n, 3)), rng.uniform(0.0, 2.0, (n, 3))
+    l_a, l_b = c_a * (1 - t_a)[:, None], c_b * (1 - t_b)[:, None]
+    none = np.zeros((n, 3))
+    assert np.allclose(media_mix(l_a, t_a, none, np.ones(n)), l_a) and np.allclose(media_mix(none, np.ones(n), l_b, t_b), l_b)
+    same = media_mix(c_a * (1 - t_a)[:, None], t_a, c_a * (1 - t_b)[:, None], t_b)
+    assert np.allclose(same, c_a * (1 - t_a * t_b)[:, None])
+    assert np.allclose(media_mix(l_a, t_a, l_b, t_b), media_mix(l_b, t_b, l_a, t_a))
+    opaque = media_mix(c_a * (1 - 1e-12), np.full(n, 1e-12), l_b * 1e-3, 1 - (1 - t_b) * 1e-3)
+    assert np.allclose(opaque, c_a, rtol=1e-3, atol=1e-4)          # the thin one keeps tau_b / (tau_a + tau_b) < 4e-5
+    thin = media_mix(c_a * 1e-6, np.full(n, 1 - 1e-6), c_b * 1e-6, np.full(n, 1 - 1e-6))
+    assert np.allclose(thin, (c_a + c_b) * 1e-6, rtol=1e-5)
+    assert np.isfinite(media_mix(l_a, np.zeros(n), l_b, np.zeros(n))).all()

@@ -54,7 +54,7 @@ def test_cloud_demos_render_with_the_ray_march_and_key_c_switches_the_renderer(n
 @pytest.mark.parametrize("name", ["sunset", "flight"])
 def test_hazy_demos_take_the_air_instead_of_the_fog(name):
     """``haze="air"``: the physical sky's aerial perspective hazes terrain and clouds, no fog pass runs
-    (the two would count the air's light twice); the frame differs from the fog's and is not blank."""
+    (the demo takes one haze or the other); the frame differs from the fog's and is not blank."""
     gpu = create_headless((96, 54))
     images = {}
     try:

@@ -36,6 +36,7 @@ class FogPlugin(Plugin):
     def build(self, app) -> None:
         self.composition = composition(app)
         self.composition.readers.add("fog")       # clouds fogged by their own distance
+        self.composition.media_writers.add("fog")  # a local medium the aerial perspective mixes with
         self.fog_pass = FogPass(self)
         app.graph.add_pass(self.fog_pass)
 
@@ -58,6 +59,7 @@ class FogPlugin(Plugin):
     def cleanup(self, app) -> None:
         if self.composition is not None:
             self.composition.readers.discard("fog")
+            self.composition.media_writers.discard("fog")
         if self.fog_pass is not None:
             self.fog_pass.release()
 

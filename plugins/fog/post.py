@@ -6,7 +6,7 @@ import math
 import numpy as np
 
 from atmos.camera import set_camera_uniforms
-from atmos.composition import CLOUD_DISTANCE
+from atmos.composition import CLOUD_DISTANCE, MEDIA_LIGHT, MEDIA_TRANSMITTANCE
 from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.graph.frame import BLEND_TRANSMITTANCE, blend
 from atmos.plugins.fog.noise import NoiseVolumes, octave_key
@@ -18,13 +18,14 @@ FRAGMENT = "fog/fog.frag"
 VERTEX = "lib/fullscreen.vert"
 
 
-def fog_program(gpu, settings, from_depth: bool, clouds: bool = False):
+def fog_program(gpu, settings, from_depth: bool, clouds: bool = False, media: bool = False):
     """The fog program for ``settings`` from ``gpu``'s cache (one variant per mode, octave count,
-    noise kind, colour source and whether clouds give their own distance)."""
+    noise kind, colour source, whether clouds give their own distance and whether it also writes the
+    media targets, :mod:`atmos.composition`)."""
     defines = {"FOG_MODE": MODES[settings.mode], "FOG_OCTAVES": settings.octaves,
                "FOG_PROCEDURAL": int(settings.noise == "procedural"), "FOG_FROM_DEPTH": int(from_depth),
                "FOG_CLOUDS": int(clouds), "FOG_SKY_COLOR": int(settings.color_from == "sky"),
-               "FOG_HORIZON_SAMPLES": SAMPLES}
+               "FOG_HORIZON_SAMPLES": SAMPLES, "FOG_MEDIA": int(media)}
     return gpu.program(defines, vertex_shader=VERTEX, fragment_shader=FRAGMENT)
 
 
@@ -91,14 +92,18 @@ class FogPass(RenderPass):
         builder.write(COLOR)
         if self.plugin.composition.distance:   # the clouds' own distance (atmos.composition)
             builder.read(CLOUD_DISTANCE)
+        if self.plugin.composition.media:      # the aerial perspective mixes the air with the fog
+            for name in (MEDIA_LIGHT, MEDIA_TRANSMITTANCE):
+                builder.read(name)
+                builder.write(name)
 
     def prepare(self, gpu) -> None:
         self.gpu = gpu
         self._sync(self.plugin.settings)
 
-    def _sync(self, settings, clouds: bool = False):
+    def _sync(self, settings, clouds: bool = False, media: bool = False):
         """Compile the variant and (re)make noise volumes when the settings need other ones."""
-        prog = fog_program(self.gpu, settings, from_depth=True, clouds=clouds)
+        prog = fog_program(self.gpu, settings, from_depth=True, clouds=clouds, media=media)
         wants = settings.heterogeneous and settings.noise == "texture"
         if self.volumes is not None and (not wants or not self.volumes.matches(settings)):
             self.volumes.release()
@@ -108,11 +113,11 @@ class FogPass(RenderPass):
         return prog
 
     def execute(self, frame: PassContext) -> None:
-        view, gpu = frame.view, frame.gpu
+        view = frame.view
         settings = self.plugin.settings
-        clouds = frame.declares(CLOUD_DISTANCE)
-        prog = self._sync(settings, clouds)
-        frame.framebuffer(color=[COLOR]).use()
+        clouds, media = frame.declares(CLOUD_DISTANCE), frame.declares(MEDIA_LIGHT)
+        prog = self._sync(settings, clouds, media)
+        frame.framebuffer(color=[COLOR, MEDIA_LIGHT, MEDIA_TRANSMITTANCE] if media else [COLOR]).use()
         frame.blend_transmittance()
         frame.resource(DEPTH).use(0)
         if clouds:

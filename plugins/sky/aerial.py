@@ -7,7 +7,9 @@ sky's own atmosphere and LUTs (``shaders/sky/aerial.frag``; float64:
 :func:`atmos.plugins.sky.atmosphere.aerial_perspective`). Distant hills turn the sky's blue by day and
 its orange at sunset, with no fog colour to choose. Clouds that give the media passes their own distance
 (:mod:`atmos.composition`) are hazed by it. It runs after the other media passes (local fog lies in
-front of the surfaces it covers; the atmosphere spans the whole ray). Culled with Preetham or off.
+front of the surfaces it covers; the atmosphere spans the whole ray); with a fog it mixes the air with
+the fog along the ray (:mod:`atmos.composition` media_mix): an opaque fog hides the air behind it, and
+neither medium's light is counted twice. Culled with Preetham or off.
 
 With ``SkySettings.aerial_froxels`` (default (32, 32, 64)) the pass first fills the transient
 "aerial_volume", a froxel volume: each froxel column's ray marched slice by slice (slices squared out
@@ -22,7 +24,7 @@ import math
 import numpy as np
 
 from atmos.camera import set_camera_uniforms, view_basis
-from atmos.composition import CLOUD_DISTANCE
+from atmos.composition import CLOUD_DISTANCE, MEDIA_LIGHT, MEDIA_TRANSMITTANCE
 from atmos.gpu import clamp_sampler
 from atmos.graph import FullscreenPass, PassContext, TextureDesc
 from atmos.lighting import unit_sun
@@ -32,6 +34,7 @@ from atmos.render_core import COLOR, DEPTH
 AERIAL = "aerial_perspective"
 AERIAL_VOLUME = "aerial_volume"          # the froxel volume (a transient of this pass)
 VOLUME_UNIT = 3                          # aerial.frag samples it here
+MEDIA_UNITS = (4, 5)                     # and the local media (atmos.composition) here
 GROUP = 8                                # aerial_volume.comp's work group: 8 x 8 froxel columns
 
 
@@ -65,9 +68,13 @@ class AerialPerspectivePass(FullscreenPass):
     def clouds(self) -> bool:
         return self.plugin.composition.distance
 
+    def media(self) -> bool:
+        return self.plugin.composition.media
+
     def defines(self) -> dict:
         return {**atmosphere_defines(), "AERIAL_STEPS": self.plugin.settings.aerial_steps,
-                "AERIAL_CLOUDS": int(self.clouds()), "AERIAL_VOLUME": int(self.froxels() is not None)}
+                "AERIAL_CLOUDS": int(self.clouds()), "AERIAL_VOLUME": int(self.froxels() is not None),
+                "AERIAL_MEDIA": int(self.media())}
 
     def froxels(self):
         return self.plugin.settings.aerial_froxels
@@ -83,6 +90,9 @@ class AerialPerspectivePass(FullscreenPass):
         builder.read(SKY_LUTS)
         if self.clouds():
             builder.read(CLOUD_DISTANCE)
+        if self.media():                        # a fog in front: the air mixed with it (atmos.composition)
+            builder.read(MEDIA_LIGHT)
+            builder.read(MEDIA_TRANSMITTANCE)
 
     def prepare(self, gpu) -> None:
         super().prepare(gpu)
@@ -112,6 +122,9 @@ class AerialPerspectivePass(FullscreenPass):
         frame.resource(DEPTH).use(0)
         if frame.declares(CLOUD_DISTANCE):
             frame.resource(CLOUD_DISTANCE).use(2)
+        if frame.declares(MEDIA_LIGHT):
+            for name, unit in zip((MEDIA_LIGHT, MEDIA_TRANSMITTANCE), MEDIA_UNITS):
+                frame.resource(name).use(unit)
         set_camera_uniforms(p, view.camera, view.aspect)
         set_atmosphere_uniforms(p, settings.atmosphere)
         for name, value in values.items():

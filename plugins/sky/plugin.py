@@ -115,13 +115,15 @@ class SkyPlugin(Plugin):
         return settings
 
     def _read_distance(self) -> None:
-        """The aerial perspective reads the clouds' own distance (atmos.composition) while it is on."""
+        """The aerial perspective reads the clouds' own distance and the local media (atmos.composition)
+        while it is on."""
         if self.composition is None:
             return
-        if active(self.settings):
-            self.composition.readers.add(AERIAL)
-        else:
-            self.composition.readers.discard(AERIAL)
+        for readers in (self.composition.readers, self.composition.media_readers):
+            if active(self.settings):
+                readers.add(AERIAL)
+            else:
+                readers.discard(AERIAL)
 
     def finish(self, app) -> None:
         labels = {s.label for s in app.schedule.systems}
@@ -133,6 +135,7 @@ class SkyPlugin(Plugin):
         self._release_luts()
         if self.composition is not None:
             self.composition.readers.discard(AERIAL)
+            self.composition.media_readers.discard(AERIAL)
         self._drop_sun_path(app.get_resource(Sun))
 
     def _luts(self) -> AtmosphereLuts:

@@ -10,6 +10,9 @@
 // (sky/aerial_volume.comp: the air's colour and extinction, read trilinearly at (uv, the slice of d,
 // sky/aerial_slices.glsl)); a ray longer than its range (far clouds), or whose froxels straddle the
 // horizon, marches itself. float64 reference: plugins/sky/atmosphere.py aerial_perspective.
+// AERIAL_MEDIA 1: a local medium (the fog) has blended its (L_l, T_l) over the colour already, C1 =
+// C T_l + L_l, and left them in "media_light"/"media_transmittance" (atmos/composition.py): the air and
+// it mixed along the ray give C T_l T_a + media_mix(air, local), i.e. media_mix - T_a L_l blended over C1.
 in vec2 v_uv;
 out vec4 frag;
 layout(binding = 0) uniform sampler2D scene_depth;
@@ -30,6 +33,11 @@ vec4 aerial(vec3 dir, float distance) {
     vec3 light = atm_aerial(view_r, dir.y, sun_dir.y, dot(dir, sun_dir), distance, AERIAL_STEPS, transmittance);
     return vec4(light, dot(transmittance, vec3(1.0 / 3.0)));
 }
+#if AERIAL_MEDIA
+#include "lib/media_mix.glsl"
+layout(binding = 4) uniform sampler2D media_light;
+layout(binding = 5) uniform sampler2D media_transmittance;
+#endif
 #if AERIAL_VOLUME
 #include "sky/aerial_slices.glsl"
 layout(binding = 3) uniform sampler3D aerial_volume;
@@ -72,6 +80,11 @@ void main() {
 #if AERIAL_CLOUDS
     vec2 cloud = cloud_cover_distance(texelFetch(cloud_distance, ivec2(gl_FragCoord.xy), 0).rg);
     if (cloud.x > 0.0) ap = cloud.x * aerial_at(dir, cloud.y) + (1.0 - cloud.x) * ap;
+#endif
+#if AERIAL_MEDIA
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    vec4 local = vec4(texelFetch(media_light, px, 0).rgb, texelFetch(media_transmittance, px, 0).r);
+    ap = vec4(media_mix(ap, local) - ap.a * local.rgb, ap.a);
 #endif
     frag = ap;
 }
