@@ -81,43 +81,54 @@ class Composition:
         return bool(self.media_writers) and bool(self.media_readers)
 
 
-class ClearDistance(RenderPass):
-    """Pass "cloud_distance_clear" (phase clear): creates ``"cloud_distance"`` at the frame's size and
-    clears it to 0 (no layer) when the Composition has a writer and a reader; else declares nothing
-    (culled)."""
+class CompositionClear(RenderPass):
+    """A pass of phase clear that creates a Composition's shared targets at the frame's size and clears
+    them when its plugins both write and read them (:meth:`wanted`); else declares nothing (culled).
+    ``targets(size)``: (name, TextureDesc, clear value) of each."""
+    phase = "clear"
+
+    def __init__(self, comp: Composition, gpu):
+        self.comp, self.gpu = comp, gpu
+
+    def wanted(self) -> bool:
+        raise NotImplementedError
+
+    def targets(self, size) -> tuple:
+        raise NotImplementedError
+
+    def setup(self, builder) -> None:
+        if self.wanted():
+            for name, desc, _ in self.targets(tuple(self.gpu.size)):
+                builder.create(name, desc)
+
+    def execute(self, frame) -> None:
+        for name, _, value in self.targets(tuple(self.gpu.size)):
+            frame.framebuffer(color=[name]).clear(value, value, value, value)
+
+
+class ClearDistance(CompositionClear):
+    """Pass "cloud_distance_clear": ``"cloud_distance"`` cleared to 0 (no layer) when the Composition
+    has a writer and a reader."""
     name = "cloud_distance_clear"
-    phase = "clear"
 
-    def __init__(self, comp: Composition, gpu):
-        self.comp, self.gpu = comp, gpu
+    def wanted(self) -> bool:
+        return self.comp.distance
 
-    def setup(self, builder) -> None:
-        if self.comp.distance:
-            builder.create(CLOUD_DISTANCE, distance_desc(self.gpu.size))
-
-    def execute(self, frame) -> None:
-        frame.framebuffer(color=[CLOUD_DISTANCE]).clear(0.0, 0.0, 0.0, 0.0)
+    def targets(self, size) -> tuple:
+        return ((CLOUD_DISTANCE, distance_desc(size), 0.0),)
 
 
-class ClearMedia(RenderPass):
-    """Pass "media_clear" (phase clear): creates ``"media_light"`` (RGBA float32, cleared to 0) and
-    ``"media_transmittance"`` (R float32, cleared to 1) at the frame's size when the Composition's
-    media are written and read; else declares nothing (culled)."""
+class ClearMedia(CompositionClear):
+    """Pass "media_clear": ``"media_light"`` (RGBA float32, cleared to 0) and ``"media_transmittance"``
+    (R float32, cleared to 1) when the Composition's media are written and read."""
     name = "media_clear"
-    phase = "clear"
 
-    def __init__(self, comp: Composition, gpu):
-        self.comp, self.gpu = comp, gpu
+    def wanted(self) -> bool:
+        return self.comp.media
 
-    def setup(self, builder) -> None:
-        if self.comp.media:
-            size = tuple(self.gpu.size)
-            builder.create(MEDIA_LIGHT, TextureDesc(size, components=4, dtype="f4", filter="nearest"))
-            builder.create(MEDIA_TRANSMITTANCE, TextureDesc(size, components=1, dtype="f4", filter="nearest"))
-
-    def execute(self, frame) -> None:
-        frame.framebuffer(color=[MEDIA_LIGHT]).clear(0.0, 0.0, 0.0, 0.0)
-        frame.framebuffer(color=[MEDIA_TRANSMITTANCE]).clear(1.0, 1.0, 1.0, 1.0)
+    def targets(self, size) -> tuple:
+        return ((MEDIA_LIGHT, TextureDesc(size, components=4, dtype="f4", filter="nearest"), 0.0),
+                (MEDIA_TRANSMITTANCE, TextureDesc(size, components=1, dtype="f4", filter="nearest"), 1.0))
 
 
 def composition(app) -> Composition:
