@@ -6,7 +6,7 @@ import math
 import numpy as np
 
 from atmos.camera import set_camera_uniforms
-from atmos.composition import CLOUD_DISTANCE, MEDIA_LIGHT, MEDIA_TRANSMITTANCE
+from atmos.composition import CLOUD_DISTANCE, MEDIA_LIGHT, blend_onto_media, medium_targets
 from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.graph.frame import BLEND_TRANSMITTANCE, blend
 from atmos.plugins.fog.noise import NoiseVolumes, octave_key
@@ -25,7 +25,7 @@ def fog_program(gpu, settings, from_depth: bool, clouds: bool = False, media: bo
     defines = {"FOG_MODE": MODES[settings.mode], "FOG_OCTAVES": settings.octaves,
                "FOG_PROCEDURAL": int(settings.noise == "procedural"), "FOG_FROM_DEPTH": int(from_depth),
                "FOG_CLOUDS": int(clouds), "FOG_SKY_COLOR": int(settings.color_from == "sky"),
-               "FOG_HORIZON_SAMPLES": SAMPLES, "FOG_MEDIA": int(media)}
+               "FOG_HORIZON_SAMPLES": SAMPLES, "LOCAL_MEDIA": int(media)}
     return gpu.program(defines, vertex_shader=VERTEX, fragment_shader=FRAGMENT)
 
 
@@ -92,10 +92,7 @@ class FogPass(RenderPass):
         builder.write(COLOR)
         if self.plugin.composition.distance:   # the clouds' own distance (atmos.composition)
             builder.read(CLOUD_DISTANCE)
-        if self.plugin.composition.media:      # the aerial perspective mixes the air with the fog
-            for name in (MEDIA_LIGHT, MEDIA_TRANSMITTANCE):
-                builder.read(name)
-                builder.write(name)
+        blend_onto_media(builder, self.plugin.composition)   # the aerial perspective mixes the air with it
 
     def prepare(self, gpu) -> None:
         self.gpu = gpu
@@ -117,7 +114,7 @@ class FogPass(RenderPass):
         settings = self.plugin.settings
         clouds, media = frame.declares(CLOUD_DISTANCE), frame.declares(MEDIA_LIGHT)
         prog = self._sync(settings, clouds, media)
-        frame.framebuffer(color=[COLOR, MEDIA_LIGHT, MEDIA_TRANSMITTANCE] if media else [COLOR]).use()
+        frame.framebuffer(color=medium_targets(frame, COLOR)).use()
         frame.blend_transmittance()
         frame.resource(DEPTH).use(0)
         if clouds:

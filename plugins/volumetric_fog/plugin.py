@@ -4,6 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from atmos.camera import set_camera_uniforms
+from atmos.composition import blend_onto_media, composition, medium_targets
 from atmos.graph import FullscreenPass, PassContext
 from atmos.lighting import Sun, sun_and_day
 from atmos.plugin import Plugin
@@ -41,9 +42,16 @@ class VolumetricFogPass(FullscreenPass):
     fragment = "volumetric_fog/fog.frag"
     reads = (COLOR, DEPTH)
 
+    def setup(self, builder) -> None:
+        super().setup(builder)
+        blend_onto_media(builder, self.plugin.composition)   # the aerial perspective mixes the air with it
+
+    def defines(self) -> dict:
+        return {"LOCAL_MEDIA": int(self.plugin.composition.media)}
+
     def execute(self, frame: PassContext) -> None:
         view, p = frame.view, self.program
-        frame.framebuffer(color=[COLOR]).use()
+        frame.framebuffer(color=medium_targets(frame, COLOR)).use()
         frame.blend_transmittance()
         frame.resource(DEPTH).use(0)
         set_camera_uniforms(p, view.camera, view.aspect)
@@ -64,4 +72,9 @@ class VolumetricFogPlugin(Plugin):
         return float(view.time) if self.settings.animate else 0.0
 
     def build(self, app) -> None:
+        self.composition = composition(app)
+        self.composition.media_writers.add(VolumetricFogPass.name)   # a local medium (atmos.composition)
         app.graph.add_pass(VolumetricFogPass(self))
+
+    def cleanup(self, app) -> None:
+        self.composition.media_writers.discard(VolumetricFogPass.name)

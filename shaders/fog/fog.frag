@@ -5,15 +5,11 @@
 // 0 (apply_fog): from a distance texture (+inf = sky) and a world-position texture.
 // FOG_CLOUDS 1: "cloud_distance" (premultiplied (a·d, a), atmos/composition.py) fogs the clouds by
 // their own distance: f = a f(d_cloud) + (1 - a) f(d_behind). FOG_SKY_COLOR 1: the fog colour is
-// fog_color × the sky's horizon radiance in the ray's azimuth (plugins/fog/sky_color.py). FOG_MEDIA 1:
-// the same (light, transmittance) also onto "media_light" and "media_transmittance" (the local media
-// the aerial perspective mixes the air with, atmos/composition.py), blended alike.
+// fog_color × the sky's horizon radiance in the ray's azimuth (plugins/fog/sky_color.py). LOCAL_MEDIA 1:
+// the same onto the media targets (lib/media_out.glsl).
 in vec2 v_uv;
 out vec4 frag;
-#if FOG_MEDIA
-layout(location = 1) out vec4 media_light;
-layout(location = 2) out vec4 media_transmittance;
-#endif
+#include "lib/media_out.glsl"
 #include "fog/factor.glsl"
 uniform int fog_sky_keep;    // 1: sky pixels are left to the sky
 #if FOG_CLOUDS
@@ -70,8 +66,5 @@ void main() {
     if (cloud.x > 0.0) f = cloud.x * fog_factor(cloud.y, eye + dir * cloud.y) + (1.0 - cloud.x) * f;
 #endif
     frag = vec4(in_color(dir) * (1.0 - f), f);
-#if FOG_MEDIA
-    media_light = frag;
-    media_transmittance = vec4(0.0, 0.0, 0.0, f);     // blended: T_target = 0 + f · T_target
-#endif
+    write_media(frag);
 }
