@@ -88,8 +88,8 @@ def _clouds_option(command) -> None:
                               "atmosphere after Hillaire 2020, which also lights the sun and ambient (default physical)")
     command.add_argument("--haze", choices=HAZES, default="fog",
                          help="distance haze of the hazy demos (sunset, flight): an exponential fog toward the "
-                              "sky's colour, or the physical sky's aerial perspective, Earth's own air (needs "
-                              "--sky physical; default fog)")
+                              "sky's colour, the physical sky's aerial perspective, Earth's own air, or both mixed "
+                              "along each ray (air and both need --sky physical; default fog)")
 
 
 def cmd_info(args) -> int:
@@ -171,9 +171,10 @@ def main(argv: list[str] | None = None) -> int:
     from atmos.output import OutputError
     top = parser()
     args = top.parse_args(argv)
-    conflict = haze_conflict(getattr(args, "haze", "fog"), getattr(args, "sky", "physical"))
+    haze = getattr(args, "haze", "fog")
+    conflict = haze_conflict(haze, getattr(args, "sky", "physical"))
     if conflict:
-        top.error(f"--haze air is {conflict} (--sky physical)")
+        top.error(f"--haze {haze} is {conflict} (--sky physical)")
     commands = {"info": lambda: cmd_info(args), "demo": lambda: cmd_demo(args, top), "run": lambda: cmd_run(args, top),
                 "graph": lambda: cmd_graph(args, top)}
     if args.command not in commands:

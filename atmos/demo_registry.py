@@ -10,13 +10,14 @@ from atmos.checks import check_choice
 DEFAULT_DEMO = "sunset"
 CLOUD_RENDERERS = ("sprites", "march")
 SKY_MODELS = ("preetham", "physical")      # atmos.plugins.sky.MODELS (kept here so the CLI imports no plugin)
-HAZES = ("fog", "air")      # the hazy demos' distance haze: a FogPlugin toward the sky, or the physical sky's aerial perspective
+HAZES = ("fog", "air", "both")   # the hazy demos' distance haze: a FogPlugin toward the sky, the physical sky's
+                                 # aerial perspective, or both mixed along each ray (atmos.composition)
 
 
 def haze_conflict(haze: str, sky: str) -> str | None:
     """Why ``haze`` cannot go with ``sky`` (the end of a message; None: it can). The one rule that
     DemoSettings, ``atmos.run`` and the CLI state in their own words."""
-    if haze == "air" and sky != "physical":
+    if haze in ("air", "both") and sky != "physical":
         return f"the physical sky's aerial perspective: it needs sky='physical', got sky={sky!r}"
     return None
 
@@ -29,7 +30,7 @@ class DemoSettings:
     headless: bool = False
     clouds: str = "sprites"       # the cloud scenes' renderer: point sprites or the ray march (key C flips it)
     sky: str = "physical"         # the sky's model in the demos with a sky (SkySettings.model)
-    haze: str = "fog"             # sunset's and flight's haze: "fog" (FogPlugin toward the sky) or "air" (aerial perspective)
+    haze: str = "fog"             # sunset's and flight's haze: "fog" (FogPlugin toward the sky), "air" (aerial perspective) or "both"
 
     def __post_init__(self):
         check_choice("DemoSettings", "clouds", self.clouds, CLOUD_RENDERERS)
@@ -37,7 +38,7 @@ class DemoSettings:
         check_choice("DemoSettings", "haze", self.haze, HAZES)
         conflict = haze_conflict(self.haze, self.sky)
         if conflict:
-            raise ValueError(f"DemoSettings.haze 'air' is {conflict} (or take haze='fog')")
+            raise ValueError(f"DemoSettings.haze {self.haze!r} is {conflict} (or take haze='fog')")
 
 
 def list_demos() -> dict[str, str]:

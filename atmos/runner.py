@@ -195,7 +195,7 @@ def run(game, *, size: tuple[int, int] = (960, 540), title: str | None = None, h
     ``clouds``: the cloud renderer a cloud scene uses, "sprites" (point sprites) or "march" (the ray
     march), like ``atmos demo --clouds`` (the demos ``sunset``, ``flight`` and ``weather`` read it);
     ``sky``: "preetham" or "physical", like ``atmos demo --sky`` (the demos with a sky read it);
-    ``haze``: "fog" or "air" (the physical sky's aerial perspective), like ``atmos demo --haze``.
+    ``haze``: "fog", "air" (the physical sky's aerial perspective) or "both", like ``atmos demo --haze``.
     Headless: ``frames`` frames (default the game's ``DEFAULT_FRAMES`` or 90) at 1/30 s, written to
     ``out`` (``.mp4``, ``.gif``, ``.png`` or a folder) if given; returns what was written. Windowed:
     until the window closes (or ``frames`` frames); returns None."""
@@ -208,7 +208,7 @@ def run(game, *, size: tuple[int, int] = (960, 540), title: str | None = None, h
     haze = check_choice("atmos.run", "haze", haze, HAZES)
     conflict = haze_conflict(haze, sky)
     if conflict:
-        raise ValueError(f"atmos.run haze='air' is {conflict}")
+        raise ValueError(f"atmos.run haze={haze!r} is {conflict}")
     if headless is None:
         problem = display_problem()
         headless = problem is not None

@@ -40,8 +40,9 @@ def build_cloudscape(app, settings, *, hours: float, speed: float = 0.0, cloud_d
     """Add the whole scene to ``app``; returns the CloudsPlugin (``configure(weather={"cloud_density": n})``
     changes the cover live). ``haze``: a distance haze that hazes terrain and clouds by their own
     distance (:mod:`atmos.composition`), as ``settings.haze`` says: "fog", an exponential fog toward
-    the horizon sky's colour (thicker than clear air: the stylised look), or "air", the physical
-    sky's aerial perspective (its own atmosphere and LUTs, ``SkySettings.aerial_perspective``). ``horizon``:
+    the horizon sky's colour (thicker than clear air: the stylised look), "air", the physical sky's
+    aerial perspective (its own atmosphere and LUTs, ``SkySettings.aerial_perspective``), or "both",
+    the air mixed with the fog along each ray (:func:`atmos.composition.media_mix`). ``horizon``:
     clouds to the horizon, the volume fading out over its outer EDGE_FADE into the far field
     (:mod:`atmos.plugins.cloud_far_field`)."""
     weather = example_weather(SHAPE, cloud_density=cloud_density, wind=wind)
@@ -51,7 +52,7 @@ def build_cloudscape(app, settings, *, hours: float, speed: float = 0.0, cloud_d
     app.insert_resource(VolumeOrigin(-SHAPE[0] / 2, 0.0, -SHAPE[2] / 2))
     app.add_plugins(DefaultPlugins(overlay=not settings.headless),
                     DaylightPlugin(hours=hours, speed=speed),
-                    SkyPlugin(model=settings.sky, aerial_perspective=haze and settings.haze == "air"),
+                    SkyPlugin(model=settings.sky, aerial_perspective=haze and settings.haze in ("air", "both")),
                     TerrainPlugin(size=40000.0, cells=71, relief=500.0),
                     cloud_plugin,
                     CloudShadowsPlugin(),
@@ -61,7 +62,7 @@ def build_cloudscape(app, settings, *, hours: float, speed: float = 0.0, cloud_d
     app.add_system(switch_key, "update", label="cloud_renderer_switch")
     if horizon:
         app.add_plugins(CloudFarFieldPlugin())
-    if haze and settings.haze == "fog":
+    if haze and settings.haze in ("fog", "both"):
         app.add_plugins(FogPlugin(mode="exp", density=4e-5, sky="keep", color_from="sky", fog_color=(1.0, 1.0, 1.0)))
     app.frames.slices_per_frame = slices_per_frame
     cam = app.resource(Camera)

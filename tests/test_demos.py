@@ -52,31 +52,35 @@ def test_cloud_demos_render_with_the_ray_march_and_key_c_switches_the_renderer(n
 
 
 @pytest.mark.parametrize("name", ["sunset", "flight"])
-def test_hazy_demos_take_the_air_instead_of_the_fog(name):
-    """``haze="air"``: the physical sky's aerial perspective hazes terrain and clouds, no fog pass runs
-    (the demo takes one haze or the other); the frame differs from the fog's and is not blank."""
+def test_hazy_demos_take_the_air_the_fog_or_both(name):
+    """``haze="air"``: the physical sky's aerial perspective hazes terrain and clouds, no fog pass runs;
+    ``"both"``: the fog and the air mixed along each ray (the media targets between them); each frame
+    differs from the fog's and is not blank."""
     gpu = create_headless((96, 54))
     images = {}
     try:
-        for haze in ("fog", "air"):
+        for haze in ("fog", "air", "both"):
             app = build_app(name, DemoSettings(size=gpu.size, headless=True, frames=2, haze=haze), gpu)
             app.run_frames(2, 1 / 30)
             images[haze] = gpu.read_pixels().astype(float)
             assert gpu.ctx.error == "GL_NO_ERROR"
             passes = kept(app)
-            assert ("aerial_perspective" in passes) == (haze == "air")
-            assert ("fog" in passes) == (haze == "fog")
+            assert ("aerial_perspective" in passes) == (haze != "fog")
+            assert ("fog" in passes) == (haze != "air")
+            assert ("media_clear" in passes) == (haze == "both")
             app.close()
     finally:
         gpu.release()
-    assert images["air"].max() > 20 and images["air"].std() > 3, f"{name} with the air renders a blank image"
-    assert abs(images["air"] - images["fog"]).mean() > 1.0, "the haze changes the image"
+    for haze in ("air", "both"):
+        assert images[haze].max() > 20 and images[haze].std() > 3, f"{name} with {haze} renders a blank image"
+        assert abs(images[haze] - images["fog"]).mean() > 1.0, "the haze changes the image"
 
 
 def test_demo_settings_name_the_cloud_renderers():
     with pytest.raises(ValueError, match="DemoSettings.clouds must be one of 'sprites', 'march', got 'voxels'"):
         DemoSettings(clouds="voxels")
-    with pytest.raises(ValueError, match="DemoSettings.haze must be one of 'fog', 'air', got 'smoke'"):
+    with pytest.raises(ValueError, match="DemoSettings.haze must be one of 'fog', 'air', 'both', got 'smoke'"):
         DemoSettings(haze="smoke")
-    with pytest.raises(ValueError, match="haze 'air' is the physical sky's aerial perspective: it needs sky='physical'"):
-        DemoSettings(sky="preetham", haze="air")
+    for haze in ("air", "both"):
+        with pytest.raises(ValueError, match=f"haze '{haze}' is the physical sky's aerial perspective: it needs sky='physical'"):
+            DemoSettings(sky="preetham", haze=haze)

@@ -118,7 +118,7 @@ def test_atmos_run_chooses_the_cloud_renderer_like_the_demo_option(tmp_path):
     for bad in ("voxels", None, 2):
         with pytest.raises(ValueError, match=r"atmos\.run\.clouds must be one of 'sprites', 'march', got "):
             atmos.run(build, size=(32, 18), frames=1, headless=True, clouds=bad)
-    with pytest.raises(ValueError, match=r"atmos\.run\.haze must be one of 'fog', 'air', got 'smoke'"):
+    with pytest.raises(ValueError, match=r"atmos\.run\.haze must be one of 'fog', 'air', 'both', got 'smoke'"):
         atmos.run(build, size=(32, 18), frames=1, headless=True, haze="smoke")
     with pytest.raises(ValueError, match=r"haze='air' is the physical sky's aerial perspective: it needs sky='physical'"):
         atmos.run(build, size=(32, 18), frames=1, headless=True, sky="preetham", haze="air")
