@@ -668,3 +668,23 @@ def test_at_dusk_the_tops_keep_the_sun_after_the_bases_lose_it(gpu, ctx, rendere
         0.5 * (layer[0] + layer[1]),) * 2))
     flat_top, flat_base = draw()
     assert top > 1.6 * base and top > 1.1 * flat_top and base < 0.9 * flat_base, (top, base, flat_top, flat_base)
+
+
+def test_the_sun_by_height_stays_finite_at_the_extremes():
+    """The cloud light's sun colours by height (light.sun_colors through the physical sky's vectorised
+    sun_radiance) for layers below the ground, of no height, above the atmosphere's top, and a sun from
+    the zenith to 30 deg below the horizon: finite, non-negative, one row per height, and none once the
+    layer's sun has set."""
+    from atmos.plugins.cloud_render.light import SUN_HEIGHTS, light_uniforms, sun_colors
+    from atmos.plugins.clouds import CloudSettings
+    s = AtmosphereSettings()
+    for elevation in (90.0, 10.0, 0.0, -0.5, -2.0, -30.0):
+        sun = Sun(direction=sun_at(elevation, 40.0))
+        sun.color_by_altitude = lambda d, h: sun_light.sun_color(d, h, s)
+        for layer in ((-500.0, -100.0), (1500.0, 1500.0), (900.0, 2100.0), (9e4, 2e5)):
+            colors = sun_colors(sun, layer)
+            assert colors.shape == (SUN_HEIGHTS, 3) and np.isfinite(colors).all() and colors.min() >= 0.0
+            sources = np.asarray(light_uniforms(CloudSettings(), sun, layer=layer)["sun_sources"])
+            assert np.isfinite(sources).all() and sources.min() >= 0.0
+            if elevation <= -30.0:
+                assert colors.max() == 0.0, "a sun 30 deg down has set for every layer"
