@@ -1,5 +1,6 @@
 """The haze counted once: with a FogPlugin the marched shafts add no light of their own, they take
-away the fog's in-scatter where the clouds shadow the air (plugins/light_shafts/march.py, SHAFT_FOG)."""
+away the fog's in-scatter where the clouds shadow the air (plugins/light_shafts/march.py, SHAFT_FOG);
+likewise the air's with the sky's aerial perspective (SHAFT_AERIAL), and both with both."""
 import math
 
 import numpy as np
@@ -111,3 +112,53 @@ def test_with_the_skys_aerial_perspective_shafts_only_take_its_light_away_in_clo
     put_in = (alone - plain).mean(-1)               # the aerial perspective's light on the scene (the sky holds
     scene = put_in > 1e-4                           # its own: there the shafts take from the sky view's air)
     assert scene.mean() > 0.2 and (dark[scene] <= put_in[scene] + 2e-3).all(), "never more than it put in"
+
+
+def both_frame(gpu, density, shafts: bool, light: bool = True) -> np.ndarray:
+    """The gap view under an exponential fog and the physical sky's aerial perspective (mixed along the
+    ray, atmos.composition), with or without shafts; ``light`` False: the fog's colour black."""
+    from atmos.plugins.sky import SkyPlugin
+    extra = [LightShaftsPlugin(steps=48, max_distance=3000.0)] if shafts else []
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False),
+                               SkyPlugin(model="physical", stars=False, aerial_perspective=True), GroundPlugin(),
+                               CloudsPlugin(CloudSettings(cell_size=CELL, base_altitude=BASE, shading=False,
+                                                          sigma_t=0.05), density=density),
+                               FogPlugin(mode="exp", density=1.5e-3, sky="keep",
+                                         fog_color=(0.9, 0.9, 1.0) if light else (0.0, 0.0, 0.0)), *extra)
+    app.insert_resource(Sun(np.array([0.0, 1.0, 0.25])))
+    app.startup()
+    cam = app.resource(Camera)
+    cam.position = np.array([320.0, 60.0, 20.0])
+    cam.yaw, cam.pitch, cam.far = math.pi, 0.25, 5000.0
+    try:
+        app.run_frames(1)
+        kept = app.graph.compile().kept
+        assert {"fog", "aerial_perspective", "media_clear"} <= set(kept) and ("light_shafts" in kept) == shafts
+        return app.read_linear()[..., :3].astype(np.float64)
+    finally:
+        app.close()
+
+
+def test_with_fog_and_air_both_the_shafts_take_away_both_in_cloud_shadow_only(fog_gpu):
+    """SHAFT_FOG and SHAFT_AERIAL together (the fog under the air, mixed): nothing changes without
+    clouds; with them the shafts only take light away, more in the shadowed air than in the lit gap, and
+    the air's in-scatter is shadowed too (seen alone with the fog's colour black)."""
+    empty = np.zeros((32, 4, 32), np.float32)
+    alone, both = both_frame(fog_gpu, empty, False), both_frame(fog_gpu, empty, True)
+    assert np.abs(both - alone).max() < 2e-3 * max(alone.max(), 1.0), "nothing shadows the air: nothing taken"
+    volume = columns_volume()
+    alone, both = both_frame(fog_gpu, volume, False), both_frame(fog_gpu, volume, True)
+    dark = (alone - both).mean(-1)
+    assert np.isfinite(both).all() and dark.min() > -2e-3, "the shafts only take light away"
+    lost = dark.mean(axis=0)
+    w = lost.size
+    centre = lost[int(0.45 * w):int(0.55 * w)].mean()
+    sides = np.concatenate([lost[int(0.02 * w):int(0.2 * w)], lost[int(0.8 * w):int(0.98 * w)]]).mean()
+    assert sides > 3.0 * centre and sides > 2e-3, (sides, centre)
+    # the fog's light black: what is taken away then is the air's in-scatter in the clouds' shadow (seen:
+    # 4.1e-3 beside the gap, 4e-4 in it; the fog's and the air's together 8.2e-2 and 4.6e-3)
+    air = (both_frame(fog_gpu, volume, False, light=False) - both_frame(fog_gpu, volume, True, light=False)).mean(-1)
+    air_lost = air.mean(axis=0)
+    air_sides = np.concatenate([air_lost[int(0.02 * w):int(0.2 * w)], air_lost[int(0.8 * w):int(0.98 * w)]]).mean()
+    assert air.min() > -2e-3 and air_sides > 1e-3 and air_sides > 3.0 * air_lost[int(0.45 * w):int(0.55 * w)].mean(), \
+        "the air's in-scatter is shadowed too"

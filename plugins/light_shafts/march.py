@@ -82,7 +82,7 @@ class MarchedShafts:
         if aerial is not None:
             builder.read(SKY_LUTS)
             if aerial.composition.distance:
-                builder.read(CLOUD_DISTANCE)
+                builder.read(CLOUD_DISTANCE)          # (a second read of the same is the same read)
 
     def execute(self, frame: PassContext, settings, clouds: bool, fog=None, aerial=None) -> None:
         view = frame.view

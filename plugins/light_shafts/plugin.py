@@ -114,7 +114,8 @@ class LightShaftsPlugin(Plugin):
     cloud shadow map or in screen space (``mode``). ``LightShaftsPlugin(settings=None, **fields)``
     with :class:`LightShaftSettings`; ``configure(**changes)`` changes any of them live (next frame;
     ``mode`` and ``downsample`` change the pass's targets). With a FogPlugin the march only takes away the
-    fog's in-scatter in cloud shadow (the fog owns the air's light: :class:`LightShaftSettings`)."""
+    fog's in-scatter in cloud shadow (the fog owns the air's light: :class:`LightShaftSettings`), with the
+    sky's aerial perspective the air's, with both both (each dimmed by the other in front)."""
 
     settings_class = LightShaftSettings
 
@@ -136,6 +137,6 @@ class LightShaftsPlugin(Plugin):
         self.sky = next((p for p in app.plugins if isinstance(p, SkyPlugin)), None)
 
     def aerial(self):
-        """The SkyPlugin when its aerial perspective owns the air's light and no fog does (the march then
-        takes away that in-scatter in cloud shadow); else None."""
-        return self.sky if self.fog is None and self.sky is not None and active(self.sky.settings) else None
+        """The SkyPlugin when its aerial perspective is on (the march then takes away the air's
+        in-scatter in cloud shadow, with a fog as well both, each dimmed by the other); else None."""
+        return self.sky if self.sky is not None and active(self.sky.settings) else None

@@ -19,6 +19,9 @@
 //   L = -sum_i w(s_i) T(s_i) E_sun(p_i) [s_ray(p_i) p_R(cos) + s_mie(p_i) p_M(cos)] (1 - V(s_i)) ds,  T = 1,
 // T(s) ~ exp(-ext(p) s) the air's transmittance from the eye, E_sun = atm_sun × its transmittance to the
 // sun (sky/atmosphere.glsl); w as above with the scene's distance (the clouds hazed at their own).
+// Both (a fog under the aerial perspective, mixed along the ray: atmos/composition.py): both sums, each
+// medium's in-scatter at s dimmed by the other in front of s too (the fog's by the air's grey
+// transmittance exp(-ext s), the air's by the fog's f(s)).
 #include "lib/view_ray.glsl"
 #include "lib/phase.glsl"
 #include "cloud_shadows/column.glsl"
@@ -70,6 +73,10 @@ void main() {
 #if SHAFT_FOG || SHAFT_AERIAL
     vec2 cloud = cloud_cover_distance(has_cloud_distance != 0 ? texture(cloud_distance, uv).rg : vec2(0.0));
     float a = cloud.x, dc = cloud.y;            // the clouds' coverage and own distance
+    vec3 taken = vec3(0.0);                     // the in-scatter the clouds' shadow takes away
+#endif
+#if SHAFT_AERIAL
+    float r = atm_clamp_radius(view_r), nu = dot(dir, sun_dir);
 #endif
 #if SHAFT_FOG
     // the fog's own distance: the scene's, the sky's far plane, or (keep) none above the horizon and
@@ -89,15 +96,18 @@ void main() {
         float s = s0 + j * dsf;
         float w = (s < dc ? a : 0.0) + (s < behind ? 1.0 - a : 0.0);
         float tau = has_clouds != 0 ? sun_optical_depth(camera_pos + dir * s, sun_dir) : 0.0;
-        lost += w * (f0 - f1) * (1.0 - exp(-tau));
+        float air = 1.0;                        // the air in front of s (with the aerial perspective)
+#if SHAFT_AERIAL
+        vec3 s_ray0, s_mie0;
+        air = dot(exp(-atm_coefficients(atm_point(r, dir.y, sun_dir.y, nu, s).x, s_ray0, s_mie0) * s), vec3(1.0 / 3.0));
+#endif
+        lost += w * (f0 - f1) * (1.0 - exp(-tau)) * air;
         f0 = f1;
     }
-    frag = vec4(-fog_sun_share * in_color(dir) * lost, 1.0);
-    return;
+    taken += fog_sun_share * in_color(dir) * lost;
 #endif
 #if SHAFT_AERIAL
     float reach_air = max(d, a > 0.0 ? min(dc, max_distance) : 0.0);
-    float r = atm_clamp_radius(view_r), nu = dot(dir, sun_dir);
     float pr = atm_rayleigh_phase(nu), pm = atm_hg_phase(atm_g, nu);
     float dsa = reach_air / float(steps);
     vec3 shadowed = vec3(0.0);
@@ -109,10 +119,17 @@ void main() {
         vec2 at = atm_point(r, dir.y, sun_dir.y, nu, s);
         vec3 s_ray, s_mie;
         vec3 ext = atm_coefficients(at.x, s_ray, s_mie);
+        float fogged = 1.0;                     // the fog in front of s (with a FogPlugin)
+#if SHAFT_FOG
+        fogged = fog_factor(s, end);
+#endif
         shadowed += w * exp(-ext * s) * atm_transmittance_to_sun(at.x, at.y) * (s_ray * pr + s_mie * pm)
-                    * (1.0 - exp(-tau));
+                    * (1.0 - exp(-tau)) * fogged;
     }
-    frag = vec4(-shadowed * dsa * atm_sun, 1.0);
+    taken += shadowed * dsa * atm_sun;
+#endif
+#if SHAFT_FOG || SHAFT_AERIAL
+    frag = vec4(-taken, 1.0);
     return;
 #endif
     float ds = d / float(steps);
