@@ -70,10 +70,14 @@ def test_cloud_shadows_show_as_darker_rays_in_the_fog(fog_gpu):
     assert (dark <= inscatter + 4e-3).all()
 
 
-def aerial_frame(gpu, density, shafts: bool, aerial: bool = True) -> np.ndarray:
-    """The gap view under the physical sky, its aerial perspective on (or off), with or without shafts."""
+def aerial_frame(gpu, density, shafts: bool, aerial: bool = True, fog_color=None) -> np.ndarray:
+    """The gap view under the physical sky, its aerial perspective on (or off), with or without shafts;
+    ``fog_color``: under an exponential fog of that colour too (mixed with the air along the ray,
+    atmos.composition)."""
     from atmos.plugins.sky import SkyPlugin
     extra = [LightShaftsPlugin(steps=48, max_distance=3000.0)] if shafts else []
+    if fog_color is not None:
+        extra.append(FogPlugin(mode="exp", density=1.5e-3, sky="keep", fog_color=fog_color))
     app = App(gpu).add_plugins(DefaultPlugins(overlay=False), SkyPlugin(model="physical", stars=False,
                                                                          aerial_perspective=aerial), GroundPlugin(),
                                CloudsPlugin(CloudSettings(cell_size=CELL, base_altitude=BASE, shading=False,
@@ -87,6 +91,7 @@ def aerial_frame(gpu, density, shafts: bool, aerial: bool = True) -> np.ndarray:
         app.run_frames(1)
         kept = app.graph.compile().kept
         assert ("aerial_perspective" in kept) == aerial and ("light_shafts" in kept) == shafts
+        assert ("media_clear" in kept) == (aerial and fog_color is not None)
         return app.read_linear()[..., :3].astype(np.float64)
     finally:
         app.close()
@@ -115,28 +120,8 @@ def test_with_the_skys_aerial_perspective_shafts_only_take_its_light_away_in_clo
 
 
 def both_frame(gpu, density, shafts: bool, light: bool = True) -> np.ndarray:
-    """The gap view under an exponential fog and the physical sky's aerial perspective (mixed along the
-    ray, atmos.composition), with or without shafts; ``light`` False: the fog's colour black."""
-    from atmos.plugins.sky import SkyPlugin
-    extra = [LightShaftsPlugin(steps=48, max_distance=3000.0)] if shafts else []
-    app = App(gpu).add_plugins(DefaultPlugins(overlay=False),
-                               SkyPlugin(model="physical", stars=False, aerial_perspective=True), GroundPlugin(),
-                               CloudsPlugin(CloudSettings(cell_size=CELL, base_altitude=BASE, shading=False,
-                                                          sigma_t=0.05), density=density),
-                               FogPlugin(mode="exp", density=1.5e-3, sky="keep",
-                                         fog_color=(0.9, 0.9, 1.0) if light else (0.0, 0.0, 0.0)), *extra)
-    app.insert_resource(Sun(np.array([0.0, 1.0, 0.25])))
-    app.startup()
-    cam = app.resource(Camera)
-    cam.position = np.array([320.0, 60.0, 20.0])
-    cam.yaw, cam.pitch, cam.far = math.pi, 0.25, 5000.0
-    try:
-        app.run_frames(1)
-        kept = app.graph.compile().kept
-        assert {"fog", "aerial_perspective", "media_clear"} <= set(kept) and ("light_shafts" in kept) == shafts
-        return app.read_linear()[..., :3].astype(np.float64)
-    finally:
-        app.close()
+    """:func:`aerial_frame` under the fog too; ``light`` False: the fog's colour black."""
+    return aerial_frame(gpu, density, shafts, fog_color=(0.9, 0.9, 1.0) if light else (0.0, 0.0, 0.0))
 
 
 def test_with_fog_and_air_both_the_shafts_take_away_both_in_cloud_shadow_only(fog_gpu):
