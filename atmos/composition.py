@@ -83,18 +83,12 @@ class Composition:
 
 class CompositionClear(RenderPass):
     """A pass of phase clear that creates a Composition's shared targets at the frame's size and clears
-    them when its plugins both write and read them (:meth:`wanted`); else declares nothing (culled).
+    them while ``wanted()`` (its plugins both write and read them); else declares nothing (culled).
     ``targets(size)``: (name, TextureDesc, clear value) of each."""
     phase = "clear"
 
-    def __init__(self, comp: Composition, gpu):
-        self.comp, self.gpu = comp, gpu
-
-    def wanted(self) -> bool:
-        raise NotImplementedError
-
-    def targets(self, size) -> tuple:
-        raise NotImplementedError
+    def __init__(self, gpu, wanted, targets):
+        self.gpu, self.wanted, self.targets = gpu, wanted, targets
 
     def setup(self, builder) -> None:
         if self.wanted():
@@ -111,11 +105,8 @@ class ClearDistance(CompositionClear):
     has a writer and a reader."""
     name = "cloud_distance_clear"
 
-    def wanted(self) -> bool:
-        return self.comp.distance
-
-    def targets(self, size) -> tuple:
-        return ((CLOUD_DISTANCE, distance_desc(size), 0.0),)
+    def __init__(self, comp: Composition, gpu):
+        super().__init__(gpu, lambda: comp.distance, lambda size: ((CLOUD_DISTANCE, distance_desc(size), 0.0),))
 
 
 class ClearMedia(CompositionClear):
@@ -123,23 +114,19 @@ class ClearMedia(CompositionClear):
     (R float32, cleared to 1) when the Composition's media are written and read."""
     name = "media_clear"
 
-    def wanted(self) -> bool:
-        return self.comp.media
-
-    def targets(self, size) -> tuple:
-        return ((MEDIA_LIGHT, TextureDesc(size, components=4, dtype="f4", filter="nearest"), 0.0),
-                (MEDIA_TRANSMITTANCE, TextureDesc(size, components=1, dtype="f4", filter="nearest"), 1.0))
+    def __init__(self, comp: Composition, gpu):
+        super().__init__(gpu, lambda: comp.media, lambda size: (
+            (MEDIA_LIGHT, TextureDesc(size, components=4, dtype="f4", filter="nearest"), 0.0),
+            (MEDIA_TRANSMITTANCE, TextureDesc(size, components=1, dtype="f4", filter="nearest"), 1.0)))
 
 
-def blend_onto_media(builder, comp: Composition) -> bool:
+def blend_onto_media(builder, comp: Composition) -> None:
     """In a local medium's ``setup``: where the aerial perspective reads the media, read and write both
-    targets too (the pass blends onto them as onto the colour, ``lib/media_out.glsl``). Returns whether
-    it does (the shader's LOCAL_MEDIA)."""
+    targets too (the pass blends onto them as onto the colour, ``lib/media_out.glsl``, LOCAL_MEDIA 1)."""
     if comp.media:
         for name in (MEDIA_LIGHT, MEDIA_TRANSMITTANCE):
             builder.read(name)
             builder.write(name)
-    return comp.media
 
 
 def medium_targets(frame, color: str) -> list:

@@ -7,7 +7,7 @@ import numpy as np
 
 from atmos.plugins.cloud_far_field.reference import column_at_rank, far_relief, field_fbm, field_rank, relief_light
 from atmos.plugins.cloud_raymarch.reference import integrate, rays
-from atmos.plugins.cloud_render.light import cell_tau, sun_colors, sun_light, sun_source_at, unit_direction
+from atmos.plugins.cloud_render.light import cell_tau, layer_sun, sun_source_at, unit_direction
 from atmos.shading.diffusion import field_radiance
 from atmos.shading.medium import OCTAVES, source_reference
 
@@ -75,14 +75,13 @@ def far_source(field: FarField, medium, settings, p, dirs, band, sun) -> np.ndar
     column = cell_tau(medium) * column_at_rank(c[:, 0], field.columns)
     above = sample_profile(field.profile, c[:, 0], h01)[..., 1]
     up, down = column * above, column * (1.0 - above)
-    sun_color, ambient = sun_light(sun, band[0] + 0.5 * band[1])
+    by_height, sun_color, ambient = layer_sun(sun, (band[0], band[0] + band[1]))
     diffusion = None
     if field.field_profile is not None and settings.ms_diffusion > 0:       # the volume's field at this rank
         values = sample_profile(field.field_profile, c[:, 0], h01)
         diffusion = field_radiance(values, dirs, (medium.phase_g, medium.phase_g2, medium.phase_w), sun_dir)
-    by_height = sun_source_at(sun_colors(sun, (band[0], band[0] + band[1])), h01)
     return source_reference(medium, settings, None, up, down, dirs @ sun_dir, dirs[:, 1], sun_color, ambient, sun_dir,
-                            diffusion, octaves=octaves, sun_colors=by_height)
+                            diffusion, octaves=octaves, sun_colors=sun_source_at(by_height, h01))
 
 
 def far_march_reference(field: FarField, medium, settings, band, camera, sun, size) -> dict:

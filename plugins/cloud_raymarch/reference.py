@@ -11,7 +11,7 @@ import numpy as np
 
 from atmos.camera import view_basis
 from atmos.plugins.cloud_raymarch.settings import SUN_GROWTH, SUN_SPACING
-from atmos.plugins.cloud_render.light import sun_colors, sun_light, sun_source_at, unit_direction
+from atmos.plugins.cloud_render.light import layer_sun, sun_source_at, unit_direction
 from atmos.plugins.cloud_render.reference import column_depth
 from atmos.shading.diffusion import diffusion_radiance
 from atmos.shading.medium import source_reference
@@ -34,7 +34,7 @@ def march_reference(density, transmittance, medium, settings, layout, camera, su
     for sky; ``field``: the set's diffusion field (its own shape, 4), None: none. Returns ``light`` (h, w, 3), ``alpha`` (h, w) and ``distance`` (h, w): a·distance."""
     d = np.asarray(density, np.float64)
     trans_volume = np.asarray(transmittance, np.float64)
-    shape, tshape = np.array(d.shape, np.float64), np.array(trans_volume.shape, np.float64)
+    shape = np.array(d.shape, np.float64)
     lo, hi = np.asarray(layout.lo, np.float64), np.asarray(layout.hi, np.float64)
     extent, cell = hi - lo, np.asarray(layout.cell, np.float64)
     dirs, start = rays(camera, size)
@@ -48,8 +48,7 @@ def march_reference(density, transmittance, medium, settings, layout, camera, su
     if scene is not None:
         leave = np.minimum(leave, np.asarray(scene, np.float64).reshape(-1))
     step_base = settings.step * cell.min()
-    sun_color, ambient = sun_light(sun, layout.middle_altitude)
-    by_height = sun_colors(sun, layout.heights)
+    by_height, sun_color, ambient = layer_sun(sun, layout.heights)
     sun_dir = unit_direction(sun)
     column_tau = medium.sigma_t * cell[1]
     lobes = (medium.phase_g, medium.phase_g2, medium.phase_w)

@@ -82,6 +82,13 @@ def sun_colors(sun: Sun | None, layer=None) -> np.ndarray:
     return sun.color_at(base + np.arange(SUN_HEIGHTS) / (SUN_HEIGHTS - 1) * (top - base))
 
 
+def layer_sun(sun: Sun | None, layer=None) -> tuple[np.ndarray, np.ndarray, tuple]:
+    """(the sun's colours at the layer's heights (:func:`sun_colors`), the middle's (the ground's
+    light takes it), the ambient): the sun every cloud renderer and reference lights a layer with."""
+    colors = sun_colors(sun, layer)
+    return colors, colors[SUN_HEIGHTS // 2], sun_light(sun)[1]
+
+
 def sun_source_at(sources, v) -> np.ndarray:
     """(..., 3) float64: volume.glsl's ``sun_source_at`` of the (SUN_HEIGHTS, 3) ``sources`` at height
     fractions ``v`` (...,) of the layer (0 base, 1 top; clamped), linear between the samples."""
@@ -110,10 +117,9 @@ def light_uniforms(cloud_settings, sun: Sun | None, octaves=DEFAULT_OCTAVES, dif
     multiple-scattering octaves (a, b, c), the diffusion field's weight and the layer (base, top) world
     y (m) over which the clouds take the sun's colour (``sun_sources``: :func:`sun_colors`; the ground's
     light takes the middle's; None: the camera's colour everywhere)."""
-    colors = sun_colors(sun, layer)
-    ambient = sun_light(sun)[1]
+    colors, middle, ambient = layer_sun(sun, layer)
     direction = unit_direction(sun)
-    e, sky, ground = environment(cloud_settings, colors[SUN_HEIGHTS // 2], ambient, direction)
+    e, sky, ground = environment(cloud_settings, middle, ambient, direction)
     s = cloud_settings
     sources = s.albedo * s.sun_intensity * colors
     return {"sun_sources": [tuple(float(v) for v in row) for row in sources],

@@ -30,11 +30,6 @@ class CloudLayout:
         return np.array([self.origin_xz[0] * self.cell[0], self.base, self.origin_xz[1] * self.cell[2]])
 
     @property
-    def middle_altitude(self) -> float:
-        """World y of the layer's middle."""
-        return float(self.base + 0.5 * self.shape[1] * self.cell[1])
-
-    @property
     def heights(self) -> tuple[float, float]:
         """(base, top) world y of the layer, over which the cloud light takes the sun's colour
         (``Sun.color_at``, :func:`atmos.plugins.cloud_render.light.sun_colors`)."""
