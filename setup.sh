@@ -11,13 +11,14 @@ if ! ldconfig -p 2>/dev/null | grep -q 'libEGL.so.1' || ! ls /usr/lib/*/dri/swra
     DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq libegl1 libegl-mesa0 libgl1-mesa-dri libgl1 >/dev/null
 fi
 
-# A virtual X server and xdotool let the tests drive the window path on a machine without a screen.
-if ! command -v Xvfb >/dev/null || ! command -v xdotool >/dev/null; then
+# A virtual X server and xdotool let the tests drive the window path on a machine without a screen;
+# Khronos's reference GLSL compiler checks every shader the tests compile (atmos/gpu/portability.py).
+if ! command -v Xvfb >/dev/null || ! command -v xdotool >/dev/null || ! command -v glslangValidator >/dev/null; then
     if command -v apt-get >/dev/null; then
-        echo "setup: installing xvfb and xdotool (window tests)"
+        echo "setup: installing xvfb, xdotool (window tests) and glslang-tools (the GLSL portability check)"
         SUDO=""; [ "$(id -u)" = 0 ] || SUDO="sudo"
         $SUDO apt-get update -qq
-        DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq xvfb xdotool >/dev/null || true
+        DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq xvfb xdotool glslang-tools >/dev/null || true
     fi
 fi
 

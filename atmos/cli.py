@@ -97,6 +97,8 @@ def cmd_info(args) -> int:
     gpu = create_headless((16, 16))
     try:
         for k, v in gpu.info().items():
+            if k == "software rasterizer":
+                v = "yes: correct, but frames are slow (a GPU driver with OpenGL 4.3 makes them real time)" if v else "no"
             print(f"{k:40s} {v}")
     finally:
         gpu.release()

@@ -1,11 +1,17 @@
-"""Shared fixtures: one headless EGL context for the whole session; every GL test ends on GL_NO_ERROR."""
+"""Shared fixtures: one headless EGL context for the whole session; every GL test ends on GL_NO_ERROR.
+Where the reference GLSL compiler is installed, every program the tests build is also checked by it
+(atmos.gpu.portability; tests/test_glsl_portability.py says when it is missing)."""
 import os
+import shutil
 
 import pytest
 
 from atmos.gpu import create_headless
+from atmos.gpu.portability import COMPILER, ENV
 
 os.environ.setdefault("ATMOS_HEADLESS", "1")
+if shutil.which(COMPILER):
+    os.environ.setdefault(ENV, "1")
 
 
 @pytest.fixture(scope="session")

@@ -24,6 +24,12 @@ def test_demo_list(capsys):
 def test_info(capsys):
     code, out, _ = run(capsys, "info")
     assert code == 0 and "GL_RENDERER" in out and "GL_VERSION" in out
+    from atmos.gpu import create_headless
+    gpu = create_headless((8, 8))
+    software = gpu.software
+    gpu.release()
+    line = next(l for l in out.splitlines() if l.startswith("software rasterizer"))
+    assert line.split()[2] == ("yes:" if software else "no"), line
 
 
 def test_info_into_a_closed_pipe_is_not_an_error():

@@ -136,7 +136,7 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale,
     uniforms = sprite_uniforms(renderer, sim, layout, cam, aspect, height, 255.0)
     vp = cam.view_projection(aspect)
 
-    src, _ = load_source("cloud_render/sprite.vert")
+    src = load_source("cloud_render/sprite.vert").text
     names = ["gl_Position", "gl_PointSize", "v_octaves", "v_ambient", "v_center", "v_radius", "v_tau", "v_coverage",
              "v_conic", "v_falloff", "v_stretch", "v_slope", "v_sun"]
     prog = ctx.program(vertex_shader=src, varyings=names)

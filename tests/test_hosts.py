@@ -61,6 +61,22 @@ def test_wrap_context_takes_a_moderngl_context_and_names_what_it_got():
     gpu.release()
 
 
+def test_a_software_rasterizer_in_a_window_says_so_once(capsys, monkeypatch):
+    from atmos.gpu import context
+    monkeypatch.setattr(context, "_NOTICED", [])
+    gpu = atmos.create_headless((8, 8))
+    assert "software rasterizer" not in capsys.readouterr().err, "headless runs (tests, renders) stay quiet"
+    monkeypatch.setattr(context, "is_software", lambda ctx: True)
+    for _ in range(2):
+        atmos.wrap_context(gpu.ctx, (8, 8)).release()
+    err = capsys.readouterr().err
+    assert err.count("software rasterizer") == 1 and "frame times will be slow" in err, err
+    monkeypatch.setattr(context, "is_software", lambda ctx: False)
+    atmos.wrap_context(gpu.ctx, (8, 8)).release()
+    assert capsys.readouterr().err == ""
+    gpu.release()
+
+
 # -- real hosts in windows -------------------------------------------------------------------------
 needs_x = pytest.mark.skipif(shutil.which("Xvfb") is None, reason="Xvfb is not installed (setup.sh installs it)")
 

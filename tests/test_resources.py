@@ -5,7 +5,7 @@ import pytest
 from atmos.app import App
 from atmos.defaults import DefaultPlugins
 from atmos.frames import FrameScheduler, SlicedJob, SliceTask, TripleSet, timer_query_measure
-from atmos.gpu import create_headless
+from atmos.gpu import MIN_GL_VERSION, create_headless
 from atmos.gpu.queries import QueryPool, query_pool
 from atmos.graph import PassTimers, TextureDesc, TexturePool
 from atmos.plugins.ground import GroundPlugin
@@ -139,7 +139,7 @@ def test_gpu_context_owns_its_query_pool(gpu, ctx):
 
 
 def test_query_pool_recycles_queries(count_queries):
-    ctx = moderngl.create_standalone_context(backend="egl")
+    ctx = moderngl.create_standalone_context(require=MIN_GL_VERSION, backend="egl")
     pool = query_pool(ctx)
     q = pool.acquire()
     assert pool.made == 1 and pool.in_use == 1 and len(count_queries) == 1

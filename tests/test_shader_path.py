@@ -61,10 +61,10 @@ def test_third_party_plugin_draws_with_its_own_shader_through_an_app(fresh_gpu):
 
 
 def test_plugin_file_includes_atmos_lib_and_its_own_pieces(mypkg):
-    source, files = load_source("mypkg/glow.frag")
-    assert files == ["mypkg/glow.frag", "lib/view_ray.glsl", "mypkg/palette.glsl"]
-    assert "vec3 view_ray_dir(vec2 uv, mat3 view_basis)" in source     # atmos's shaders/lib/
-    assert "const vec3 GLOW_UP" in source
+    source = load_source("mypkg/glow.frag")
+    assert source.files == ["mypkg/glow.frag", "lib/view_ray.glsl", "mypkg/palette.glsl"]
+    assert "vec3 view_ray_dir(vec2 uv, mat3 view_basis)" in source.text     # atmos's shaders/lib/
+    assert "const vec3 GLOW_UP" in source.text
 
 
 def test_compile_error_names_the_plugin_file_and_line(gpu, ctx, mypkg):

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import operator
+import sys
 import weakref
 
 import moderngl
@@ -9,7 +10,8 @@ import numpy as np
 
 from atmos.gpu.host_memory import is_software, return_freed_textures
 from atmos.gpu.queries import QueryPool, query_pool
-from atmos.gpu.shaders import build_program
+from atmos.gpu import portability
+from atmos.gpu.shaders import ShaderError, compile_program, load_stages
 
 MIN_GL_VERSION = 430  # compute shaders
 
@@ -75,10 +77,11 @@ def create_headless(size: tuple[int, int] = (640, 360), backend: str = "egl") ->
     if not isinstance(backend, str) or not backend:
         raise ValueError(f"backend must be a glcontext backend name such as 'egl', got {backend!r}")
     try:
-        ctx = moderngl.create_standalone_context(backend=backend)
+        # asked for explicitly: NVIDIA's EGL hands out OpenGL 3.3 unless 4.3 is requested (Mesa gives its newest)
+        ctx = moderngl.create_standalone_context(require=MIN_GL_VERSION, backend=backend)
     except Exception as error:  # moderngl/glcontext raise plain Exceptions with the loader's message
         raise GpuError(
-            f"no usable OpenGL: creating a headless {backend.upper()} context failed ({error}). "
+            f"no usable OpenGL: creating a headless {backend.upper()} OpenGL 4.3 core context failed ({error}). "
             "Install Mesa's EGL and DRI drivers (Debian: libegl1 libegl-mesa0 libgl1-mesa-dri) "
             "or a GPU driver with EGL.") from None
     try:
@@ -107,6 +110,18 @@ def wrap_context(ctx, size: tuple[int, int]) -> "GpuContext":
                          "for the context current in this thread use atmos.from_current(size)")
     _check_version(ctx)
     return GpuContext(ctx, size, headless=False)
+
+
+_NOTICED: list = []   # one notice per process
+
+
+def _notice_software_window(ctx) -> None:
+    """Print once per process, to stderr, that a window renders on a software rasterizer."""
+    if _NOTICED:
+        return
+    _NOTICED.append(ctx.info.get("GL_RENDERER", "?"))
+    print(f"atmos: this window's OpenGL is a software rasterizer ({_NOTICED[0]}): the frames are right, but "
+          "frame times will be slow; a GPU driver with OpenGL 4.3 makes them real time", file=sys.stderr, flush=True)
 
 
 def require_gpu(gpu, what: str = "gpu") -> "GpuContext":
@@ -139,6 +154,8 @@ class GpuContext:
         self.software = is_software(ctx)
         if self.software:
             return_freed_textures()
+            if not headless:
+                _notice_software_window(ctx)
         self.target: moderngl.Framebuffer = ctx.screen
         self.resize(size)
 
@@ -205,7 +222,8 @@ class GpuContext:
     # -- programs and lifetime ---------------------------------------------------------------
     def program(self, defines: dict | None = None, **stages: str):
         """A compiled program from shader files on the search path (atmos's ``shaders/``, then the
-        directories of :func:`atmos.gpu.add_shader_path`), compiled once per (files, defines).
+        directories of :func:`atmos.gpu.add_shader_path`), compiled once per (files, defines), and
+        checked by the reference compiler when ``ATMOS_GLSL_CHECK=1`` (:mod:`atmos.gpu.portability`).
         The context owns it: it is released by :meth:`release`, never by its users.
 
         ``gpu.program(vertex_shader="sky.vert", fragment_shader="sky.frag")`` or
@@ -215,7 +233,15 @@ class GpuContext:
         key = (tuple(sorted(stages.items())), tuple(sorted((defines or {}).items())))
         program = self._programs.get(key)
         if program is None:
-            program = self._programs[key] = build_program(self.ctx, stages, defines)
+            sources = load_stages(stages, defines)
+            program = compile_program(self.ctx, sources)
+            if portability.enabled():
+                try:
+                    portability.check_program(sources)
+                except ShaderError:
+                    program.release()
+                    raise
+            self._programs[key] = program
         return program
 
     @property
@@ -266,10 +292,11 @@ class GpuContext:
             raise GpuError(f"OpenGL error {error}" + (f" after {where}" if where else ""))
 
     def info(self) -> dict:
-        """Renderer, version and the limits atmos cares about."""
+        """Renderer, version, whether the renderer is a software rasterizer, and the limits atmos cares about."""
         self._require_live()
         info = self.ctx.info
         keys = ["GL_VENDOR", "GL_RENDERER", "GL_VERSION", "GL_MAX_TEXTURE_SIZE", "GL_MAX_3D_TEXTURE_SIZE",
                 "GL_MAX_COMPUTE_WORK_GROUP_INVOCATIONS", "GL_MAX_COMPUTE_WORK_GROUP_COUNT",
                 "GL_MAX_COMPUTE_WORK_GROUP_SIZE", "GL_MAX_SHADER_STORAGE_BLOCK_SIZE", "GL_MAX_SAMPLES"]
-        return {k: info[k] for k in keys if k in info}
+        return {**{k: info[k] for k in keys[:3] if k in info}, "software rasterizer": self.software,
+                **{k: info[k] for k in keys[3:] if k in info}}

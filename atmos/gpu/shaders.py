@@ -15,10 +15,10 @@ A third-party plugin ships its GLSL beside its Python and registers it once, e.g
     add_shader_path(Path(__file__).parent / "shaders", prefix="mypkg")
     gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="mypkg/glow.frag")
 
-Every file included into a stage gets its own GLSL source-string number through ``#line``, so a
-compiler message such as ``2:14(7): error: ...`` (Mesa) or ``2(14) : error ...`` (NVIDIA) is mapped
-back to the real file: ``shaders/<name>:14`` for atmos's files, ``<directory>/<path>:14`` (the
-directory as it was registered) for the others. A name found nowhere is an error that lists every
+A stage is assembled into one text without ``#line`` directives, and each of its lines remembers
+the file and line it came from, so a compiler message such as ``0:14(7): error: ...`` (Mesa) or
+``0(14) : error ...`` (NVIDIA) names the real file: ``shaders/<name>:14`` for atmos's files,
+``<directory>/<path>:14`` (the directory as it was registered) for the others. A name found nowhere is an error that lists every
 place it was looked for.
 """
 from __future__ import annotations
@@ -34,7 +34,9 @@ import moderngl
 
 _INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*$')
 _VERSION = re.compile(r"^\s*#version\b")
-_MESSAGE = re.compile(r"^(\d+):(\d+)\((\d+)\):\s*(.*)$|^(\d+)\((\d+)\)\s*:\s*(.*)$")
+_MESSAGE = re.compile(r"^\d+:(\d+)\(\d+\):\s*(.*)$"                      # Mesa: 0:14(7): error: ...
+                      r"|^\d+\((\d+)\)\s*:\s*(.*)$"                        # NVIDIA: 0(14) : error C0000: ...
+                      r"|^(?P<kind>ERROR|WARNING):\s*\d+:(\d+):\s*(.*)$")      # AMD, glslang: ERROR: 0:14: ...
 
 
 class ShaderError(RuntimeError):
@@ -127,32 +129,50 @@ def _display(name: str) -> str:
         return name
 
 
-def load_source(name: str, defines: dict | None = None) -> tuple[str, list[str]]:
-    """Return (GLSL text, files) for shader ``name``: includes expanded, ``defines`` added.
+@dataclass(frozen=True)
+class GlslSource:
+    """One shader stage as the driver gets it: ``text`` (includes expanded, defines added, no
+    ``#line`` directives) and ``origins[i]``, the (file name, line) that line ``i + 1`` of ``text``
+    came from (``None`` for the added ``#define`` lines)."""
+    text: str
+    origins: tuple
 
-    ``files[i]`` is the name of the file behind GLSL source-string number ``i`` used in ``#line``
-    directives (where each lives: :func:`shader_paths`).
+    @property
+    def files(self) -> list[str]:
+        """The file names in the order they were first included, the stage's own file first."""
+        return list(dict.fromkeys(o[0] for o in self.origins if o is not None))
+
+    def where(self, line: int) -> str:
+        """How errors name line ``line`` (1-based) of :attr:`text`: ``shaders/lib/x.glsl:14``."""
+        origin = self.origins[line - 1] if 1 <= line <= len(self.origins) else None
+        if origin is None:
+            return f"<{self.files[0]}, line {line} as compiled>" if self.files else f"<line {line}>"
+        return f"{_display(origin[0])}:{origin[1]}"
+
+
+def load_source(name: str, defines: dict | None = None) -> GlslSource:
+    """Shader ``name`` as one GLSL text: includes expanded in place, ``defines`` added after ``#version``.
+
+    No ``#line`` directive is emitted (NVIDIA rejects source-string numbers beyond the strings it was
+    given, and a bare ``#line`` would make every file's lines collide); the returned
+    :class:`GlslSource` maps each line back to its file and line instead.
     """
-    files: list[str] = []
     lines: list[str] = []
+    origins: list = []
 
     def expand(file: str, stack: tuple[str, ...]) -> None:
         if file in stack:
             raise ShaderError(f"{_display(file)}: #include cycle: {' -> '.join(stack + (file,))}")
-        index = len(files)
         shown, source = _locate(file)
-        files.append(file)
-        text = source.splitlines()
-        if stack:
-            lines.append(f"#line 1 {index}")
-        for number, line in enumerate(text, start=1):
+        for number, line in enumerate(source.splitlines(), start=1):
             if _VERSION.match(line):
                 if stack:
                     raise ShaderError(f"{shown}:{number}: an included file must not have #version")
                 lines.append(line)
+                origins.append((file, number))
                 for key, value in (defines or {}).items():
                     lines.append(f"#define {key} {value}")
-                lines.append(f"#line {number + 1} {index}")
+                    origins.append(None)
                 continue
             match = _INCLUDE.match(line)
             if match:
@@ -162,51 +182,58 @@ def load_source(name: str, defines: dict | None = None) -> tuple[str, list[str]]
                     if "shader file not found" not in str(error) or " (included from " in str(error):
                         raise
                     raise ShaderError(f"{error} (included from {shown}:{number})") from None
-                lines.append(f"#line {number + 1} {index}")
             else:
                 lines.append(line)
+                origins.append((file, number))
 
     expand(name, ())
     if not lines or not _VERSION.match(lines[0]):
         raise ShaderError(f"{_display(name)}:1: the first line must be a #version directive")
-    return "\n".join(lines) + "\n", files
+    return GlslSource("\n".join(lines) + "\n", tuple(origins))
 
 
-def explain(error: Exception, stages: dict[str, tuple[str, list[str]]]) -> ShaderError:
+def located_messages(text: str, source: GlslSource) -> list[str]:
+    """The compiler's messages in ``text`` that name a line, as ``<file>:<line>: <message>``.
+
+    Understands Mesa's ``0:14(7): error: ...``, NVIDIA's ``0(14) : error C0000: ...`` and the
+    ``ERROR: 0:14: ...`` of AMD's driver and of glslang."""
+    messages = []
+    for raw in text.splitlines():
+        match = _MESSAGE.match(raw.strip())
+        if match:
+            groups = [g for g in match.groups() if g is not None]
+            line, message = int(groups[-2]), groups[-1]
+            if match.group("kind"):
+                message = f"{match.group('kind').lower()}: {message}"
+            messages.append(f"{source.where(line)}: {message}")
+    return messages
+
+
+def explain(error: Exception, stages: dict[str, GlslSource]) -> ShaderError:
     """Turn a moderngl compile/link error into a ShaderError naming ``<file>:<line>`` (the real file)."""
     text = str(error)
     kind = "link" if "Linker" in text else "compile"
     stage = next((s for s in stages if s in text), None)
-    files = stages[stage][1] if stage else []
-    messages = []
-    for raw in text.splitlines():
-        match = _MESSAGE.match(raw.strip())
-        if not match:
-            continue
-        if match.group(1) is not None:
-            index, line, message = int(match.group(1)), match.group(2), match.group(4)
-        else:
-            index, line, message = int(match.group(5)), match.group(6), match.group(7)
-        file = _display(files[index]) if index < len(files) else f"<source {index}>"
-        messages.append(f"{file}:{line}: {message}")
+    messages = located_messages(text, stages[stage]) if stage else []
     if not messages:
-        names = ", ".join(_display(s[0]) for s in stages.values())
+        names = ", ".join(_display(s.files[0]) for s in stages.values())
         messages = [f"{names}: " + " ".join(l.strip() for l in text.splitlines() if l.strip())]
     return ShaderError(f"GLSL {kind} failed:\n" + "\n".join(messages))
 
 
-def build_program(ctx: moderngl.Context, stages: dict[str, str], defines: dict | None = None):
-    """Compile a program from shader file names keyed by moderngl stage name: the internal of
-    :meth:`GpuContext.program <atmos.gpu.GpuContext.program>`, which caches and releases what
-    this makes (everything else asks the GpuContext).
+def load_stages(stages: dict[str, str], defines: dict | None = None) -> dict[str, GlslSource]:
+    """:func:`load_source` of each shader file name keyed by moderngl stage name (``vertex_shader``,
+    ``fragment_shader``, ``geometry_shader``, or ``compute_shader`` alone)."""
+    return {stage: load_source(name, defines) for stage, name in stages.items()}
 
-    ``stages`` holds ``vertex_shader``/``fragment_shader``/``geometry_shader`` names for a render
-    program, or ``compute_shader`` alone for a compute program.
-    """
-    sources = {stage: load_source(name, defines) for stage, name in stages.items()}
+
+def compile_program(ctx: moderngl.Context, sources: dict[str, GlslSource]):
+    """Compile loaded stages into a moderngl program (a compute shader for ``compute_shader``): the
+    internal of :meth:`GpuContext.program <atmos.gpu.GpuContext.program>`, which caches and
+    releases what this makes (everything else asks the GpuContext)."""
     try:
         if "compute_shader" in sources:
-            return ctx.compute_shader(sources["compute_shader"][0])
-        return ctx.program(**{stage: src for stage, (src, _) in sources.items()})
+            return ctx.compute_shader(sources["compute_shader"].text)
+        return ctx.program(**{stage: src.text for stage, src in sources.items()})
     except moderngl.Error as error:
-        raise explain(error, {s: (stages[s], f) for s, (_, f) in sources.items()}) from None
+        raise explain(error, sources) from None
