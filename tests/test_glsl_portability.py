@@ -19,7 +19,7 @@ def test_the_suite_checks_every_program_where_it_must(gpu):
             pytest.fail(f"{COMPILER} is not installed: install Debian's glslang-tools (setup.sh does) so that "
                         "every shader the tests compile is also checked by the reference compiler")
         pytest.skip(f"{COMPILER} is not installed; {gpu.info()['GL_RENDERER']} compiles every shader itself")
-    assert portability.enabled(), f"{ENV} is not 1 although {COMPILER} is installed (tests/conftest.py sets it)"
+    assert portability.check_enabled(), f"{ENV} is not 1 although {COMPILER} is installed (tests/conftest.py sets it)"
 
 
 @pytest.fixture

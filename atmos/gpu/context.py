@@ -10,7 +10,7 @@ import numpy as np
 
 from atmos.gpu.host_memory import is_software, return_freed_textures
 from atmos.gpu.queries import QueryPool, query_pool
-from atmos.gpu import portability
+from atmos.gpu.portability import check_enabled, check_program
 from atmos.gpu.shaders import ShaderError, compile_program, load_stages
 
 MIN_GL_VERSION = 430  # compute shaders
@@ -235,9 +235,9 @@ class GpuContext:
         if program is None:
             sources = load_stages(stages, defines)
             program = compile_program(self.ctx, sources)
-            if portability.enabled():
+            if check_enabled():
                 try:
-                    portability.check_program(sources)
+                    check_program(sources)
                 except ShaderError:
                     program.release()
                     raise

@@ -29,8 +29,8 @@ _ACCEPTED: set[bytes] = set()
 _MESSAGE = re.compile(r"^(?P<kind>ERROR|WARNING):\s*(?P<where>[^:\s]+):(?P<line>\d+):\s*(?P<text>.*)$")
 
 
-def enabled() -> bool:
-    """True when ``ATMOS_GLSL_CHECK=1``."""
+def check_enabled() -> bool:
+    """True when ``ATMOS_GLSL_CHECK=1``: GpuContext.program checks what it compiles."""
     return os.environ.get(ENV, "") == "1"
 
 
