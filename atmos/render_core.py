@@ -74,11 +74,12 @@ class ClearPass(RenderPass):
 
 
 DITHER_STEP = 1.0 / 255.0     # one step of 8-bit output
+HDR_MAX = 16384.0             # the most light one effect adds to a colour pixel (shaders/lib/hdr_max.glsl)
 
 
 def tone_map(hdr, exposure: float = 1.0) -> np.ndarray:
-    """Display values in [0, 1] of linear HDR colours (float64 reference of ``core/present.frag``
-    before dithering): exposure, the ACES fit of Narkowicz, then gamma 1/2.2."""
+    """Display values in [0, 1] of linear HDR colours (``core/present.frag`` before dithering and
+    rounding): exposure, the ACES fit of Narkowicz, then gamma 1/2.2."""
     x = np.maximum(np.asarray(hdr, np.float64) * exposure, 0.0)
     return np.clip((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0) ** (1.0 / 2.2)
 
@@ -97,6 +98,17 @@ def dither_offsets(width: int, height: int) -> np.ndarray:
     return total - 1.0
 
 
+def present_levels(hdr, exposure: float = 1.0, dither: bool = True) -> np.ndarray:
+    """The 8-bit levels (0..255, float64) ``core/present.frag`` writes for an (h, w, 3) HDR image, rows
+    bottom-up: :func:`tone_map`, plus :func:`dither_offsets` × ``DITHER_STEP`` when ``dither``, rounded
+    to the nearest level (the shader writes exactly level / 255, so the framebuffer's conversion to
+    8 bits keeps it whatever its rounding)."""
+    x = tone_map(hdr, exposure)
+    if dither:
+        x = x + DITHER_STEP * dither_offsets(x.shape[1], x.shape[0])
+    return np.clip(np.floor(x * 255.0 + 0.5), 0.0, 255.0)
+
+
 def where_nothing_was_drawn(frame: PassContext):
     """Bind ``color`` over ``depth`` so a pass on the far plane (``vertex = "lib/fullscreen_far.vert"``)
     draws only where the depth is still 1, where nothing was drawn: depth test ``<=``, depth writes
@@ -112,9 +124,9 @@ def where_nothing_was_drawn(frame: PassContext):
 
 class PresentPass(FullscreenPass):
     """Tone-maps the HDR ``color`` into the screen (window or offscreen target), with sRGB gamma
-    and (``RenderCoreSettings.dither``) a triangular dither of one 8-bit step against banding
-    (:func:`tone_map`, :func:`dither_offsets`); the screen's alpha is 1 (``color.a``, the sky
-    occlusion, is not shown)."""
+    and (``RenderCoreSettings.dither``) a triangular dither of one 8-bit step against banding,
+    rounded to 8-bit levels in the shader (:func:`present_levels`); the screen's alpha is 1
+    (``color.a``, the sky occlusion, is not shown)."""
     name = "present"
     phase = "present"
     fragment = "core/present.frag"

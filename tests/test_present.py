@@ -1,11 +1,13 @@
-"""The present pass: tone map against its float64 reference, and the triangular dither before 8-bit
-output (no banding in a shallow gradient, the mean unchanged)."""
+"""The present pass: tone map against its float64 reference, the triangular dither before 8-bit
+output (no banding in a shallow gradient, the mean unchanged), and exact 8-bit levels written, so the
+framebuffer's own float -> 8-bit rounding (not round-to-nearest on every GPU) changes nothing."""
 import numpy as np
 import pytest
 
 from atmos.app import App
 from atmos.graph import RenderPass
-from atmos.render_core import COLOR, DITHER_STEP, RenderCorePlugin, dither_offsets, tone_map
+from atmos.render_core import COLOR, DITHER_STEP, RenderCorePlugin, dither_offsets, present_levels, tone_map
+from fullscreen_probe import run_fullscreen
 
 
 class GradientPass(RenderPass):
@@ -59,10 +61,47 @@ def test_dither_offsets_are_triangular_and_unbiased():
 
 def test_present_matches_its_reference(gpu, ctx, shallow_gradient):
     out = present(gpu, shallow_gradient).astype(int)
-    h, w = out.shape[:2]
-    ref = np.clip(tone_map(shallow_gradient[..., :3].astype(np.float64)) + DITHER_STEP * dither_offsets(w, h), 0, 1)
-    diff = np.abs(out - np.round(ref * 255.0))
-    assert diff.max() <= 1 and (diff == 0).mean() > 0.99
+    diff = np.abs(out - present_levels(shallow_gradient[..., :3].astype(np.float64)))
+    # float32 (pow as exp2(y·log2 x): ~1e-6 relative on a GPU) against float64: values of at most 0.5
+    # differ by ≤ 255 · 0.5 · 1e-6 = 1.3e-4 step, so only pixels that close to a tie (≤ 2.6e-4 of them)
+    # may round to the neighbouring level
+    assert diff.max() <= 1 and (diff == 0).mean() > 0.999
+
+
+def round_to_nearest(v) -> np.ndarray:
+    """float -> 8-bit as the GL prefers (and Mesa's llvmpipe does): the nearest level."""
+    return np.floor(np.clip(v, 0.0, 1.0) * 255.0 + 0.5)
+
+
+def nvidia_unorm8(v) -> np.ndarray:
+    """float -> 8-bit as measured on a machine with an NVIDIA GPU (H200, driver 580): truncated to 12
+    fractional bits, then rounded with ties down, floor((floor(v·4096)·255 + 2047) / 4096); values up
+    to 1/16 step above a tie go down (3 % of uniform values). The measured level-by-level thresholds
+    and the count of such values in a random sample agree with it."""
+    return np.floor((np.floor(np.clip(v, 0.0, 1.0) * 4096.0) * 255.0 + 2047.0) / 4096.0)
+
+
+def test_present_writes_exact_levels_that_any_rounding_keeps(gpu, ctx, rng):
+    """The shader's own output (read as float) is level / 255, so the nearest-level and NVIDIA's
+    conversion give the same byte, the level of :func:`present_levels`; the unrounded values they would
+    turn into different bytes (what the test would see without the rounding in the shader)."""
+    w, h = 256, 64
+    hdr = np.empty((h, w, 3))
+    hdr[: h // 2] = np.geomspace(1e-4, 20.0, w)[None, :, None]           # every level once or more
+    hdr[h // 2:] = rng.uniform(0.0, 2.0, (h - h // 2, w, 3))
+    image = np.concatenate([hdr, np.ones((h, w, 1))], -1).astype(np.float16)
+
+    def uniforms(program):
+        program["exposure"].value = 1.0
+        program["dither"].value = DITHER_STEP
+    out = run_fullscreen(gpu, "core/present.frag", (w, h), [image], uniforms, nearest=True)[..., :3]
+    # level / 255.0 in float32: within 2.5 ulp (GLSL's division) of the level, ulp ≤ 2^-24 below 1
+    assert np.abs(out * 255.0 - np.round(out * 255.0)).max() <= 255.0 * 2.5 * 2.0 ** -24
+    assert np.array_equal(nvidia_unorm8(out), round_to_nearest(out))
+    levels = present_levels(image[..., :3].astype(np.float64))
+    assert (round_to_nearest(out) != levels).mean() < 1e-3        # ties, as in the test above
+    unrounded = tone_map(image[..., :3].astype(np.float64)) + DITHER_STEP * dither_offsets(w, h)
+    assert (nvidia_unorm8(unrounded) != round_to_nearest(unrounded)).mean() > 0.01
 
 
 def test_dither_removes_banding_and_keeps_the_mean(gpu, ctx, shallow_gradient):
@@ -78,3 +117,13 @@ def test_dither_removes_banding_and_keeps_the_mean(gpu, ctx, shallow_gradient):
             assert np.abs(out - ideal).max() <= 1.5, "noise of at most one step (plus rounding)"
     assert errors[True] < 0.1, f"banding left: columns off by up to {errors[True]:.2f} steps"
     assert errors[False] > 0.25, "without dither the same ramp bands (the test can fail)"
+
+
+def test_hdr_max_is_one_number_in_python_and_glsl():
+    """The cap on the light one effect adds (render_core.HDR_MAX, shaders/lib/hdr_max.glsl): 2^14, about a quarter of
+    float16's 65504, so blends of values at most this stay finite on every driver."""
+    import re
+    from importlib.resources import files
+    from atmos.render_core import HDR_MAX
+    text = files("atmos.shaders").joinpath("lib", "hdr_max.glsl").read_text()
+    assert float(re.search(r"const float HDR_MAX = ([0-9.e+]+);", text)[1]) == HDR_MAX == 2.0 ** 14

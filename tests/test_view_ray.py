@@ -8,7 +8,7 @@ import pytest
 from atmos.app import App
 from atmos.camera import Camera, set_camera_uniforms, view_basis
 from atmos.defaults import DefaultPlugins
-from atmos.gpu import create_headless
+from atmos.gpu import create_headless, load_source
 from atmos.lighting import Sun
 from atmos.plugins.ground import GroundPlugin
 from atmos.plugins.light_shafts import LightShaftsPlugin
@@ -90,6 +90,42 @@ def test_view_rays_and_distances_match_float64_at_huge_far_near_ratios(gpu, ctx,
     assert np.all(np.abs(out[~sky, 3] - true[~sky]) <= ulp_bound[~sky] * np.linalg.norm(rays, axis=-1)[~sky])
     assert np.all(depth[0, :8] == 0.0)                   # the near plane
     assert np.allclose(out[0, :8, 3], near * np.linalg.norm(rays[0, :8], axis=-1), rtol=2e-6)
+
+
+F32 = np.float32
+
+
+def view_depth_as_written(depth, near, far) -> np.ndarray:
+    """float32 numpy model of lib/view_ray.glsl's view_depth in its `precise` order:
+    near / ((1 − depth) + depth · (near / far)), each operation rounded to float32."""
+    d, n = np.asarray(depth, F32), F32(near)
+    return n / ((F32(1.0) - d) + d * (n / F32(far)))
+
+
+def view_depth_factored(depth, near, far) -> np.ndarray:
+    """float32 numpy model of the same sum factored to 1 + depth · (near/far − 1) with one rounding
+    (an fma), as GLSL lets a compiler evaluate it without `precise` and NVIDIA's does."""
+    d, n = np.asarray(depth, F32), F32(near)
+    k = n / F32(far) - F32(1.0)
+    return n / (1.0 + d.astype(np.float64) * np.float64(k)).astype(F32)
+
+
+@pytest.mark.parametrize("near, far", [(0.1, 1e10), (0.1, 2000.0), (1e-3, 1e12)])
+def test_view_depth_is_precise_because_the_factored_sum_misses_the_tolerance(near, far):
+    """The distance test above (2e-6 of the float64 distance of the stored depth) passes the order
+    view_ray.glsl writes and fails the factored sum at far/near 2e4 and 1e11 (near/far − 1 loses
+    near/far's low bits, or all of 1e-11), so the shader must keep its order: `precise`."""
+    body = load_source("test/view_ray.frag").text.split("float view_depth(", 1)[1].split("\n}", 1)[0]
+    assert "precise float" in body, "view_depth's sum is not `precise`: a compiler may factor it"
+    cam = Camera(near=near, far=far)
+    z = np.geomspace(near, min(far, near * 2.0 ** 22), 200001)
+    d = window_depth(cam, z).astype(F32)
+    d = d[d < 1.0]
+    exact = near / ((1.0 - d.astype(np.float64)) + d * (near / far))
+    as_written = np.abs(view_depth_as_written(d, near, far) / exact - 1.0).max()
+    factored = np.abs(view_depth_factored(d, near, far) / exact - 1.0).max()
+    assert as_written < 2e-6
+    assert factored > 2e-6 if far / near < 1e13 else factored < 2e-6, factored
 
 
 def test_float32_unprojection_fails_where_the_camera_basis_does_not():

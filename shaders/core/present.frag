@@ -1,7 +1,7 @@
 #version 430
 // Present: HDR scene colour -> display. Exposure, ACES-fitted tone curve, sRGB encoding, then a
-// triangular (TPDF) dither of ±1 step of the 8-bit output so gradients do not band; float64
-// reference: atmos/render_core.py (tone_map, dither_offsets).
+// triangular (TPDF) dither of ±1 step of the 8-bit output so gradients do not band, rounded to the
+// nearest 8-bit level here; float64 reference: atmos/render_core.py (present_levels).
 in vec2 v_uv;
 out vec4 frag;
 layout(binding = 0) uniform sampler2D hdr;
@@ -27,6 +27,9 @@ vec3 tpdf(uvec2 pixel) {
 
 void main() {
     vec3 c = texture(hdr, v_uv).rgb * exposure;
-    c = pow(aces(max(c, vec3(0.0))), vec3(1.0 / 2.2));
-    frag = vec4(c + dither * tpdf(uvec2(gl_FragCoord.xy)), 1.0);
+    c = pow(aces(max(c, vec3(0.0))), vec3(1.0 / 2.2)) + dither * tpdf(uvec2(gl_FragCoord.xy));
+    // An exact level k/255: the framebuffer's own float -> 8-bit conversion need not round to nearest
+    // (GL lets it pick either neighbour; NVIDIA's rounds values up to 1/16 step above a tie down,
+    // a bias of the mean), but every conversion keeps a level.
+    frag = vec4(clamp(floor(c * 255.0 + 0.5), 0.0, 255.0) / 255.0, 1.0);
 }

@@ -22,8 +22,12 @@ vec3 view_ray_dir(vec2 uv, mat3 view_basis) {
 // depth = (1/near - 1/z) / (1/near - 1/far), so z = near / ((1 - depth) + depth * (near / far)).
 // 1 - depth is exact in float32 for depth >= 0.5 and nothing overflows or cancels however large
 // far/near is (near / far may be 1e-11). depth 0 -> near, depth 1 -> far.
+// `precise`: kept in this order. Without it a compiler may factor the sum into 1 + depth * (near/far - 1)
+// (GLSL allows it; NVIDIA's does), which loses near/far's low bits (all of them at near/far 1e-11):
+// up to 1.7e-4 relative near the far plane (tests/test_view_ray.py models both orders).
 float view_depth(float depth, float near, float far) {
-    return near / ((1.0 - depth) + depth * (near / far));
+    precise float scaled = (1.0 - depth) + depth * (near / far);
+    return near / scaled;
 }
 
 // Distance from the camera to the surface behind the pixel; `none` where nothing was drawn (depth 1).
