@@ -32,6 +32,38 @@ def ctx(gpu):
     assert gpu.ctx.error == "GL_NO_ERROR"
 
 
+@pytest.fixture(scope="session")
+def filter_bits(gpu):
+    """The context's texture filter's sub-texel weight precision, measured: None where it filters in
+    float (Mesa's llvmpipe), else its bits (8 on NVIDIA: a sample is up to 1/512 of the two texels'
+    difference off). Tests of passes that sample through the filter give it to their references."""
+    import numpy as np
+    import moderngl
+    ctx = gpu.ctx
+    gpu.make_current()
+    n = 4097
+    texture = ctx.texture((2, 1), 1, np.array([0.0, 1.0], "f4").tobytes(), dtype="f4")
+    texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
+    texture.repeat_x = texture.repeat_y = False
+    out = ctx.buffer(reserve=4 * n)
+    program = ctx.compute_shader("""#version 430
+        layout(local_size_x = 1) in;
+        layout(binding = 0) uniform sampler2D s;
+        layout(std430, binding = 0) writeonly buffer Out { float v[]; };
+        void main() { uint k = gl_GlobalInvocationID.x; v[k] = textureLod(s, vec2(0.25 + 0.5 * float(k) / 4096.0, 0.5), 0.0).r; }""")
+    try:
+        texture.use(0)
+        out.bind_to_storage_buffer(0)
+        program.run(n)
+        ctx.memory_barrier()
+        got = np.frombuffer(out.read(), "f4").astype(np.float64)
+    finally:
+        for obj in (program, out, texture):
+            obj.release()
+    error = np.abs(got - np.arange(n) / 4096.0).max()    # u from texel centre 0.25 to 0.75: weight k / 4096
+    return None if error < 1e-6 else int(np.floor(-np.log2(2.0 * error)))
+
+
 @pytest.fixture
 def rng(request):
     """A fresh random generator per test; the seed is printed so a failure can be replayed

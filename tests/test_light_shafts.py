@@ -57,6 +57,19 @@ def test_blur_matches_reference_on_small_random_masks(gpu, ctx, rng, where):
     assert expected.max() > 0 or where == "far_outside"     # all taps may leave the mask there
 
 
+def test_the_blur_adds_at_most_hdr_max_whatever_its_settings(gpu, ctx):
+    """weight and exposure have no upper bound: their product, up to 1e600, is held at float32's largest
+    and the sum at HDR_MAX, so blending it onto the float16 colour stays finite (on a float32 target the
+    uncapped sum would be 1e30 or inf here)."""
+    from atmos.render_core import HDR_MAX
+    mask = np.full((8, 8, 3), 65504.0)
+    for extreme in (dict(weight=1e30), dict(exposure=1e30), dict(weight=1e300, exposure=1e300)):
+        params = LightShaftSettings(mode="screen", **extreme)
+        out = gpu_blur(gpu, mask, (0.5, 0.5), params)
+        assert np.isfinite(out).all() and out[..., :3].max() == HDR_MAX, (extreme, out.max())
+        assert np.allclose(out[..., :3], reference.radial_blur(mask, (0.5, 0.5), params))
+
+
 def test_blur_reference_by_hand():
     """One bright texel: the shaft runs from it away from the sun, falling off by decay per tap."""
     mask = np.zeros((1, 9, 1))

@@ -42,12 +42,19 @@ def mip_chain(texture: np.ndarray) -> list:
     return levels
 
 
-def sample(texture: np.ndarray, uv: np.ndarray) -> np.ndarray:
-    """Bilinear with repeat, texel i centred at (i + 0.5)/n (texture(), one level)."""
+def sample(texture: np.ndarray, uv: np.ndarray, weight_bits: int | None = None) -> np.ndarray:
+    """Bilinear with repeat, texel i centred at (i + 0.5)/n (texture(), one level); ``weight_bits``: a
+    model of a texture unit's filter (float32 coordinates, sub-texel weights rounded to that many bits:
+    8 on a machine with an NVIDIA GPU), None: exact (a texture unit that filters in float)."""
     n = texture.shape[0]
-    p = uv * n - 0.5
+    if weight_bits is None:
+        p = uv * n - 0.5
+    else:
+        p = (np.asarray(uv, np.float32) * np.float32(n) - np.float32(0.5)).astype(np.float64)
     i0 = np.floor(p).astype(np.int64)
     f = p - i0
+    if weight_bits is not None:
+        f = np.round(f * 2.0 ** int(weight_bits)) / 2.0 ** int(weight_bits)
     at = lambda di, dk: texture[(i0[..., 0] + di) % n, (i0[..., 1] + dk) % n]
     return ((1 - f[..., 0]) * (1 - f[..., 1]) * at(0, 0) + f[..., 0] * (1 - f[..., 1]) * at(1, 0)
             + (1 - f[..., 0]) * f[..., 1] * at(0, 1) + f[..., 0] * f[..., 1] * at(1, 1))

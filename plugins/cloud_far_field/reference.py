@@ -190,18 +190,20 @@ def light_by_rank(sums_a, sums_b, density_a, density_b, t: float, a_shift, fade:
     return out
 
 
-def field_fbm(xz, octaves, offsets, tile_size: float, channel: int = 0) -> np.ndarray:
+def field_fbm(xz, octaves, offsets, tile_size: float, channel: int = 0, weight_bits: int | None = None) -> np.ndarray:
     """The fbm (...,) of ``cloud_far_field/field.glsl`` at world ``xz`` (..., 2), mip 0: ``octaves`` the
     four downloaded textures (size, size, 4) [x, y, channel] (``OctaveTextures.download``), octave k read
     at its own turned uv (:func:`atmos.plugins.cloud_far_field.pattern.octave_uv`), ``offsets`` (4, 2)
     each octave's drift in its uv (:func:`.layer.drift`), ``tile_size`` the layer's tile (m,
     FarFieldLayer.tile_size); bilinear with repeat, texel i centred at (i + 0.5)/size; ``channel``: the
-    channel read (pattern.CHANNEL_STEPS: the point, the relief's samples toward and away from the sun)."""
+    channel read (pattern.CHANNEL_STEPS: the point, the relief's samples toward and away from the sun);
+    ``weight_bits``: filtered as a texture unit with that many bits of sub-texel weight would (:func:`.cover.sample`)."""
     from atmos.plugins.cloud_far_field.cover import sample
     from atmos.plugins.cloud_far_field.pattern import octave_uv
     from atmos.plugins.sky_layer.octaves import WEIGHTS
     uv = octave_uv(xz, offsets, tile_size)
-    return sum(w * sample(np.asarray(tex, np.float64)[..., channel], uv[k]) for k, (w, tex) in enumerate(zip(WEIGHTS, octaves)))
+    return sum(w * sample(np.asarray(tex, np.float64)[..., channel], uv[k], weight_bits)
+               for k, (w, tex) in enumerate(zip(WEIGHTS, octaves)))
 
 
 def field_rank(fbm, quantiles) -> np.ndarray:
@@ -256,15 +258,16 @@ def slant_rank(rank, height: float, cot, cover: float, crossings, tile_size: flo
 
 
 def far_field_alpha(xz, dirs, height: float, octaves, offsets, tile_size: float, quantiles, columns,
-                    column_tau: float, cover: float, crossings, thickness: float = 1.0) -> np.ndarray:
+                    column_tau: float, cover: float, crossings, thickness: float = 1.0,
+                    weight_bits: int | None = None) -> np.ndarray:
     """far.frag's opacity (...,) where the view ``dirs`` (..., 3, unit) meet the middle plane at world
     ``xz`` (..., 2), mip 0, before the edge, horizon and scene fades: thickness · column_tau (sigma_t ·
     cell height) · the volume's column sum at the point's rank, both as :func:`slant_rank` gives them
     for clouds ``height`` (m) high at the ray's slant (``cover``, ``crossings``: the layer's), seen along
-    the slant 1 / max(|dir_y|, MIN_SLANT)."""
+    the slant 1 / max(|dir_y|, MIN_SLANT); ``weight_bits``: the octaves filtered as by :func:`field_fbm`."""
     dirs = np.asarray(dirs, np.float64)
     slant = np.maximum(np.abs(dirs[..., 1]), MIN_SLANT)
-    rank = field_rank(field_fbm(xz, octaves, offsets, tile_size), quantiles)
+    rank = field_rank(field_fbm(xz, octaves, offsets, tile_size, weight_bits=weight_bits), quantiles)
     rank, factor = slant_rank(rank, height, np.linalg.norm(dirs[..., [0, 2]], axis=-1) / slant, cover, crossings, tile_size)
     tau = float(thickness) * float(column_tau) * factor * column_at_rank(rank, columns)
     return 1.0 - np.exp(-tau / slant)

@@ -68,6 +68,17 @@ def column_depth(density, uvw, column_tau: float, shading_shape=None) -> tuple[n
     return c[:, 0], c[:, 1]
 
 
+def texel_filter(grid, points, weight_bits: int | None = None) -> np.ndarray:
+    """Clamp-to-edge trilinear samples of ``grid`` at index-space ``points`` (..., 3): exact, as
+    ``volume.glsl`` texel_trilinear filters; with ``weight_bits`` a model of a texture unit's filter
+    (float32 coordinates, sub-texel weights rounded to that many bits: 8 on a machine with an NVIDIA GPU)."""
+    if weight_bits is None:
+        return trilinear(grid, points)
+    p = np.clip(np.asarray(points, np.float32).astype(np.float64), 0, np.array(np.shape(grid)) - 1)
+    i0, step = np.floor(p), 2.0 ** int(weight_bits)
+    return trilinear(grid, i0 + np.round((p - i0) * step) / step)
+
+
 def shifted(volume: np.ndarray, shift) -> np.ndarray:
     """``volume`` (nx, ny, nz) read at cell ``c + shift`` for every cell c, zero past its edge
     (set A on set B's grid: :attr:`~atmos.plugins.clouds.CloudSets.a_shift`)."""
@@ -81,12 +92,14 @@ def shifted(volume: np.ndarray, shift) -> np.ndarray:
 
 
 def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, uniforms: dict, view_proj,
-                    light: dict, a_shift=(0, 0, 0)) -> dict:
+                    light: dict, a_shift=(0, 0, 0), weight_bits: int | None = None) -> dict:
     """Arrays over the vertices of every segment (gi, j, gk, packed level and span), in order: ``position`` (n, 4),
     ``size``, ``octaves`` (n, 4), ``ambient`` (n, 3), ``sun`` (n, 3: the sun's source at its height), ``center`` (n, 3), ``radius``, ``tau``, ``stretch``, ``coverage``,
     ``visible``. ``trans_a``/``trans_b`` None: no shading (T = 1). ``light``: the light uniforms
     (:func:`atmos.plugins.cloud_render.light.light_uniforms`). ``a_shift``: A's cell for B's cell c is
-    c + a_shift (zero past A's edge for the cell sums; clamp-to-edge for the sampled light, as the GPU)."""
+    c + a_shift (zero past A's edge for the cell sums; clamp-to-edge for the sampled light, as the GPU).
+    ``weight_bits``: the sun's transmittance filtered as a texture unit with that many bits of sub-texel
+    weight would (:func:`texel_filter`; None: exactly, as sprite.vert)."""
     u = uniforms
     shape = np.array(u["volume_shape"])
     gx, gz = u["group_size"]
@@ -134,8 +147,8 @@ def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, 
             T = np.ones(len(c))
         else:
             tex = np.array(np.shape(trans_a))
-            T = trilinear(np.asarray(trans_a, np.float64), (tap + shift) / shape * tex - 0.5) * (1 - t) + \
-                trilinear(np.asarray(trans_b, np.float64), tap / shape * tex - 0.5) * t
+            T = (texel_filter(np.asarray(trans_a, np.float64), (tap + shift) / shape * tex - 0.5, weight_bits) * (1 - t)
+                 + texel_filter(np.asarray(trans_b, np.float64), tap / shape * tex - 0.5, weight_bits) * t)
         octaves += octave_weights(T, a_ms, b_ms) / 8.0
         slope += side * np.log(np.maximum(T, MIN_T))[:, None]
     world = np.asarray(u["layer_min"]) + center * np.asarray(u["cell_size"])

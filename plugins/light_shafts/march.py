@@ -15,6 +15,7 @@ from atmos.plugins.cloud_far_field.layer import FAR_FIELD
 from atmos.plugins.cloud_render.offscreen import OffscreenClouds
 from atmos.plugins.cloud_shadows.plugin import column_uniforms
 from atmos.plugins.clouds.sets import CLOUD_SETS, CloudSets
+from atmos.plugins.light_shafts.settings import FLOAT32_MAX
 from atmos.plugins.sky.luts import SKY_LUTS, atmosphere_defines, set_atmosphere_uniforms, view_radius
 from atmos.render_core import COLOR, DEPTH
 
@@ -24,13 +25,14 @@ SHAFT_DEPTH = "light_shafts_depth"     # low-res farthest scene depth
 
 def march_irradiance(sun, settings) -> np.ndarray | None:
     """The sun irradiance the haze is lit by, ``sun_intensity × Sun.color`` × smoothstep(0,
-    ``horizon_fade``, sun height); None when nothing would show (no sun, below the horizon, black)."""
+    ``horizon_fade``, sun height), at most float32's largest finite value (its uniform); None when
+    nothing would show (no sun, below the horizon, black)."""
     s = unit_sun(sun.direction)
     if s is None or s[1] <= 0.0 or settings.scattering == 0.0:
         return None
     x = min(float(s[1]) / settings.horizon_fade, 1.0)
     e = settings.sun_intensity * x * x * (3.0 - 2.0 * x) * np.asarray(sun.color, np.float64)
-    return e if e.max() > 0.0 else None
+    return np.minimum(e, FLOAT32_MAX) if e.max() > 0.0 else None
 
 
 class MarchedShafts:

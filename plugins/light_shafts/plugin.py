@@ -9,7 +9,7 @@ from atmos.plugin import Plugin
 from atmos.plugins.cloud_far_field.layer import FAR_FIELD
 from atmos.plugins.clouds.sets import CLOUD_SETS
 from atmos.plugins.light_shafts.march import MarchedShafts
-from atmos.plugins.light_shafts.settings import LightShaftSettings
+from atmos.plugins.light_shafts.settings import LightShaftSettings, blur_scale
 from atmos.plugins.light_shafts.screen_sun import screen_sun
 from atmos.plugins.sky import SkyPlugin
 from atmos.plugins.sky.aerial import active
@@ -25,8 +25,7 @@ def blur_uniforms(program, sun_uv, settings: LightShaftSettings, strength: float
     program["samples"].value = settings.samples
     program["density"].value = settings.density
     program["decay"].value = settings.decay
-    program["weight"].value = settings.weight
-    program["scale"].value = settings.exposure * strength
+    program["scale"].value = blur_scale(settings, strength)
 
 
 class LightShaftsPass(RenderPass):

@@ -9,6 +9,8 @@ import numpy as np
 
 from atmos.blue_noise import blue_noise
 from atmos.plugins.cloud_shadows.reference import zero_border_bilinear
+from atmos.plugins.light_shafts.settings import blur_scale
+from atmos.render_core import HDR_MAX
 from atmos.shading.medium import phase
 
 LUMA = np.array([0.2126, 0.7152, 0.0722])
@@ -39,7 +41,8 @@ def occlusion_mask(color, depth, sun_uv, settings) -> np.ndarray:
 
 def radial_blur(mask, sun_uv, settings, strength: float = 1.0) -> np.ndarray:
     """(h, w, c): per pixel, ``samples`` bilinear taps (zero outside the mask) stepping toward the sun,
-    tap i weighing ``weight·decay^(i−1)``, summed and scaled by ``exposure·strength``."""
+    tap i weighing ``weight·decay^(i−1)``, summed and scaled by ``exposure·strength``, at most
+    :data:`~atmos.render_core.HDR_MAX`."""
     mask = np.asarray(mask, np.float64)
     h, w, channels = mask.shape
     uv = pixel_uv(w, h)
@@ -50,9 +53,9 @@ def radial_blur(mask, sun_uv, settings, strength: float = 1.0) -> np.ndarray:
         texel = (uv - i * step) * np.array([w, h]) - 0.5          # (h, w, 2) as (x, y)
         p = texel[..., ::-1]                                        # index order of mask: (row, column)
         for ch in range(channels):
-            out[..., ch] += zero_border_bilinear(mask[..., ch], p) * (settings.weight * falloff)
+            out[..., ch] += zero_border_bilinear(mask[..., ch], p) * falloff
         falloff *= settings.decay
-    return out * (settings.exposure * strength)
+    return np.minimum(out * blur_scale(settings, strength), HDR_MAX)
 
 
 def march_jitter(w: int, h: int) -> np.ndarray:
@@ -67,7 +70,8 @@ def march_shafts(low_depth, basis, camera_pos, near: float, far: float, frame_si
     """(h, w, 4) (in-scattered light, transmittance) of the marched shafts at the low-res texels of
     ``low_depth`` (window depth, row 0 at the bottom): ``settings.steps`` samples at ``(i + jitter)·ds``
     along each texel's view ray (through its block's centre; ``basis``: :func:`atmos.camera.view_basis`)
-    to its depth or ``max_distance``, ``L = Σ σ p(cos) E exp(−τ_sun − σ s_i) ds``, ``T = exp(−σ d)``;
+    to its depth or ``max_distance``, ``L = Σ σ p(cos) E exp(−τ_sun − σ s_i) ds`` (at most ``HDR_MAX``),
+    ``T = exp(−σ d)``;
     ``optical_depth(points (..., 3)) -> (...)`` the sun's optical depth through the clouds (None: 0),
     e.g. :func:`atmos.plugins.cloud_shadows.reference.sun_optical_depth` bound to a volume."""
     depth = np.asarray(low_depth, np.float64)
@@ -87,5 +91,5 @@ def march_shafts(low_depth, basis, camera_pos, near: float, far: float, frame_si
         tau = 0.0 if optical_depth is None else optical_depth(np.asarray(camera_pos, np.float64) + direction * s[..., None])
         total += np.exp(-tau - sigma * s)
     p = phase(direction @ np.asarray(sun_dir, np.float64), settings.phase_g, settings.phase_g2, settings.phase_w)
-    light = np.asarray(irradiance, np.float64) * (sigma * p * total * ds)[..., None]
+    light = np.minimum(np.asarray(irradiance, np.float64) * (sigma * p * total * ds)[..., None], HDR_MAX)
     return np.concatenate([light, np.exp(-sigma * d)[..., None]], -1)

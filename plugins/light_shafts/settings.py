@@ -4,12 +4,15 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from atmos.checks import CheckedSettings, check_choice, check_int, check_num
 
 MODES = ("march", "screen")
 MAX_SAMPLES = 256
 MAX_STEPS = 256
 MAX_DOWNSAMPLE = 8
+FLOAT32_MAX = float(np.finfo(np.float32).max)   # a float32 uniform of more is inf
 _OWNER = "LightShaftSettings"
 
 
@@ -46,7 +49,8 @@ class LightShaftSettings(CheckedSettings):
     0 on open sky, 1 on opaque geometry or cloud, the coverage on cloud edges. So clouds drawn over
     the sky cut the shafts however brightly the sun lights them; fog tints the sky but keeps it sky.
     Blur, per pixel: ``samples`` taps on the way to the sun covering ``density`` of it; tap i
-    (1-based) weighs ``weight · decay^(i−1)``; the sum times ``exposure`` is added to the colour.
+    (1-based) weighs ``weight · decay^(i−1)``; the sum times ``exposure``, at most
+    :data:`atmos.render_core.HDR_MAX`, is added to the colour.
     ``downsample``: mask and blur at 1/downsample of the frame size (read by the pass's ``setup``
     every frame: a change resizes them on the next frame).
     Fades (1 → 0): ``horizon_fade``: the sun's height (y of its unit direction) from this down to 0;
@@ -103,3 +107,9 @@ class LightShaftSettings(CheckedSettings):
             fog_sun_share=check_num(o, "fog_sun_share", self.fog_sun_share, 0.0, 1.0),
         )
         self.store(checked)
+
+
+def blur_scale(settings: LightShaftSettings, strength: float) -> float:
+    """``weight × exposure × strength``, the screen mode's blur scale, at most float32's largest
+    finite value (a float32 uniform of more is inf, and inf × a dark tap NaN)."""
+    return min(settings.weight * settings.exposure * strength, FLOAT32_MAX)

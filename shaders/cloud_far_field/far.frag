@@ -41,6 +41,17 @@ layout(binding = 19) uniform sampler2D far_field_light;   // RankLight.field: (r
 uniform float lod_scale;       // texels per metre × a pixel's angle (rad): the mip level from the footprint,
                                // not from screen derivatives (the same under any camera roll)
 
+// A RankLight texture (rank, row) at uv: bilinear, clamp to edge, weights in float32 (np.interp in the
+// reference; a texture unit's 8-bit sub-texel weights would move the clouds' height between ranks).
+vec4 rank_lookup(sampler2D s, vec2 uv) {
+    ivec2 n = textureSize(s, 0);
+    vec2 p = clamp(uv * vec2(n) - 0.5, vec2(0.0), vec2(n - 1));
+    ivec2 i = ivec2(p), j = min(i + 1, n - 1);      // p >= 0: ivec2 is its floor
+    vec2 f = p - vec2(i), g = 1.0 - f;
+    return g.y * (g.x * texelFetch(s, i, 0) + f.x * texelFetch(s, ivec2(j.x, i.y), 0))
+         + f.y * (g.x * texelFetch(s, ivec2(i.x, j.y), 0) + f.x * texelFetch(s, j, 0));
+}
+
 // (rank, optical depth factor) of a point of rank r of a layer of clouds `height` (m) high seen with
 // the view's cot(elevation) `cot`. Along a line the pattern changes cover n times per metre
 // (field_crossings at the cover's quantile, per tile): chords of mean length 2c / n, gaps 2 (1 - c) / n,
@@ -81,18 +92,23 @@ void main() {
     vec4 r = far_field_rank(hit.xz, lod);
     // the clouds' height h: RankLight's thickness at the median covered rank; seen at a slant their
     // sides widen the layer's cover (slant_rank)
-    float height = layer_height * textureLod(far_thickness_by_rank, vec2(1.0 - 0.5 * cover, 0.5), 0.0).r;
+    float height = layer_height * rank_lookup(far_thickness_by_rank, vec2(1.0 - 0.5 * cover, 0.5)).r;
     vec2 slanted = slant_rank(r.x, height, length(dir.xz) / max(abs(dir.y), MIN_SLANT));
     float tau = thickness * column_tau * slanted.y * far_quantile(slanted.x);
     float alpha = (1.0 - exp(-tau / max(abs(dir.y), MIN_SLANT))) * fade;
+    if (!(alpha > 0.0)) {                                // none (thickness 0: no pow(0, 0) below)
+        frag = vec4(0.0);
+        frag_distance = vec4(0.0);
+        return;
+    }
     vec2 at = vec2(slanted.x, dir.y < 0.0 ? 0.25 : 0.75);  // row 0: seen from above, 1: from below
     // the sun's light moved by the relief: lit edges facing the sun, shaded ones behind, none added
     float relief = far_relief(r, thickness * column_tau, sun_dir.y);
-    vec4 sun = relief_light(clamp(pow(max(textureLod(far_sun_by_rank, at, 0.0), 0.0), vec4(thickness)), 0.0, 1.0),
+    vec4 sun = relief_light(clamp(pow(max(rank_lookup(far_sun_by_rank, at), 0.0), vec4(thickness)), 0.0, 1.0),
                             relief * octave_exponents());
-    vec3 source = sun_source_at(textureLod(far_height_by_rank, at, 0.0).r);
+    vec3 source = sun_source_at(rank_lookup(far_height_by_rank, at).r);
     vec3 light = sun_part(octave_weights_of(sun), dot(dir, sun_dir), source) + ambient_source(0.5 * tau, 0.5 * tau, dir.y)
-               + (ms_diffusion > 0.0 ? diffusion_light(textureLod(far_field_light, at, 0.0), dir, source) : vec3(0.0));
-    frag = vec4(light * alpha, alpha);
+               + (ms_diffusion > 0.0 ? diffusion_light(rank_lookup(far_field_light, at), dir, source) : vec3(0.0));
+    frag = vec4(min(light, vec3(HDR_MAX)) * alpha, alpha);   // volume.glsl: never inf in float16
     frag_distance = vec4(alpha * length(hit - camera_pos), alpha, 0.0, alpha);
 }

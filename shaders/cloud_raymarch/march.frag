@@ -203,7 +203,7 @@ void main() {
 #if FAR_FIELD
             if (df > 0.0) J = mix(J, far_source(fc, fh, dir), df / (dv + df));
 #endif
-            light += w * J;
+            light += w * min(J, vec3(HDR_MAX));   // lib/hdr_max.glsl (through volume.glsl)
             weighted += w * sp;
             trans *= 1.0 - a;
             if (trans < min_transmittance) break;

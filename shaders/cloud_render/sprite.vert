@@ -9,6 +9,9 @@
 // (cells past the volume's edge count as empty;
 // the grid is B's placement, A's cell is c + a_shift);
 // empty blocks and blocks past the edge are thrown out of the view volume.
+// The light samples filter in float32 (volume.glsl texel_trilinear), not with a texture unit's 8-bit
+// sub-texel weights: once per sprite, and T falls by orders of magnitude between cells.
+#define CLOUD_EXACT_FILTER
 #include "cloud_render/volume.glsl"
 layout(location = 0) in ivec4 in_segment;
 uniform ivec3 volume_shape;

@@ -32,6 +32,30 @@ uniform float column_tau;      // sigma_t * cell height: optical depth of one ce
 uniform float edge_fade;       // CloudSettings.edge_fade: density fades to 0 toward the inscribed circle
 #include "clouds/edge.glsl"
 const float PI = 3.14159265358979;
+#include "lib/hdr_max.glsl"
+
+// Trilinear at level 0 with clamp to edge and float32 weights (shading/reference.py multilinear): a
+// texture unit's filter takes 8-bit sub-texel weights on some GPUs (a machine with an NVIDIA GPU), up to
+// 1/256 of the texels' difference off, percents of T where it falls by orders of magnitude between cells.
+vec4 texel_trilinear(sampler3D s, vec3 uvw) {
+    ivec3 n = textureSize(s, 0);
+    vec3 p = clamp(uvw * vec3(n) - 0.5, vec3(0.0), vec3(n - 1));
+    ivec3 i = ivec3(p), j = min(i + 1, n - 1);      // p >= 0: ivec3 is its floor
+    vec3 f = p - vec3(i), g = 1.0 - f;               // (1 - f) a + f b: no cancellation when b << a
+    vec4 y0 = g.y * (g.x * texelFetch(s, i, 0) + f.x * texelFetch(s, ivec3(j.x, i.y, i.z), 0))
+            + f.y * (g.x * texelFetch(s, ivec3(i.x, j.y, i.z), 0) + f.x * texelFetch(s, ivec3(j.x, j.y, i.z), 0));
+    vec4 y1 = g.y * (g.x * texelFetch(s, ivec3(i.x, i.y, j.z), 0) + f.x * texelFetch(s, ivec3(j.x, i.y, j.z), 0))
+            + f.y * (g.x * texelFetch(s, ivec3(i.x, j.y, j.z), 0) + f.x * texelFetch(s, j, 0));
+    return g.z * y0 + f.z * y1;
+}
+
+// The volume's lookups: the texture unit's filter, or texel_trilinear (8 fetches) where
+// CLOUD_EXACT_FILTER is defined before the include (sprite.vert: once per sprite).
+#ifdef CLOUD_EXACT_FILTER
+#define CLOUD_SAMPLE(s, uvw) texel_trilinear(s, uvw)
+#else
+#define CLOUD_SAMPLE(s, uvw) textureLod(s, uvw, 0.0)
+#endif
 
 // uvw: B's texture coordinates (the volume is drawn at B's placement); A's are offset by a_shift.
 vec3 a_uvw(vec3 uvw) {
@@ -40,18 +64,18 @@ vec3 a_uvw(vec3 uvw) {
 }
 
 float cloud_density(vec3 uvw) {
-    return cloud_edge_weight(uvw.xz, edge_fade) * mix(textureLod(density_a, a_uvw(uvw), 0.0).r, textureLod(density_b, uvw, 0.0).r, t);
+    return cloud_edge_weight(uvw.xz, edge_fade) * mix(CLOUD_SAMPLE(density_a, a_uvw(uvw)).r, CLOUD_SAMPLE(density_b, uvw).r, t);
 }
 
 float cloud_transmittance(vec3 uvw) {
-    return has_shading == 0 ? 1.0 : mix(textureLod(trans_a, a_uvw(uvw), 0.0).r, textureLod(trans_b, uvw, 0.0).r, t);
+    return has_shading == 0 ? 1.0 : mix(CLOUD_SAMPLE(trans_a, a_uvw(uvw)).r, CLOUD_SAMPLE(trans_b, uvw).r, t);
 }
 
 // (tau_up, tau_down): optical depth from uvw straight up and straight down to the volume's faces, from
 // the light volume's columns (atmos/shading/columns.py: density integrals in fine cells, per set, at the
 // shading scale) times column_tau and the edge fade (which depends on x and z only).
 vec2 cloud_columns(vec3 uvw) {
-    vec2 c = mix(textureLod(columns_a, a_uvw(uvw), 0.0).rg, textureLod(columns_b, uvw, 0.0).rg, t);
+    vec2 c = mix(CLOUD_SAMPLE(columns_a, a_uvw(uvw)).rg, CLOUD_SAMPLE(columns_b, uvw).rg, t);
     return column_tau * cloud_edge_weight(uvw.xz, edge_fade) * c;
 }
 
@@ -106,7 +130,7 @@ vec3 ambient_source(float tau_up, float tau_down, float ray_y) {
 // The diffusion field (atmos/shading/diffusion.py): (phi, F) of the sun's scattered fluence for unit
 // irradiance, mix(A, B, t) like the density.
 vec4 cloud_diffusion(vec3 uvw) {
-    return mix(textureLod(diffusion_a, a_uvw(uvw), 0.0), textureLod(diffusion_b, uvw, 0.0), t);
+    return mix(CLOUD_SAMPLE(diffusion_a, a_uvw(uvw)), CLOUD_SAMPLE(diffusion_b, uvw), t);
 }
 
 // The field's share of J beside the octaves for a field value f = (phi, F) under the sun's `source`: source beta

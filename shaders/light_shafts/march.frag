@@ -22,6 +22,7 @@
 // Both (a fog under the aerial perspective, mixed along the ray: atmos/composition.py): both sums, each
 // medium's in-scatter at s dimmed by the other in front of s too (the fog's by the air's grey
 // transmittance exp(-ext s), the air's by the fog's f(s)).
+#include "lib/hdr_max.glsl"
 #include "lib/view_ray.glsl"
 #include "lib/phase.glsl"
 #include "cloud_shadows/column.glsl"
@@ -31,7 +32,7 @@ uniform vec3 camera_pos;
 uniform float near;
 uniform float far;
 uniform vec3 sun_dir;          // unit, toward the sun
-uniform vec3 irradiance;       // sun_intensity * Sun.color * horizon fade
+uniform vec3 irradiance;       // sun_intensity * Sun.color * horizon fade, at most float32's largest
 uniform vec3 lobes;            // phase_g, phase_g2, phase_w
 uniform float scattering;      // 1/m
 uniform float max_distance;
@@ -140,5 +141,5 @@ void main() {
         sum += exp(-tau - scattering * s);
     }
     vec3 light = irradiance * (scattering * phase2(dot(dir, sun_dir), lobes) * sum * ds);
-    frag = vec4(light, exp(-scattering * d));
+    frag = vec4(min(light, vec3(HDR_MAX)), exp(-scattering * d));   // blended onto the float16 colour
 }
