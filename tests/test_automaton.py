@@ -383,6 +383,13 @@ def test_shape_too_big_for_gpu(gpu, ctx, layout):
             CloudAutomaton(gpu, shape, layout=layout)
 
 
+def test_more_layers_than_the_advection_takes_is_a_clear_error(gpu, ctx):
+    from atmos.automaton.automaton import MAX_LAYERS
+    with pytest.raises(ValueError, match=rf"has {MAX_LAYERS + 1} layers; the automaton advects at most {MAX_LAYERS}"):
+        CloudAutomaton(gpu, (4, MAX_LAYERS + 1, 4))
+    CloudAutomaton(gpu, (4, MAX_LAYERS, 4)).release()
+
+
 def test_release(make):
     ca = make((4, 3, 4))
     ca.release()

@@ -51,6 +51,7 @@ from atmos.gpu.context import GpuContext, require_gpu
 from atmos.hashing import stream_key
 
 PRECISION_BITS = 16
+MAX_LAYERS = 128        # layers (ny) the advection takes shifts for (common.glsl: a uniform array)
 PLANES = PRECISION_BITS + 1
 LAYOUTS = ("packed", "cell")
 RULES = ("p_ext", "p_hum", "p_act")
@@ -101,6 +102,8 @@ class CloudAutomaton:
                 f"{_mb(biggest)}, but a shader storage block holds at most {_mb(limit)} "
                 f"(GL_MAX_SHADER_STORAGE_BLOCK_SIZE); use a smaller shape"
                 + (" or layout='packed'" if layout == "cell" else ""))
+        if ny > MAX_LAYERS:
+            raise ValueError(f"shape {shape} has {ny} layers; the automaton advects at most {MAX_LAYERS} (ny <= {MAX_LAYERS})")
         max_groups = ctx.info.get("GL_MAX_COMPUTE_WORK_GROUP_COUNT", (65535, 65535, 65535))
         groups = -(-count // _GROUP)
         gx = min(groups, int(max_groups[0]))
@@ -135,10 +138,6 @@ class CloudAutomaton:
             for buf in self._state:
                 buf.clear()
             self._current = 0
-            self._shifts = ctx.buffer(reserve=8 * ny)
-            self._shifts.clear()
-            self._shift_bytes = bytes(8 * ny)
-            objects.append(self._shifts)
             self._dummy = ctx.buffer(reserve=16)
             objects.append(self._dummy)
         except Exception:
@@ -236,16 +235,14 @@ class CloudAutomaton:
         self._current = 1 - self._current
 
         if shifts.any():
-            data = shifts.astype("<i4").tobytes()
-            if data != self._shift_bytes:
-                self._shifts.write(data)
-                self._shift_bytes = data
+            padded = np.zeros((MAX_LAYERS, 2), "<i4")
+            padded[: len(shifts)] = shifts
             ctx.memory_barrier(moderngl.SHADER_STORAGE_BARRIER_BIT)
             src, dst = self._state[self._current], self._state[1 - self._current]
             src.bind_to_storage_buffer(0)
             dst.bind_to_storage_buffer(1)
-            self._shifts.bind_to_storage_buffer(5)
             self._set_grid(self._prog_advect)
+            self._prog_advect["u_shifts"].write(padded.tobytes())
             self._prog_advect.run(*self._grid)
             self._current = 1 - self._current
         ctx.memory_barrier(moderngl.ALL_BARRIER_BITS)
@@ -260,7 +257,7 @@ class CloudAutomaton:
         if self._released:
             return
         self._released = True
-        objects = [self._shifts, self._dummy, self._staging, *self._state, *self._prob_buffers]
+        objects = [self._dummy, self._staging, *self._state, *self._prob_buffers]
         for obj in objects:
             if obj is not None:
                 obj.release()

@@ -6,7 +6,6 @@ layout(local_size_x = 64) in;
 
 layout(std430, binding = 0) readonly buffer Src { uint src[]; };
 layout(std430, binding = 1) writeonly buffer Dst { uint dst[]; };
-layout(std430, binding = 5) readonly buffer Shifts { ivec2 shifts[]; };
 
 void main() {
     uint c = invocation_index();
@@ -17,7 +16,7 @@ void main() {
     uint row = c / uint(u_size.x);
     int y = int(row % uint(u_size.y));
     int z = int(row / uint(u_size.y));
-    ivec2 s = shifts[y];
+    ivec2 s = u_shifts[y];
     int xs = x - s.x;
     int zs = z - s.y;
     uint v = 0u;

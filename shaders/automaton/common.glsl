@@ -13,6 +13,10 @@ uniform uint u_count;        // invocations that do work (words or cells)
 uniform uvec3 u_mode;
 uniform uvec3 u_threshold;   // T = floor(p * 65536 + 0.5) in [0, 65536] for mode 1
 uniform uvec2 u_keys[3 * PRECISION_BITS];   // stream keys (ka, kb) of (seed, step, rule, plane)
+// Advection's shift (sx, sz) per layer y, a uniform (captured when the step is dispatched: a buffer
+// updated per step raced the queued advections reading it on NVIDIA); automaton.py MAX_LAYERS.
+#define MAX_LAYERS 128
+uniform ivec2 u_shifts[MAX_LAYERS];
 
 uint invocation_index() {
     return gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * (gl_NumWorkGroups.x * gl_WorkGroupSize.x);

@@ -7,7 +7,6 @@ layout(local_size_x = 64) in;
 
 layout(std430, binding = 0) readonly buffer Src { uint src[]; };
 layout(std430, binding = 1) writeonly buffer Dst { uint dst[]; };
-layout(std430, binding = 5) readonly buffer Shifts { ivec2 shifts[]; };   // per layer y (sx, sz)
 
 uniform uint u_last_mask;
 
@@ -26,7 +25,7 @@ void main() {
     uint row = w / uint(nwx);
     int y = int(row % uint(u_size.y));
     int z = int(row / uint(u_size.y));
-    ivec2 s = shifts[y];                   // clamped on the CPU to |s| <= n + 32
+    ivec2 s = u_shifts[y];                 // clamped on the CPU to |s| <= n
     int zs = z - s.y;
     if (zs < 0 || zs >= u_size.z) {
         dst[w] = 0u;
