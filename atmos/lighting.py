@@ -2,7 +2,7 @@
 
 :func:`sky_light` gives the sun's colour (reddened near the horizon, zero at night) and the sky's
 ambient colour for a sun direction: what DaylightPlugin writes into :class:`Sun`, and what the sky
-(``NIGHT_SKY``) and the cloud light (:mod:`atmos.shading.scattering`) build on.
+(``NIGHT_SKY``) and the cloud light (:mod:`atmos.plugins.clouds.light.scattering`) build on.
 """
 from __future__ import annotations
 
@@ -96,7 +96,7 @@ def sky_light(sun_dir, ambient_scale: float = 1.0) -> tuple[np.ndarray, np.ndarr
     Sun: reddened by ``exp(-RAYLEIGH * air mass)`` (Kasten-Young air mass), faded out across the
     horizon over the sun disc (-0.5 deg .. 0.5 deg), 0 below. Ambient: day blue, tinted at twilight,
     dark blue at night (``NIGHT_SKY``), scaled by ``ambient_scale`` (a cloud
-    :class:`~atmos.shading.Scattering`'s ``ambient``). Continuous in the direction.
+    :class:`~atmos.plugins.clouds.light.Scattering`'s ``ambient``). Continuous in the direction.
     """
     u = check_sun_dir(sun_dir)
     e = math.degrees(math.asin(max(-1.0, min(1.0, u[1]))))

@@ -12,7 +12,7 @@ import time
 import numpy as np
 
 from atmos.gpu import create_headless
-from atmos.automaton import CloudAutomaton, reference
+from atmos.plugins.clouds.automaton import CloudAutomaton, reference
 
 THESIS_STEP_MS = 12.5   # Table 8.1, "Simulation step update", GeForce 8700M GT, 256x32x256
 

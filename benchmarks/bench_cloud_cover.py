@@ -15,7 +15,7 @@ import numpy as np
 from atmos.app import App
 from atmos.gpu import create_headless
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
-from atmos.plugins.weather import Ellipsoid, WeatherSettings
+from atmos.plugins.clouds.weather import Ellipsoid, WeatherSettings
 
 OUT = Path(__file__).resolve().parents[1] / "out" / "bench_cloud_cover.png"
 SCHEDULE = [(0, 80), (1000, 160), (1300, 40)]      # (step, cloud_density)

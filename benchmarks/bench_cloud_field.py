@@ -1,4 +1,4 @@
-"""The diffusion field's CG solve (atmos/shading/diffusion.py): error vs iterations vs time, cold and warm.
+"""The diffusion field's CG solve (plugins/clouds/light/diffusion.py): error vs iterations vs time, cold and warm.
 
 A plain script (``python benchmarks/bench_cloud_field.py [--demo sunset] [--runs 3]``): runs the demo's
 cloud chain until two texture sets hold clouds, then solves set B's field on the GPU with a cap of
@@ -22,7 +22,7 @@ from atmos.demo_registry import DemoSettings
 from atmos.gpu import create_headless
 from atmos.plugins.clouds import CloudSimulation, read_volume
 from atmos.runner import build_app
-from atmos.shading.diffusion import (DIFFUSION, ITERATIONS, WARM_ITERATIONS, diffusion_reference, field_medium,
+from atmos.plugins.clouds.light.diffusion import (DIFFUSION, ITERATIONS, WARM_ITERATIONS, diffusion_reference, field_medium,
                                      read_field, resample)
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -17,8 +17,8 @@ from atmos.app import App
 from atmos.defaults import DefaultPlugins
 from atmos.gpu import create_headless
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin, CloudSimulation
-from atmos.plugins.clouds.top_view import CloudTopViewPlugin
-from atmos.plugins.weather import WeatherSettings
+from atmos.plugins.clouds.simulation.top_view import CloudTopViewPlugin
+from atmos.plugins.clouds.weather import WeatherSettings
 
 
 def scene(gpu, shape, mode: str) -> App:

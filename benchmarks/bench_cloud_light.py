@@ -3,7 +3,7 @@ cost with the new lighting vs the old (HEAD's shaders), in one run.
 
 Static volumes (``CloudsPlugin(density=...)``) are drawn by the sprites (downsample 1/2, LOD on/off)
 and the ray march (``RaymarchCloudsPlugin.reference()`` at several step lengths) and read back with ``App.read_linear()``; the reference is
-:func:`atmos.shading.path_tracer.trace` of the same medium and light (``medium.environment``), all
+:func:`atmos.plugins.clouds.light.path_tracer.trace` of the same medium and light (``medium.environment``), all
 orders (``--max-order 1``: single scattering only, against the renderers with
 ``ms_contribution = 0``; sky and ground light are then off too). Six views: side, from below,
 toward the sun (20°), grazing sun (3°) (the goal's four), and outside the goal: toward a
@@ -39,13 +39,13 @@ from atmos import App, DefaultPlugins, create_headless
 from atmos.camera import Camera, view_basis
 from atmos.gpu import add_shader_path
 from atmos.lighting import Sun
-from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
-from atmos.plugins.cloud_raymarch.settings import REFERENCE
-from atmos.plugins.cloud_render import CloudRenderPlugin
-from atmos.plugins.cloud_render.light import DEFAULT_DIFFUSION, DEFAULT_OCTAVES, sun_light
+from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
+from atmos.plugins.clouds.raymarch.settings import REFERENCE
+from atmos.plugins.clouds.sprites import CloudRenderPlugin
+from atmos.plugins.clouds.volume.light import DEFAULT_DIFFUSION, DEFAULT_OCTAVES, sun_light
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
-from atmos.shading.medium import environment
-from atmos.shading.path_tracer import trace
+from atmos.plugins.clouds.light.medium import environment
+from atmos.plugins.clouds.light.path_tracer import trace
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "out"
@@ -208,19 +208,19 @@ def tracer_noise(ref, err):
 
 
 # -- the old lighting: HEAD's shaders in a temporary directory on the search path ------------------
-OLD_FILES = ("sprite.vert", "sprite.frag", "volume.glsl")
+OLD_FILES = ("clouds/sprites/sprite.vert", "clouds/sprites/sprite.frag", "clouds/volume/volume.glsl")
 
 
 def old_program(gpu, directory: Path):
-    """HEAD's sprite program, its cloud_render includes pointed at the copies (prefix "old")."""
+    """HEAD's sprite program, its sprite and volume includes pointed at the copies (prefix "old")."""
     for name in OLD_FILES:
-        text = subprocess.run(["git", "show", f"HEAD:shaders/cloud_render/{name}"], cwd=ROOT, check=True,
+        text = subprocess.run(["git", "show", f"HEAD:shaders/{name}"], cwd=ROOT, check=True,
                               capture_output=True, text=True).stdout
-        text = re.sub(r'#include "cloud_render/', '#include "old/cloud_render/', text)
-        (directory / "cloud_render").mkdir(parents=True, exist_ok=True)
-        (directory / "cloud_render" / name).write_text(text)
+        text = re.sub(r'#include "clouds/(sprites|volume)/', r'#include "old/clouds/\1/', text)
+        (directory / name).parent.mkdir(parents=True, exist_ok=True)
+        (directory / name).write_text(text)
     add_shader_path(directory, prefix="old")
-    return gpu.program(vertex_shader="old/cloud_render/sprite.vert", fragment_shader="old/cloud_render/sprite.frag")
+    return gpu.program(vertex_shader="old/clouds/sprites/sprite.vert", fragment_shader="old/clouds/sprites/sprite.frag")
 
 
 COST_SIZE = (640, 360)

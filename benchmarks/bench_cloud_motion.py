@@ -19,11 +19,11 @@ from atmos.camera import Camera
 from atmos.defaults import DefaultPlugins
 from atmos.gpu import create_headless
 from atmos.lighting import Sun
-from atmos.plugins.cloud_render import CloudRenderPlugin
-from atmos.plugins.cloud_render.example import example_weather
+from atmos.plugins.clouds.sprites import CloudRenderPlugin
+from atmos.plugins.clouds.weather.example import example_weather
 from atmos.plugins.clouds import CloudSettings, CloudSimulation, CloudsPlugin
 from atmos.plugins.sky_gradient import SkyGradientPlugin
-from atmos.plugins.weather import VolumeOrigin
+from atmos.plugins.clouds.weather import VolumeOrigin
 
 ROOT = Path(__file__).resolve().parents[1]
 SHAPE, CELL, BASE = (64, 12, 64), (20.0, 15.0, 20.0), 300.0

@@ -11,8 +11,8 @@ import numpy as np
 from PIL import Image
 
 from atmos import create_headless
-from atmos.plugins.cloud_raymarch import noise_reference as ref
-from atmos.plugins.cloud_raymarch.noise import DetailNoise
+from atmos.plugins.clouds.raymarch import noise_reference as ref
+from atmos.plugins.clouds.raymarch.noise import DetailNoise
 
 
 def grey(a: np.ndarray, zoom: int = 1) -> Image.Image:

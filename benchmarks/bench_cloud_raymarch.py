@@ -50,9 +50,9 @@ sys.path.insert(0, str(HERE))
 import bench_cloud_light as light  # noqa: E402  (its volumes, views, references and metrics)
 
 from atmos import create_headless  # noqa: E402
-from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin  # noqa: E402
-from atmos.plugins.cloud_raymarch.settings import REFERENCE  # noqa: E402
-from atmos.plugins.cloud_render import CloudRenderPlugin  # noqa: E402
+from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin  # noqa: E402
+from atmos.plugins.clouds.raymarch.settings import REFERENCE  # noqa: E402
+from atmos.plugins.clouds.sprites import CloudRenderPlugin  # noqa: E402
 
 ROOT = HERE.parent
 OUT = ROOT / "out"
@@ -411,7 +411,7 @@ class Drift:
         self.px, self.fields = px, {}
 
     def start(self, ms, cam, target):
-        from atmos.plugins.weather import VolumeOrigin
+        from atmos.plugins.clouds.weather import VolumeOrigin
         self.origin = ms.app.resource(VolumeOrigin)
         self.x0 = self.origin.x
         focal = 0.5 * light.SIZE[1] / math.tan(cam.fov_y / 2)

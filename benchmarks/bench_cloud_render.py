@@ -30,9 +30,9 @@ from atmos.camera import Camera
 from atmos.defaults import DefaultPlugins
 from atmos.gpu import create_headless
 from atmos.lighting import Sun
-from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
-from atmos.plugins.cloud_render import CloudRenderPlugin
-from atmos.plugins.cloud_render.example import example_weather
+from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
+from atmos.plugins.clouds.sprites import CloudRenderPlugin
+from atmos.plugins.clouds.weather.example import example_weather
 from atmos.plugins.clouds import CloudSettings, CloudSimulation, CloudsPlugin
 from atmos.plugins.ground import GroundPlugin
 from atmos.plugins.sky_gradient import SkyGradientPlugin

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from atmos.gpu import create_headless
-from atmos.automaton import CloudAutomaton
+from atmos.plugins.clouds.automaton import CloudAutomaton
 from atmos.plugins.clouds import DensityMaps, Smoother, read_volume, reference, slice_range
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -48,7 +48,7 @@ def median_ms(ctx, run, runs: int) -> float:
 
 def region_volume_ms(gpu, shape, runs: int) -> dict[int, float]:
     """ms to render the region volume (and its probabilities) from n random weather ellipsoids."""
-    from atmos.plugins.weather import RegionVolume, WeatherSettings
+    from atmos.plugins.clouds.weather import RegionVolume, WeatherSettings
     rng = np.random.default_rng(1)
     region = RegionVolume(gpu, shape)
     params = WeatherSettings(volume_shape=shape)

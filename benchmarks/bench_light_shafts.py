@@ -10,8 +10,8 @@ import numpy as np
 from atmos import create_headless
 from atmos.camera import Camera, view_basis
 from atmos.demo_registry import DemoSettings
-from atmos.plugins.clouds.layout import CloudLayout
-from atmos.plugins.cloud_shadows.reference import sun_optical_depth
+from atmos.plugins.clouds.volume.layout import CloudLayout
+from atmos.plugins.clouds.shadows.reference import sun_optical_depth
 from atmos.plugins.light_shafts import LightShaftSettings, LightShaftsPass, reference
 from atmos.runner import build_app
 

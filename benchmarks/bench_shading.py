@@ -17,9 +17,9 @@ import time
 import numpy as np
 
 from atmos.gpu import create_headless
-from atmos.automaton import CloudAutomaton
-from atmos.shading import ShearWarpShader, raymarch, reference
-from atmos.shading.shear_warp import read_volume, upload_volume
+from atmos.plugins.clouds.automaton import CloudAutomaton
+from atmos.plugins.clouds.light import ShearWarpShader, raymarch, reference
+from atmos.plugins.clouds.light.shear_warp import read_volume, upload_volume
 
 THESIS_MS = 8.696          # sec. 8.2: full-resolution shading, 256x32x256, GeForce 8700M GT
 ELEVATIONS = (90, 60, 45, 30, 10, 1)

@@ -38,15 +38,15 @@ from atmos.camera import Camera  # noqa: E402
 from atmos.defaults import DefaultPlugins  # noqa: E402
 from atmos.gpu import create_headless  # noqa: E402
 from atmos.gpu.census import GLCensus  # noqa: E402
-from atmos.plugins.cloud_render import CloudRenderPlugin  # noqa: E402
-from atmos.plugins.cloud_render.example import example_weather  # noqa: E402
-from atmos.plugins.cloud_shadows import CloudShadowsPlugin  # noqa: E402
+from atmos.plugins.clouds.sprites import CloudRenderPlugin  # noqa: E402
+from atmos.plugins.clouds.weather.example import example_weather  # noqa: E402
+from atmos.plugins.clouds.shadows import CloudShadowsPlugin  # noqa: E402
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin  # noqa: E402
 from atmos.plugins.daylight import DaylightPlugin  # noqa: E402
 from atmos.plugins.ground import GroundPlugin  # noqa: E402
 from atmos.plugins.light_shafts import LightShaftsPlugin  # noqa: E402
 from atmos.plugins.sky import SkyPlugin  # noqa: E402
-from atmos.plugins.weather import Ellipsoid, VolumeOrigin, add_ellipsoid  # noqa: E402
+from atmos.plugins.clouds.weather import Ellipsoid, VolumeOrigin, add_ellipsoid  # noqa: E402
 
 SIZE = (160, 90)
 SIZES = [(160, 90), (171, 95), (150, 84), (193, 108), (128, 72), (177, 100)]

@@ -15,18 +15,18 @@ from atmos.camera import Camera
 from atmos.defaults import DefaultPlugins
 from atmos.input import Input
 from atmos.keys import key
-from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
-from atmos.plugins.cloud_render import CloudRenderPlugin
-from atmos.plugins.cloud_render.example import example_weather
-from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
-from atmos.plugins.cloud_shadows import CloudShadowsPlugin
+from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
+from atmos.plugins.clouds.sprites import CloudRenderPlugin
+from atmos.plugins.clouds.weather.example import example_weather
+from atmos.plugins.clouds.far_field import CloudFarFieldPlugin
+from atmos.plugins.clouds.shadows import CloudShadowsPlugin
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
 from atmos.plugins.daylight import DaylightPlugin
 from atmos.plugins.fog import FogPlugin
 from atmos.plugins.light_shafts import LightShaftsPlugin
 from atmos.plugins.sky import SkyPlugin
 from atmos.plugins.terrain import TerrainPlugin
-from atmos.plugins.weather import VolumeOrigin
+from atmos.plugins.clouds.weather import VolumeOrigin
 
 SHAPE = (128, 16, 128)
 CELL = (40.0, 40.0, 40.0)
@@ -44,7 +44,7 @@ def build_cloudscape(app, settings, *, hours: float, speed: float = 0.0, cloud_d
     aerial perspective (its own atmosphere and LUTs, ``SkySettings.aerial_perspective``), or "both",
     the air mixed with the fog along each ray (:func:`atmos.composition.media_mix`). ``horizon``:
     clouds to the horizon, the volume fading out over its outer EDGE_FADE into the far field
-    (:mod:`atmos.plugins.cloud_far_field`)."""
+    (:mod:`atmos.plugins.clouds.far_field`)."""
     weather = example_weather(SHAPE, cloud_density=cloud_density, wind=wind)
     clouds = CloudSettings(cell_size=CELL, base_altitude=BASE_ALTITUDE, smoothing_slices=8, group_size=(32, 32),
                            sigma_t=0.02, edge_fade=EDGE_FADE if horizon else 0.0)

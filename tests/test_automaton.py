@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from atmos.hashing import hash4, hash_counter, lowbias32, stream_key
-from atmos.automaton import CloudAutomaton, reference
+from atmos.plugins.clouds.automaton import CloudAutomaton, reference
 
 LAYOUTS = ("packed", "cell")
 
@@ -53,7 +53,7 @@ def test_hash_glsl_matches_numpy(gpu, ctx, rng):
     inputs[:16] = 0
     inputs[16:32, 0] = 0xFFFFFFFF
     inputs[:, 3] &= np.uint32(0xFFFF)
-    prog = gpu.program(compute_shader="automaton/hash_check.comp")
+    prog = gpu.program(compute_shader="clouds/automaton/hash_check.comp")
     src = ctx.buffer(inputs.astype("<u4").tobytes())
     dst = ctx.buffer(reserve=8 * n)
     try:
@@ -212,7 +212,7 @@ def test_automata_of_different_shapes_share_the_context_programs(gpu, make, rng,
             ca.step(**kwargs)
     for ca, e in zip(autos, expected):
         assert all(np.array_equal(g, x) for g, x in zip(ca.download(), e))
-    prefix = "automaton/packed_" if layout == "packed" else "automaton/cell_"
+    prefix = "clouds/automaton/packed_" if layout == "packed" else "clouds/automaton/cell_"
     assert {prefix + "step.comp", prefix + "advect.comp"} <= gpu.compiled_files
     programs = len(gpu._programs)
     autos[0].release()
@@ -384,7 +384,7 @@ def test_shape_too_big_for_gpu(gpu, ctx, layout):
 
 
 def test_more_layers_than_the_advection_takes_is_a_clear_error(gpu, ctx):
-    from atmos.automaton.automaton import MAX_LAYERS
+    from atmos.plugins.clouds.automaton.automaton import MAX_LAYERS
     with pytest.raises(ValueError, match=rf"has {MAX_LAYERS + 1} layers; the automaton advects at most {MAX_LAYERS}"):
         CloudAutomaton(gpu, (4, MAX_LAYERS + 1, 4))
     CloudAutomaton(gpu, (4, MAX_LAYERS, 4)).release()
@@ -401,7 +401,7 @@ def test_release(make):
 @pytest.mark.parametrize("layout", ["packed", "cell"])
 def test_step_with_region_texture_equals_step_with_arrays(gpu, ctx, rng, layout):
     """The weather region's probability texture drives a step on the GPU exactly like float32 arrays."""
-    from atmos.plugins.weather import RegionVolume, WeatherSettings
+    from atmos.plugins.clouds.weather import RegionVolume, WeatherSettings
     shape = (37, 6, 11)
     params = WeatherSettings(hum_scale=0.3, act_scale=0.05, ext_scale=0.2, volume_shape=shape)
     ellipsoids = np.zeros((6, 8), np.float32)

@@ -351,7 +351,7 @@ RESOURCE_CASES = (
 def _resource(kind):
     from atmos.frames import FrameScheduler
     from atmos.plugins.daylight import TimeOfDay
-    from atmos.plugins.weather import VolumeOrigin
+    from atmos.plugins.clouds.weather import VolumeOrigin
     return {"VolumeOrigin": VolumeOrigin, "TimeOfDay": TimeOfDay, "FrameScheduler": FrameScheduler}[kind]()
 
 
@@ -370,7 +370,7 @@ def test_a_bad_resource_field_is_refused_when_assigned(kind, field, label, value
 
 
 def _ellipsoid_cases():
-    from atmos.plugins.weather import MAX_CELLS, Ellipsoid
+    from atmos.plugins.clouds.weather import MAX_CELLS, Ellipsoid
     cases = []
     for f in dataclasses.fields(Ellipsoid):
         cases += [(f.name, label, v) for label, v in (("nan", NAN), ("+inf", INF), ("-inf", -INF), ("string", "1"),
@@ -387,7 +387,7 @@ ELLIPSOID_CASES = _ellipsoid_cases()
 
 @pytest.mark.parametrize("field, label, value", ELLIPSOID_CASES, ids=[f"{f}={l}" for f, l, _ in ELLIPSOID_CASES])
 def test_add_ellipsoid_refuses_a_bad_ellipsoid_and_creates_nothing(field, label, value):
-    from atmos.plugins.weather import Ellipsoid, add_ellipsoid
+    from atmos.plugins.clouds.weather import Ellipsoid, add_ellipsoid
     from atmos.world import World
     world = World()
     with pytest.raises(ValueError) as error:
@@ -404,7 +404,7 @@ def test_a_bad_ellipsoid_made_by_hand_is_skipped_with_one_warning_naming_it(smal
     entity; the others still form the region volume, in this frame and every later one."""
     from atmos.defaults import DefaultPlugins
     from atmos.plugins.ground import GroundPlugin
-    from atmos.plugins.weather import (Ellipsoid, RegionVolume, WeatherPlugin, add_ellipsoid, ellipsoid_array,
+    from atmos.plugins.clouds.weather import (Ellipsoid, RegionVolume, WeatherPlugin, add_ellipsoid, ellipsoid_array,
                                        region_volume)
     weather = WeatherPlugin(volume_shape=(16, 8, 16), cloud_density=2, shrink_time=0.0)   # the good ones
     app = App(small_gpu).add_plugins(DefaultPlugins(overlay=False), GroundPlugin(), weather)
@@ -458,8 +458,8 @@ CONSTRUCTOR_CASES = [
     ("TextureDesc dtype", lambda: _desc((4, 4), dtype="f8"), r"TextureDesc\.dtype must be one of"),
     ("FrameWriter fps", lambda: _writer(fps=0.0), r"FrameWriter\.fps must be a finite number > 0"),
     ("FrameWriter fps", lambda: _writer(fps=NAN), r"FrameWriter\.fps must be"),
-    ("WeatherPlugin seed", lambda: _plugin("weather", "WeatherPlugin", seed=-1), r"WeatherPlugin\.seed must be"),
-    ("WeatherPlugin dtype", lambda: _plugin("weather", "WeatherPlugin", dtype="f8"), r"WeatherPlugin\.dtype must be"),
+    ("WeatherPlugin seed", lambda: _plugin("clouds.weather", "WeatherPlugin", seed=-1), r"WeatherPlugin\.seed must be"),
+    ("WeatherPlugin dtype", lambda: _plugin("clouds.weather", "WeatherPlugin", dtype="f8"), r"WeatherPlugin\.dtype must be"),
     ("CloudsPlugin seed", lambda: _plugin("clouds", "CloudsPlugin", seed=1.5), r"CloudsPlugin\.seed must be"),
     ("CloudsPlugin warmup_steps", lambda: _plugin("clouds", "CloudsPlugin", warmup_steps=-1),
      r"CloudsPlugin\.warmup_steps must be"),

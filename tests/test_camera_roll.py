@@ -58,7 +58,7 @@ def night(app):
 
 def active_effects(app) -> dict:
     """What each cloudscape family drew this frame: the sprites and where the shafts' sun is."""
-    from atmos.plugins.cloud_render import CloudRenderPlugin
+    from atmos.plugins.clouds.sprites import CloudRenderPlugin
     from atmos.plugins.light_shafts.plugin import LightShaftsPlugin
     from atmos.plugins.light_shafts.screen_sun import screen_sun
     from atmos.lighting import Sun

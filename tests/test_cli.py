@@ -60,7 +60,7 @@ def test_graph_of_the_cloud_demo_runs_no_simulation(capsys, monkeypatch):
     assert code == 0
     for phase in ("[sky]", "[opaque]", "[shadows]", "[translucent]", "[post]", "[present]"):
         assert phase in out
-    assert "cloud_sets@0" in out and "(plugins/cloud_render/plugin.py:" in out
+    assert "cloud_sets@0" in out and "(plugins/clouds/sprites/plugin.py:" in out
     kept, culled = out.split("culled:")[0], out.split("culled:")[1].split("resources:")[0]
     assert ". cloud_render " in kept and "- cloud_raymarch " in culled, "sprites by default, the ray march off"
 
@@ -69,7 +69,7 @@ def test_graph_of_the_cloud_demo_with_the_ray_march(capsys):
     code, out, _ = run(capsys, "graph", "sunset", "--clouds", "march")
     assert code == 0
     kept, culled = out.split("culled:")[0], out.split("culled:")[1].split("resources:")[0]
-    assert ". cloud_raymarch " in kept and "(plugins/cloud_raymarch/plugin.py:" in kept
+    assert ". cloud_raymarch " in kept and "(plugins/clouds/raymarch/plugin.py:" in kept
     assert "- cloud_render " in culled and ". cloud_render " not in kept, "the sprites are off (culled)"
 
 

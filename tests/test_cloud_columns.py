@@ -1,4 +1,4 @@
-"""The light volume's columns (atmos/shading/columns.py): the density integrated straight up and down
+"""The light volume's columns (plugins/clouds/light/columns.py): the density integrated straight up and down
 per cell of the shading grid, once per texture set, read by both cloud renderers' light."""
 import numpy as np
 import pytest
@@ -6,8 +6,8 @@ import pytest
 from atmos.app import App
 from atmos.frames.texture_sets import make_texture
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin, read_volume
-from atmos.shading.columns import COLUMNS, STORE_MAX, ColumnShader, column_desc, column_reference
-from atmos.shading.shear_warp import upload_volume
+from atmos.plugins.clouds.light.columns import COLUMNS, STORE_MAX, ColumnShader, column_desc, column_reference
+from atmos.plugins.clouds.light.shear_warp import upload_volume
 from tests.test_clouds import params
 
 

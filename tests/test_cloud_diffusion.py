@@ -1,4 +1,4 @@
-"""The diffusion field (atmos/shading/diffusion.py): a P1 solve of the sun's scattered fluence on the
+"""The diffusion field (plugins/clouds/light/diffusion.py): a P1 solve of the sun's scattered fluence on the
 shading grid, per texture set, read by both cloud renderers' light beside the octaves."""
 import numpy as np
 import pytest
@@ -6,14 +6,14 @@ import pytest
 from atmos import DefaultPlugins
 from atmos.app import App
 from atmos.frames.texture_sets import make_texture
-from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
-from atmos.plugins.cloud_render import CloudRenderPlugin
+from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
+from atmos.plugins.clouds.sprites import CloudRenderPlugin
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin, read_volume
-from atmos.shading.diffusion import (DIFFUSION, TOLERANCE, DiffusionSolver, apply, diffusion_desc,
+from atmos.plugins.clouds.light.diffusion import (DIFFUSION, TOLERANCE, DiffusionSolver, apply, diffusion_desc,
                                      diffusion_reference, diffusion_system, field_radiance, field_shape,
                                      read_field, resample, solve_cg)
-from atmos.shading.grid import shading_shape
-from atmos.shading.shear_warp import upload_volume
+from atmos.plugins.clouds.light.grid import shading_shape
+from atmos.plugins.clouds.light.shear_warp import upload_volume
 from tests.test_clouds import params
 
 SUN = np.array([0.3, 0.5, -0.8]) / np.linalg.norm([0.3, 0.5, -0.8])
@@ -117,7 +117,7 @@ def test_the_field_lights_a_lit_surface_seen_with_the_sun_behind():
     its share H of it outward (bench_cloud_light "sun behind": the cumulus was -17.8 % dark with no floor,
     -9.1 % with -cos phi, +2.0 % now). Toward the sun the P1 term is larger and stands. H is checked
     against a quadrature of the lobes."""
-    from atmos.shading.medium import hemisphere_share, hg
+    from atmos.plugins.clouds.light.medium import hemisphere_share, hg
     lobes = (0.85, -0.3, 0.1)
     mu = (np.arange(200000) + 0.5) / 200000                       # midpoint rule over the hemisphere
     quad = 2 * np.pi * np.mean((1 - lobes[2]) * hg(mu, lobes[0]) + lobes[2] * hg(mu, lobes[1]))
@@ -163,7 +163,7 @@ def test_every_shaded_texture_set_a_renderer_reads_carries_its_field_and_unshade
         assert density.any(), "clouds formed"
         tr = texture_set["transmittance"]
         T = np.frombuffer(tr.read(), np.float16).reshape(tr.size[::-1]).transpose(2, 1, 0).astype(np.float64)
-        from atmos.shading.medium import mean_cosine
+        from atmos.plugins.clouds.light.medium import mean_cosine
         ref = diffusion_reference(density, s.cell_size, s.sigma_t, s.albedo,
                                   mean_cosine(s.phase_g, s.phase_g2, s.phase_w), T, sim.sun())
         got = read_field(texture_set[DIFFUSION])

@@ -9,12 +9,12 @@ import pytest
 from atmos.camera import Camera
 from atmos.demo_registry import DemoSettings
 from atmos.gpu import create_headless
-from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
-from atmos.plugins.cloud_far_field.layer import profile_heights
-from atmos.plugins.cloud_far_field.reference import column_profile, column_quantiles, light_by_rank, volume_cover
+from atmos.plugins.clouds.far_field import CloudFarFieldPlugin
+from atmos.plugins.clouds.far_field.layer import profile_heights
+from atmos.plugins.clouds.far_field.reference import column_profile, column_quantiles, light_by_rank, volume_cover
 from atmos.plugins.clouds import CloudSimulation, CloudsPlugin
-from atmos.plugins.clouds.edge import edge_weight
-from atmos.plugins.clouds.smoothing import read_volume
+from atmos.plugins.clouds.volume.edge import edge_weight
+from atmos.plugins.clouds.simulation.smoothing import read_volume
 from atmos.runner import build_app
 
 
@@ -133,7 +133,7 @@ def light_scene(gpu, density, edge_fade: float, group=(4, 4), far_size: int = 64
     """A static volume drawn by the sprites (the diffusion field on) with a far field, rendered once:
     (app, the CloudFarFieldPlugin, the frame's CloudSets). The caller closes the app."""
     from atmos import App, DefaultPlugins
-    from atmos.plugins.cloud_render import CloudRenderPlugin
+    from atmos.plugins.clouds.sprites import CloudRenderPlugin
     from atmos.plugins.clouds import CloudSettings
     medium = CloudSettings(group_size=group, edge_fade=edge_fade, **LIGHT_MEDIUM)
     app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(medium, density=density),
@@ -148,8 +148,8 @@ def light_scene(gpu, density, edge_fade: float, group=(4, 4), far_size: int = 64
 
 def light_reference(far, sets) -> dict:
     """light_by_rank (float64) of the sets' textures as the GPU holds them, ranked by its quantiles."""
-    from atmos.plugins.cloud_render.light import cell_tau
-    from atmos.shading.diffusion import DIFFUSION, read_field
+    from atmos.plugins.clouds.volume.light import cell_tau
+    from atmos.plugins.clouds.light.diffusion import DIFFUSION, read_field
     _, quantiles = far.layer.read_cover()
     a, b = sets.a, sets.b
     return light_by_rank(*(sets.maps_of(s).read_sums()[0] for s in (a, b)), *(read_volume(s["density"]) for s in (a, b)),
@@ -236,10 +236,10 @@ def test_the_far_fields_opacity_matches_float64(gpu, ctx, filter_bits, pitch):
     column optical depth at the middle plane's hit, at the rank and scale slant_rank gives for clouds of
     the measured height (RankLight's thickness at the median covered rank) at the ray's slant, over the
     slant, times the horizon fade; as a flat layer (height 0) it is far off (the test can fail)."""
-    from atmos.plugins.cloud_far_field.cover import fbm_quantiles, pattern_crossings
-    from atmos.plugins.cloud_far_field.layer import column_tau, drift
-    from atmos.plugins.cloud_far_field.reference import far_field_alpha
-    from atmos.plugins.cloud_raymarch.reference import rays
+    from atmos.plugins.clouds.far_field.cover import fbm_quantiles, pattern_crossings
+    from atmos.plugins.clouds.far_field.layer import column_tau, drift
+    from atmos.plugins.clouds.far_field.reference import far_field_alpha
+    from atmos.plugins.clouds.raymarch.reference import rays
     app = far_scene(gpu, size=64, tile_size=20000.0, animate=False)
     try:
         far = next(p for p in app.plugins if isinstance(p, CloudFarFieldPlugin))
@@ -298,8 +298,8 @@ def test_the_far_fields_cover_repeats_at_no_tile_lag(gpu, ctx):
     """The cover (fbm above its median) of the pattern drawn (the GPU's baked octaves, each turned and
     with its own period: pattern.py) correlates along x and along z at lags of 1, 2, 3 tiles no more
     than at lags between them; with one period and no turn for all octaves it repeated exactly (1.0)."""
-    from atmos.plugins.cloud_far_field.layer import drift
-    from atmos.plugins.cloud_far_field.reference import field_fbm
+    from atmos.plugins.clouds.far_field.layer import drift
+    from atmos.plugins.clouds.far_field.reference import field_fbm
     app = far_scene(gpu, size=128, tile_size=1000.0, animate=False)
     try:
         far = next(p for p in app.plugins if isinstance(p, CloudFarFieldPlugin))
@@ -333,9 +333,9 @@ def test_the_far_fields_clouds_change_as_often_per_metre_as_the_volumes(gpu, ctx
     volume_transitions in float64), so the cover drawn (column sum at the rank above the cover threshold,
     the GPU's octaves in float64) changes along a line as often per metre as the volume's, within 15 %;
     a fixed 8 km tile (the old default) made the far field's clouds 2.5-3x wider."""
-    from atmos.plugins.cloud_far_field.cover import fbm_quantiles
-    from atmos.plugins.cloud_far_field.layer import drift
-    from atmos.plugins.cloud_far_field.reference import column_at_rank, field_fbm, field_rank, volume_transitions
+    from atmos.plugins.clouds.far_field.cover import fbm_quantiles
+    from atmos.plugins.clouds.far_field.layer import drift
+    from atmos.plugins.clouds.far_field.reference import column_at_rank, field_fbm, field_rank, volume_transitions
     app = far_scene(gpu, size=128, animate=False)
     try:
         far = next(p for p in app.plugins if isinstance(p, CloudFarFieldPlugin))

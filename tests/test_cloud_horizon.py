@@ -20,16 +20,16 @@ import pytest
 from atmos.camera import Camera
 from atmos.demo_registry import DemoSettings
 from atmos.gpu import create_headless
-from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
-from atmos.plugins.cloud_far_field.cover import fbm_quantiles
-from atmos.plugins.cloud_far_field.layer import column_tau, drift
-from atmos.plugins.cloud_far_field.reference import far_optical_depth
-from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
-from atmos.plugins.cloud_render.plugin import CloudRenderPlugin
-from atmos.plugins.cloud_shadows import CloudShadowsPlugin
-from atmos.plugins.cloud_shadows.reference import shifted
+from atmos.plugins.clouds.far_field import CloudFarFieldPlugin
+from atmos.plugins.clouds.far_field.cover import fbm_quantiles
+from atmos.plugins.clouds.far_field.layer import column_tau, drift
+from atmos.plugins.clouds.far_field.reference import far_optical_depth
+from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
+from atmos.plugins.clouds.sprites.plugin import CloudRenderPlugin
+from atmos.plugins.clouds.shadows import CloudShadowsPlugin
+from atmos.plugins.clouds.shadows.reference import shifted
 from atmos.plugins.clouds import CloudSimulation
-from atmos.plugins.clouds.edge import edge_weight
+from atmos.plugins.clouds.volume.edge import edge_weight
 from atmos.runner import build_app
 
 SIZE = (160, 96)

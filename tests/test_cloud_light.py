@@ -6,11 +6,11 @@ import pytest
 from atmos import App, DefaultPlugins
 from atmos.camera import Camera, view_basis
 from atmos.lighting import Sun
-from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
-from atmos.plugins.cloud_render import CloudRenderPlugin
+from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
+from atmos.plugins.clouds.sprites import CloudRenderPlugin
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
 from atmos.plugins.sky_gradient import SkyGradientPlugin
-from atmos.plugins.weather import VolumeOrigin
+from atmos.plugins.clouds.weather import VolumeOrigin
 from atmos.render_core import CapturePass, RenderCorePlugin, tone_map
 
 SHAPE = (16, 4, 16)
@@ -199,13 +199,13 @@ def test_sprites_light_varies_across_each_sprite_as_the_sun_transmittance_does(g
 
 
 def test_sky_light_is_exact_in_a_white_furnace_and_follows_the_columns():
-    """J's sky and ground part (atmos.shading.medium, the numpy twin of volume.glsl's
+    """J's sky and ground part (atmos.plugins.clouds.light.medium, the numpy twin of volume.glsl's
     ambient_source, checked against the GPU by the sprite-vertex test): with sky and ground of equal
     radiance at albedo 1 every point of any cloud sees exactly that radiance (the old exp(-a tau)
     dimming gave less deep inside); sky only, the diffusion profile darkens from the top face to
     the bottom face, and a thin base seen from below gets the phase's forward share."""
-    from atmos.plugins.cloud_render.plugin import CloudRenderSettings
-    from atmos.shading.medium import source_reference
+    from atmos.plugins.clouds.sprites.plugin import CloudRenderSettings
+    from atmos.plugins.clouds.light.medium import source_reference
     up, down = (v.ravel() for v in np.meshgrid([0.0, 0.3, 3.0, 30.0, 300.0], [0.0, 0.3, 3.0, 30.0, 300.0]))
     n = len(up)
     sky = np.array([0.3, 0.4, 0.6])
@@ -225,14 +225,14 @@ def test_sky_light_is_exact_in_a_white_furnace_and_follows_the_columns():
 
 
 def test_the_octaves_count_forward_scatterings_on_the_way_in(rng):
-    """atmos.shading.medium.octave_transmittances (the twin of shaders/lib/octaves.glsl, checked on the
+    """atmos.plugins.clouds.light.medium.octave_transmittances (the twin of shaders/lib/octaves.glsl, checked on the
     GPU through the renderers' J tests): light that reached a point forward-scattered k times, k Poisson
     with mean (1 - a) tau, against the Poisson probabilities written out; the last octave is every higher
     count, so the four sum to T^a; a lit rim (T -> 1) holds no multiple scattering, and any T in [0, 1]
     (0 and 1 included) gives finite values in [0, 1]."""
     import math
 
-    from atmos.shading.medium import octave_transmittances
+    from atmos.plugins.clouds.light.medium import octave_transmittances
     a = rng.uniform(0.05, 0.95)
     tau = np.concatenate([[0.0, 1e-6, 50.0, 1e4], rng.exponential(3.0, 200)])
     T = np.exp(-tau)

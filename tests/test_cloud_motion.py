@@ -9,12 +9,12 @@ from atmos.app import App
 from atmos.camera import Camera
 from atmos.defaults import DefaultPlugins
 from atmos.lighting import Sun
-from atmos.plugins.cloud_render import CloudRenderPlugin
-from atmos.plugins.cloud_render.example import example_weather
+from atmos.plugins.clouds.sprites import CloudRenderPlugin
+from atmos.plugins.clouds.weather.example import example_weather
 from atmos.plugins.clouds import CloudSettings, CloudSimulation, CloudsPlugin
-from atmos.plugins.clouds.sets import shifted_max
+from atmos.plugins.clouds.volume.sets import shifted_max
 from atmos.plugins.sky_gradient import SkyGradientPlugin
-from atmos.plugins.weather import VolumeOrigin
+from atmos.plugins.clouds.weather import VolumeOrigin
 
 OUT = Path(__file__).resolve().parents[1] / "out"
 SHAPE = (48, 12, 48)

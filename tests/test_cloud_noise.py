@@ -1,4 +1,4 @@
-"""The ray march's detail noise (plugins/cloud_raymarch/noise.py): the GPU textures against their float64
+"""The ray march's detail noise (plugins/clouds/raymarch/noise.py): the GPU textures against their float64
 reference, exact tiling, the erosion detail_density against its reference and at the extremes, bind,
 and the per-context cache (one build, freed with the context)."""
 import moderngl
@@ -7,8 +7,8 @@ import pytest
 
 from atmos.gpu import GpuError, create_headless
 from atmos.gpu.census import GLCensus
-from atmos.plugins.cloud_raymarch import noise_reference as ref
-from atmos.plugins.cloud_raymarch.noise import (BASE_LAYOUT, COVERAGE, DETAIL_FADE, DETAIL_LAYOUT, DETAIL_RATIO,
+from atmos.plugins.clouds.raymarch import noise_reference as ref
+from atmos.plugins.clouds.raymarch.noise import (BASE_LAYOUT, COVERAGE, DETAIL_FADE, DETAIL_LAYOUT, DETAIL_RATIO,
                                                 DetailNoise, detail_defines, detail_offsets)
 from fullscreen_probe import run_fullscreen
 
@@ -160,7 +160,7 @@ def test_bind_sets_only_the_uniforms_the_program_has(gpu, ctx):
                               defines=detail_defines(octaves))
         noise.bind(program, 10.0, (3.0, 0.0, 1.0), SCALE, STRENGTH)
         if octaves == 3:
-            from atmos.plugins.cloud_raymarch.noise import BASE_UNIT, DETAIL_UNIT
+            from atmos.plugins.clouds.raymarch.noise import BASE_UNIT, DETAIL_UNIT
             assert program["detail_fine_noise"].value == DETAIL_UNIT and program["detail_base_noise"].value == BASE_UNIT
             assert program["detail_band_strength"].value == pytest.approx(0.4)
             assert program["detail_band_width"].value == pytest.approx(1.0 - 0.75 * STRENGTH)

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from atmos.graph import PassBuilder, RenderGraph, RenderPass
-from atmos.plugins.cloud_render import CloudRenderPlugin
-from atmos.plugins.cloud_render import offscreen_reference as ref
-from atmos.plugins.cloud_render.offscreen import CLOUD_COLOR, CLOUD_DEPTH, OffscreenClouds
+from atmos.plugins.clouds.sprites import CloudRenderPlugin
+from atmos.plugins.clouds.volume import offscreen_reference as ref
+from atmos.plugins.clouds.volume.offscreen import CLOUD_COLOR, CLOUD_DEPTH, OffscreenClouds
 from atmos.render_core import COLOR, DEPTH
 from tests.test_cloud_render import BELOW, frame, look, save, scene
 

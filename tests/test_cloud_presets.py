@@ -6,7 +6,7 @@ from atmos import App, Camera, DefaultPlugins
 from atmos.gpu import create_headless
 from atmos.plugins.clouds.presets import PRESETS, SHAPE, CloudSky, cloud_settings
 from atmos.plugins.sky_gradient import SkyGradientPlugin
-from atmos.plugins.weather import VolumeOrigin
+from atmos.plugins.clouds.weather import VolumeOrigin
 
 
 @pytest.mark.parametrize("name", sorted(PRESETS))

@@ -6,17 +6,17 @@ import pytest
 from atmos import App, DefaultPlugins
 from atmos.camera import Camera
 from atmos.lighting import Sun
-from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
-from atmos.plugins.cloud_raymarch.plugin import LOW_COLOR, skip_map
-from atmos.plugins.cloud_raymarch.reference import march_reference
-from atmos.shading.diffusion import DIFFUSION, read_field
-from atmos.plugins.cloud_render import CloudRenderPlugin
+from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
+from atmos.plugins.clouds.raymarch.plugin import LOW_COLOR, skip_map
+from atmos.plugins.clouds.raymarch.reference import march_reference
+from atmos.plugins.clouds.light.diffusion import DIFFUSION, read_field
+from atmos.plugins.clouds.sprites import CloudRenderPlugin
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
-from atmos.plugins.clouds.density_maps import DensityMaps
-from atmos.plugins.weather import VolumeOrigin
-from atmos.plugins.cloud_raymarch.reference import integrate, rays
-from atmos.shading.medium import source_reference
-from atmos.shading.reference import multilinear
+from atmos.plugins.clouds.simulation.density_maps import DensityMaps
+from atmos.plugins.clouds.weather import VolumeOrigin
+from atmos.plugins.clouds.raymarch.reference import integrate, rays
+from atmos.plugins.clouds.light.medium import source_reference
+from atmos.plugins.clouds.light.reference import multilinear
 
 SHAPE = (16, 4, 16)
 CELL = (20.0, 30.0, 25.0)
@@ -278,7 +278,7 @@ def test_a_scene_draws_with_one_cloud_renderer_never_both(gpu, ctx):
 
 
 def test_with_fog_far_field_and_terrain_the_clouds_show(gpu, ctx):
-    from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
+    from atmos.plugins.clouds.far_field import CloudFarFieldPlugin
     from atmos.plugins.fog import FogPlugin
     from atmos.plugins.sky_gradient import SkyGradientPlugin
     from atmos.plugins.terrain import TerrainPlugin

@@ -6,11 +6,11 @@ import pytest
 from atmos import App, DefaultPlugins
 from atmos.camera import Camera
 from atmos.lighting import Sun
-from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
-from atmos.plugins.cloud_far_field.cover import level_table
-from atmos.plugins.cloud_far_field.layer import drift
-from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
-from atmos.plugins.cloud_raymarch.far_reference import FarField, far_march_reference
+from atmos.plugins.clouds.far_field import CloudFarFieldPlugin
+from atmos.plugins.clouds.far_field.cover import level_table
+from atmos.plugins.clouds.far_field.layer import drift
+from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
+from atmos.plugins.clouds.raymarch.far_reference import FarField, far_march_reference
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
 
 SHAPE = (16, 8, 16)

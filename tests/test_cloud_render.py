@@ -12,20 +12,20 @@ from atmos.camera import Camera
 from atmos.defaults import DefaultPlugins
 from atmos.gpu.shaders import load_source
 from atmos.lighting import Sun
-from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
-from atmos.plugins.cloud_render import CloudLayout, CloudRenderPlugin, select_segments, sun_light
+from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
+from atmos.plugins.clouds.sprites import CloudLayout, CloudRenderPlugin, select_segments, sun_light
 from atmos.gpu import clamp_sampler
-from atmos.plugins.cloud_render.binding import bind_volume, unbind_volume
-from atmos.plugins.cloud_render.light import light_uniforms
-from atmos.plugins.cloud_render.example import example_weather
-from atmos.plugins.cloud_render.plugin import sprite_uniforms
-from atmos.plugins.cloud_render.segments import (column_levels, draw_units, max_level, pack, segment_columns,
+from atmos.plugins.clouds.volume.binding import bind_volume, unbind_volume
+from atmos.plugins.clouds.volume.light import light_uniforms
+from atmos.plugins.clouds.weather.example import example_weather
+from atmos.plugins.clouds.sprites.plugin import sprite_uniforms
+from atmos.plugins.clouds.sprites.segments import (column_levels, draw_units, max_level, pack, segment_columns,
                                                  unpack)
-from atmos.plugins.cloud_render.reference import group_cells, sprite_vertices
+from atmos.plugins.clouds.sprites.reference import group_cells, sprite_vertices
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin, read_volume
 from atmos.plugins.ground import GroundPlugin
 from atmos.plugins.sky_gradient import SkyGradientPlugin
-from atmos.plugins.weather import VolumeOrigin
+from atmos.plugins.clouds.weather import VolumeOrigin
 
 OUT = Path(__file__).resolve().parents[1] / "out"
 SHAPE = (48, 12, 48)
@@ -90,8 +90,8 @@ def test_sprite_light_is_the_mean_over_the_cells_mass(rng):
     """A cell's mass is its density times the trilinear hat around its centre: the 8 light samples
     at ± sqrt(1/9) cell (HAT_SPREAD) average the trilinear T exactly as that hat weighs it, where
     the centre sample alone is darker on a convex T (issue 12)."""
-    from atmos.plugins.cloud_render.reference import HAT_SPREAD
-    from atmos.shading.reference import trilinear
+    from atmos.plugins.clouds.sprites.reference import HAT_SPREAD
+    from atmos.plugins.clouds.light.reference import trilinear
     grid = np.exp(-1.2 * np.arange(5.0))[:, None, None] * rng.uniform(0.95, 1.05, (5, 5, 5))   # T along x
     centre = np.array([2.0, 2.0, 2.0])
     u = (np.arange(60) + 0.5) / 60 * 2.0 - 1.0                        # midpoint rule over the hat's support
@@ -136,7 +136,7 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale,
     uniforms = sprite_uniforms(renderer, sim, layout, cam, aspect, height, 255.0)
     vp = cam.view_projection(aspect)
 
-    src = load_source("cloud_render/sprite.vert").text
+    src = load_source("clouds/sprites/sprite.vert").text
     names = ["gl_Position", "gl_PointSize", "v_octaves", "v_ambient", "v_center", "v_radius", "v_tau", "v_coverage",
              "v_conic", "v_falloff", "v_stretch", "v_slope", "v_sun"]
     prog = ctx.program(vertex_shader=src, varyings=names)

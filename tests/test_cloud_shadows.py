@@ -12,12 +12,12 @@ from atmos.gpu import create_headless
 from atmos.graph import PassBuilder, RenderPass
 from atmos.lighting import Sun
 from atmos.plugin import Plugin
-from atmos.plugins.clouds.layout import CloudLayout
-from atmos.plugins.cloud_shadows import CloudShadowSettings, CloudShadowsPlugin, cloud_layout, reference
+from atmos.plugins.clouds.volume.layout import CloudLayout
+from atmos.plugins.clouds.shadows import CloudShadowSettings, CloudShadowsPlugin, cloud_layout, reference
 from atmos.plugins.clouds import CloudSettings, CloudSimulation, CloudsPlugin
 from atmos.plugins.ground import GroundPlugin
 from atmos.plugins.sky_gradient import SkyGradientPlugin
-from atmos.plugins.weather import VolumeOrigin, WeatherSettings
+from atmos.plugins.clouds.weather import VolumeOrigin, WeatherSettings
 from atmos.render_core import COLOR, DEPTH, CapturePass
 
 OUT = os.path.join(os.path.dirname(__file__), "..", "out")
@@ -295,10 +295,10 @@ def test_shadows_on_the_ground_look_right_and_move_with_the_clouds():
 def test_shadows_continue_with_the_far_field_beyond_the_volume(gpu, ctx):
     """Past the volume the ground is shadowed by the far field's cover (numpy reference), darker under
     its clouds than under its gaps; without the far field it is fully lit there."""
-    from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
-    from atmos.plugins.cloud_far_field.layer import column_tau, drift
-    from atmos.plugins.cloud_far_field.reference import far_optical_depth
-    from atmos.plugins.cloud_far_field.cover import fbm_quantiles
+    from atmos.plugins.clouds.far_field import CloudFarFieldPlugin
+    from atmos.plugins.clouds.far_field.layer import column_tau, drift
+    from atmos.plugins.clouds.far_field.reference import far_optical_depth
+    from atmos.plugins.clouds.far_field.cover import fbm_quantiles
     size = gpu.size
     params = CloudShadowSettings(base_altitude=60.0, cell_size=(4.0, 2.0, 4.0), sigma=0.5)
     fill, probe = FillPass(), CapturePass()

@@ -1,4 +1,4 @@
-"""The temporal resolve of the ray-marched clouds (plugins/cloud_raymarch/temporal.py) on synthetic
+"""The temporal resolve of the ray-marched clouds (plugins/clouds/raymarch/temporal.py) on synthetic
 full-res "truth" images sampled at each frame's jittered pixels, against its float64 reference."""
 import math
 
@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from atmos.camera import Camera
-from atmos.plugins.cloud_raymarch.temporal import TemporalClouds, bayer, detects_change, jitter, low_size
-from atmos.plugins.cloud_raymarch.temporal_reference import ReferenceHistory, resolve_reference
+from atmos.plugins.clouds.raymarch.temporal import TemporalClouds, bayer, detects_change, jitter, low_size
+from atmos.plugins.clouds.raymarch.temporal_reference import ReferenceHistory, resolve_reference
 
 SIZE = (64, 48)
 ASPECT = SIZE[0] / SIZE[1]
@@ -178,7 +178,7 @@ def random_inputs(rng, size, r):
 
 def ground_depth(cam, size, extra_box=None, ground=True):
     """Window-space depth of a ground plane y = 0 (or none) and optionally a near box of pixels at 300 m."""
-    from atmos.plugins.cloud_raymarch.temporal_reference import _rays
+    from atmos.plugins.clouds.raymarch.temporal_reference import _rays
     rays = _rays(cam, size[0] / size[1], size)
     t = np.where(ground & (rays[..., 1] < -1e-6), -(cam.position[1]) / np.minimum(rays[..., 1], -1e-6), np.inf)
     z = t                                           # view depth: the ray's forward component is 1
@@ -492,7 +492,7 @@ WALL = -500.0       # the cloud fills z < WALL (m): terrain beyond it is seen th
 def wall_truth(cam, size=SIZE):
     """A cloud filling z < WALL in front of a ground plane y = 0, seen by ``cam``: the alpha of the
     ray's stretch inside it before the ground (sky: 1500 m of it); (colour, distance, depth)."""
-    from atmos.plugins.cloud_raymarch.temporal_reference import _rays, scene_distance
+    from atmos.plugins.clouds.raymarch.temporal_reference import _rays, scene_distance
     depth = ground_depth(cam, size)
     rays = _rays(cam, size[0] / size[1], size)
     dirs = rays / np.linalg.norm(rays, axis=-1, keepdims=True)

@@ -4,7 +4,7 @@ import pytest
 
 from atmos.app import App
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin, read_volume, reference
-from atmos.plugins.weather import Ellipsoid, VolumeOrigin, WeatherSettings
+from atmos.plugins.clouds.weather import Ellipsoid, VolumeOrigin, WeatherSettings
 
 
 def params(shape=(32, 8, 32), **kw):
@@ -206,7 +206,7 @@ def test_shading_stage_lights_each_step_with_the_sun_of_its_start(gpu, ctx):
     """Transmittance in a completed set = one-shot shading of that set's density with the sun as it
     was when the step began, however much the sun moved while the step was sliced over frames."""
     from atmos.lighting import Sun
-    from atmos.shading import compute_transmittance
+    from atmos.plugins.clouds.light import compute_transmittance
     settings = CloudSettings(smoothing_slices=2, group_size=(8, 8), sigma_t=0.5, cell_size=(2.0, 1.0, 2.0),
                              shading_slices_per_run=4)
     app, sim = clouds_app(gpu, params(), settings)

@@ -8,13 +8,13 @@ from atmos.camera import Camera, view_basis
 from atmos.composition import CLOUD_DISTANCE, ClearDistance, Composition
 from atmos.graph import RenderPass
 from atmos.lighting import Sun
-from atmos.plugins.cloud_render import CloudRenderPlugin
+from atmos.plugins.clouds.sprites import CloudRenderPlugin
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
 from atmos.plugins.fog import FogPlugin, FogSettings, apply_fog
 from atmos.plugins.fog.factors import apply_fog_ref
 from atmos.plugins.fog.sky_color import SAMPLES, horizon_colors, sky_fog_color
 from atmos.plugins.sky import SkySettings
-from atmos.plugins.weather import VolumeOrigin
+from atmos.plugins.clouds.weather import VolumeOrigin
 
 SHAPE = (16, 4, 16)
 CELL = (40.0, 40.0, 40.0)
@@ -164,7 +164,7 @@ def test_fog_attenuates_a_cloud_over_the_sky_by_the_clouds_own_distance(gpu, ctx
 
 
 def test_fog_attenuates_the_far_field_by_its_own_distance(gpu, ctx):
-    from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
+    from atmos.plugins.clouds.far_field import CloudFarFieldPlugin
     fog = FogPlugin(mode="exp", density=0.0, sky="keep", fog_color=(0.9, 0.6, 0.3))
     density = np.zeros(SHAPE, np.float32)
     density[4:12, 1:3, 4:12] = 1.0

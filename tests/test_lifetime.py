@@ -204,12 +204,12 @@ def test_a_failed_startup_leaves_the_app_unable_to_run_with_the_reason():
 def test_no_cache_keeps_a_released_context_alive():
     """A context that ran clouds, shading, fog and the sky is garbage once released: no program,
     query or measure cache holds it (the shading cache once kept every context alive)."""
-    from atmos.plugins.cloud_render import CloudRenderPlugin
-    from atmos.plugins.cloud_render.example import example_weather
+    from atmos.plugins.clouds.sprites import CloudRenderPlugin
+    from atmos.plugins.clouds.weather.example import example_weather
     from atmos.plugins.clouds import CloudSettings, CloudsPlugin
     from atmos.plugins.fog import FogPlugin
     from atmos.plugins.sky import SkyPlugin
-    from atmos.shading import compute_transmittance
+    from atmos.plugins.clouds.light import compute_transmittance
 
     gpu = create_headless((48, 27))
     clouds = CloudsPlugin(CloudSettings(weather=example_weather((16, 8, 16), 10), smoothing_slices=2,

@@ -12,9 +12,9 @@ from atmos.defaults import DefaultPlugins
 from atmos.gpu import create_headless
 from atmos.graph import PassBuilder, RenderPass
 from atmos.lighting import Sun
-from atmos.plugins.cloud_shadows import reference as shadow_reference
+from atmos.plugins.clouds.shadows import reference as shadow_reference
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
-from atmos.plugins.clouds.sets import CLOUD_SETS
+from atmos.plugins.clouds.volume.sets import CLOUD_SETS
 from atmos.plugins.ground import GroundPlugin
 from atmos.plugins.light_shafts import LightShaftsPlugin, reference
 from atmos.plugins.light_shafts.march import SHAFT_COLOR, SHAFT_DEPTH, march_irradiance

@@ -26,18 +26,18 @@ from atmos.defaults import DefaultPlugins
 from atmos.gpu import create_headless
 from atmos.lighting import Sun
 from atmos.plugin import Plugin
-import atmos.plugins.clouds.simulation as cloud_simulation
-import atmos.plugins.weather.system as weather_system
+import atmos.plugins.clouds.simulation.chain as cloud_simulation
+import atmos.plugins.clouds.weather.system as weather_system
 from atmos.checks import CheckedSettings
-from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
-from atmos.plugins.cloud_raymarch.plugin import LOW_COLOR as RAYMARCH_LOW_COLOR
-from atmos.plugins.cloud_render import CloudRenderPlugin
-from atmos.plugins.cloud_render.example import example_weather
-from atmos.plugins.cloud_render.offscreen import CLOUD_COLOR
-from atmos.plugins.cloud_shadows import CloudShadowsPlugin
-from atmos.plugins.cloud_far_field import CloudFarFieldPlugin
+from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
+from atmos.plugins.clouds.raymarch.plugin import LOW_COLOR as RAYMARCH_LOW_COLOR
+from atmos.plugins.clouds.sprites import CloudRenderPlugin
+from atmos.plugins.clouds.weather.example import example_weather
+from atmos.plugins.clouds.volume.offscreen import CLOUD_COLOR
+from atmos.plugins.clouds.shadows import CloudShadowsPlugin
+from atmos.plugins.clouds.far_field import CloudFarFieldPlugin
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
-from atmos.plugins.clouds.top_view import CloudTopViewPlugin
+from atmos.plugins.clouds.simulation.top_view import CloudTopViewPlugin
 from atmos.plugins.daylight import DaylightPlugin, TimeOfDay
 from atmos.plugins.fog import FogPlugin
 from atmos.plugins.ground import GroundPlugin
@@ -50,9 +50,9 @@ from atmos.plugins.sky_layer import SkyLayerPlugin
 from atmos.plugins.terrain import TerrainPlugin
 from atmos.plugins.test_volume import TestVolumePlugin, VolumeBox
 from atmos.plugins.volumetric_fog import VolumetricFogPlugin
-from atmos.plugins.weather import WeatherPlugin
-from atmos.shading.scattering import Scattering
-from atmos.shading.shear_warp import ShadingTask
+from atmos.plugins.clouds.weather import WeatherPlugin
+from atmos.plugins.clouds.light.scattering import Scattering
+from atmos.plugins.clouds.light.shear_warp import ShadingTask
 from atmos.render_core import CapturePass, RenderCorePlugin
 
 SIZE = (64, 40)

@@ -1,4 +1,4 @@
-"""The Monte-Carlo path tracer (atmos.shading.path_tracer) on analytic cases: the single-scattering
+"""The Monte-Carlo path tracer (atmos.plugins.clouds.light.path_tracer) on analytic cases: the single-scattering
 integral of a uniform box, the optically thin limit, a uniform slab against a discrete-ordinates
 solution derived here, energy conservation at albedo 1 and the white furnace."""
 import math
@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from atmos.shading.path_tracer import phase, trace
+from atmos.plugins.clouds.light.path_tracer import phase, trace
 
 SLAB = dict(density=np.ones((1, 1, 1)), cell=(400.0, 1.0, 400.0), lo=(-200.0, 0.0, -200.0))
 

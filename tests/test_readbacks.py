@@ -17,7 +17,7 @@ from atmos.graph.timing import RING
 from atmos.plugins.clouds import CloudSimulation, DensityMaps, reference
 from atmos.runner import build_app
 
-MAPS, FAR = ("Buffer.read", "plugins/clouds/density_maps.py"), ("Buffer.read", "plugins/cloud_far_field/layer.py")
+MAPS, FAR = ("Buffer.read", "plugins/clouds/simulation/density_maps.py"), ("Buffer.read", "plugins/clouds/far_field/layer.py")
 ALLOWED = {("Query.elapsed", "atmos/graph/timing.py"), MAPS, FAR}
 
 

@@ -7,11 +7,11 @@ import pytest
 from atmos.frames import SlicedJob, TripleSet
 from atmos.graph import TextureDesc
 from atmos.lighting import sky_light
-from atmos.shading import (LightVolumeShader, Scattering, ShadingTask, ShearWarpShader,
+from atmos.plugins.clouds.light import (LightVolumeShader, Scattering, ShadingTask, ShearWarpShader,
                            compute_fixed_ratio, compute_transmittance, light_volume_reference,
                            reference as R)
-from atmos.shading.scattering import harris_reference
-from atmos.shading.shear_warp import read_volume, upload_volume
+from atmos.plugins.clouds.light.scattering import harris_reference
+from atmos.plugins.clouds.light.shear_warp import read_volume, upload_volume
 
 SHAPE = (20, 12, 16)
 

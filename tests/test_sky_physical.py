@@ -372,7 +372,7 @@ def test_the_aerial_froxel_volume_is_allocated_only_while_used_and_checked(gpu, 
 
 def test_aerial_perspective_hazes_clouds_by_their_own_distance_and_follows_fog(gpu, ctx):
     """With clouds and fog: the pass reads the clouds' distance and runs after the fog; finite frames."""
-    from atmos.plugins.cloud_render import CloudRenderPlugin
+    from atmos.plugins.clouds.sprites import CloudRenderPlugin
     from atmos.plugins.clouds import CloudSettings, CloudsPlugin
     density = np.zeros((8, 4, 8), np.float32)
     density[1:7, 1:3, 1:7] = 1.0
@@ -534,7 +534,7 @@ def test_fog_colour_follows_the_physical_sky(gpu, ctx):
 
 
 def test_clouds_are_lit_by_the_physical_sun_colour():
-    from atmos.plugins.cloud_render.light import light_uniforms
+    from atmos.plugins.clouds.volume.light import light_uniforms
     from atmos.plugins.clouds import CloudSettings
     sun = Sun(direction=sun_at(2.0))
     s = AtmosphereSettings()
@@ -552,8 +552,8 @@ def test_clouds_above_keep_the_sun_after_the_grounds_sunset(gpu, ctx):
     """The physical sky gives the sun's colour by altitude: at -0.8 deg the ground has lost the sun, a layer
     1.5 km up has not (the horizon dips 1.2 deg there); by day the layer sees it through less air.
     The clouds take it at their heights; the Preetham model gives none, and switching back drops it."""
-    from atmos.plugins.cloud_render import CloudRenderPlugin
-    from atmos.plugins.cloud_render.light import light_uniforms
+    from atmos.plugins.clouds.sprites import CloudRenderPlugin
+    from atmos.plugins.clouds.volume.light import light_uniforms
     from atmos.plugins.clouds import CloudSettings, CloudsPlugin
     s = AtmosphereSettings()
     low = Sun(direction=sun_at(-0.8))
@@ -638,8 +638,9 @@ def test_at_dusk_the_tops_keep_the_sun_after_the_bases_lose_it(gpu, ctx, rendere
     renderers take the sun's colour at each height (volume.glsl sun_source_at): the top glows red over a
     base lit by the sky alone. Drawn again with the middle's colour at every height (the model before),
     the base is brighter and the top darker."""
-    from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
-    from atmos.plugins.cloud_render import CloudRenderPlugin, light
+    from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
+    from atmos.plugins.clouds.sprites import CloudRenderPlugin
+    from atmos.plugins.clouds.volume import light
     from atmos.plugins.clouds import CloudSettings, CloudsPlugin
 
     def draw():
@@ -675,7 +676,7 @@ def test_the_sun_by_height_stays_finite_at_the_extremes():
     sun_radiance) for layers below the ground, of no height, above the atmosphere's top, and a sun from
     the zenith to 30 deg below the horizon: finite, non-negative, one row per height, and none once the
     layer's sun has set."""
-    from atmos.plugins.cloud_render.light import SUN_HEIGHTS, light_uniforms, sun_colors
+    from atmos.plugins.clouds.volume.light import SUN_HEIGHTS, light_uniforms, sun_colors
     from atmos.plugins.clouds import CloudSettings
     s = AtmosphereSettings()
     for elevation in (90.0, 10.0, 0.0, -0.5, -2.0, -30.0):

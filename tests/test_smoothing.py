@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from atmos.automaton import CloudAutomaton
+from atmos.plugins.clouds.automaton import CloudAutomaton
 from atmos.plugins.clouds import DensityMaps, Smoother, read_volume, reference, slice_range
 
 LAYOUTS = ("packed", "cell")
@@ -297,4 +297,4 @@ def test_smoothers_and_maps_of_other_shapes_share_the_context_programs(gpu, ctx,
         expected = reference.smooth(cld, radius, "tent", smoother.min_density("f4"))
         assert_matches(read_volume(texture), expected, "f4")
         assert_maps(maps, read_volume(texture), expected)
-    assert {"clouds/smooth.comp", "clouds/density_sums.comp", "clouds/density_max.comp"} <= gpu.compiled_files
+    assert {"clouds/simulation/smooth.comp", "clouds/simulation/density_sums.comp", "clouds/simulation/density_max.comp"} <= gpu.compiled_files

@@ -10,13 +10,13 @@ from PIL import Image
 from atmos import App, DefaultPlugins, create_headless
 from atmos.camera import Camera
 from atmos.lighting import Sun
-from atmos.plugins.cloud_raymarch import RaymarchCloudsPlugin
-from atmos.plugins.cloud_render import CloudRenderPlugin
-from atmos.plugins.cloud_render.reference import soft_fade
+from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
+from atmos.plugins.clouds.sprites import CloudRenderPlugin
+from atmos.plugins.clouds.sprites.reference import soft_fade
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
 from atmos.plugins.ground import GroundPlugin
 from atmos.plugins.sky_gradient import SkyGradientPlugin
-from atmos.plugins.weather import VolumeOrigin
+from atmos.plugins.clouds.weather import VolumeOrigin
 
 OUT = Path(__file__).resolve().parents[1] / "out"
 

@@ -7,7 +7,7 @@ import pytest
 
 from atmos.app import App
 from atmos.world import World
-from atmos.plugins.weather import (MAX_CLOUD_DENSITY, Ellipsoid, RegionVolume, VolumeOrigin, WeatherSettings,
+from atmos.plugins.clouds.weather import (MAX_CLOUD_DENSITY, Ellipsoid, RegionVolume, VolumeOrigin, WeatherSettings,
                                    WeatherPlugin, ellipsoid_array, probabilities, region_volume,
                                    step_weather, wind_field_at)
 

@@ -1,17 +1,18 @@
-"""The cloud simulation: weather → region volume → automaton → smoothing → density maps.
+"""The cloud family under one roof. Sub-packages, from the simulation to the pictures:
 
-``CloudsPlugin`` adds the whole chain to an App as a sliced job (``CloudSimulation``);
-``Smoother`` turns the automaton's cld bits into a float density volume on the GPU (eq. 2.11,
-sec. 4.4); ``DensityMaps`` sums it into top-view maps (all heights and per height band) and
-max-downsamples them to the sprite-group grid (7.2.2); ``reference`` holds the numpy float64
-references of smoothing and density maps.
+``weather`` (ellipsoids → region volume) → ``automaton`` (Dobashi's cellular automaton) →
+``simulation`` (``CloudsPlugin``: the chain as a sliced job into three texture sets, smoothing,
+density maps) → ``light`` (shading toward the sun, the diffusion field, the light model and the
+path tracer) → ``volume`` (what every renderer shares: the sets and layout it publishes, the light
+binding, the off-screen clouds) → the renderers ``raymarch`` and ``sprites``, the ``far_field`` to
+the horizon and the ground ``shadows``; ``presets`` (``CloudSky``) puts them together for a game.
 """
-from atmos.plugins.clouds import reference
-from atmos.plugins.clouds.density_maps import DensityMaps
-from atmos.plugins.clouds.plugin import CloudsPlugin
-from atmos.plugins.clouds.sets import CLOUD_SETS, CloudSets
-from atmos.plugins.clouds.simulation import CloudSettings, CloudSimulation
-from atmos.plugins.clouds.smoothing import FORMATS, Smoother, read_volume, slice_range
+from atmos.plugins.clouds.simulation import reference
+from atmos.plugins.clouds.simulation.chain import CloudSettings, CloudSimulation
+from atmos.plugins.clouds.simulation.density_maps import DensityMaps
+from atmos.plugins.clouds.simulation.plugin import CloudsPlugin
+from atmos.plugins.clouds.simulation.smoothing import FORMATS, Smoother, read_volume, slice_range
+from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CloudSets
 
 __all__ = ["CLOUD_SETS", "CloudSets", "CloudSettings", "CloudSimulation", "CloudsPlugin", "DensityMaps", "FORMATS", "Smoother",
            "read_volume", "reference", "slice_range"]

@@ -14,12 +14,12 @@ from dataclasses import dataclass, replace
 from atmos.camera import Camera
 from atmos.checks import check_choice, check_num
 from atmos.plugin import Plugin, PluginGroup
-from atmos.plugins.cloud_render import CloudRenderPlugin
-from atmos.plugins.cloud_render.example import example_weather
-from atmos.plugins.cloud_shadows import CloudShadowsPlugin
-from atmos.plugins.clouds.plugin import CloudsPlugin
-from atmos.plugins.clouds.simulation import CloudSettings
-from atmos.plugins.weather import VolumeOrigin
+from atmos.plugins.clouds.sprites import CloudRenderPlugin
+from atmos.plugins.clouds.weather.example import example_weather
+from atmos.plugins.clouds.shadows import CloudShadowsPlugin
+from atmos.plugins.clouds.simulation.plugin import CloudsPlugin
+from atmos.plugins.clouds.simulation.chain import CloudSettings
+from atmos.plugins.clouds.weather import VolumeOrigin
 
 SHAPE = (128, 16, 128)          # cells of every preset's volume: x, height, z
 FULL_COVER = 700                # weather ellipsoids over 128 x 128 columns that close the sky

@@ -1,7 +1,7 @@
 """The march mode of the light shafts: sun light scattered by a thin haze along each view ray,
 shadowed by the clouds through the ground shadows' density maps (shaders/light_shafts/march.frag),
 at low resolution and upsampled by depth with the off-screen clouds' draws
-(:class:`~atmos.plugins.cloud_render.offscreen.OffscreenClouds`). Reference: :func:`.reference.march_shafts`."""
+(:class:`~atmos.plugins.clouds.volume.offscreen.OffscreenClouds`). Reference: :func:`.reference.march_shafts`."""
 from __future__ import annotations
 
 import numpy as np
@@ -11,10 +11,10 @@ from atmos.camera import set_camera_uniforms
 from atmos.composition import CLOUD_DISTANCE
 from atmos.graph import PassBuilder, PassContext
 from atmos.lighting import unit_sun
-from atmos.plugins.cloud_far_field.layer import FAR_FIELD
-from atmos.plugins.cloud_render.offscreen import OffscreenClouds
-from atmos.plugins.cloud_shadows.plugin import column_uniforms
-from atmos.plugins.clouds.sets import CLOUD_SETS, CloudSets
+from atmos.plugins.clouds.far_field.layer import FAR_FIELD
+from atmos.plugins.clouds.volume.offscreen import OffscreenClouds
+from atmos.plugins.clouds.shadows.plugin import column_uniforms
+from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CloudSets
 from atmos.plugins.light_shafts.settings import FLOAT32_MAX
 from atmos.plugins.sky.luts import SKY_LUTS, atmosphere_defines, set_atmosphere_uniforms, view_radius
 from atmos.render_core import COLOR, DEPTH

@@ -6,8 +6,8 @@ import math
 
 from atmos.graph import PassBuilder, PassContext, RenderPass, TextureDesc
 from atmos.plugin import Plugin
-from atmos.plugins.cloud_far_field.layer import FAR_FIELD
-from atmos.plugins.clouds.sets import CLOUD_SETS
+from atmos.plugins.clouds.far_field.layer import FAR_FIELD
+from atmos.plugins.clouds.volume.sets import CLOUD_SETS
 from atmos.plugins.light_shafts.march import MarchedShafts
 from atmos.plugins.light_shafts.settings import LightShaftSettings, blur_scale
 from atmos.plugins.light_shafts.screen_sun import screen_sun

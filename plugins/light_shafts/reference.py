@@ -8,10 +8,10 @@ from __future__ import annotations
 import numpy as np
 
 from atmos.blue_noise import blue_noise
-from atmos.plugins.cloud_shadows.reference import zero_border_bilinear
+from atmos.plugins.clouds.shadows.reference import zero_border_bilinear
 from atmos.plugins.light_shafts.settings import blur_scale
 from atmos.render_core import HDR_MAX
-from atmos.shading.medium import phase
+from atmos.plugins.clouds.light.medium import phase
 
 LUMA = np.array([0.2126, 0.7152, 0.0722])
 
@@ -73,7 +73,7 @@ def march_shafts(low_depth, basis, camera_pos, near: float, far: float, frame_si
     to its depth or ``max_distance``, ``L = Σ σ p(cos) E exp(−τ_sun − σ s_i) ds`` (at most ``HDR_MAX``),
     ``T = exp(−σ d)``;
     ``optical_depth(points (..., 3)) -> (...)`` the sun's optical depth through the clouds (None: 0),
-    e.g. :func:`atmos.plugins.cloud_shadows.reference.sun_optical_depth` bound to a volume."""
+    e.g. :func:`atmos.plugins.clouds.shadows.reference.sun_optical_depth` bound to a volume."""
     depth = np.asarray(low_depth, np.float64)
     h, w = depth.shape
     x, y = np.meshgrid(np.arange(w), np.arange(h))

@@ -26,8 +26,8 @@ class LightShaftSettings(CheckedSettings):
     (the sky: ``max_distance`` metres), ``steps`` samples from a per-pixel jittered start gather sun
     light scattered by a thin haze of scattering coefficient ``scattering`` (1/m, albedo 1) with the
     two-lobe Henyey-Greenstein phase ``phase_g``, ``phase_g2``, ``phase_w`` of
-    :mod:`atmos.shading.medium`, the sun irradiance ``sun_intensity × Sun.color`` reaching each
-    sample through the clouds (the ground shadows' density maps, :mod:`atmos.plugins.cloud_shadows`;
+    :mod:`atmos.plugins.clouds.light.medium`, the sun irradiance ``sun_intensity × Sun.color`` reaching each
+    sample through the clouds (the ground shadows' density maps, :mod:`atmos.plugins.clouds.shadows`;
     no clouds: unshadowed haze) and the haze's own transmittance toward the eye, which also dims the
     colour behind. At 1/``downsample`` resolution, upsampled by depth. Shafts are real rays: the air
     between cloud shadows is lit, the air in them is not. With a FogPlugin in the App the fog owns the

@@ -1,4 +1,4 @@
-// The multiple-scattering octaves' sun transmittances (atmos/shading/medium.py octave_transmittances):
+// The multiple-scattering octaves' sun transmittances (plugins/clouds/light/medium.py octave_transmittances):
 // light that reached a point with k forward scatterings on its way from the sun, k Poisson-distributed
 // with mean x = (1 - a) tau (tau = -ln T the sun's optical depth, a = ms_attenuation: the share of
 // scatterings that turn light aside; the rest stay in the forward peak). (T, T x, T x^2/2): none, one,

@@ -1,6 +1,6 @@
 #version 430
 // Test probe: detail_density(d, p, probe_footprint) at the point p = texel.xyz (m) with d = texel.w of unit 0's input.
-#include "cloud_raymarch/detail.glsl"
+#include "clouds/raymarch/detail.glsl"
 
 uniform sampler2D probe_points;
 uniform float probe_footprint;     // the pixel's width (m) at every point

@@ -1,0 +1,229 @@
+"""FarFieldLayer: the far field's textures and cover for one frame, shared by every pass that needs it.
+
+The far field's clouds are a function of world (x, z): the four octave textures, each at its own
+turned uv (:mod:`.pattern`, drift included), each point taking the volume's column sum at its rank
+(:mod:`.cover`). The tile they are drawn at, :attr:`FarFieldLayer.tile_size`, is the setting's or
+(None) sized so that their cover changes per metre as often as the volume's (:meth:`update_tile`, from a
+measure read back once per simulation step, a step after it was taken: no frame waits for it). The far-field
+pass draws them; the ground shadows (:mod:`atmos.plugins.clouds.shadows`) darken the ground under them
+with the same function (``shaders/clouds/far_field/field.glsl``). The plugin imports this object as the
+graph resource ``"far_field"``; each pass that uses it calls :meth:`prepare` (re-bakes the octaves
+when the sun turned, measures the cover) and :meth:`use`. The same measure gives the volume's vertical
+shape by rank (:attr:`FarFieldLayer.profile`, :meth:`read_profile`), which the ray march's volumetric
+far field takes its density from; a second dispatch its light by rank (:attr:`FarFieldLayer.light`,
+:mod:`.rank_light`), which both far fields light their columns with.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from atmos.plugins.clouds.far_field.columns import rank_texture, read_rank_texture, use_columns
+from atmos.plugins.clouds.far_field.cover import QUANTILES, level_table, matched_tile_size, pattern_crossings
+from atmos.plugins.clouds.far_field.pattern import CHANNEL_STEPS, PERIODS, octave_frequencies, octave_offsets, rotations
+from atmos.plugins.clouds.far_field.rank_light import RankLight
+from atmos.plugins.clouds.volume.light import cell_tau, light_uniforms
+from atmos.plugins.clouds.volume.sets import CloudSets
+from atmos.plugins.sky_layer.octaves import OctaveTextures
+
+FAR_FIELD = "far_field"          # the imported graph resource
+REBAKE_TOLERANCE = 0.05          # re-bake the octaves when the sun moved the light step by this fraction
+OCTAVE_UNIT = 5                  # texture units 5..8 (field.glsl)
+PROFILE_UNIT = 14                # the profile texture for the shaders that declare far_profile (2D)
+MAX_HEIGHTS = 64                 # cover.comp's most height samples
+TILE_TIME = 5.0                  # s: the matched tile follows a change of the volume's with this time constant
+
+
+def profile_heights(layers: int) -> int:
+    """Height samples of the measured profile: the layer's height in cells, at most MAX_HEIGHTS."""
+    return max(1, min(int(layers), MAX_HEIGHTS))
+
+
+def travel(settings, sets: CloudSets, time: float) -> np.ndarray:
+    """(2,) metres the pattern has drifted. ``settings.wind`` None: the distance the simulated clouds
+    have moved with their wind (``CloudSets.wind_travel``, cells × cell size), so both move together;
+    a tuple: that (x, z) drift in m/s with the App clock ``time``."""
+    if settings.wind is None:
+        return np.asarray(sets.wind_travel, np.float64) * np.asarray(sets.settings.cell_size, np.float64)[[0, 2]]
+    return np.asarray(settings.wind, np.float64) * float(time)
+
+
+def drift(settings, sets: CloudSets, time: float, tile_size: float) -> np.ndarray:
+    """(4, 2) each octave's drift in its own uv (turned, its period: :mod:`.pattern`), wrapped to [0, 1):
+    the same world travel (:func:`travel`) for every octave, with the layer's tile ``tile_size`` (m,
+    FarFieldLayer.tile_size)."""
+    return octave_offsets(travel(settings, sets, time), tile_size)
+
+
+def column_tau(settings, sets: CloudSets) -> float:
+    """field.glsl's field_column_tau: optical depth per cell of a column sum, ``thickness · sigma_t ·
+    cell height`` (the column far.frag draws and the ground shadows take beyond the volume)."""
+    return float(settings.thickness) * cell_tau(sets.settings)
+
+
+class FarFieldLayer:
+    """The octave textures and the measured cover of the far field (GL objects of one GpuContext)."""
+
+    def __init__(self, gpu, plugin):
+        self.gpu, self.plugin = gpu, plugin
+        self.octaves = OctaveTextures(gpu)
+        self.cover = gpu.track(gpu.ctx.buffer(reserve=4 * (2 + QUANTILES)))   # cover, column_quantiles, transitions
+        self._staged = gpu.track(gpu.ctx.buffer(reserve=self.cover.size))      # a copy of one step's measure
+        self._staged_for = None              # the set B whose measure is staged (held: never a reused id)
+        self._target = None                  # the matched tile the drawn one follows (m)
+        self.tile_size = float(self.plugin.settings.tile_size or 8000.0)    # metres per tile as drawn (update_tile)
+        self._tile_time = None               # App time of the last update_tile
+        self._matched = False                # tile_size follows a measure (else the first one sets it)
+        self.profile = None                  # (INTERVALS, heights) rg32f: the volume's shape by rank (cover.comp)
+        self.light = RankLight(gpu)          # the volume's light by rank (light_by_rank.comp)
+        self._prepared = None                # the SceneView of the frame prepared last (held: never a reused id)
+
+    @property
+    def settings(self):
+        return self.plugin.settings
+
+    def prepare(self, view, sim: CloudSets) -> None:
+        """Bake (when needed), measure the cover and, while a far field is drawn, the light by rank (small
+        dispatches), once per frame: every user (the far-field pass or the march, the shadows, the
+        shafts) calls it, the first one does it."""
+        if view is self._prepared:
+            return
+        self._prepared = view
+        params = self.settings
+        sun_dir = light_uniforms(sim.settings, view.sun)["sun_dir"]
+        if self.octaves.needs_bake(params, sun_dir, REBAKE_TOLERANCE):
+            self.octaves.bake(params, sun_dir, octave_frequencies(params.base_frequency), rotations(), CHANNEL_STEPS)
+        self.measure_cover(sim)
+        if self.plugin.drawn_by_march() or params.enabled:      # a far field is drawn (not just shadows)
+            self.light.measure(sim, self.cover, self.plugin.light_settings().ms_attenuation,
+                               profile_heights(sim.shape[1]))
+        self.update_tile(sim, float(view.time))
+
+    def update_tile(self, sim: CloudSets, time: float) -> None:
+        """:attr:`tile_size` from the last measure: ``settings.tile_size`` when set, else the tile at which
+        the far field's cover changes along a line as often per metre as the volume's (cover.comp's
+        transitions per cell / the cell size; :func:`.cover.matched_tile_size`; :meth:`_step_measure`),
+        followed with the time constant TILE_TIME (the pattern zooms slowly, never jumps; a first measure
+        is taken at once)."""
+        params = self.settings
+        dt = time - self._tile_time if self._tile_time is not None else 0.0
+        self._tile_time = time
+        if params.tile_size is not None:
+            self._matched = False
+            self.tile_size = float(params.tile_size)
+            return
+        measured = self._step_measure(sim)
+        if measured is not None:
+            cover, transitions = measured
+            cell = float(np.mean(np.asarray(sim.settings.cell_size, np.float64)[[0, 2]]))
+            self._target = matched_tile_size(pattern_crossings(params.base_frequency, params.seed, params.size),
+                                             cover, transitions / cell)
+        if self._target is None:
+            return
+        k = min(1.0, max(dt, 0.0) / TILE_TIME) if self._matched else 1.0
+        self.tile_size *= (self._target / self.tile_size) ** k
+        self._matched = True
+
+    def _step_measure(self, sim: CloudSets) -> tuple[float, float] | None:
+        """(cover, transitions per cell) once per simulation step, else None: when a step's sets are first
+        drawn, the staged copy of the last step's measure is read (frames old: no wait) and this frame's
+        is copied on the GPU into its place. The very first measure is read at once (start-up)."""
+        if sim.b is self._staged_for:
+            return None
+        first = self._staged_for is None
+        measured = None if first else _transitions(self._staged)
+        self.gpu.ctx.copy_buffer(self._staged, self.cover)
+        self._staged_for = sim.b
+        return _transitions(self._staged) if first else measured
+
+    def measure_cover(self, sim: CloudSets, profile: bool | None = None) -> None:
+        """The simulation's edge-weighted cover and column-sum quantiles into the buffer the shaders
+        read (float32: cover, then QUANTILES column sums in cells; :meth:`read_cover`), and with
+        ``profile`` (None: when the ray march draws the far field, ``drawn_by_march()``; it reads the
+        sets' density) the covered columns' vertical profile per rank interval into :attr:`profile`
+        (:meth:`read_profile`)."""
+        profile = self.plugin.drawn_by_march() if profile is None else bool(profile)
+        c = self.gpu.program(compute_shader="clouds/far_field/cover.comp", defines={"PROFILE": int(profile)})
+        use_columns(c, sim, density=profile)
+        if profile:
+            self._profile_texture(profile_heights(sim.shape[1])).bind_to_image(0, read=False, write=True)
+        c["threshold"].value = float(sim.settings.cover_threshold)
+        c["max_sum"].value = float(sim.shape[1])
+        self.cover.bind_to_storage_buffer(0)
+        c.run(1)
+        self.gpu.ctx.memory_barrier()
+
+    def _profile_texture(self, heights: int):
+        if self.profile is None or self.profile.size[1] != heights:
+            if self.profile is not None:
+                self.profile.release()
+            self.profile = rank_texture(self.gpu, heights, 2)
+        return self.profile
+
+    def read_profile(self) -> np.ndarray:
+        """(INTERVALS, heights, 2) as last measured: [k, j] = (density per unit column sum, share of the
+        column above) of rank interval k at height sample j (a GPU → CPU copy: tests and tools)."""
+        if self.profile is None:
+            raise RuntimeError("FarFieldLayer.read_profile: no profile measured yet; it is measured while a ray "
+                               "march draws the far field, or by measure_cover(sim, profile=True)")
+        self.gpu.ctx.memory_barrier()
+        return read_rank_texture(self.profile)
+
+    def read_cover(self) -> tuple[float, np.ndarray]:
+        """(cover, (QUANTILES,) column-sum quantiles) as last measured (a GPU → CPU copy: tests and tools)."""
+        values = np.frombuffer(self.cover.read(), np.float32).astype(np.float64)
+        return float(values[0]), values[1:1 + QUANTILES]
+
+    def read_transitions(self) -> tuple[float, float]:
+        """(cover, the cover's transitions per cell along a line) as last measured (a GPU → CPU copy: tests
+        and tools)."""
+        return _transitions(self.cover)
+
+    def use(self, program, view, sim: CloudSets) -> None:
+        """Bind the textures (units 5..8), the cover (storage buffer 0) and set field.glsl's uniforms."""
+        params = self.settings
+        self.octaves.use(OCTAVE_UNIT)
+        self.cover.bind_to_storage_buffer(0)
+        if "far_profile" in program and self.profile is not None:
+            self.profile.use(PROFILE_UNIT)
+        self.light.use(program)
+        time = float(view.time) if params.animate else 0.0
+        layout = sim.layout()
+        camera = np.asarray(view.camera.position, np.float64)
+        offsets = octave_offsets(camera[[0, 2]] + travel(params, sim, time), self.tile_size)
+        values = dict(field_origin=tuple(camera[[0, 2]]), field_tile_size=float(self.tile_size),
+                      field_lod_shift=tuple(np.log2(PERIODS)),
+                      field_mid_height=float(0.5 * (layout.lo[1] + layout.hi[1])),
+                      field_column_tau=column_tau(params, sim))
+        for name, value in values.items():
+            if name in program:
+                program[name].value = value
+        program["field_offsets"].write(offsets.astype("f4").tobytes())
+        program["field_turns"].write(np.transpose(rotations(), (0, 2, 1)).astype("f4").tobytes())   # column-major
+        quantiles, first = level_table(params.base_frequency, params.seed, params.size)
+        program["field_quantiles"].write(np.asarray(quantiles, "f4").tobytes())
+        if "field_crossings" in program:              # far.frag's slant_rank
+            program["field_crossings"].write(np.asarray(pattern_crossings(params.base_frequency, params.seed, params.size),
+                                                        "f4").tobytes())
+        if "field_first_level" in program:
+            program["field_first_level"].value = first
+
+    def release(self) -> None:
+        if self.octaves is not None:
+            self.octaves.release()
+            self.octaves = None
+        for buffer in (self.cover, self._staged):
+            if buffer is not None:
+                buffer.release()
+        self.cover = self._staged = self._staged_for = None
+        if self.profile is not None:
+            self.profile.release()
+            self.profile = None
+        if self.light is not None:
+            self.light.release()
+            self.light = None
+
+
+def _transitions(buffer) -> tuple[float, float]:
+    """(cover, transitions per cell) of a cover.comp measure in ``buffer``."""
+    values = np.frombuffer(buffer.read(), np.float32).astype(np.float64)
+    return float(values[0]), float(values[1 + QUANTILES])

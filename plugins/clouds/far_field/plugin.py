@@ -1,0 +1,107 @@
+"""CloudFarFieldPlugin and its pass: the clouds beyond the simulated volume, out to the horizon."""
+from __future__ import annotations
+
+import numpy as np
+
+from atmos.camera import set_camera_uniforms
+from atmos.composition import CLOUD_DISTANCE, composition
+from atmos.graph import FullscreenPass, PassContext
+from atmos.plugin import Plugin
+from atmos.plugins.clouds.far_field.layer import FAR_FIELD, FarFieldLayer
+from atmos.plugins.clouds.far_field.settings import CloudFarFieldSettings
+from atmos.plugins.clouds.volume.light import CloudLightSettings, light_uniforms
+from atmos.plugins.clouds.volume.field_demand import field_demand
+from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CloudSets
+from atmos.render_core import COLOR, DEPTH
+
+
+class CloudFarFieldPass(FullscreenPass):
+    """Phase translucent, before the cloud renderers (its clouds are behind theirs): blends the far
+    field onto ``color`` (premultiplied) where the layer's middle plane is in front of ``depth``, and
+    its distance onto ``"cloud_distance"`` when a media pass reads it (:mod:`atmos.composition`)."""
+    name = "cloud_far_field"
+    phase = "translucent"
+    fragment = "clouds/far_field/far.frag"
+    reads = (COLOR, DEPTH, CLOUD_SETS, FAR_FIELD)
+
+    def setup(self, builder) -> None:
+        if self.plugin.drawn_by_march():
+            return                          # a ray march draws the far field volumetrically: culled
+        super().setup(builder)
+        if self.plugin.composition.distance:
+            builder.read(CLOUD_DISTANCE)
+            builder.write(CLOUD_DISTANCE)
+
+    def execute(self, frame: PassContext) -> None:
+        params = self.plugin.settings
+        if not params.enabled:
+            return
+        view, p = frame.view, self.program
+        sim: CloudSets = frame.resource(CLOUD_SETS)
+        layer: FarFieldLayer = frame.resource(FAR_FIELD)
+        layer.prepare(view, sim)
+        layout = sim.layout()
+        distance = frame.declares(CLOUD_DISTANCE)
+        frame.framebuffer(color=[COLOR, CLOUD_DISTANCE] if distance else [COLOR]).use()
+        frame.blend_over()
+        layer.use(p, view, sim)
+        frame.resource(DEPTH).use(9)
+        set_camera_uniforms(p, view.camera, view.aspect)
+        light = self.plugin.light_settings()       # the renderer's octaves; its field's weight where measured
+        diffusion = light.ms_diffusion if layer.light.has_field else 0.0
+        values = dict(light_uniforms(sim.settings, view.sun, light.octaves, diffusion, layout.heights),
+                      footprint_min=tuple(layout.lo[[0, 2]]), footprint_size=tuple(layout.hi[[0, 2]] - layout.lo[[0, 2]]),
+                      edge_fade=float(sim.settings.edge_fade), layer_height=float(layout.hi[1] - layout.lo[1]),
+                      lod_scale=float(params.size / layer.tile_size * 2.0 * np.tan(view.camera.fov_y / 2)
+                                      / max(view.size[1], 1)),
+                      **{name: float(getattr(params, name)) for name in
+                         ("thickness", "horizon_fade")})
+        for name, value in values.items():
+            if name in p:
+                p[name].value = value
+        frame.fullscreen(p)
+
+
+class CloudFarFieldPlugin(Plugin):
+    """Clouds to the horizon: ``CloudFarFieldPlugin(settings=None, **fields)`` with
+    :class:`CloudFarFieldSettings`; needs a CloudsPlugin (its "cloud_sets"), whose ``edge_fade``
+    sets the band over which the volume fades out and the far field fades in. ``configure(**changes)``
+    changes any setting live (next frame; texture settings re-bake the octaves)."""
+
+    settings_class = CloudFarFieldSettings
+
+    def build(self, app) -> None:
+        if app.graph is None:
+            raise ValueError("CloudFarFieldPlugin needs an App with a GPU context (App(gpu))")
+        self.composition = composition(app)
+        self.composition.writers.add("cloud_far_field")   # the fog gets the layer's own distance
+        self.layer = FarFieldLayer(app.gpu, self)          # also read by the ground shadows
+        self.demand = field_demand(app)                    # the cloud renderers (light_settings)
+        self.marchers = set()       # renderers that may march the far field themselves (drawn_by_march)
+        app.graph.import_resource(FAR_FIELD, self.layer)
+        self.pass_ = CloudFarFieldPass(self)
+        app.graph.add_pass(self.pass_)
+
+    def cleanup(self, app) -> None:
+        layer = getattr(self, "layer", None)
+        if layer is not None:
+            layer.release()
+        comp = getattr(self, "composition", None)
+        if comp is not None:
+            comp.writers.discard("cloud_far_field")
+
+    def light_settings(self) -> CloudLightSettings:
+        """The octaves and field weight the far field is lit with: the cloud renderer's (FieldDemand.light;
+        the defaults without one), so the far clouds continue the volume's light."""
+        return self.demand.light() or CloudLightSettings()
+
+    def drawn_by_march(self) -> bool:
+        """Whether a cloud renderer marches the far field itself this frame (a registered renderer's
+        ``marches_far_field()``, e.g. RaymarchCloudsPlugin with ``far_field``): the 2D pass then
+        declares nothing and is culled; the layer stays imported for the shadows and the march."""
+        return any(m.marches_far_field() for m in getattr(self, "marchers", ()))
+
+    def finish(self, app) -> None:
+        """Run before every other translucent pass (the cloud renderers draw nearer clouds over it)."""
+        self.pass_.before = tuple(p.name for p in app.graph.passes
+                                  if p.phase == "translucent" and p is not self.pass_)

@@ -1,0 +1,129 @@
+"""RankLight: the volume's own light by column rank, which the far fields light their columns with.
+
+The far field gives a point of rank r the volume's column sum at r (:mod:`.cover`); this measure gives
+it the light of the volume's columns of that rank too (``shaders/clouds/far_field/light_by_rank.comp``,
+float64 reference :func:`atmos.plugins.clouds.far_field.reference.light_by_rank`): the mean sun
+transmittances of the octaves (``medium.octave_transmittances``) and, where the sets carry a diffusion field, its mean
+(phi, F), each as seen from above and from below; both per height bin for the ray march's
+volumetric far field; the height their light comes from (where the 2D far field takes the sun's
+colour); and the clouds' thickness (the height their density spans), how high the 2D
+far field's clouds stand when seen at a slant (``far.frag`` slant_rank). So the far field is as bright per cover as the volume at every sun, not a guess
+from a slanted column. Two small dispatches per frame after the cover (:meth:`FarFieldLayer.prepare`).
+"""
+from __future__ import annotations
+
+from atmos.plugins.clouds.far_field.columns import INTERVALS, rank_texture, read_rank_texture, use_columns
+from atmos.plugins.clouds.volume.light import cell_tau
+from atmos.plugins.clouds.light.diffusion import DIFFUSION
+
+SUN_UNIT = 18                    # sun_by_rank for the shaders that declare far_sun_by_rank (2D)
+FIELD_UNIT = 19                  # field_column for those that declare far_field_light (2D)
+FIELD_PROFILE_UNIT = 20          # field_profile for those that declare far_field_light_profile (2D)
+THICKNESS_UNIT = 21              # thickness for those that declare far_thickness_by_rank (2D)
+SUN_PROFILE_UNIT = 22            # sun_profile for those that declare far_sun_profile (the march's)
+HEIGHT_UNIT = 24                 # height for those that declare far_height_by_rank (2D)
+READ_UNITS = {"transmittance": (2, 3), DIFFUSION: (16, 17)}   # light_by_rank.comp's inputs beside columns.glsl's
+FIELD_BINS = 16                  # light_by_rank.comp's most height bins (sun_profile, field_profile)
+SUMS = INTERVALS * 2 * 11 + INTERVALS * FIELD_BINS * 9      # its Sums buffer (uint32): the slots, the bins
+GROUP = 256                      # its work group (columns per group in STAGE 0)
+
+
+class RankLight:
+    """The textures of one measure (GL objects of one GpuContext): ``sun`` (INTERVALS, 2) rgba32f,
+    ``thickness`` (INTERVALS, 1) and ``height`` (INTERVALS, 2) r32f, ``sun_profile`` (INTERVALS, bins) rgba32f, and with a field
+    ``field`` (INTERVALS, 2) and ``field_profile`` (INTERVALS, bins) rgba32f."""
+
+    def __init__(self, gpu):
+        self.gpu = gpu
+        self.sun = self.thickness = self.height = self.sun_profile = self.field = self.field_profile = self.sums = None
+        self.has_field = False           # the last measure took a diffusion field
+
+    def measure(self, sim, cover_buffer, attenuation: float, heights: int) -> None:
+        """Measure mix(A, B, t) of ``sim`` (the frame's CloudSets) ranked by the quantiles in
+        ``cover_buffer`` (cover.comp's, already written), the octaves' ``attenuation`` a, at ``heights``
+        samples per column: one invocation per column, then one work group for the means."""
+        self.has_field = DIFFUSION in sim.a and DIFFUSION in sim.b
+        shading = "transmittance" in sim.a and "transmittance" in sim.b
+        bins = min(int(heights), FIELD_BINS)
+        self._allocate(bins)
+        for name, (unit_a, unit_b) in READ_UNITS.items():
+            if name in sim.a and name in sim.b:
+                sim.a[name].use(unit_a)
+                sim.b[name].use(unit_b)
+        values = dict(heights=int(heights), bins=bins, has_shading=int(shading), attenuation=float(attenuation),
+                      column_tau=cell_tau(sim.settings))
+        cover_buffer.bind_to_storage_buffer(0)
+        self.sums.bind_to_storage_buffer(1)
+        columns = sim.shape[0] * sim.shape[2]
+        for stage, groups in ((0, -(-columns // GROUP)), (1, 1)):
+            c = self.gpu.program(compute_shader="clouds/far_field/light_by_rank.comp",
+                                 defines={"FIELD": int(self.has_field), "STAGE": stage})
+            use_columns(c, sim)
+            for name, value in values.items():
+                if name in c:
+                    c[name].value = value
+            if stage == 1:
+                self.sun.bind_to_image(0, read=False, write=True)
+                self.thickness.bind_to_image(3, read=False, write=True)
+                self.height.bind_to_image(5, read=False, write=True)
+                self.sun_profile.bind_to_image(4, read=False, write=True)
+                if self.has_field:
+                    self.field.bind_to_image(1, read=False, write=True)
+                    self.field_profile.bind_to_image(2, read=False, write=True)
+            c.run(groups)
+            self.gpu.ctx.memory_barrier()
+
+    def _allocate(self, bins: int) -> None:
+        if self.sun is None:
+            self.sun, self.thickness = rank_texture(self.gpu, 2, 4), rank_texture(self.gpu, 1, 1)
+            self.height = rank_texture(self.gpu, 2, 1)
+            self.sums = self.gpu.track(self.gpu.ctx.buffer(bytes(4 * SUMS)))    # zero; STAGE 1 clears it
+        if self.sun_profile is None or self.sun_profile.size[1] != bins:
+            self._release_profiles()
+            self.sun_profile = rank_texture(self.gpu, bins, 4)
+        if self.has_field and self.field_profile is None:
+            self.field, self.field_profile = rank_texture(self.gpu, 2, 4), rank_texture(self.gpu, bins, 4)
+
+    def use(self, program) -> None:
+        """Bind the textures the program declares (far_sun_by_rank, far_thickness_by_rank, far_height_by_rank,
+        far_sun_profile, far_field_light, far_field_light_profile)."""
+        field = self.has_field
+        for name, texture, unit in (("far_sun_by_rank", self.sun, SUN_UNIT),
+                                    ("far_thickness_by_rank", self.thickness, THICKNESS_UNIT),
+                                    ("far_height_by_rank", self.height, HEIGHT_UNIT),
+                                    ("far_sun_profile", self.sun_profile, SUN_PROFILE_UNIT),
+                                    ("far_field_light", self.field if field else None, FIELD_UNIT),
+                                    ("far_field_light_profile", self.field_profile if field else None, FIELD_PROFILE_UNIT)):
+            if name in program and texture is not None:
+                texture.use(unit)
+
+    def read(self) -> dict:
+        """The last measure as float64 arrays (a GPU → CPU copy: tests and tools): ``sun`` (INTERVALS, 2, 4)
+        [k, v] = the mean octave transmittances of rank interval k seen from above (v = 0) and below (1),
+        ``thickness`` (INTERVALS,) its clouds' mean height as a fraction of the layer, ``height`` (INTERVALS, 2)
+        the mean height fraction its light comes from seen from above and below, ``sun_profile``
+        (INTERVALS, bins, 4) the mean octave transmittances per height bin;
+        with a field also ``field`` (INTERVALS, 2, 4) the mean (phi, F) likewise and ``field_profile``
+        (INTERVALS, bins, 4) per height bin."""
+        if self.sun is None:
+            raise RuntimeError("RankLight.read: nothing measured yet (FarFieldLayer.prepare measures it)")
+        self.gpu.ctx.memory_barrier()
+        out = {"sun": read_rank_texture(self.sun), "thickness": read_rank_texture(self.thickness)[:, 0, 0],
+               "height": read_rank_texture(self.height)[:, :, 0],
+               "sun_profile": read_rank_texture(self.sun_profile)}
+        if self.has_field:
+            out.update(field=read_rank_texture(self.field), field_profile=read_rank_texture(self.field_profile))
+        return out
+
+    def _release_profiles(self) -> None:
+        for texture in (self.sun_profile, self.field, self.field_profile):
+            if texture is not None:
+                texture.release()
+        self.sun_profile = self.field = self.field_profile = None
+
+    def release(self) -> None:
+        self._release_profiles()
+        for resource in (self.sun, self.thickness, self.height, self.sums):
+            if resource is not None:
+                resource.release()
+        self.sun = self.thickness = self.height = self.sums = None

@@ -1,0 +1,141 @@
+"""The radiometric model every cloud renderer draws, in physical units.
+
+The medium (``CloudSettings``): density ``rho(x)`` from the volume ``[x, y, z]`` placed by
+:mod:`atmos.plugins.clouds.volume.layout`, trilinear between cell centres; extinction ``sigma_t * rho``
+(``sigma_t`` in 1/m at density 1; cells need not be cubes: optical depth is measured along world
+paths, so the thesis's per-cell sigma is derived, :func:`cell_sigma`); scattering
+``albedo * sigma_t * rho``; phase function ``(1 - phase_w) HG(phase_g) + phase_w HG(phase_g2)``
+(Henyey-Greenstein lobes normalised over the sphere, 1/sr).
+
+The light: sun irradiance ``E = sun_intensity * Sun.color`` (on a plane facing the sun; the colour
+already carries its path through the atmosphere and is 0 below the horizon; the default 4 pi makes
+isotropic single scattering of a unit colour equal to the colour, the old ``sun x T`` model); sky
+radiance ``L_sky = sky_intensity * Sun.ambient`` from every direction above the horizon; the ground
+below a Lambertian ``ground_albedo`` lit by both, radiance ``ground_albedo * (E * max(sun_y, 0) / pi
++ L_sky)``. :func:`environment` gives the three; :mod:`atmos.plugins.clouds.light.path_tracer` renders exactly
+this scene (all orders), the real-time renderers approximate it (``clouds/volume/volume.glsl``):
+
+    source per unit extinction J = albedo * (E * (sum_i b^i p(cos; c^i g) P_i(T) + beta L_field)
+                                             + (L_sky + L_ground) / 2 + h (L_sky - L_ground) / 2)
+
+with ``T`` the transmittance toward the sun and ``p`` the phase at the angle between the view ray and
+the sun (per pixel). The sun's light splits in two. What stays forward: octaves ``i < 4`` after
+Wrenninge (b: ``ms_contribution``, c: ``ms_eccentricity``), each over the light that reached the point
+forward-scattered ``i`` times on its way (:func:`octave_transmittances`): the count is Poisson with
+mean ``x = (1 - a) tau`` (``tau = -ln T``; a: ``ms_attenuation``, the share of scatterings that turn
+light aside, near ``1 - g_mean``), so ``P = (T, T x, T x²/2, T^a - those)``, the last all higher counts.
+Light only forward-scattered once has a path behind it: the thin lit rim of a cloud holds little of it
+(its "powder" darkening), and deep in the cloud it falls as ``T^a``. What is turned aside: the
+diffusion field (:mod:`atmos.plugins.clouds.light.diffusion`, weight beta: ``ms_diffusion``), a P1 solve of the
+scattered fluence whose radiance ``L_field`` is diffuse and runs with the flux.
+``tau_up``/``tau_down`` (straight up and down to the volume's faces) come from the light volume's
+columns, computed once per texture set (:mod:`atmos.plugins.clouds.light.columns`).
+Sky and ground light: the diffusion solution between a slab's two lit faces, ``u = (tau_down −
+tau_up) / (tau_up + tau_down + 2 z)`` with the extrapolation length ``z = 2 / (3 (1 − g_mean))``
+(deep in a cloud the light is the faces' mean, near a face that face's; a white furnace, equal sky
+and ground at albedo 1, gives exactly ``J = L`` at any depth), plus where the column is thin the
+phase's forward share ``g_mean ray_y`` (looking up at a thin base sees sky light scattered forward):
+``h = clamp(u + g_mean ray_y exp(−(tau_up + tau_down) / 2 z), −1, 1)``. No fitted constant dims it;
+a, b, c and beta are fitted to the path tracer (``benchmarks/bench_cloud_light.py --fit``) over both
+volumes, both renderers and five views.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+OCTAVES = 4
+
+
+def hg(cos, g):
+    """One Henyey-Greenstein lobe (1/sr)."""
+    return (1.0 - g * g) / (4.0 * math.pi * np.maximum(1.0 + g * g - 2.0 * g * np.asarray(cos), 1e-12) ** 1.5)
+
+
+def phase(cos, g: float, g2: float, w: float):
+    """The two-lobe phase function (1/sr) at the cosine of the scattering angle."""
+    return (1.0 - w) * hg(cos, g) + w * hg(cos, g2)
+
+
+def cell_sigma(sigma_t: float, cell, direction) -> float:
+    """Extinction per unit index-space length along ``direction`` (world) for cells of size ``cell``:
+    what grid-space shading (the shear-warp, stepping in cells) multiplies by."""
+    cell = np.asarray(cell, np.float64)
+    u = np.asarray(direction, np.float64) / cell
+    n = np.linalg.norm(u)
+    if not (n > 0 and np.isfinite(n)):
+        return float(sigma_t * np.cbrt(cell.prod()))
+    return float(sigma_t * np.linalg.norm(u / n * cell))
+
+
+def environment(settings, sun_color, sky, sun_dir) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(sun irradiance E, sky radiance, ground radiance) as float64 RGB for a ``CloudSettings``."""
+    e = settings.sun_intensity * np.asarray(sun_color, np.float64)
+    l_sky = settings.sky_intensity * np.asarray(sky, np.float64)
+    s = np.asarray(sun_dir, np.float64)
+    up = max(float(s[1] / np.linalg.norm(s)), 0.0)
+    return e, l_sky, settings.ground_albedo * (e * up / math.pi + l_sky)
+
+
+def hemisphere_share(g: float, g2: float, w: float) -> float:
+    """The two-lobe phase's share of the light scattered into a direction d that came from the
+    hemisphere about d: per HG lobe (1 - g²) / 2g (1 / (1 - g) - 1 / sqrt(1 + g²)) (1/2 at g = 0)."""
+    def lobe(g):
+        return 0.5 + 0.375 * g if abs(g) < 1e-4 else (1 - g * g) / (2 * g) * (1 / (1 - g) - 1 / math.sqrt(1 + g * g))
+    return (1.0 - w) * lobe(g) + w * lobe(g2)
+
+
+def mean_cosine(g: float, g2: float, w: float) -> float:
+    """The two-lobe phase function's mean cosine ``(1 - w) g + w g2``."""
+    return (1.0 - w) * g + w * g2
+
+
+def octave_transmittances(T, a: float) -> np.ndarray:
+    """(..., 4): the octaves' sun transmittances P_i of the module docstring at transmittance ``T``:
+    light that reached the point forward-scattered k times on its way, k Poisson with mean
+    x = (1 - a) tau (tau = -ln T; ``a`` the share of scatterings that turn light aside), (T, T x, T x²/2)
+    for k = 0, 1, 2 and the rest of T^a (all k) for the higher counts (``shaders/lib/octaves.glsl``)."""
+    T = np.clip(np.asarray(T, np.float64), 0.0, 1.0)
+    x = -(1.0 - a) * np.log(np.maximum(T, 1e-30))
+    low = [T, T * x, 0.5 * T * x * x]
+    return np.stack([*low, np.maximum(T ** a - sum(low), 0.0)], -1)
+
+
+def octave_weights(T, a: float, b: float) -> np.ndarray:
+    """(..., 4): ``b^i P_i(T)`` of the module docstring."""
+    return octave_transmittances(T, a) * b ** np.arange(OCTAVES)
+
+
+def ambient_profile(tau_up, tau_down, g_mean: float, ray_y) -> np.ndarray:
+    """``h`` of the module docstring: J's sky and ground part is ``(L_sky + L_ground) / 2 + h
+    (L_sky - L_ground) / 2`` (times the albedo) at column optical depths ``tau_up``/``tau_down``."""
+    up, down = np.asarray(tau_up, np.float64), np.asarray(tau_down, np.float64)
+    z = 2.0 / (3.0 * (1.0 - min(g_mean, 0.99)))
+    u = (down - up) / (up + down + 2.0 * z)
+    return np.clip(u + g_mean * np.asarray(ray_y, np.float64) * np.exp(-(up + down) / (2.0 * z)), -1.0, 1.0)
+
+
+def source_reference(settings, render, T, tau_up, tau_down, cos, ray_y, sun_color, sky, sun_dir,
+                     diffusion=None, *, octaves=None, sun_colors=None) -> np.ndarray:
+    """float64 (n, 3): J of the module docstring at points with transmittance ``T`` (or, given
+    ``octaves`` (n, 4), those as the octaves' sun transmittances: the far fields' by rank), column optical
+    depths ``tau_up``/``tau_down``, view/sun cosine ``cos`` and view ray y ``ray_y`` (``render``:
+    the CloudRenderSettings or RaymarchCloudSettings); ``diffusion``: the diffusion field's radiance
+    there (:func:`atmos.plugins.clouds.light.diffusion.diffusion_radiance`, unit irradiance), added with the weight
+    ``render.ms_diffusion`` (None: no field); ``sun_colors`` (n, 3): the sun's colour at each point
+    (None: ``sun_color``, which the ground's light takes in any case)."""
+    e, l_sky, l_ground = environment(settings, sun_color, sky, sun_dir)
+    if sun_colors is not None:
+        e = settings.sun_intensity * np.asarray(sun_colors, np.float64)
+    tau_up, tau_down = np.asarray(tau_up, np.float64), np.asarray(tau_down, np.float64)
+    a, b, c = render.ms_attenuation, render.ms_contribution, render.ms_eccentricity
+    g_mean = mean_cosine(settings.phase_g, settings.phase_g2, settings.phase_w)
+    w = octave_weights(T, a, b) if octaves is None else np.asarray(octaves, np.float64) * b ** np.arange(OCTAVES)
+    sun = sum(w[..., i] * phase(cos, settings.phase_g * c ** i, settings.phase_g2 * c ** i, settings.phase_w)
+              for i in range(OCTAVES))
+    if diffusion is not None:
+        sun = sun + render.ms_diffusion * np.asarray(diffusion, np.float64)
+    h = ambient_profile(tau_up, tau_down, g_mean, ray_y)[..., None]
+    amb = 0.5 * (l_sky + l_ground) + 0.5 * h * (l_sky - l_ground)
+    return settings.albedo * (sun[..., None] * e + amb)

@@ -1,0 +1,315 @@
+"""RaymarchCloudsPlugin: the CloudsPlugin's clouds ray-marched (issue 15), beside the sprites.
+
+Pass "cloud_raymarch" (phase translucent) reads "depth" and "cloud_sets" and blends premultiplied
+onto "color" (and onto "cloud_distance" when a media pass wants it, :mod:`atmos.composition`). The
+march (``shaders/clouds/raymarch/march.frag``; float64 reference :mod:`.reference`) goes through the
+layer's box with the light of ``clouds/volume/volume.glsl`` (the sprites' model), skips empty sprite
+groups × height bands (:func:`skip_map`), stops at ``min_transmittance`` and grows its step with the
+distance. At ``resolution`` r > 1 it marches one pixel per r × r block into the low-res targets
+"cloud_raymarch_color" (RGBA16F), "cloud_raymarch_distance" (RG32F (a·distance, a)) and
+"cloud_raymarch_depth" (the scene depth the ray saw): texel (i, j) is the ray through the full-res
+pixel (i·r + o.x, j·r + o.y), o the frame's jitter offset; then :meth:`RaymarchPass._resolve`
+(the temporal resolve's hook, wired to :class:`.temporal.TemporalClouds`: with ``reprojection`` it
+returns full-res (colour, distance) textures that :meth:`RaymarchPass._blend` blends; without, it
+blends a depth-aware upsample of this frame's samples itself —
+:class:`~atmos.plugins.clouds.volume.offscreen.OffscreenClouds`' composite — and returns None).
+"""
+from __future__ import annotations
+
+import moderngl
+import numpy as np
+
+from atmos.blue_noise import BLUE_NOISE_UNIT, blue_noise_texture
+from atmos.camera import set_camera_uniforms
+from atmos.composition import CLOUD_DISTANCE, composition, distance_desc
+from atmos.graph import PassBuilder, PassContext, RenderPass, TextureDesc
+from atmos.plugin import Plugin
+from atmos.plugins.clouds.far_field.layer import FAR_FIELD
+from atmos.plugins.clouds.far_field.plugin import CloudFarFieldPlugin
+from atmos.plugins.clouds.raymarch.far import far_uniforms
+from atmos.plugins.clouds.raymarch.noise import pixel_angle
+from atmos.plugins.clouds.raymarch.settings import REFERENCE, SUN_GROWTH, SUN_SPACING, RaymarchCloudSettings
+from atmos.plugins.clouds.raymarch.temporal import TemporalClouds, jitter
+from atmos.gpu import clamp_sampler
+from atmos.plugins.clouds.volume.binding import bind_volume, unbind_volume
+from atmos.plugins.clouds.volume.light import unit_direction
+from atmos.plugins.clouds.volume.offscreen import OffscreenClouds, low_size
+from atmos.plugins.clouds.volume.field_demand import field_demand
+from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CLOUD_VOLUME, CloudSets
+from atmos.plugins.clouds.simulation.chain import CloudSimulation
+from atmos.render_core import COLOR, DEPTH
+
+LOW_COLOR = "cloud_raymarch_color"
+LOW_DISTANCE = "cloud_raymarch_distance"
+LOW_DEPTH = "cloud_raymarch_depth"
+SKIP_UNIT, DEPTH_UNIT = 4, 9              # (5..8: the far field's octaves, field.glsl)
+
+
+def skip_map(max_maps: np.ndarray) -> np.ndarray:
+    """(gz, bands, gx) float32 — texture order of a (gx, bands, gz) 3D texture — from CloudSets'
+    max maps (1 + bands, gx, gz): per group × band the max over it and its 26 neighbours, so a 0 means
+    the trilinear density (which reads half a cell past a group) is exactly 0 anywhere inside."""
+    m = np.asarray(max_maps, np.float32)[1:].transpose(2, 0, 1)          # (gz, bands, gx)
+    padded = np.pad(m, 1)
+    out = np.zeros_like(m)
+    n = m.shape
+    for dz in range(3):
+        for dy in range(3):
+            for dx in range(3):
+                np.maximum(out, padded[dz:dz + n[0], dy:dy + n[1], dx:dx + n[2]], out=out)
+    return out
+
+
+def sample_offset(frame_index: int, r: int) -> tuple[int, int]:
+    """The jitter offset o of a frame: the temporal resolve's sequence (all r² offsets every r² frames)."""
+    return tuple(int(v) for v in jitter(frame_index, r))
+
+
+class RaymarchCloudsPlugin(Plugin):
+    """Ray-marched clouds of the CloudsPlugin's "cloud_sets" (no CloudRenderPlugin needed; a scene uses
+    one renderer or the other): ``RaymarchCloudsPlugin(settings=None, **fields)`` with
+    :class:`RaymarchCloudSettings`; ``configure(**changes)`` changes any of them live."""
+
+    settings_class = RaymarchCloudSettings
+
+    def __init__(self, settings: RaymarchCloudSettings | None = None, **fields):
+        super().__init__(settings, **fields)
+        self.gpu = self.composition = self.far = self.demand = None
+        self.simulated = False
+
+    @classmethod
+    def reference(cls, **fields) -> "RaymarchCloudsPlugin":
+        """The march in the reference configuration (:data:`.settings.REFERENCE`: full resolution,
+        uniform quarter-cell midpoint steps, no noise, jitter, history or early exit); ``fields``
+        change any setting (e.g. ``step=0.1``, ``enabled=False``, ``base_altitude``)."""
+        return cls(**{**REFERENCE, **fields})
+
+    def build(self, app) -> None:
+        if app.graph is None:
+            raise ValueError("RaymarchCloudsPlugin needs an App with a GPU context (App(gpu))")
+        self.gpu = app.gpu
+        self.composition = composition(app)
+        self.composition.writers.add(RaymarchPass.name)     # the fog gets the clouds' own distance
+        app.graph.add_pass(RaymarchPass(self))
+        self.demand = field_demand(app)
+        self.demand.readers.add(self)
+
+    def finish(self, app) -> None:
+        self.simulated = app.get_resource(CloudSimulation) is not None     # weather-driven, not static
+        self.far = next((p for p in app.plugins if isinstance(p, CloudFarFieldPlugin)), None)
+        if self.far is not None:
+            self.far.marchers.add(self)     # its 2D pass steps aside while this marches the far field
+
+    def marches_far_field(self) -> bool:
+        """Whether the march goes on through the volumetric far field (``far_field`` on, enabled, and a
+        CloudFarFieldPlugin, whose cover it uses, in the scene and enabled)."""
+        s = self.settings
+        return bool(s.enabled and s.far_field and self.far is not None and self.far.settings.enabled)
+
+    def cleanup(self, app) -> None:
+        if self.demand is not None:
+            self.demand.readers.discard(self)
+        if self.composition is not None:
+            self.composition.writers.discard(RaymarchPass.name)
+        if self.far is not None:
+            self.far.marchers.discard(self)
+            self.far = None
+
+    def sigma_t(self, sim: CloudSets) -> float:
+        """Extinction in 1/m at density 1: the medium's."""
+        return float(sim.settings.sigma_t)
+
+    def wind(self, sim: CloudSets) -> tuple:
+        """m/s the detail noise scrolls with: the weather's wind (cells/s × cell size) for simulated
+        clouds, else (static ``CloudsPlugin(density=...)``) the ``wind`` setting."""
+        if not self.simulated:
+            return tuple(self.settings.wind)
+        return tuple(float(w) * float(c) for w, c in zip(sim.settings.weather.wind, sim.settings.cell_size))
+
+
+class RaymarchPass(RenderPass):
+    """Pass "cloud_raymarch"; see the module docstring. ``enabled`` False: declares nothing (culled)."""
+    name = "cloud_raymarch"
+    phase = "translucent"
+    exclusive = CLOUD_VOLUME                # never on beside the sprites (a GraphError names both)
+
+    def __init__(self, plugin: RaymarchCloudsPlugin):
+        self.plugin = plugin
+        self.gpu = self.sampler = self.offscreen = self.skip = self.temporal = self.noise = self.jitter = None
+        self._skip_key = None
+        self.frame_index = 0
+
+    def setup(self, builder: PassBuilder) -> None:
+        s = self.plugin.settings
+        if not s.enabled:
+            return
+        builder.read(DEPTH)
+        builder.read(CLOUD_SETS)
+        if self.plugin.marches_far_field():
+            builder.read(FAR_FIELD)
+        builder.read(COLOR)                 # blends onto it
+        builder.write(COLOR)
+        if self.plugin.composition.distance:
+            builder.read(CLOUD_DISTANCE)
+            builder.write(CLOUD_DISTANCE)
+        if s.resolution > 1:
+            low = low_size(self.plugin.gpu.size, s.resolution)
+            builder.create(LOW_COLOR, TextureDesc(low, components=4, dtype="f2", filter="nearest"))
+            builder.create(LOW_DISTANCE, distance_desc(low))
+            builder.create(LOW_DEPTH, TextureDesc(low, depth=True, filter="nearest"))
+
+    def prepare(self, gpu) -> None:
+        self.gpu = gpu
+        self.sampler = clamp_sampler(gpu.ctx)
+        self.offscreen = OffscreenClouds(gpu, LOW_COLOR, LOW_DEPTH, LOW_DISTANCE)
+        self.temporal = TemporalClouds(gpu)
+
+    def program(self, far: bool = False):
+        """The variant for the detail octaves, sun steps and far field (the program cache: a dict lookup)."""
+        s = self.plugin.settings
+        return self.gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="clouds/raymarch/march.frag",
+                                defines={"DETAIL_OCTAVES": s.detail_octaves,
+                                         "SUN_STEPS": s.sun_steps,
+                                         "FAR_FIELD": int(far)})
+
+    def _skip_texture(self, sim: CloudSets):
+        """The dilated skip map as a small r32f 3D texture, re-uploaded when the max maps change."""
+        key = (sim.max_a, sim.max_b, sim.a_shift)      # held, so a new array is never taken for an old one
+        old = self._skip_key
+        if old is None or old[0] is not key[0] or old[1] is not key[1] or old[2] != key[2]:
+            data = skip_map(sim.max_maps())
+            size = (data.shape[2], data.shape[1], data.shape[0])
+            if self.skip is None or self.skip.size != size:
+                if self.skip is not None:
+                    self.skip.release()
+                self.skip = self.gpu.ctx.texture3d(size, 1, dtype="f4")
+                self.skip.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            self.skip.write(np.ascontiguousarray(data).tobytes())
+            self._skip_key = key
+        return self.skip
+
+    def _uniforms(self, frame: PassContext, sim: CloudSets, layout, offset) -> dict:
+        s, view = self.plugin.settings, frame.view
+        cell = np.asarray(layout.cell, np.float64)
+        maps = sim.maps_of(sim.view()[0])
+        skip_cells = (float(layout.group[0]), float(maps.band_height), float(layout.group[1]))
+        grid = (layout.grid[0], -(-layout.shape[1] // maps.band_height), layout.grid[1])
+        sun = unit_direction(view.sun)
+        return {"layer_min": tuple(float(v) for v in layout.lo), "layer_max": tuple(float(v) for v in layout.hi),
+                "cell_size": tuple(float(c) for c in cell), "sigma_t": self.plugin.sigma_t(sim),
+                "steps": s.steps, "step_base": float(s.step * cell.min()), "step_growth": s.step_growth,
+                "min_transmittance": s.min_transmittance, "skipping": int(s.empty_space_skipping),
+                "skip_cells": skip_cells, "max_skips": int(sum(grid)) + 3, "factor": s.resolution,
+                "sample_offset": tuple(offset), "frame_size": tuple(int(v) for v in view.size),
+                "jitter": int(s.jitter),
+                "sun_march": tuple(float(v) for v in sun * SUN_SPACING * cell.min()), "sun_growth": SUN_GROWTH,
+                "pixel_angle": pixel_angle(view)}
+
+    def execute(self, frame: PassContext) -> None:
+        s, view = self.plugin.settings, frame.view
+        sim: CloudSets = frame.resource(CLOUD_SETS)
+        r = s.resolution
+        offset = sample_offset(self.frame_index, r) if r > 1 else (0, 0)
+        distance = frame.declares(CLOUD_DISTANCE)
+        far = frame.declares(FAR_FIELD)
+        p = self.program(far)
+        if r == 1:                          # straight onto the frame
+            frame.framebuffer(color=[COLOR, CLOUD_DISTANCE] if distance else [COLOR]).use()
+            frame.blend_over()
+        else:                               # every texel is overwritten: no clear
+            frame.framebuffer(color=[LOW_COLOR, LOW_DISTANCE], depth=LOW_DEPTH).use()
+            frame.gpu.ctx.enable(moderngl.DEPTH_TEST)
+            frame.gpu.ctx.depth_func = "1"  # always: the shader writes the scene depth it saw
+        set_camera_uniforms(p, view.camera, view.aspect)
+        layout = sim.layout(s.base_altitude)
+        for name, value in self._uniforms(frame, sim, layout, offset).items():
+            if name in p:                   # a compiler may drop a uniform a variant does not use
+                p[name].value = value
+        bind_volume(p, sim, self.sampler, view.sun, s.octaves, s.ms_diffusion, layout.heights)
+        if s.empty_space_skipping:
+            self._skip_texture(sim).use(SKIP_UNIT)
+        else:                               # nothing uploaded; the shader reads no skip map
+            self._release_skip()
+        frame.resource(DEPTH).use(DEPTH_UNIT)
+        if s.jitter:
+            if self.jitter is None:
+                self.jitter = blue_noise_texture(self.gpu.ctx)
+            self.jitter.use(BLUE_NOISE_UNIT)
+        if far:
+            self._bind_far(frame, p, sim)
+        if s.detail_octaves:
+            layout = sim.layout(s.base_altitude)
+            self._detail().bind(p, view.time, self.plugin.wind(sim), s.detail_scale * float(np.min(layout.cell)),
+                                s.detail_strength, layer=(float(layout.lo[1]), float(layout.hi[1] - layout.lo[1])))
+        try:
+            frame.fullscreen(p)
+        finally:
+            unbind_volume(self.sampler)
+        if r > 1:
+            textures = self._resolve(frame, LOW_COLOR, LOW_DISTANCE, offset)
+            if textures is not None:
+                self._blend(frame, *textures, distance)
+        else:
+            self.temporal.release()         # no history at full resolution
+        self.frame_index += 1
+
+    def _bind_far(self, frame: PassContext, p, sim: CloudSets) -> None:
+        """The far field's textures, cover and uniforms (field.glsl, far.glsl) for this frame."""
+        view, s = frame.view, self.plugin.settings
+        layer = frame.resource(FAR_FIELD)
+        layer.prepare(view, sim)
+        layer.use(p, view, sim)
+        values = far_uniforms(s, layer.settings, sim.layout(s.base_altitude), view, layer.tile_size)
+        for name, value in values.items():
+            if name in p:
+                p[name].value = value
+
+    def _detail(self):
+        """The context's detail noise (built on first use, then held: no lookup per frame)."""
+        if self.noise is None:
+            from atmos.plugins.clouds.raymarch.noise import DetailNoise
+            self.noise = DetailNoise(self.gpu)
+        return self.noise
+
+    def _resolve(self, frame: PassContext, low_color: str, low_distance: str, offset):
+        """The temporal resolve's hook. ``reprojection`` on: :class:`.temporal.TemporalClouds`
+        resolves the low-res samples with its history and returns the full-res (colour, distance)
+        textures, which :meth:`_blend` blends. Off: the history is dropped and a depth-aware upsample
+        of this frame's samples is blended straight onto "color" (and "cloud_distance"); None."""
+        view, s = frame.view, self.plugin.settings
+        camera = view.camera
+        if s.reprojection:
+            return self.temporal.resolve(frame.resource(low_color), frame.resource(low_distance), view.size,
+                                         self.plugin.settings.resolution, offset, camera, view.aspect,
+                                         depth=frame.resource(DEPTH), history_clamp=s.history_clamp,
+                                         motion_limit=s.motion_limit, low_depth=frame.resource(LOW_DEPTH))
+        self.temporal.release()
+        self.offscreen.end(frame, self.plugin.settings.resolution, camera.near, camera.far,
+                           frame.declares(CLOUD_DISTANCE), offset=offset)
+        return None
+
+    def _blend(self, frame: PassContext, color, distance_texture, distance: bool) -> None:
+        """Blend full-res premultiplied (colour, (a·distance, a)) textures onto the frame."""
+        frame.reset_state()
+        frame.framebuffer(color=[COLOR, CLOUD_DISTANCE] if distance else [COLOR]).use()
+        color.use(0)
+        distance_texture.use(1)
+        frame.blend_over()
+        frame.fullscreen(self.gpu.program(vertex_shader="lib/fullscreen.vert",
+                                          fragment_shader="clouds/raymarch/blend.frag"))
+
+    def _release_skip(self) -> None:
+        if self.skip is not None:
+            self.skip.release()
+        self.skip = self._skip_key = None
+
+    def release(self) -> None:
+        if self.temporal is not None:
+            self.temporal.release()
+        if self.sampler is not None:
+            self.sampler.release()
+        self.sampler = self.noise = None     # the noise textures belong to the context's cache
+        self._release_skip()
+        if self.jitter is not None:
+            self.jitter.release()
+            self.jitter = None

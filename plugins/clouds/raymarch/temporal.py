@@ -1,0 +1,326 @@
+"""Temporal reprojection of the ray-marched clouds: march 1 pixel of every r × r block per frame,
+resolve the full-resolution image from this frame's samples and the reprojected history.
+
+Each frame the march writes a low-res target whose texel (i, j) is the full-res pixel
+(i·r + ox, j·r + oy), (ox, oy) = :func:`jitter` (frame, r). :meth:`TemporalClouds.resolve` then,
+per full-res pixel (``shaders/clouds/raymarch/temporal.frag``):
+
+* marched this frame → the fresh sample, exactly;
+* else the history, reprojected with the previous frame's camera: the ray's direction is projected
+  first (sky at infinity), then the point at the distance the history holds there (camera + ray ·
+  distance; where it holds no cloud, the scene's distance behind the pixel, so cloudless terrain
+  moves with the terrain instead of staying put as sky would — the flight demo's 2-pixel stripes); clamped to the box of the current 3×3 low-res neighbourhood (``history_clamp``), the
+  history first corrected by this frame's samples (the upsample's weights times fresh − history at
+  each sample, reprojected with this pixel's motion: history and fresh samples agree, no 2-pixel
+  pattern while moving), the clamp and the correction loosened to 0 below ``CLAMP_MOTION`` pixels of
+  motion, so that a still camera over still clouds keeps every fresh sample and converges to the
+  full-res march in r² frames, while clouds that move are clamped; rejected, falling back to the depth-aware upsample
+  of this frame's samples (``clouds/volume/upsample.glsl``, shared with OffscreenClouds' composite), when its point was off screen or the scene behind the pixel changed
+  (``DEPTH_TOLERANCE``: an object moved in front, or away); and mixed toward the upsample the faster
+  the pixel moves (weight 1 − motion / ``motion_limit``, motion in full-res pixels per frame).
+* under a camera still for r² frames (:func:`detects_change`: every pixel's last sample is then
+  real, and marched with this camera) the history stays where the clouds evolve in place and is
+  tested where they drift. The history also keeps each pixel's last marched sample (a fourth target;
+  the upsample where the scene behind it changed), and drift is told from evolution by matching
+  (``shaders/clouds/raymarch/drift.frag``, a low-res pass; twin :func:`.temporal_reference.drift_flags`):
+  each low-res texel compares this frame's 3×3 samples with the samples marched at the same pixels r²
+  frames ago, unshifted and shifted by one texel (r px) each way. Where a shift explains the change
+  better than none (by ``DRIFT_GAIN`` of it, the change above ``DRIFT_FLOOR``), or the samples changed
+  by more than ``DRIFT_MEAN`` on average or one by more than ``DRIFT_CHANGE`` (a drift too fast for
+  the shifts), the clouds moved: within one texel the block's fresh sample is compared with the
+  history there, rejected (the upsample) where they differ by more than ``CHANGE_TOLERANCE`` (all of
+  it from the tolerance, none below half; at 0.5–2 px/frame of drift stale history is worse than the
+  upsample). Elsewhere the history stays: evolving clouds (sunset, bench_cloud_stability.py) change
+  about half their samples by more than 2 % in r² frames, and the upsample there would be both wrong
+  and flickering. Testing the history against itself everywhere fed on itself: a rejected block held
+  the upsample, whose own error read as a change the next frame (7× the clouds' own change).
+
+The output (premultiplied colour RGBA16F, (a·distance, a) RG32F as in :mod:`atmos.composition`) is
+the next frame's history; the pass blends it onto "color" (and "cloud_distance"). The numpy float64
+reference is :mod:`.temporal_reference`.
+
+Knobs and their cost (the resolve itself is one fullscreen pass: 1 fresh + 4 bilinear + 9
+neighbourhood fetches of the low-res targets, 2 × 4 bilinear history fetches, 2 depth fetches, 1
+last-sample fetch each pixel, plus 4 × 2 × 4 for the correction while moving: 1.43× the resolve
+without it, 640×360 r 2 on llvmpipe; under a still camera also 9 drift-flag fetches, after the
+low-res drift pass: 25 + 9 × 9 fetches per low-res texel; 36 bytes of history per pixel, twice):
+
+* ``reprojection`` (the plugin's): off → no history (the upsample alone, which blurs at r > 1);
+  on → r² frames to converge when still, a ghost after fast motion bounded by the clamp.
+* ``history_clamp`` (0..1, :data:`HISTORY_CLAMP`): how hard moving history is clamped to this
+  frame's neighbourhood; 0 keeps it (sharpest, ghosts after motion), 1 removes ghosts but flickers
+  thin features that the sparse samples miss. Free (the fetches are made for the upsample anyway).
+* ``motion_limit`` (pixels per frame, :data:`MOTION_LIMIT`): history is dropped at this motion;
+  smaller → less smear on fast turns, blurrier (upsampled) clouds while moving. Free.
+"""
+from __future__ import annotations
+
+import math
+
+import moderngl
+import numpy as np
+
+from atmos.camera import camera_matrices, gl_matrix
+from atmos.plugins.clouds.volume.offscreen import EDGE
+
+RESOLUTIONS = (1, 2, 4)
+HISTORY_CLAMP = 1.0        # default clamp weight of moving history (0..1)
+MOTION_LIMIT = 16.0        # default pixels of motion per frame at which history is dropped
+CLAMP_MOTION = 1.0         # pixels of motion per frame below which the clamp is loosened linearly to 0 ...
+CHANGE_TOLERANCE = 0.02    # ... unless, where clouds drift, this frame's sample differs from the history by more
+DRIFT_GAIN = 0.3           # still camera: the share of the r²-frame change a one-texel shift must explain to be drift ...
+DRIFT_FLOOR = 0.1          # ... of a mean change (alpha, relative rgb) over the 3×3 samples above this ...
+DRIFT_MEAN = 0.15          # ... or the mean change that is drift whatever the shift explains ...
+DRIFT_CHANGE = 0.4         # ... as is this change of one sample
+DEPTH_TOLERANCE = 0.1      # relative change of the scene distance behind a pixel that rejects its history
+CUT_DISTANCE = 100.0       # m the camera moves in one frame that make a camera cut (history reset) ...
+CUT_TURN = math.radians(30.0)   # ... or radians its view direction turns
+ALPHA_EPS = 1e-4           # coverage below which a (a·d, a) pair holds no distance (sky at infinity)
+
+_UNITS = ("low_color", "low_distance", "hist_color", "hist_distance", "hist_scene", "scene_depth")
+
+
+def check_resolution(r) -> int:
+    if r not in RESOLUTIONS or isinstance(r, bool):
+        raise ValueError(f"the temporal resolve's resolution r must be 1, 2 or 4 (one pixel of every r x r "
+                         f"block marched per frame), got {r!r}")
+    return int(r)
+
+
+def bayer(r: int) -> np.ndarray:
+    """The r × r Bayer matrix ``b[y, x]`` (0 … r² − 1): consecutive values lie far apart."""
+    b = np.zeros((1, 1), np.int64)
+    while b.shape[0] < r:
+        b = np.block([[4 * b, 4 * b + 2], [4 * b + 3, 4 * b + 1]])
+    return b
+
+
+def jitter(frame_index: int, r: int) -> tuple[int, int]:
+    """The offset (ox, oy) in [0, r)² of the pixel marched in each r × r block at ``frame_index``:
+    every r² frames visit all r² offsets, in Bayer order (each next one far from the last)."""
+    r = check_resolution(r)
+    if isinstance(frame_index, bool) or not isinstance(frame_index, (int, np.integer)) or frame_index < 0:
+        raise ValueError(f"jitter's frame_index must be an integer >= 0, got {frame_index!r}")
+    y, x = np.argwhere(bayer(r) == int(frame_index) % (r * r))[0]
+    return int(x), int(y)
+
+
+def low_size(size, r: int) -> tuple[int, int]:
+    """The low-res target's (w, h) at resolution divisor r: every full-res pixel falls in one block."""
+    return math.ceil(size[0] / r), math.ceil(size[1] / r)
+
+
+def detects_change(still_frames: int, r: int) -> bool:
+    """Whether the resolve tells drifting clouds from evolving ones (the drift pass): once the camera
+    has been still for r² frames, every pixel holds a sample marched with it, so a change is the clouds'."""
+    return still_frames >= r * r
+
+
+def camera_state(camera, aspect: float) -> tuple:
+    """What a camera's image depends on: two frames with the same state need no reprojection."""
+    return (float(aspect), tuple(float(c) for c in camera.position), float(camera.yaw), float(camera.pitch),
+            float(camera.roll), float(camera.fov_y), float(camera.near), float(camera.far))
+
+
+def forward_of(camera) -> np.ndarray:
+    """The unit view direction of ``camera`` (what :meth:`TemporalClouds.is_cut` compares)."""
+    f = np.asarray(camera.forward(), np.float64)
+    return f / max(float(np.linalg.norm(f)), 1e-30)
+
+
+class TemporalClouds:
+    """Full-resolution cloud history of one pass on ``gpu``: ping-pong colour (RGBA16F), distance
+    (RG32F, (a·d, a)) and the scene distance behind each pixel (R32F), made at the first resolve,
+    remade (and so reset) when the size or r changes, kept across frames, freed by :meth:`release`.
+
+    Per frame: ``offset = temporal.offset(r)`` (march with it), then :meth:`resolve`. The previous
+    frame's camera is the one the last resolve was given (kept as a snapshot). The history resets by
+    itself on a camera cut (:meth:`is_cut`: more than :data:`CUT_DISTANCE` m or :data:`CUT_TURN` in
+    one frame) and when the size or r changes; :meth:`reset` forgets it by hand.
+    """
+
+    def __init__(self, gpu):
+        self.gpu = gpu
+        self.frame_index = 0
+        self._sets: list | None = None     # [(fbo, color, distance, scene, last sample)] × 2
+        self._drift = None                 # (fbo, texture): the low-res drift flags
+        self._key = None                   # (size, r) the history was made for
+        self._current = 0                  # which set holds the last output
+        self._valid = False
+        self._prev = None                  # (camera_state, CameraMatrices, position) of the last resolve
+        self.still_frames = 0              # resolves in a row with the camera of the one before
+        self._vaos: dict = {}              # program -> its empty vertex array
+
+    # -- per frame -----------------------------------------------------------------------------
+    def offset(self, r: int) -> tuple[int, int]:
+        """This frame's jitter offset (:func:`jitter` of the frame counter)."""
+        return jitter(self.frame_index, r)
+
+    @staticmethod
+    def is_cut(camera, prev_position, prev_forward) -> bool:
+        """Whether ``camera`` jumped since the last resolve: moved more than :data:`CUT_DISTANCE` m
+        or turned its view more than :data:`CUT_TURN` (a teleport or a cut; reprojecting would smear)."""
+        moved = float(np.linalg.norm(np.asarray(camera.position, np.float64) - prev_position))
+        cos = float(np.clip(np.dot(forward_of(camera), prev_forward), -1.0, 1.0))
+        return not (moved <= CUT_DISTANCE and math.acos(cos) <= CUT_TURN)
+
+    def reset(self) -> None:
+        """Forget the history (a camera cut): the next resolve uses this frame's samples alone."""
+        self._valid = False
+
+    def resolve(self, low_color, low_distance, size, r: int, offset, camera, aspect: float, depth=None,
+                history_clamp: float = HISTORY_CLAMP, motion_limit: float = MOTION_LIMIT, low_depth=None):
+        """Resolve this frame at full-res ``size`` (w, h) from the low-res ``low_color`` (RGBA
+        premultiplied) and ``low_distance`` ((a·d, a)) textures marched at ``offset`` with divisor
+        ``r``, seen by ``camera`` at ``aspect``; ``depth``: the scene's depth texture at ``size``
+        (None: nothing but sky); ``low_depth``: the depth each sample's ray saw (low-res; with ``depth``
+        the upsample is depth-aware, :data:`~atmos.plugins.clouds.volume.offscreen.EDGE`). Returns (color, distance) full-res textures, valid until the next
+        resolve (they are the history it reads)."""
+        r = check_resolution(r)
+        size = (int(size[0]), int(size[1]))
+        ox, oy = offset
+        if not (0 <= ox < r and 0 <= oy < r):
+            raise ValueError(f"TemporalClouds.resolve: offset must lie in [0, {r})², got {offset!r}")
+        low = low_size(size, r)
+        for name, tex in (("low_color", low_color), ("low_distance", low_distance)):
+            if tuple(tex.size) != low:
+                raise ValueError(f"TemporalClouds.resolve: {name} must be {low[0]}x{low[1]} (size {size} / {r}), "
+                                 f"got {tex.size[0]}x{tex.size[1]}")
+        if depth is not None and tuple(depth.size) != size:
+            raise ValueError(f"TemporalClouds.resolve: depth must be {size[0]}x{size[1]}, got {depth.size}")
+        if low_depth is not None and tuple(low_depth.size) != low:
+            raise ValueError(f"TemporalClouds.resolve: low_depth must be {low[0]}x{low[1]}, got {low_depth.size}")
+        if not 0.0 <= history_clamp <= 1.0 or not motion_limit > 0.0:
+            raise ValueError(f"TemporalClouds.resolve: history_clamp must be in [0, 1] and motion_limit > 0, "
+                             f"got {history_clamp!r}, {motion_limit!r}")
+        if self._key != (size, r):
+            self._make(size, r)
+        state = camera_state(camera, aspect)
+        matrices = camera_matrices(camera, aspect)
+        prev, write = self._sets[self._current], self._sets[1 - self._current]
+        p = self.gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="clouds/raymarch/temporal.frag")
+        p["view_basis"].write(matrices.gl("view_basis"))
+        self._set(p, "near", float(camera.near))
+        self._set(p, "far", float(camera.far))
+        self._set(p, "r", r)
+        self._set(p, "offset", (int(ox), int(oy)))
+        self._set(p, "has_depth", depth is not None)
+        self._set(p, "edge", EDGE if depth is not None and low_depth is not None else 1e30)
+        valid = self._valid and self._prev is not None and not self.is_cut(camera, self._prev[2], self._prev[3])
+        self._set(p, "history_valid", valid)
+        detect = valid and state == self._prev[0] and detects_change(self.still_frames + 1, r)
+        if detect:
+            self._flag_drift(low_color, prev, r, (int(ox), int(oy)), depth, matrices, camera)
+        if valid:
+            prev_state, prev_matrices, prev_position, _ = self._prev
+            proj, view = prev_matrices.projection, prev_matrices.view
+            self._set(p, "still", state == prev_state)
+            self._set(p, "detect_change", detect)
+            p["prev_proj"].write(gl_matrix(proj[[0, 1, 3], :3] @ view[:3, :3]))
+            self._set(p, "cam_delta", tuple(float(c) for c in np.asarray(camera.position) - prev_position))
+            self._set(p, "history_clamp", float(history_clamp))
+            self._set(p, "motion_limit", float(motion_limit))
+        for unit, tex in enumerate((low_color, low_distance, prev[1], prev[2], prev[3])):
+            tex.use(unit)
+        if depth is not None:
+            depth.use(5)
+        (low_depth if low_depth is not None else low_color).use(6)     # unit 6 read only at edge < 1e30
+        prev[4].use(7)
+        self._drift[1].use(8)                                          # read only when detect_change
+        write[0].use()
+        self._draw(p)
+        self._current = 1 - self._current
+        self.still_frames = self.still_frames + 1 if valid and state == self._prev[0] else 0
+        self._valid = True
+        self._prev = (state, matrices, np.array(camera.position, np.float64), forward_of(camera))
+        self.frame_index += 1
+        return write[1], write[2]
+
+    def _flag_drift(self, low_color, prev, r: int, offset, depth, matrices, camera) -> None:
+        """The low-res drift flags of this frame's samples against the last ones in the history set
+        ``prev`` (``drift.frag``); ``depth`` (or None: sky) tells where the scene changed."""
+        p = self.gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="clouds/raymarch/drift.frag")
+        self._set(p, "r", r)
+        self._set(p, "offset", offset)
+        self._set(p, "has_depth", depth is not None)
+        self._set(p, "near", float(camera.near))
+        self._set(p, "far", float(camera.far))
+        if "view_basis" in p:
+            p["view_basis"].write(matrices.gl("view_basis"))
+        low_color.use(0)
+        prev[4].use(1)
+        if depth is not None:
+            depth.use(2)
+        prev[3].use(3)
+        self._drift[0].use()
+        self._draw(p)
+
+    def _draw(self, p) -> None:
+        ctx = self.gpu.ctx
+        ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST | moderngl.CULL_FACE)
+        if p not in self._vaos:
+            self._vaos[p] = self.gpu.track(ctx.vertex_array(p, []))
+        self._vaos[p].render(moderngl.TRIANGLES, vertices=3)
+
+    @staticmethod
+    def _set(program, name, value):
+        member = program.get(name, None)      # the compiler drops what a variant does not use
+        if member is not None:
+            member.value = value
+
+    # -- lifetime ------------------------------------------------------------------------------
+    def _make(self, size, r) -> None:
+        self._free()
+        ctx = self.gpu.ctx
+        self._sets = []
+        for _ in range(2):
+            textures = [ctx.texture(size, 4, dtype="f2"), ctx.texture(size, 2, dtype="f4"),
+                        ctx.texture(size, 1, dtype="f4"), ctx.texture(size, 4, dtype="f2")]
+            for tex in textures:
+                tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+                tex.repeat_x = tex.repeat_y = False
+            fbo = ctx.framebuffer(textures)
+            fbo.use()                      # clear() re-binds the framebuffer bound before it: this one
+            fbo.clear(0.0, 0.0, 0.0, 0.0)
+            self._sets.append(tuple(self.gpu.track(o) for o in (fbo, *textures)))
+        flags = ctx.texture(low_size(size, r), 1, dtype="f1")
+        flags.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        fbo = ctx.framebuffer([flags])
+        fbo.use()
+        fbo.clear(0.0, 0.0, 0.0, 0.0)
+        self._drift = tuple(self.gpu.track(o) for o in (fbo, flags))
+        self._key, self._current, self._valid = (size, r), 0, False
+
+    def _free(self) -> None:
+        held = [*(self._sets or ()), *((self._drift,) if self._drift else ())]
+        if any(self.gpu.ctx.fbo is objects[0] for objects in held):
+            self.gpu.target.use()          # never leave a released framebuffer bound
+        for objects in held:
+            for obj in objects:
+                obj.release()
+        self._sets, self._drift, self._key, self._valid = None, None, None, False
+
+    def release(self) -> None:
+        """Free the history (the next resolve makes it again); the program is the context's."""
+        self._free()
+        for vao in self._vaos.values():
+            vao.release()
+        self._vaos = {}
+
+    def read_history(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The last output as float64 arrays, GL row order (row 0 at the bottom): colour (h, w, 4),
+        distance (h, w, 2), scene distance (h, w) (−1: sky), each pixel's last sample (h, w, 4). For
+        tests and debugging (a GPU read)."""
+        if self._sets is None:
+            raise ValueError("TemporalClouds.read_history: nothing resolved yet (or released)")
+        (w, h), _ = self._key
+        _, color, distance, scene, last = self._sets[self._current]
+        out = [np.frombuffer(t.read(), dt).reshape(h, w, n).astype(np.float64)
+               for t, dt, n in ((color, np.float16, 4), (distance, np.float32, 2), (scene, np.float32, 1),
+                                (last, np.float16, 4))]
+        return out[0], out[1], out[2][..., 0], out[3]
+
+    @property
+    def allocated(self) -> bool:
+        """Whether history textures exist (tests: a culled pass allocates none)."""
+        return self._sets is not None

@@ -1,0 +1,104 @@
+"""CloudShadowsPlugin: darkens the scene's surfaces where the cloud layer blocks the sun (thesis 7.3.1)."""
+from __future__ import annotations
+
+import numpy as np
+
+from atmos.camera import set_camera_uniforms
+from atmos.graph import FullscreenPass, PassContext
+from atmos.lighting import unit_sun
+from atmos.plugin import Plugin
+from atmos.plugins.clouds.volume.layout import CloudLayout
+from atmos.plugins.clouds.far_field.layer import FAR_FIELD, column_tau
+from atmos.plugins.clouds.shadows.settings import CloudShadowSettings
+from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CloudSets
+from atmos.render_core import COLOR, DEPTH
+
+
+def direct_weight(sun_direction, sun_color, settings) -> float:
+    """How much of the light shadows can take away: ``direct_fraction`` × smoothstep(0,
+    ``horizon_fade``, sun height), and 0 when the sun has no colour (night) or no direction."""
+    s = unit_sun(sun_direction)
+    if s is None or not max(float(c) for c in sun_color) > 0.0:
+        return 0.0
+    x = float(np.clip(s[1] / settings.horizon_fade, 0.0, 1.0))
+    return settings.direct_fraction * x * x * (3.0 - 2.0 * x)
+
+
+def cloud_layout(sim, settings: CloudShadowSettings) -> CloudLayout:
+    """The volume's world placement (``layout()`` of CloudSets or the CloudSimulation), with ``settings.base_altitude``
+    and ``settings.cell_size`` where they are set."""
+    return sim.layout(settings.base_altitude, settings.cell_size)
+
+
+def column_uniforms(program, sim: CloudSets, layout: CloudLayout, extinction: float) -> None:
+    """Set the uniforms of shaders/clouds/shadows/column.glsl (bind B's and A's sums to units 1 and 0 yourself)."""
+    program["extinction"].value = extinction
+    program["t"].value = sim.t
+    program["a_shift"].value = sim.a_shift[0], sim.a_shift[2]
+    program["layer_min"].value = tuple(float(v) for v in layout.lo)
+    program["cell_size"].value = layout.cell
+    program["shape"].value = layout.shape
+    program["edge_fade"].value = float(sim.settings.edge_fade)
+
+
+class CloudShadowsPass(FullscreenPass):
+    """Multiplies "color" by the shadow factor where "depth" has geometry (blend ZERO, SRC_COLOR)."""
+    name = "cloud_shadows"
+    phase = "shadows"
+    fragment = "clouds/shadows/shadow.frag"
+    reads = (COLOR, DEPTH, CLOUD_SETS)
+
+    def far_field(self) -> bool:
+        """Whether the shadows continue with a far field's cover (one is imported, ``settings.far_field``)."""
+        return self.plugin.settings.far_field and self.plugin.graph.imports(FAR_FIELD)
+
+    def defines(self) -> dict:
+        return {"CLOUD_FAR_FIELD": 1} if self.far_field() else {}
+
+    def setup(self, builder) -> None:
+        super().setup(builder)
+        if self.far_field():
+            builder.read(FAR_FIELD)
+
+    def execute(self, frame: PassContext) -> None:
+        view, gpu, p = frame.view, frame.gpu, self.program
+        params = self.plugin.settings
+        sun = view.sun
+        weight = direct_weight(sun.direction, sun.color, params)
+        if weight <= 0.0 or params.strength == 0.0:
+            return                                  # no direct light to take away: nothing to draw
+        sim: CloudSets = frame.resource(CLOUD_SETS)
+        layout = cloud_layout(sim, params)
+        sigma = sim.settings.sigma if params.sigma is None else params.sigma
+        a, b, t = sim.view()
+        frame.framebuffer(color=[COLOR]).use()
+        ctx = gpu.ctx
+        ctx.enable(ctx.BLEND)
+        ctx.blend_func = ctx.ZERO, ctx.SRC_COLOR, ctx.ZERO, ctx.ONE    # alpha (sky occlusion) kept
+        sim.maps_of(a).sums.use(0)
+        sim.maps_of(b).sums.use(1)
+        frame.resource(DEPTH).use(2)
+        set_camera_uniforms(p, view.camera, view.aspect)
+        p["sun_dir"].value = tuple(unit_sun(sun.direction))
+        p["weight"].value = weight
+        column_uniforms(p, sim, layout, sigma * params.strength)
+        if frame.declares(FAR_FIELD):
+            layer = frame.resource(FAR_FIELD)
+            layer.prepare(view, sim)
+            layer.use(p, view, sim)
+            p["field_column_tau"].value = column_tau(layer.settings, sim) * params.strength
+        frame.fullscreen(p)
+
+
+class CloudShadowsPlugin(Plugin):
+    """Ground shadows of the clouds of a CloudsPlugin (phase shadows: over the ground and terrain,
+    under the clouds themselves): ``CloudShadowsPlugin(settings=None, **fields)`` with
+    :class:`CloudShadowSettings`; ``configure(**changes)`` changes any of them live (next frame)."""
+
+    settings_class = CloudShadowSettings
+
+    def build(self, app) -> None:
+        if app.graph is None:
+            raise ValueError("CloudShadowsPlugin needs an App with a GPU context (App(gpu))")
+        self.graph = app.graph
+        app.graph.add_pass(CloudShadowsPass(self))

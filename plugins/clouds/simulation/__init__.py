@@ -1,0 +1,2 @@
+"""The cloud simulation chain: CloudsPlugin, the sliced job into three texture sets, smoothing and
+density maps."""

@@ -1,0 +1,53 @@
+"""A top view of the cloud field: the summed density maps of sets A and B, interpolated, on screen.
+
+What the thesis's Figure 7.3 shows; the `cloud_field` demo uses it until the sprite renderer draws
+the clouds in 3D.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from atmos.checks import CheckedSettings, check_num
+from atmos.graph import FullscreenPass, PassContext
+from atmos.plugin import Plugin
+from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CloudSets
+from atmos.render_core import COLOR
+
+
+class CloudTopViewPass(FullscreenPass):
+    name = "cloud_top_view"
+    phase = "opaque"
+    fragment = "clouds/simulation/top_view.frag"
+    reads = (CLOUD_SETS,)
+
+    def execute(self, frame: PassContext) -> None:
+        sim: CloudSets = frame.resource(CLOUD_SETS)
+        a, b, t = sim.view()
+        frame.framebuffer(color=[COLOR]).use()
+        sim.maps_of(a).sums.use(0)
+        sim.maps_of(b).sums.use(1)
+        self.program["t"].value = t
+        self.program["a_shift"].value = sim.a_shift[0], sim.a_shift[2]
+        self.program["full"].value = self.plugin.settings.full_column
+        self.program["aspect"].value = frame.view.aspect
+        frame.fullscreen(self.program)
+
+
+@dataclass(frozen=True)
+class CloudTopViewSettings(CheckedSettings):
+    """``full_column``: the summed density (cells) drawn fully white, > 0. Live."""
+    full_column: float = 4.0
+
+    def __post_init__(self):
+        self.store(dict(full_column=check_num("CloudTopViewSettings", "full_column", self.full_column, 0.0,
+                                              lo_open=True)))
+
+
+class CloudTopViewPlugin(Plugin):
+    """Draws the cloud field seen from above: ``CloudTopViewPlugin(settings=None, **fields)`` with
+    :class:`CloudTopViewSettings`; ``configure(full_column=...)`` changes it on the next frame."""
+
+    settings_class = CloudTopViewSettings
+
+    def build(self, app) -> None:
+        app.graph.add_pass(CloudTopViewPass(self))

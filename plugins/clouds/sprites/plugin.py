@@ -1,0 +1,296 @@
+"""CloudRenderPlugin: the CloudSimulation's clouds as point sprites (thesis ch. 6, 7.2).
+
+Drawing: the segments a frame draws (group x, slice or block y, group z, level and span; see
+``segments``) go, back to front, into an instance buffer, and the whole layer is ONE multi-draw with
+no vertex buffer: gl_VertexID is a block's place in its unit (a group, or 2 beside a boundary the
+camera stands on), walked farther neighbour first from where the camera stands (blending is in
+vertex order, so the back-to-front order holds inside a unit too). The vertex shader fetches
+density and transmittance as mix(A, B, t), throws empty cells out of the view volume, sizes the
+sprite from distance and density, and lights it (the source J of :mod:`atmos.plugins.clouds.light.medium`: octave
+weights of the sun's transmittance, sky and ground light dimmed by the columns above and below, and
+log T's slope fitted to its 8 light taps); the fragment shader applies the particle profile, the phase
+function at its own view ray and the sun's light varied across the sprite as T varies (one J per
+sprite spread a dense cloud's lit top over the darker cells below it: toward a 20° sun −13.7 % against
+the march, now +4.4 %, ``tests/test_cloud_light.py``), and fades the
+sprite out over its radius in front of the scene's depth (soft particles: no hard line where a sprite
+meets terrain). Blending is premultiplied (ONE, ONE_MINUS_SRC_ALPHA), so "color"'s alpha stays
+in [0, 1]; the depth test runs against the scene's "depth" with depth writes off.
+
+Opacity: a sprite spreads its block's optical depth ``sigma_t × V × (density summed)`` (V the cell
+volume) over the screen like the block's mass: an elliptical Gaussian with that mass's covariance on
+the screen axes (its cells' spread plus each cell's, the quadratic B-spline's 1/4 cell² per axis),
+cut to 0 where its long axis reaches the sprite's radius ``size_factor × max(cx, cz) × 2^L / 2``
+(:mod:`.particle`). The ray march draws nearly the same mass (its trilinear hat: 1/6), so the image
+no longer grows with the size factor once the radius holds the Gaussian (≥ ~3): the old fixed
+``(1 − r²)²`` disc of the whole diameter spread the same optical depth over more pixels, and as
+``1 − exp(−tau)`` is concave the cloud drew more opaque and brighter, +2.5 % at size 3 to +42 % at 6
+(the +24..+72 % of level-of-detail blocks was the same: their disc was 2^L times wider). Level-of-
+detail blocks now carry their own mass's spread, narrower than their spacing, so they ripple
+(stripes 2^L cells apart) and stay off by default. Sprites under a pixel are drawn 1 pixel wide with their opacity scaled
+by their area in pixels; sprites within one diameter of the near plane fade out linearly, so the
+near plane never clips a visible sprite away (no pop).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import moderngl
+import numpy as np
+
+from atmos.camera import Camera, camera_matrices
+from atmos.checks import check_bool, check_int, check_num
+from atmos.composition import CLOUD_DISTANCE, composition
+from atmos.graph import PassBuilder, PassContext, RenderPass
+from atmos.plugin import Plugin
+from atmos.gpu import clamp_sampler
+from atmos.plugins.clouds.volume.binding import bind_volume, unbind_volume
+from atmos.plugins.clouds.volume.light import CloudLightSettings
+from atmos.plugins.clouds.volume.offscreen import MAX_DOWNSAMPLE, OffscreenClouds, low_size
+from atmos.plugins.clouds.volume.layout import CloudLayout
+from atmos.plugins.clouds.sprites.segments import MAX_LEVEL, SegmentStats, select_segments, unpack
+from atmos.plugins.clouds.volume.field_demand import field_demand
+from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CLOUD_VOLUME, CloudSets
+from atmos.render_core import COLOR, DEPTH
+
+
+@dataclass(frozen=True)
+class CloudRenderSettings(CloudLightSettings):
+    """How the sprites are drawn (all live: a change shows on the next frame).
+
+    ``base_altitude``: world y of the layer's bottom (None: ``CloudSettings.base_altitude``; placement:
+    :mod:`atmos.plugins.clouds.volume.layout`). ``size_factor``:
+    sprite diameter in cells (>= 0.001): where the mass's Gaussian footprint is cut off (≥ ~3 holds
+    it and the image stays the same; smaller cuts it into a flatter disc). ``sigma``: extinction
+    per cell length at density 1 (None: the simulation's ``CloudSettings.sigma``). ``frustum_culling``
+    and ``empty_space_skipping`` switch the two culling tests; ``max_point_size`` caps sprite pixels
+    (None: the GL limit). ``downsample`` (1..8): draw the sprites off screen at 1/downsample of the
+    frame size and upsample them (:mod:`.offscreen`; 2 fills a quarter of the pixels; read by the
+    pass's ``setup`` every frame, so a change resizes the off-screen targets on the next frame).
+    ``lod_pixels``: level of detail — columns where a block of 2^L cells spans at most this many
+    target pixels are drawn one sprite per block (L ≤ 2, :mod:`.segments`); None: every cell.
+    ``ms_attenuation``, ``ms_contribution``, ``ms_eccentricity``: the multiple-scattering octaves, and
+    ``ms_diffusion`` the diffusion field's weight beside them, inherited from :class:`~atmos.plugins.clouds.volume.light.CloudLightSettings` (shared with the
+    ray-marched clouds). ``enabled`` False declares nothing (the pass is culled, allocates nothing).
+    """
+    base_altitude: float | None = None
+    size_factor: float = 3.0
+    sigma: float | None = None
+    frustum_culling: bool = True
+    empty_space_skipping: bool = True
+    max_point_size: float | None = None
+    downsample: int = 2
+    lod_pixels: float | None = None
+    enabled: bool = True
+
+    def __post_init__(self):
+        o = "CloudRenderSettings"
+        self.store(dict(
+            base_altitude=check_num(o, "base_altitude", self.base_altitude, optional=True),
+            size_factor=check_num(o, "size_factor", self.size_factor, 1e-3, 64.0),   # ~0: NaN sprites; 64 cells: a whole volume
+            sigma=check_num(o, "sigma", self.sigma, 0.0, optional=True),
+            frustum_culling=check_bool(o, "frustum_culling", self.frustum_culling),
+            empty_space_skipping=check_bool(o, "empty_space_skipping", self.empty_space_skipping),
+            max_point_size=check_num(o, "max_point_size", self.max_point_size, 1.0, optional=True),
+            downsample=check_int(o, "downsample", self.downsample, 1, MAX_DOWNSAMPLE),
+            lod_pixels=check_num(o, "lod_pixels", self.lod_pixels, 0.0, lo_open=True, optional=True),
+            enabled=check_bool(o, "enabled", self.enabled),
+            **self.light_checks(),
+        ))
+
+
+class CloudRenderPlugin(Plugin):
+    """Point-sprite clouds of the CloudsPlugin's simulation (its imported "cloud_sets"):
+    ``CloudRenderPlugin(settings=None, **fields)`` with :class:`CloudRenderSettings`;
+    ``configure(**changes)`` changes any of them live (next frame). After each frame ``stats``
+    holds the :class:`SegmentStats` counters.
+    """
+
+    settings_class = CloudRenderSettings
+
+    def __init__(self, settings: CloudRenderSettings | None = None, **fields):
+        super().__init__(settings, **fields)
+        self.stats = SegmentStats()
+        self.gpu = self.demand = None
+
+    def build(self, app) -> None:
+        if app.graph is None:
+            raise ValueError("CloudRenderPlugin needs an App with a GPU context (App(gpu))")
+        self.gpu = app.gpu
+        self.composition = composition(app)
+        self.composition.writers.add("cloud_render")     # the sprites give the fog their own distance
+        app.graph.add_pass(CloudSpritePass(self))
+        self.demand = field_demand(app)
+        self.demand.readers.add(self)
+
+    def cleanup(self, app) -> None:
+        if self.demand is not None:
+            self.demand.readers.discard(self)
+        comp = getattr(self, "composition", None)
+        if comp is not None:
+            comp.writers.discard("cloud_render")
+
+    # -- shared with the reference ray marcher --------------------------------------------------
+    def layout(self, sim: CloudSets) -> CloudLayout:
+        """The volume's world placement now, column boxes padded by one cell's largest sprite radius
+        (:func:`select_segments` scales it by a column's block size)."""
+        cell, s = sim.settings.cell_size, self.settings
+        return sim.layout(s.base_altitude, pad=0.5 * s.size_factor * max(cell[0], cell[2]))
+
+    def extinction(self, sim: CloudSets) -> float:
+        """Extinction per cube-root cell length at density 1 (the thesis's sigma)."""
+        sigma = self.settings.sigma
+        return float(sim.settings.sigma if sigma is None else sigma)
+
+    def sigma_t(self, sim: CloudSets) -> float:
+        """Extinction in 1/m at density 1 (the medium's, or this plugin's ``sigma`` override)."""
+        return self.extinction(sim) / float(np.cbrt(np.prod(sim.settings.cell_size)))
+
+
+COMMAND_BYTES = 20
+
+
+def sprite_uniforms(plugin, sim, layout: CloudLayout, camera: Camera, aspect: float, height: int,
+                    point_limit: float) -> dict:
+    """The uniforms of ``clouds/sprites/sprite.vert`` but view_proj and the volume's (:func:`bind_volume`)."""
+    cell = np.asarray(layout.cell, np.float64)
+    tau_scale = plugin.extinction(sim) * cell.prod() / np.cbrt(cell.prod())     # sigma_t × V
+    settings = plugin.settings
+    limit = point_limit if settings.max_point_size is None else min(point_limit, settings.max_point_size)
+    return {"volume_shape": tuple(int(n) for n in layout.shape), "group_size": tuple(layout.group),
+            "layer_min": tuple(float(v) for v in layout.lo), "cell_size": tuple(float(c) for c in cell),
+            "camera_cell": tuple(float(v) for v in (np.asarray(camera.position, np.float64) - layout.lo) / cell),
+            "base_diameter": float(settings.size_factor * max(cell[0], cell[2])),
+            "pixel_scale": float(height) / 2.0 * float(camera_matrices(camera, aspect).projection[1, 1]),
+            "max_point_size": float(limit), "tau_scale": float(tau_scale), "near": float(camera.near),
+            "far": float(camera.far),
+            "camera_pos": tuple(float(v) for v in camera.position),
+            "camera_right": tuple(float(v) for v in camera.right()),
+            "camera_up": tuple(float(v) for v in camera.up())}
+
+
+class CloudSpritePass(RenderPass):
+    """Pass "cloud_render" (phase translucent): reads "depth" and "cloud_sets", blends the sprites
+    onto "color" (with ``downsample`` > 1 through the low-res "cloud_color"/"cloud_depth" it creates)."""
+    name = "cloud_render"
+    phase = "translucent"
+    exclusive = CLOUD_VOLUME                # never on beside the ray march (a GraphError names both)
+
+    def __init__(self, plugin: CloudRenderPlugin):
+        self.plugin = plugin
+        self.program = self.sampler = self.offscreen = None
+        self.instances = self.commands = self.vao = None
+        self._group = self._uploaded = None
+
+    def setup(self, builder: PassBuilder) -> None:
+        if not self.plugin.settings.enabled:
+            return                          # declares nothing: culled, allocates nothing
+        builder.read(DEPTH)
+        builder.read(CLOUD_SETS)
+        builder.read(COLOR)                 # blends onto it
+        builder.write(COLOR)
+        downsample = self.plugin.settings.downsample
+        distance = self.plugin.composition.distance
+        if distance:                        # a media pass reads it: blend onto it (atmos.composition)
+            builder.read(CLOUD_DISTANCE)
+            builder.write(CLOUD_DISTANCE)
+        if downsample > 1:
+            OffscreenClouds.declare(builder, self.plugin.gpu.size, downsample, distance)
+
+    def prepare(self, gpu) -> None:
+        self.program = gpu.program(vertex_shader="clouds/sprites/sprite.vert", fragment_shader="clouds/sprites/sprite.frag")
+        self.offscreen = OffscreenClouds(gpu)
+        self.sampler = clamp_sampler(gpu.ctx)
+        limit = gpu.ctx.info.get("GL_POINT_SIZE_RANGE", (1.0, 64.0))[1]
+        self.point_limit = float(limit)
+
+    def _buffers(self, gpu, group, shape) -> None:
+        """An instance buffer for every segment (made once per group size and volume shape)."""
+        if self._group == (group, shape):
+            return
+        self._release_buffers()
+        gx, gz = group
+        grid = (-(-shape[0] // gx)) * (-(-shape[2] // gz)) * shape[1]
+        self.instances = gpu.ctx.buffer(reserve=16 * grid)
+        self.commands = gpu.ctx.buffer(reserve=COMMAND_BYTES * 16)
+        self.vao = gpu.ctx.vertex_array(self.program, [(self.instances, "4i/i", "in_segment")])
+        self._group = (group, shape)
+        self._uploaded = None
+
+    def _draw(self, segments: np.ndarray, group) -> None:
+        """Every run of segments with one level and span as one instanced draw of its blocks, all in one
+        multi-draw: commands (blocks per unit, segments, first vertex 0, first instance). moderngl
+        strides array commands by 20 bytes (the indexed layout), hence the zero pad."""
+        code = segments[:, 3]
+        starts = np.flatnonzero(np.r_[True, code[1:] != code[:-1]])
+        counts = np.diff(np.r_[starts, len(code)])
+        level, sx, sz = unpack(code[starts])
+        blocks = (group[0] * sx >> level) * (group[1] * sz >> level)
+        zero = np.zeros_like(counts)
+        commands = np.stack([blocks, counts, zero, starts, zero], -1).astype(np.uint32)
+        if commands.nbytes > self.commands.size:
+            self.commands.orphan(commands.nbytes)
+        self.commands.write(commands.tobytes())
+        self.vao.render_indirect(self.commands, moderngl.POINTS, count=len(commands))
+
+    def execute(self, frame: PassContext) -> None:
+        plugin = self.plugin
+        settings = plugin.settings
+        distance = frame.declares(CLOUD_DISTANCE)
+        if not settings.enabled:
+            return
+        view, gpu = frame.view, frame.gpu
+        sim: CloudSets = frame.resource(CLOUD_SETS)
+        camera = view.camera
+        aspect = view.aspect
+        layout = plugin.layout(sim)
+        matrices = camera_matrices(camera, aspect)
+        view_proj = matrices.view_proj
+        maps = sim.maps_of(sim.view()[0])
+        ctx, p, factor = gpu.ctx, self.program, settings.downsample
+        uniforms = sprite_uniforms(plugin, sim, layout, camera, aspect, low_size(gpu.size, factor)[1],
+                                   self.point_limit)
+        segments, plugin.stats = select_segments(
+            layout, camera.position, view_proj if settings.frustum_culling else None,
+            sim.max_maps() if settings.empty_space_skipping else None, maps.band_height,
+            settings.lod_pixels, uniforms["pixel_scale"], MAX_LEVEL)
+        if not len(segments):
+            return
+        self._buffers(gpu, layout.group, layout.shape)
+        if segments is not self._uploaded:          # select_segments hands back the same array when nothing moved
+            self.instances.write(segments.tobytes())
+            self._uploaded = segments
+        if factor == 1:
+            fbo = frame.framebuffer(color=[COLOR, CLOUD_DISTANCE] if distance else [COLOR], depth=DEPTH)
+            fbo.use()
+        else:
+            fbo = self.offscreen.begin(frame, factor, distance)
+        # the soft particles' scene depth: the attached depth target's (sampled, never written)
+        frame.resource(DEPTH if factor == 1 else self.offscreen.depth).use(5)
+        p["view_proj"].write(matrices.gl("view_proj"))
+        for name, value in uniforms.items():
+            if name in p:              # a compiler may drop a uniform a variant does not use
+                p[name].value = value
+        fbo.depth_mask = False
+        frame.blend_over()
+        ctx.enable(moderngl.DEPTH_TEST | moderngl.PROGRAM_POINT_SIZE)
+        ctx.depth_func = "<="          # a tiny near plane rounds far depths to 1.0: still in front of the sky
+        bind_volume(p, sim, self.sampler, view.sun, settings.octaves, settings.ms_diffusion, layout.heights)
+        try:
+            self._draw(segments, layout.group)
+        finally:
+            unbind_volume(self.sampler)
+        if factor > 1:
+            self.offscreen.end(frame, factor, camera.near, camera.far, distance)
+
+    def _release_buffers(self) -> None:
+        for obj in (self.vao, self.instances, self.commands):
+            if obj is not None:
+                obj.release()
+        self.vao = self.instances = self.commands = None
+        self._group = self._uploaded = None
+
+    def release(self) -> None:
+        self._release_buffers()
+        if self.sampler is not None:
+            self.sampler.release()
+        self.sampler = None

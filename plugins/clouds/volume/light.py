@@ -1,0 +1,133 @@
+"""The light both cloud renderers share (``clouds/volume/volume.glsl``; the model is
+:mod:`atmos.plugins.clouds.light.medium`): the sun's colour faded across the horizon and over the layer's height,
+and the uniforms of J."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from atmos.checks import CheckedSettings, check_num
+from atmos.lighting import Sun
+from atmos.plugins.clouds.light.medium import environment, hemisphere_share
+
+DEFAULT_AMBIENT = (0.35, 0.47, 0.65)
+DEFAULT_OCTAVES = (0.25, 0.9525, 0.875)   # a, b, c of the octaves, fitted to the path tracer (bench_cloud_light --fit)
+DEFAULT_DIFFUSION = 0.575                 # the diffusion field's weight beta, fitted with them (README "Cloud light")
+SUN_HEIGHTS = 5                           # volume.glsl's samples of the sun's colour over the layer, base to top (2: the middle)
+
+
+@dataclass(frozen=True)
+class CloudLightSettings(CheckedSettings):
+    """The multiple-scattering octaves both cloud renderers share (the sprites' CloudRenderSettings
+    and the march's RaymarchCloudSettings inherit them): ``ms_attenuation`` a (the share of scatterings
+    that turn light aside: the octaves' Poisson mean (1 - a) tau), ``ms_contribution`` b (octave i's
+    weight b^i), ``ms_eccentricity`` c (its lobes c^i g), each in [0, 1] (:mod:`atmos.plugins.clouds.light.medium`);
+    ``ms_diffusion`` (0..2): the weight beta of the diffusion field, the light turned aside
+    (:mod:`atmos.plugins.clouds.light.diffusion`: J += sun_source beta max(phi - 3 g F.ray, -cos 2 H phi, 0) / 4pi, cos =
+    ray . sun); 0 turns the term off (and, with no other reader, the field's solve:
+    ``plugins/clouds/volume/field_demand.py``). The defaults are the search ``benchmarks/bench_cloud_light.py
+    --fit`` found against the path tracer on the bench's two volumes, scoring both renderers in the
+    goal's four views and a low sun (README "Cloud light"). The 2D far field is lit with the drawing
+    renderer's settings (``CloudFarFieldPlugin.light_settings``). A subclass's ``__post_init__`` stores
+    :meth:`light_checks` beside its own checks (alone, the class checks just these)."""
+    ms_attenuation: float = DEFAULT_OCTAVES[0]
+    ms_contribution: float = DEFAULT_OCTAVES[1]
+    ms_eccentricity: float = DEFAULT_OCTAVES[2]
+    ms_diffusion: float = DEFAULT_DIFFUSION
+
+    def __post_init__(self):
+        self.store(self.light_checks())
+
+    def light_checks(self) -> dict:
+        """The checked octave fields, named after the concrete settings class."""
+        o = type(self).__name__
+        return {**{name: check_num(o, name, getattr(self, name), 0.0, 1.0)
+                   for name in ("ms_attenuation", "ms_contribution", "ms_eccentricity")},
+                "ms_diffusion": check_num(o, "ms_diffusion", self.ms_diffusion, 0.0, 2.0)}
+
+    @property
+    def octaves(self) -> tuple:
+        """(a, b, c): what :func:`light_uniforms` and ``bind_volume`` take."""
+        return self.ms_attenuation, self.ms_contribution, self.ms_eccentricity
+
+
+def sun_light(sun: Sun | None, altitude: float | None = None) -> tuple[tuple, tuple]:
+    """(sun colour, ambient) as float tuples. With an ``altitude`` (m) and a sky that gives the sun's
+    colour by altitude (``Sun.color_by_altitude``), the colour there (the planet's shadow included: a
+    cloud layer keeps its sun after the ground's sunset); else ``Sun.color``, faded to 0 across the
+    horizon (direction y from −0.01 to 0.01), so a sun below it leaves ambient light only."""
+    sun = sun or Sun()
+    if altitude is not None and sun.color_by_altitude is not None:
+        ambient = tuple(float(c) for c in getattr(sun, "ambient", DEFAULT_AMBIENT))
+        return tuple(float(c) for c in sun.color_at(altitude)), ambient
+    direction = np.asarray(sun.direction, np.float64)
+    norm = np.linalg.norm(direction)
+    y = direction[1] / norm if norm > 0 and np.isfinite(norm) else -1.0
+    x = min(max((y + 0.01) / 0.02, 0.0), 1.0)
+    fade = x * x * (3.0 - 2.0 * x)
+    color = tuple(float(c) * fade for c in sun.color)
+    ambient = tuple(float(c) for c in getattr(sun, "ambient", DEFAULT_AMBIENT))
+    return color, ambient
+
+
+def sun_colors(sun: Sun | None, layer=None) -> np.ndarray:
+    """(SUN_HEIGHTS, 3) float64: the sun's colour (:func:`sun_light`) at the heights ``base + k / 4 (top −
+    base)`` of ``layer`` = (base, top) world y (m), what volume.glsl's ``sun_sources`` hold (× albedo ×
+    intensity); ``layer`` None: the camera's colour at every height."""
+    sun = sun or Sun()
+    if layer is None or sun.color_by_altitude is None:
+        return np.tile(np.asarray(sun_light(sun)[0], np.float64), (SUN_HEIGHTS, 1))
+    base, top = (float(v) for v in layer)
+    return sun.color_at(base + np.arange(SUN_HEIGHTS) / (SUN_HEIGHTS - 1) * (top - base))
+
+
+def layer_sun(sun: Sun | None, layer=None) -> tuple[np.ndarray, np.ndarray, tuple]:
+    """(the sun's colours at the layer's heights (:func:`sun_colors`), the middle's (the ground's
+    light takes it), the ambient): the sun every cloud renderer and reference lights a layer with."""
+    colors = sun_colors(sun, layer)
+    return colors, colors[SUN_HEIGHTS // 2], sun_light(sun)[1]
+
+
+def sun_source_at(sources, v) -> np.ndarray:
+    """(..., 3) float64: volume.glsl's ``sun_source_at`` of the (SUN_HEIGHTS, 3) ``sources`` at height
+    fractions ``v`` (...,) of the layer (0 base, 1 top; clamped), linear between the samples."""
+    s = np.asarray(sources, np.float64)
+    x = np.clip(np.asarray(v, np.float64), 0.0, 1.0) * (len(s) - 1)
+    k = np.minimum(x.astype(np.int64), len(s) - 2)
+    f = (x - k)[..., None]
+    return s[k] * (1.0 - f) + s[k + 1] * f
+
+
+def unit_direction(sun: Sun | None) -> np.ndarray:
+    d = np.asarray((sun or Sun()).direction, np.float64)
+    n = np.linalg.norm(d)
+    return d / n if n > 0 and np.isfinite(n) else np.array([0.0, -1.0, 0.0])
+
+
+def cell_tau(cloud_settings) -> float:
+    """sigma_t × cell height: the optical depth of one cell of density 1, vertically (volume.glsl's
+    column_tau; the far field's columns per summed cell)."""
+    return float(cloud_settings.sigma_t * cloud_settings.cell_size[1])
+
+
+def light_uniforms(cloud_settings, sun: Sun | None, octaves=DEFAULT_OCTAVES, diffusion: float = 0.0,
+                   layer=None) -> dict:
+    """The light uniforms of ``volume.glsl`` for a ``CloudSettings`` medium, the ``Sun``, the
+    multiple-scattering octaves (a, b, c), the diffusion field's weight and the layer (base, top) world
+    y (m) over which the clouds take the sun's colour (``sun_sources``: :func:`sun_colors`; the ground's
+    light takes the middle's; None: the camera's colour everywhere)."""
+    colors, middle, ambient = layer_sun(sun, layer)
+    direction = unit_direction(sun)
+    e, sky, ground = environment(cloud_settings, middle, ambient, direction)
+    s = cloud_settings
+    sources = s.albedo * s.sun_intensity * colors
+    return {"sun_sources": [tuple(float(v) for v in row) for row in sources],
+            "sky_source": tuple(float(v) for v in 0.5 * s.albedo * sky),
+            "ground_source": tuple(float(v) for v in 0.5 * s.albedo * ground),
+            "sun_dir": tuple(float(v) for v in direction),
+            "phase_lobes": (float(s.phase_g), float(s.phase_g2), float(s.phase_w)),
+            "outward_share": float(hemisphere_share(s.phase_g, s.phase_g2, s.phase_w)),
+            "ms_octaves": tuple(float(v) for v in octaves),
+            "column_tau": cell_tau(s),
+            "ms_diffusion": float(diffusion)}

@@ -1,0 +1,87 @@
+"""Off-screen clouds at 1/``factor`` of the frame size, upsampled onto the frame (GPU Gems 3, ch. 23).
+
+Filling sprite pixels is most of the cloud pass's cost; at factor 2 the sprites fill a quarter of
+the pixels. Three draws: ``far_depth.frag`` writes each block's farthest scene depth into the
+low-res depth target (so a sprite seen through any pixel of the block is drawn); the sprites are
+drawn into the cleared low-res colour target against it; ``composite.frag`` blends the result onto
+the frame — bilinear inside surfaces, nearest-depth at geometry edges. References:
+:mod:`.offscreen_reference`.
+"""
+from __future__ import annotations
+
+import math
+
+import moderngl
+
+from atmos.composition import CLOUD_DISTANCE, distance_desc
+from atmos.graph import PassBuilder, PassContext, TextureDesc
+from atmos.render_core import COLOR, DEPTH
+
+CLOUD_COLOR = "cloud_color"
+CLOUD_DEPTH = "cloud_depth"
+CLOUD_LOW_DISTANCE = "cloud_distance_low"   # the low-res "cloud_distance" (atmos.composition)
+MAX_DOWNSAMPLE = 8
+EDGE = 0.1           # relative view-depth difference between a pixel and a low-res texel that makes an edge
+
+
+def low_size(size, factor: int) -> tuple[int, int]:
+    """The low-res target's size: every pixel of the frame falls in one block."""
+    return math.ceil(size[0] / factor), math.ceil(size[1] / factor)
+
+
+class OffscreenClouds:
+    """The low-res targets' declarations and the depth and composite draws of a cloud pass
+    (programs belong to the GpuContext)."""
+
+    def __init__(self, gpu, color: str = CLOUD_COLOR, depth: str = CLOUD_DEPTH, distance: str = CLOUD_LOW_DISTANCE):
+        self.color, self.depth = color, depth         # the low-res targets' names (another pass: its own)
+        self.distance = distance
+        fullscreen = "lib/fullscreen.vert"
+        self.far_depth = gpu.program(vertex_shader=fullscreen, fragment_shader="clouds/volume/far_depth.frag")
+        self.composite = gpu.program(vertex_shader=fullscreen, fragment_shader="clouds/volume/composite.frag")
+
+    @staticmethod
+    def declare(builder: PassBuilder, size, factor: int, distance: bool = False, color: str = CLOUD_COLOR,
+                depth: str = CLOUD_DEPTH) -> None:
+        low = low_size(size, factor)
+        builder.create(color, TextureDesc(low, components=4, dtype="f2", filter="nearest"))
+        builder.create(depth, TextureDesc(low, depth=True, filter="nearest"))
+        if distance:
+            builder.create(CLOUD_LOW_DISTANCE, distance_desc(low))
+
+    def begin(self, frame: PassContext, factor: int, distance: bool = False):
+        """Write the low-res depth, clear the low-res colour; returns the framebuffer to draw sprites into."""
+        ctx = frame.gpu.ctx
+        frame.framebuffer(depth=self.depth).use()
+        frame.resource(DEPTH).use(0)
+        self.far_depth["factor"].value = factor
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.depth_func = "1"                # always: the shader writes the block's farthest depth
+        frame.fullscreen(self.far_depth)
+        fbo = frame.framebuffer(color=[self.color, self.distance] if distance else [self.color],
+                                depth=self.depth)
+        fbo.depth_mask = False              # clear the colour only: the sprites test the depth just written
+        fbo.clear(0.0, 0.0, 0.0, 0.0)
+        fbo.use()                           # clear() re-binds the framebuffer bound before it
+        return fbo
+
+    def end(self, frame: PassContext, factor: int, near: float, far: float, distance: bool = False,
+            medium: bool = False, offset=None) -> None:
+        """Blend the low-res clouds onto "color" (premultiplied, :meth:`PassContext.blend_over`), and
+        their distance onto the cleared "cloud_distance" with the same weights when ``distance``;
+        ``medium``: the low-res target holds (in-scattered light, transmittance) of a medium instead,
+        blended by :meth:`PassContext.blend_transmittance` (alpha kept). ``offset`` (ox, oy): low-res
+        texel (i, j) holds the frame's pixel (i·factor + ox, j·factor + oy); None: the block's centre."""
+        frame.reset_state()                 # the sprites' depth test and point size are done
+        frame.framebuffer(color=[COLOR, CLOUD_DISTANCE] if distance else [COLOR]).use()
+        names = (self.color, self.depth, DEPTH) + ((self.distance,) if distance else ())
+        for unit, name in enumerate(names):
+            frame.resource(name).use(unit)
+        p = self.composite
+        p["factor"].value = factor
+        p["inv_near_far"].value = (1.0 / near, 1.0 / far)
+        p["edge"].value = EDGE
+        centre = 0.5 * (factor - 1)
+        p["sample_offset"].value = (centre, centre) if offset is None else tuple(float(v) for v in offset)
+        frame.blend_transmittance() if medium else frame.blend_over()
+        frame.fullscreen(p)

@@ -1,0 +1,178 @@
+#version 430
+// The temporal resolve of the ray-marched clouds (plugins/clouds/raymarch/temporal.py says what and
+// why; float64 reference: plugins/clouds/raymarch/temporal_reference.py). Drawn over the full-res
+// history target: colour (premultiplied), distance (a·d, a), and the scene distance behind the pixel.
+#include "lib/view_ray.glsl"
+#include "clouds/volume/upsample.glsl"
+
+layout(binding = 0) uniform sampler2D low_color;      // this frame's samples: texel (i, j) = pixel (i·r + ox, j·r + oy)
+layout(binding = 1) uniform sampler2D low_distance;
+layout(binding = 2) uniform sampler2D hist_color;     // the previous frame's output, full res
+layout(binding = 3) uniform sampler2D hist_distance;
+layout(binding = 4) uniform sampler2D hist_scene;     // its scene distance (m), -1 = sky
+layout(binding = 5) uniform sampler2D scene_depth;    // this frame's depth (when has_depth)
+layout(binding = 6) uniform sampler2D low_depth;      // the scene depth each sample's ray saw (edge < 1e30)
+layout(binding = 7) uniform sampler2D hist_sample;    // each pixel's last marched sample (carried for drift.frag)
+layout(binding = 8) uniform sampler2D drift;          // low-res: 1 where this frame's samples moved (drift.frag; detect_change)
+
+uniform mat3 view_basis;      // this frame's rays (lib/view_ray.glsl)
+uniform float near, far;
+uniform int r;
+uniform ivec2 offset;
+uniform bool has_depth;
+uniform float edge;           // the depth-aware upsample's edge (offscreen.EDGE; 1e30: bilinear)
+uniform bool history_valid;
+uniform bool still;           // the camera did not change: the history is at this very pixel
+uniform bool detect_change;   // still for r² frames: every pixel's last sample is real, a change is the clouds'
+
+uniform mat3 prev_proj;       // v (m, relative to the previous camera) -> (clip x, clip y, clip w) then
+uniform vec3 cam_delta;       // this camera's position - the previous one's
+uniform float history_clamp;
+uniform float motion_limit;
+
+const float CLAMP_MOTION = 1.0;      // temporal.py's constants
+const float DEPTH_TOLERANCE = 0.1;
+const float ALPHA_EPS = 1e-4;
+const float CHANGE_TOLERANCE = 0.02;
+
+layout(location = 0) out vec4 out_color;
+layout(location = 1) out vec4 out_distance;
+layout(location = 2) out vec4 out_scene;
+layout(location = 3) out vec4 out_sample;
+
+// Bilinear sample of a colour and a distance texture at texel-centre coordinates p, clamped to the edge
+// (done by hand: the same weights as the reference, whatever the texture's filter).
+void bilinear2(sampler2D a, sampler2D b, vec2 p, out vec4 va, out vec2 vb) {
+    ivec2 last = textureSize(a, 0) - 1;
+    ivec2 p0 = ivec2(floor(p));
+    vec2 f = p - vec2(p0);
+    va = vec4(0.0); vb = vec2(0.0);
+    for (int k = 0; k < 4; ++k) {
+        ivec2 o = ivec2(k & 1, k >> 1);
+        ivec2 q = clamp(p0 + o, ivec2(0), last);
+        vec2 w = mix(1.0 - f, f, vec2(o));
+        va += w.x * w.y * texelFetch(a, q, 0);
+        vb += w.x * w.y * texelFetch(b, q, 0).rg;
+    }
+}
+
+// v relative to the previous camera (w = 1 a point, w = 0 a direction) -> previous texel coordinates;
+// false when behind the previous camera.
+bool project(vec3 v, vec2 size, out vec2 q) {
+    vec3 c = prev_proj * v;
+    if (c.z <= 0.0) { q = vec2(-1e9); return false; }
+    q = (c.xy / c.z * 0.5 + 0.5) * size - 0.5;
+    return true;
+}
+
+void main() {
+    vec2 size = vec2(textureSize(hist_color, 0));
+    ivec2 pix = ivec2(gl_FragCoord.xy);
+    vec2 uv = gl_FragCoord.xy / size;
+    vec3 dir = view_ray_dir(uv, view_basis);
+    float scene = -1.0;
+    if (has_depth) scene = view_ray_distance(uv, texelFetch(scene_depth, pix, 0).r, view_basis, near, far, -1.0);
+    out_scene = vec4(scene, 0.0, 0.0, 1.0);
+
+    // a pixel marched this frame: its sample, exactly
+    ivec2 rel = pix - offset;
+    if (rel.x >= 0 && rel.y >= 0 && rel.x % r == 0 && rel.y % r == 0) {
+        ivec2 q = min(rel / r, textureSize(low_color, 0) - 1);
+        out_color = texelFetch(low_color, q, 0);
+        out_distance = vec4(texelFetch(low_distance, q, 0).rg, 0.0, 1.0);
+        out_sample = out_color;
+        return;
+    }
+    // this frame's samples upsampled, and the box of the 3x3 low-res texels around the pixel
+    vec2 lp = (vec2(pix) - vec2(offset)) / float(r);
+    ivec2 last = textureSize(low_color, 0) - 1;
+    ivec2 taps[4];
+    float weights[4];
+    float inv_pixel = upsample_inv_depth(has_depth ? texelFetch(scene_depth, pix, 0).r : 1.0, vec2(1.0 / near, 1.0 / far));
+    upsample_taps(low_depth, last, lp, inv_pixel, vec2(1.0 / near, 1.0 / far), edge, taps, weights);
+    vec4 c = vec4(0.0); vec2 d = vec2(0.0);
+    for (int k = 0; k < 4; ++k) {
+        c += weights[k] * texelFetch(low_color, taps[k], 0);
+        d += weights[k] * texelFetch(low_distance, taps[k], 0).rg;
+    }
+    if (!history_valid) {
+        out_sample = c;
+        out_color = c;
+        out_distance = vec4(d, 0.0, 1.0);
+        return;
+    }
+    ivec2 centre = clamp(ivec2(floor(lp + 0.5)), ivec2(0), last);
+    vec4 lo_c = vec4(1e30), hi_c = vec4(-1e30);
+    vec2 lo_d = vec2(1e30), hi_d = vec2(-1e30);
+    for (int j = -1; j <= 1; ++j)
+        for (int i = -1; i <= 1; ++i) {
+            ivec2 q = clamp(centre + ivec2(i, j), ivec2(0), last);
+            vec4 nc = texelFetch(low_color, q, 0);
+            vec2 nd = texelFetch(low_distance, q, 0).rg;
+            lo_c = min(lo_c, nc); hi_c = max(hi_c, nc);
+            lo_d = min(lo_d, nd); hi_d = max(hi_d, nd);
+        }
+
+    // where this pixel's cloud was: by direction first, then at the distance the history holds there
+    // (or, where it holds no cloud, the scene's)
+    vec2 q = vec2(pix);
+    bool inside = true;
+    if (!still) {
+        inside = project(dir, size, q);
+        vec4 hc; vec2 hd;
+        bilinear2(hist_color, hist_distance, q, hc, hd);
+        // no cloud held there: the scene behind the pixel moves it (terrain), else it is sky at infinity
+        float at = hd.y > ALPHA_EPS ? hd.x / hd.y : scene;
+        if (inside && at > 0.0) inside = project(cam_delta + dir * at, size, q);
+        inside = inside && all(greaterThanEqual(q, vec2(-0.5))) && all(lessThanEqual(q, size - 0.5));
+    }
+    float motion = length(q - vec2(pix));
+    vec4 hc; vec2 hd;
+    bilinear2(hist_color, hist_distance, q, hc, hd);
+    ivec2 nearest = clamp(ivec2(floor(q + 0.5)), ivec2(0), ivec2(size) - 1);
+    out_sample = texelFetch(hist_sample, nearest, 0);
+
+    // disocclusion: the scene behind the pixel is not the one the history saw there
+    float prev_scene = texelFetch(hist_scene, nearest, 0).r;
+    float expected = scene < 0.0 ? -1.0 : length(cam_delta + dir * scene);
+    bool same = (expected < 0.0) == (prev_scene < 0.0)
+             && (expected < 0.0 || abs(prev_scene - expected) <= DEPTH_TOLERANCE * expected);
+    if (!(inside && same)) out_sample = c;      // no last sample of this scene here: the upsample stands in
+
+    // a still camera, every pixel's last sample real: where the clouds around the pixel drift (the
+    // drift pass), has the image changed where it was marched? this frame's nearest sample against the
+    // history there. Where they change in place (evolving), the history stays.
+    float drifting = 0.0;
+    if (detect_change)
+        for (int k = 0; k < 9; ++k)
+            drifting = max(drifting, texelFetch(drift, clamp(centre + ivec2(k % 3 - 1, k / 3 - 1), ivec2(0), last), 0).r);
+    vec2 qf = vec2(centre * r + offset) + (q - vec2(pix));
+    vec4 predicted = texelFetch(hist_color, clamp(ivec2(floor(qf + 0.5)), ivec2(0), ivec2(size) - 1), 0);
+    vec4 now = texelFetch(low_color, centre, 0);
+    vec3 drgb = abs(now.rgb - predicted.rgb);
+    float change = drifting * max(abs(now.a - predicted.a),
+                                  max(drgb.r, max(drgb.g, drgb.b)) / max(max(hi_c.r, max(hi_c.g, hi_c.b)), 1e-3));
+    float moved = max(min(motion / CLAMP_MOTION, 1.0), min(change / CHANGE_TOLERANCE, 1.0));
+    // correct the history by this frame's samples: their bilinear blend of (fresh - history at the
+    // sample, moved like this pixel), with the upsample's depth-aware weights, so history and fresh
+    // samples agree (no 2-pixel pattern)
+    vec4 dc = vec4(0.0); vec2 dd = vec2(0.0);
+    for (int k = 0; k < 4; ++k) {
+        if (weights[k] == 0.0) continue;
+        vec4 pc; vec2 pd;
+        bilinear2(hist_color, hist_distance, vec2(taps[k] * r + offset) + (q - vec2(pix)), pc, pd);
+        dc += weights[k] * (texelFetch(low_color, taps[k], 0) - pc);
+        dd += weights[k] * (texelFetch(low_distance, taps[k], 0).rg - pd);
+    }
+    hc += moved * dc;
+    hd += moved * dd;
+    float clamp_w = history_clamp * moved;
+    hc = mix(hc, clamp(hc, lo_c, hi_c), clamp_w);
+    hd = mix(hd, clamp(hd, lo_d, hi_d), clamp_w);
+    // drifting clouds: the history is stale where its sample changed, the upsample of this frame's
+    // samples is nearer (all of it from CHANGE_TOLERANCE, none below half)
+    float trust = 1.0 - clamp(2.0 * change / CHANGE_TOLERANCE - 1.0, 0.0, 1.0);
+    float keep = (inside && same) ? trust * clamp(1.0 - motion / motion_limit, 0.0, 1.0) : 0.0;
+    out_color = (1.0 - keep) * c + keep * hc;                 // not mix(): exact at keep = 1
+    out_distance = vec4((1.0 - keep) * d + keep * hd, 0.0, 1.0);
+}

@@ -1,0 +1,63 @@
+// Optical depth toward the sun through the cloud layer from the density maps (thesis 7.3.1): a point
+// is projected along the direction toward the sun onto the middle of the layer, where the top-view
+// summed density mix(A, B, t) (layer 0 of the density maps, each set at its own placement) is read
+// bilinearly, zero outside the volume, times the volume's edge fade there, times the fraction of the layer above the point;
+// with CLOUD_FAR_FIELD defined the far field's column (clouds/far_field/field.glsl) adds its optical depth
+// with the complementary weight, so shadows continue past the volume: the column the far field draws
+// (far.frag), field_column_tau (thickness · sigma_t · cell height) × the volume's column sum at the
+// rank of the point where the sun's ray meets the middle plane (far_quantile(far_field_rank)). Shared by the
+// ground shadows (shadow.frag) and the marched light shafts (light_shafts/march.frag);
+// plugins/clouds/shadows/reference.py sun_optical_depth is the same in numpy.
+layout(binding = 0) uniform sampler2DArray sums_a;
+layout(binding = 1) uniform sampler2DArray sums_b;
+uniform float extinction;      // sigma × strength, per cell of summed density
+uniform float t;               // interpolation factor between A and B
+uniform ivec2 a_shift;         // (x, z) cells from B's column to A's at the same place (CloudSets.a_shift)
+uniform vec3 layer_min;        // world corner of cell (0, 0, 0): (origin.x·cx, base_altitude, origin.z·cz)
+uniform vec3 cell_size;
+uniform ivec3 shape;
+uniform float edge_fade;       // CloudSettings.edge_fade: columns fade with the volume's edge (clouds/volume/edge.glsl)
+#include "clouds/volume/edge.glsl"
+#ifdef CLOUD_FAR_FIELD
+#include "clouds/far_field/field.glsl"
+#endif
+
+const float MIN_SUN_HEIGHT = 1e-4;
+
+bool outside(ivec2 c) {
+    return any(lessThan(c, ivec2(0))) || any(greaterThanEqual(c, shape.xz));
+}
+
+// Column c of B's placement (layer_min), A read at its own (c + a_shift): zero outside either volume.
+float column(ivec2 c) {
+    if (outside(c)) return 0.0;
+    ivec2 ca = c + a_shift;
+    float a = outside(ca) ? 0.0 : texelFetch(sums_a, ivec3(ca, 0), 0).r;
+    return mix(a, texelFetch(sums_b, ivec3(c, 0), 0).r, t);
+}
+
+// Bilinear, texel i centred at i, zero outside the volume.
+float column_sum(vec2 p) {
+    if (any(lessThanEqual(p, vec2(-1.0))) || any(greaterThanEqual(p, vec2(shape.xz)))) return 0.0;
+    vec2 i0 = floor(p);
+    vec2 f = p - i0;
+    ivec2 i = ivec2(i0);
+    return mix(mix(column(i), column(i + ivec2(1, 0)), f.x),
+               mix(column(i + ivec2(0, 1)), column(i + ivec2(1, 1)), f.x), f.y);
+}
+
+// Optical depth between world point p and the sun (sun_dir unit, toward the sun) through the clouds.
+float sun_optical_depth(vec3 p, vec3 sun_dir) {
+    float thickness = float(shape.y) * cell_size.y;
+    float run = max(layer_min.y + 0.5 * thickness - p.y, 0.0) / max(sun_dir.y, MIN_SUN_HEIGHT);
+    vec3 q = p + run * sun_dir;
+    vec2 texel = (q.xz - layer_min.xz) / cell_size.xz - 0.5;
+    float above = clamp((layer_min.y + thickness - p.y) / thickness, 0.0, 1.0);
+    float fade = cloud_edge_weight((texel + 0.5) / vec2(shape.xz), edge_fade);
+    float tau = extinction * column_sum(texel) * fade * above;
+#ifdef CLOUD_FAR_FIELD
+    // beyond the volume the far field's cover continues with the complementary weight (field.glsl)
+    tau += field_column_tau * far_quantile(far_field_rank(q.xz, 0.0).x) * (1.0 - fade) * above;
+#endif
+    return tau;
+}

@@ -1,0 +1,28 @@
+#version 430
+// Cloud ground shadows (thesis 7.3.1): the scene point behind each pixel is projected along the
+// direction toward the sun onto the middle of the cloud layer, where the top-view summed density
+// mix(A, B, t) (layer 0 of the density maps, each set at its own placement) gives the optical depth. Output is the factor the
+// colour is multiplied by (blend ZERO, SRC_COLOR); plugins/clouds/shadows/reference.py is the same in numpy.
+#include "lib/view_ray.glsl"
+out vec4 frag;
+#include "clouds/shadows/column.glsl"
+layout(binding = 2) uniform sampler2D scene_depth;
+uniform mat3 view_basis;       // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
+uniform vec3 camera_pos;
+uniform float near;
+uniform float far;
+uniform vec3 sun_dir;          // unit, toward the sun
+uniform float weight;          // direct_fraction × horizon fade (reference.direct_weight)
+
+void main() {
+    ivec2 pixel = ivec2(gl_FragCoord.xy);
+    float depth = texelFetch(scene_depth, pixel, 0).r;
+    if (depth >= 1.0 || weight <= 0.0) {
+        frag = vec4(1.0);
+        return;
+    }
+    vec2 uv = gl_FragCoord.xy / vec2(textureSize(scene_depth, 0));
+    vec3 p = camera_pos + view_ray(uv, view_basis) * view_depth(depth, near, far);
+    float tau = sun_optical_depth(p, sun_dir);
+    frag = vec4(vec3(1.0 - weight * (1.0 - exp(-tau))), 1.0);
+}
