@@ -29,8 +29,9 @@ _EXPORTS = {
     "COLOR": "atmos.render_core", "DEPTH": "atmos.render_core", "SCREEN": "atmos.render_core",
     "CapturePass": "atmos.render_core", "OpaquePass": "atmos.render_core", "RenderCorePlugin": "atmos.render_core",
     # what passes see and write
-    "SceneView": "atmos.scene_view", "Camera": "atmos.camera", "CameraPlugin": "atmos.camera", "set_camera_uniforms": "atmos.camera", "Sun": "atmos.lighting",
-    "set_sun_uniforms": "atmos.lighting", "set_scene_uniforms": "atmos.lighting", "FixedClock": "atmos.clock",
+    "SceneView": "atmos.scene_view", "Camera": "atmos.camera", "CameraPlugin": "atmos.camera_control",
+    "set_camera_uniforms": "atmos.scene_uniforms", "Sun": "atmos.lighting", "set_sun_uniforms": "atmos.scene_uniforms",
+    "set_scene_uniforms": "atmos.scene_uniforms", "write_uniforms": "atmos.gpu.uniforms", "FixedClock": "atmos.clock",
     # games: running, input, moving things and the camera
     "run": "atmos.runner", "DemoSettings": "atmos.demo_registry", "Input": "atmos.input",
     "InputPlugin": "atmos.input", "key": "atmos.keys", "mouse": "atmos.keys", "Transform": "atmos.transform",

@@ -3,9 +3,15 @@ from __future__ import annotations
 
 import time
 
+import numpy as np
+
 from atmos.checks import check_int, check_num
 from atmos.clock import FixedClock
+from atmos.frames import FrameScheduler
+from atmos.gpu.context import require_gpu
+from atmos.graph import RenderGraph
 from atmos.plugin import Plugin, PluginGroup
+from atmos.render_core import LinearCapturePass
 from atmos.scene_view import SceneView
 from atmos.schedule import Schedule
 from atmos.world import World
@@ -27,10 +33,6 @@ class App:
     """
 
     def __init__(self, gpu=None, *, fixed_step: float = 1 / 30, max_frame_dt: float = 0.1):
-        from atmos.frames import FrameScheduler
-        from atmos.graph import RenderGraph
-        from atmos.gpu.context import require_gpu
-
         if gpu is not None:
             require_gpu(gpu, "App gpu")._require_live()
         self.gpu = gpu
@@ -192,9 +194,6 @@ class App:
     def read_linear(self):
         """Render once (like :meth:`render`) and return the linear HDR ``color`` before exposure and
         tone mapping: float32 (height, width, 4), first row at the top (alpha: sky occlusion)."""
-        import numpy as np
-
-        from atmos.render_core import LinearCapturePass
         graph = self._require_graph("read_linear")
         capture = next((p for p in graph.passes if isinstance(p, LinearCapturePass)), None)
         if capture is None:                  # kept once added: reads back only when armed

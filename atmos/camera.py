@@ -1,4 +1,4 @@
-"""The perspective camera resource, its matrices and the camera uniforms every pass writes."""
+"""The perspective camera resource and its matrices (scene data: the uniforms are atmos.scene_uniforms')."""
 from __future__ import annotations
 
 import math
@@ -8,7 +8,6 @@ import numpy as np
 
 from atmos.checks import check_num, check_vec
 from atmos.orientation import angles, basis
-from atmos.plugin import Plugin
 
 
 #: The smallest ``near`` (m): rasterised geometry keeps a depth below 1 out to about 1.6e7 × near
@@ -188,37 +187,3 @@ def camera_matrices(camera: Camera, aspect: float) -> CameraMatrices:
             _MATRICES.clear()
         matrices = _MATRICES[key] = CameraMatrices(camera, aspect)
     return matrices
-
-
-def set_camera_uniforms(program, camera: Camera, aspect: float) -> None:
-    """Write the camera uniforms ``program`` has (the compiler drops unused ones): ``view_proj``,
-    ``inv_view_proj``, ``view_basis`` (:func:`view_basis`), ``camera_pos``, ``near``, ``far``.
-
-    ``view_basis``, ``camera_pos``, ``near`` and ``far`` are what ``lib/view_ray.glsl`` needs for
-    view rays and distances from depth at any far/near ratio; prefer them to ``inv_view_proj``.
-    The matrices come from :func:`camera_matrices`: computed once per frame, whatever the passes."""
-    matrices = camera_matrices(camera, aspect)
-    get = program.get
-    for name in ("view_proj", "inv_view_proj", "view_basis"):
-        member = get(name, None)
-        if member is not None:
-            member.write(matrices.gl(name))
-    for name, value in (("camera_pos", matrices.camera_pos), ("near", float(camera.near)), ("far", float(camera.far))):
-        member = get(name, None)
-        if member is not None:
-            member.value = value
-
-
-class CameraPlugin(Plugin):
-    """Adds the :class:`Camera` resource (``CameraPlugin(camera)`` to start from your own). What moves
-    it is another plugin's: :class:`atmos.camera_control.FlyCameraPlugin` (in DefaultPlugins),
-    :class:`atmos.camera_control.ChaseCameraPlugin`, or your own system."""
-
-    def __init__(self, camera: Camera | None = None):
-        super().__init__()
-        if camera is not None and not isinstance(camera, Camera):
-            raise ValueError(f"CameraPlugin takes an atmos Camera or None, got {type(camera).__name__}")
-        self.camera = camera or Camera()
-
-    def build(self, app) -> None:
-        app.insert_resource(self.camera)

@@ -1,4 +1,5 @@
-"""Camera controllers: the WASD fly camera (the default) and a chase camera that follows an entity.
+"""The camera resource's plugin and its controllers: the WASD fly camera (the default) and a chase
+camera that follows an entity.
 
 ``DefaultPlugins()`` includes :class:`FlyCameraPlugin`; ``DefaultPlugins(fly_camera=False)`` leaves it
 out, and a game adds ``ChaseCameraPlugin(distance=12)`` and points it at its player with
@@ -18,6 +19,21 @@ from atmos.keys import key
 from atmos.orientation import angles
 from atmos.plugin import Plugin
 from atmos.transform import Transform
+
+
+class CameraPlugin(Plugin):
+    """Adds the :class:`atmos.Camera` resource (``CameraPlugin(camera)`` to start from your own). What moves
+    it is another plugin's: :class:`FlyCameraPlugin` (in DefaultPlugins),
+    :class:`ChaseCameraPlugin`, or your own system."""
+
+    def __init__(self, camera: Camera | None = None):
+        super().__init__()
+        if camera is not None and not isinstance(camera, Camera):
+            raise ValueError(f"CameraPlugin takes an atmos Camera or None, got {type(camera).__name__}")
+        self.camera = camera or Camera()
+
+    def build(self, app) -> None:
+        app.insert_resource(self.camera)
 
 
 @dataclass(frozen=True)

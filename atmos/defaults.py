@@ -1,10 +1,10 @@
 """DefaultPlugins: what every rendered scene starts from."""
-from atmos.camera import CameraPlugin
+from atmos.camera_control import CameraPlugin
 from atmos.checks import check_bool
 from atmos.camera_control import FlyCameraPlugin
 from atmos.input import InputPlugin
 from atmos.plugin import PluginGroup
-from atmos.plugins.overlay import OverlayPlugin
+from atmos.overlay import OverlayPlugin
 from atmos.render_core import RenderCorePlugin
 from atmos.transform import TransformPlugin
 

@@ -11,7 +11,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from atmos.camera import set_camera_uniforms
 from atmos.checks import check_sun_dir, check_vec
 
 RAYLEIGH = np.array([0.03, 0.07, 0.16])      # extinction of sunlight per air mass (red, green, blue)
@@ -116,19 +115,3 @@ def sun_and_day(sun: Sun) -> tuple[np.ndarray, float]:
         s = np.array([0.0, 1.0, 0.0])
     day = float(np.clip((s[1] + 0.15) / 0.25, 0.0, 1.0))
     return s, day * day * (3 - 2 * day)
-
-
-def set_sun_uniforms(program, sun: Sun) -> None:
-    """Write ``sun_dir``, ``sun_color`` and ``sky_ambient`` (the Sun's ambient) where the program has them."""
-    get = program.get
-    for name, value in (("sun_dir", sun.direction), ("sun_color", sun.color), ("sky_ambient", sun.ambient)):
-        member = get(name, None)
-        if member is not None:
-            member.value = tuple(float(v) for v in value)
-
-
-def set_scene_uniforms(program, view) -> None:
-    """The camera (:func:`atmos.camera.set_camera_uniforms`) and sun (:func:`set_sun_uniforms`)
-    uniforms of a :class:`atmos.SceneView`: what a pass drawing the lit scene writes each frame."""
-    set_camera_uniforms(program, view.camera, view.aspect)
-    set_sun_uniforms(program, view.sun)

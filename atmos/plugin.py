@@ -2,12 +2,9 @@
 from __future__ import annotations
 
 from importlib.metadata import entry_points
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from atmos.checks import configure_settings, plugin_settings
-
-if TYPE_CHECKING:
-    from atmos.app import App
 
 ENTRY_POINT_GROUP = "atmos.plugins"
 

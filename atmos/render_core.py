@@ -39,6 +39,7 @@ from atmos.hashing import lowbias32
 
 from atmos.graph import FullscreenPass, PassBuilder, PassContext, RenderPass, TextureDesc
 from atmos.plugin import Plugin
+from atmos.scene_uniforms import set_scene_uniforms
 
 SCREEN = "screen"
 COLOR = "color"
@@ -154,7 +155,6 @@ class OpaquePass(RenderPass):
 
     def begin(self, frame: PassContext) -> None:
         """Bind colour and depth, turn the depth test on, write the camera and sun uniforms."""
-        from atmos.lighting import set_scene_uniforms
         frame.framebuffer(color=[COLOR], depth=DEPTH).use()
         frame.gpu.ctx.enable(moderngl.DEPTH_TEST)
         set_scene_uniforms(self.program, frame.view)

@@ -170,7 +170,7 @@ def _label(game) -> str:
 def run_window(name, settings: DemoSettings, title: str | None = None) -> None:
     """``name`` (:func:`load_game`) in a window (:mod:`atmos.window`: ESC quits, F1 the overlay);
     the caption shows the frame times and the slowest passes."""
-    from atmos.plugins.overlay import FrameTimes
+    from atmos.overlay import FrameTimes
     from atmos.window import run_window as window_loop
 
     caption = title or f"atmos — {name}"

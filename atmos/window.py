@@ -38,13 +38,7 @@ class WindowEvents:
             getattr(inp, method)(*args)
 
     def on_key_press(self, symbol, modifiers):
-        from atmos.keys import key
         self._tell("press", symbol)
-        if symbol == key.F1:
-            from atmos.plugins.overlay import OverlayPlugin
-            overlay = next((p for p in self.app.plugins if isinstance(p, OverlayPlugin)), None)
-            if overlay is not None:
-                overlay.configure(visible=not overlay.settings.visible)
 
     def on_key_release(self, symbol, modifiers):
         self._tell("release", symbol)

@@ -70,3 +70,22 @@ def test_fly_camera_is_optional_and_moves_with_held_keys():
         app.close()
     with pytest.raises(ValueError, match="DefaultPlugins.fly_camera must be True or False"):
         DefaultPlugins(fly_camera="no")
+
+
+def test_f1_shows_and_hides_the_frame_time_overlay(gpu, ctx):
+    """The overlay toggles itself from Input (a window, a script or a test press F1 alike): the
+    'overlay' pass is culled while hidden and kept once shown."""
+    from atmos.overlay import OverlayPlugin
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False))
+    overlay = next(p for p in app.plugins if isinstance(p, OverlayPlugin))
+    kept = lambda: "overlay" in [p.name for p in app.graph.compile().order]
+    inp = app.resource(Input)
+    app.update(1 / 60)
+    assert not overlay.settings.visible and not kept()
+    for visible in (True, False):
+        inp.press(key.F1)
+        app.update(1 / 60)                     # toggled by this frame's system, drawn from the next frame
+        inp.release(key.F1)
+        app.update(1 / 60)
+        assert overlay.settings.visible is visible and kept() is visible
+    app.close()

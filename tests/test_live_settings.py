@@ -43,7 +43,7 @@ from atmos.plugins.fog import FogPlugin
 from atmos.plugins.ground import GroundPlugin
 from atmos.plugins.light_shafts import LightShaftsPlugin
 from atmos.plugins.light_shafts.plugin import MASK
-from atmos.plugins.overlay import OverlayPlugin
+from atmos.overlay import OverlayPlugin
 from atmos.plugins.sky import SkyPlugin
 from atmos.plugins.sky_gradient import SkyGradientPlugin
 from atmos.plugins.sky_layer import SkyLayerPlugin

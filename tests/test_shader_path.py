@@ -9,7 +9,7 @@ from atmos.app import App
 from atmos.defaults import DefaultPlugins
 from atmos.gpu import ShaderError, add_shader_path, load_source, remove_shader_path, shader_paths
 from atmos.graph import FullscreenPass, PassContext
-from atmos.lighting import set_scene_uniforms
+from atmos.scene_uniforms import set_scene_uniforms
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR
 

@@ -8,7 +8,8 @@ import pytest
 from PIL import Image
 
 from atmos.app import App
-from atmos.camera import Camera, set_camera_uniforms, view_basis
+from atmos.camera import Camera, view_basis
+from atmos.scene_uniforms import set_camera_uniforms
 from atmos.cli import main
 from atmos.defaults import DefaultPlugins
 from atmos.gpu import create_headless

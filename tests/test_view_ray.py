@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from atmos.app import App
-from atmos.camera import Camera, set_camera_uniforms, view_basis
+from atmos.camera import Camera, view_basis
+from atmos.scene_uniforms import set_camera_uniforms
 from atmos.defaults import DefaultPlugins
 from atmos.gpu import create_headless, load_source
 from atmos.lighting import Sun

@@ -16,6 +16,7 @@ from atmos.plugin import Plugin
 from atmos.plugins.fog.noise import NoiseVolumes
 from atmos.plugins.fog.post import FogPass, draw_state, fog_program, restore_state, set_fog_uniforms
 from atmos.plugins.fog.settings import MODES, FogSettings
+from atmos.gpu.uniforms import write_uniforms
 
 __all__ = ["FogPlugin", "FogSettings", "FogPass", "apply_fog", "MODES"]
 
@@ -125,9 +126,7 @@ def apply_fog(gpu, color, distance, mode: str = "exp2", density: float = 0.044, 
         cloud_tex.use(2)
         dir_tex.use(7)
         set_fog_uniforms(prog, settings, time, horizon)
-        prog["fog_far"].value = far
-        if "fog_camera" in prog:
-            prog["fog_camera"].value = tuple(float(v) for v in camera)
+        write_uniforms(prog, fog_far=far, fog_camera=tuple(float(v) for v in camera))
         fbo.use()
         gl.viewport = (0, 0, w, h)
         draw_state(gl)

@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 
-from atmos.camera import set_camera_uniforms
+from atmos.scene_uniforms import set_camera_uniforms
 from atmos.composition import CLOUD_DISTANCE, MEDIA_LIGHT, blend_onto_media, medium_targets
 from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.graph.frame import BLEND_TRANSMITTANCE, blend
@@ -13,6 +13,7 @@ from atmos.plugins.fog.noise import NoiseVolumes, octave_key
 from atmos.plugins.fog.settings import MODES
 from atmos.plugins.fog.sky_color import SAMPLES
 from atmos.render_core import COLOR, DEPTH
+from atmos.gpu.uniforms import write_uniforms
 
 FRAGMENT = "fog/fog.frag"
 VERTEX = "lib/fullscreen.vert"
@@ -29,36 +30,21 @@ def fog_program(gpu, settings, from_depth: bool, clouds: bool = False, media: bo
     return gpu.program(defines, vertex_shader=VERTEX, fragment_shader=FRAGMENT)
 
 
-def _set(prog, name, values) -> None:
-    """Write a uniform (array) if the compiler kept it; arrays are cut to their kept length."""
-    if name not in prog:
-        return
-    uniform = prog[name]
-    if isinstance(values, list):
-        values = values[:uniform.array_length] if uniform.array_length > 1 else values[0]
-    uniform.value = values
-
 
 def set_fog_uniforms(prog, settings, time: float, horizon=None) -> None:
     """The factor's uniforms (fog/factor.glsl) and the fog colour and sky handling (fog/fog.frag);
     ``horizon``: the (SAMPLES, 3) sky colours of ``color_from="sky"`` (:mod:`.sky_color`)."""
-    if horizon is not None and "fog_horizon" in prog:
-        prog["fog_horizon"].write(np.asarray(horizon, np.float32).tobytes())
-    _set(prog, "fog_density", settings.density)
-    _set(prog, "fog_start", settings.start)
-    _set(prog, "fog_end", settings.end)
-    _set(prog, "fog_color", settings.fog_color)
-    _set(prog, "fog_sky_keep", int(settings.sky == "keep"))
+    if horizon is not None:
+        write_uniforms(prog, fog_horizon=np.asarray(horizon, np.float32).tobytes())
+    write_uniforms(prog, fog_density=settings.density, fog_start=settings.start, fog_end=settings.end,
+                   fog_color=settings.fog_color, fog_sky_keep=int(settings.sky == "keep"))
     if not settings.heterogeneous:
         return
     periods = list(settings.resolutions) + [2] * (4 - len(settings.resolutions))
-    _set(prog, "fog_time", float(time))
-    _set(prog, "fog_tile", settings.tile_size)
-    _set(prog, "fog_amplitude", settings.amplitude)
-    _set(prog, "fog_period", periods)
-    _set(prog, "fog_key", [octave_key(settings.seed, i) for i in range(4)])
-    _set(prog, "fog_wind", list(settings.winds))
-    _set(prog, "fog_turn", [(math.cos(a), math.sin(a)) for a in settings.turns])
+    write_uniforms(prog, fog_time=float(time), fog_tile=settings.tile_size, fog_amplitude=settings.amplitude,
+                   fog_period=periods, fog_key=[octave_key(settings.seed, i) for i in range(4)],
+                   fog_wind=list(settings.winds),
+                   fog_turn=[(math.cos(a), math.sin(a)) for a in settings.turns])
 
 
 def draw_state(ctx) -> None:

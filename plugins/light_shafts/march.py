@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from atmos.blue_noise import BLUE_NOISE_UNIT, blue_noise_texture
-from atmos.camera import set_camera_uniforms
+from atmos.scene_uniforms import set_camera_uniforms
 from atmos.composition import CLOUD_DISTANCE
 from atmos.graph import PassBuilder, PassContext
 from atmos.lighting import unit_sun

@@ -23,7 +23,8 @@ import math
 
 import numpy as np
 
-from atmos.camera import set_camera_uniforms, view_basis
+from atmos.camera import view_basis
+from atmos.scene_uniforms import set_camera_uniforms
 from atmos.composition import CLOUD_DISTANCE, MEDIA_LIGHT, MEDIA_TRANSMITTANCE
 from atmos.gpu import clamp_sampler
 from atmos.graph import FullscreenPass, PassContext, TextureDesc

@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from atmos.plugins.sky import atmosphere as ref
+import atmos.plugins.sky.atmosphere as ref
 from atmos.plugins.sky.atmosphere_settings import AtmosphereSettings
 
 SUN_STEPS = 128      # midpoint steps of the optical depth toward the sun per collision

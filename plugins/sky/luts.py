@@ -15,8 +15,9 @@ from functools import lru_cache
 import moderngl
 import numpy as np
 
-from atmos.plugins.sky import atmosphere as ref
+import atmos.plugins.sky.atmosphere as ref
 from atmos.plugins.sky.atmosphere_settings import AtmosphereSettings
+from atmos.gpu.uniforms import write_uniforms
 
 TRANSMITTANCE_UNIT, MULTISCATTERING_UNIT, SKY_VIEW_UNIT = 10, 11, 12   # texture units the sky pass binds
 SUN_TOLERANCE = 5e-4          # the sky view is remade when the sun's height (y) moved more (≈ 0.03° near the horizon)
@@ -53,10 +54,8 @@ def set_atmosphere_uniforms(program, settings: AtmosphereSettings) -> None:
               "atm_oz_w": m["oz_w"], "atm_g": m["g"], "atm_ms": m["ms"], "atm_ray": m["ray"], "atm_mie_s": m["mie_s"],
               "atm_mie_t": m["mie_t"], "atm_ozone": m["ozone"], "atm_albedo": m["albedo"], "atm_sun": m["sun"],
               "atm_transmittance": TRANSMITTANCE_UNIT, "atm_multiscattering": MULTISCATTERING_UNIT}
-    for name, value in values.items():
-        member = program.get(name, None)
-        if member is not None:
-            member.value = tuple(float(x) for x in value) if isinstance(value, np.ndarray) else value
+    write_uniforms(program, {name: tuple(float(x) for x in value) if isinstance(value, np.ndarray) else value
+                             for name, value in values.items()})
 
 
 class AtmosphereLuts:

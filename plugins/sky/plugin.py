@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.camera import Camera, set_camera_uniforms
+from atmos.camera import Camera
+from atmos.scene_uniforms import set_camera_uniforms
 from atmos.composition import composition
 from atmos.graph import FullscreenPass, PassContext, RenderPass
 from atmos.lighting import Sun
 from atmos.plugin import Plugin
-from atmos.plugins.sky import sun_light
+import atmos.plugins.sky.sun_light as sun_light
 from atmos.plugins.sky.aerial import AERIAL, AerialPerspectivePass, active
 from atmos.plugins.sky.luts import (SKY_LUTS, SKY_VIEW_UNIT, AtmosphereLuts, atmosphere_defines, camera_altitude,
                                     set_atmosphere_uniforms, view_radius)

@@ -6,7 +6,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from atmos.plugins.sky import stars
+import atmos.plugins.sky.stars as stars
 from atmos.plugins.sky.settings import SkySettings
 from atmos.plugins.sky.preetham import COS_FLOOR, unit_vectors
 

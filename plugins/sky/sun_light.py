@@ -22,7 +22,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from atmos.plugins.sky import atmosphere as ref
+import atmos.plugins.sky.atmosphere as ref
 from atmos.plugins.sky.atmosphere_settings import AtmosphereSettings
 from atmos.plugins.sky.reference import daylight
 

@@ -3,7 +3,7 @@ from dataclasses import dataclass
 
 from atmos.checks import CheckedSettings, check_vec
 from atmos.graph import FullscreenPass, PassContext
-from atmos.lighting import set_scene_uniforms
+from atmos.scene_uniforms import set_scene_uniforms
 from atmos.plugin import Plugin
 from atmos.render_core import DEPTH, where_nothing_was_drawn
 

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.camera import set_camera_uniforms
+from atmos.scene_uniforms import set_camera_uniforms
 from atmos.graph import FullscreenPass, PassContext
 from atmos.lighting import Sun, sun_and_day
 from atmos.plugin import Plugin

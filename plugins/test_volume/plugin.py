@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from atmos.checks import CheckedSettings, check_int, check_num, check_shape, check_vec
 from atmos.frames import SlicedJob, SliceTask, TripleSet
 from atmos.graph import FullscreenPass, PassContext, TextureDesc
-from atmos.lighting import set_scene_uniforms
+from atmos.scene_uniforms import set_scene_uniforms
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
 

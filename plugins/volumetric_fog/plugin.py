@@ -3,13 +3,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.camera import set_camera_uniforms
+from atmos.scene_uniforms import set_camera_uniforms
 from atmos.composition import blend_onto_media, composition, medium_targets
 from atmos.graph import FullscreenPass, PassContext
 from atmos.lighting import Sun, sun_and_day
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
 from atmos.plugins.volumetric_fog.settings import VolumetricFogSettings
+from atmos.gpu.uniforms import write_uniforms
 
 
 def sun_terms(sun: Sun, settings: VolumetricFogSettings):
@@ -29,9 +30,7 @@ def set_medium_uniforms(program, settings: VolumetricFogSettings, sun: Sun, time
               "steps": settings.steps, "light_steps": settings.light_steps, "light_step": settings.light_step,
               "max_distance": settings.max_distance, "sun_dir": tuple(s), "sun_light": tuple(sun_light),
               "ambient_light": tuple(ambient_light)}
-    for name, value in values.items():
-        if name in program:          # the compiler drops uniforms it proves unused
-            program[name].value = value
+    write_uniforms(program, values)
 
 
 class VolumetricFogPass(FullscreenPass):

@@ -49,6 +49,7 @@ import numpy as np
 from atmos.checks import check_shape, is_int
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.hashing import stream_key
+from atmos.gpu.uniforms import write_uniforms
 
 PRECISION_BITS = 16
 MAX_LAYERS = 128        # layers (ny) the advection takes shifts for (common.glsl: a uniform array)
@@ -220,11 +221,8 @@ class CloudAutomaton:
 
         ctx, prog = self.ctx, self._prog_step
         self._set_grid(prog)
-        self._set(prog, "u_mode", tuple(modes))
-        self._set(prog, "u_threshold", tuple(thresholds))
-        member = prog.get("u_keys", None)
-        if member is not None:
-            member.write(keys)
+        write_uniforms(prog, u_mode=tuple(modes), u_threshold=tuple(thresholds))
+        write_uniforms(prog, u_keys=keys)
         src, dst = self._state[self._current], self._state[1 - self._current]
         src.bind_to_storage_buffer(0)
         dst.bind_to_storage_buffer(1)
@@ -268,18 +266,11 @@ class CloudAutomaton:
                 f"step_count={self.step_count})")
 
     # -- internals -----------------------------------------------------------------------------
-    @staticmethod
-    def _set(prog, name, value) -> None:
-        member = prog.get(name, None)
-        if member is not None:
-            member.value = value
 
     def _set_grid(self, prog, count: int | None = None) -> None:
         """This automaton's size uniforms (the programs are shared with other automata: set before each run)."""
-        self._set(prog, "u_size", self.shape)
-        self._set(prog, "u_nwx", self.words_x)
-        self._set(prog, "u_count", self._count if count is None else count)
-        self._set(prog, "u_last_mask", self._last_mask)
+        write_uniforms(prog, u_size=self.shape, u_nwx=self.words_x,
+                       u_count=self._count if count is None else count, u_last_mask=self._last_mask)
 
     def _check_alive(self) -> None:
         if self._released:
@@ -394,8 +385,7 @@ class CloudAutomaton:
             def fill(buffer):
                 probabilities.use(0)
                 buffer.bind_to_storage_buffer(6)
-                self._set(cells, "u_size", self.shape)
-                self._set(cells, "u_channel", channel)
+                write_uniforms(cells, u_size=self.shape, u_channel=channel)
                 cells.run(*grid)
                 self.ctx.memory_barrier(moderngl.SHADER_STORAGE_BARRIER_BIT)
             return fill

@@ -8,6 +8,7 @@ import numpy as np
 
 from atmos.plugins.clouds.far_field.cover import QUANTILES
 from atmos.plugins.clouds.volume.sets import CloudSets
+from atmos.gpu.uniforms import write_uniforms
 
 INTERVALS = QUANTILES - 1        # the rank intervals, between the quantiles (columns.glsl INTERVALS)
 SUMS_UNITS = (0, 1)              # columns.glsl's sums_a, sums_b (2D arrays)
@@ -22,10 +23,7 @@ def use_columns(program, sim: CloudSets, density: bool = True) -> None:
     if density:
         for s, unit in zip((sim.a, sim.b), DENSITY_UNITS):
             s["density"].use(unit)
-    values = dict(t=float(sim.t), a_shift=(sim.a_shift[0], sim.a_shift[2]), edge_fade=float(sim.settings.edge_fade))
-    for name, value in values.items():
-        if name in program:
-            program[name].value = value
+    write_uniforms(program, t=float(sim.t), a_shift=(sim.a_shift[0], sim.a_shift[2]), edge_fade=float(sim.settings.edge_fade))
 
 
 def rank_texture(gpu, rows: int, components: int):

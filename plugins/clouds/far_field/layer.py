@@ -24,6 +24,7 @@ from atmos.plugins.clouds.far_field.rank_light import RankLight
 from atmos.plugins.clouds.volume.light import cell_tau, light_uniforms
 from atmos.plugins.clouds.volume.sets import CloudSets
 from atmos.plugins.sky_layer.octaves import OctaveTextures
+from atmos.gpu.uniforms import write_uniforms
 
 FAR_FIELD = "far_field"          # the imported graph resource
 REBAKE_TOLERANCE = 0.05          # re-bake the octaves when the sun moved the light step by this fraction
@@ -194,18 +195,12 @@ class FarFieldLayer:
                       field_lod_shift=tuple(np.log2(PERIODS)),
                       field_mid_height=float(0.5 * (layout.lo[1] + layout.hi[1])),
                       field_column_tau=column_tau(params, sim))
-        for name, value in values.items():
-            if name in program:
-                program[name].value = value
-        program["field_offsets"].write(offsets.astype("f4").tobytes())
-        program["field_turns"].write(np.transpose(rotations(), (0, 2, 1)).astype("f4").tobytes())   # column-major
         quantiles, first = level_table(params.base_frequency, params.seed, params.size)
-        program["field_quantiles"].write(np.asarray(quantiles, "f4").tobytes())
-        if "field_crossings" in program:              # far.frag's slant_rank
-            program["field_crossings"].write(np.asarray(pattern_crossings(params.base_frequency, params.seed, params.size),
-                                                        "f4").tobytes())
-        if "field_first_level" in program:
-            program["field_first_level"].value = first
+        crossings = pattern_crossings(params.base_frequency, params.seed, params.size)   # far.frag's slant_rank
+        write_uniforms(program, values, field_offsets=offsets.astype("f4").tobytes(),
+                       field_turns=np.transpose(rotations(), (0, 2, 1)).astype("f4").tobytes(),   # column-major
+                       field_quantiles=np.asarray(quantiles, "f4").tobytes(), field_first_level=first,
+                       field_crossings=np.asarray(crossings, "f4").tobytes())
 
     def release(self) -> None:
         if self.octaves is not None:

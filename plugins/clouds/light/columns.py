@@ -17,7 +17,7 @@ import numpy as np
 from atmos.frames import SliceTask
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.graph import TextureDesc
-from atmos.plugins.clouds.light import grid
+import atmos.plugins.clouds.light.grid as grid
 from atmos.plugins.clouds.light.reference import lerp_matrix, multilinear
 from atmos.plugins.clouds.light.shear_warp import check_volume_texture, groups, program
 

@@ -32,10 +32,11 @@ from atmos.checks import check_int, check_num
 from atmos.frames import SliceTask
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.graph import TextureDesc
-from atmos.plugins.clouds.light import grid
+import atmos.plugins.clouds.light.grid as grid
 from atmos.plugins.clouds.light.medium import hemisphere_share, mean_cosine
 from atmos.plugins.clouds.light.reference import multilinear
 from atmos.plugins.clouds.light.shear_warp import check_volume_texture, groups, program
+from atmos.gpu.uniforms import write_uniforms
 
 FLOOR = 1e-3               # 1/m: transport extinction floor (empty cells still conduct, finitely)
 TOLERANCE = 1e-4           # relative residual |b - A phi| / |b| the GPU solve stops at
@@ -236,10 +237,7 @@ class DiffusionSolver:
     def _dispatch(self, stage: int, **values) -> None:
         """Stages 2 and 3 (the iteration) run indirect: no groups once converged."""
         prog = program(self.gpu, "diffusion")
-        values = {"stage": stage, "cur": self._cur, "first": int(self._first), **values}
-        for name, value in values.items():
-            if name in prog:
-                prog[name].value = value
+        write_uniforms(prog, values, stage=stage, cur=self._cur, first=int(self._first))
         self._cells.bind_to_storage_buffer(0)
         self._parts.bind_to_storage_buffer(1)
         self._args.bind_to_storage_buffer(2)

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from atmos.checks import check_sun_dir
-from atmos.plugins.clouds.light import grid
+import atmos.plugins.clouds.light.grid as grid
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.plugins.clouds.light.shear_warp import ShearWarpShader, read_volume, upload_volume
 

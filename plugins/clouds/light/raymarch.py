@@ -8,7 +8,7 @@ Gauss-Legendre. Cost grows with the path length; the shear-warp is the fast path
 from __future__ import annotations
 
 from atmos.checks import check_sun_dir
-from atmos.plugins.clouds.light import grid
+import atmos.plugins.clouds.light.grid as grid
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.plugins.clouds.light.shear_warp import _RESULT_FORMATS, check_volume_texture, groups, program
 

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from atmos.plugins.clouds.light import grid
+import atmos.plugins.clouds.light.grid as grid
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.plugins.clouds.light.shear_warp import _RESULT_FORMATS, check_volume_texture, groups, program
 

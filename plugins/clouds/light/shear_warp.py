@@ -24,7 +24,8 @@ import numpy as np
 from atmos.checks import check_shape, check_sun_dir
 from atmos.frames import SliceTask
 from atmos.gpu.context import GpuContext, require_gpu
-from atmos.plugins.clouds.light import grid
+from atmos.gpu.uniforms import write_uniforms
+import atmos.plugins.clouds.light.grid as grid
 
 _RESULT_FORMATS = {"f4": "r32f", "f2": "r16f"}
 
@@ -160,7 +161,7 @@ class ShearWarpShader:
         for name, axis in (("axis_a", a), ("axis_b", b), ("axis_c", c)):
             prog[name].value = tuple(int(x) for x in basis[axis])
         prog["step_dir"].value = tuple(float(x) for x in plan.step)
-        _set(prog, "step_len", plan.length)
+        write_uniforms(prog, step_len=plan.length)
         prog["sigma"].value = self._sigma
         prog["density"].value = 0
         self._density.use(0)
@@ -185,11 +186,6 @@ class ShearWarpShader:
             obj.release()
         self._objects.clear()
 
-
-def _set(prog, name: str, value) -> None:
-    member = prog.get(name, None)
-    if member is not None:
-        member.value = value
 
 
 class ShadingTask(SliceTask):

@@ -28,6 +28,7 @@ import moderngl
 import numpy as np
 
 from atmos.gpu.context import GpuContext, require_gpu
+from atmos.gpu.uniforms import write_uniforms
 
 NOISE_RULE = 0xC1D           # stream id of the noise's hashes: stream_key(seed, 0, NOISE_RULE, plane)
 PERLIN_GAIN = 1.5            # Perlin FBM -> [0, 1]: clamp(0.5 + 0.5 GAIN fbm)
@@ -147,16 +148,12 @@ class DetailNoise:
         self.detail.use(DETAIL_UNIT)
         offset_base, offset_fine = detail_offsets(time, wind, scale)
         strength = float(strength)
-        for name, value in (("detail_base_noise", BASE_UNIT), ("detail_fine_noise", DETAIL_UNIT),
-                            ("detail_offset_base", tuple(offset_base)), ("detail_offset_fine", tuple(offset_fine)),
-                            ("detail_inv_scale", 1.0 / scale), ("detail_inv_scale_fine", DETAIL_RATIO / scale),
-                            ("detail_strength", strength), ("detail_band_strength", BAND_STRENGTH * strength),
-                            ("detail_band_width", band_width(strength)),
-                            ("detail_layer", (float(layer[0]), 1.0 / max(float(layer[1]), 1e-6))),
-                            ("detail_coverage", COVERAGE)):
-            member = program.get(name, None)
-            if member is not None:
-                member.value = value
+        write_uniforms(program, detail_base_noise=BASE_UNIT, detail_fine_noise=DETAIL_UNIT,
+                       detail_offset_base=tuple(offset_base), detail_offset_fine=tuple(offset_fine),
+                       detail_inv_scale=1.0 / scale, detail_inv_scale_fine=DETAIL_RATIO / scale,
+                       detail_strength=strength, detail_band_strength=BAND_STRENGTH * strength,
+                       detail_band_width=band_width(strength),
+                       detail_layer=(float(layer[0]), 1.0 / max(float(layer[1]), 1e-6)), detail_coverage=COVERAGE)
 
     def read(self) -> tuple[np.ndarray, np.ndarray]:
         """Both textures as float64 in [0, 1], (n, n, n, 4) indexed [x, y, z, channel] (tests, pictures)."""

@@ -20,7 +20,7 @@ import moderngl
 import numpy as np
 
 from atmos.blue_noise import BLUE_NOISE_UNIT, blue_noise_texture
-from atmos.camera import set_camera_uniforms
+from atmos.scene_uniforms import set_camera_uniforms
 from atmos.composition import CLOUD_DISTANCE, composition, distance_desc
 from atmos.graph import PassBuilder, PassContext, RenderPass, TextureDesc
 from atmos.plugin import Plugin

@@ -62,6 +62,7 @@ import numpy as np
 
 from atmos.camera import camera_matrices, gl_matrix
 from atmos.plugins.clouds.volume.offscreen import EDGE
+from atmos.gpu.uniforms import write_uniforms
 
 RESOLUTIONS = (1, 2, 4)
 HISTORY_CLAMP = 1.0        # default clamp weight of moving history (0..1)
@@ -200,26 +201,21 @@ class TemporalClouds:
         prev, write = self._sets[self._current], self._sets[1 - self._current]
         p = self.gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="clouds/raymarch/temporal.frag")
         p["view_basis"].write(matrices.gl("view_basis"))
-        self._set(p, "near", float(camera.near))
-        self._set(p, "far", float(camera.far))
-        self._set(p, "r", r)
-        self._set(p, "offset", (int(ox), int(oy)))
-        self._set(p, "has_depth", depth is not None)
-        self._set(p, "edge", EDGE if depth is not None and low_depth is not None else 1e30)
+        write_uniforms(p, near=float(camera.near), far=float(camera.far), r=r, offset=(int(ox), int(oy)),
+                       has_depth=depth is not None,
+                       edge=EDGE if depth is not None and low_depth is not None else 1e30)
         valid = self._valid and self._prev is not None and not self.is_cut(camera, self._prev[2], self._prev[3])
-        self._set(p, "history_valid", valid)
+        write_uniforms(p, history_valid=valid)
         detect = valid and state == self._prev[0] and detects_change(self.still_frames + 1, r)
         if detect:
             self._flag_drift(low_color, prev, r, (int(ox), int(oy)), depth, matrices, camera)
         if valid:
             prev_state, prev_matrices, prev_position, _ = self._prev
             proj, view = prev_matrices.projection, prev_matrices.view
-            self._set(p, "still", state == prev_state)
-            self._set(p, "detect_change", detect)
+            write_uniforms(p, still=state == prev_state, detect_change=detect)
             p["prev_proj"].write(gl_matrix(proj[[0, 1, 3], :3] @ view[:3, :3]))
-            self._set(p, "cam_delta", tuple(float(c) for c in np.asarray(camera.position) - prev_position))
-            self._set(p, "history_clamp", float(history_clamp))
-            self._set(p, "motion_limit", float(motion_limit))
+            write_uniforms(p, cam_delta=tuple(float(c) for c in np.asarray(camera.position) - prev_position),
+                           history_clamp=float(history_clamp), motion_limit=float(motion_limit))
         for unit, tex in enumerate((low_color, low_distance, prev[1], prev[2], prev[3])):
             tex.use(unit)
         if depth is not None:
@@ -240,11 +236,8 @@ class TemporalClouds:
         """The low-res drift flags of this frame's samples against the last ones in the history set
         ``prev`` (``drift.frag``); ``depth`` (or None: sky) tells where the scene changed."""
         p = self.gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="clouds/raymarch/drift.frag")
-        self._set(p, "r", r)
-        self._set(p, "offset", offset)
-        self._set(p, "has_depth", depth is not None)
-        self._set(p, "near", float(camera.near))
-        self._set(p, "far", float(camera.far))
+        write_uniforms(p, r=r, offset=offset, has_depth=depth is not None, near=float(camera.near),
+                       far=float(camera.far))
         if "view_basis" in p:
             p["view_basis"].write(matrices.gl("view_basis"))
         low_color.use(0)
@@ -262,11 +255,6 @@ class TemporalClouds:
             self._vaos[p] = self.gpu.track(ctx.vertex_array(p, []))
         self._vaos[p].render(moderngl.TRIANGLES, vertices=3)
 
-    @staticmethod
-    def _set(program, name, value):
-        member = program.get(name, None)      # the compiler drops what a variant does not use
-        if member is not None:
-            member.value = value
 
     # -- lifetime ------------------------------------------------------------------------------
     def _make(self, size, r) -> None:

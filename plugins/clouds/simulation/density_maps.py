@@ -30,6 +30,7 @@ import numpy as np
 from atmos.checks import check_shape, is_int
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.plugins.clouds.simulation.smoothing import check_texture_limit, check_volume_texture, check_z_range
+from atmos.gpu.uniforms import write_uniforms
 
 
 def group_grid(nx: int, nz: int, group_size) -> tuple[int, int]:
@@ -110,7 +111,7 @@ class DensityMaps:
         density.use(0)
         self.sums.bind_to_image(0, read=False, write=True)
         # the programs are shared with other DensityMaps on the GpuContext: this one's uniforms each run
-        self._set(self._sum_prog, u_size=self.shape, u_band_height=self.band_height, u_density=0)
+        write_uniforms(self._sum_prog, u_size=self.shape, u_band_height=self.band_height, u_density=0)
         self._sum_prog["u_z0"].value = z0
         self._sum_prog.run(-(-nx // 64), z1 - z0, 1)
         self.ctx.memory_barrier()
@@ -119,7 +120,7 @@ class DensityMaps:
         if gz1 > gz0:
             self.sums.use(0)
             self.max_maps.bind_to_image(0, read=False, write=True)
-            self._set(self._max_prog, u_extent=(nx, nz), u_group=self.group_size, u_grid=self.grid, u_sums=0)
+            write_uniforms(self._max_prog, u_extent=(nx, nz), u_group=self.group_size, u_grid=self.grid, u_sums=0)
             self._max_prog["u_gz0"].value = gz0
             self._max_prog.run(-(-self.grid[0] // 8), -(-(gz1 - gz0) // 8), 1 + self.bands)
             self.ctx.memory_barrier()
@@ -167,9 +168,3 @@ class DensityMaps:
         return (f"DensityMaps(shape={self.shape}, band_height={self.band_height}, "
                 f"group_size={self.group_size}, grid={self.grid})")
 
-    @staticmethod
-    def _set(program, **values) -> None:
-        for name, value in values.items():
-            member = program.get(name, None)
-            if member is not None:
-                member.value = value

@@ -25,6 +25,7 @@ import numpy as np
 from atmos.checks import check_shape, is_int
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.plugins.clouds.automaton import LAYOUTS
+from atmos.gpu.uniforms import write_uniforms
 
 WEIGHTS = ("tent", "box")
 MAX_RADIUS = 8
@@ -190,13 +191,8 @@ class Smoother:
         the GpuContext use the same program, so they are written before every run)."""
         defines = {"FORMAT": FORMATS[dtype], "LAYOUT_PACKED": int(self.layout == "packed")}
         program = self.gpu.program(compute_shader="clouds/simulation/smooth.comp", defines=defines)
-        values = {"u_size": self.shape, "u_radius": self.radius, "u_nwx": self.words_x,
-                  "u_cld_offset": self._cld_offset, "u_total": self.total,
-                  "u_min_density": MIN_DENSITY[dtype]}
-        for name, value in values.items():
-            member = program.get(name, None)
-            if member is not None:
-                member.value = value
+        write_uniforms(program, u_size=self.shape, u_radius=self.radius, u_nwx=self.words_x,
+                       u_cld_offset=self._cld_offset, u_total=self.total, u_min_density=MIN_DENSITY[dtype])
         for name, values in self._arrays.items():
             member = program.get(name, None)
             if member is not None:

@@ -6,6 +6,7 @@ from atmos.plugins.clouds.volume.light import DEFAULT_OCTAVES, light_uniforms
 from atmos.plugins.clouds.volume.sets import CloudSets
 from atmos.plugins.clouds.light.columns import COLUMNS
 from atmos.plugins.clouds.light.diffusion import DIFFUSION
+from atmos.gpu.uniforms import write_uniforms
 
 UNITS = (0, 1, 2, 3, 10, 11, 16, 17)   # density, transmittance, columns, diffusion field (each a, b)
 
@@ -33,13 +34,9 @@ def bind_volume(program, sim, sampler, sun: Sun | None, octaves=DEFAULT_OCTAVES,
     for unit in UNITS:
         sampler.use(unit)
     program["t"].value = float(t)
-    if "a_shift" in program:
-        program["a_shift"].value = (sim if isinstance(sim, CloudSets) else sim.sets()).a_shift
-    values = {"has_shading": int(shading), "edge_fade": float(sim.settings.edge_fade),
-              **light_uniforms(sim.settings, sun, octaves, diffusion if field else 0.0, layer)}
-    for name, value in values.items():
-        if name in program:
-            program[name].value = value
+    write_uniforms(program, light_uniforms(sim.settings, sun, octaves, diffusion if field else 0.0, layer),
+                   a_shift=(sim if isinstance(sim, CloudSets) else sim.sets()).a_shift, has_shading=int(shading),
+                   edge_fade=float(sim.settings.edge_fade))
     return float(t)
 
 

@@ -23,6 +23,7 @@ import numpy as np
 from atmos.checks import check_shape
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.plugins.clouds.weather.components import check_ellipsoid_array
+from atmos.gpu.uniforms import write_uniforms
 
 CHUNK = 256
 _FORMATS = {"f4": ("r32f", "rgba32f", np.float32), "f2": ("r16f", "rgba16f", np.float16)}
@@ -80,9 +81,7 @@ class RegionVolume:
             if gy > int(self._max_groups[1]):
                 raise ValueError(f"{len(a)} ellipsoids need {len(items)} work groups, more than this GPU "
                                  f"can dispatch at once; use fewer or smaller ellipsoids")
-            self._set(self._scatter, "size", self.shape)
-            self._set(self._scatter, "item_count", len(items))
-            self._set(self._scatter, "groups_x", gx)
+            write_uniforms(self._scatter, size=self.shape, item_count=len(items), groups_x=gx)
             for binding, name in enumerate(("ellipsoids", "boxes", "items")):
                 self._buffers[name].bind_to_storage_buffer(binding)
             self._cells.bind_to_storage_buffer(3)
@@ -90,7 +89,7 @@ class RegionVolume:
             self.ctx.memory_barrier()
         self._cells.bind_to_storage_buffer(3)
         self.texture.bind_to_image(0, read=False, write=True)
-        self._set(self._resolve, "size", self.shape)
+        write_uniforms(self._resolve, size=self.shape)
         self._resolve.run(-(-nx // 8), -(-ny // 8), -(-nz // 4))
         self.ctx.memory_barrier()
         return self.texture
@@ -117,9 +116,8 @@ class RegionVolume:
         nx, ny, nz = self.shape
         self.texture.use(0)
         self.prob_texture.bind_to_image(0, read=False, write=True)
-        self._set(self._probs, "region", 0)
-        self._set(self._probs, "size", self.shape)
-        self._set(self._probs, "scales", (hum_scale, act_scale, ext_scale, vanish_threshold))
+        write_uniforms(self._probs, region=0, size=self.shape,
+                       scales=(hum_scale, act_scale, ext_scale, vanish_threshold))
         self._probs.run(-(-nx // 8), -(-ny // 8), -(-nz // 4))
         self.ctx.memory_barrier()
         return self.prob_texture
@@ -151,10 +149,6 @@ class RegionVolume:
     def _program(self, name, defines):
         return self.gpu.program(compute_shader=name, defines=defines)
 
-    @staticmethod
-    def _set(program, name, value) -> None:
-        if name in program:
-            program[name].value = value
 
     def _check_alive(self) -> None:
         if self._released:

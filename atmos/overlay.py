@@ -1,8 +1,8 @@
 """Frame-time overlay: a bar graph of recent frame times (green < 16.7 ms, yellow < 33.3 ms, red above).
 
-Toggle with F1 in a window (``OverlayPlugin.configure(visible=...)``). The numbers are kept even
-when hidden, for the window caption and for benchmarks; per-pass timings come from the render
-graph's timer queries.
+F1 shows or hides it (its own system reads :class:`atmos.Input`; or ``OverlayPlugin.configure(visible=...)``).
+The numbers are kept even when hidden, for the window caption and for benchmarks; per-pass timings
+come from the render graph's timer queries.
 """
 from __future__ import annotations
 
@@ -14,6 +14,8 @@ import numpy as np
 
 from atmos.checks import CheckedSettings, check_bool, check_int
 from atmos.graph import FullscreenPass, PassBuilder, PassContext
+from atmos.input import Input
+from atmos.keys import key
 from atmos.plugin import Plugin
 from atmos.render_core import SCREEN
 
@@ -112,5 +114,12 @@ class OverlayPlugin(Plugin):
     def build(self, app) -> None:
         app.insert_resource(self.times)
         app.add_system(record_frame_time, "update", label="record_frame_time")
+        app.add_system(self.toggle, "update", label="overlay_toggle")
         if app.graph is not None:
             app.graph.add_pass(OverlayPass(self))
+
+    def toggle(self, app) -> None:
+        """F1 pressed this frame (in the App's :class:`atmos.Input`, if it has one): show or hide."""
+        inp = app.get_resource(Input)
+        if inp is not None and key.F1 in inp.pressed:
+            self.configure(visible=not self.settings.visible)
