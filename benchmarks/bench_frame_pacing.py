@@ -1,6 +1,6 @@
 """Frame pacing: a heavy simulation split into slices over frames vs. a whole step in one frame.
 
-A synthetic heavy job (``shaders/test/frames_heavy.comp``: a few hundred rounds of math per texel
+A synthetic heavy job (``tests/data/shaders/frames_heavy.comp``: a few hundred rounds of math per texel
 over a 128×32×128 rgba16f volume, split into 32 slices of 4 z-layers) writes texture set C while a
 light per-frame draw shows mix(A, B, t). Every frame ends with ``ctx.finish()`` so the frame time is
 the real GPU time. Prints median, p99 and max frame time per mode, and writes the per-frame times to
@@ -19,13 +19,13 @@ from pathlib import Path
 import numpy as np
 
 from atmos.frames import FrameScheduler, SlicedJob, SliceTask, TripleSet
-from atmos.gpu import create_headless
-
+from atmos.gpu import add_shader_path, create_headless
 from atmos.graph import TextureDesc
 
 VOLUME = (128, 32, 128)
 SLICES = 32
 ROOT = Path(__file__).resolve().parents[1]
+add_shader_path(ROOT / "tests" / "data" / "shaders", prefix="test")   # the synthetic job the tests also run
 
 
 def heavy_job(gpu, iterations: int) -> SlicedJob:

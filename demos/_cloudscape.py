@@ -17,7 +17,6 @@ from atmos.input import Input
 from atmos.keys import key
 from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
 from atmos.plugins.clouds.sprites import CloudRenderPlugin
-from atmos.plugins.clouds.weather.example import example_weather
 from atmos.plugins.clouds.far_field import CloudFarFieldPlugin
 from atmos.plugins.clouds.shadows import CloudShadowsPlugin
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
@@ -26,7 +25,7 @@ from atmos.plugins.fog import FogPlugin
 from atmos.plugins.light_shafts import LightShaftsPlugin
 from atmos.plugins.sky import SkyPlugin
 from atmos.plugins.terrain import TerrainPlugin
-from atmos.plugins.clouds.weather import VolumeOrigin
+from atmos.plugins.clouds.weather import VolumeOrigin, example_weather
 
 SHAPE = (128, 16, 128)
 CELL = (40.0, 40.0, 40.0)

@@ -1,7 +1,6 @@
 """cloud_field: clouds forming from an empty sky and staying stable, seen from the top."""
 from atmos.defaults import DefaultPlugins
-from atmos.plugins.clouds import CloudSettings, CloudsPlugin
-from atmos.plugins.clouds.simulation.top_view import CloudTopViewPlugin
+from atmos.plugins.clouds import CloudSettings, CloudsPlugin, CloudTopViewPlugin
 from atmos.plugins.clouds.weather import WeatherSettings
 
 TITLE = "the cloud automaton forming clouds from an empty sky, top view of the summed slices"

@@ -13,8 +13,7 @@ from atmos.keys import key
 from atmos.defaults import DefaultPlugins
 from atmos.demo_registry import DemoSettings
 from atmos.lighting import Sun
-from atmos.plugins.fog import FogPlugin
-from atmos.plugins.fog.settings import PAPER_RESOLUTIONS
+from atmos.plugins.fog import PAPER_RESOLUTIONS, FogPlugin
 from atmos.plugins.sky_gradient import SkyGradientPlugin
 from atmos.plugins.terrain import TerrainPlugin
 

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from atmos import Camera, ChaseCameraPlugin, DefaultPlugins, Input, Transform, key
-from atmos.plugins.clouds.presets import CloudSky
+from atmos.plugins.clouds import CloudSky
 from atmos.plugins.daylight import DaylightPlugin, TimeOfDay
 from atmos.plugins.fog import FogPlugin
 from atmos.plugins.mesh import MeshInstance, MeshPlugin, box, glider

@@ -6,12 +6,14 @@ import shutil
 
 import pytest
 
-from atmos.gpu import create_headless
+from atmos.gpu import add_shader_path, create_headless
 from atmos.gpu.portability import COMPILER, ENV
 
 os.environ.setdefault("ATMOS_HEADLESS", "1")
 if shutil.which(COMPILER):
     os.environ.setdefault(ENV, "1")
+TEST_SHADERS = os.path.join(os.path.dirname(__file__), "data", "shaders")
+add_shader_path(TEST_SHADERS, prefix="test")          # the tests' own GLSL: "test/solid.frag", ...
 
 
 @pytest.fixture(scope="session")

@@ -7,8 +7,8 @@ import pytest
 
 from atmos.graph import PassBuilder, RenderGraph, RenderPass
 from atmos.plugins.clouds.sprites import CloudRenderPlugin
-from atmos.plugins.clouds.volume import offscreen_reference as ref
-from atmos.plugins.clouds.volume.offscreen import CLOUD_COLOR, CLOUD_DEPTH, OffscreenClouds
+from atmos import offscreen_reference as ref
+from atmos.offscreen import CLOUD_COLOR, CLOUD_DEPTH, OffscreenLayer
 from atmos.render_core import COLOR, DEPTH
 from tests.test_cloud_render import BELOW, frame, look, save, scene
 
@@ -25,7 +25,7 @@ def random_depth(rng, size):
 
 
 class OffscreenProbe(RenderPass):
-    """Runs OffscreenClouds.begin, fills the low-res colour with given clouds, then end; keeps the low depth."""
+    """Runs OffscreenLayer.begin, fills the low-res colour with given clouds, then end; keeps the low depth."""
     name = "probe"
     phase = "translucent"
 
@@ -37,10 +37,10 @@ class OffscreenProbe(RenderPass):
         builder.read(DEPTH)
         builder.read(COLOR)
         builder.write(COLOR)
-        OffscreenClouds.declare(builder, self.size, self.factor)
+        OffscreenLayer.declare(builder, self.size, self.factor)
 
     def prepare(self, gpu) -> None:
-        self.offscreen = OffscreenClouds(gpu)
+        self.offscreen = OffscreenLayer(gpu)
 
     def execute(self, frame) -> None:
         self.offscreen.begin(frame, self.factor)

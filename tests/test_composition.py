@@ -12,7 +12,8 @@ from atmos.plugins.clouds.sprites import CloudRenderPlugin
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
 from atmos.plugins.fog import FogPlugin, FogSettings, apply_fog
 from atmos.plugins.fog.factors import apply_fog_ref
-from atmos.plugins.fog.sky_color import SAMPLES, horizon_colors, sky_fog_color
+from atmos.plugins.fog.sky_color import SAMPLES, horizon_table, sky_fog_color
+from atmos.plugins.sky.light import horizon_colors
 from atmos.plugins.sky import SkySettings
 from atmos.plugins.clouds.weather import VolumeOrigin
 
@@ -50,7 +51,7 @@ def test_apply_fog_fogs_a_cloud_layer_by_its_own_distance_like_the_float64_refer
     color, distance, cloud, dirs, positions = layers(rng)
     settings = FogSettings(mode=mode, density=6e-4, sky=sky, fog_color=(1.0, 0.9, 0.8), color_from=color_from,
                            **extra)
-    horizon = horizon_colors(Sun.from_angles(5.0, 30.0), SkySettings()) if color_from == "sky" else None
+    horizon = horizon_colors(Sun.from_angles(5.0, 30.0), SkySettings(), SAMPLES) if color_from == "sky" else None
     got = apply_fog(gpu, color, distance, mode, 6e-4, (1.0, 0.9, 0.8), sky=sky, far=8000.0, cloud=cloud,
                     directions=dirs, positions=positions, horizon=horizon, color_from=color_from, **extra)
     want = apply_fog_ref(color, distance, settings, positions=positions, far=8000.0, cloud=cloud, directions=dirs,
@@ -65,13 +66,13 @@ def test_apply_fog_fogs_a_cloud_layer_by_its_own_distance_like_the_float64_refer
 
 def test_the_sky_fog_colour_is_the_horizon_sky_in_the_rays_azimuth():
     sun = Sun.from_angles(4.6, 80.0)
-    table = horizon_colors(sun, SkySettings())
+    table = horizon_colors(sun, SkySettings(), SAMPLES)
     assert table.shape == (SAMPLES, 3) and np.isfinite(table).all()
     toward = sky_fog_color(unit([np.sin(np.radians(80)), 0.0, -np.cos(np.radians(80))]), table, (1, 1, 1))
     away = sky_fog_color(unit([-np.sin(np.radians(80)), 0.0, np.cos(np.radians(80))]), table, (1, 1, 1))
     assert toward.sum() > 2.0 * away.sum(), "the horizon glows toward the low sun"
     assert toward[0] > toward[2], "and is warm there"
-    flat = horizon_colors(Sun(ambient=(0.2, 0.3, 0.4)))          # no sky plugin: the Sun's ambient
+    flat = horizon_table(Sun(ambient=(0.2, 0.3, 0.4)))          # no sky plugin: the Sun's ambient
     assert np.allclose(sky_fog_color(unit([1.0, 0.3, 2.0]), flat, (0.5, 1, 1)), [0.1, 0.3, 0.4])
     with pytest.raises(ValueError, match="FogSettings.color_from"):
         FogSettings(color_from="sun")

@@ -4,6 +4,7 @@ import pytest
 from atmos.gpu import ShaderError
 from atmos.gpu.context import GpuError, _check_version
 from atmos.gpu.shaders import load_source
+from conftest import TEST_SHADERS
 
 
 def test_headless_context_is_gl43(gpu, ctx):
@@ -29,13 +30,13 @@ def test_unusable_backend_is_a_clear_error():
 def test_compile_error_names_file_and_line(gpu, ctx):
     with pytest.raises(ShaderError) as info:
         gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="test/broken.frag")
-    assert "shaders/test/broken.frag:7" in str(info.value)
+    assert f"{TEST_SHADERS}/broken.frag:7" in str(info.value)
 
 
 def test_error_in_included_file_names_the_include(gpu, ctx):
     with pytest.raises(ShaderError) as info:
         gpu.program(compute_shader="test/broken_include.comp")
-    assert "shaders/test/broken_lib.glsl:4" in str(info.value)
+    assert f"{TEST_SHADERS}/broken_lib.glsl:4" in str(info.value)
 
 
 def test_include_and_defines(ctx):

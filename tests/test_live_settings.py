@@ -33,7 +33,7 @@ from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
 from atmos.plugins.clouds.raymarch.plugin import LOW_COLOR as RAYMARCH_LOW_COLOR
 from atmos.plugins.clouds.sprites import CloudRenderPlugin
 from atmos.plugins.clouds.weather.example import example_weather
-from atmos.plugins.clouds.volume.offscreen import CLOUD_COLOR
+from atmos.offscreen import CLOUD_COLOR
 from atmos.plugins.clouds.shadows import CloudShadowsPlugin
 from atmos.plugins.clouds.far_field import CloudFarFieldPlugin
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin

@@ -12,7 +12,7 @@ from atmos.defaults import DefaultPlugins
 from atmos.lighting import Sun
 from atmos.plugins.daylight import DaylightPlugin
 from atmos.plugins.fog import FogPlugin
-from atmos.plugins.fog.sky_color import horizon_directions
+from atmos.plugins.sky.light import horizon_directions
 from atmos.plugins.ground import GroundPlugin
 from atmos.plugins.sky import AtmosphereSettings, SkyPlugin, SkySettings, physical_sky_color
 from atmos.plugins.sky import atmosphere as ref

@@ -46,7 +46,7 @@ def reference_rays(camera: Camera, size) -> np.ndarray:
 
 
 def render_view_rays(gpu, camera: Camera, depth: np.ndarray) -> np.ndarray:
-    """(h, w, 4) output of shaders/test/view_ray.frag (unit direction, distance), the camera's
+    """(h, w, 4) output of tests/data/shaders/view_ray.frag (unit direction, distance), the camera's
     uniforms set by set_camera_uniforms."""
     h, w = depth.shape
 

@@ -14,5 +14,17 @@ from atmos.plugins.clouds.simulation.plugin import CloudsPlugin
 from atmos.plugins.clouds.simulation.smoothing import FORMATS, Smoother, read_volume, slice_range
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CloudSets
 
-__all__ = ["CLOUD_SETS", "CloudSets", "CloudSettings", "CloudSimulation", "CloudsPlugin", "DensityMaps", "FORMATS", "Smoother",
-           "read_volume", "reference", "slice_range"]
+__all__ = ["CLOUD_SETS", "CloudSets", "CloudSettings", "CloudSimulation", "CloudSky", "CloudTopViewPlugin", "CloudsPlugin",
+           "DensityMaps", "FORMATS", "Smoother", "read_volume", "reference", "slice_range"]
+
+_LAZY = {"CloudSky": "atmos.plugins.clouds.presets", "CloudTopViewPlugin": "atmos.plugins.clouds.simulation.top_view"}
+
+
+def __getattr__(name: str):
+    """The presets and the top view on first use (they bring the renderers: a pass that only reads the
+    published sets does not need them)."""
+    if name not in _LAZY:
+        raise AttributeError(f"module 'atmos.plugins.clouds' has no attribute {name!r}")
+    from importlib import import_module
+    value = globals()[name] = getattr(import_module(_LAZY[name]), name)
+    return value

@@ -13,12 +13,15 @@ from atmos.checks import check_vec
 from atmos.composition import composition
 from atmos.gpu.context import release_gl, require_gpu
 from atmos.plugin import Plugin
+from atmos.plugins.fog.medium import FogMedium
 from atmos.plugins.fog.noise import NoiseVolumes
 from atmos.plugins.fog.post import FogPass, draw_state, fog_program, restore_state, set_fog_uniforms
-from atmos.plugins.fog.settings import MODES, FogSettings
+from atmos.plugins.fog.settings import MODES, PAPER_RESOLUTIONS, FogSettings
+from atmos.plugins.fog.sky_color import SAMPLES, horizon_table
+from atmos.plugins.sky import SkyLight
 from atmos.gpu.uniforms import write_uniforms
 
-__all__ = ["FogPlugin", "FogSettings", "FogPass", "apply_fog", "MODES"]
+__all__ = ["FogMedium", "FogPlugin", "FogSettings", "FogPass", "apply_fog", "MODES", "PAPER_RESOLUTIONS"]
 
 
 class FogPlugin(Plugin):
@@ -40,22 +43,17 @@ class FogPlugin(Plugin):
         self.composition.media_writers.add("fog")  # a local medium the aerial perspective mixes with
         self.fog_pass = FogPass(self)
         app.graph.add_pass(self.fog_pass)
+        app.insert_resource(FogMedium(self))
 
     def finish(self, app) -> None:
-        from atmos.plugins.sky import SkyPlugin
-        self._sky = next((p for p in app.plugins if isinstance(p, SkyPlugin)), None)
-
-    def sky_settings(self):
-        """The App's SkyPlugin's settings (``color_from="sky"``), None without one."""
-        return None if self._sky is None else self._sky.settings
+        self._sky = app.get_resource(SkyLight)
 
     def horizon(self, view):
         """This frame's horizon table of ``color_from="sky"`` (:mod:`.sky_color`: the App's sky seen
         from the camera's altitude, at the SceneView ``view``'s sun), None with a fixed colour."""
         if self.settings.color_from != "sky":
             return None
-        from atmos.plugins.fog.sky_color import horizon_colors
-        return horizon_colors(view.sun, self.sky_settings(), altitude=max(float(view.camera.position[1]), 0.0))
+        return horizon_table(view.sun, self._sky, altitude=max(float(view.camera.position[1]), 0.0))
 
     def cleanup(self, app) -> None:
         if self.composition is not None:
@@ -143,7 +141,6 @@ def apply_fog(gpu, color, distance, mode: str = "exp2", density: float = 0.044, 
 
 def _check_layers(shape, cloud, directions, horizon, settings):
     """apply_fog's cloud layer, view directions and horizon table, checked and made contiguous."""
-    from atmos.plugins.fog.sky_color import SAMPLES
 
     h, w = shape
     needs_dirs = cloud is not None or settings.color_from == "sky"
@@ -169,7 +166,7 @@ def _check_layers(shape, cloud, directions, horizon, settings):
         horizon = np.asarray(horizon if horizon is not None else (), np.float64)
         if horizon.shape != (SAMPLES, 3) or not np.isfinite(horizon).all() or (horizon < 0).any():
             raise ValueError(f"horizon must be ({SAMPLES}, 3) non-negative sky colours for color_from='sky' "
-                             f"(atmos.plugins.fog.sky_color.horizon_colors), got shape {horizon.shape}")
+                             f"(atmos.plugins.fog.sky_color.horizon_table), got shape {horizon.shape}")
     return cloud, directions, horizon
 
 

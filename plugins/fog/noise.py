@@ -2,7 +2,7 @@
 
 Octave i is periodic gradient noise n_i with an integer lattice of period P_i = ``resolutions[i]``
 cells per tile (gradients: one of Perlin's 12 cube-edge vectors, picked by ``lowbias32``-based
-:func:`atmos.hashing.hash_counter` of the wrapped cell index, exactly as ``shaders/fog/noise.glsl``).
+:func:`atmos.hashing.hash_counter` of the wrapped cell index, exactly as ``shaders/lib/gradient_noise.glsl``: :mod:`atmos.gradient_noise`).
 A world point x maps to tile coordinates u_i = R_y(turn_i) (x - wind_i t) / tile_size and to lattice
 coordinates u_i P_i. The texture variant stores n_i at texel centres, (j + 0.5) / texels_per_cell
 lattice units, in a (P_i texels_per_cell)^3 r32f volume sampled with repeat + trilinear filtering.
@@ -15,40 +15,15 @@ from functools import lru_cache
 import numpy as np
 
 from atmos.gpu.context import GpuContext, require_gpu
-from atmos.hashing import hash_counter, stream_key
+from atmos.gradient_noise import periodic_noise, sample_repeat_trilinear
+from atmos.hashing import stream_key
 
 FOG_RULE = 0xF06  # stream id of the fog gradients: stream_key(seed, 0, FOG_RULE, octave)
-GRADIENTS = np.array([(1, 1, 0), (-1, 1, 0), (1, -1, 0), (-1, -1, 0), (1, 0, 1), (-1, 0, 1),
-                      (1, 0, -1), (-1, 0, -1), (0, 1, 1), (0, -1, 1), (0, 1, -1), (0, -1, -1)], np.float64)
-
-
 @lru_cache(maxsize=64)
 def octave_key(seed: int, octave: int) -> tuple[int, int]:
     """The (ka, kb) hash keys of one octave's gradients (cached: the fog pass writes them every frame)."""
     ka, kb = stream_key(seed, 0, FOG_RULE, octave)
     return int(ka), int(kb)
-
-
-def _fade(t):
-    return t * t * t * (t * (t * 6.0 - 15.0) + 10.0)
-
-
-def periodic_noise(q, period: int, key) -> np.ndarray:
-    """float64 noise at lattice coordinates ``q`` (..., 3); periodic with ``period`` on every axis."""
-    q = np.asarray(q, np.float64)
-    q = q - period * np.floor(q / period)
-    c = np.floor(q)
-    f = q - c
-    i = c.astype(np.int64)
-    u = _fade(f)
-    total = np.zeros(q.shape[:-1])
-    for corner in np.ndindex(2, 2, 2):
-        w = (i + corner) % period
-        counter = w[..., 0] + period * (w[..., 1] + period * w[..., 2])
-        g = GRADIENTS[hash_counter(counter, *key) % np.uint32(12)]
-        weight = np.prod(np.where(np.array(corner, bool), u, 1.0 - u), axis=-1)
-        total += weight * np.sum(g * (f - corner), axis=-1)
-    return total
 
 
 def noise_volume_ref(period: int, texels_per_cell: int, key) -> np.ndarray:
@@ -57,20 +32,6 @@ def noise_volume_ref(period: int, texels_per_cell: int, key) -> np.ndarray:
     j = (np.arange(n) + 0.5) / texels_per_cell
     q = np.stack(np.meshgrid(j, j, j, indexing="ij"), axis=-1)
     return periodic_noise(q, period, key)
-
-
-def sample_repeat_trilinear(volume: np.ndarray, u) -> np.ndarray:
-    """GL ``texture()`` of ``volume`` [x, y, z] at normalised ``u`` (..., 3): repeat wrap, linear filter."""
-    shape = np.array(volume.shape)
-    x = np.asarray(u, np.float64) * shape - 0.5
-    i0 = np.floor(x).astype(np.int64)
-    t = x - i0
-    out = np.zeros(x.shape[:-1])
-    for corner in np.ndindex(2, 2, 2):
-        idx = (i0 + corner) % shape
-        weight = np.prod(np.where(np.array(corner, bool), t, 1.0 - t), axis=-1)
-        out += weight * volume[idx[..., 0], idx[..., 1], idx[..., 2]]
-    return out
 
 
 def tile_coords(world, time: float, wind, turn: float, tile_size: float) -> np.ndarray:

@@ -1,7 +1,7 @@
 """The march mode of the light shafts: sun light scattered by a thin haze along each view ray,
 shadowed by the clouds through the ground shadows' density maps (shaders/light_shafts/march.frag),
 at low resolution and upsampled by depth with the off-screen clouds' draws
-(:class:`~atmos.plugins.clouds.volume.offscreen.OffscreenClouds`). Reference: :func:`.reference.march_shafts`."""
+(:class:`~atmos.offscreen.OffscreenLayer`). Reference: :func:`.reference.march_shafts`."""
 from __future__ import annotations
 
 import numpy as np
@@ -11,12 +11,11 @@ from atmos.scene_uniforms import set_camera_uniforms
 from atmos.composition import CLOUD_DISTANCE
 from atmos.graph import PassBuilder, PassContext
 from atmos.lighting import unit_sun
-from atmos.plugins.clouds.far_field.layer import FAR_FIELD
-from atmos.plugins.clouds.volume.offscreen import OffscreenClouds
-from atmos.plugins.clouds.shadows.plugin import column_uniforms
-from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CloudSets
+from atmos.plugins.clouds import CLOUD_SETS, CloudSets
+from atmos.plugins.clouds.far_field import FAR_FIELD
+from atmos.plugins.clouds.shadows import column_uniforms
+from atmos.offscreen import OffscreenLayer
 from atmos.plugins.light_shafts.settings import FLOAT32_MAX
-from atmos.plugins.sky.luts import SKY_LUTS, atmosphere_defines, set_atmosphere_uniforms, view_radius
 from atmos.render_core import COLOR, DEPTH
 
 SHAFT_COLOR = "light_shafts_march"     # low-res (in-scattered light, transmittance)
@@ -40,7 +39,7 @@ class MarchedShafts:
 
     def __init__(self, gpu):
         self.gpu = gpu
-        self.offscreen = OffscreenClouds(gpu, SHAFT_COLOR, SHAFT_DEPTH)
+        self.offscreen = OffscreenLayer(gpu, SHAFT_COLOR, SHAFT_DEPTH)
         self.jitter = None                  # the blue-noise tile of the rays' start offsets (first use)
 
     def release(self) -> None:
@@ -50,17 +49,13 @@ class MarchedShafts:
 
     def program(self, far_field: bool, fog=None, aerial=None):
         """The march, with the far field's shadows beyond the volume (column.glsl's CLOUD_FAR_FIELD) or
-        without; ``fog`` (FogSettings): the variant that shadows the fog's in-scatter (SHAFT_FOG; its
-        turbulence evaluated procedurally, the fog's noise volumes are not bound here); ``aerial``
-        (the SkyPlugin): the variant that shadows the sky's aerial perspective (SHAFT_AERIAL)."""
+        without; ``fog`` (the FogMedium): the variant that shadows the fog's in-scatter (SHAFT_FOG);
+        ``aerial`` (the SkyLight): the variant that shadows the sky's aerial perspective (SHAFT_AERIAL)."""
         defines = {"CLOUD_FAR_FIELD": 1} if far_field else {}
         if aerial is not None:
-            defines.update(SHAFT_AERIAL=1, **atmosphere_defines())
+            defines.update(SHAFT_AERIAL=1, **aerial.aerial_defines())
         if fog is not None:
-            from atmos.plugins.fog.settings import MODES
-            from atmos.plugins.fog.sky_color import SAMPLES
-            defines.update(SHAFT_FOG=1, FOG_MODE=MODES[fog.mode], FOG_OCTAVES=fog.octaves, FOG_PROCEDURAL=1,
-                           FOG_SKY_COLOR=int(fog.color_from == "sky"), FOG_HORIZON_SAMPLES=SAMPLES)
+            defines.update(SHAFT_FOG=1, **fog.defines())
         return self.gpu.program(defines or None, vertex_shader="lib/fullscreen.vert",
                                 fragment_shader="light_shafts/march.frag")
 
@@ -68,10 +63,10 @@ class MarchedShafts:
     def declare(builder: PassBuilder, size, factor: int, clouds: bool, far_field: bool = False, fog=None,
                 aerial=None) -> None:
         """``far_field``: the graph imports a CloudFarFieldPlugin's layer; the rays see its shadows too.
-        ``fog``: the App's FogPlugin; its clouds' own distance is read when the fog reads one.
-        ``aerial``: the SkyPlugin whose aerial perspective the march shadows (its LUTs are read, and the
+        ``fog``: the App's FogMedium; its clouds' own distance is read when the fog reads one.
+        ``aerial``: the SkyLight whose aerial perspective the march shadows (its LUTs are read, and the
         clouds' own distance when its pass reads one)."""
-        OffscreenClouds.declare(builder, size, factor, color=SHAFT_COLOR, depth=SHAFT_DEPTH)
+        OffscreenLayer.declare(builder, size, factor, color=SHAFT_COLOR, depth=SHAFT_DEPTH)
         builder.read(DEPTH)
         builder.read(COLOR)
         builder.write(COLOR)
@@ -79,11 +74,11 @@ class MarchedShafts:
             builder.read(CLOUD_SETS)
             if far_field:
                 builder.read(FAR_FIELD)
-        if fog is not None and fog.composition is not None and fog.composition.distance:
+        if fog is not None and fog.reads_cloud_distance:
             builder.read(CLOUD_DISTANCE)
         if aerial is not None:
-            builder.read(SKY_LUTS)
-            if aerial.composition.distance:
+            aerial.declare_aerial(builder)
+            if aerial.reads_cloud_distance:
                 builder.read(CLOUD_DISTANCE)          # (a second read of the same is the same read)
 
     def execute(self, frame: PassContext, settings, clouds: bool, fog=None, aerial=None) -> None:
@@ -96,7 +91,7 @@ class MarchedShafts:
         frame.reset_state()
         frame.framebuffer(color=[SHAFT_COLOR]).use()
         far_field = clouds and frame.declares(FAR_FIELD)
-        p = self.program(far_field, fog.settings if fog is not None else None, aerial)
+        p = self.program(far_field, fog, aerial)
         frame.resource(SHAFT_DEPTH).use(2)
         if self.jitter is None:
             self.jitter = blue_noise_texture(self.gpu.ctx)
@@ -130,18 +125,14 @@ class MarchedShafts:
     @staticmethod
     def fog_uniforms(frame: PassContext, program, fog, settings) -> None:
         """The fog's factor and colour (as its own pass sets them) and its clouds' distance (unit 3)."""
-        from atmos.plugins.fog.post import set_fog_uniforms
-        view, fs = frame.view, fog.settings
-        set_fog_uniforms(program, fs, view.time + fs.time_offset, fog.horizon(view))
+        fog.set_uniforms(program, frame.view)
         bind_cloud_distance(frame, program)
         program["fog_sun_share"].value = settings.fog_sun_share
 
     @staticmethod
     def aerial_uniforms(frame: PassContext, program, sky) -> None:
         """The sky's atmosphere (its LUTs bound, the camera's radius) and the clouds' distance (unit 3)."""
-        frame.resource(SKY_LUTS).use()
-        set_atmosphere_uniforms(program, sky.settings.atmosphere)
-        program["view_r"].value = view_radius(sky.settings.atmosphere, frame.view.camera)
+        sky.set_aerial_uniforms(frame, program)
         bind_cloud_distance(frame, program)
 
 

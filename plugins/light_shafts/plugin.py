@@ -6,13 +6,13 @@ import math
 
 from atmos.graph import PassBuilder, PassContext, RenderPass, TextureDesc
 from atmos.plugin import Plugin
-from atmos.plugins.clouds.far_field.layer import FAR_FIELD
-from atmos.plugins.clouds.volume.sets import CLOUD_SETS
+from atmos.plugins.clouds import CLOUD_SETS
+from atmos.plugins.clouds.far_field import FAR_FIELD
+from atmos.plugins.fog import FogMedium
 from atmos.plugins.light_shafts.march import MarchedShafts
 from atmos.plugins.light_shafts.settings import LightShaftSettings, blur_scale
 from atmos.plugins.light_shafts.screen_sun import screen_sun
-from atmos.plugins.sky import SkyPlugin
-from atmos.plugins.sky.aerial import active
+from atmos.plugins.sky import SkyLight
 from atmos.render_core import COLOR, DEPTH
 
 MASK = "light_shafts_mask"
@@ -121,8 +121,8 @@ class LightShaftsPlugin(Plugin):
     def __init__(self, settings: LightShaftSettings | None = None, **fields):
         super().__init__(settings, **fields)
         self.gpu = self.graph = None
-        self.fog = None                 # the App's FogPlugin (finish), whose in-scatter the march shadows
-        self.sky = None                 # the App's SkyPlugin (finish): its aerial perspective, when on
+        self.fog = None                 # the App's FogMedium (finish), whose in-scatter the march shadows
+        self.sky = None                 # the App's SkyLight (finish): its aerial perspective, when on
 
     def build(self, app) -> None:
         if app.graph is None:
@@ -131,11 +131,10 @@ class LightShaftsPlugin(Plugin):
         app.graph.add_pass(LightShaftsPass(self))
 
     def finish(self, app) -> None:
-        from atmos.plugins.fog import FogPlugin
-        self.fog = next((p for p in app.plugins if isinstance(p, FogPlugin)), None)
-        self.sky = next((p for p in app.plugins if isinstance(p, SkyPlugin)), None)
+        self.fog = app.get_resource(FogMedium)
+        self.sky = app.get_resource(SkyLight)
 
     def aerial(self):
-        """The SkyPlugin when its aerial perspective is on (the march then takes away the air's
+        """The SkyLight when its aerial perspective is on (the march then takes away the air's
         in-scatter in cloud shadow, with a fog as well both, each dimmed by the other); else None."""
-        return self.sky if self.sky is not None and active(self.sky.settings) else None
+        return self.sky if self.sky is not None and self.sky.aerial else None

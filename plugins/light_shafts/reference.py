@@ -8,10 +8,10 @@ from __future__ import annotations
 import numpy as np
 
 from atmos.blue_noise import blue_noise
-from atmos.plugins.clouds.shadows.reference import zero_border_bilinear
+from atmos.plugins.clouds.shadows import reference as shadows_reference
 from atmos.plugins.light_shafts.settings import blur_scale
 from atmos.render_core import HDR_MAX
-from atmos.plugins.clouds.light.medium import phase
+from atmos.phase import phase
 
 LUMA = np.array([0.2126, 0.7152, 0.0722])
 
@@ -53,7 +53,7 @@ def radial_blur(mask, sun_uv, settings, strength: float = 1.0) -> np.ndarray:
         texel = (uv - i * step) * np.array([w, h]) - 0.5          # (h, w, 2) as (x, y)
         p = texel[..., ::-1]                                        # index order of mask: (row, column)
         for ch in range(channels):
-            out[..., ch] += zero_border_bilinear(mask[..., ch], p) * falloff
+            out[..., ch] += shadows_reference.zero_border_bilinear(mask[..., ch], p) * falloff
         falloff *= settings.decay
     return np.minimum(out * blur_scale(settings, strength), HDR_MAX)
 

@@ -10,8 +10,9 @@ effects that want the sky's light; ``evaluate_sky`` computes the pass's colours 
 """
 from atmos.plugins.sky.atmosphere_settings import AtmosphereSettings
 from atmos.plugins.sky.settings import MODELS, SkySettings
+from atmos.plugins.sky.light import SkyLight
 from atmos.plugins.sky.plugin import SkyPass, SkyPlugin
-from atmos.plugins.sky.reference import physical_sky_color, sky_color, sky_radiance
+from atmos.plugins.sky.radiance import physical_sky_color, sky_color, sky_radiance
 from atmos.plugins.sky.shader import evaluate_sky
 
-__all__ = ["AtmosphereSettings", "MODELS", "physical_sky_color", "SkySettings", "SkyPlugin", "SkyPass", "sky_radiance", "sky_color", "evaluate_sky"]
+__all__ = ["AtmosphereSettings", "MODELS", "SkyLight", "physical_sky_color", "SkySettings", "SkyPlugin", "SkyPass", "sky_radiance", "sky_color", "evaluate_sky"]

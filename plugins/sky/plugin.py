@@ -14,6 +14,7 @@ import atmos.plugins.sky.sun_light as sun_light
 from atmos.plugins.sky.aerial import AERIAL, AerialPerspectivePass, active
 from atmos.plugins.sky.luts import (SKY_LUTS, SKY_VIEW_UNIT, AtmosphereLuts, atmosphere_defines, camera_altitude,
                                     set_atmosphere_uniforms, view_radius)
+from atmos.plugins.sky.light import SkyLight
 from atmos.plugins.sky.settings import SkySettings
 from atmos.plugins.sky.shader import set_sky_uniforms, sky_defines
 from atmos.render_core import DEPTH, where_nothing_was_drawn
@@ -90,8 +91,8 @@ class SkyPlugin(Plugin):
     With ``model="physical"`` the system ``sky_light`` (after DaylightPlugin's ``daylight``) writes
     ``Sun.color`` and ``Sun.ambient`` from the same atmosphere (:mod:`atmos.plugins.sky.sun_light`),
     and ``Sun.color_by_altitude`` (the sun's colour at any altitude: the clouds take it at theirs),
-    and a FogPlugin's ``color_from="sky"`` takes its horizon from it
-    (:func:`atmos.plugins.fog.sky_color.horizon_colors`)."""
+    and it publishes :class:`~atmos.plugins.sky.light.SkyLight`, the sky's light as other effects see
+    it (a FogPlugin's ``color_from="sky"`` takes its horizon from it)."""
 
     settings_class = SkySettings
 
@@ -108,6 +109,7 @@ class SkyPlugin(Plugin):
         app.graph.add_pass(SkyPass(self))
         app.graph.add_pass(AerialPerspectivePass(self))
         app.graph.import_resource(SKY_LUTS, self._luts)
+        app.insert_resource(SkyLight(self))
         self._read_distance()
 
     def configure(self, **changes) -> SkySettings:

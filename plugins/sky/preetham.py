@@ -7,7 +7,7 @@ y; zenith luminance (kcd/m²) and chromaticity from the turbidity T and the sun 
 
 Where the model is invalid it is clamped, so that every input gives a finite colour: views below the
 horizon use ``cos θ = COS_FLOOR`` (the horizon's value), a sun below the horizon uses ``θs = 90°``
-(the night fade of :mod:`atmos.plugins.sky.reference` takes over there).
+(the night fade of :mod:`atmos.plugins.sky.radiance` takes over there).
 """
 from __future__ import annotations
 

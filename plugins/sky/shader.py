@@ -68,7 +68,7 @@ def set_sky_uniforms(program, settings: SkySettings, sun_dir, sun_color, time: f
 def evaluate_sky(gpu, view_dirs, sun_dir, sun_color, settings: SkySettings | None = None, time: float = 0.0,
                  pixel_angle: float = 0.0) -> np.ndarray:
     """(n, 3) float32 sky colours computed on the GPU for ``view_dirs`` (n, 3): what
-    :func:`atmos.plugins.sky.reference.sky_color` computes in float64. ``gpu``: a GpuContext."""
+    :func:`atmos.plugins.sky.radiance.sky_color` computes in float64. ``gpu``: a GpuContext."""
     dirs = unit_vectors(view_dirs, "view_dirs").reshape(-1, 3)
     n = len(dirs)
     if n == 0:

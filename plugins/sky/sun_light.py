@@ -24,7 +24,7 @@ import numpy as np
 
 import atmos.plugins.sky.atmosphere as ref
 from atmos.plugins.sky.atmosphere_settings import AtmosphereSettings
-from atmos.plugins.sky.reference import daylight
+from atmos.plugins.sky.radiance import daylight
 
 ELEVATION_STEP = 0.5            # degrees of sun elevation between nodes
 ALTITUDE_ROOT_STEP = 10.0       # nodes at altitudes (10 k)² m: 0, 100, 400, 900 ... 40 000 m at k = 20

@@ -6,7 +6,7 @@ uniform float fog_start;
 uniform float fog_end;
 
 #if FOG_MODE >= 3
-#include "fog/noise.glsl"
+#include "lib/gradient_noise.glsl"
 uniform float fog_time;       // seconds; octave i is displaced by fog_wind[i] * fog_time
 uniform float fog_tile;       // metres covered by one noise tile
 uniform float fog_amplitude;  // grey-scale range of an octave: noise_i = 0.5 + 0.5 * amplitude * n
@@ -27,7 +27,7 @@ float fog_turbulence(vec3 world) {
         vec2 cs = fog_turn[i];
         vec3 u = vec3(cs.x * p.x - cs.y * p.z, p.y, cs.y * p.x + cs.x * p.z) / fog_tile;
 #if FOG_PROCEDURAL
-        float n = fog_periodic_noise(u * float(fog_period[i]), fog_period[i], fog_key[i]);
+        float n = periodic_gradient_noise(u * float(fog_period[i]), fog_period[i], fog_key[i]);
 #else
         float n = texture(fog_noise[i], u).r;
 #endif

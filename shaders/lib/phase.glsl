@@ -1,4 +1,4 @@
-// Phase functions of the radiometric model (plugins/clouds/light/medium.py hg and phase), in 1/sr.
+// Phase functions of the radiometric model (atmos/phase.py hg and phase), in 1/sr.
 
 // One Henyey-Greenstein lobe at the cosine c of the scattering angle.
 float hg(float c, float g) {

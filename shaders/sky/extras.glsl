@@ -1,6 +1,6 @@
 // What both skies (Preetham, sky.glsl; physical, physical.frag) draw over their radiance: the sun disc
 // (limb-darkened, antialiased over a pixel) and its glare, the stars. float64 reference:
-// plugins/sky/reference.py (sun_disc, star_field); uniforms set by plugins/sky/shader.py:set_sky_uniforms.
+// plugins/sky/radiance.py (sun_disc, star_field); uniforms set by plugins/sky/shader.py:set_sky_uniforms.
 #include "sky/stars.glsl"
 
 uniform vec3 sky_sun_dir;       // unit, toward the sun

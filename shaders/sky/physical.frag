@@ -1,7 +1,7 @@
 #version 430
 // The physical sky pass (SkySettings.model = "physical"): the sky-view LUT along each pixel's view ray,
 // `night` (the airglow and starlight the model leaves out) faded in over twilight, the sun disc and
-// stars of sky/extras.glsl. float64 reference: plugins/sky/reference.py:physical_sky_color.
+// stars of sky/extras.glsl. float64 reference: plugins/sky/radiance.py:physical_sky_color.
 in vec2 v_uv;
 out vec4 frag;
 uniform mat3 view_basis;

@@ -1,5 +1,5 @@
 // The whole sky colour for a unit view direction: Preetham by day faded to `night` over twilight,
-// the sun disc, stars (sky/extras.glsl), all dimmed below the horizon. float64 reference: plugins/sky/reference.py;
+// the sun disc, stars (sky/extras.glsl), all dimmed below the horizon. float64 reference: plugins/sky/radiance.py;
 // uniforms set by plugins/sky/shader.py:set_sky_uniforms, constants passed as defines.
 #include "sky/preetham.glsl"
 uniform float turbidity;

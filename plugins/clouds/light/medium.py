@@ -45,17 +45,9 @@ import math
 
 import numpy as np
 
+from atmos.phase import hg, phase
+
 OCTAVES = 4
-
-
-def hg(cos, g):
-    """One Henyey-Greenstein lobe (1/sr)."""
-    return (1.0 - g * g) / (4.0 * math.pi * np.maximum(1.0 + g * g - 2.0 * g * np.asarray(cos), 1e-12) ** 1.5)
-
-
-def phase(cos, g: float, g2: float, w: float):
-    """The two-lobe phase function (1/sr) at the cosine of the scattering angle."""
-    return (1.0 - w) * hg(cos, g) + w * hg(cos, g2)
 
 
 def cell_sigma(sigma_t: float, cell, direction) -> float:

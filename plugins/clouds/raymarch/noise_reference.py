@@ -8,7 +8,7 @@ The noise, per texture of ``size``^3 texels (texel j sits at tile coordinate u =
   :func:`atmos.hashing.hash_counter`), searched in the 3^3 cells around q; bright at the points.
 * Worley FBM at frequency f: 0.625·W_f + 0.25·W_2f + 0.125·W_4f (each octave its own key).
 * Perlin FBM at f: (4 n_f + 2 n_2f + n_4f) / 7 of the periodic gradient noise n of
-  ``plugins/fog/noise.py`` (the same lattice hash), mapped to [0, 1] by clamp(0.5 + 0.5·GAIN·fbm).
+  ``atmos/gradient_noise.py`` (the same lattice hash), mapped to [0, 1] by clamp(0.5 + 0.5·GAIN·fbm).
 * Perlin–Worley PW = remap(P, -W, 1, 0, 1) = (P + W) / (1 + W), in [0, 1] for P, W in [0, 1], with W
   the Worley FBM of the same frequency (channel G): Nubis' remap(perlin, worley - 1, 1, 0, 1) written
   with our bright-at-the-points W = 1 - F1 (theirs is the distance-like 1 - W): the Perlin billows
@@ -29,7 +29,7 @@ from atmos.hashing import hash_counter, stream_key
 from atmos.plugins.clouds.raymarch.noise import (BAND_STRENGTH, BASE_LAYOUT, COVERAGE, DETAIL_LAYOUT, DETAIL_RATIO, NOISE_RULE,
                                                 PERLIN_GAIN, PW_RANGE, WORLEY_RANGE, band_width, detail_fade,
                                                 detail_offsets)
-from atmos.plugins.fog.noise import periodic_noise, sample_repeat_trilinear
+from atmos.gradient_noise import periodic_noise, sample_repeat_trilinear
 
 WORLEY_WEIGHTS = (0.625, 0.25, 0.125)
 PERLIN_WEIGHTS = (4 / 7, 2 / 7, 1 / 7)

@@ -12,7 +12,7 @@ pixel (i·r + o.x, j·r + o.y), o the frame's jitter offset; then :meth:`Raymarc
 (the temporal resolve's hook, wired to :class:`.temporal.TemporalClouds`: with ``reprojection`` it
 returns full-res (colour, distance) textures that :meth:`RaymarchPass._blend` blends; without, it
 blends a depth-aware upsample of this frame's samples itself —
-:class:`~atmos.plugins.clouds.volume.offscreen.OffscreenClouds`' composite — and returns None).
+:class:`~atmos.offscreen.OffscreenLayer`' composite — and returns None).
 """
 from __future__ import annotations
 
@@ -33,7 +33,7 @@ from atmos.plugins.clouds.raymarch.temporal import TemporalClouds, jitter
 from atmos.gpu import clamp_sampler
 from atmos.plugins.clouds.volume.binding import bind_volume, unbind_volume
 from atmos.plugins.clouds.volume.light import unit_direction
-from atmos.plugins.clouds.volume.offscreen import OffscreenClouds, low_size
+from atmos.offscreen import OffscreenLayer, low_size
 from atmos.plugins.clouds.volume.field_demand import field_demand
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CLOUD_VOLUME, CloudSets
 from atmos.plugins.clouds.simulation.chain import CloudSimulation
@@ -161,7 +161,7 @@ class RaymarchPass(RenderPass):
     def prepare(self, gpu) -> None:
         self.gpu = gpu
         self.sampler = clamp_sampler(gpu.ctx)
-        self.offscreen = OffscreenClouds(gpu, LOW_COLOR, LOW_DEPTH, LOW_DISTANCE)
+        self.offscreen = OffscreenLayer(gpu, LOW_COLOR, LOW_DEPTH, LOW_DISTANCE)
         self.temporal = TemporalClouds(gpu)
 
     def program(self, far: bool = False):

@@ -15,7 +15,7 @@ per full-res pixel (``shaders/clouds/raymarch/temporal.frag``):
   pattern while moving), the clamp and the correction loosened to 0 below ``CLAMP_MOTION`` pixels of
   motion, so that a still camera over still clouds keeps every fresh sample and converges to the
   full-res march in r² frames, while clouds that move are clamped; rejected, falling back to the depth-aware upsample
-  of this frame's samples (``clouds/volume/upsample.glsl``, shared with OffscreenClouds' composite), when its point was off screen or the scene behind the pixel changed
+  of this frame's samples (``lib/upsample.glsl``, shared with OffscreenLayer' composite), when its point was off screen or the scene behind the pixel changed
   (``DEPTH_TOLERANCE``: an object moved in front, or away); and mixed toward the upsample the faster
   the pixel moves (weight 1 − motion / ``motion_limit``, motion in full-res pixels per frame).
 * under a camera still for r² frames (:func:`detects_change`: every pixel's last sample is then
@@ -61,7 +61,7 @@ import moderngl
 import numpy as np
 
 from atmos.camera import camera_matrices, gl_matrix
-from atmos.plugins.clouds.volume.offscreen import EDGE
+from atmos.offscreen import EDGE
 from atmos.gpu.uniforms import write_uniforms
 
 RESOLUTIONS = (1, 2, 4)
@@ -175,7 +175,7 @@ class TemporalClouds:
         premultiplied) and ``low_distance`` ((a·d, a)) textures marched at ``offset`` with divisor
         ``r``, seen by ``camera`` at ``aspect``; ``depth``: the scene's depth texture at ``size``
         (None: nothing but sky); ``low_depth``: the depth each sample's ray saw (low-res; with ``depth``
-        the upsample is depth-aware, :data:`~atmos.plugins.clouds.volume.offscreen.EDGE`). Returns (color, distance) full-res textures, valid until the next
+        the upsample is depth-aware, :data:`~atmos.offscreen.EDGE`). Returns (color, distance) full-res textures, valid until the next
         resolve (they are the history it reads)."""
         r = check_resolution(r)
         size = (int(size[0]), int(size[1]))

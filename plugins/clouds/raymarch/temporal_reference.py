@@ -11,8 +11,8 @@ import numpy as np
 
 from atmos.camera import Camera, view_basis
 
-from atmos.plugins.clouds.volume.offscreen import EDGE
-from atmos.plugins.clouds.volume.offscreen_reference import inv_depth, upsample_weights
+from atmos.offscreen import EDGE
+from atmos.offscreen_reference import inv_depth, upsample_weights
 
 from .temporal import (ALPHA_EPS, CHANGE_TOLERANCE, CLAMP_MOTION, DEPTH_TOLERANCE, DRIFT_CHANGE, DRIFT_FLOOR, DRIFT_GAIN, DRIFT_MEAN, HISTORY_CLAMP,
                        MOTION_LIMIT, TemporalClouds, camera_state, detects_change, forward_of)

@@ -45,7 +45,7 @@ from atmos.plugin import Plugin
 from atmos.gpu import clamp_sampler
 from atmos.plugins.clouds.volume.binding import bind_volume, unbind_volume
 from atmos.plugins.clouds.volume.light import CloudLightSettings
-from atmos.plugins.clouds.volume.offscreen import MAX_DOWNSAMPLE, OffscreenClouds, low_size
+from atmos.offscreen import MAX_DOWNSAMPLE, OffscreenLayer, low_size
 from atmos.plugins.clouds.volume.layout import CloudLayout
 from atmos.plugins.clouds.sprites.segments import MAX_LEVEL, SegmentStats, select_segments, unpack
 from atmos.plugins.clouds.volume.field_demand import field_demand
@@ -194,11 +194,11 @@ class CloudSpritePass(RenderPass):
             builder.read(CLOUD_DISTANCE)
             builder.write(CLOUD_DISTANCE)
         if downsample > 1:
-            OffscreenClouds.declare(builder, self.plugin.gpu.size, downsample, distance)
+            OffscreenLayer.declare(builder, self.plugin.gpu.size, downsample, distance)
 
     def prepare(self, gpu) -> None:
         self.program = gpu.program(vertex_shader="clouds/sprites/sprite.vert", fragment_shader="clouds/sprites/sprite.frag")
-        self.offscreen = OffscreenClouds(gpu)
+        self.offscreen = OffscreenLayer(gpu)
         self.sampler = clamp_sampler(gpu.ctx)
         limit = gpu.ctx.info.get("GL_POINT_SIZE_RANGE", (1.0, 64.0))[1]
         self.point_limit = float(limit)

@@ -11,6 +11,7 @@
 * :class:`WeatherPlugin` — the rules as the App ``simulate`` system ``"weather"``.
 """
 from atmos.plugins.clouds.weather import reference
+from atmos.plugins.clouds.weather.example import example_weather
 from atmos.plugins.clouds.weather.components import COLUMNS, MAX_CELLS, Ellipsoid, VolumeOrigin, add_ellipsoid
 from atmos.plugins.clouds.weather.settings import MAX_CLOUD_DENSITY, WeatherSettings
 from atmos.plugins.clouds.weather.reference import probabilities, region_volume
@@ -18,6 +19,6 @@ from atmos.plugins.clouds.weather.region import RegionVolume
 from atmos.plugins.clouds.weather.system import (StepReport, WeatherPlugin, ellipsoid_array, step_weather,
                                           wind_field_at)
 
-__all__ = ["COLUMNS", "Ellipsoid", "MAX_CELLS", "add_ellipsoid", "MAX_CLOUD_DENSITY", "RegionVolume", "StepReport", "VolumeOrigin",
+__all__ = ["COLUMNS", "example_weather", "Ellipsoid", "MAX_CELLS", "add_ellipsoid", "MAX_CLOUD_DENSITY", "RegionVolume", "StepReport", "VolumeOrigin",
            "WeatherSettings", "WeatherPlugin", "ellipsoid_array", "probabilities", "reference",
            "region_volume", "step_weather", "wind_field_at"]

@@ -1,7 +1,7 @@
 """A cloud layer for tests, benchmarks and screenshots: weather with a chosen number of clouds."""
 from __future__ import annotations
 
-from atmos.plugins.clouds.weather import WeatherSettings
+from atmos.plugins.clouds.weather.settings import WeatherSettings
 
 
 def example_weather(shape=(64, 16, 64), cloud_density: int = 60, **overrides) -> WeatherSettings:

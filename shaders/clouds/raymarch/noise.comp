@@ -6,7 +6,7 @@
 // Perlin FBM = clamp(.5 + .5 PERLIN_GAIN (4 n_f + 2 n_2f + n_4f) / 7), Perlin–Worley = (P + W) / (1 + W);
 // stored contrast-stretched: stretch(v, range) = clamp((v - range.x) / (range.y - range.x), 0, 1).
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
-#include "fog/noise.glsl"
+#include "lib/gradient_noise.glsl"
 
 layout(rgba8, binding = 0) writeonly uniform image3D noise_volume;
 uniform int size;
@@ -45,9 +45,9 @@ float worley_fbm(vec3 u, int f, int channel) {
 }
 
 float perlin_fbm(vec3 u, int f) {
-    float n = (4.0 * fog_periodic_noise(u * float(f), f, layer_key(1, 0, 0))
-             + 2.0 * fog_periodic_noise(u * float(2 * f), 2 * f, layer_key(1, 0, 1))
-             + fog_periodic_noise(u * float(4 * f), 4 * f, layer_key(1, 0, 2))) / 7.0;
+    float n = (4.0 * periodic_gradient_noise(u * float(f), f, layer_key(1, 0, 0))
+             + 2.0 * periodic_gradient_noise(u * float(2 * f), 2 * f, layer_key(1, 0, 1))
+             + periodic_gradient_noise(u * float(4 * f), 4 * f, layer_key(1, 0, 2))) / 7.0;
     return clamp(0.5 + 0.5 * PERLIN_GAIN * n, 0.0, 1.0);
 }
 

@@ -3,7 +3,7 @@
 // why; float64 reference: plugins/clouds/raymarch/temporal_reference.py). Drawn over the full-res
 // history target: colour (premultiplied), distance (a·d, a), and the scene distance behind the pixel.
 #include "lib/view_ray.glsl"
-#include "clouds/volume/upsample.glsl"
+#include "lib/upsample.glsl"
 
 layout(binding = 0) uniform sampler2D low_color;      // this frame's samples: texel (i, j) = pixel (i·r + ox, j·r + oy)
 layout(binding = 1) uniform sampler2D low_distance;

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.plugins.clouds.volume.offscreen import EDGE, low_size
+from atmos.offscreen import EDGE, low_size
 
 
 def far_depth(depth: np.ndarray, factor: int) -> np.ndarray:
@@ -21,7 +21,7 @@ def far_depth(depth: np.ndarray, factor: int) -> np.ndarray:
 
 def upsample_weights(low_depth: np.ndarray, px: np.ndarray, py: np.ndarray, pixel_inv: np.ndarray,
                      near: float, far: float, edge: float = EDGE):
-    """``clouds/volume/upsample.glsl``: the four low-res texels around (px, py) (texel centres at
+    """``lib/upsample.glsl``: the four low-res texels around (px, py) (texel centres at
     integers, clamped) as [(qx, qy, weight)], bilinear unless one's view depth differs from the
     pixel's (``pixel_inv`` = 1 / view depth) by more than ``edge`` (relative); then weight 1 on the
     texel nearest in depth (the first of equals, in the order (0,0), (1,0), (0,1), (1,1))."""

@@ -1,11 +1,12 @@
-"""Off-screen clouds at 1/``factor`` of the frame size, upsampled onto the frame (GPU Gems 3, ch. 23).
+"""An off-screen layer at 1/``factor`` of the frame size, upsampled onto the frame (GPU Gems 3, ch. 23):
+what the cloud renderers draw their clouds into and the light shafts their march.
 
 Filling sprite pixels is most of the cloud pass's cost; at factor 2 the sprites fill a quarter of
-the pixels. Three draws: ``far_depth.frag`` writes each block's farthest scene depth into the
-low-res depth target (so a sprite seen through any pixel of the block is drawn); the sprites are
-drawn into the cleared low-res colour target against it; ``composite.frag`` blends the result onto
-the frame — bilinear inside surfaces, nearest-depth at geometry edges. References:
-:mod:`.offscreen_reference`.
+the pixels. Three draws: ``core/offscreen_far_depth.frag`` writes each block's farthest scene depth
+into the low-res depth target (so a sprite seen through any pixel of the block is drawn); the layer is
+drawn into the cleared low-res colour target against it; ``core/offscreen_composite.frag`` blends the
+result onto the frame — bilinear inside surfaces, nearest-depth at geometry edges
+(``lib/upsample.glsl``). References: :mod:`atmos.offscreen_reference`.
 """
 from __future__ import annotations
 
@@ -29,16 +30,16 @@ def low_size(size, factor: int) -> tuple[int, int]:
     return math.ceil(size[0] / factor), math.ceil(size[1] / factor)
 
 
-class OffscreenClouds:
-    """The low-res targets' declarations and the depth and composite draws of a cloud pass
-    (programs belong to the GpuContext)."""
+class OffscreenLayer:
+    """The low-res targets' declarations and the depth and composite draws of a pass that draws off
+    screen (the cloud renderers, the light shafts' march; programs belong to the GpuContext)."""
 
     def __init__(self, gpu, color: str = CLOUD_COLOR, depth: str = CLOUD_DEPTH, distance: str = CLOUD_LOW_DISTANCE):
         self.color, self.depth = color, depth         # the low-res targets' names (another pass: its own)
         self.distance = distance
         fullscreen = "lib/fullscreen.vert"
-        self.far_depth = gpu.program(vertex_shader=fullscreen, fragment_shader="clouds/volume/far_depth.frag")
-        self.composite = gpu.program(vertex_shader=fullscreen, fragment_shader="clouds/volume/composite.frag")
+        self.far_depth = gpu.program(vertex_shader=fullscreen, fragment_shader="core/offscreen_far_depth.frag")
+        self.composite = gpu.program(vertex_shader=fullscreen, fragment_shader="core/offscreen_composite.frag")
 
     @staticmethod
     def declare(builder: PassBuilder, size, factor: int, distance: bool = False, color: str = CLOUD_COLOR,

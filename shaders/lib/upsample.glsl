@@ -1,4 +1,4 @@
-// Depth-aware upsampling of a low-resolution layer (plugins/clouds/volume/offscreen.py's composite and
+// Depth-aware upsampling of a low-resolution layer (atmos/offscreen.py's composite and
 // the ray march's temporal resolve; numpy twin: offscreen_reference.upsample_weights). The four
 // low-res texels around p (texel centres at integers, clamped to the edge) with bilinear weights,
 // unless one saw a scene whose view depth differs from this pixel's by more than `edge` (relative):

@@ -1,4 +1,5 @@
-"""The whole sky colour in float64 numpy, as ``shaders/sky/sky.glsl`` draws it.
+"""The whole sky colour in float64 numpy, as ``shaders/sky/sky.glsl`` draws it: what effects ask of the
+sky's light at run time (the Sun's daylight, the fog's horizon) and what the sky's tests compare with.
 
 ``sky_radiance`` (the diffuse sky, for anyone who wants the sky's light in a direction):
 ``mix(night, scale · preetham · ozone, day) · below``, where ``ozone`` is the Chappuis absorption

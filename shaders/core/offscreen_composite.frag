@@ -1,6 +1,6 @@
 #version 430
 // The low-resolution clouds (premultiplied rgb, coverage a) upsampled onto the frame, blended
-// ONE, ONE_MINUS_SRC_ALPHA, depth-aware (clouds/volume/upsample.glsl: bilinear inside surfaces, the
+// ONE, ONE_MINUS_SRC_ALPHA, depth-aware (lib/upsample.glsl: bilinear inside surfaces, the
 // texel nearest in depth at geometry edges).
 layout(binding = 0) uniform sampler2D clouds;
 layout(binding = 1) uniform sampler2D cloud_depth;   // the farthest scene depth of each block
@@ -14,7 +14,7 @@ uniform vec2 sample_offset;  // texel (i, j) holds the frame's pixel (i, j) * fa
 out vec4 frag;
 layout(location = 1) out vec4 frag_distance;
 
-#include "clouds/volume/upsample.glsl"
+#include "lib/upsample.glsl"
 
 void main() {
     vec2 p = (gl_FragCoord.xy - 0.5 - sample_offset) / float(factor);   // low-res texel centres at integers

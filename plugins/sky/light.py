@@ -1,0 +1,82 @@
+"""SkyLight: the sky's light as other effects see it (the resource a SkyPlugin publishes).
+
+``horizon(sun, altitude, n)``: the sky's radiance just above the horizon (``ELEVATION``) at ``n``
+azimuths round it, ``2π i / n`` from −z toward +x as :meth:`atmos.lighting.Sun.from_angles` counts
+them: the Preetham sky (its turbidity and scale) or the physical one (its atmosphere, seen from
+``altitude``), computed once per change of its inputs. ``aerial``: whether the aerial perspective
+is on; ``declare_aerial``/``aerial_defines``/``set_aerial_uniforms``: what a pass that reads the
+air's light (the light shafts' march) needs of it.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+import atmos.plugins.sky.radiance as radiance
+from atmos.plugins.sky.aerial import active
+from atmos.plugins.sky.luts import SKY_LUTS, atmosphere_defines, set_atmosphere_uniforms, view_radius
+from atmos.plugins.sky.sun_light import horizon_radiance
+
+ELEVATION = math.radians(2.0)
+
+
+def horizon_directions(n: int) -> np.ndarray:
+    """(n, 3) unit directions ``ELEVATION`` above the horizon at azimuths 2π i / n."""
+    a = 2.0 * np.pi * np.arange(n) / n
+    c = math.cos(ELEVATION)
+    return np.stack([np.sin(a) * c, np.full(n, math.sin(ELEVATION)), -np.cos(a) * c], -1)
+
+
+def horizon_colors(sun, sky_settings, n: int, altitude: float = 0.0) -> np.ndarray:
+    """(n, 3) float64 linear radiance of the horizon sky of ``sky_settings`` (a SkySettings) for ``sun``
+    (an :class:`atmos.Sun`), seen from ``altitude`` (m; the physical sky)."""
+    if sky_settings.model == "physical":
+        return horizon_radiance(horizon_directions(n), sun.direction, altitude, sky_settings.atmosphere,
+                                sky_settings.night)
+    return radiance.sky_radiance(horizon_directions(n), np.asarray(sun.direction, np.float64),
+                                 sky_settings.turbidity, sky_settings.scale, sky_settings.night)
+
+
+class SkyLight:
+    """See the module docstring; ``plugin`` is the SkyPlugin that publishes it."""
+
+    def __init__(self, plugin):
+        self._plugin = plugin
+        self._key = self._table = None
+
+    @property
+    def settings(self):
+        return self._plugin.settings
+
+    def horizon(self, sun, altitude: float, n: int) -> np.ndarray:
+        """(n, 3) float64 horizon radiance (module docstring); the last table again while its inputs hold."""
+        settings = self.settings
+        altitude = float(altitude) if settings.model == "physical" else 0.0
+        key = (settings, tuple(np.asarray(sun.direction, np.float64)), altitude, int(n))
+        if key != self._key:
+            self._key, self._table = key, horizon_colors(sun, settings, n, altitude)
+        return self._table
+
+    @property
+    def aerial(self) -> bool:
+        """The aerial perspective is on (SkySettings.aerial_perspective with the physical model)."""
+        return active(self.settings)
+
+    @property
+    def reads_cloud_distance(self) -> bool:
+        """The aerial perspective hazes clouds by their own distance (atmos.composition)."""
+        return self._plugin.composition is not None and self._plugin.composition.distance
+
+    def declare_aerial(self, builder) -> None:
+        """A pass that reads the air's light reads the sky's LUTs."""
+        builder.read(SKY_LUTS)
+
+    def aerial_defines(self) -> dict:
+        return atmosphere_defines()
+
+    def set_aerial_uniforms(self, frame, program) -> None:
+        """The atmosphere's uniforms, its LUTs bound and the camera's radius (``view_r``)."""
+        frame.resource(SKY_LUTS).use()
+        set_atmosphere_uniforms(program, self.settings.atmosphere)
+        program["view_r"].value = view_radius(self.settings.atmosphere, frame.view.camera)
