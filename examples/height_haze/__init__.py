@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from atmos import COLOR, DEPTH, FullscreenPass, PassContext, Plugin, add_shader_path, set_camera_uniforms
+from atmos import COLOR, DEPTH, FullscreenPass, PassContext, Plugin, add_shader_path, set_camera_uniforms, write_uniforms
 from atmos.checks import CheckedSettings, check_num, check_vec
 
 
@@ -45,8 +45,8 @@ class HeightHazePass(FullscreenPass):
         frame.blend_transmittance()       # rgb = light + T * rgb; the graph resets state after
         frame.resource(DEPTH).use(0)
         set_camera_uniforms(p, frame.view.camera, frame.view.aspect)
-        for name in ("density", "base", "scale_height", "max_distance", "haze_color"):
-            p[name].value = getattr(s, name)
+        write_uniforms(p, density=s.density, base=s.base, scale_height=s.scale_height,
+                       max_distance=s.max_distance, haze_color=s.haze_color)   # skips what the compiler dropped
         frame.fullscreen(p)
 
 
