@@ -45,8 +45,8 @@ _EXPORTS = {
     # writing frames to files
     "OutputPlugin": "atmos.output", "FrameWriter": "atmos.output", "OutputError": "atmos.output",
     # work spread over frames
-    "TextureSet": "atmos.frames", "TripleSet": "atmos.frames", "SlicedJob": "atmos.frames",
-    "SliceTask": "atmos.frames", "FrameScheduler": "atmos.frames",
+    "TextureSet": "atmos.slicing", "TripleSet": "atmos.slicing", "SlicedJob": "atmos.slicing",
+    "SliceTask": "atmos.slicing", "FrameScheduler": "atmos.slicing",
 }
 
 __all__ = sorted(_EXPORTS)

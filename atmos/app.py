@@ -7,7 +7,7 @@ import numpy as np
 
 from atmos.checks import check_int, check_num
 from atmos.clock import FixedClock
-from atmos.frames import FrameScheduler
+from atmos.slicing import FrameScheduler
 from atmos.gpu.context import require_gpu
 from atmos.graph import RenderGraph
 from atmos.plugin import Plugin, PluginGroup

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from atmos.frames import FrameScheduler, SlicedJob, SliceTask, TripleSet
+from atmos.slicing import FrameScheduler, SlicedJob, SliceTask, TripleSet
 from atmos.gpu import add_shader_path, create_headless
 from atmos.graph import TextureDesc
 

@@ -164,7 +164,7 @@ def fog(cfg) -> dict:
 
 def pacing(cfg) -> dict:
     import bench_frame_pacing
-    from atmos.frames import FrameScheduler
+    from atmos.slicing import FrameScheduler
     from atmos.gpu import create_headless
     gpu = create_headless((256, 144))
     rows = []
@@ -188,7 +188,7 @@ def pacing(cfg) -> dict:
 def sunset(cfg) -> dict:
     import bench_python_frame
     from atmos.demo_registry import DemoSettings
-    from atmos.frames import timer_query_measure
+    from atmos.slicing import timer_query_measure
     from atmos.gpu import create_headless
     from atmos.graph.timing import RING
     from atmos.runner import build_app

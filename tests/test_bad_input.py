@@ -349,7 +349,7 @@ RESOURCE_CASES = (
 
 
 def _resource(kind):
-    from atmos.frames import FrameScheduler
+    from atmos.slicing import FrameScheduler
     from atmos.plugins.daylight import TimeOfDay
     from atmos.plugins.clouds.weather import VolumeOrigin
     return {"VolumeOrigin": VolumeOrigin, "TimeOfDay": TimeOfDay, "FrameScheduler": FrameScheduler}[kind]()
@@ -467,7 +467,7 @@ CONSTRUCTOR_CASES = [
 
 
 def _slice_task(name, slices=1, run=lambda index, job: None):
-    from atmos.frames import SliceTask
+    from atmos.slicing import SliceTask
     return SliceTask(name, slices, run)
 
 

@@ -51,7 +51,7 @@ def test_graph_text_and_dot(capsys):
 
 
 def test_graph_of_the_cloud_demo_runs_no_simulation(capsys, monkeypatch):
-    from atmos.frames import SlicedJob
+    from atmos.slicing import SlicedJob
 
     def refuse(*args, **kwargs):
         raise AssertionError("atmos graph ran a simulation slice")

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from atmos.app import App
-from atmos.frames.texture_sets import make_texture
+from atmos.slicing.texture_sets import make_texture
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin, read_volume
 from atmos.plugins.clouds.light.columns import COLUMNS, STORE_MAX, ColumnShader, column_desc, column_reference
 from atmos.plugins.clouds.light.shear_warp import upload_volume

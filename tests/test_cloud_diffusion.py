@@ -5,7 +5,7 @@ import pytest
 
 from atmos import DefaultPlugins
 from atmos.app import App
-from atmos.frames.texture_sets import make_texture
+from atmos.slicing.texture_sets import make_texture
 from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
 from atmos.plugins.clouds.sprites import CloudRenderPlugin
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin, read_volume

@@ -1,9 +1,9 @@
-"""atmos.frames: three texture sets, sliced jobs and the frame scheduler."""
+"""atmos.slicing: three texture sets, sliced jobs and the frame scheduler."""
 import moderngl
 import numpy as np
 import pytest
 
-from atmos.frames import FrameScheduler, SlicedJob, SliceTask, TextureSet, TripleSet, make_texture
+from atmos.slicing import FrameScheduler, SlicedJob, SliceTask, TextureSet, TripleSet, make_texture
 from atmos.graph import TextureDesc as Desc
 
 
@@ -403,7 +403,7 @@ def test_failed_slice_is_retried(gpu, ctx):
 
 
 def test_gpu_measure_times_a_slice(ctx):
-    from atmos.frames import gpu_measure, timer_query_measure
+    from atmos.slicing import gpu_measure, timer_query_measure
     ran = []
     for measure in (gpu_measure(ctx), timer_query_measure(ctx)):
         ms = measure(lambda: ran.append(1))

@@ -4,7 +4,7 @@ import pytest
 
 from atmos.app import App
 from atmos.defaults import DefaultPlugins
-from atmos.frames import FrameScheduler, SlicedJob, SliceTask, TripleSet, timer_query_measure
+from atmos.slicing import FrameScheduler, SlicedJob, SliceTask, TripleSet, timer_query_measure
 from atmos.gpu import MIN_GL_VERSION, create_headless
 from atmos.gpu.queries import QueryPool, query_pool
 from atmos.graph import PassTimers, TextureDesc, TexturePool
@@ -203,7 +203,7 @@ def gl_objects(app, gpu, made):
 
 def test_2000_frames_with_a_time_budget_make_no_queries_or_gl_objects(fresh_gpu, count_queries, monkeypatch):
     # timer queries even on llvmpipe (whose results mean nothing, but they are made and read the same)
-    monkeypatch.setattr("atmos.frames.job.is_software", lambda ctx: False)
+    monkeypatch.setattr("atmos.slicing.job.is_software", lambda ctx: False)
     app = scene(fresh_gpu)
     app.frames = FrameScheduler(time_budget_ms=1000.0)
     job = app.frames.add(tiny_job(fresh_gpu))

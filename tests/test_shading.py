@@ -4,7 +4,7 @@ import math
 import numpy as np
 import pytest
 
-from atmos.frames import SlicedJob, TripleSet
+from atmos.slicing import SlicedJob, TripleSet
 from atmos.graph import TextureDesc
 from atmos.lighting import sky_light
 from atmos.plugins.clouds.light import (LightVolumeShader, Scattering, ShadingTask, ShearWarpShader,

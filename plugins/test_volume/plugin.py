@@ -5,7 +5,7 @@ import math
 from dataclasses import dataclass
 
 from atmos.checks import CheckedSettings, check_int, check_num, check_shape, check_vec
-from atmos.frames import SlicedJob, SliceTask, TripleSet
+from atmos.slicing import SlicedJob, SliceTask, TripleSet
 from atmos.graph import FullscreenPass, PassContext, TextureDesc
 from atmos.scene_uniforms import set_scene_uniforms
 from atmos.plugin import Plugin

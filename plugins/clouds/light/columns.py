@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.frames import SliceTask
+from atmos.slicing import SliceTask
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.graph import TextureDesc
 import atmos.plugins.clouds.light.grid as grid

@@ -29,7 +29,7 @@ import math
 import numpy as np
 
 from atmos.checks import check_int, check_num
-from atmos.frames import SliceTask
+from atmos.slicing import SliceTask
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.graph import TextureDesc
 import atmos.plugins.clouds.light.grid as grid

@@ -12,7 +12,7 @@ small. The float64 twin is :func:`reference.shear_warp_scheme`.
 Sliced use (thesis sec. 7.1): :meth:`ShearWarpShader.begin` latches the density, sun direction and
 sigma (a sun moving later changes the *next* pass, never this one), then :meth:`run_slices` runs
 any ``[i0, i1)`` of the :attr:`slice_count` slices in order; :class:`ShadingTask` wraps that as a
-:class:`~atmos.frames.SliceTask` writing into texture set C.
+:class:`~atmos.slicing.SliceTask` writing into texture set C.
 """
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ import moderngl
 import numpy as np
 
 from atmos.checks import check_shape, check_sun_dir
-from atmos.frames import SliceTask
+from atmos.slicing import SliceTask
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.gpu.uniforms import write_uniforms
 import atmos.plugins.clouds.light.grid as grid
@@ -189,7 +189,7 @@ class ShearWarpShader:
 
 
 class ShadingTask(SliceTask):
-    """The shading task of a :class:`~atmos.frames.SlicedJob`: ``slices_per_run`` shear-warp slices
+    """The shading task of a :class:`~atmos.slicing.SlicedJob`: ``slices_per_run`` shear-warp slices
     per job slice, reading ``set[density]`` and writing ``set[result]`` of texture set C.
 
     ``sun`` and ``sigma`` are values or zero-argument callables, read once when a step starts (the

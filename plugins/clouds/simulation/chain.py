@@ -23,7 +23,7 @@ import numpy as np
 from atmos.checks import (CheckedSettings, check_bool, check_choice, check_int, check_num, check_vec,
                           is_int)
 
-from atmos.frames import SlicedJob, SliceTask, TripleSet
+from atmos.slicing import SlicedJob, SliceTask, TripleSet
 from atmos.graph import TextureDesc
 from atmos.plugins.clouds.automaton import CloudAutomaton
 from atmos.plugins.clouds.simulation.density_maps import DensityMaps

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.frames import TextureSet
+from atmos.slicing import TextureSet
 from atmos.graph import TextureDesc
 from atmos.plugins.clouds.simulation.density_maps import DensityMaps
 from atmos.plugins.clouds.volume.sets import CloudSets

@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from atmos.frames import TextureSet
+from atmos.slicing import TextureSet
 from atmos.plugins.clouds.simulation.density_maps import DensityMaps
 from atmos.plugins.clouds.volume.layout import CloudLayout
 

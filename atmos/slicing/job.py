@@ -12,7 +12,7 @@ import time
 from dataclasses import dataclass, field
 from typing import Callable
 
-from atmos.frames.texture_sets import TextureSet, TripleSet
+from atmos.slicing.texture_sets import TextureSet, TripleSet
 from atmos.gpu.host_memory import is_software
 from atmos.gpu.queries import query_pool
 

@@ -1,4 +1,4 @@
-"""Hands out each frame's slices of the registered :class:`~atmos.frames.job.SlicedJob` objects.
+"""Hands out each frame's slices of the registered :class:`~atmos.slicing.job.SlicedJob` objects.
 
 Modes:
 
@@ -17,7 +17,7 @@ import weakref
 from dataclasses import dataclass
 
 from atmos.checks import check_bool, check_choice, check_int, check_num
-from atmos.frames.job import Measure, SlicedJob, gpu_measure, perf_measure
+from atmos.slicing.job import Measure, SlicedJob, gpu_measure, perf_measure
 
 MODES = ("sliced", "naive")
 
@@ -38,7 +38,7 @@ class FrameScheduler:
 
     ``measure`` times one slice (a callable that runs its argument and returns milliseconds): by
     default ``time.perf_counter`` around the slice, or, when ``sync`` is true, the GPU's cost of the
-    slice (:func:`~atmos.frames.job.gpu_measure`: timer queries on a GPU, synced wall time on llvmpipe). ``sync`` defaults to true exactly when a time budget is in use (the budget
+    slice (:func:`~atmos.slicing.job.gpu_measure`: timer queries on a GPU, synced wall time on llvmpipe). ``sync`` defaults to true exactly when a time budget is in use (the budget
     needs the GPU cost; without one, syncing would only stall the pipeline).
     """
 
