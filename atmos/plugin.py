@@ -40,13 +40,13 @@ class Plugin:
         self.settings = configure_settings(self.name, self.settings, changes)
         return self.settings
 
-    def build(self, app: App) -> None:
-        """Add systems, resources and render passes to ``app``."""
+    def build(self, app) -> None:
+        """Add systems, resources and render passes to ``app`` (an :class:`atmos.App`)."""
 
-    def finish(self, app: App) -> None:
+    def finish(self, app) -> None:
         """Late setup, after every plugin's ``build`` (e.g. read other plugins' resources)."""
 
-    def cleanup(self, app: App) -> None:
+    def cleanup(self, app) -> None:
         """Release what ``build``/``finish`` created (GL objects above all); called by App.close()."""
 
     @property

@@ -6,6 +6,8 @@ from atmos.camera import Camera, camera_matrices
 from atmos.gpu.uniforms import write_uniforms
 from atmos.lighting import Sun
 
+MATRICES = ("view_proj", "inv_view_proj", "view_basis")   # computed on first use per frame (CameraMatrices.gl)
+
 
 def set_camera_uniforms(program, camera: Camera, aspect: float) -> None:
     """Write the camera uniforms ``program`` has (the compiler drops unused ones): ``view_proj``,
@@ -15,9 +17,8 @@ def set_camera_uniforms(program, camera: Camera, aspect: float) -> None:
     view rays and distances from depth at any far/near ratio; prefer them to ``inv_view_proj``.
     The matrices come from :func:`atmos.camera.camera_matrices`: computed once per frame, whatever the passes."""
     matrices = camera_matrices(camera, aspect)
-    write_uniforms(program, view_proj=matrices.gl("view_proj"), inv_view_proj=matrices.gl("inv_view_proj"),
-                   view_basis=matrices.gl("view_basis"), camera_pos=matrices.camera_pos, near=float(camera.near),
-                   far=float(camera.far))
+    write_uniforms(program, {name: matrices.gl(name) for name in MATRICES if name in program},
+                   camera_pos=matrices.camera_pos, near=float(camera.near), far=float(camera.far))
 
 
 def set_sun_uniforms(program, sun: Sun) -> None:

@@ -48,11 +48,7 @@ def filter_bits(gpu):
     texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
     texture.repeat_x = texture.repeat_y = False
     out = ctx.buffer(reserve=4 * n)
-    program = ctx.compute_shader("""#version 430
-        layout(local_size_x = 1) in;
-        layout(binding = 0) uniform sampler2D s;
-        layout(std430, binding = 0) writeonly buffer Out { float v[]; };
-        void main() { uint k = gl_GlobalInvocationID.x; v[k] = textureLod(s, vec2(0.25 + 0.5 * float(k) / 4096.0, 0.5), 0.0).r; }""")
+    program = gpu.program(compute_shader="test/filter_probe.comp")
     try:
         texture.use(0)
         out.bind_to_storage_buffer(0)
@@ -60,7 +56,7 @@ def filter_bits(gpu):
         ctx.memory_barrier()
         got = np.frombuffer(out.read(), "f4").astype(np.float64)
     finally:
-        for obj in (program, out, texture):
+        for obj in (out, texture):
             obj.release()
     error = np.abs(got - np.arange(n) / 4096.0).max()    # u from texel centre 0.25 to 0.75: weight k / 4096
     return None if error < 1e-6 else int(np.floor(-np.log2(2.0 * error)))

@@ -117,7 +117,8 @@ def test_the_field_lights_a_lit_surface_seen_with_the_sun_behind():
     its share H of it outward (bench_cloud_light "sun behind": the cumulus was -17.8 % dark with no floor,
     -9.1 % with -cos phi, +2.0 % now). Toward the sun the P1 term is larger and stands. H is checked
     against a quadrature of the lobes."""
-    from atmos.plugins.clouds.light.medium import hemisphere_share, hg
+    from atmos.phase import hg
+    from atmos.plugins.clouds.light.medium import hemisphere_share
     lobes = (0.85, -0.3, 0.1)
     mu = (np.arange(200000) + 0.5) / 200000                       # midpoint rule over the hemisphere
     quad = 2 * np.pi * np.mean((1 - lobes[2]) * hg(mu, lobes[0]) + lobes[2] * hg(mu, lobes[1]))

@@ -13,20 +13,18 @@ from __future__ import annotations
 
 import hashlib
 import os
-import re
 import shutil
 import subprocess
 import tempfile
 from pathlib import Path
 
-from atmos.gpu.shaders import GlslSource, ShaderError
+from atmos.gpu.shaders import GlslSource, ShaderError, compiler_message
 
 ENV = "ATMOS_GLSL_CHECK"
 COMPILER = "glslangValidator"
 _SUFFIX = {"vertex_shader": "vert", "fragment_shader": "frag", "geometry_shader": "geom",
            "compute_shader": "comp"}
 _ACCEPTED: set[bytes] = set()
-_MESSAGE = re.compile(r"^(?P<kind>ERROR|WARNING):\s*(?P<where>[^:\s]+):(?P<line>\d+):\s*(?P<text>.*)$")
 
 
 def check_enabled() -> bool:
@@ -57,13 +55,16 @@ def check_program(sources: dict[str, GlslSource]) -> None:
         if line.strip() in files:                      # a file's name before its messages ("ERROR: 0:14: ...")
             current = files[line.strip()]
             continue
-        match = _MESSAGE.match(line.strip())
-        if not match or (match["kind"] == "WARNING" and "'#extension'" not in line) \
-                or match["text"].startswith(("'' : compilation terminated", "'' : missing #endif")):
+        found = compiler_message(line)
+        if found is None:
             continue
-        source = files.get(match["where"], current)    # while linking: "ERROR: fragment_shader.frag:14: ..."
-        where = source.where(int(match["line"])) if source is not None else match["where"]
-        problems.append(f"{where}: {match['kind'].lower()}: {match['text']}")
+        name, number, message = found
+        kind, text = message.split(": ", 1)
+        if (kind == "warning" and "'#extension'" not in text) or text.startswith(("'' : compilation terminated",
+                                                                                   "'' : missing #endif")):
+            continue
+        source = files.get(name, current)             # while linking: "ERROR: fragment_shader.frag:14: ..."
+        problems.append(f"{source.where(number) if source is not None else name}: {message}")
     if done.returncode != 0 and not problems:
         problems = [line.strip() for line in (done.stdout + done.stderr).splitlines() if line.strip()]
     if problems:

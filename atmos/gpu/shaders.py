@@ -34,9 +34,9 @@ import moderngl
 
 _INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*$')
 _VERSION = re.compile(r"^\s*#version\b")
-_MESSAGE = re.compile(r"^\d+:(\d+)\(\d+\):\s*(.*)$"                      # Mesa: 0:14(7): error: ...
-                      r"|^\d+\((\d+)\)\s*:\s*(.*)$"                        # NVIDIA: 0(14) : error C0000: ...
-                      r"|^(?P<kind>ERROR|WARNING):\s*\d+:(\d+):\s*(.*)$")      # AMD, glslang: ERROR: 0:14: ...
+_MESSAGES = (re.compile(r"^(?P<where>\d+):(?P<line>\d+)\(\d+\):\s*(?P<text>.*)$"),       # Mesa: 0:14(7): error: ...
+             re.compile(r"^(?P<where>\d+)\((?P<line>\d+)\)\s*:\s*(?P<text>.*)$"),         # NVIDIA: 0(14) : error C0000: ...
+             re.compile(r"^(?P<kind>ERROR|WARNING):\s*(?P<where>[^:\s]+):(?P<line>\d+):\s*(?P<text>.*)$"))  # glslang, AMD
 
 
 class ShaderError(RuntimeError):
@@ -192,21 +192,23 @@ def load_source(name: str, defines: dict | None = None) -> GlslSource:
     return GlslSource("\n".join(lines) + "\n", tuple(origins))
 
 
-def located_messages(text: str, source: GlslSource) -> list[str]:
-    """The compiler's messages in ``text`` that name a line, as ``<file>:<line>: <message>``.
-
-    Understands Mesa's ``0:14(7): error: ...``, NVIDIA's ``0(14) : error C0000: ...`` and the
-    ``ERROR: 0:14: ...`` of AMD's driver and of glslang."""
-    messages = []
-    for raw in text.splitlines():
-        match = _MESSAGE.match(raw.strip())
+def compiler_message(raw: str) -> tuple[str, int, str] | None:
+    """``(where, line, message)`` of one compiler output line that names a line, the message led by its
+    kind (``error: ...``); None for any other line. Understands Mesa's ``0:14(7): error: ...``,
+    NVIDIA's ``0(14) : error C0000: ...`` and the ``ERROR: 0:14: ...`` of glslang and AMD's driver;
+    ``where`` is the source-string number, or the file glslang names while linking."""
+    raw = raw.strip()
+    for pattern in _MESSAGES:
+        match = pattern.match(raw)
         if match:
-            groups = [g for g in match.groups() if g is not None]
-            line, message = int(groups[-2]), groups[-1]
-            if match.group("kind"):
-                message = f"{match.group('kind').lower()}: {message}"
-            messages.append(f"{source.where(line)}: {message}")
-    return messages
+            kind = match.groupdict().get("kind")
+            return match["where"], int(match["line"]), f"{kind.lower()}: {match['text']}" if kind else match["text"]
+    return None
+
+
+def located_messages(text: str, source: GlslSource) -> list[str]:
+    """The compiler's messages in ``text`` that name a line, as ``<file>:<line>: <message>``."""
+    return [f"{source.where(found[1])}: {found[2]}" for found in map(compiler_message, text.splitlines()) if found]
 
 
 def explain(error: Exception, stages: dict[str, GlslSource]) -> ShaderError:

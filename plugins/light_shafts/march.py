@@ -17,6 +17,7 @@ from atmos.plugins.clouds.shadows import column_uniforms
 from atmos.offscreen import OffscreenLayer
 from atmos.plugins.light_shafts.settings import FLOAT32_MAX
 from atmos.render_core import COLOR, DEPTH
+from atmos.gpu.uniforms import write_uniforms
 
 SHAFT_COLOR = "light_shafts_march"     # low-res (in-scattered light, transmittance)
 SHAFT_DEPTH = "light_shafts_depth"     # low-res farthest scene depth
@@ -116,9 +117,7 @@ class MarchedShafts:
             self.fog_uniforms(frame, p, fog, settings)
         if aerial is not None:
             self.aerial_uniforms(frame, p, aerial)
-        for name, value in values.items():
-            if name in p:
-                p[name].value = value
+        write_uniforms(p, values)
         frame.fullscreen(p)
         self.offscreen.end(frame, factor, view.camera.near, view.camera.far, medium=True)
 

@@ -31,6 +31,7 @@ from atmos.graph import FullscreenPass, PassContext, TextureDesc
 from atmos.lighting import unit_sun
 from atmos.plugins.sky.luts import SKY_LUTS, atmosphere_defines, set_atmosphere_uniforms, view_radius
 from atmos.render_core import COLOR, DEPTH
+from atmos.gpu.uniforms import write_uniforms
 
 AERIAL = "aerial_perspective"
 AERIAL_VOLUME = "aerial_volume"          # the froxel volume (a transient of this pass)
@@ -128,9 +129,7 @@ class AerialPerspectivePass(FullscreenPass):
                 frame.resource(name).use(unit)
         set_camera_uniforms(p, view.camera, view.aspect)
         set_atmosphere_uniforms(p, settings.atmosphere)
-        for name, value in values.items():
-            if name in p:
-                p[name].value = value
+        write_uniforms(p, values)
         frame.fullscreen(p)
         if volume is not None:
             self.sampler.clear(VOLUME_UNIT)
@@ -140,9 +139,7 @@ class AerialPerspectivePass(FullscreenPass):
         c = self.gpu.program(compute_shader="sky/aerial_volume.comp", defines=atmosphere_defines())
         set_camera_uniforms(c, view.camera, view.aspect)
         set_atmosphere_uniforms(c, self.plugin.settings.atmosphere)
-        for name, value in values.items():
-            if name in c:
-                c[name].value = value
+        write_uniforms(c, values)
         volume.bind_to_image(0, read=False, write=True)
         w, h, _ = volume.size
         c.run(-(-w // GROUP), -(-h // GROUP), 1)

@@ -9,6 +9,7 @@ import numpy as np
 import atmos.plugins.sky.stars as stars
 from atmos.plugins.sky.settings import SkySettings
 from atmos.plugins.sky.preetham import COS_FLOOR, unit_vectors
+from atmos.gpu.uniforms import write_uniforms
 
 DAY_FADE = (-0.2, 0.02)      # sun height (sin elevation): night below the first, full Preetham day above the second
 GROUND_DIM = 0.3
@@ -58,11 +59,7 @@ def set_sky_uniforms(program, settings: SkySettings, sun_dir, sun_color, time: f
               "star_threshold": stars.star_threshold(settings.star_density) if settings.stars else 0,
               "star_brightness": settings.star_brightness, "twinkle": settings.twinkle,
               "sky_time": float(time) % stars.TWINKLE_PERIOD, "pixel_angle": float(pixel_angle)}
-    get = program.get
-    for name, value in values.items():
-        member = get(name, None)
-        if member is not None:
-            member.value = value
+    write_uniforms(program, values)
 
 
 def evaluate_sky(gpu, view_dirs, sun_dir, sun_color, settings: SkySettings | None = None, time: float = 0.0,

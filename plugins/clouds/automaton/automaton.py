@@ -139,6 +139,7 @@ class CloudAutomaton:
             for buf in self._state:
                 buf.clear()
             self._current = 0
+            self._shifts = self._shift_bytes = None   # the advection's last shifts and their uniform bytes
             self._dummy = ctx.buffer(reserve=16)
             objects.append(self._dummy)
         except Exception:
@@ -221,8 +222,7 @@ class CloudAutomaton:
 
         ctx, prog = self.ctx, self._prog_step
         self._set_grid(prog)
-        write_uniforms(prog, u_mode=tuple(modes), u_threshold=tuple(thresholds))
-        write_uniforms(prog, u_keys=keys)
+        write_uniforms(prog, u_mode=tuple(modes), u_threshold=tuple(thresholds), u_keys=keys)
         src, dst = self._state[self._current], self._state[1 - self._current]
         src.bind_to_storage_buffer(0)
         dst.bind_to_storage_buffer(1)
@@ -233,14 +233,17 @@ class CloudAutomaton:
         self._current = 1 - self._current
 
         if shifts.any():
-            padded = np.zeros((MAX_LAYERS, 2), "<i4")
-            padded[: len(shifts)] = shifts
+            if not np.array_equal(shifts, self._shifts):
+                self._shifts = shifts
+                padded = np.zeros((MAX_LAYERS, 2), "<i4")
+                padded[: len(shifts)] = shifts
+                self._shift_bytes = padded.tobytes()
             ctx.memory_barrier(moderngl.SHADER_STORAGE_BARRIER_BIT)
             src, dst = self._state[self._current], self._state[1 - self._current]
             src.bind_to_storage_buffer(0)
             dst.bind_to_storage_buffer(1)
             self._set_grid(self._prog_advect)
-            self._prog_advect["u_shifts"].write(padded.tobytes())
+            write_uniforms(self._prog_advect, u_shifts=self._shift_bytes)   # per run: the program is shared
             self._prog_advect.run(*self._grid)
             self._current = 1 - self._current
         ctx.memory_barrier(moderngl.ALL_BARRIER_BITS)

@@ -13,6 +13,7 @@ from atmos.plugins.clouds.volume.light import CloudLightSettings, light_uniforms
 from atmos.plugins.clouds.volume.field_demand import field_demand
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CloudSets
 from atmos.render_core import COLOR, DEPTH
+from atmos.gpu.uniforms import write_uniforms
 
 
 class CloudFarFieldPass(FullscreenPass):
@@ -56,9 +57,7 @@ class CloudFarFieldPass(FullscreenPass):
                                       / max(view.size[1], 1)),
                       **{name: float(getattr(params, name)) for name in
                          ("thickness", "horizon_fade")})
-        for name, value in values.items():
-            if name in p:
-                p[name].value = value
+        write_uniforms(p, values)
         frame.fullscreen(p)
 
 

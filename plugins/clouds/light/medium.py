@@ -45,7 +45,7 @@ import math
 
 import numpy as np
 
-from atmos.phase import hg, phase
+from atmos.phase import phase
 
 OCTAVES = 4
 

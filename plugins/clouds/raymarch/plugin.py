@@ -38,6 +38,7 @@ from atmos.plugins.clouds.volume.field_demand import field_demand
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CLOUD_VOLUME, CloudSets
 from atmos.plugins.clouds.simulation.chain import CloudSimulation
 from atmos.render_core import COLOR, DEPTH
+from atmos.gpu.uniforms import write_uniforms
 
 LOW_COLOR = "cloud_raymarch_color"
 LOW_DISTANCE = "cloud_raymarch_distance"
@@ -222,9 +223,7 @@ class RaymarchPass(RenderPass):
             frame.gpu.ctx.depth_func = "1"  # always: the shader writes the scene depth it saw
         set_camera_uniforms(p, view.camera, view.aspect)
         layout = sim.layout(s.base_altitude)
-        for name, value in self._uniforms(frame, sim, layout, offset).items():
-            if name in p:                   # a compiler may drop a uniform a variant does not use
-                p[name].value = value
+        write_uniforms(p, self._uniforms(frame, sim, layout, offset))
         bind_volume(p, sim, self.sampler, view.sun, s.octaves, s.ms_diffusion, layout.heights)
         if s.empty_space_skipping:
             self._skip_texture(sim).use(SKIP_UNIT)
@@ -259,10 +258,7 @@ class RaymarchPass(RenderPass):
         layer = frame.resource(FAR_FIELD)
         layer.prepare(view, sim)
         layer.use(p, view, sim)
-        values = far_uniforms(s, layer.settings, sim.layout(s.base_altitude), view, layer.tile_size)
-        for name, value in values.items():
-            if name in p:
-                p[name].value = value
+        write_uniforms(p, far_uniforms(s, layer.settings, sim.layout(s.base_altitude), view, layer.tile_size))
 
     def _detail(self):
         """The context's detail noise (built on first use, then held: no lookup per frame)."""

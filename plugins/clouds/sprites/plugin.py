@@ -51,6 +51,7 @@ from atmos.plugins.clouds.sprites.segments import MAX_LEVEL, SegmentStats, selec
 from atmos.plugins.clouds.volume.field_demand import field_demand
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CLOUD_VOLUME, CloudSets
 from atmos.render_core import COLOR, DEPTH
+from atmos.gpu.uniforms import write_uniforms
 
 
 @dataclass(frozen=True)
@@ -266,10 +267,7 @@ class CloudSpritePass(RenderPass):
             fbo = self.offscreen.begin(frame, factor, distance)
         # the soft particles' scene depth: the attached depth target's (sampled, never written)
         frame.resource(DEPTH if factor == 1 else self.offscreen.depth).use(5)
-        p["view_proj"].write(matrices.gl("view_proj"))
-        for name, value in uniforms.items():
-            if name in p:              # a compiler may drop a uniform a variant does not use
-                p[name].value = value
+        write_uniforms(p, uniforms, view_proj=matrices.gl("view_proj"))
         fbo.depth_mask = False
         frame.blend_over()
         ctx.enable(moderngl.DEPTH_TEST | moderngl.PROGRAM_POINT_SIZE)
