@@ -4,12 +4,9 @@
 //   (1 - T_a T_b) / (tau_a + tau_b) * (L_a tau_a / (1 - T_a) + L_b tau_b / (1 - T_b)),   tau = -ln T,
 // each medium's light per unit optical depth weighted by its share of the whole. Either alone (T = 1,
 // L = 0 for the other) gives itself back.
-float media_per_depth(float T, float tau) {
-    return tau < 1e-4 ? 1.0 + 0.5 * tau : tau / (1.0 - T);
-}
+#include "lib/exp_mean.glsl"
 
 vec3 media_mix(vec4 a, vec4 b) {
     float ta = -log(clamp(a.a, 1e-30, 1.0)), tb = -log(clamp(b.a, 1e-30, 1.0)), total = ta + tb;
-    float share = total < 1e-4 ? 1.0 - 0.5 * total : (1.0 - exp(-total)) / total;
-    return share * (a.rgb * media_per_depth(a.a, ta) + b.rgb * media_per_depth(b.a, tb));
+    return exp_mean(total) * (a.rgb / exp_mean(ta) + b.rgb / exp_mean(tb));
 }

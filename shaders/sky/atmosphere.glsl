@@ -1,6 +1,7 @@
 // The physical atmosphere after Hillaire 2020: medium, geometry, LUT mappings and the ray march.
 // float64 reference: plugins/sky/atmosphere.py (read its docstring); uniforms set by
 // plugins/sky/luts.py:set_atmosphere_uniforms; sizes and step counts passed as defines.
+#include "lib/exp_mean.glsl"
 uniform float atm_rg;          // planet radius, m
 uniform float atm_rt;          // top of the atmosphere, m
 uniform float atm_hr;          // Rayleigh scale height
@@ -98,8 +99,7 @@ void atm_segment(float r, float mu, float mu_s, float nu, float t0, float t1, ve
     vec3 s_ray, s_mie;
     vec3 ext = atm_coefficients(ri, s_ray, s_mie);
     vec3 seg = exp(-ext * dt);
-    vec3 spread = vec3(ext.x > 0.0 ? (1.0 - seg.x) / ext.x : dt, ext.y > 0.0 ? (1.0 - seg.y) / ext.y : dt,
-                       ext.z > 0.0 ? (1.0 - seg.z) / ext.z : dt);
+    vec3 spread = dt * exp_mean(ext * dt);    // ∫ e^(−σt s) ds over dt
     vec3 source = atm_transmittance_to_sun(ri, mus_i) * (s_ray * pr + s_mie * pm);
     if (!isotropic && atm_ms > 0.0)
         source += atm_ms * texture(atm_multiscattering, atm_ms_uv(ri, mus_i)).rgb * (s_ray + s_mie);
