@@ -6,7 +6,7 @@ start is relaxed until its tightest cluster is its largest void, then pixels are
 the tightest clusters (down from the start's count) and adding into the largest voids (up to the
 whole tile). Value ``(rank + 0.5) / size²``: every value once, uniform, and any threshold of it is
 evenly spread. The cloud march and the light shafts' march offset their first samples by it
-(:func:`blue_noise_texture`, unit BLUE_NOISE_UNIT, ``texelFetch(blue_noise, pixel % size)``):
+(:func:`blue_noise_texture`, ``texelFetch(blue_noise, pixel % size)``):
 interleaved gradient noise, the cloud march's before, is a set of diagonal lines, which a moving
 camera's reprojected history drew as a woven hatching; the shafts' white noise clumped.
 """
@@ -16,8 +16,6 @@ from functools import lru_cache
 
 import moderngl
 import numpy as np
-
-BLUE_NOISE_UNIT = 23     # the texture unit the marches read it at (below: volume.glsl, the far field, sky LUTs)
 
 
 def _kernel(size: int, sigma: float) -> np.ndarray:

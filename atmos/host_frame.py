@@ -21,6 +21,7 @@ from atmos.checks import check_bool
 from atmos.graph import FullscreenPass, PassContext
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
+from atmos.gpu.uniforms import bind_textures
 
 HOST_COLOR = "host_color"
 HOST_DEPTH = "host_depth"
@@ -65,8 +66,7 @@ class HostFramePass(FullscreenPass):
         compare = depth.compare_func
         depth.compare_func = ""                          # sampled as values; the game's setting comes back
         try:
-            color.use(0)
-            depth.use(1)
+            bind_textures(self.program, host_color=color, host_depth=depth)
             frame.fullscreen(self.program)
         finally:
             depth.compare_func = compare

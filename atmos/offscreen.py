@@ -17,6 +17,7 @@ import moderngl
 from atmos.composition import CLOUD_DISTANCE, distance_desc
 from atmos.graph import PassBuilder, PassContext, TextureDesc
 from atmos.render_core import COLOR, DEPTH
+from atmos.gpu.uniforms import bind_textures
 
 CLOUD_COLOR = "cloud_color"
 CLOUD_DEPTH = "cloud_depth"
@@ -54,7 +55,7 @@ class OffscreenLayer:
         """Write the low-res depth, clear the low-res colour; returns the framebuffer to draw sprites into."""
         ctx = frame.gpu.ctx
         frame.framebuffer(depth=self.depth).use()
-        frame.resource(DEPTH).use(0)
+        bind_textures(self.far_depth, scene_depth=frame.resource(DEPTH))
         self.far_depth["factor"].value = factor
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "1"                # always: the shader writes the block's farthest depth
@@ -75,10 +76,11 @@ class OffscreenLayer:
         texel (i, j) holds the frame's pixel (i·factor + ox, j·factor + oy); None: the block's centre."""
         frame.reset_state()                 # the sprites' depth test and point size are done
         frame.framebuffer(color=[COLOR, CLOUD_DISTANCE] if distance else [COLOR]).use()
-        names = (self.color, self.depth, DEPTH) + ((self.distance,) if distance else ())
-        for unit, name in enumerate(names):
-            frame.resource(name).use(unit)
         p = self.composite
+        bind_textures(p, clouds=frame.resource(self.color), cloud_depth=frame.resource(self.depth),
+                      scene_depth=frame.resource(DEPTH))
+        if distance:
+            bind_textures(p, cloud_distance=frame.resource(self.distance))
         p["factor"].value = factor
         p["inv_near_far"].value = (1.0 / near, 1.0 / far)
         p["edge"].value = EDGE

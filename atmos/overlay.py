@@ -18,6 +18,7 @@ from atmos.input import Input
 from atmos.keys import key
 from atmos.plugin import Plugin
 from atmos.render_core import SCREEN
+from atmos.gpu.uniforms import bind_textures
 
 HISTORY = 128
 
@@ -91,7 +92,7 @@ class OverlayPass(FullscreenPass):
         frame.resource(SCREEN).use()
         w, h = min(settings.size[0], gpu.size[0]), min(settings.size[1], gpu.size[1])
         self.data.write(np.asarray(self.times.ms, np.float32).tobytes())
-        self.data.use(0)
+        bind_textures(self.program, frame_ms=self.data)
         gpu.ctx.viewport = (4, 4, w, h) if gpu.size[0] > w + 8 else (0, 0, w, h)   # the graph resets it
         frame.blend_alpha()                  # over the screen; its alpha stays what present wrote (1)
         frame.fullscreen(self.program)

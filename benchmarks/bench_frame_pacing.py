@@ -21,6 +21,7 @@ import numpy as np
 from atmos.slicing import FrameScheduler, SlicedJob, SliceTask, TripleSet
 from atmos.gpu import add_shader_path, create_headless
 from atmos.graph import TextureDesc
+from atmos.gpu.uniforms import bind_textures
 
 VOLUME = (128, 32, 128)
 SLICES = 32
@@ -55,13 +56,10 @@ class Viewer:
         self.gpu = gpu
         self.program = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="test/frames_draw.frag")
         self.vao = gpu.track(gpu.ctx.vertex_array(self.program, []))
-        self.program["volume_a"] = 0
-        self.program["volume_b"] = 1
 
     def draw(self, job: SlicedJob) -> None:
         a, b, t = job.view()
-        a["volume"].use(0)
-        b["volume"].use(1)
+        bind_textures(self.program, volume_a=a["volume"], volume_b=b["volume"])
         self.program["t"] = t
         self.program["layer"] = 0.5
         self.gpu.target.use()

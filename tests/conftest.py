@@ -8,6 +8,7 @@ import pytest
 
 from atmos.gpu import add_shader_path, create_headless
 from atmos.gpu.portability import COMPILER, ENV
+from atmos.gpu.uniforms import bind_textures
 
 os.environ.setdefault("ATMOS_HEADLESS", "1")
 if shutil.which(COMPILER):
@@ -50,7 +51,7 @@ def filter_bits(gpu):
     out = ctx.buffer(reserve=4 * n)
     program = gpu.program(compute_shader="test/filter_probe.comp")
     try:
-        texture.use(0)
+        bind_textures(program, s=texture)
         out.bind_to_storage_buffer(0)
         program.run(n)
         ctx.memory_barrier()

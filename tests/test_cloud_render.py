@@ -163,7 +163,7 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale,
             parts.append(np.frombuffer(out.read(), np.float32).reshape(-1, 29).astype(np.float64))
             for obj in (vao, out, inst):
                 obj.release()
-        unbind_volume(sampler)
+        unbind_volume(prog, sampler)
     finally:
         for obj in (sampler, prog):
             obj.release()

@@ -34,7 +34,7 @@ def gpu_blur(gpu, mask: np.ndarray, sun_uv, params, strength=1.0) -> np.ndarray:
     """The blur shader alone on an (h, w, 3) mask (float16 RGBA texture, linear filtering)."""
     h, w = mask.shape[:2]
     rgba = np.concatenate([mask, np.zeros((h, w, 1))], -1).astype(np.float16)
-    return run_fullscreen(gpu, "light_shafts/blur.frag", (w, h), [rgba],
+    return run_fullscreen(gpu, "light_shafts/blur.frag", (w, h), {"mask": rgba},
                           lambda program: blur_uniforms(program, sun_uv, params, strength))
 
 

@@ -94,7 +94,7 @@ def test_present_writes_exact_levels_that_any_rounding_keeps(gpu, ctx, rng):
     def uniforms(program):
         program["exposure"].value = 1.0
         program["dither"].value = DITHER_STEP
-    out = run_fullscreen(gpu, "core/present.frag", (w, h), [image], uniforms, nearest=True)[..., :3]
+    out = run_fullscreen(gpu, "core/present.frag", (w, h), {"hdr": image}, uniforms, nearest=True)[..., :3]
     # level / 255.0 in float32: within 2.5 ulp (GLSL's division) of the level, ulp ≤ 2^-24 below 1
     assert np.abs(out * 255.0 - np.round(out * 255.0)).max() <= 255.0 * 2.5 * 2.0 ** -24
     assert np.array_equal(nvidia_unorm8(out), round_to_nearest(out))

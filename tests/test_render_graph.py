@@ -3,6 +3,7 @@ import numpy as np
 import pytest
 
 from atmos.graph import GraphError, PassContext, RenderGraph, RenderPass, TextureDesc, TexturePool
+from atmos.gpu.uniforms import bind_textures
 
 VERT = "lib/fullscreen.vert"
 SMALL = TextureDesc((8, 8))
@@ -394,8 +395,7 @@ def _fill(p, frame):
 
 
 def _swizzle(p, frame):
-    frame.resource("color").use(location=0)
-    p.program["src"].value = 0
+    bind_textures(p.program, src=frame.resource("color"))
     frame.framebuffer(color=["target"]).use()
     frame.fullscreen(p.program)
 

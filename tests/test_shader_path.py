@@ -8,6 +8,7 @@ import pytest
 from atmos.app import App
 from atmos.defaults import DefaultPlugins
 from atmos.gpu import ShaderError, add_shader_path, load_source, remove_shader_path, shader_paths
+from atmos.gpu.uniforms import bind_textures
 from atmos.graph import FullscreenPass, PassContext
 from atmos.scene_uniforms import set_scene_uniforms
 from atmos.plugin import Plugin
@@ -74,6 +75,32 @@ def test_compile_error_names_the_plugin_file_and_line(gpu, ctx, mypkg):
     with pytest.raises(ShaderError) as info:
         gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="mypkg/broken_include.frag")
     assert f"{SHADERS}/broken_piece.glsl:3:" in str(info.value)
+
+
+def test_samplers_declare_their_units_once_and_textures_are_bound_by_name(gpu, ctx, mypkg):
+    program = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="mypkg/two_textures.frag")
+    textures = {name: ctx.texture((1, 1), 1, np.array([value], "f4").tobytes(), dtype="f4")
+                for name, value in (("first", 0.25), ("second", 0.75), ("unused", 0.5), ("stray", 9.0))}
+    target = ctx.texture((1, 1), 4, dtype="f4")
+    fbo, vao = ctx.framebuffer([target]), ctx.vertex_array(program, [])
+    try:
+        textures["stray"].use(0)                                            # what unit 0 held before
+        assert sorted(bind_textures(program, textures)) == [4, 9]           # the GLSL's units; "unused" skipped
+        fbo.use()
+        vao.render(vertices=3)
+        assert np.frombuffer(target.read(), "f4")[:2].tolist() == [0.25, 0.75]
+    finally:
+        gpu.target.use()
+        for obj in (vao, fbo, target, *textures.values()):
+            obj.release()
+    with pytest.raises(ShaderError) as info:
+        gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="mypkg/shared_unit.frag")
+    message = str(info.value)
+    assert "second and first" in message and "share texture unit 4" in message
+    assert f"{SHADERS}/shared_unit.frag:4" in message and f"{SHADERS}/unit_piece.glsl:2" in message
+    with pytest.raises(ShaderError) as info:
+        gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="mypkg/unbound_sampler.frag")
+    assert f"{SHADERS}/unbound_sampler.frag:3: sampler nowhere needs layout(binding = N)" in str(info.value)
 
 
 def test_unknown_file_names_the_search_path(mypkg):

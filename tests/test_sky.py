@@ -99,7 +99,7 @@ def render_sky(gpu, camera: Camera, size, params: SkySettings, sun, sun_color, t
     def uniforms(prog):
         set_camera_uniforms(prog, camera, w / h)      # view_basis
         set_sky_uniforms(prog, params, sun, sun_color, time, camera.fov_y / h)
-    return run_fullscreen(gpu, "sky/sky.frag", size, (), uniforms, defines=sky_defines())
+    return run_fullscreen(gpu, "sky/sky.frag", size, None, uniforms, defines=sky_defines())
 
 
 def pixel_centres(size):

@@ -53,7 +53,7 @@ def render_view_rays(gpu, camera: Camera, depth: np.ndarray) -> np.ndarray:
     def uniforms(prog):
         set_camera_uniforms(prog, camera, w / h)
         prog["none"].value = NONE
-    return run_fullscreen(gpu, "test/view_ray.frag", (w, h), [depth.astype(np.float32)], uniforms, nearest=True)
+    return run_fullscreen(gpu, "test/view_ray.frag", (w, h), {"scene_depth": depth.astype(np.float32)}, uniforms, nearest=True)
 
 
 @pytest.mark.parametrize("near, far", [(0.1, 1e10), (0.1, 2000.0), (1e-3, 1e12)])

@@ -34,6 +34,8 @@ import moderngl
 
 _INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*$')
 _VERSION = re.compile(r"^\s*#version\b")
+_SAMPLER = re.compile(r"^\s*(layout\s*\(\s*binding\s*=\s*\w+\s*\)\s*)?uniform\s+(?:(?:lowp|mediump|highp)\s+)?"
+                      r"[iu]?sampler\w*\s+(\w+)")
 _MESSAGES = (re.compile(r"^(?P<where>\d+):(?P<line>\d+)\(\d+\):\s*(?P<text>.*)$"),       # Mesa: 0:14(7): error: ...
              re.compile(r"^(?P<where>\d+)\((?P<line>\d+)\)\s*:\s*(?P<text>.*)$"),         # NVIDIA: 0(14) : error C0000: ...
              re.compile(r"^(?P<kind>ERROR|WARNING):\s*(?P<where>[^:\s]+):(?P<line>\d+):\s*(?P<text>.*)$"))  # glslang, AMD
@@ -235,7 +237,35 @@ def compile_program(ctx: moderngl.Context, sources: dict[str, GlslSource]):
     releases what this makes (everything else asks the GpuContext)."""
     try:
         if "compute_shader" in sources:
-            return ctx.compute_shader(sources["compute_shader"].text)
-        return ctx.program(**{stage: src.text for stage, src in sources.items()})
+            program = ctx.compute_shader(sources["compute_shader"].text)
+        else:
+            program = ctx.program(**{stage: src.text for stage, src in sources.items()})
     except moderngl.Error as error:
         raise explain(error, sources) from None
+    try:
+        check_sampler_units(program, sources)
+    except ShaderError:
+        program.release()
+        raise
+    return program
+
+
+def check_sampler_units(program, sources: dict[str, GlslSource]) -> None:
+    """Every sampler the program uses declares its texture unit (``layout(binding = N)``: the one place
+    a unit is written; Python binds by name, :func:`atmos.gpu.uniforms.bind_textures`), and no two
+    share one: a ShaderError naming both declarations otherwise."""
+    seen: dict[int, tuple[str, str]] = {}
+    for src in sources.values():
+        for index, line in enumerate(src.text.splitlines()):
+            match = _SAMPLER.match(line)
+            if not match or match.group(2) not in program:
+                continue
+            name = match.group(2)
+            where = src.where(index + 1)
+            if not match.group(1):
+                raise ShaderError(f"{where}: sampler {name} needs layout(binding = N): its texture unit")
+            units = program[name].value          # a sampler array: consecutive units
+            for unit in units if isinstance(units, list) else [units]:
+                if unit in seen and seen[unit][0] != name:
+                    raise ShaderError(f"{where}: sampler {name} and {seen[unit][0]} ({seen[unit][1]}) share texture unit {unit}")
+                seen[unit] = (name, where)

@@ -1,4 +1,6 @@
-"""The one uniform writer: values by name into a program, skipping the uniforms its compiler dropped."""
+"""The one uniform writer and the one texture binder: values and textures by name into a program,
+skipping what its compiler dropped. A texture's unit is written once, in the GLSL that declares its
+sampler (``layout(binding = N)``); Python binds by the sampler's name and never names a unit."""
 from __future__ import annotations
 
 from collections.abc import Mapping
@@ -20,3 +22,27 @@ def write_uniforms(program, values: Mapping[str, object] | None = None, /, **mor
             member.value = value[:member.array_length] if member.array_length > 1 else value[0]
         else:
             member.value = value
+
+
+def bind_textures(program, textures: Mapping[str, object] | None = None, /, sampler=None, **more) -> list[int]:
+    """Bind each texture to the unit of ``program``'s sampler of that name (the ``layout(binding = N)``
+    of its declaration; a sequence of textures to a sampler array, element by element); a name the
+    program does not use is skipped. ``sampler`` (a moderngl Sampler) is bound at those units too.
+    Returns the units bound (to clear ``sampler`` from afterwards)."""
+    get = program.get
+    units = []
+    for name, texture in ({**textures, **more} if textures else more).items():
+        member = get(name, None)
+        if member is None:
+            continue
+        value = member.value                 # a sampler array: its units (one int where one element is used)
+        if isinstance(texture, (list, tuple)):
+            pairs = zip(value if isinstance(value, list) else [value], texture)
+        else:
+            pairs = ((value, texture),)
+        for unit, one in pairs:
+            one.use(unit)
+            if sampler is not None:
+                sampler.use(unit)
+            units.append(unit)
+    return units

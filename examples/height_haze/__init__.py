@@ -9,7 +9,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from atmos import COLOR, DEPTH, FullscreenPass, PassContext, Plugin, add_shader_path, set_camera_uniforms, write_uniforms
+from atmos import (COLOR, DEPTH, FullscreenPass, PassContext, Plugin, add_shader_path, bind_textures, set_camera_uniforms,
+                   write_uniforms)
 from atmos.checks import CheckedSettings, check_num, check_vec
 
 
@@ -43,7 +44,7 @@ class HeightHazePass(FullscreenPass):
         s, p = self.plugin.settings, self.program
         frame.framebuffer(color=[COLOR]).use()
         frame.blend_transmittance()       # rgb = light + T * rgb; the graph resets state after
-        frame.resource(DEPTH).use(0)
+        bind_textures(p, scene_depth=frame.resource(DEPTH))
         set_camera_uniforms(p, frame.view.camera, frame.view.aspect)
         write_uniforms(p, density=s.density, base=s.base, scale_height=s.scale_height,
                        max_distance=s.max_distance, haze_color=s.haze_color)   # skips what the compiler dropped

@@ -19,7 +19,7 @@ from atmos.plugins.fog.post import FogPass, draw_state, fog_program, restore_sta
 from atmos.plugins.fog.settings import MODES, PAPER_RESOLUTIONS, FogSettings
 from atmos.plugins.fog.sky_color import SAMPLES, horizon_table
 from atmos.plugins.sky import SkyLight
-from atmos.gpu.uniforms import write_uniforms
+from atmos.gpu.uniforms import bind_textures, write_uniforms
 
 __all__ = ["FogMedium", "FogPlugin", "FogSettings", "FogPass", "apply_fog", "MODES", "PAPER_RESOLUTIONS"]
 
@@ -118,11 +118,8 @@ def apply_fog(gpu, color, distance, mode: str = "exp2", density: float = 0.044, 
         made.append(vao)
         if settings.heterogeneous and settings.noise == "texture":
             volumes = NoiseVolumes(gpu, settings)
-            volumes.use(3)
-        dist_tex.use(0)
-        pos_tex.use(1)
-        cloud_tex.use(2)
-        dir_tex.use(7)
+            volumes.bind(prog)
+        bind_textures(prog, fog_distance=dist_tex, fog_position=pos_tex, cloud_distance=cloud_tex, fog_direction=dir_tex)
         set_fog_uniforms(prog, settings, time, horizon)
         write_uniforms(prog, fog_far=far, fog_camera=tuple(float(v) for v in camera))
         fbo.use()

@@ -17,6 +17,7 @@ import numpy as np
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.gradient_noise import periodic_noise, sample_repeat_trilinear
 from atmos.hashing import stream_key
+from atmos.gpu.uniforms import bind_textures
 
 FOG_RULE = 0xF06  # stream id of the fog gradients: stream_key(seed, 0, FOG_RULE, octave)
 @lru_cache(maxsize=64)
@@ -93,9 +94,9 @@ class NoiseVolumes:
     def matches(self, settings) -> bool:
         return self.key == (settings.seed, settings.resolutions[:settings.octaves], settings.texels_per_cell)
 
-    def use(self, first_unit: int = 3) -> None:
-        for i, tex in enumerate(self.textures):
-            tex.use(first_unit + i)
+    def bind(self, program) -> None:
+        """Bind octave i's volume to the program's ``fog_noise[i]`` (``fog/factor.glsl``)."""
+        bind_textures(program, fog_noise=self.textures)
 
     def read(self) -> list[np.ndarray]:
         """The volumes as float32 arrays indexed [x, y, z] (for tests)."""

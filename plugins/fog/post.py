@@ -13,7 +13,7 @@ from atmos.plugins.fog.noise import NoiseVolumes, octave_key
 from atmos.plugins.fog.settings import MODES
 from atmos.plugins.fog.sky_color import SAMPLES
 from atmos.render_core import COLOR, DEPTH
-from atmos.gpu.uniforms import write_uniforms
+from atmos.gpu.uniforms import bind_textures, write_uniforms
 
 FRAGMENT = "fog/fog.frag"
 VERTEX = "lib/fullscreen.vert"
@@ -102,11 +102,11 @@ class FogPass(RenderPass):
         prog = self._sync(settings, clouds, media)
         frame.framebuffer(color=medium_targets(frame, COLOR)).use()
         frame.blend_transmittance()
-        frame.resource(DEPTH).use(0)
+        bind_textures(prog, scene_depth=frame.resource(DEPTH))
         if clouds:
-            frame.resource(CLOUD_DISTANCE).use(2)
+            bind_textures(prog, cloud_distance=frame.resource(CLOUD_DISTANCE))
         if self.volumes is not None:
-            self.volumes.use(3)
+            self.volumes.bind(prog)
         set_camera_uniforms(prog, view.camera, view.aspect)
         set_fog_uniforms(prog, settings, view.time + settings.time_offset, self.plugin.horizon(view))
         frame.fullscreen(prog)

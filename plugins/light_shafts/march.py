@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.blue_noise import BLUE_NOISE_UNIT, blue_noise_texture
+from atmos.blue_noise import blue_noise_texture
 from atmos.scene_uniforms import set_camera_uniforms
 from atmos.composition import CLOUD_DISTANCE
 from atmos.graph import PassBuilder, PassContext
@@ -17,7 +17,7 @@ from atmos.plugins.clouds.shadows import column_uniforms
 from atmos.offscreen import OffscreenLayer
 from atmos.plugins.light_shafts.settings import FLOAT32_MAX
 from atmos.render_core import COLOR, DEPTH
-from atmos.gpu.uniforms import write_uniforms
+from atmos.gpu.uniforms import bind_textures, write_uniforms
 
 SHAFT_COLOR = "light_shafts_march"     # low-res (in-scattered light, transmittance)
 SHAFT_DEPTH = "light_shafts_depth"     # low-res farthest scene depth
@@ -93,15 +93,11 @@ class MarchedShafts:
         frame.framebuffer(color=[SHAFT_COLOR]).use()
         far_field = clouds and frame.declares(FAR_FIELD)
         p = self.program(far_field, fog, aerial)
-        frame.resource(SHAFT_DEPTH).use(2)
         if self.jitter is None:
             self.jitter = blue_noise_texture(self.gpu.ctx)
-        self.jitter.use(BLUE_NOISE_UNIT)
+        bind_textures(p, low_depth=frame.resource(SHAFT_DEPTH), blue_noise=self.jitter)
         if clouds:
             sim: CloudSets = frame.resource(CLOUD_SETS)
-            a, b, _ = sim.view()
-            sim.maps_of(a).sums.use(0)
-            sim.maps_of(b).sums.use(1)
             column_uniforms(p, sim, sim.layout(), sim.settings.sigma)
             if far_field:
                 layer = frame.resource(FAR_FIELD)
@@ -123,21 +119,21 @@ class MarchedShafts:
 
     @staticmethod
     def fog_uniforms(frame: PassContext, program, fog, settings) -> None:
-        """The fog's factor and colour (as its own pass sets them) and its clouds' distance (unit 3)."""
+        """The fog's factor and colour (as its own pass sets them) and its clouds' distance."""
         fog.set_uniforms(program, frame.view)
         bind_cloud_distance(frame, program)
         program["fog_sun_share"].value = settings.fog_sun_share
 
     @staticmethod
     def aerial_uniforms(frame: PassContext, program, sky) -> None:
-        """The sky's atmosphere (its LUTs bound, the camera's radius) and the clouds' distance (unit 3)."""
+        """The sky's atmosphere (its LUTs bound, the camera's radius) and the clouds' distance."""
         sky.set_aerial_uniforms(frame, program)
         bind_cloud_distance(frame, program)
 
 
 def bind_cloud_distance(frame: PassContext, program) -> None:
-    """The clouds' own distance at unit 3 when the pass declared it (``has_cloud_distance``)."""
+    """The clouds' own distance when the pass declared it (``has_cloud_distance``)."""
     clouds = frame.declares(CLOUD_DISTANCE)
     if clouds:
-        frame.resource(CLOUD_DISTANCE).use(3)
+        bind_textures(program, cloud_distance=frame.resource(CLOUD_DISTANCE))
     program["has_cloud_distance"].value = int(clouds)

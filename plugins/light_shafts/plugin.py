@@ -14,6 +14,7 @@ from atmos.plugins.light_shafts.settings import LightShaftSettings, blur_scale
 from atmos.plugins.light_shafts.screen_sun import screen_sun
 from atmos.plugins.sky import SkyLight
 from atmos.render_core import COLOR, DEPTH
+from atmos.gpu.uniforms import bind_textures
 
 MASK = "light_shafts_mask"
 BLUR = "light_shafts_blur"
@@ -86,8 +87,7 @@ class LightShaftsPass(RenderPass):
         ctx = gpu.ctx
         mask = frame.resource(MASK)
         frame.framebuffer(color=[MASK]).use()
-        frame.resource(COLOR).use(0)
-        frame.resource(DEPTH).use(1)
+        bind_textures(self.mask, scene_color=frame.resource(COLOR), scene_depth=frame.resource(DEPTH))
         self.mask["mask_size"].value = mask.size
         self.mask["sun_uv"].value = where.uv
         self.mask["threshold"].value = params.threshold
@@ -97,12 +97,12 @@ class LightShaftsPass(RenderPass):
         frame.fullscreen(self.mask)
 
         frame.framebuffer(color=[BLUR]).use()
-        mask.use(0)
+        bind_textures(self.blur, mask=mask)
         blur_uniforms(self.blur, where.uv, params, where.strength)
         frame.fullscreen(self.blur)
 
         frame.framebuffer(color=[COLOR]).use()
-        frame.resource(BLUR).use(0)
+        bind_textures(self.composite, shafts=frame.resource(BLUR))
         ctx.enable(ctx.BLEND)
         ctx.blend_func = ctx.ONE, ctx.ONE
         frame.fullscreen(self.composite)

@@ -31,12 +31,10 @@ from atmos.graph import FullscreenPass, PassContext, TextureDesc
 from atmos.lighting import unit_sun
 from atmos.plugins.sky.luts import SKY_LUTS, atmosphere_defines, set_atmosphere_uniforms, view_radius
 from atmos.render_core import COLOR, DEPTH
-from atmos.gpu.uniforms import write_uniforms
+from atmos.gpu.uniforms import bind_textures, write_uniforms
 
 AERIAL = "aerial_perspective"
 AERIAL_VOLUME = "aerial_volume"          # the froxel volume (a transient of this pass)
-VOLUME_UNIT = 3                          # aerial.frag samples it here
-MEDIA_UNITS = (4, 5)                     # and the local media (atmos.composition) here
 GROUP = 8                                # aerial_volume.comp's work group: 8 x 8 froxel columns
 
 
@@ -110,29 +108,26 @@ class AerialPerspectivePass(FullscreenPass):
     def execute(self, frame: PassContext) -> None:
         view, p = frame.view, self.program
         settings = self.plugin.settings
-        frame.resource(SKY_LUTS).use()
+        frame.resource(SKY_LUTS).bind(p)
         values = dict(sun_dir=tuple(float(v) for v in unit_sun(view.sun.direction)),
                       view_r=view_radius(settings.atmosphere, view.camera),
                       aerial_range=volume_range(view.camera, view.aspect, settings.atmosphere))
         volume = frame.resource(AERIAL_VOLUME) if frame.declares(AERIAL_VOLUME) else None
         if volume is not None:
             self._fill(volume, view, values)
-            volume.use(VOLUME_UNIT)
-            self.sampler.use(VOLUME_UNIT)
+        units = bind_textures(p, sampler=self.sampler, aerial_volume=volume) if volume is not None else []
         frame.framebuffer(color=[COLOR]).use()
         frame.blend_transmittance()
-        frame.resource(DEPTH).use(0)
-        if frame.declares(CLOUD_DISTANCE):
-            frame.resource(CLOUD_DISTANCE).use(2)
-        if frame.declares(MEDIA_LIGHT):
-            for name, unit in zip((MEDIA_LIGHT, MEDIA_TRANSMITTANCE), MEDIA_UNITS):
-                frame.resource(name).use(unit)
+        bind_textures(p, scene_depth=frame.resource(DEPTH))
+        # graph resources under the names the shader's samplers carry (atmos.composition)
+        bind_textures(p, {name: frame.resource(name) for name in (CLOUD_DISTANCE, MEDIA_LIGHT, MEDIA_TRANSMITTANCE)
+                          if frame.declares(name)})
         set_camera_uniforms(p, view.camera, view.aspect)
         set_atmosphere_uniforms(p, settings.atmosphere)
         write_uniforms(p, values)
         frame.fullscreen(p)
-        if volume is not None:
-            self.sampler.clear(VOLUME_UNIT)
+        for unit in units:
+            self.sampler.clear(unit)
 
     def _fill(self, volume, view, values) -> None:
         """The froxel volume: one invocation per froxel column, marching through the slices (aerial_volume.comp)."""

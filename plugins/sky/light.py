@@ -77,6 +77,6 @@ class SkyLight:
 
     def set_aerial_uniforms(self, frame, program) -> None:
         """The atmosphere's uniforms, its LUTs bound and the camera's radius (``view_r``)."""
-        frame.resource(SKY_LUTS).use()
+        frame.resource(SKY_LUTS).bind(program)
         set_atmosphere_uniforms(program, self.settings.atmosphere)
         program["view_r"].value = view_radius(self.settings.atmosphere, frame.view.camera)

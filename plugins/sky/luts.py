@@ -17,9 +17,8 @@ import numpy as np
 
 import atmos.plugins.sky.atmosphere as ref
 from atmos.plugins.sky.atmosphere_settings import AtmosphereSettings
-from atmos.gpu.uniforms import write_uniforms
+from atmos.gpu.uniforms import bind_textures, write_uniforms
 
-TRANSMITTANCE_UNIT, MULTISCATTERING_UNIT, SKY_VIEW_UNIT = 10, 11, 12   # texture units the sky pass binds
 SUN_TOLERANCE = 5e-4          # the sky view is remade when the sun's height (y) moved more (≈ 0.03° near the horizon)
 ALTITUDE_TOLERANCE = (1.0, 0.01)   # ... or the camera's altitude by more than max(1 m, 1 %)
 
@@ -48,19 +47,18 @@ def atmosphere_defines() -> dict:
 
 
 def set_atmosphere_uniforms(program, settings: AtmosphereSettings) -> None:
-    """Every uniform of ``sky/atmosphere.glsl`` that ``program`` uses (samplers: the units above)."""
+    """Every uniform of ``sky/atmosphere.glsl`` that ``program`` uses (its LUTs: :meth:`AtmosphereLuts.bind`)."""
     m = ref.medium(settings)
     values = {"atm_rg": m["rg"], "atm_rt": m["rt"], "atm_hr": m["hr"], "atm_hm": m["hm"], "atm_oz_c": m["oz_c"],
               "atm_oz_w": m["oz_w"], "atm_g": m["g"], "atm_ms": m["ms"], "atm_ray": m["ray"], "atm_mie_s": m["mie_s"],
-              "atm_mie_t": m["mie_t"], "atm_ozone": m["ozone"], "atm_albedo": m["albedo"], "atm_sun": m["sun"],
-              "atm_transmittance": TRANSMITTANCE_UNIT, "atm_multiscattering": MULTISCATTERING_UNIT}
+              "atm_mie_t": m["mie_t"], "atm_ozone": m["ozone"], "atm_albedo": m["albedo"], "atm_sun": m["sun"]}
     write_uniforms(program, {name: tuple(float(x) for x in value) if isinstance(value, np.ndarray) else value
                              for name, value in values.items()})
 
 
 class AtmosphereLuts:
     """The transmittance (256×64, holding the optical depth τ), multiple-scattering (32×32) and sky-view (192×108) textures of one
-    sky on ``gpu`` (a GpuContext); :meth:`update` before drawing, :meth:`use` binds them, :meth:`read`
+    sky on ``gpu`` (a GpuContext); :meth:`update` before drawing, :meth:`bind` binds them, :meth:`read`
     returns one as float32 (H, W, 3) (tests), :meth:`release` frees them."""
 
     def __init__(self, gpu):
@@ -109,18 +107,17 @@ class AtmosphereLuts:
         set_atmosphere_uniforms(program, settings)
         for key, value in uniforms.items():
             program[key].value = value
-        self.textures["transmittance"].use(TRANSMITTANCE_UNIT)
-        self.textures["multiscattering"].use(MULTISCATTERING_UNIT)
+        if name != "transmittance":
+            self.bind(program)
         tex = self.textures[name]
         tex.bind_to_image(0, read=False, write=True)
         program.run(math.ceil(tex.width / 8), math.ceil(tex.height / 8))
         self.gpu.ctx.memory_barrier()
 
-    def use(self) -> None:
-        """Bind the three textures to their units (the sky pass reads them there)."""
-        self.textures["transmittance"].use(TRANSMITTANCE_UNIT)
-        self.textures["multiscattering"].use(MULTISCATTERING_UNIT)
-        self.textures["sky_view"].use(SKY_VIEW_UNIT)
+    def bind(self, program) -> None:
+        """Bind the textures ``program`` samples (``atm_transmittance``, ``atm_multiscattering``, ``sky_view``)."""
+        bind_textures(program, atm_transmittance=self.textures["transmittance"],
+                      atm_multiscattering=self.textures["multiscattering"], sky_view=self.textures["sky_view"])
 
     def read(self, name: str) -> np.ndarray:
         """float32 (height, width, 3) of the texture ``name`` ("transmittance", "multiscattering", "sky_view")."""

@@ -12,7 +12,7 @@ from atmos.lighting import Sun
 from atmos.plugin import Plugin
 import atmos.plugins.sky.sun_light as sun_light
 from atmos.plugins.sky.aerial import AERIAL, AerialPerspectivePass, active
-from atmos.plugins.sky.luts import (SKY_LUTS, SKY_VIEW_UNIT, AtmosphereLuts, atmosphere_defines, camera_altitude,
+from atmos.plugins.sky.luts import (SKY_LUTS, AtmosphereLuts, atmosphere_defines, camera_altitude,
                                     set_atmosphere_uniforms, view_radius)
 from atmos.plugins.sky.light import SkyLight
 from atmos.plugins.sky.settings import SkySettings
@@ -76,9 +76,8 @@ class SkyPass(FullscreenPass):
         set_sky_uniforms(p, settings, view.sun.direction, view.sun.color, view.time,
                          camera.fov_y / max(1, view.size[1]))
         if self.physical:
-            frame.resource(SKY_LUTS).use()
+            frame.resource(SKY_LUTS).bind(p)
             set_atmosphere_uniforms(p, settings.atmosphere)
-            p["sky_view"].value = SKY_VIEW_UNIT
             p["view_r"].value = view_radius(settings.atmosphere, camera)
         frame.fullscreen(p)
 

@@ -6,6 +6,7 @@ import math
 import moderngl
 import numpy as np
 
+from atmos.gpu.uniforms import bind_textures
 from atmos.plugins.sky_layer.settings import SkyLayerSettings
 from atmos.value_noise import key, value_noise
 
@@ -96,9 +97,9 @@ class OctaveTextures:
         w, h = tex.size
         return np.frombuffer(tex.read(), np.float32).reshape(h, w, 4).transpose(1, 0, 2).astype(np.float64)
 
-    def use(self, first_unit: int = 0) -> None:
-        for k, tex in enumerate(self.textures):
-            tex.use(first_unit + k)
+    def bind(self, program) -> None:
+        """Bind octave k to the program's sampler ``octave{k}``."""
+        bind_textures(program, {f"octave{k}": tex for k, tex in enumerate(self.textures)})
 
     def release(self) -> None:
         for tex in self.textures:

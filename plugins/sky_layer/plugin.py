@@ -8,6 +8,7 @@ from atmos.graph import FullscreenPass, PassContext
 from atmos.lighting import Sun, sun_and_day
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
+from atmos.gpu.uniforms import bind_textures
 from atmos.plugins.sky_layer.octaves import OctaveTextures
 from atmos.plugins.sky_layer.settings import SkyLayerSettings
 
@@ -44,8 +45,8 @@ class SkyLayerPass(FullscreenPass):
             plugin.octaves.bake(params, s)
         frame.framebuffer(color=[COLOR]).use()
         frame.blend_over()
-        plugin.octaves.use(0)
-        frame.resource(DEPTH).use(4)
+        plugin.octaves.bind(p)
+        bind_textures(p, scene_depth=frame.resource(DEPTH))
         set_camera_uniforms(p, view.camera, view.aspect)
         p["offsets"].write(scroll_offsets(params.wind, plugin.time(view)).astype("f4").tobytes())
         for name in ("altitude", "tile_size", "horizon_fade", "emptiness", "sharpness", "thickness",

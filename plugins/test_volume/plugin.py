@@ -10,6 +10,7 @@ from atmos.graph import FullscreenPass, PassContext, TextureDesc
 from atmos.scene_uniforms import set_scene_uniforms
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
+from atmos.gpu.uniforms import bind_textures
 
 TEST_VOLUME_SETS = "test_volume_sets"     # the imported (A, B, t) of the test volume's texture sets
 
@@ -112,9 +113,7 @@ class TestVolumePass(FullscreenPass):
         a, b, t = frame.resource(TEST_VOLUME_SETS)
         frame.framebuffer(color=[COLOR]).use()
         frame.blend_over()
-        a["density"].use(0)
-        b["density"].use(1)
-        frame.resource(DEPTH).use(2)
+        bind_textures(p, density_a=a["density"], density_b=b["density"], scene_depth=frame.resource(DEPTH))
         set_scene_uniforms(p, frame.view)
         p["t"].value = t
         box = self.plugin.settings.box

@@ -18,6 +18,7 @@ from atmos.graph import FullscreenPass, PassContext
 from atmos.plugin import Plugin
 from atmos.plugins.text.raster import font as load_font, rasterize
 from atmos.render_core import SCREEN
+from atmos.gpu.uniforms import bind_textures
 
 CACHE = 256      # rasterised labels kept on the GPU, least recently drawn released first
 
@@ -92,7 +93,7 @@ class TextPass(FullscreenPass):
             texture = self._texture(ctx, label)
             x, y = label_origin(label, (texture.height, texture.width), (w, h))
             ctx.viewport = (x, h - y - texture.height, texture.width, texture.height)   # the graph resets it
-            texture.use(0)
+            bind_textures(program, coverage=texture)
             program["color"].value = label.color
             frame.fullscreen(program)
 

@@ -10,7 +10,7 @@ from atmos.lighting import Sun, sun_and_day
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
 from atmos.plugins.volumetric_fog.settings import VolumetricFogSettings
-from atmos.gpu.uniforms import write_uniforms
+from atmos.gpu.uniforms import bind_textures, write_uniforms
 
 
 def sun_terms(sun: Sun, settings: VolumetricFogSettings):
@@ -52,7 +52,7 @@ class VolumetricFogPass(FullscreenPass):
         view, p = frame.view, self.program
         frame.framebuffer(color=medium_targets(frame, COLOR)).use()
         frame.blend_transmittance()
-        frame.resource(DEPTH).use(0)
+        bind_textures(p, scene_depth=frame.resource(DEPTH))
         set_camera_uniforms(p, view.camera, view.aspect)
         set_medium_uniforms(p, self.plugin.settings, view.sun, self.plugin.time(view))
         frame.fullscreen(p)

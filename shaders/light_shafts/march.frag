@@ -43,7 +43,7 @@ uniform vec2 frame_size;
 out vec4 frag;
 #if SHAFT_FOG || SHAFT_AERIAL
 #include "lib/cloud_distance.glsl"
-uniform int has_cloud_distance;   // 1: cloud_distance is bound (unit 3)
+uniform int has_cloud_distance;   // 1: cloud_distance is bound
 layout(binding = 3) uniform sampler2D cloud_distance;
 #endif
 #if SHAFT_FOG

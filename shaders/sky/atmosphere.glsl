@@ -16,8 +16,8 @@ uniform vec3 atm_mie_t;        // Mie extinction
 uniform vec3 atm_ozone;        // ozone absorption
 uniform vec3 atm_albedo;       // ground albedo
 uniform vec3 atm_sun;          // sun irradiance (sun_intensity × sun_color)
-uniform sampler2D atm_transmittance;
-uniform sampler2D atm_multiscattering;
+layout(binding = 10) uniform sampler2D atm_transmittance;
+layout(binding = 11) uniform sampler2D atm_multiscattering;
 
 const float ATM_PI = 3.14159265358979;
 

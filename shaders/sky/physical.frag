@@ -5,7 +5,7 @@
 in vec2 v_uv;
 out vec4 frag;
 uniform mat3 view_basis;
-uniform sampler2D sky_view;
+layout(binding = 12) uniform sampler2D sky_view;
 uniform float view_r;          // the camera's radius from the planet's centre
 #include "lib/view_ray.glsl"
 #include "sky/atmosphere.glsl"

@@ -49,7 +49,7 @@ import numpy as np
 from atmos.checks import check_shape, is_int
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.hashing import stream_key
-from atmos.gpu.uniforms import write_uniforms
+from atmos.gpu.uniforms import bind_textures, write_uniforms
 
 PRECISION_BITS = 16
 MAX_LAYERS = 128        # layers (ny) the advection takes shifts for (common.glsl: a uniform array)
@@ -386,7 +386,7 @@ class CloudAutomaton:
 
         def fill_from(channel):
             def fill(buffer):
-                probabilities.use(0)
+                bind_textures(cells, u_probabilities=probabilities)
                 buffer.bind_to_storage_buffer(6)
                 write_uniforms(cells, u_size=self.shape, u_channel=channel)
                 cells.run(*grid)

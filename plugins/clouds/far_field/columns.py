@@ -8,21 +8,17 @@ import numpy as np
 
 from atmos.plugins.clouds.far_field.cover import QUANTILES
 from atmos.plugins.clouds.volume.sets import CloudSets
-from atmos.gpu.uniforms import write_uniforms
+from atmos.gpu.uniforms import bind_textures, write_uniforms
 
 INTERVALS = QUANTILES - 1        # the rank intervals, between the quantiles (columns.glsl INTERVALS)
-SUMS_UNITS = (0, 1)              # columns.glsl's sums_a, sums_b (2D arrays)
-DENSITY_UNITS = (14, 15)         # its density_a, density_b (3D; units no renderer binds)
 
 
 def use_columns(program, sim: CloudSets, density: bool = True) -> None:
     """Bind mix(A, B, t)'s column sums (and, with ``density``, the density volumes) where columns.glsl
     reads them and set its ``t``, ``a_shift`` and ``edge_fade``."""
-    for s, unit in zip((sim.a, sim.b), SUMS_UNITS):
-        sim.maps_of(s).sums.use(unit)
+    bind_textures(program, sums_a=sim.maps_of(sim.a).sums, sums_b=sim.maps_of(sim.b).sums)
     if density:
-        for s, unit in zip((sim.a, sim.b), DENSITY_UNITS):
-            s["density"].use(unit)
+        bind_textures(program, density_a=sim.a["density"], density_b=sim.b["density"])
     write_uniforms(program, t=float(sim.t), a_shift=(sim.a_shift[0], sim.a_shift[2]), edge_fade=float(sim.settings.edge_fade))
 
 

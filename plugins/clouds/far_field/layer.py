@@ -24,12 +24,10 @@ from atmos.plugins.clouds.far_field.rank_light import RankLight
 from atmos.plugins.clouds.volume.light import cell_tau, light_uniforms
 from atmos.plugins.clouds.volume.sets import CloudSets
 from atmos.plugins.sky_layer.octaves import OctaveTextures
-from atmos.gpu.uniforms import write_uniforms
+from atmos.gpu.uniforms import bind_textures, write_uniforms
 
 FAR_FIELD = "far_field"          # the imported graph resource
 REBAKE_TOLERANCE = 0.05          # re-bake the octaves when the sun moved the light step by this fraction
-OCTAVE_UNIT = 5                  # texture units 5..8 (field.glsl)
-PROFILE_UNIT = 14                # the profile texture for the shaders that declare far_profile (2D)
 MAX_HEIGHTS = 64                 # cover.comp's most height samples
 TILE_TIME = 5.0                  # s: the matched tile follows a change of the volume's with this time constant
 
@@ -180,12 +178,12 @@ class FarFieldLayer:
         return _transitions(self.cover)
 
     def use(self, program, view, sim: CloudSets) -> None:
-        """Bind the textures (units 5..8), the cover (storage buffer 0) and set field.glsl's uniforms."""
+        """Bind the textures (field.glsl's octaves), the cover (storage buffer 0) and set field.glsl's uniforms."""
         params = self.settings
-        self.octaves.use(OCTAVE_UNIT)
+        self.octaves.bind(program)
         self.cover.bind_to_storage_buffer(0)
-        if "far_profile" in program and self.profile is not None:
-            self.profile.use(PROFILE_UNIT)
+        if self.profile is not None:
+            bind_textures(program, far_profile=self.profile)
         self.light.use(program)
         time = float(view.time) if params.animate else 0.0
         layout = sim.layout()

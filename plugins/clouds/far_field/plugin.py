@@ -13,7 +13,7 @@ from atmos.plugins.clouds.volume.light import CloudLightSettings, light_uniforms
 from atmos.plugins.clouds.volume.field_demand import field_demand
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CloudSets
 from atmos.render_core import COLOR, DEPTH
-from atmos.gpu.uniforms import write_uniforms
+from atmos.gpu.uniforms import bind_textures, write_uniforms
 
 
 class CloudFarFieldPass(FullscreenPass):
@@ -46,7 +46,7 @@ class CloudFarFieldPass(FullscreenPass):
         frame.framebuffer(color=[COLOR, CLOUD_DISTANCE] if distance else [COLOR]).use()
         frame.blend_over()
         layer.use(p, view, sim)
-        frame.resource(DEPTH).use(9)
+        bind_textures(p, scene_depth=frame.resource(DEPTH))
         set_camera_uniforms(p, view.camera, view.aspect)
         light = self.plugin.light_settings()       # the renderer's octaves; its field's weight where measured
         diffusion = light.ms_diffusion if layer.light.has_field else 0.0

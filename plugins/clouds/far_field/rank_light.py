@@ -15,14 +15,9 @@ from __future__ import annotations
 from atmos.plugins.clouds.far_field.columns import INTERVALS, rank_texture, read_rank_texture, use_columns
 from atmos.plugins.clouds.volume.light import cell_tau
 from atmos.plugins.clouds.light.diffusion import DIFFUSION
+from atmos.gpu.uniforms import bind_textures
 
-SUN_UNIT = 18                    # sun_by_rank for the shaders that declare far_sun_by_rank (2D)
-FIELD_UNIT = 19                  # field_column for those that declare far_field_light (2D)
-FIELD_PROFILE_UNIT = 20          # field_profile for those that declare far_field_light_profile (2D)
-THICKNESS_UNIT = 21              # thickness for those that declare far_thickness_by_rank (2D)
-SUN_PROFILE_UNIT = 22            # sun_profile for those that declare far_sun_profile (the march's)
-HEIGHT_UNIT = 24                 # height for those that declare far_height_by_rank (2D)
-READ_UNITS = {"transmittance": (2, 3), DIFFUSION: (16, 17)}   # light_by_rank.comp's inputs beside columns.glsl's
+READS = {"transmittance": "trans", DIFFUSION: "diffusion"}   # light_by_rank.comp's inputs beside columns.glsl's
 FIELD_BINS = 16                  # light_by_rank.comp's most height bins (sun_profile, field_profile)
 SUMS = INTERVALS * 2 * 11 + INTERVALS * FIELD_BINS * 9      # its Sums buffer (uint32): the slots, the bins
 GROUP = 256                      # its work group (columns per group in STAGE 0)
@@ -46,10 +41,8 @@ class RankLight:
         shading = "transmittance" in sim.a and "transmittance" in sim.b
         bins = min(int(heights), FIELD_BINS)
         self._allocate(bins)
-        for name, (unit_a, unit_b) in READ_UNITS.items():
-            if name in sim.a and name in sim.b:
-                sim.a[name].use(unit_a)
-                sim.b[name].use(unit_b)
+        inputs = {f"{sampler}_{x}": s[name] for name, sampler in READS.items() if name in sim.a and name in sim.b
+                  for x, s in (("a", sim.a), ("b", sim.b))}
         values = dict(heights=int(heights), bins=bins, has_shading=int(shading), attenuation=float(attenuation),
                       column_tau=cell_tau(sim.settings))
         cover_buffer.bind_to_storage_buffer(0)
@@ -59,6 +52,7 @@ class RankLight:
             c = self.gpu.program(compute_shader="clouds/far_field/light_by_rank.comp",
                                  defines={"FIELD": int(self.has_field), "STAGE": stage})
             use_columns(c, sim)
+            bind_textures(c, inputs)
             for name, value in values.items():
                 if name in c:
                     c[name].value = value
@@ -87,15 +81,11 @@ class RankLight:
     def use(self, program) -> None:
         """Bind the textures the program declares (far_sun_by_rank, far_thickness_by_rank, far_height_by_rank,
         far_sun_profile, far_field_light, far_field_light_profile)."""
-        field = self.has_field
-        for name, texture, unit in (("far_sun_by_rank", self.sun, SUN_UNIT),
-                                    ("far_thickness_by_rank", self.thickness, THICKNESS_UNIT),
-                                    ("far_height_by_rank", self.height, HEIGHT_UNIT),
-                                    ("far_sun_profile", self.sun_profile, SUN_PROFILE_UNIT),
-                                    ("far_field_light", self.field if field else None, FIELD_UNIT),
-                                    ("far_field_light_profile", self.field_profile if field else None, FIELD_PROFILE_UNIT)):
-            if name in program and texture is not None:
-                texture.use(unit)
+        textures = dict(far_sun_by_rank=self.sun, far_thickness_by_rank=self.thickness, far_height_by_rank=self.height,
+                        far_sun_profile=self.sun_profile)
+        if self.has_field:
+            textures.update(far_field_light=self.field, far_field_light_profile=self.field_profile)
+        bind_textures(program, {name: texture for name, texture in textures.items() if texture is not None})
 
     def read(self) -> dict:
         """The last measure as float64 arrays (a GPU → CPU copy: tests and tools): ``sun`` (INTERVALS, 2, 4)

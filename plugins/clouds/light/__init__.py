@@ -19,6 +19,7 @@ from atmos.plugins.clouds.light.raymarch import raymarch
 from atmos.plugins.clouds.light.scattering import LightVolumeShader, Scattering, light_volume_reference
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.plugins.clouds.light.shear_warp import ShadingTask, ShearWarpShader, groups, program, read_volume, upload_volume
+from atmos.gpu.uniforms import bind_textures
 
 METHODS = ("shear-warp", "raymarch")
 
@@ -59,8 +60,7 @@ def compute_transmittance(gpu: GpuContext, density, sun_dir, sigma, method: str 
         out = ctx.texture3d(density.shape, 1, dtype="f4")
         made.append(out)
         prog = program(gpu, "upsample")
-        shader.result.use(0)
-        prog["coarse"].value = 0
+        bind_textures(prog, coarse=shader.result)
         prog["coarse_size"].value = shader.shading_shape
         out.bind_to_image(0, read=False, write=True)
         prog.run(*(groups(n, 4) for n in density.shape))

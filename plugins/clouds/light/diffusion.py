@@ -36,7 +36,7 @@ import atmos.plugins.clouds.light.grid as grid
 from atmos.plugins.clouds.light.medium import hemisphere_share, mean_cosine
 from atmos.plugins.clouds.light.reference import multilinear
 from atmos.plugins.clouds.light.shear_warp import check_volume_texture, groups, program
-from atmos.gpu.uniforms import write_uniforms
+from atmos.gpu.uniforms import bind_textures, write_uniforms
 
 FLOOR = 1e-3               # 1/m: transport extinction floor (empty cells still conduct, finitely)
 TOLERANCE = 1e-4           # relative residual |b - A phi| / |b| the GPU solve stops at
@@ -256,11 +256,10 @@ class DiffusionSolver:
         if sun.shape != (3,) or not (np.isfinite(n) and n > 0):
             raise ValueError(f"sun_dir must be a finite nonzero 3-vector, got {sun_dir!r}")
         coarse = np.asarray(cell, np.float64) * np.array(self.shape) / np.array(self.field_shape)
-        density.use(0)
-        transmittance.use(1)
+        bind_textures(program(self.gpu, "diffusion"), fine=density, trans=transmittance)
         self._cur, self._first, self.iterations = 0, True, 0
         self._args.write(np.array([self.groups, 1, 1], np.uint32).tobytes())
-        common = {"fine": 0, "trans": 1, "fine_size": self.shape, "trans_size": self.shading_shape,
+        common = {"fine_size": self.shape, "trans_size": self.shading_shape,
                   "size": self.field_shape,
                   "sigma_t": float(sigma_t), "albedo": float(albedo), "g": float(g), "tolerance": self.tolerance,
                   "cell": tuple(float(v) for v in coarse), "s": tuple(float(v) for v in -sun / n)}

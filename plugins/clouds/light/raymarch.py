@@ -11,6 +11,7 @@ from atmos.checks import check_sun_dir
 import atmos.plugins.clouds.light.grid as grid
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.plugins.clouds.light.shear_warp import _RESULT_FORMATS, check_volume_texture, groups, program
+from atmos.gpu.uniforms import bind_textures
 
 
 def raymarch(gpu: GpuContext, density_texture, sun_dir, sigma, target) -> None:
@@ -23,8 +24,7 @@ def raymarch(gpu: GpuContext, density_texture, sun_dir, sigma, target) -> None:
     u = check_sun_dir(sun_dir)
     sigma = min(grid.check_sigma(sigma), grid.SIGMA_MAX)
     prog = program(gpu, "raymarch", RESULT_FORMAT=_RESULT_FORMATS[target.dtype])
-    density_texture.use(0)
-    prog["density"].value = 0
+    bind_textures(prog, density=density_texture)
     prog["sun_dir"].value = tuple(float(x) for x in u)
     prog["sigma"].value = sigma
     target.bind_to_image(0, read=False, write=True)

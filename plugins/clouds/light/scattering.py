@@ -24,6 +24,7 @@ import numpy as np
 import atmos.plugins.clouds.light.grid as grid
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.plugins.clouds.light.shear_warp import _RESULT_FORMATS, check_volume_texture, groups, program
+from atmos.gpu.uniforms import bind_textures
 
 MODES = ("single", "multiple-forward")
 
@@ -99,8 +100,7 @@ class LightVolumeShader:
             colors.append(tuple(float(x) for x in c))
         fmt = {"f2": "rgba16f", "f4": "rgba32f"}[target.dtype]
         prog = program(self.gpu, "light", RESULT_FORMAT=fmt)
-        transmittance.use(0)
-        prog["transmittance"].value = 0
+        bind_textures(prog, transmittance=transmittance)
         prog["sun_color"].value, prog["ambient"].value = colors
         target.bind_to_image(0, read=False, write=True)
         prog.run(*(groups(n, 4) for n in shape))

@@ -24,7 +24,7 @@ import numpy as np
 from atmos.checks import check_shape, check_sun_dir
 from atmos.slicing import SliceTask
 from atmos.gpu.context import GpuContext, require_gpu
-from atmos.gpu.uniforms import write_uniforms
+from atmos.gpu.uniforms import bind_textures, write_uniforms
 import atmos.plugins.clouds.light.grid as grid
 
 _RESULT_FORMATS = {"f4": "r32f", "f2": "r16f"}
@@ -108,8 +108,7 @@ class ShearWarpShader:
         sigma = min(grid.check_sigma(sigma), grid.SIGMA_MAX)
         if self._coarse is not None:
             prog = program(self.gpu, "downsample", SCALE=self.scale)
-            density_texture.use(0)
-            prog["fine"].value = 0
+            bind_textures(prog, fine=density_texture)
             prog["fine_size"].value = self.shape
             self._coarse.bind_to_image(0, read=False, write=True)
             prog.run(*(groups(n, 4) for n in self.shading_shape))
@@ -163,8 +162,7 @@ class ShearWarpShader:
         prog["step_dir"].value = tuple(float(x) for x in plan.step)
         write_uniforms(prog, step_len=plan.length)
         prog["sigma"].value = self._sigma
-        prog["density"].value = 0
-        self._density.use(0)
+        bind_textures(prog, density=self._density)
         self._target.bind_to_image(2, read=False, write=True)
         nb, nc = self.shading_shape[b], self.shading_shape[c]
         for i in range(i0, i1):

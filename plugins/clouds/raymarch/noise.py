@@ -28,7 +28,7 @@ import moderngl
 import numpy as np
 
 from atmos.gpu.context import GpuContext, require_gpu
-from atmos.gpu.uniforms import write_uniforms
+from atmos.gpu.uniforms import bind_textures, write_uniforms
 
 NOISE_RULE = 0xC1D           # stream id of the noise's hashes: stream_key(seed, 0, NOISE_RULE, plane)
 PERLIN_GAIN = 1.5            # Perlin FBM -> [0, 1]: clamp(0.5 + 0.5 GAIN fbm)
@@ -41,7 +41,6 @@ BAND_WIDTH = 0.25            # W: at full strength the shape band remaps coverag
 DETAIL_FADE = (1 / 16, 1 / 4)   # a band's strength fades from 1 to 0 as the pixel's width grows over this many of its tiles
 BASE_LAYOUT = (0, 4, (4, 8, 16))     # (texture index, Perlin frequency, Worley FBM frequencies)
 DETAIL_LAYOUT = (1, 0, (2, 4, 8))    # Perlin frequency 0: no Perlin–Worley; A = 1
-BASE_UNIT, DETAIL_UNIT = 12, 13      # texture units bind() uses (5..8: the far field's octaves)
 SIZES = (4, 8, 16, 32, 64, 128, 256)
 
 _CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()   # GpuContext -> {(sizes, seed): textures}
@@ -140,16 +139,14 @@ class DetailNoise:
         return tuple(made)
 
     def bind(self, program, time: float, wind, scale: float, strength: float, layer=(0.0, 1.0)) -> None:
-        """Bind ``base`` to unit 12 and ``detail`` to unit 13 and set the uniforms of ``detail.glsl``
+        """Bind ``base`` and ``detail`` to ``detail.glsl``'s samplers and set the uniforms
         that ``program`` has (a compiler drops unused ones): the scroll of ``wind`` (m/s, 3 numbers)
         over ``time`` (s), the base tile ``scale`` (m), the ``strength`` (0..1) and ``layer``, the
         layer's (base y, height) in m (the height gradient)."""
-        self.base.use(BASE_UNIT)
-        self.detail.use(DETAIL_UNIT)
+        bind_textures(program, detail_base_noise=self.base, detail_fine_noise=self.detail)
         offset_base, offset_fine = detail_offsets(time, wind, scale)
         strength = float(strength)
-        write_uniforms(program, detail_base_noise=BASE_UNIT, detail_fine_noise=DETAIL_UNIT,
-                       detail_offset_base=tuple(offset_base), detail_offset_fine=tuple(offset_fine),
+        write_uniforms(program, detail_offset_base=tuple(offset_base), detail_offset_fine=tuple(offset_fine),
                        detail_inv_scale=1.0 / scale, detail_inv_scale_fine=DETAIL_RATIO / scale,
                        detail_strength=strength, detail_band_strength=BAND_STRENGTH * strength,
                        detail_band_width=band_width(strength),

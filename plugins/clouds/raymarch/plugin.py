@@ -19,7 +19,7 @@ from __future__ import annotations
 import moderngl
 import numpy as np
 
-from atmos.blue_noise import BLUE_NOISE_UNIT, blue_noise_texture
+from atmos.blue_noise import blue_noise_texture
 from atmos.scene_uniforms import set_camera_uniforms
 from atmos.composition import CLOUD_DISTANCE, composition, distance_desc
 from atmos.graph import PassBuilder, PassContext, RenderPass, TextureDesc
@@ -38,12 +38,11 @@ from atmos.plugins.clouds.volume.field_demand import field_demand
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CLOUD_VOLUME, CloudSets
 from atmos.plugins.clouds.simulation.chain import CloudSimulation
 from atmos.render_core import COLOR, DEPTH
-from atmos.gpu.uniforms import write_uniforms
+from atmos.gpu.uniforms import bind_textures, write_uniforms
 
 LOW_COLOR = "cloud_raymarch_color"
 LOW_DISTANCE = "cloud_raymarch_distance"
 LOW_DEPTH = "cloud_raymarch_depth"
-SKIP_UNIT, DEPTH_UNIT = 4, 9              # (5..8: the far field's octaves, field.glsl)
 
 
 def skip_map(max_maps: np.ndarray) -> np.ndarray:
@@ -226,14 +225,14 @@ class RaymarchPass(RenderPass):
         write_uniforms(p, self._uniforms(frame, sim, layout, offset))
         bind_volume(p, sim, self.sampler, view.sun, s.octaves, s.ms_diffusion, layout.heights)
         if s.empty_space_skipping:
-            self._skip_texture(sim).use(SKIP_UNIT)
+            bind_textures(p, skip_map=self._skip_texture(sim))
         else:                               # nothing uploaded; the shader reads no skip map
             self._release_skip()
-        frame.resource(DEPTH).use(DEPTH_UNIT)
+        bind_textures(p, scene_depth=frame.resource(DEPTH))
         if s.jitter:
             if self.jitter is None:
                 self.jitter = blue_noise_texture(self.gpu.ctx)
-            self.jitter.use(BLUE_NOISE_UNIT)
+            bind_textures(p, blue_noise=self.jitter)
         if far:
             self._bind_far(frame, p, sim)
         if s.detail_octaves:
@@ -243,7 +242,7 @@ class RaymarchPass(RenderPass):
         try:
             frame.fullscreen(p)
         finally:
-            unbind_volume(self.sampler)
+            unbind_volume(p, self.sampler)
         if r > 1:
             textures = self._resolve(frame, LOW_COLOR, LOW_DISTANCE, offset)
             if textures is not None:
@@ -288,11 +287,10 @@ class RaymarchPass(RenderPass):
         """Blend full-res premultiplied (colour, (a·distance, a)) textures onto the frame."""
         frame.reset_state()
         frame.framebuffer(color=[COLOR, CLOUD_DISTANCE] if distance else [COLOR]).use()
-        color.use(0)
-        distance_texture.use(1)
+        program = self.gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="clouds/raymarch/blend.frag")
+        bind_textures(program, clouds=color, cloud_distance=distance_texture)
         frame.blend_over()
-        frame.fullscreen(self.gpu.program(vertex_shader="lib/fullscreen.vert",
-                                          fragment_shader="clouds/raymarch/blend.frag"))
+        frame.fullscreen(program)
 
     def _release_skip(self) -> None:
         if self.skip is not None:

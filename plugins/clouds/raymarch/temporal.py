@@ -62,7 +62,7 @@ import numpy as np
 
 from atmos.camera import camera_matrices, gl_matrix
 from atmos.offscreen import EDGE
-from atmos.gpu.uniforms import write_uniforms
+from atmos.gpu.uniforms import bind_textures, write_uniforms
 
 RESOLUTIONS = (1, 2, 4)
 HISTORY_CLAMP = 1.0        # default clamp weight of moving history (0..1)
@@ -77,8 +77,6 @@ DEPTH_TOLERANCE = 0.1      # relative change of the scene distance behind a pixe
 CUT_DISTANCE = 100.0       # m the camera moves in one frame that make a camera cut (history reset) ...
 CUT_TURN = math.radians(30.0)   # ... or radians its view direction turns
 ALPHA_EPS = 1e-4           # coverage below which a (a·d, a) pair holds no distance (sky at infinity)
-
-_UNITS = ("low_color", "low_distance", "hist_color", "hist_distance", "hist_scene", "scene_depth")
 
 
 def check_resolution(r) -> int:
@@ -216,13 +214,11 @@ class TemporalClouds:
             p["prev_proj"].write(gl_matrix(proj[[0, 1, 3], :3] @ view[:3, :3]))
             write_uniforms(p, cam_delta=tuple(float(c) for c in np.asarray(camera.position) - prev_position),
                            history_clamp=float(history_clamp), motion_limit=float(motion_limit))
-        for unit, tex in enumerate((low_color, low_distance, prev[1], prev[2], prev[3])):
-            tex.use(unit)
+        bind_textures(p, low_color=low_color, low_distance=low_distance, hist_color=prev[1], hist_distance=prev[2],
+                      hist_scene=prev[3], hist_sample=prev[4], drift=self._drift[1],            # drift: read when detect_change
+                      low_depth=low_depth if low_depth is not None else low_color)     # low_depth: read at edge < 1e30
         if depth is not None:
-            depth.use(5)
-        (low_depth if low_depth is not None else low_color).use(6)     # unit 6 read only at edge < 1e30
-        prev[4].use(7)
-        self._drift[1].use(8)                                          # read only when detect_change
+            bind_textures(p, scene_depth=depth)
         write[0].use()
         self._draw(p)
         self._current = 1 - self._current
@@ -240,11 +236,9 @@ class TemporalClouds:
                        far=float(camera.far))
         if "view_basis" in p:
             p["view_basis"].write(matrices.gl("view_basis"))
-        low_color.use(0)
-        prev[4].use(1)
+        bind_textures(p, low_color=low_color, hist_sample=prev[4], hist_scene=prev[3])
         if depth is not None:
-            depth.use(2)
-        prev[3].use(3)
+            bind_textures(p, scene_depth=depth)
         self._drift[0].use()
         self._draw(p)
 

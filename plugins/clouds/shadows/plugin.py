@@ -12,6 +12,7 @@ from atmos.plugins.clouds.far_field.layer import FAR_FIELD, column_tau
 from atmos.plugins.clouds.shadows.settings import CloudShadowSettings
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CloudSets
 from atmos.render_core import COLOR, DEPTH
+from atmos.gpu.uniforms import bind_textures
 
 
 def direct_weight(sun_direction, sun_color, settings) -> float:
@@ -31,7 +32,8 @@ def cloud_layout(sim, settings: CloudShadowSettings) -> CloudLayout:
 
 
 def column_uniforms(program, sim: CloudSets, layout: CloudLayout, extinction: float) -> None:
-    """Set the uniforms of shaders/clouds/shadows/column.glsl (bind B's and A's sums to units 1 and 0 yourself)."""
+    """Bind mix(A, B, t)'s column sums and set the uniforms of shaders/clouds/shadows/column.glsl."""
+    bind_textures(program, sums_a=sim.maps_of(sim.a).sums, sums_b=sim.maps_of(sim.b).sums)
     program["extinction"].value = extinction
     program["t"].value = sim.t
     program["a_shift"].value = sim.a_shift[0], sim.a_shift[2]
@@ -70,14 +72,11 @@ class CloudShadowsPass(FullscreenPass):
         sim: CloudSets = frame.resource(CLOUD_SETS)
         layout = cloud_layout(sim, params)
         sigma = sim.settings.sigma if params.sigma is None else params.sigma
-        a, b, t = sim.view()
         frame.framebuffer(color=[COLOR]).use()
         ctx = gpu.ctx
         ctx.enable(ctx.BLEND)
         ctx.blend_func = ctx.ZERO, ctx.SRC_COLOR, ctx.ZERO, ctx.ONE    # alpha (sky occlusion) kept
-        sim.maps_of(a).sums.use(0)
-        sim.maps_of(b).sums.use(1)
-        frame.resource(DEPTH).use(2)
+        bind_textures(p, scene_depth=frame.resource(DEPTH))
         set_camera_uniforms(p, view.camera, view.aspect)
         p["sun_dir"].value = tuple(unit_sun(sun.direction))
         p["weight"].value = weight

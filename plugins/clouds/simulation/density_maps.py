@@ -30,7 +30,7 @@ import numpy as np
 from atmos.checks import check_shape, is_int
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.plugins.clouds.simulation.smoothing import check_texture_limit, check_volume_texture, check_z_range
-from atmos.gpu.uniforms import write_uniforms
+from atmos.gpu.uniforms import bind_textures, write_uniforms
 
 
 def group_grid(nx: int, nz: int, group_size) -> tuple[int, int]:
@@ -108,19 +108,19 @@ class DensityMaps:
         z0, z1 = check_z_range(nz, z0, z1)
         if z0 == z1:
             return
-        density.use(0)
+        bind_textures(self._sum_prog, u_density=density)
         self.sums.bind_to_image(0, read=False, write=True)
         # the programs are shared with other DensityMaps on the GpuContext: this one's uniforms each run
-        write_uniforms(self._sum_prog, u_size=self.shape, u_band_height=self.band_height, u_density=0)
+        write_uniforms(self._sum_prog, u_size=self.shape, u_band_height=self.band_height)
         self._sum_prog["u_z0"].value = z0
         self._sum_prog.run(-(-nx // 64), z1 - z0, 1)
         self.ctx.memory_barrier()
         gz0 = z0 // self.group_size[1]
         gz1 = self.grid[1] if z1 == nz else z1 // self.group_size[1]
         if gz1 > gz0:
-            self.sums.use(0)
+            bind_textures(self._max_prog, u_sums=self.sums)
             self.max_maps.bind_to_image(0, read=False, write=True)
-            write_uniforms(self._max_prog, u_extent=(nx, nz), u_group=self.group_size, u_grid=self.grid, u_sums=0)
+            write_uniforms(self._max_prog, u_extent=(nx, nz), u_group=self.group_size, u_grid=self.grid)
             self._max_prog["u_gz0"].value = gz0
             self._max_prog.run(-(-self.grid[0] // 8), -(-(gz1 - gz0) // 8), 1 + self.bands)
             self.ctx.memory_barrier()

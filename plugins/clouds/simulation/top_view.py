@@ -12,6 +12,7 @@ from atmos.graph import FullscreenPass, PassContext
 from atmos.plugin import Plugin
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CloudSets
 from atmos.render_core import COLOR
+from atmos.gpu.uniforms import bind_textures
 
 
 class CloudTopViewPass(FullscreenPass):
@@ -24,8 +25,7 @@ class CloudTopViewPass(FullscreenPass):
         sim: CloudSets = frame.resource(CLOUD_SETS)
         a, b, t = sim.view()
         frame.framebuffer(color=[COLOR]).use()
-        sim.maps_of(a).sums.use(0)
-        sim.maps_of(b).sums.use(1)
+        bind_textures(self.program, sums_a=sim.maps_of(a).sums, sums_b=sim.maps_of(b).sums)
         self.program["t"].value = t
         self.program["a_shift"].value = sim.a_shift[0], sim.a_shift[2]
         self.program["full"].value = self.plugin.settings.full_column

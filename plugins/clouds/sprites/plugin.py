@@ -51,7 +51,7 @@ from atmos.plugins.clouds.sprites.segments import MAX_LEVEL, SegmentStats, selec
 from atmos.plugins.clouds.volume.field_demand import field_demand
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CLOUD_VOLUME, CloudSets
 from atmos.render_core import COLOR, DEPTH
-from atmos.gpu.uniforms import write_uniforms
+from atmos.gpu.uniforms import bind_textures, write_uniforms
 
 
 @dataclass(frozen=True)
@@ -266,7 +266,7 @@ class CloudSpritePass(RenderPass):
         else:
             fbo = self.offscreen.begin(frame, factor, distance)
         # the soft particles' scene depth: the attached depth target's (sampled, never written)
-        frame.resource(DEPTH if factor == 1 else self.offscreen.depth).use(5)
+        bind_textures(p, scene_depth=frame.resource(DEPTH if factor == 1 else self.offscreen.depth))
         write_uniforms(p, uniforms, view_proj=matrices.gl("view_proj"))
         fbo.depth_mask = False
         frame.blend_over()
@@ -276,7 +276,7 @@ class CloudSpritePass(RenderPass):
         try:
             self._draw(segments, layout.group)
         finally:
-            unbind_volume(self.sampler)
+            unbind_volume(p, self.sampler)
         if factor > 1:
             self.offscreen.end(frame, factor, camera.near, camera.far, distance)
 

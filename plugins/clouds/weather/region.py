@@ -23,7 +23,7 @@ import numpy as np
 from atmos.checks import check_shape
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.plugins.clouds.weather.components import check_ellipsoid_array
-from atmos.gpu.uniforms import write_uniforms
+from atmos.gpu.uniforms import bind_textures, write_uniforms
 
 CHUNK = 256
 _FORMATS = {"f4": ("r32f", "rgba32f", np.float32), "f2": ("r16f", "rgba16f", np.float16)}
@@ -114,9 +114,9 @@ class RegionVolume:
             self.prob_texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
             self.gpu.track(self.prob_texture)
         nx, ny, nz = self.shape
-        self.texture.use(0)
+        bind_textures(self._probs, region=self.texture)
         self.prob_texture.bind_to_image(0, read=False, write=True)
-        write_uniforms(self._probs, region=0, size=self.shape,
+        write_uniforms(self._probs, size=self.shape,
                        scales=(hum_scale, act_scale, ext_scale, vanish_threshold))
         self._probs.run(-(-nx // 8), -(-ny // 8), -(-nz // 4))
         self.ctx.memory_barrier()

@@ -7,7 +7,7 @@
 // One invocation per coarse (x, z) column; the slice range [z0, ...) is over z.
 layout(local_size_x = 8, local_size_y = 8) in;
 #include "clouds/light/sample.glsl"
-uniform sampler3D fine;
+layout(binding = 0) uniform sampler3D fine;
 uniform ivec3 fine_size;
 uniform int z0;                // first coarse z cell of this slice
 layout(rg16f, binding = 0) uniform writeonly image3D columns;

@@ -14,9 +14,9 @@ uniform int cur;              // which of the two rz / rr partial arrays is the 
 uniform int first;            // the first iteration after init: beta = 0
 uniform int cold;             // init from x = 0
 uniform ivec3 size;           // the shading grid
-uniform sampler3D fine;       // the density (fine cells)
+layout(binding = 0) uniform sampler3D fine;       // the density (fine cells)
 uniform ivec3 fine_size;
-uniform sampler3D trans;      // the transmittance toward the sun on the shading grid
+layout(binding = 1) uniform sampler3D trans;      // the transmittance toward the sun on the shading grid
 uniform ivec3 trans_size;     // the shading grid (the field's grid `size` may be coarser: diffusion.field_shape)
 uniform float sigma_t, albedo, g, tolerance;
 uniform vec3 cell;            // shading cell size, metres

@@ -3,7 +3,7 @@
 // cell (reference.downsample). Summing value / SCALE^3 keeps huge densities finite.
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
 #include "clouds/light/sample.glsl"
-uniform sampler3D fine;
+layout(binding = 0) uniform sampler3D fine;
 uniform ivec3 fine_size;
 layout(r32f, binding = 0) uniform writeonly image3D coarse;
 

@@ -4,7 +4,7 @@
 // two crossings the density along the ray is cubic, integrated exactly by 2-point Gauss-Legendre.
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
 #include "clouds/light/sample.glsl"
-uniform sampler3D density;
+layout(binding = 0) uniform sampler3D density;
 layout(RESULT_FORMAT, binding = 0) uniform writeonly image3D result;
 uniform vec3 sun_dir;          // unit, index space
 uniform float sigma;

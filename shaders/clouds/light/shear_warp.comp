@@ -6,7 +6,7 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 #include "clouds/light/sample.glsl"
 
-uniform sampler3D density;                         // shading grid, texelFetch only
+layout(binding = 0) uniform sampler3D density;                         // shading grid, texelFetch only
 layout(r32f, binding = 0) uniform readonly image2D prev_slice;
 layout(r32f, binding = 1) uniform writeonly image2D next_slice;
 layout(RESULT_FORMAT, binding = 2) uniform writeonly image3D result;

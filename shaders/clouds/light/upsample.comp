@@ -3,7 +3,7 @@
 // what hardware linear filtering of the coarse texture gives a renderer at the same texture coordinates.
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
 #include "clouds/light/sample.glsl"
-uniform sampler3D coarse;
+layout(binding = 0) uniform sampler3D coarse;
 uniform ivec3 coarse_size;
 layout(r32f, binding = 0) uniform writeonly image3D fine;
 

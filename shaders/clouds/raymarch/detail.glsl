@@ -32,8 +32,8 @@
 #define DETAIL_OCTAVES 0
 #endif
 
-uniform sampler3D detail_base_noise;   // unit 12: RGBA8, repeat, linear
-uniform sampler3D detail_fine_noise;   // unit 13
+layout(binding = 12) uniform sampler3D detail_base_noise;   // RGBA8, repeat, linear
+layout(binding = 13) uniform sampler3D detail_fine_noise;
 uniform vec3 detail_offset_base;       // wind·time in base tiles, mod 1
 uniform vec3 detail_offset_fine;       // wind·time in detail tiles, mod 1
 uniform float detail_inv_scale;        // 1 / detail_scale (1/m)

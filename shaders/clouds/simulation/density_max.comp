@@ -4,7 +4,7 @@
 // gz = u_gz0 + gl_GlobalInvocationID.y and layer gl_GlobalInvocationID.z.
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 
-uniform sampler2DArray u_sums;            // (nx, nz, layers), r32f
+layout(binding = 0) uniform sampler2DArray u_sums;            // (nx, nz, layers), r32f
 layout(binding = 0, r32f) uniform writeonly image2DArray u_max;    // (gx, gz, layers)
 
 uniform ivec2 u_extent;                   // nx, nz

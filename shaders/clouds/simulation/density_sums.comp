@@ -4,7 +4,7 @@
 // [b * u_band_height, min((b + 1) * u_band_height, ny)). float32 sums of non-negative values.
 layout(local_size_x = 64, local_size_y = 1, local_size_z = 1) in;
 
-uniform sampler3D u_density;              // (nx, ny, nz), r16f or r32f
+layout(binding = 0) uniform sampler3D u_density;              // (nx, ny, nz), r16f or r32f
 layout(binding = 0, r32f) uniform writeonly image2DArray u_sums;   // (nx, nz, bands + 1)
 
 uniform ivec3 u_size;

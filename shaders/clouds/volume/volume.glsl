@@ -14,7 +14,7 @@ layout(binding = 3) uniform sampler3D trans_b;
 layout(binding = 10) uniform sampler3D columns_a;     // the light volume's columns (up, down), shading scale
 layout(binding = 11) uniform sampler3D columns_b;
 layout(binding = 16) uniform sampler3D diffusion_a;   // the diffusion field (phi, F), its own grid
-layout(binding = 17) uniform sampler3D diffusion_b;   // (12, 13: the march's detail noise; 14, 15: far field)
+layout(binding = 17) uniform sampler3D diffusion_b;
 uniform float ms_diffusion;    // its weight beta (CloudLightSettings.ms_diffusion); 0: no field bound
 uniform float t;
 uniform ivec3 a_shift;         // cells from B's cell to A's at the same world point (CloudSets.a_shift)

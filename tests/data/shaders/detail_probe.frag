@@ -2,7 +2,7 @@
 // Test probe: detail_density(d, p, probe_footprint) at the point p = texel.xyz (m) with d = texel.w of unit 0's input.
 #include "clouds/raymarch/detail.glsl"
 
-uniform sampler2D probe_points;
+layout(binding = 0) uniform sampler2D probe_points;
 uniform float probe_footprint;     // the pixel's width (m) at every point
 out vec4 frag;
 

@@ -1,7 +1,7 @@
 #version 430
 // Light per-frame draw for benchmarks/bench_frame_pacing.py: a slice of mix(A, B, t).
-uniform sampler3D volume_a;
-uniform sampler3D volume_b;
+layout(binding = 0) uniform sampler3D volume_a;
+layout(binding = 1) uniform sampler3D volume_b;
 uniform float t;
 uniform float layer;
 in vec2 v_uv;
