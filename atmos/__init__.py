@@ -32,7 +32,8 @@ _EXPORTS = {
     "SceneView": "atmos.scene_view", "Camera": "atmos.camera", "CameraPlugin": "atmos.camera_control",
     "set_camera_uniforms": "atmos.scene_uniforms", "Sun": "atmos.lighting", "set_sun_uniforms": "atmos.scene_uniforms",
     "set_scene_uniforms": "atmos.scene_uniforms", "write_uniforms": "atmos.gpu.uniforms",
-    "bind_textures": "atmos.gpu.uniforms", "FixedClock": "atmos.clock",
+    "bind_textures": "atmos.gpu.uniforms", "bind_images": "atmos.gpu.uniforms", "bind_buffers": "atmos.gpu.uniforms",
+    "FixedClock": "atmos.clock",
     # games: running, input, moving things and the camera
     "run": "atmos.runner", "DemoSettings": "atmos.demo_registry", "Input": "atmos.input",
     "InputPlugin": "atmos.input", "key": "atmos.keys", "mouse": "atmos.keys", "Transform": "atmos.transform",

@@ -21,7 +21,7 @@ import numpy as np
 from atmos.slicing import FrameScheduler, SlicedJob, SliceTask, TripleSet
 from atmos.gpu import add_shader_path, create_headless
 from atmos.graph import TextureDesc
-from atmos.gpu.uniforms import bind_textures
+from atmos.gpu.uniforms import bind_images, bind_textures
 
 VOLUME = (128, 32, 128)
 SLICES = 32
@@ -38,8 +38,7 @@ def heavy_job(gpu, iterations: int) -> SlicedJob:
         job.state["time"] = step * 0.1
 
     def run(index, job_ctx):
-        job_ctx.target["volume"].bind_to_image(0, read=False, write=True)
-        job_ctx.previous["volume"].bind_to_image(1, read=True, write=False)
+        bind_images(program, dst=job_ctx.target["volume"], src=job_ctx.previous["volume"])
         program["z0"] = index * layers
         program["iterations"] = iterations
         program["time"] = job_ctx.state["time"]

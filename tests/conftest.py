@@ -8,7 +8,7 @@ import pytest
 
 from atmos.gpu import add_shader_path, create_headless
 from atmos.gpu.portability import COMPILER, ENV
-from atmos.gpu.uniforms import bind_textures
+from atmos.gpu.uniforms import bind_buffers, bind_textures
 
 os.environ.setdefault("ATMOS_HEADLESS", "1")
 if shutil.which(COMPILER):
@@ -52,7 +52,7 @@ def filter_bits(gpu):
     program = gpu.program(compute_shader="test/filter_probe.comp")
     try:
         bind_textures(program, s=texture)
-        out.bind_to_storage_buffer(0)
+        bind_buffers(program, Out=out)
         program.run(n)
         ctx.memory_barrier()
         got = np.frombuffer(out.read(), "f4").astype(np.float64)

@@ -4,6 +4,7 @@ import pytest
 
 from atmos.hashing import hash4, hash_counter, lowbias32, stream_key
 from atmos.plugins.clouds.automaton import CloudAutomaton, reference
+from atmos.gpu.uniforms import bind_buffers
 
 LAYOUTS = ("packed", "cell")
 
@@ -57,8 +58,7 @@ def test_hash_glsl_matches_numpy(gpu, ctx, rng):
     src = ctx.buffer(inputs.astype("<u4").tobytes())
     dst = ctx.buffer(reserve=8 * n)
     try:
-        src.bind_to_storage_buffer(0)
-        dst.bind_to_storage_buffer(1)
+        bind_buffers(prog, Inputs=src, Outputs=dst)
         prog["u_count"].value = n
         prog.run(-(-n // 64))
         ctx.memory_barrier()

@@ -5,6 +5,7 @@ import pytest
 
 from atmos.slicing import FrameScheduler, SlicedJob, SliceTask, TextureSet, TripleSet, make_texture
 from atmos.graph import TextureDesc as Desc
+from atmos.gpu.uniforms import bind_images
 
 
 SIZE = (8, 4, 6)          # x, y, z: one z-layer per slice
@@ -25,8 +26,7 @@ def fill_job(gpu, name="fill", size=SIZE, layers_per_slice=1, log=None):
     def run(index, job_ctx):
         if log is not None:
             log.append(("slice", job_ctx.step, index))
-        job_ctx.target["vol"].bind_to_image(0, read=False, write=True)
-        job_ctx.previous["vol"].bind_to_image(1, read=True, write=False)
+        bind_images(program, dst=job_ctx.target["vol"], src=job_ctx.previous["vol"])
         program["z0"] = index * layers_per_slice
         program["step_value"] = job_ctx.state["step_value"]
         program["feedback"] = FEEDBACK

@@ -8,7 +8,7 @@ import pytest
 from atmos.app import App
 from atmos.defaults import DefaultPlugins
 from atmos.gpu import ShaderError, add_shader_path, load_source, remove_shader_path, shader_paths
-from atmos.gpu.uniforms import bind_textures
+from atmos.gpu.uniforms import bind_buffers, bind_images, bind_textures
 from atmos.graph import FullscreenPass, PassContext
 from atmos.scene_uniforms import set_scene_uniforms
 from atmos.plugin import Plugin
@@ -101,6 +101,26 @@ def test_samplers_declare_their_units_once_and_textures_are_bound_by_name(gpu, c
     with pytest.raises(ShaderError) as info:
         gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="mypkg/unbound_sampler.frag")
     assert f"{SHADERS}/unbound_sampler.frag:3: sampler nowhere needs layout(binding = N)" in str(info.value)
+
+
+def test_images_and_storage_blocks_are_bound_by_name_with_their_declared_access(gpu, ctx, mypkg):
+    program = gpu.program(compute_shader="mypkg/images.comp")
+    assert program.extra["images"] == {"src": (2, True, False), "dst": (5, False, True)}
+    src = ctx.texture((1, 1), 1, np.array([0.25], "f4").tobytes(), dtype="f4")
+    dst = ctx.texture((1, 1), 1, dtype="f4")
+    out = ctx.buffer(reserve=4)
+    try:
+        bind_images(program, src=src, dst=dst, missing=src)                 # "missing": not in the program
+        bind_buffers(program, Out=out)
+        program.run(1)
+        ctx.memory_barrier()
+        assert np.frombuffer(dst.read(), "f4")[0] == 0.5 and np.frombuffer(out.read(), "f4")[0] == 1.25
+    finally:
+        for obj in (src, dst, out):
+            obj.release()
+    with pytest.raises(ShaderError) as info:
+        gpu.program(compute_shader="mypkg/shared_buffer.comp")
+    assert "buffer Out and In" in str(info.value) and "share storage buffer binding 1" in str(info.value)
 
 
 def test_unknown_file_names_the_search_path(mypkg):

@@ -13,6 +13,7 @@ from atmos.plugins.sky_layer import SkyLayerSettings, SkyLayerPlugin, reference
 from atmos.plugins.sky_layer.octaves import OctaveTextures
 from atmos.plugins.sky_layer.plugin import layer_light, scroll_offsets
 from atmos.render_core import CapturePass
+from atmos.gpu.uniforms import bind_buffers
 
 
 # -- octave textures ---------------------------------------------------------------------------------
@@ -75,8 +76,7 @@ def gpu_shade(gpu, fbm, fade, params, light):
     src = ctx.buffer(data.tobytes())
     dst = ctx.buffer(np.full((n, 4), np.nan, np.float32).tobytes())
     try:
-        src.bind_to_storage_buffer(0)
-        dst.bind_to_storage_buffer(1)
+        bind_buffers(prog, Inputs=src, Outputs=dst)
         prog["count"].value = n
         for name in ("emptiness", "sharpness", "thickness", "color", "lit_color"):
             prog[name].value = getattr(params, name)

@@ -14,6 +14,7 @@ from atmos import value_noise as noise
 from atmos.plugins.volumetric_fog import reference
 from atmos.plugins.volumetric_fog.plugin import set_medium_uniforms, sun_terms
 from atmos.render_core import CapturePass
+from atmos.gpu.uniforms import bind_buffers
 
 EPS32 = 2.0 ** -24
 
@@ -28,8 +29,7 @@ def gpu_fbm(gpu, points, octaves, seed):
     src = ctx.buffer(pts.tobytes())
     dst = ctx.buffer(np.full(n, np.nan, np.float32).tobytes())
     try:
-        src.bind_to_storage_buffer(0)
-        dst.bind_to_storage_buffer(1)
+        bind_buffers(prog, Points=src, Values=dst)
         prog["count"].value, prog["octaves"].value, prog["seed"].value = n, octaves, seed
         prog.run(-(-n // 64))
         ctx.memory_barrier()
@@ -47,8 +47,7 @@ def gpu_march(gpu, origins, dirs, limits, params, sun, time=0.0):
     src = ctx.buffer(rays.tobytes())
     dst = ctx.buffer(np.full((n, 4), np.nan, np.float32).tobytes())
     try:
-        src.bind_to_storage_buffer(0)
-        dst.bind_to_storage_buffer(1)
+        bind_buffers(prog, Rays=src, Results=dst)
         set_medium_uniforms(prog, params, sun, time)
         prog["count"].value = n
         prog.run(-(-n // 16))

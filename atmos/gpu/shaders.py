@@ -34,8 +34,15 @@ import moderngl
 
 _INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*$')
 _VERSION = re.compile(r"^\s*#version\b")
-_SAMPLER = re.compile(r"^\s*(layout\s*\(\s*binding\s*=\s*\w+\s*\)\s*)?uniform\s+(?:(?:lowp|mediump|highp)\s+)?"
-                      r"[iu]?sampler\w*\s+(\w+)")
+_LAYOUT = r"^[ \t]*(?:layout\s*\((?P<layout>[^)]*)\)\s*)?"
+_WORDS = r"(?:(?:coherent|volatile|restrict|readonly|writeonly|lowp|mediump|highp)\s+)*"
+_UNIFORM = r"(?P<before>" + _WORDS + r")uniform\s+(?P<after>" + _WORDS + r")"
+_BINDINGS = {   # what a program binds by name, and the unit namespace each kind has
+    "sampler": re.compile(_LAYOUT + _UNIFORM + r"[iu]?sampler\w*\s+(?P<name>\w+)", re.M),
+    "image": re.compile(_LAYOUT + _UNIFORM + r"[iu]?image\w*\s+(?P<name>\w+)", re.M),
+    "buffer": re.compile(_LAYOUT + r"(?P<before>" + _WORDS + r")buffer\s+(?P<name>\w+)\s*\{", re.M),
+}
+_UNIT_WORD = {"sampler": "texture unit", "image": "image unit", "buffer": "storage buffer binding"}
 _MESSAGES = (re.compile(r"^(?P<where>\d+):(?P<line>\d+)\(\d+\):\s*(?P<text>.*)$"),       # Mesa: 0:14(7): error: ...
              re.compile(r"^(?P<where>\d+)\((?P<line>\d+)\)\s*:\s*(?P<text>.*)$"),         # NVIDIA: 0(14) : error C0000: ...
              re.compile(r"^(?P<kind>ERROR|WARNING):\s*(?P<where>[^:\s]+):(?P<line>\d+):\s*(?P<text>.*)$"))  # glslang, AMD
@@ -243,29 +250,53 @@ def compile_program(ctx: moderngl.Context, sources: dict[str, GlslSource]):
     except moderngl.Error as error:
         raise explain(error, sources) from None
     try:
-        check_sampler_units(program, sources)
+        check_units(program, sources)
     except ShaderError:
         program.release()
         raise
     return program
 
 
-def check_sampler_units(program, sources: dict[str, GlslSource]) -> None:
-    """Every sampler the program uses declares its texture unit (``layout(binding = N)``: the one place
-    a unit is written; Python binds by name, :func:`atmos.gpu.uniforms.bind_textures`), and no two
-    share one: a ShaderError naming both declarations otherwise."""
-    seen: dict[int, tuple[str, str]] = {}
-    for src in sources.values():
-        for index, line in enumerate(src.text.splitlines()):
-            match = _SAMPLER.match(line)
-            if not match or match.group(2) not in program:
-                continue
-            name = match.group(2)
-            where = src.where(index + 1)
-            if not match.group(1):
-                raise ShaderError(f"{where}: sampler {name} needs layout(binding = N): its texture unit")
-            units = program[name].value          # a sampler array: consecutive units
-            for unit in units if isinstance(units, list) else [units]:
-                if unit in seen and seen[unit][0] != name:
-                    raise ShaderError(f"{where}: sampler {name} and {seen[unit][0]} ({seen[unit][1]}) share texture unit {unit}")
-                seen[unit] = (name, where)
+def check_units(program, sources: dict[str, GlslSource]) -> None:
+    """Every sampler, image and storage block the program uses declares its unit (``layout(binding = N)``:
+    the one place a unit is written; Python binds by name, :mod:`atmos.gpu.uniforms`), and no two of a
+    kind share one: a ShaderError naming both declarations otherwise. Keeps each image's unit and
+    declared access (readonly, writeonly or both) in ``program.extra["images"]`` for ``bind_images``."""
+    images: dict[str, tuple[int, bool, bool]] = {}
+    for kind, pattern in _BINDINGS.items():
+        seen: dict[int, tuple[str, str]] = {}
+        for src in sources.values():
+            for match in pattern.finditer(src.text):
+                name = match.group("name")
+                if name not in program:
+                    continue
+                where = src.where(src.text.count("\n", 0, match.start()) + 1)
+                binding = re.search(r"\bbinding\s*=\s*(\w+)", match.group("layout") or "")
+                if not binding:
+                    raise ShaderError(f"{where}: {kind} {name} needs layout(binding = N): its {_UNIT_WORD[kind]}")
+                member = program[name]
+                if kind == "image":          # (an image uniform's value does not read back on every driver)
+                    units = _constant(binding.group(1), src.text, where)
+                else:
+                    units = member.binding if kind == "buffer" else member.value   # a sampler array: its units
+                for unit in units if isinstance(units, list) else [units]:
+                    if unit in seen and seen[unit][0] != name:
+                        raise ShaderError(f"{where}: {kind} {name} and {seen[unit][0]} ({seen[unit][1]}) share "
+                                          f"{_UNIT_WORD[kind]} {unit}")
+                    seen[unit] = (name, where)
+                if kind == "image":
+                    words = (match.group("before") + match.group("after")).split()
+                    images[name] = (units, "writeonly" not in words, "readonly" not in words)
+    program.extra = {"images": images}
+
+
+def _constant(word: str, text: str, where: str) -> int:
+    """An integer literal, or a name ``#define``d as one in ``text``."""
+    for _ in range(8):
+        if word.isdigit():
+            return int(word)
+        define = re.search(rf"^\s*#define\s+{word}\s+(\w+)\s*$", text, re.M)
+        if not define:
+            break
+        word = define.group(1)
+    raise ShaderError(f"{where}: layout(binding = {word}) must be an integer (or a name #defined as one)")

@@ -1,6 +1,6 @@
-"""The one uniform writer and the one texture binder: values and textures by name into a program,
-skipping what its compiler dropped. A texture's unit is written once, in the GLSL that declares its
-sampler (``layout(binding = N)``); Python binds by the sampler's name and never names a unit."""
+"""The one uniform writer and the binders: values, textures, images and storage buffers by name into a
+program, skipping what its compiler dropped. A unit is written once, in the GLSL that declares the
+sampler, image or buffer (``layout(binding = N)``); Python binds by name and never names a unit."""
 from __future__ import annotations
 
 from collections.abc import Mapping
@@ -46,3 +46,24 @@ def bind_textures(program, textures: Mapping[str, object] | None = None, /, samp
                 sampler.use(unit)
             units.append(unit)
     return units
+
+
+def bind_images(program, images: Mapping[str, object] | None = None, /, **more) -> None:
+    """Bind each texture as an image at the unit of ``program``'s image uniform of that name (its
+    ``layout(binding = N, format)``), for the access its declaration gives (``readonly``,
+    ``writeonly`` or both); a name the program does not use is skipped."""
+    declared = program.extra["images"]        # (unit, read, write) by name, from the compiler check
+    for name, texture in ({**images, **more} if images else more).items():
+        if name in declared:
+            unit, read, write = declared[name]
+            texture.bind_to_image(unit, read=read, write=write)
+
+
+def bind_buffers(program, buffers: Mapping[str, object] | None = None, /, **more) -> None:
+    """Bind each buffer at the binding of ``program``'s storage block of that name (its
+    ``layout(std430, binding = N) buffer Name``); a name the program does not use is skipped."""
+    get = program.get
+    for name, buffer in ({**buffers, **more} if buffers else more).items():
+        member = get(name, None)
+        if member is not None:
+            buffer.bind_to_storage_buffer(member.binding)

@@ -17,7 +17,7 @@ import numpy as np
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.gradient_noise import periodic_noise, sample_repeat_trilinear
 from atmos.hashing import stream_key
-from atmos.gpu.uniforms import bind_textures
+from atmos.gpu.uniforms import bind_images, bind_textures
 
 FOG_RULE = 0xF06  # stream id of the fog gradients: stream_key(seed, 0, FOG_RULE, octave)
 @lru_cache(maxsize=64)
@@ -80,7 +80,7 @@ class NoiseVolumes:
                     tex.write(np.full(n ** 3, fill, np.float32).tobytes())
                 tex.repeat_x = tex.repeat_y = tex.repeat_z = True
                 tex.filter = (ctx.LINEAR, ctx.LINEAR)
-                tex.bind_to_image(0, read=False, write=True)
+                bind_images(shader, volume=tex)
                 shader["period"].value = period
                 shader["texels_per_cell"].value = tpc
                 shader["key"].value = octave_key(settings.seed, i)

@@ -31,7 +31,7 @@ from atmos.graph import FullscreenPass, PassContext, TextureDesc
 from atmos.lighting import unit_sun
 from atmos.plugins.sky.luts import SKY_LUTS, atmosphere_defines, set_atmosphere_uniforms, view_radius
 from atmos.render_core import COLOR, DEPTH
-from atmos.gpu.uniforms import bind_textures, write_uniforms
+from atmos.gpu.uniforms import bind_images, bind_textures, write_uniforms
 
 AERIAL = "aerial_perspective"
 AERIAL_VOLUME = "aerial_volume"          # the froxel volume (a transient of this pass)
@@ -135,7 +135,7 @@ class AerialPerspectivePass(FullscreenPass):
         set_camera_uniforms(c, view.camera, view.aspect)
         set_atmosphere_uniforms(c, self.plugin.settings.atmosphere)
         write_uniforms(c, values)
-        volume.bind_to_image(0, read=False, write=True)
+        bind_images(c, aerial_volume=volume)
         w, h, _ = volume.size
         c.run(-(-w // GROUP), -(-h // GROUP), 1)
         self.gpu.ctx.memory_barrier()

@@ -17,7 +17,7 @@ import numpy as np
 
 import atmos.plugins.sky.atmosphere as ref
 from atmos.plugins.sky.atmosphere_settings import AtmosphereSettings
-from atmos.gpu.uniforms import bind_textures, write_uniforms
+from atmos.gpu.uniforms import bind_images, bind_textures, write_uniforms
 
 SUN_TOLERANCE = 5e-4          # the sky view is remade when the sun's height (y) moved more (≈ 0.03° near the horizon)
 ALTITUDE_TOLERANCE = (1.0, 0.01)   # ... or the camera's altitude by more than max(1 m, 1 %)
@@ -110,7 +110,7 @@ class AtmosphereLuts:
         if name != "transmittance":
             self.bind(program)
         tex = self.textures[name]
-        tex.bind_to_image(0, read=False, write=True)
+        bind_images(program, lut=tex)
         program.run(math.ceil(tex.width / 8), math.ceil(tex.height / 8))
         self.gpu.ctx.memory_barrier()
 

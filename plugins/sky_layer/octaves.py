@@ -6,7 +6,7 @@ import math
 import moderngl
 import numpy as np
 
-from atmos.gpu.uniforms import bind_textures
+from atmos.gpu.uniforms import bind_images, bind_textures
 from atmos.plugins.sky_layer.settings import SkyLayerSettings
 from atmos.value_noise import key, value_noise
 
@@ -74,7 +74,7 @@ class OctaveTextures:
             if shift_maps is not None:
                 prog["light_shift"].value = tuple(np.asarray(shift_maps[k], np.float64) @ shift)
             prog["key"].value = octave_key(settings.seed, k)
-            tex.bind_to_image(0, read=False, write=True)
+            bind_images(prog, octave=tex)
             prog.run(groups, groups)
         ctx.memory_barrier()
         for tex in self.textures:

@@ -10,7 +10,7 @@ from atmos.graph import FullscreenPass, PassContext, TextureDesc
 from atmos.scene_uniforms import set_scene_uniforms
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
-from atmos.gpu.uniforms import bind_textures
+from atmos.gpu.uniforms import bind_images, bind_textures
 
 TEST_VOLUME_SETS = "test_volume_sets"     # the imported (A, B, t) of the test volume's texture sets
 
@@ -83,7 +83,7 @@ class TestVolumePlugin(Plugin):
     def _fill_slice(self, index: int, job) -> None:
         nx, ny, nz = self.settings.resolution
         layers = nz // self.settings.slices
-        job.target["density"].bind_to_image(0, read=False, write=True)
+        bind_images(self.program, density=job.target["density"])
         self.program["time"].value = self._time
         self.program["z0"].value = index * layers
         self.program.run(math.ceil(nx / 8), math.ceil(ny / 4), math.ceil(layers / 4))

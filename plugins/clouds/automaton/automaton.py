@@ -29,7 +29,7 @@ Layouts:
 
 GPU-side state for the later stages (smoothing, rendering): :attr:`CloudAutomaton.state_buffer`,
 a ``moderngl.Buffer`` that holds the current state (it alternates between two buffers; read the
-property after each step, or call :meth:`CloudAutomaton.bind_state`). Its layout:
+property after each step). Its layout:
 
 * packed: ``uint32[3 * N]`` with ``N = nwx * ny * nz``; field f (0 hum, 1 act, 2 cld) of word
   ``w = wx + nwx * (y + ny * z)`` at ``[f * N + w]``; cell ``x = 32 * wx + b`` is bit b.
@@ -49,7 +49,7 @@ import numpy as np
 from atmos.checks import check_shape, is_int
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.hashing import stream_key
-from atmos.gpu.uniforms import bind_textures, write_uniforms
+from atmos.gpu.uniforms import bind_buffers, bind_textures, write_uniforms
 
 PRECISION_BITS = 16
 MAX_LAYERS = 128        # layers (ny) the advection takes shifts for (common.glsl: a uniform array)
@@ -161,10 +161,6 @@ class CloudAutomaton:
         self._check_alive()
         return self._state[self._current]
 
-    def bind_state(self, binding: int) -> None:
-        """Bind the current state buffer to shader storage binding ``binding``."""
-        self.state_buffer.bind_to_storage_buffer(binding)
-
     def upload(self, hum, act, cld) -> None:
         """Replace the state with bool arrays of shape ``(nx, ny, nz)``."""
         self._check_alive()
@@ -224,11 +220,9 @@ class CloudAutomaton:
         self._set_grid(prog)
         write_uniforms(prog, u_mode=tuple(modes), u_threshold=tuple(thresholds), u_keys=keys)
         src, dst = self._state[self._current], self._state[1 - self._current]
-        src.bind_to_storage_buffer(0)
-        dst.bind_to_storage_buffer(1)
-        for rule in range(3):
-            buf = self._prob_buffers[rule] if modes[rule] == 2 else self._dummy
-            buf.bind_to_storage_buffer(2 + rule)
+        per_cell = "Prob" if self.layout == "cell" else "Planes"     # the step's probability blocks, by rule
+        bind_buffers(prog, {f"{per_cell}{name}": self._prob_buffers[rule] if modes[rule] == 2 else self._dummy
+                            for rule, name in enumerate(("Ext", "Hum", "Act"))}, Src=src, Dst=dst)
         prog.run(*self._grid)
         self._current = 1 - self._current
 
@@ -240,8 +234,7 @@ class CloudAutomaton:
                 self._shift_bytes = padded.tobytes()
             ctx.memory_barrier(moderngl.SHADER_STORAGE_BARRIER_BIT)
             src, dst = self._state[self._current], self._state[1 - self._current]
-            src.bind_to_storage_buffer(0)
-            dst.bind_to_storage_buffer(1)
+            bind_buffers(self._prog_advect, Src=src, Dst=dst)
             self._set_grid(self._prog_advect)
             write_uniforms(self._prog_advect, u_shifts=self._shift_bytes)   # per run: the program is shared
             self._prog_advect.run(*self._grid)
@@ -361,8 +354,7 @@ class CloudAutomaton:
         if self._staging is None:
             self._staging = self.ctx.buffer(reserve=4 * self._cells)
         fill(self._staging)
-        self._staging.bind_to_storage_buffer(6)
-        self._prob_buffers[rule].bind_to_storage_buffer(7)
+        bind_buffers(self._prog_pack, Prob=self._staging, Planes=self._prob_buffers[rule])
         self._set_grid(self._prog_pack, count=self._words)
         self._prog_pack.run(*self._grid)
         self.ctx.memory_barrier(moderngl.SHADER_STORAGE_BARRIER_BIT)
@@ -387,7 +379,7 @@ class CloudAutomaton:
         def fill_from(channel):
             def fill(buffer):
                 bind_textures(cells, u_probabilities=probabilities)
-                buffer.bind_to_storage_buffer(6)
+                bind_buffers(cells, Prob=buffer)
                 write_uniforms(cells, u_size=self.shape, u_channel=channel)
                 cells.run(*grid)
                 self.ctx.memory_barrier(moderngl.SHADER_STORAGE_BARRIER_BIT)

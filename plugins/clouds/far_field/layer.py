@@ -24,7 +24,7 @@ from atmos.plugins.clouds.far_field.rank_light import RankLight
 from atmos.plugins.clouds.volume.light import cell_tau, light_uniforms
 from atmos.plugins.clouds.volume.sets import CloudSets
 from atmos.plugins.sky_layer.octaves import OctaveTextures
-from atmos.gpu.uniforms import bind_textures, write_uniforms
+from atmos.gpu.uniforms import bind_buffers, bind_images, bind_textures, write_uniforms
 
 FAR_FIELD = "far_field"          # the imported graph resource
 REBAKE_TOLERANCE = 0.05          # re-bake the octaves when the sun moved the light step by this fraction
@@ -144,10 +144,10 @@ class FarFieldLayer:
         c = self.gpu.program(compute_shader="clouds/far_field/cover.comp", defines={"PROFILE": int(profile)})
         use_columns(c, sim, density=profile)
         if profile:
-            self._profile_texture(profile_heights(sim.shape[1])).bind_to_image(0, read=False, write=True)
+            bind_images(c, column_profile=self._profile_texture(profile_heights(sim.shape[1])))
         c["threshold"].value = float(sim.settings.cover_threshold)
         c["max_sum"].value = float(sim.shape[1])
-        self.cover.bind_to_storage_buffer(0)
+        bind_buffers(c, Cover=self.cover)
         c.run(1)
         self.gpu.ctx.memory_barrier()
 
@@ -178,10 +178,10 @@ class FarFieldLayer:
         return _transitions(self.cover)
 
     def use(self, program, view, sim: CloudSets) -> None:
-        """Bind the textures (field.glsl's octaves), the cover (storage buffer 0) and set field.glsl's uniforms."""
+        """Bind field.glsl's textures and cover and set its uniforms."""
         params = self.settings
         self.octaves.bind(program)
-        self.cover.bind_to_storage_buffer(0)
+        bind_buffers(program, Cover=self.cover)
         if self.profile is not None:
             bind_textures(program, far_profile=self.profile)
         self.light.use(program)

@@ -15,7 +15,7 @@ from __future__ import annotations
 from atmos.plugins.clouds.far_field.columns import INTERVALS, rank_texture, read_rank_texture, use_columns
 from atmos.plugins.clouds.volume.light import cell_tau
 from atmos.plugins.clouds.light.diffusion import DIFFUSION
-from atmos.gpu.uniforms import bind_textures
+from atmos.gpu.uniforms import bind_buffers, bind_images, bind_textures
 
 READS = {"transmittance": "trans", DIFFUSION: "diffusion"}   # light_by_rank.comp's inputs beside columns.glsl's
 FIELD_BINS = 16                  # light_by_rank.comp's most height bins (sun_profile, field_profile)
@@ -45,25 +45,21 @@ class RankLight:
                   for x, s in (("a", sim.a), ("b", sim.b))}
         values = dict(heights=int(heights), bins=bins, has_shading=int(shading), attenuation=float(attenuation),
                       column_tau=cell_tau(sim.settings))
-        cover_buffer.bind_to_storage_buffer(0)
-        self.sums.bind_to_storage_buffer(1)
         columns = sim.shape[0] * sim.shape[2]
         for stage, groups in ((0, -(-columns // GROUP)), (1, 1)):
             c = self.gpu.program(compute_shader="clouds/far_field/light_by_rank.comp",
                                  defines={"FIELD": int(self.has_field), "STAGE": stage})
             use_columns(c, sim)
             bind_textures(c, inputs)
+            bind_buffers(c, Cover=cover_buffer, Sums=self.sums)
             for name, value in values.items():
                 if name in c:
                     c[name].value = value
             if stage == 1:
-                self.sun.bind_to_image(0, read=False, write=True)
-                self.thickness.bind_to_image(3, read=False, write=True)
-                self.height.bind_to_image(5, read=False, write=True)
-                self.sun_profile.bind_to_image(4, read=False, write=True)
+                bind_images(c, sun_by_rank=self.sun, thickness_by_rank=self.thickness, height_by_rank=self.height,
+                            sun_profile=self.sun_profile)
                 if self.has_field:
-                    self.field.bind_to_image(1, read=False, write=True)
-                    self.field_profile.bind_to_image(2, read=False, write=True)
+                    bind_images(c, field_column=self.field, field_profile=self.field_profile)
             c.run(groups)
             self.gpu.ctx.memory_barrier()
 

@@ -19,7 +19,7 @@ from atmos.plugins.clouds.light.raymarch import raymarch
 from atmos.plugins.clouds.light.scattering import LightVolumeShader, Scattering, light_volume_reference
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.plugins.clouds.light.shear_warp import ShadingTask, ShearWarpShader, groups, program, read_volume, upload_volume
-from atmos.gpu.uniforms import bind_textures
+from atmos.gpu.uniforms import bind_images, bind_textures
 
 METHODS = ("shear-warp", "raymarch")
 
@@ -62,7 +62,7 @@ def compute_transmittance(gpu: GpuContext, density, sun_dir, sigma, method: str 
         prog = program(gpu, "upsample")
         bind_textures(prog, coarse=shader.result)
         prog["coarse_size"].value = shader.shading_shape
-        out.bind_to_image(0, read=False, write=True)
+        bind_images(prog, fine=out)
         prog.run(*(groups(n, 4) for n in density.shape))
         ctx.memory_barrier()
         return read_volume(out)

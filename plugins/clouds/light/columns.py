@@ -20,7 +20,7 @@ from atmos.graph import TextureDesc
 import atmos.plugins.clouds.light.grid as grid
 from atmos.plugins.clouds.light.reference import lerp_matrix, multilinear
 from atmos.plugins.clouds.light.shear_warp import check_volume_texture, groups, program
-from atmos.gpu.uniforms import bind_textures
+from atmos.gpu.uniforms import bind_images, bind_textures
 
 COLUMNS = "columns"          # the texture set's name for it
 STORE_MAX = 65000.0          # rg16f's range (columns.comp): an optical depth this large is opaque anyway
@@ -87,7 +87,7 @@ class ColumnShader:
         bind_textures(prog, fine=density)
         prog["fine_size"].value = self.shape
         prog["z0"].value = z0
-        target.bind_to_image(0, read=False, write=True)
+        bind_images(prog, columns=target)
         prog.run(groups(self.shading_shape[0], 8), groups(z1 - z0, 8))
         self.gpu.ctx.memory_barrier()
 

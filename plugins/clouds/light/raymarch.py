@@ -11,7 +11,7 @@ from atmos.checks import check_sun_dir
 import atmos.plugins.clouds.light.grid as grid
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.plugins.clouds.light.shear_warp import _RESULT_FORMATS, check_volume_texture, groups, program
-from atmos.gpu.uniforms import bind_textures
+from atmos.gpu.uniforms import bind_images, bind_textures
 
 
 def raymarch(gpu: GpuContext, density_texture, sun_dir, sigma, target) -> None:
@@ -27,6 +27,6 @@ def raymarch(gpu: GpuContext, density_texture, sun_dir, sigma, target) -> None:
     bind_textures(prog, density=density_texture)
     prog["sun_dir"].value = tuple(float(x) for x in u)
     prog["sigma"].value = sigma
-    target.bind_to_image(0, read=False, write=True)
+    bind_images(prog, result=target)
     prog.run(*(groups(n, 4) for n in shape))
     ctx.memory_barrier()

@@ -24,7 +24,7 @@ import numpy as np
 import atmos.plugins.clouds.light.grid as grid
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.plugins.clouds.light.shear_warp import _RESULT_FORMATS, check_volume_texture, groups, program
-from atmos.gpu.uniforms import bind_textures
+from atmos.gpu.uniforms import bind_images, bind_textures
 
 MODES = ("single", "multiple-forward")
 
@@ -102,6 +102,6 @@ class LightVolumeShader:
         prog = program(self.gpu, "light", RESULT_FORMAT=fmt)
         bind_textures(prog, transmittance=transmittance)
         prog["sun_color"].value, prog["ambient"].value = colors
-        target.bind_to_image(0, read=False, write=True)
+        bind_images(prog, light=target)
         prog.run(*(groups(n, 4) for n in shape))
         self.ctx.memory_barrier()

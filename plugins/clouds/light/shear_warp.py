@@ -24,7 +24,7 @@ import numpy as np
 from atmos.checks import check_shape, check_sun_dir
 from atmos.slicing import SliceTask
 from atmos.gpu.context import GpuContext, require_gpu
-from atmos.gpu.uniforms import bind_textures, write_uniforms
+from atmos.gpu.uniforms import bind_images, bind_textures, write_uniforms
 import atmos.plugins.clouds.light.grid as grid
 
 _RESULT_FORMATS = {"f4": "r32f", "f2": "r16f"}
@@ -110,7 +110,7 @@ class ShearWarpShader:
             prog = program(self.gpu, "downsample", SCALE=self.scale)
             bind_textures(prog, fine=density_texture)
             prog["fine_size"].value = self.shape
-            self._coarse.bind_to_image(0, read=False, write=True)
+            bind_images(prog, coarse=self._coarse)
             prog.run(*(groups(n, 4) for n in self.shading_shape))
             self.ctx.memory_barrier()
             density_texture = self._coarse
@@ -163,12 +163,11 @@ class ShearWarpShader:
         write_uniforms(prog, step_len=plan.length)
         prog["sigma"].value = self._sigma
         bind_textures(prog, density=self._density)
-        self._target.bind_to_image(2, read=False, write=True)
+        bind_images(prog, result=self._target)
         nb, nc = self.shading_shape[b], self.shading_shape[c]
         for i in range(i0, i1):
             src, dst = self._slices[i % 2], self._slices[1 - i % 2]
-            src.bind_to_image(0, read=True, write=False)
-            dst.bind_to_image(1, read=False, write=True)
+            bind_images(prog, prev_slice=src, next_slice=dst)
             prog["slice"].value = plan.order[i]
             prog["first"].value = int(i == 0)
             prog.run(groups(nb, 8), groups(nc, 8))

@@ -28,7 +28,7 @@ import moderngl
 import numpy as np
 
 from atmos.gpu.context import GpuContext, require_gpu
-from atmos.gpu.uniforms import bind_textures, write_uniforms
+from atmos.gpu.uniforms import bind_images, bind_textures, write_uniforms
 
 NOISE_RULE = 0xC1D           # stream id of the noise's hashes: stream_key(seed, 0, NOISE_RULE, plane)
 PERLIN_GAIN = 1.5            # Perlin FBM -> [0, 1]: clamp(0.5 + 0.5 GAIN fbm)
@@ -122,7 +122,7 @@ class DetailNoise:
                 made.append(tex)
                 tex.repeat_x = tex.repeat_y = tex.repeat_z = True
                 tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
-                tex.bind_to_image(0, read=False, write=True)
+                bind_images(program, noise_volume=tex)
                 program["size"].value = size
                 program["seed"].value = self.seed
                 program["texture_index"].value = index

@@ -30,7 +30,7 @@ import numpy as np
 from atmos.checks import check_shape, is_int
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.plugins.clouds.simulation.smoothing import check_texture_limit, check_volume_texture, check_z_range
-from atmos.gpu.uniforms import bind_textures, write_uniforms
+from atmos.gpu.uniforms import bind_images, bind_textures, write_uniforms
 
 
 def group_grid(nx: int, nz: int, group_size) -> tuple[int, int]:
@@ -109,7 +109,7 @@ class DensityMaps:
         if z0 == z1:
             return
         bind_textures(self._sum_prog, u_density=density)
-        self.sums.bind_to_image(0, read=False, write=True)
+        bind_images(self._sum_prog, u_sums=self.sums)
         # the programs are shared with other DensityMaps on the GpuContext: this one's uniforms each run
         write_uniforms(self._sum_prog, u_size=self.shape, u_band_height=self.band_height)
         self._sum_prog["u_z0"].value = z0
@@ -119,7 +119,7 @@ class DensityMaps:
         gz1 = self.grid[1] if z1 == nz else z1 // self.group_size[1]
         if gz1 > gz0:
             bind_textures(self._max_prog, u_sums=self.sums)
-            self.max_maps.bind_to_image(0, read=False, write=True)
+            bind_images(self._max_prog, u_max=self.max_maps)
             write_uniforms(self._max_prog, u_extent=(nx, nz), u_group=self.group_size, u_grid=self.grid)
             self._max_prog["u_gz0"].value = gz0
             self._max_prog.run(-(-self.grid[0] // 8), -(-(gz1 - gz0) // 8), 1 + self.bands)

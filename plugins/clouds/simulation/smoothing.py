@@ -25,7 +25,7 @@ import numpy as np
 from atmos.checks import check_shape, is_int
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.plugins.clouds.automaton import LAYOUTS
-from atmos.gpu.uniforms import write_uniforms
+from atmos.gpu.uniforms import bind_buffers, bind_images, write_uniforms
 
 WEIGHTS = ("tent", "box")
 MAX_RADIUS = 8
@@ -172,8 +172,8 @@ class Smoother:
             return
         program = self._program(dtype)
         program["u_z0"].value = z0
-        state_buffer.bind_to_storage_buffer(0)
-        texture.bind_to_image(0, read=False, write=True)
+        bind_buffers(program, State=state_buffer)
+        bind_images(program, u_density=texture)
         nx, ny, _ = self.shape
         program.run(-(-nx // _LOCAL[0]), -(-ny // _LOCAL[1]), z1 - z0)
         self.ctx.memory_barrier()

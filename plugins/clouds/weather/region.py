@@ -23,7 +23,7 @@ import numpy as np
 from atmos.checks import check_shape
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.plugins.clouds.weather.components import check_ellipsoid_array
-from atmos.gpu.uniforms import bind_textures, write_uniforms
+from atmos.gpu.uniforms import bind_buffers, bind_images, bind_textures, write_uniforms
 
 CHUNK = 256
 _FORMATS = {"f4": ("r32f", "rgba32f", np.float32), "f2": ("r16f", "rgba16f", np.float16)}
@@ -82,13 +82,12 @@ class RegionVolume:
                 raise ValueError(f"{len(a)} ellipsoids need {len(items)} work groups, more than this GPU "
                                  f"can dispatch at once; use fewer or smaller ellipsoids")
             write_uniforms(self._scatter, size=self.shape, item_count=len(items), groups_x=gx)
-            for binding, name in enumerate(("ellipsoids", "boxes", "items")):
-                self._buffers[name].bind_to_storage_buffer(binding)
-            self._cells.bind_to_storage_buffer(3)
+            bind_buffers(self._scatter, Ellipsoids=self._buffers["ellipsoids"], Boxes=self._buffers["boxes"],
+                         Items=self._buffers["items"], Region=self._cells)
             self._scatter.run(gx, gy, 1)
             self.ctx.memory_barrier()
-        self._cells.bind_to_storage_buffer(3)
-        self.texture.bind_to_image(0, read=False, write=True)
+        bind_buffers(self._resolve, Region=self._cells)
+        bind_images(self._resolve, region=self.texture)
         write_uniforms(self._resolve, size=self.shape)
         self._resolve.run(-(-nx // 8), -(-ny // 8), -(-nz // 4))
         self.ctx.memory_barrier()
@@ -115,7 +114,7 @@ class RegionVolume:
             self.gpu.track(self.prob_texture)
         nx, ny, nz = self.shape
         bind_textures(self._probs, region=self.texture)
-        self.prob_texture.bind_to_image(0, read=False, write=True)
+        bind_images(self._probs, probs=self.prob_texture)
         write_uniforms(self._probs, size=self.shape,
                        scales=(hum_scale, act_scale, ext_scale, vanish_threshold))
         self._probs.run(-(-nx // 8), -(-ny // 8), -(-nz // 4))
