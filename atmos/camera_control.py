@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from atmos.camera import Camera
-from atmos.checks import CheckedSettings, check_num
+from atmos.checks import CheckedSettings, num_field
 from atmos.input import Input
 from atmos.keys import key
 from atmos.orientation import angles
@@ -38,14 +38,9 @@ class CameraPlugin(Plugin):
 
 @dataclass(frozen=True)
 class FlyCameraSettings(CheckedSettings):
-    """``speed``: metres per second (shift: 5×); ``turn``: radians per pixel of mouse drag. All live."""
-    speed: float = 20.0
-    turn: float = 0.004
-
-    def __post_init__(self):
-        o = "FlyCameraSettings"
-        self.store(dict(speed=check_num(o, "speed", self.speed, 0.0, 1e7),
-                        turn=check_num(o, "turn", self.turn, 0.0, 1.0)))
+    """The fly camera's speeds (all live)."""
+    speed: float = num_field(20.0, 0.0, 1e7, "metres per second (shift: 5×)")
+    turn: float = num_field(0.004, 0.0, 1.0, "radians per pixel of mouse drag")
 
 
 class FlyCameraPlugin(Plugin):
@@ -74,23 +69,14 @@ class FlyCameraPlugin(Plugin):
 
 @dataclass(frozen=True)
 class ChaseCameraSettings(CheckedSettings):
-    """``distance`` behind and ``height`` above the target (m); ``look_ahead``: aims at the point this
-    far in front of it; ``stiffness``: 1/s, how fast the camera catches up (exponential; larger is
-    tighter); ``bank``: how much of the target's roll the camera takes (0 keeps the horizon level,
-    1 rolls with it). All live."""
-    distance: float = 12.0
-    height: float = 3.0
-    look_ahead: float = 8.0
-    stiffness: float = 6.0
-    bank: float = 0.5
-
-    def __post_init__(self):
-        o = "ChaseCameraSettings"
-        self.store(dict(distance=check_num(o, "distance", self.distance, 0.0, 1e6),
-                        height=check_num(o, "height", self.height, -1e6, 1e6),
-                        look_ahead=check_num(o, "look_ahead", self.look_ahead, 0.0, 1e6),
-                        stiffness=check_num(o, "stiffness", self.stiffness, 0.0, 1e6, lo_open=True),
-                        bank=check_num(o, "bank", self.bank, 0.0, 1.0)))
+    """Where the chase camera sits relative to its target and how it follows it (all live)."""
+    distance: float = num_field(12.0, 0.0, 1e6, "m behind the target")
+    height: float = num_field(3.0, -1e6, 1e6, "m above the target")
+    look_ahead: float = num_field(8.0, 0.0, 1e6, "aims at the point this many m in front of the target")
+    stiffness: float = num_field(6.0, 0.0, 1e6, "1/s, how fast the camera catches up (exponential; larger "
+                                 "is tighter)", lo_open=True)
+    bank: float = num_field(0.5, 0.0, 1.0, "how much of the target's roll the camera takes (0 keeps the "
+                            "horizon level, 1 rolls with it)")
 
 
 def chase_point(pose, settings: ChaseCameraSettings) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -4,9 +4,13 @@ and the settings convention every plugin follows.
 
 The convention
 --------------
-* A plugin's settings are ONE frozen dataclass ``<Thing>Settings(CheckedSettings)`` whose
-  ``__post_init__`` checks every field with the ``check_*`` functions here (and keeps the
-  normalised values with :meth:`CheckedSettings.store`).
+* A plugin's settings are ONE frozen dataclass ``<Thing>Settings(CheckedSettings)``; each field is
+  declared once, with its rule and its doc: ``steps: int = int_field(24, 1, 256, "samples per ray")``
+  (:func:`num_field`, :func:`int_field`, :func:`vec_field`, :func:`bool_field`, :func:`choice_field`,
+  :func:`nested_field`). ``CheckedSettings.__post_init__`` runs each field's check (the ``check_*``
+  functions here) and keeps the normalised values; the class docstring gets a line per field (its
+  default, what it allows, its doc). A class with rules across fields adds them in its own
+  ``__post_init__`` after ``super().__post_init__()``.
 * The plugin names it in ``settings_class`` and keeps it as ``plugin.settings``;
   ``Plugin(settings=None, **fields)`` builds it with :func:`plugin_settings` (the fields on top of
   ``settings`` or the defaults) and ``plugin.configure(**changes)`` swaps in what
@@ -199,14 +203,102 @@ def check_known(owner: str, changes: dict, known) -> None:
         raise ValueError(f"unknown {owner} setting(s) {', '.join(unknown)}; known: {', '.join(sorted(known))}")
 
 
+def _field(default, doc: str, check, **args):
+    return dataclasses.field(default=default, metadata={"check": (check, args), "doc": doc})
+
+
+def num_field(default, lo: float | None = None, hi: float | None = None, doc: str = "", *, lo_open: bool = False,
+              optional: bool = False):
+    """A field holding a finite number in [lo, hi] (:func:`check_num`)."""
+    return _field(default, doc, check_num, lo=lo, hi=hi, lo_open=lo_open, optional=optional)
+
+
+def int_field(default, lo: int, hi: int, doc: str = ""):
+    """A field holding a whole number in lo..hi (:func:`check_int`)."""
+    return _field(default, doc, check_int, lo=lo, hi=hi)
+
+
+def vec_field(default, n: int, kind: str = "finite", doc: str = "", *, lo: float | None = None,
+              optional: bool = False):
+    """A field holding ``n`` numbers (:func:`check_vec`)."""
+    return _field(default, doc, check_vec, n=n, kind=kind, lo=lo, optional=optional)
+
+
+def bool_field(default: bool, doc: str = ""):
+    """A field holding True or False (:func:`check_bool`)."""
+    return _field(default, doc, check_bool)
+
+
+def choice_field(default: str, choices, doc: str = ""):
+    """A field holding one of the strings ``choices`` (:func:`check_choice`)."""
+    return _field(default, doc, check_choice, choices=tuple(choices))
+
+
+def nested_field(default, doc: str = ""):
+    """A field holding settings of their own (a CheckedSettings of ``default``'s type); ``replace``
+    takes a dict of changes to them."""
+    return _field(default, doc, check_type, cls=type(default))
+
+
+def check_type(owner: str, name: str, value, cls):
+    """An instance of ``cls``."""
+    if not isinstance(value, cls):
+        article = "an" if cls.__name__[0] in "AEIOU" else "a"
+        raise ValueError(f"{owner}.{name} must be {article} {cls.__name__}, got {type(value).__name__}")
+    return value
+
+
+def _allowed(check, args) -> str:
+    if check is check_num:
+        bounds = [t for t in ("" if args["lo"] is None else f"{'>' if args['lo_open'] else '>='} {args['lo']}",
+                              "" if args["hi"] is None else f"<= {args['hi']}") if t]
+        return " and ".join(bounds) or "any finite number"
+    if check is check_int:
+        return f"{args['lo']}..{args['hi']}"
+    if check is check_vec:
+        return f"{args['n']} {args['kind']} numbers" + (f" >= {args['lo']}" if args["lo"] is not None else "")
+    if check is check_bool:
+        return "True or False"
+    if check is check_choice:
+        return " | ".join(map(repr, args["choices"]))
+    return f"a {args['cls'].__name__}"
+
+
 class CheckedSettings:
-    """Base of every plugin's frozen settings dataclass (its ``__post_init__`` checks every field).
+    """Base of every plugin's frozen settings dataclass: its ``__post_init__`` runs the rule declared on
+    each field (module docstring).
 
     ``FIXED``: names of the fields that cannot change while the plugin runs (they size what it makes
     once); :func:`configure_settings` refuses them.
     """
 
     FIXED: ClassVar[tuple[str, ...]] = ()
+
+    def __init_subclass__(cls, **kwargs):
+        """Append a line per declared field to the class docstring: its default, what it allows, its doc."""
+        super().__init_subclass__(**kwargs)
+        lines = []
+        for name in cls.__dict__.get("__annotations__", {}):
+            f = cls.__dict__.get(name)
+            if isinstance(f, dataclasses.Field) and "check" in f.metadata:
+                check, args = f.metadata["check"]
+                none = " or None" if args.get("optional") else ""
+                fixed = ", fixed" if name in cls.FIXED else ""
+                default = repr(f.default)
+                if isinstance(f.default, CheckedSettings) and len(default) > 60:
+                    default = f"{type(f.default).__name__}()"
+                lines.append(f"    ``{name}`` = {default} ({_allowed(check, args)}{none}{fixed}): {f.metadata['doc']}")
+        if lines:
+            cls.__doc__ = (cls.__doc__ or "").rstrip() + "\n\n    Fields:\n\n" + "\n".join(lines) + "\n"
+
+    def __post_init__(self):
+        owner = type(self).__name__
+        checked = {}
+        for f in dataclasses.fields(self):
+            if "check" in f.metadata:
+                check, args = f.metadata["check"]
+                checked[f.name] = check(owner, f.name, getattr(self, f.name), **args)
+        self.store(checked)
 
     def replace(self, **changes):
         """A checked copy with ``changes``; unknown names and bad values raise ValueError. A field

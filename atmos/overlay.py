@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from atmos.checks import CheckedSettings, check_bool, check_int
+from atmos.checks import CheckedSettings, bool_field, check_int
 from atmos.graph import FullscreenPass, PassBuilder, PassContext
 from atmos.input import Input
 from atmos.keys import key
@@ -25,12 +25,15 @@ HISTORY = 128
 
 @dataclass(frozen=True)
 class OverlaySettings(CheckedSettings):
-    """``visible``: draw the bars (the times are recorded either way); ``size``: (width, height) of
-    the graph in pixels, 1..4096 each (cut to the screen). All live."""
-    visible: bool = True
+    """The frame-time bars (all live). ``size`` is checked by hand (not in the list below):
+
+    ``size`` = (256, 64): (width, height) of the graph in pixels, 1..4096 each (cut to the screen).
+    """
+    visible: bool = bool_field(True, "draw the bars (the times are recorded either way)")
     size: tuple = (256, 64)
 
     def __post_init__(self):
+        super().__post_init__()
         o = "OverlaySettings"
         try:
             size = tuple(check_int(o, f"size[{i}]", n, 1, 4096) for i, n in enumerate(self.size))
@@ -38,7 +41,7 @@ class OverlaySettings(CheckedSettings):
             size = ()
         if len(size) != 2:
             raise ValueError(f"{o}.size must be (width, height) in pixels, got {self.size!r}")
-        self.store(dict(visible=check_bool(o, "visible", self.visible), size=size))
+        self.store(dict(size=size))
 
 
 class FrameTimes:

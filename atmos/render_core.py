@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
-from atmos.checks import CheckedSettings, check_bool, check_num, check_vec
+from atmos.checks import CheckedSettings, bool_field, num_field, vec_field
 from atmos.hashing import lowbias32
 
 from atmos.graph import FullscreenPass, PassBuilder, PassContext, RenderPass, TextureDesc
@@ -193,18 +193,12 @@ class LinearCapturePass(CapturePass):
 
 @dataclass(frozen=True)
 class RenderCoreSettings(CheckedSettings):
-    """``clear_color``: linear HDR colour ``color`` starts each frame with (non-negative);
-    ``exposure``: HDR scale before tone mapping (> 0); ``dither``: add a triangular dither of ±1
-    step before 8-bit output (mean unchanged, no banding). All live."""
-    clear_color: tuple = (0.0, 0.0, 0.0)
-    exposure: float = 1.0
-    dither: bool = True
-
-    def __post_init__(self):
-        o = "RenderCoreSettings"
-        self.store(dict(clear_color=check_vec(o, "clear_color", self.clear_color, 3, "non-negative"),
-                        exposure=check_num(o, "exposure", self.exposure, 0.0, 1e6, lo_open=True),
-                        dither=check_bool(o, "dither", self.dither)))
+    """How each frame starts and how it reaches the screen (all live)."""
+    clear_color: tuple = vec_field((0.0, 0.0, 0.0), 3, "non-negative", "linear HDR colour ``color`` starts "
+                                   "each frame with")
+    exposure: float = num_field(1.0, 0.0, 1e6, "HDR scale before tone mapping", lo_open=True)
+    dither: bool = bool_field(True, "add a triangular dither of ±1 step before 8-bit output (mean unchanged, "
+                              "no banding)")
 
 
 class RenderCorePlugin(Plugin):

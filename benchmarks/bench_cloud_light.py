@@ -159,7 +159,7 @@ class Scene:
         s = self.settings
         start = time.perf_counter()
         r = trace(self.density, self.cell, self.lo, np.broadcast_to(cam.position, d.shape), d, sigma_t=self.sigma_t,
-                  albedo=s.albedo, g=s.phase_g, g2=s.phase_g2, w=s.phase_w, sun_dir=direction, sun_irradiance=e,
+                  albedo=s.albedo, g=s.phase.g, g2=s.phase.g2, w=s.phase.w, sun_dir=direction, sun_irradiance=e,
                   sky=sky, ground=ground, samples=samples, max_order=max_order, rng=np.random.default_rng(1))
         return r.radiance.reshape(h, w, 3), r.radiance_error.reshape(h, w, 3), time.perf_counter() - start
 

@@ -117,14 +117,14 @@ def test_the_field_lights_a_lit_surface_seen_with_the_sun_behind():
     its share H of it outward (bench_cloud_light "sun behind": the cumulus was -17.8 % dark with no floor,
     -9.1 % with -cos phi, +2.0 % now). Toward the sun the P1 term is larger and stands. H is checked
     against a quadrature of the lobes."""
-    from atmos.phase import hg
-    from atmos.plugins.clouds.light.medium import hemisphere_share
+    from atmos.phase import Phase, hg
     lobes = (0.85, -0.3, 0.1)
     mu = (np.arange(200000) + 0.5) / 200000                       # midpoint rule over the hemisphere
     quad = 2 * np.pi * np.mean((1 - lobes[2]) * hg(mu, lobes[0]) + lobes[2] * hg(mu, lobes[1]))
-    share = hemisphere_share(*lobes)
+    share = Phase(*lobes).hemisphere_share
     assert share == pytest.approx(quad, rel=1e-6) and 0.85 < share < 0.95
-    assert hemisphere_share(0.0, 0.0, 0.0) == pytest.approx(0.5) and hemisphere_share(1e-5, 0.0, 0.0) == pytest.approx(0.5, abs=1e-5)
+    assert Phase(0.0, 0.0, 0.0).hemisphere_share == pytest.approx(0.5)
+    assert Phase(1e-5, 0.0, 0.0).hemisphere_share == pytest.approx(0.5, abs=1e-5)
     sun, g, phi = np.array([0.0, 0.6, 0.8]), 0.735, 2.0
     field = np.concatenate([[phi], -0.9 * phi * sun])           # |F| near phi, along the sun's light
     behind, toward, side = -sun, sun, np.array([1.0, 0.0, 0.0])
@@ -164,9 +164,8 @@ def test_every_shaded_texture_set_a_renderer_reads_carries_its_field_and_unshade
         assert density.any(), "clouds formed"
         tr = texture_set["transmittance"]
         T = np.frombuffer(tr.read(), np.float16).reshape(tr.size[::-1]).transpose(2, 1, 0).astype(np.float64)
-        from atmos.plugins.clouds.light.medium import mean_cosine
         ref = diffusion_reference(density, s.cell_size, s.sigma_t, s.albedo,
-                                  mean_cosine(s.phase_g, s.phase_g2, s.phase_w), T, sim.sun())
+                                  s.phase.mean_cosine, T, sim.sun())
         got = read_field(texture_set[DIFFUSION])
         np.testing.assert_allclose(got, ref, rtol=2 ** -10, atol=2e-3 * ref[..., 0].max())
     sprites.configure(ms_diffusion=0.0)         # no reader: the next steps solve nothing and hold no field

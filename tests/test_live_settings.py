@@ -320,11 +320,11 @@ SPECS = {
         look((0.0, 2.0, 10.0), yaw=0.0, pitch=0.05),
         dict(samples=8, density=0.4, decay=0.7, weight=0.3, exposure=2.0, threshold=0.2, ceiling=0.05, radius=0.1,
              downsample=4, horizon_fade=0.9, front_fade=1.0, edge_fade=2.0, mode="march", steps=3,
-             scattering=1e-4, max_distance=400.0, phase_g=0.0, phase_g2=0.6, phase_w=0.7, sun_intensity=2.0,
+             scattering=1e-4, max_distance=400.0, sun_intensity=2.0, **{"phase.g": 0.0, "phase.g2": 0.6, "phase.w": 0.7},
              fog_sun_share=0.3),
         before={"__all__": sun_at((0.5, 0.55)), "edge_fade": sun_at((1.15, 0.55)),
-                **{f: march_under_clouds for f in ("steps", "scattering", "max_distance", "phase_g", "phase_g2",
-                                                    "phase_w", "sun_intensity")}},
+                **{f: march_under_clouds for f in ("steps", "scattering", "max_distance", "phase.g",
+                                                    "phase.g2", "phase.w", "sun_intensity")}},
         # fog_sun_share acts only with a FogPlugin (tests/test_light_shafts_fog.py renders it): the setting read
         observe={"downsample": resource_size(MASK), "fog_sun_share": lambda app, plugin: plugin.settings.fog_sun_share}),
     "test_volume": Spec(
@@ -375,7 +375,7 @@ SPECS = {
 def _clouds_spec():
     weather = example_weather((32, 8, 32), 20)
     changes = dict(step_seconds=3.0, cover_threshold=6.0, sigma_t=2.0, scattering=Scattering("multiple-forward"),
-                   albedo=0.5, phase_g=0.2, phase_g2=0.6, phase_w=0.7, sun_intensity=2.0, sky_intensity=4.0,
+                   albedo=0.5, sun_intensity=2.0, **{"phase.g": 0.2, "phase.g2": 0.6, "phase.w": 0.7}, sky_intensity=4.0,
                    ground_albedo=1.0,
                    cell_size=(10.0, 30.0, 10.0), base_altitude=150.0, edge_fade=0.8)
     changes.update(weather_changes(weather))

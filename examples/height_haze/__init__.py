@@ -11,26 +11,17 @@ from pathlib import Path
 
 from atmos import (COLOR, DEPTH, FullscreenPass, PassContext, Plugin, add_shader_path, bind_textures, set_camera_uniforms,
                    write_uniforms)
-from atmos.checks import CheckedSettings, check_num, check_vec
+from atmos.checks import CheckedSettings, num_field, vec_field
 
 
 @dataclass(frozen=True)
 class HeightHazeSettings(CheckedSettings):
-    """``density``: extinction (1/m) at ``base`` metres; ``scale_height``: metres over which it falls
-    by e; ``max_distance``: metres of haze in front of the sky; ``haze_color``: linear RGB. All live."""
-    density: float = 2e-4
-    base: float = 0.0
-    scale_height: float = 300.0
-    max_distance: float = 20000.0
-    haze_color: tuple = (0.7, 0.78, 0.9)
-
-    def __post_init__(self):
-        o = "HeightHazeSettings"
-        self.store(dict(density=check_num(o, "density", self.density, 0.0),
-                        base=check_num(o, "base", self.base),
-                        scale_height=check_num(o, "scale_height", self.scale_height, 0.0, lo_open=True),
-                        max_distance=check_num(o, "max_distance", self.max_distance, 0.0),
-                        haze_color=check_vec(o, "haze_color", self.haze_color, 3, "non-negative")))
+    """Haze thinning with height (all live)."""
+    density: float = num_field(2e-4, 0.0, doc="extinction (1/m) at height base")
+    base: float = num_field(0.0, doc="m: where the haze has its full density")
+    scale_height: float = num_field(300.0, 0.0, doc="m over which the density falls by e", lo_open=True)
+    max_distance: float = num_field(20000.0, 0.0, doc="m of haze in front of the sky")
+    haze_color: tuple = vec_field((0.7, 0.78, 0.9), 3, "non-negative", "linear RGB of the in-scattered light")
 
 
 class HeightHazePass(FullscreenPass):

@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from atmos.checks import CheckedSettings, check_int, check_num
+from atmos.checks import CheckedSettings, check_num, int_field, num_field
 from atmos.lighting import Sun, sky_light
 from atmos.plugin import Plugin
 from atmos.plugins.daylight.solar_position import solar_direction
@@ -13,30 +13,20 @@ from atmos.plugins.daylight.solar_position import solar_direction
 
 @dataclass(frozen=True)
 class DaylightSettings(CheckedSettings):
-    """``hours``: the time of day in [0, 24] the clock starts at (``configure(hours=...)`` sets the
-    clock to it): local apparent solar time (12 = the sun due south or north), or, once a
-    ``longitude`` is given, clock time in the zone ``utc_offset`` hours from UTC (None: the
-    longitude's nominal zone, round(longitude / 15)); ``speed``: in-game hours per real second (0 stops
-    the clock); ``latitude`` in degrees (−90..90); ``longitude`` in degrees east (−180..180) or None;
-    ``day_of_year`` 1..366 of ``year`` (1900..2100). Positions within ~0.01° of NREL's SPA
+    """The clock and the place that set the sun's direction: positions within ~0.01° of NREL's SPA
     (:mod:`atmos.plugins.daylight.solar_position`). All live (next frame)."""
-    hours: float = 10.0
-    speed: float = 0.0
-    latitude: float = 45.0
-    day_of_year: float = 172.0
-    year: int = 2024
-    longitude: float | None = None
-    utc_offset: float | None = None
-
-    def __post_init__(self):
-        o = "DaylightSettings"
-        self.store(dict(hours=check_num(o, "hours", self.hours, 0.0, 24.0),
-                        speed=check_num(o, "speed", self.speed),
-                        latitude=check_num(o, "latitude", self.latitude, -90.0, 90.0),
-                        day_of_year=check_num(o, "day_of_year", self.day_of_year, 1.0, 366.0),
-                        year=check_int(o, "year", self.year, 1900, 2100),
-                        longitude=check_num(o, "longitude", self.longitude, -180.0, 180.0, optional=True),
-                        utc_offset=check_num(o, "utc_offset", self.utc_offset, -14.0, 14.0, optional=True)))
+    hours: float = num_field(10.0, 0.0, 24.0, "the time of day the clock starts at (configure(hours=...) sets "
+                             "the clock to it): local apparent solar time (12 = the sun due south or north), "
+                             "or, once a longitude is given, clock time in the zone utc_offset hours from UTC")
+    speed: float = num_field(0.0, doc="in-game hours per real second (0 stops the clock)")
+    latitude: float = num_field(45.0, -90.0, 90.0, "degrees north")
+    day_of_year: float = num_field(172.0, 1.0, 366.0, "the day of the year (1: 1 January)")
+    year: int = int_field(2024, 1900, 2100, "the year of day_of_year")
+    longitude: float | None = num_field(None, -180.0, 180.0, "degrees east; None: hours is solar time",
+                                        optional=True)
+    utc_offset: float | None = num_field(None, -14.0, 14.0, "with a longitude: hours from UTC of the clock's zone "
+                                         "(None: the longitude's nominal zone, round(longitude / 15))",
+                                         optional=True)
 
 
 @dataclass(slots=True)

@@ -3,7 +3,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from atmos.checks import CheckedSettings, check_num, check_vec
+from atmos.checks import CheckedSettings, num_field, vec_field
 
 from atmos.graph import PassContext
 from atmos.plugin import Plugin
@@ -12,17 +12,11 @@ from atmos.render_core import OpaquePass
 
 @dataclass(frozen=True)
 class GroundSettings(CheckedSettings):
-    """``half_size``: the plane reaches this many metres each way from the origin; ``tile``: checker
-    tiles of this many metres; ``albedo``: linear RGB reflectance in [0, 1]. All live."""
-    half_size: float = 4000.0
-    tile: float = 4.0
-    albedo: tuple = (0.28, 0.36, 0.2)
-
-    def __post_init__(self):
-        o = "GroundSettings"
-        self.store(dict(half_size=check_num(o, "half_size", self.half_size, 0.0, lo_open=True),
-                        tile=check_num(o, "tile", self.tile, 0.0, lo_open=True),
-                        albedo=check_vec(o, "albedo", self.albedo, 3, "non-negative")))
+    """A flat checkered ground plane at y = 0 (all live)."""
+    half_size: float = num_field(4000.0, 0.0, doc="the plane reaches this many metres each way from the origin",
+                                 lo_open=True)
+    tile: float = num_field(4.0, 0.0, doc="checker tiles of this many metres", lo_open=True)
+    albedo: tuple = vec_field((0.28, 0.36, 0.2), 3, "non-negative", "linear RGB reflectance (physical: at most 1)")
 
 
 def ground_quad(half_size: float) -> bytes:

@@ -106,7 +106,7 @@ class MarchedShafts:
         set_camera_uniforms(p, view.camera, view.aspect)
         values = dict(has_clouds=int(clouds), sun_dir=tuple(unit_sun(view.sun.direction)),
                       irradiance=tuple(float(v) for v in irradiance),
-                      lobes=(settings.phase_g, settings.phase_g2, settings.phase_w), scattering=settings.scattering,
+                      lobes=settings.phase.lobes, scattering=settings.scattering,
                       max_distance=settings.max_distance, steps=settings.steps, factor=factor,
                       frame_size=tuple(float(v) for v in view.size))
         if fog is not None:

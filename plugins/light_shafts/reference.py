@@ -11,7 +11,6 @@ from atmos.blue_noise import blue_noise
 from atmos.plugins.clouds.shadows import reference as shadows_reference
 from atmos.plugins.light_shafts.settings import blur_scale
 from atmos.render_core import HDR_MAX
-from atmos.phase import phase
 
 LUMA = np.array([0.2126, 0.7152, 0.0722])
 
@@ -90,6 +89,6 @@ def march_shafts(low_depth, basis, camera_pos, near: float, far: float, frame_si
         s = (i + j) * ds
         tau = 0.0 if optical_depth is None else optical_depth(np.asarray(camera_pos, np.float64) + direction * s[..., None])
         total += np.exp(-tau - sigma * s)
-    p = phase(direction @ np.asarray(sun_dir, np.float64), settings.phase_g, settings.phase_g2, settings.phase_w)
+    p = settings.phase(direction @ np.asarray(sun_dir, np.float64))
     light = np.minimum(np.asarray(irradiance, np.float64) * (sigma * p * total * ds)[..., None], HDR_MAX)
     return np.concatenate([light, np.exp(-sigma * d)[..., None]], -1)

@@ -4,71 +4,54 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from atmos.checks import CheckedSettings, check_num, check_vec
-
-_OWNER = "AtmosphereSettings"
-
+from atmos.checks import CheckedSettings, num_field, vec_field
 
 @dataclass(frozen=True)
 class AtmosphereSettings(CheckedSettings):
     """A planet's atmosphere after Hillaire 2020 (the defaults: Earth, Bruneton & Hillaire's values).
-    Lengths in metres, coefficients in 1/m per colour channel (linear sRGB red, green, blue).
+    Lengths in metres, coefficients in 1/m per colour channel (linear sRGB red, green, blue). All
+    live (next frame)."""
 
-    ``planet_radius``, ``atmosphere_height`` (the top is at planet_radius + atmosphere_height);
-    Rayleigh scattering ``rayleigh_scattering`` with density ``exp(-h / rayleigh_scale_height)``;
-    Mie (aerosols) ``mie_scattering`` + ``mie_absorption`` with ``exp(-h / mie_scale_height)`` and a
-    Henyey–Greenstein phase of asymmetry ``mie_g``; ozone absorption ``ozone_absorption`` with a
-    tent profile, 1 at ``ozone_altitude`` falling to 0 ``ozone_width / 2`` above and below; a
-    Lambertian ground of ``ground_albedo`` (0..1); ``sun_color``: the sun's colour above the
-    atmosphere in ``Sun.color`` units (the default puts a noon sun, 68° high, where
-    :func:`atmos.lighting.sky_light` puts it, so exposure and the scenes lit by ``Sun.color`` stay
-    as they were); ``sun_intensity``: the irradiance one unit of ``Sun.color`` stands for, as
-    :class:`~atmos.plugins.clouds.CloudSettings` ``.sun_intensity`` (the same 4π: the sky and the
-    clouds see one sun); ``multiple_scattering``: the weight of Hillaire's multiple-scattering term
-    (1: the model; 0: single scattering only). All live (next frame)."""
-
-    planet_radius: float = 6360e3
-    atmosphere_height: float = 100e3
-    rayleigh_scattering: tuple = (5.802e-6, 13.558e-6, 33.1e-6)
-    rayleigh_scale_height: float = 8000.0
-    mie_scattering: tuple = (3.996e-6, 3.996e-6, 3.996e-6)
-    mie_absorption: tuple = (0.444e-6, 0.444e-6, 0.444e-6)
-    mie_scale_height: float = 1200.0
-    mie_g: float = 0.8
-    ozone_absorption: tuple = (0.650e-6, 1.881e-6, 0.085e-6)
-    ozone_altitude: float = 25e3
-    ozone_width: float = 30e3
-    ground_albedo: tuple = (0.3, 0.3, 0.3)
-    sun_color: tuple = (1.033, 1.079, 1.124)
-    sun_intensity: float = 4.0 * math.pi
-    multiple_scattering: float = 1.0
+    planet_radius: float = num_field(6360e3, 1e3, 1e9, "m: the ground's distance from the planet's centre")
+    atmosphere_height: float = num_field(100e3, 100.0, 1e7, "m; the top is at planet_radius + this")
+    rayleigh_scattering: tuple = vec_field((5.802e-6, 13.558e-6, 33.1e-6), 3, "non-negative", "Rayleigh "
+                                           "scattering, at most 0.01")
+    rayleigh_scale_height: float = num_field(8000.0, 1.0, 1e7, "m: the Rayleigh density is exp(-h / this)")
+    mie_scattering: tuple = vec_field((3.996e-6, 3.996e-6, 3.996e-6), 3, "non-negative", "Mie (aerosol) "
+                                      "scattering, at most 0.01")
+    mie_absorption: tuple = vec_field((0.444e-6, 0.444e-6, 0.444e-6), 3, "non-negative", "Mie (aerosol) "
+                                      "absorption, at most 0.01")
+    mie_scale_height: float = num_field(1200.0, 1.0, 1e7, "m: the Mie density is exp(-h / this)")
+    mie_g: float = num_field(0.8, -0.99, 0.99, "asymmetry of the Mie Henyey–Greenstein phase")
+    ozone_absorption: tuple = vec_field((0.650e-6, 1.881e-6, 0.085e-6), 3, "non-negative", "ozone absorption "
+                                        "(a tent profile), at most 0.01")
+    ozone_altitude: float = num_field(25e3, 0.0, 1e7, "m: the ozone density is 1 here")
+    ozone_width: float = num_field(30e3, 1.0, 1e7, "m: the ozone density falls to 0 this / 2 above and below "
+                                   "ozone_altitude")
+    ground_albedo: tuple = vec_field((0.3, 0.3, 0.3), 3, "non-negative", "the Lambertian ground's albedo, each "
+                                     "at most 1")
+    sun_color: tuple = vec_field((1.033, 1.079, 1.124), 3, "non-negative", "the sun's colour above the "
+                                 "atmosphere in Sun.color units (the default puts a noon sun, 68° high, where "
+                                 ":func:`atmos.lighting.sky_light` puts it, so exposure and the scenes lit by "
+                                 "Sun.color stay as they were)")
+    sun_intensity: float = num_field(4.0 * math.pi, 0.0, 1e6, "the irradiance one unit of Sun.color stands for, "
+                                     "as :class:`~atmos.plugins.clouds.CloudSettings` ``.sun_intensity`` (the "
+                                     "same 4π: the sky and the clouds see one sun)")
+    multiple_scattering: float = num_field(1.0, 0.0, 1.0, "the weight of Hillaire's multiple-scattering term "
+                                           "(1: the model; 0: single scattering only)")
 
     def __post_init__(self):
-        o = _OWNER
-        checked = dict(
-            planet_radius=check_num(o, "planet_radius", self.planet_radius, 1e3, 1e9),
-            atmosphere_height=check_num(o, "atmosphere_height", self.atmosphere_height, 100.0, 1e7),
-            rayleigh_scattering=check_vec(o, "rayleigh_scattering", self.rayleigh_scattering, 3, "non-negative"),
-            rayleigh_scale_height=check_num(o, "rayleigh_scale_height", self.rayleigh_scale_height, 1.0, 1e7),
-            mie_scattering=check_vec(o, "mie_scattering", self.mie_scattering, 3, "non-negative"),
-            mie_absorption=check_vec(o, "mie_absorption", self.mie_absorption, 3, "non-negative"),
-            mie_scale_height=check_num(o, "mie_scale_height", self.mie_scale_height, 1.0, 1e7),
-            mie_g=check_num(o, "mie_g", self.mie_g, -0.99, 0.99),
-            ozone_absorption=check_vec(o, "ozone_absorption", self.ozone_absorption, 3, "non-negative"),
-            ozone_altitude=check_num(o, "ozone_altitude", self.ozone_altitude, 0.0, 1e7),
-            ozone_width=check_num(o, "ozone_width", self.ozone_width, 1.0, 1e7),
-            ground_albedo=check_vec(o, "ground_albedo", self.ground_albedo, 3, "non-negative"),
-            sun_color=check_vec(o, "sun_color", self.sun_color, 3, "non-negative"),
-            sun_intensity=check_num(o, "sun_intensity", self.sun_intensity, 0.0, 1e6),
-            multiple_scattering=check_num(o, "multiple_scattering", self.multiple_scattering, 0.0, 1.0),
-        )
-        if max(checked["ground_albedo"]) > 1.0:
-            raise ValueError(f"{o}.ground_albedo must be 3 numbers in [0, 1], got {self.ground_albedo!r}")
+        """The declared checks, then the upper bounds of ground_albedo and of the coefficients."""
+        given = {name: getattr(self, name) for name in ("ground_albedo", "rayleigh_scattering", "mie_scattering",
+                                                        "mie_absorption", "ozone_absorption")}  # for the messages
+        super().__post_init__()
+        o = type(self).__name__
+        if max(self.ground_albedo) > 1.0:
+            raise ValueError(f"{o}.ground_albedo must be 3 numbers in [0, 1], got {given['ground_albedo']!r}")
         for name in ("rayleigh_scattering", "mie_scattering", "mie_absorption", "ozone_absorption"):
-            if max(checked[name]) > 1e-2:
+            if max(getattr(self, name)) > 1e-2:
                 raise ValueError(f"{o}.{name} must be 3 coefficients in [0, 0.01] per metre (Earth's are "
-                                 f"~1e-6..1e-5), got {getattr(self, name)!r}")
-        self.store(checked)
+                                 f"~1e-6..1e-5), got {given[name]!r}")
 
     @property
     def top_radius(self) -> float:

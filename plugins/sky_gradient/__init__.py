@@ -1,7 +1,7 @@
 """A cheap analytic sky: horizon-to-zenith gradient, a sun disc and glow. Draws the whole background."""
 from dataclasses import dataclass
 
-from atmos.checks import CheckedSettings, check_vec
+from atmos.checks import CheckedSettings, vec_field
 from atmos.graph import FullscreenPass, PassContext
 from atmos.scene_uniforms import set_scene_uniforms
 from atmos.plugin import Plugin
@@ -10,16 +10,10 @@ from atmos.render_core import DEPTH, where_nothing_was_drawn
 
 @dataclass(frozen=True)
 class SkyGradientSettings(CheckedSettings):
-    """Sky colours (linear HDR, non-negative): ``zenith`` overhead, ``horizon`` at eye level,
-    ``ground`` below it. All live."""
-    zenith: tuple = (0.15, 0.35, 0.8)
-    horizon: tuple = (0.75, 0.85, 1.0)
-    ground: tuple = (0.35, 0.33, 0.3)
-
-    def __post_init__(self):
-        o = "SkyGradientSettings"
-        self.store({name: check_vec(o, name, getattr(self, name), 3, "non-negative")
-                    for name in ("zenith", "horizon", "ground")})
+    """The gradient's sky colours, linear HDR (all live)."""
+    zenith: tuple = vec_field((0.15, 0.35, 0.8), 3, "non-negative", "overhead")
+    horizon: tuple = vec_field((0.75, 0.85, 1.0), 3, "non-negative", "at eye level")
+    ground: tuple = vec_field((0.35, 0.33, 0.3), 3, "non-negative", "below the horizon")
 
 
 class SkyGradientPass(FullscreenPass):

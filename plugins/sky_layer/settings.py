@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from atmos.checks import CheckedSettings, check_bool, check_int, check_num, check_vec
+from atmos.checks import CheckedSettings, bool_field, check_vec, int_field, num_field, vec_field
 
 _OWNER = "SkyLayerSettings"
 MIN_GAP = 1e-3          # sharpness − emptiness must be at least this (the remap divides by it)
@@ -14,28 +14,35 @@ TEXTURE_SETTINGS = ("size", "base_frequency", "seed", "light_step")   # changing
 
 @dataclass(frozen=True)
 class SkyLayerSettings(CheckedSettings):
-    """Look (emptiness, sharpness, thickness, colours), placement (altitude, tile_size) and motion (wind).
+    """Look (emptiness, sharpness, thickness, colours), placement (altitude, tile_size) and motion (wind)
+    of the 2D cloud layer (all live; changing size, base_frequency, seed or light_step re-bakes the
+    octave textures). Octave k has ``base_frequency · 2^k`` noise cells across one tile of
+    ``tile_size`` metres. ``wind`` is checked by hand (not in the list below):
 
-    Octave k has ``base_frequency · 2^k`` noise cells across one tile of ``tile_size`` metres.
+    ``wind`` = DEFAULT_WIND: 4 × (x, z) tiles per second, octave 0 (lowest frequency) first.
     """
 
-    emptiness: float = 0.4            # fbm at or below this is clear sky
-    sharpness: float = 0.6            # fbm at or above this is full cloud
-    thickness: float = 1.5            # opacity per unit of light-march amount
-    color: tuple = (0.42, 0.45, 0.52)       # shadowed (thick) cloud colour
-    lit_color: tuple = (0.85, 0.85, 0.85)   # sunlit (thin) cloud colour
-    altitude: float = 1500.0          # metres
-    tile_size: float = 4000.0         # metres one texture repeat covers
-    horizon_fade: float = 0.12        # the layer fades in over view-ray heights 0..horizon_fade
-    wind: tuple = DEFAULT_WIND        # 4 × (x, z) tiles per second, octave 0 (lowest frequency) first
-    size: int = 256                   # octave texture resolution (texels per side), 16..2048
-    base_frequency: int = 4           # noise cells across a tile at octave 0, 1..64
-    seed: int = 0
-    light_step: float = 0.01          # tiles between the four light-march samples toward the sun
-    rebake_tolerance: float = 0.05    # re-bake when the sun moved the light step by this fraction, 0..1
-    animate: bool = True              # scroll with the App clock (False: frozen at time 0)
+    emptiness: float = num_field(0.4, 0.0, 1.0, "fbm at or below this is clear sky")
+    sharpness: float = num_field(0.6, 0.0, 1.0, f"fbm at or above this is full cloud; at least emptiness + {MIN_GAP}")
+    thickness: float = num_field(1.5, 0.0, doc="opacity per unit of light-march amount")
+    color: tuple = vec_field((0.42, 0.45, 0.52), 3, "non-negative", "shadowed (thick) cloud colour")
+    lit_color: tuple = vec_field((0.85, 0.85, 0.85), 3, "non-negative", "sunlit (thin) cloud colour")
+    altitude: float = num_field(1500.0, doc="metres: the layer is the plane y = this")
+    tile_size: float = num_field(4000.0, 0.0, doc="metres one texture repeat covers", lo_open=True)
+    horizon_fade: float = num_field(0.12, 0.0, 1.0, "the layer fades in over view-ray heights 0..this",
+                                    lo_open=True)
+    wind: tuple = DEFAULT_WIND
+    size: int = int_field(256, 16, 2048, "octave texture resolution (texels per side)")
+    base_frequency: int = int_field(4, 1, 64, "noise cells across a tile at octave 0")
+    seed: int = int_field(0, 0, 2**32 - 1, "the noise's seed")
+    light_step: float = num_field(0.01, 0.0, 0.25, "tiles between the four light-march samples toward the sun")
+    rebake_tolerance: float = num_field(0.05, 0.0, 1.0, "re-bake when the sun moved the light step by this "
+                                        "fraction")
+    animate: bool = bool_field(True, "scroll with the App clock (False: frozen at time 0)")
 
     def __post_init__(self):
+        given = self.emptiness, self.sharpness          # as given, for the message
+        super().__post_init__()
         o = _OWNER
         try:
             wind = tuple(check_vec(o, f"wind[{k}]", w, 2) for k, w in enumerate(self.wind))
@@ -43,27 +50,10 @@ class SkyLayerSettings(CheckedSettings):
             wind = ()
         if len(wind) != 4:
             raise ValueError(f"{o}.wind must be 4 (x, z) pairs in tiles per second, got {self.wind!r}")
-        checked = dict(
-            emptiness=check_num(o, "emptiness", self.emptiness, 0.0, 1.0),
-            sharpness=check_num(o, "sharpness", self.sharpness, 0.0, 1.0),
-            thickness=check_num(o, "thickness", self.thickness, 0.0),
-            color=check_vec(o, "color", self.color, 3, "non-negative"),
-            lit_color=check_vec(o, "lit_color", self.lit_color, 3, "non-negative"),
-            altitude=check_num(o, "altitude", self.altitude),
-            tile_size=check_num(o, "tile_size", self.tile_size, 0.0, lo_open=True),
-            horizon_fade=check_num(o, "horizon_fade", self.horizon_fade, 0.0, 1.0, lo_open=True),
-            wind=wind,
-            size=check_int(o, "size", self.size, 16, 2048),
-            base_frequency=check_int(o, "base_frequency", self.base_frequency, 1, 64),
-            seed=check_int(o, "seed", self.seed, 0, 2**32 - 1),
-            light_step=check_num(o, "light_step", self.light_step, 0.0, 0.25),
-            rebake_tolerance=check_num(o, "rebake_tolerance", self.rebake_tolerance, 0.0, 1.0),
-            animate=check_bool(o, "animate", self.animate),
-        )
-        if checked["sharpness"] - checked["emptiness"] < MIN_GAP:
+        if self.sharpness - self.emptiness < MIN_GAP:
             raise ValueError(f"{o}.sharpness must exceed emptiness by at least {MIN_GAP} "
-                             f"(got emptiness={self.emptiness!r}, sharpness={self.sharpness!r})")
-        self.store(checked)
+                             f"(got emptiness={given[0]!r}, sharpness={given[1]!r})")
+        self.store(dict(wind=wind))
 
     def texture_key(self) -> tuple:
         """The settings the baked octave textures depend on."""

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from atmos.checks import CheckedSettings, check_int, check_num
+from atmos.checks import CheckedSettings, int_field, num_field
 from atmos.graph import PassContext
 from atmos.plugin import Plugin
 from atmos.plugins.terrain.heightfield import height, heightfield, triangle_count
@@ -12,17 +12,10 @@ from atmos.render_core import OpaquePass
 
 @dataclass(frozen=True)
 class TerrainSettings(CheckedSettings):
-    """A ``size`` metre square of ``cells``² quads (2 triangles each; 71 → 10,082) with ``relief``
-    metre hills. All live: a change re-makes the mesh on the next frame."""
-    size: float = 256.0
-    cells: int = 71
-    relief: float = 30.0
-
-    def __post_init__(self):
-        o = "TerrainSettings"
-        self.store(dict(size=check_num(o, "size", self.size, 0.0, lo_open=True),
-                        cells=check_int(o, "cells", self.cells, 1, 1024),
-                        relief=check_num(o, "relief", self.relief)))
+    """A square heightfield of hills (all live: a change re-makes the mesh on the next frame)."""
+    size: float = num_field(256.0, 0.0, doc="metres along each side of the square", lo_open=True)
+    cells: int = int_field(71, 1, 1024, "quads along each side, cells² in all (2 triangles each; 71 → 10,082)")
+    relief: float = num_field(30.0, doc="metres: the hills' height scale")
 
     def mesh_key(self) -> tuple:
         return self.size, self.cells, self.relief

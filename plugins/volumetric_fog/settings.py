@@ -3,57 +3,36 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from atmos.checks import CheckedSettings, check_bool, check_int, check_num, check_vec
+from atmos.checks import CheckedSettings, bool_field, int_field, num_field, vec_field
 
 MAX_OCTAVES = 16
 MAX_STEPS = 1024
 MAX_LIGHT_STEPS = 32
-_OWNER = "VolumetricFogSettings"
 
 
 @dataclass(frozen=True)
 class VolumetricFogSettings(CheckedSettings):
-    """The FBM medium, the march and the colours (world units are metres, y is up).
+    """The FBM medium, the march and the colours (world units are metres, y is up; all live).
 
     density(p) = bias − falloff·‖(p − center)/scale‖ + fbm(frequency·(p − center − wind·t), octaves);
     extinction per metre = absorption · density where density > 0.
     """
 
-    center: tuple = (0.0, 0.0, 0.0)
-    scale: tuple = (2.0, 0.5, 2.0)             # stretches the envelope per axis
-    bias: float = 0.1
-    falloff: float = 0.05                      # 0: an unbounded medium (march to max_distance)
-    frequency: float = 0.15                    # noise cells per metre at the first octave
-    octaves: int = 6                           # 1..16
-    seed: int = 0
-    wind: tuple = (1.5, 0.0, 0.5)              # metres per second the noise drifts
-    absorption: float = 0.12                   # extinction per metre at density 1
-    steps: int = 48                            # 1..1024 view-ray samples
-    light_steps: int = 4                       # 0..32 samples toward the sun
-    light_step: float = 3.0                    # metres between light samples
-    max_distance: float = 400.0
-    ambient: tuple = (0.45, 0.52, 0.62)        # ambient radiance the fog scatters
-    scattering: tuple = (1.0, 0.7, 0.4)        # colour of scattered sunlight (times the sun colour)
-    animate: bool = True                       # drift with the App clock (False: frozen at time 0)
-
-    def __post_init__(self):
-        o = _OWNER
-        checked = dict(
-            center=check_vec(o, "center", self.center, 3),
-            scale=check_vec(o, "scale", self.scale, 3, "positive"),
-            wind=check_vec(o, "wind", self.wind, 3),
-            ambient=check_vec(o, "ambient", self.ambient, 3, "non-negative"),
-            scattering=check_vec(o, "scattering", self.scattering, 3, "non-negative"),
-            bias=check_num(o, "bias", self.bias),
-            falloff=check_num(o, "falloff", self.falloff, 0.0),
-            frequency=check_num(o, "frequency", self.frequency, 0.0, lo_open=True),
-            absorption=check_num(o, "absorption", self.absorption, 0.0),
-            light_step=check_num(o, "light_step", self.light_step, 0.0, lo_open=True),
-            max_distance=check_num(o, "max_distance", self.max_distance, 0.0, lo_open=True),
-            octaves=check_int(o, "octaves", self.octaves, 1, MAX_OCTAVES),
-            steps=check_int(o, "steps", self.steps, 1, MAX_STEPS),
-            light_steps=check_int(o, "light_steps", self.light_steps, 0, MAX_LIGHT_STEPS),
-            seed=check_int(o, "seed", self.seed, 0, 2**32 - 1),
-            animate=check_bool(o, "animate", self.animate),
-        )
-        self.store(checked)
+    center: tuple = vec_field((0.0, 0.0, 0.0), 3, doc="m, the centre of the medium's envelope")
+    scale: tuple = vec_field((2.0, 0.5, 2.0), 3, "positive", "stretches the envelope per axis")
+    bias: float = num_field(0.1, doc="the envelope's density at the centre (the noise is added to it)")
+    falloff: float = num_field(0.05, 0.0, doc="density lost per unit of scaled distance from the centre "
+                               "(0: an unbounded medium, marched to max_distance)")
+    frequency: float = num_field(0.15, 0.0, doc="noise cells per metre at the first octave", lo_open=True)
+    octaves: int = int_field(6, 1, MAX_OCTAVES, "FBM octaves")
+    seed: int = int_field(0, 0, 2**32 - 1, "the noise's seed")
+    wind: tuple = vec_field((1.5, 0.0, 0.5), 3, doc="metres per second the noise drifts")
+    absorption: float = num_field(0.12, 0.0, doc="extinction per metre at density 1")
+    steps: int = int_field(48, 1, MAX_STEPS, "view-ray samples")
+    light_steps: int = int_field(4, 0, MAX_LIGHT_STEPS, "samples toward the sun")
+    light_step: float = num_field(3.0, 0.0, doc="metres between light samples", lo_open=True)
+    max_distance: float = num_field(400.0, 0.0, doc="m, the farthest the view ray is marched", lo_open=True)
+    ambient: tuple = vec_field((0.45, 0.52, 0.62), 3, "non-negative", "ambient radiance the fog scatters")
+    scattering: tuple = vec_field((1.0, 0.7, 0.4), 3, "non-negative", "colour of scattered sunlight (times "
+                                  "the sun colour)")
+    animate: bool = bool_field(True, "drift with the App clock (False: frozen at time 0)")

@@ -11,7 +11,7 @@ boundaries (no light enters from outside, ``A k / (2k + 1)``, k = 2D / h), the f
 face flux 3 D_face Q1. The result (phi, F): collided fluence phi and flux F = -D grad phi + 3 D Q1
 (``numpy.gradient``'s differences), |F| clamped to phi. The renderers' radiance from it toward a
 view ray d is max(phi - 3 g F.d, -cos 2 H phi, 0) / 4pi (cos = d . sun, H the phase's
-:func:`~atmos.plugins.clouds.light.medium.hemisphere_share`): against the sun never below what a lit surface sends
+:attr:`atmos.phase.Phase.hemisphere_share`): against the sun never below what a lit surface sends
 back, its outward hemisphere's light phi / 2pi scattered outward (the truncated P1 fell to 0 against the
 flux at a lit surface; bench_cloud_light "sun behind", cumulus: no floor -17.8 %, -cos phi -9.1 %, now
 +3.5 %).
@@ -33,10 +33,10 @@ from atmos.slicing import SliceTask
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.graph import TextureDesc
 import atmos.plugins.clouds.light.grid as grid
-from atmos.plugins.clouds.light.medium import hemisphere_share, mean_cosine
+from atmos.phase import Phase
 from atmos.plugins.clouds.light.reference import multilinear
 from atmos.plugins.clouds.light.shear_warp import check_volume_texture, groups, program
-from atmos.gpu.uniforms import bind_textures, write_uniforms
+from atmos.gpu.uniforms import bind_buffers, bind_images, bind_textures, write_uniforms
 
 FLOOR = 1e-3               # 1/m: transport extinction floor (empty cells still conduct, finitely)
 TOLERANCE = 1e-4           # relative residual |b - A phi| / |b| the GPU solve stops at
@@ -194,9 +194,9 @@ def diffusion_radiance(field_volume, uvw, dirs, lobes, sun_dir) -> np.ndarray:
 def field_radiance(values, dirs, lobes, sun_dir) -> np.ndarray:
     """max(phi - 3 g F.d, -cos 2 H phi, 0) / 4pi of field values ``values`` (..., 4) = (phi, F) for view
     rays ``dirs`` (unit; cos = d . ``sun_dir``, unit, toward the sun), ``lobes`` = (g, g2, w) the phase's
-    (g its mean cosine, H its :func:`~atmos.plugins.clouds.light.medium.hemisphere_share`): against the sun never below
+    (g its mean cosine, H its :attr:`~atmos.phase.Phase.hemisphere_share`): against the sun never below
     what a lit surface sends back, its outward hemisphere's light phi / 2pi scattered outward."""
-    g, share = mean_cosine(*lobes), hemisphere_share(*lobes)
+    g, share = Phase(*lobes).mean_cosine, Phase(*lobes).hemisphere_share
     v, d = np.asarray(values, np.float64), np.asarray(dirs, np.float64)
     c = (d * np.asarray(sun_dir, np.float64)).sum(-1)
     p1 = v[..., 0] - 3 * g * (v[..., 1:] * d).sum(-1)
@@ -238,9 +238,7 @@ class DiffusionSolver:
         """Stages 2 and 3 (the iteration) run indirect: no groups once converged."""
         prog = program(self.gpu, "diffusion")
         write_uniforms(prog, values, stage=stage, cur=self._cur, first=int(self._first))
-        self._cells.bind_to_storage_buffer(0)
-        self._parts.bind_to_storage_buffer(1)
-        self._args.bind_to_storage_buffer(2)
+        bind_buffers(prog, Cells=self._cells, Parts=self._parts, Args=self._args)
         if stage in (2, 3):
             prog.run_indirect(self._args)
         else:
@@ -278,7 +276,7 @@ class DiffusionSolver:
         if size != self.field_shape or getattr(target, "components", 0) != 4 or getattr(target, "dtype", "") != "f2":
             raise ValueError(f"target must be a 4-component f2 3D texture of size {self.field_shape} "
                              f"(diffusion_desc); got {target!r}")
-        target.bind_to_image(0, read=False, write=True)
+        bind_images(program(self.gpu, "diffusion"), target=target)
         self._dispatch(4)
 
     def solve(self, density, transmittance, target, *medium, iterations: int = ITERATIONS, warm: bool = True) -> None:
@@ -365,7 +363,7 @@ def field_medium(cloud_settings, sun_dir) -> tuple:
     """(sigma_t, albedo, g_mean, cell_size, sun_dir): what :meth:`DiffusionSolver.begin` takes, from a
     ``CloudSettings`` medium."""
     s = cloud_settings
-    return (float(s.sigma_t), float(s.albedo), mean_cosine(s.phase_g, s.phase_g2, s.phase_w),
+    return (float(s.sigma_t), float(s.albedo), s.phase.mean_cosine,
             tuple(s.cell_size), tuple(float(v) for v in sun_dir))
 
 

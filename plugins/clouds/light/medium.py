@@ -4,7 +4,7 @@ The medium (``CloudSettings``): density ``rho(x)`` from the volume ``[x, y, z]``
 :mod:`atmos.plugins.clouds.volume.layout`, trilinear between cell centres; extinction ``sigma_t * rho``
 (``sigma_t`` in 1/m at density 1; cells need not be cubes: optical depth is measured along world
 paths, so the thesis's per-cell sigma is derived, :func:`cell_sigma`); scattering
-``albedo * sigma_t * rho``; phase function ``(1 - phase_w) HG(phase_g) + phase_w HG(phase_g2)``
+``albedo * sigma_t * rho``; phase function ``settings.phase`` (:class:`atmos.phase.Phase`)
 (Henyey-Greenstein lobes normalised over the sphere, 1/sr).
 
 The light: sun irradiance ``E = sun_intensity * Sun.color`` (on a plane facing the sun; the colour
@@ -70,19 +70,6 @@ def environment(settings, sun_color, sky, sun_dir) -> tuple[np.ndarray, np.ndarr
     return e, l_sky, settings.ground_albedo * (e * up / math.pi + l_sky)
 
 
-def hemisphere_share(g: float, g2: float, w: float) -> float:
-    """The two-lobe phase's share of the light scattered into a direction d that came from the
-    hemisphere about d: per HG lobe (1 - g²) / 2g (1 / (1 - g) - 1 / sqrt(1 + g²)) (1/2 at g = 0)."""
-    def lobe(g):
-        return 0.5 + 0.375 * g if abs(g) < 1e-4 else (1 - g * g) / (2 * g) * (1 / (1 - g) - 1 / math.sqrt(1 + g * g))
-    return (1.0 - w) * lobe(g) + w * lobe(g2)
-
-
-def mean_cosine(g: float, g2: float, w: float) -> float:
-    """The two-lobe phase function's mean cosine ``(1 - w) g + w g2``."""
-    return (1.0 - w) * g + w * g2
-
-
 def octave_transmittances(T, a: float) -> np.ndarray:
     """(..., 4): the octaves' sun transmittances P_i of the module docstring at transmittance ``T``:
     light that reached the point forward-scattered k times on its way, k Poisson with mean
@@ -122,9 +109,9 @@ def source_reference(settings, render, T, tau_up, tau_down, cos, ray_y, sun_colo
         e = settings.sun_intensity * np.asarray(sun_colors, np.float64)
     tau_up, tau_down = np.asarray(tau_up, np.float64), np.asarray(tau_down, np.float64)
     a, b, c = render.ms_attenuation, render.ms_contribution, render.ms_eccentricity
-    g_mean = mean_cosine(settings.phase_g, settings.phase_g2, settings.phase_w)
+    g_mean = settings.phase.mean_cosine
     w = octave_weights(T, a, b) if octaves is None else np.asarray(octaves, np.float64) * b ** np.arange(OCTAVES)
-    sun = sum(w[..., i] * phase(cos, settings.phase_g * c ** i, settings.phase_g2 * c ** i, settings.phase_w)
+    sun = sum(w[..., i] * phase(cos, settings.phase.g * c ** i, settings.phase.g2 * c ** i, settings.phase.w)
               for i in range(OCTAVES))
     if diffusion is not None:
         sun = sun + render.ms_diffusion * np.asarray(diffusion, np.float64)

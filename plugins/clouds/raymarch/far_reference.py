@@ -79,7 +79,7 @@ def far_source(field: FarField, medium, settings, p, dirs, band, sun) -> np.ndar
     diffusion = None
     if field.field_profile is not None and settings.ms_diffusion > 0:       # the volume's field at this rank
         values = sample_profile(field.field_profile, c[:, 0], h01)
-        diffusion = field_radiance(values, dirs, (medium.phase_g, medium.phase_g2, medium.phase_w), sun_dir)
+        diffusion = field_radiance(values, dirs, medium.phase.lobes, sun_dir)
     return source_reference(medium, settings, None, up, down, dirs @ sun_dir, dirs[:, 1], sun_color, ambient, sun_dir,
                             diffusion, octaves=octaves, sun_colors=sun_source_at(by_height, h01))
 

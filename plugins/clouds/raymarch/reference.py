@@ -51,7 +51,7 @@ def march_reference(density, transmittance, medium, settings, layout, camera, su
     by_height, sun_color, ambient = layer_sun(sun, layout.heights)
     sun_dir = unit_direction(sun)
     column_tau = medium.sigma_t * cell[1]
-    lobes = (medium.phase_g, medium.phase_g2, medium.phase_w)
+    lobes = medium.phase.lobes
 
     def sample(i, p):
         uvw = (p - lo) / extent

@@ -20,9 +20,10 @@ from functools import cached_property
 
 import numpy as np
 
-from atmos.checks import (CheckedSettings, check_bool, check_choice, check_int, check_num, check_vec,
-                          is_int)
+from atmos.checks import (CheckedSettings, bool_field, check_int, choice_field, int_field, is_int, nested_field,
+                          num_field, vec_field)
 
+from atmos.phase import Phase
 from atmos.slicing import SlicedJob, SliceTask, TripleSet
 from atmos.graph import TextureDesc
 from atmos.plugins.clouds.automaton import CloudAutomaton
@@ -42,68 +43,63 @@ from atmos.plugins.clouds.weather import RegionVolume, VolumeOrigin, WeatherSett
 
 @dataclass(frozen=True)
 class CloudSettings(CheckedSettings):
-    """How the cloud chain is computed, and the weather it is computed from.
+    """How the cloud chain is computed, and the weather it is computed from. The medium and its light
+    are in physical units (:mod:`atmos.plugins.clouds.light.medium`); the thesis's per-cell sigma is
+    derived (:attr:`sigma`).
 
-    ``weather``: the :class:`WeatherSettings` (ellipsoids and probabilities; ``configure(weather=
-    {"cloud_density": 200})`` changes single fields of it). ``step_seconds``: weather time one
-    simulation step represents. ``layout``: automaton layout ("packed" or "cell").
-    ``density_dtype``: "f2" or "f4" smoothed density. ``radius`` (an int or three, 0..8) and
-    ``weights`` ("tent" or "box"): smoothing neighbourhood (eq. 2.11). ``band_height`` and
-    ``group_size``: density maps per height band and the sprite-group grid they are max-downsampled
-    to. ``smoothing_slices``: z ranges the smoothing and density maps are split into.
-    ``cover_threshold``: a column counts as covered when its summed density exceeds this (cells).
-    ``base_altitude``: world y of the volume's bottom (see :mod:`atmos.plugins.clouds.volume.layout`).
-    ``edge_fade`` (0..1): the renderers fade the density to 0 over this outer fraction of the
-    volume's half width, toward its inscribed circle (:mod:`atmos.plugins.clouds.volume.edge`; 0: the square).
-    The medium and its light (physical units, :mod:`atmos.plugins.clouds.light.medium`): ``sigma_t`` extinction
-    in 1/m at density 1 (the thesis's per-cell sigma is derived: :attr:`sigma`); ``albedo``
-    single-scattering albedo; ``phase_g``, ``phase_g2``, ``phase_w`` the two Henyey-Greenstein lobes
-    and the second's weight; ``sun_intensity`` (sun irradiance = this × ``Sun.color``),
-    ``sky_intensity`` (sky radiance = this × ``Sun.ambient``), ``ground_albedo`` (light from below).
-    Shading (thesis ch. 5): ``shading`` on or off;
-    ``scattering`` single or Harris multiple forward scattering (:class:`Scattering`, None: single);
-    ``shading_scale`` 1, 2 or 4 (full, half, quarter resolution); ``shading_slices_per_run``
-    light-space slices per job slice; ``cell_size`` the world size of a cell (x, y, z; each >= 0.001 m), so the sun
-    direction is taken into cell units (cells need not be cubes).
+    Live (the next step, or the next frame for placement and light): ``weather`` (but its
+    ``volume_shape``), ``step_seconds``, ``cover_threshold``, the medium and light fields,
+    ``scattering``, ``cell_size``, ``base_altitude``, ``edge_fade``. FIXED (they size the automaton,
+    the textures, the maps and the job's slices): the others.
 
-    Live (the next step, or the next frame for placement and light): ``weather`` (but its ``volume_shape``),
-    ``step_seconds``, ``cover_threshold``, the medium and light fields, ``scattering``, ``cell_size``,
-    ``base_altitude``, ``edge_fade``. FIXED (they size the automaton, the textures, the maps and the job's
-    slices): the others.
+    Checked by hand (not in the list below):
+
+    ``radius`` = (1, 1, 1): the smoothing neighbourhood (eq. 2.11), an int or three (rx, ry, rz), each 0..8.
+    ``group_size`` = (32, 32): cells per sprite group, the grid the density maps are max-downsampled
+    to, an int or two (group_x, group_z), each 1..4096.
+    ``smoothing_slices`` = 4: z ranges the smoothing and density maps are split into, 1..nz of
+    ``weather.volume_shape``.
+    ``scattering`` = None: single or Harris multiple forward scattering (a :class:`Scattering`; None:
+    single).
+    ``shading_scale`` = 1: the shading's resolution, 1, 2 or 4 (full, half, quarter).
     """
-    weather: WeatherSettings = WeatherSettings()
-    step_seconds: float = 1.0
-    layout: str = "packed"
-    density_dtype: str = "f2"
+    weather: WeatherSettings = nested_field(WeatherSettings(), "the ellipsoids and probabilities "
+                                            "(``configure(weather={\"cloud_density\": 200})`` changes single "
+                                            "fields of it)")
+    step_seconds: float = num_field(1.0, 0.0, doc="weather time one simulation step represents", lo_open=True)
+    layout: str = choice_field("packed", ("packed", "cell"), "the automaton's layout")
+    density_dtype: str = choice_field("f2", FORMATS, "the smoothed density's texture format")
     radius: tuple = (1, 1, 1)
-    weights: str = "tent"
-    band_height: int = 4
+    weights: str = choice_field("tent", WEIGHTS, "the smoothing's weights (eq. 2.11)")
+    band_height: int = int_field(4, 1, 4096, "height slices per band of the density maps")
     group_size: tuple = (32, 32)
     smoothing_slices: int = 4
-    cover_threshold: float = 0.5
-    shading: bool = True
-    sigma_t: float = 0.6
-    albedo: float = 1.0
-    phase_g: float = 0.85
-    phase_g2: float = -0.3
-    phase_w: float = 0.1
-    sun_intensity: float = 4.0 * math.pi
-    sky_intensity: float = 1.0
-    ground_albedo: float = 0.3
+    cover_threshold: float = num_field(0.5, 0.0, doc="a column counts as covered when its summed density "
+                                       "exceeds this (cells)")
+    shading: bool = bool_field(True, "the shading toward the sun (thesis ch. 5) on or off")
+    sigma_t: float = num_field(0.6, 0.0, doc="extinction in 1/m at density 1")
+    albedo: float = num_field(1.0, 0.0, 1.0, "single-scattering albedo")
+    phase: Phase = nested_field(Phase(0.85, -0.3, 0.1), "the cloud droplets' two-lobe phase function")
+    sun_intensity: float = num_field(4.0 * math.pi, 0.0, doc="sun irradiance = this × ``Sun.color``")
+    sky_intensity: float = num_field(1.0, 0.0, doc="sky radiance = this × ``Sun.ambient``")
+    ground_albedo: float = num_field(0.3, 0.0, 1.0, "the ground's albedo (light from below)")
     scattering: Scattering | None = None
     shading_scale: int = 1
-    shading_slices_per_run: int = 8
-    cell_size: tuple = (1.0, 1.0, 1.0)
-    base_altitude: float = 100.0
-    edge_fade: float = 0.0
+    shading_slices_per_run: int = int_field(8, 1, 4096, "light-space slices per job slice of the shading")
+    cell_size: tuple = vec_field((1.0, 1.0, 1.0), 3, "positive", "the world size of a cell (x, y, z; m), so the "
+                                 "sun direction is taken into cell units (cells need not be cubes)", lo=1e-3)
+    base_altitude: float = num_field(100.0, doc="world y of the volume's bottom "
+                                     "(:mod:`atmos.plugins.clouds.volume.layout`)")
+    edge_fade: float = num_field(0.0, 0.0, 1.0, "the renderers fade the density to 0 over this outer fraction of "
+                                 "the volume's half width, toward its inscribed circle "
+                                 "(:mod:`atmos.plugins.clouds.volume.edge`; 0: the square)")
 
     FIXED = ("layout", "density_dtype", "radius", "weights", "band_height", "group_size", "smoothing_slices",
              "shading", "shading_scale", "shading_slices_per_run")
 
     def __post_init__(self):
+        super().__post_init__()
         o = "CloudSettings"
-        if not isinstance(self.weather, WeatherSettings):
-            raise ValueError(f"{o}.weather must be a WeatherSettings, got {type(self.weather).__name__}")
         nz = self.weather.volume_shape[2]
         radius = (self.radius,) * 3 if is_int(self.radius) else self.radius
         group = (self.group_size,) * 2 if is_int(self.group_size) else self.group_size
@@ -123,29 +119,10 @@ class CloudSettings(CheckedSettings):
             raise ValueError(f"{o}.shading_scale must be 1, 2 or 4 (full, half, quarter resolution), "
                              f"got {self.shading_scale!r}") from None
         self.store(dict(
-            step_seconds=check_num(o, "step_seconds", self.step_seconds, 0.0, lo_open=True),
-            layout=check_choice(o, "layout", self.layout, ("packed", "cell")),
-            density_dtype=check_choice(o, "density_dtype", self.density_dtype, tuple(FORMATS)),
             radius=tuple(check_int(o, f"radius[{i}]", r, 0, 8) for i, r in enumerate(radius)),
-            weights=check_choice(o, "weights", self.weights, WEIGHTS),
-            band_height=check_int(o, "band_height", self.band_height, 1, 4096),
             group_size=tuple(check_int(o, f"group_size[{i}]", g, 1, 4096) for i, g in enumerate(group)),
             smoothing_slices=check_int(o, "smoothing_slices", self.smoothing_slices, 1, nz),
-            cover_threshold=check_num(o, "cover_threshold", self.cover_threshold, 0.0),
-            shading=check_bool(o, "shading", self.shading),
-            sigma_t=check_num(o, "sigma_t", self.sigma_t, 0.0),
-            albedo=check_num(o, "albedo", self.albedo, 0.0, 1.0),
-            phase_g=check_num(o, "phase_g", self.phase_g, -0.99, 0.99),
-            phase_g2=check_num(o, "phase_g2", self.phase_g2, -0.99, 0.99),
-            phase_w=check_num(o, "phase_w", self.phase_w, 0.0, 1.0),
-            sun_intensity=check_num(o, "sun_intensity", self.sun_intensity, 0.0),
-            sky_intensity=check_num(o, "sky_intensity", self.sky_intensity, 0.0),
-            ground_albedo=check_num(o, "ground_albedo", self.ground_albedo, 0.0, 1.0),
             shading_scale=shading_scale,
-            shading_slices_per_run=check_int(o, "shading_slices_per_run", self.shading_slices_per_run, 1, 4096),
-            cell_size=check_vec(o, "cell_size", self.cell_size, 3, "positive", lo=1e-3),   # metres; 0 gives NaN
-            base_altitude=check_num(o, "base_altitude", self.base_altitude),
-            edge_fade=check_num(o, "edge_fade", self.edge_fade, 0.0, 1.0),
         ))
 
     @cached_property

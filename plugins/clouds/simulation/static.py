@@ -57,7 +57,7 @@ class StaticClouds:
         sun = np.asarray(self.sun(), np.float64)
         s = self.settings
         wanted = self.demand.wanted()
-        key = (tuple(sun), s.sigma_t, s.scattering, tuple(s.cell_size), s.albedo, s.phase_g, s.phase_g2, s.phase_w,
+        key = (tuple(sun), s.sigma_t, s.scattering, tuple(s.cell_size), s.albedo, s.phase,
                wanted)
         if key == self._shaded:
             return

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from atmos.checks import CheckedSettings, check_num
+from atmos.checks import CheckedSettings, num_field
 from atmos.graph import FullscreenPass, PassContext
 from atmos.plugin import Plugin
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CloudSets
@@ -35,12 +35,8 @@ class CloudTopViewPass(FullscreenPass):
 
 @dataclass(frozen=True)
 class CloudTopViewSettings(CheckedSettings):
-    """``full_column``: the summed density (cells) drawn fully white, > 0. Live."""
-    full_column: float = 4.0
-
-    def __post_init__(self):
-        self.store(dict(full_column=check_num("CloudTopViewSettings", "full_column", self.full_column, 0.0,
-                                              lo_open=True)))
+    """How bright the top view draws the summed density (live)."""
+    full_column: float = num_field(4.0, 0.0, doc="the summed density (cells) drawn fully white", lo_open=True)
 
 
 class CloudTopViewPlugin(Plugin):

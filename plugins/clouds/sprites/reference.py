@@ -15,7 +15,8 @@ import numpy as np
 from atmos.plugins.clouds.volume.light import sun_source_at
 from atmos.plugins.clouds.sprites.particle import centre_tau, footprint, screen_axes
 from atmos.plugins.clouds.sprites.segments import unpack
-from atmos.plugins.clouds.light.medium import ambient_profile, mean_cosine, octave_weights
+from atmos.phase import Phase
+from atmos.plugins.clouds.light.medium import ambient_profile, octave_weights
 from atmos.plugins.clouds.light.columns import column_reference, columns_at
 from atmos.plugins.clouds.light.grid import SCALES
 from atmos.plugins.clouds.light.grid import shading_shape as grid_shape
@@ -134,7 +135,7 @@ def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, 
     spread = np.sqrt(cells_var + HAT_SPREAD)
     center = c + np.where(visible[:, None], mean, 0.5 * s[:, None])     # the block's centre of mass
     a_ms, b_ms, _ = light["ms_octaves"]
-    g_mean = mean_cosine(*light["phase_lobes"])
+    g_mean = Phase(*light["phase_lobes"]).mean_cosine
     uvw = center / shape
     uvw_a = (center + shift) / shape
     grid = None if trans_a is None else np.shape(trans_a)

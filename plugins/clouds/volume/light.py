@@ -3,13 +3,14 @@
 and the uniforms of J."""
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 
-from atmos.checks import CheckedSettings, check_num
+from atmos.checks import CheckedSettings, num_field
 from atmos.lighting import Sun
-from atmos.plugins.clouds.light.medium import environment, hemisphere_share
+from atmos.plugins.clouds.light.medium import environment
 
 DEFAULT_AMBIENT = (0.35, 0.47, 0.65)
 DEFAULT_OCTAVES = (0.25, 0.9525, 0.875)   # a, b, c of the octaves, fitted to the path tracer (bench_cloud_light --fit)
@@ -20,31 +21,31 @@ SUN_HEIGHTS = 5                           # volume.glsl's samples of the sun's c
 @dataclass(frozen=True)
 class CloudLightSettings(CheckedSettings):
     """The multiple-scattering octaves both cloud renderers share (the sprites' CloudRenderSettings
-    and the march's RaymarchCloudSettings inherit them): ``ms_attenuation`` a (the share of scatterings
-    that turn light aside: the octaves' Poisson mean (1 - a) tau), ``ms_contribution`` b (octave i's
-    weight b^i), ``ms_eccentricity`` c (its lobes c^i g), each in [0, 1] (:mod:`atmos.plugins.clouds.light.medium`);
-    ``ms_diffusion`` (0..2): the weight beta of the diffusion field, the light turned aside
-    (:mod:`atmos.plugins.clouds.light.diffusion`: J += sun_source beta max(phi - 3 g F.ray, -cos 2 H phi, 0) / 4pi, cos =
-    ray . sun); 0 turns the term off (and, with no other reader, the field's solve:
-    ``plugins/clouds/volume/field_demand.py``). The defaults are the search ``benchmarks/bench_cloud_light.py
-    --fit`` found against the path tracer on the bench's two volumes, scoring both renderers in the
-    goal's four views and a low sun (README "Cloud light"). The 2D far field is lit with the drawing
-    renderer's settings (``CloudFarFieldPlugin.light_settings``). A subclass's ``__post_init__`` stores
-    :meth:`light_checks` beside its own checks (alone, the class checks just these)."""
-    ms_attenuation: float = DEFAULT_OCTAVES[0]
-    ms_contribution: float = DEFAULT_OCTAVES[1]
-    ms_eccentricity: float = DEFAULT_OCTAVES[2]
-    ms_diffusion: float = DEFAULT_DIFFUSION
-
-    def __post_init__(self):
-        self.store(self.light_checks())
+    and the march's RaymarchCloudSettings inherit them; :mod:`atmos.plugins.clouds.light.medium`), and
+    the weight of the diffusion field beside them. The defaults are the search
+    ``benchmarks/bench_cloud_light.py --fit`` found against the path tracer on the bench's two volumes,
+    scoring both renderers in the goal's four views and a low sun (README "Cloud light"). The 2D far
+    field is lit with the drawing renderer's settings (``CloudFarFieldPlugin.light_settings``). A
+    subclass with its own ``__post_init__`` stores :meth:`light_checks` beside its own checks."""
+    ms_attenuation: float = num_field(DEFAULT_OCTAVES[0], 0.0, 1.0, "a: the share of scatterings that turn "
+                                      "light aside (the octaves' Poisson mean (1 - a) tau)")
+    ms_contribution: float = num_field(DEFAULT_OCTAVES[1], 0.0, 1.0, "b: octave i's weight b^i")
+    ms_eccentricity: float = num_field(DEFAULT_OCTAVES[2], 0.0, 1.0, "c: octave i's lobes c^i g")
+    ms_diffusion: float = num_field(DEFAULT_DIFFUSION, 0.0, 2.0, "the weight beta of the diffusion field, the "
+                                    "light turned aside (:mod:`atmos.plugins.clouds.light.diffusion`: J += "
+                                    "sun_source beta max(phi - 3 g F.ray, -cos 2 H phi, 0) / 4pi, cos = ray . sun); "
+                                    "0 turns the term off (and, with no other reader, the field's solve: "
+                                    "``plugins/clouds/volume/field_demand.py``)")
 
     def light_checks(self) -> dict:
-        """The checked octave fields, named after the concrete settings class."""
+        """The checked octave fields, named after the concrete settings class (what
+        ``CheckedSettings.__post_init__`` checks of them)."""
         o = type(self).__name__
-        return {**{name: check_num(o, name, getattr(self, name), 0.0, 1.0)
-                   for name in ("ms_attenuation", "ms_contribution", "ms_eccentricity")},
-                "ms_diffusion": check_num(o, "ms_diffusion", self.ms_diffusion, 0.0, 2.0)}
+        checked = {}
+        for f in dataclasses.fields(CloudLightSettings):
+            check, args = f.metadata["check"]
+            checked[f.name] = check(o, f.name, getattr(self, f.name), **args)
+        return checked
 
     @property
     def octaves(self) -> tuple:
@@ -126,8 +127,8 @@ def light_uniforms(cloud_settings, sun: Sun | None, octaves=DEFAULT_OCTAVES, dif
             "sky_source": tuple(float(v) for v in 0.5 * s.albedo * sky),
             "ground_source": tuple(float(v) for v in 0.5 * s.albedo * ground),
             "sun_dir": tuple(float(v) for v in direction),
-            "phase_lobes": (float(s.phase_g), float(s.phase_g2), float(s.phase_w)),
-            "outward_share": float(hemisphere_share(s.phase_g, s.phase_g2, s.phase_w)),
+            "phase_lobes": s.phase.lobes,
+            "outward_share": float(s.phase.hemisphere_share),
             "ms_octaves": tuple(float(v) for v in octaves),
             "column_tau": cell_tau(s),
             "ms_diffusion": float(diffusion)}
