@@ -63,6 +63,7 @@ def parser() -> argparse.ArgumentParser:
     graph = sub.add_parser("graph", help="print a demo's compiled render graph")
     graph.add_argument("name", nargs="?", default=DEFAULT_DEMO)
     graph.add_argument("--dot", action="store_true", help="Graphviz dot instead of text")
+    graph.add_argument("--png", metavar="PATH", help="also draw the frame to a PNG (passes by phase, resources, lifetimes)")
     _clouds_option(graph)
     return top
 
@@ -158,6 +159,9 @@ def cmd_graph(args, top) -> int:
                                                  haze=args.haze), gpu, start=False)
     try:
         print(app.graph.to_dot() if args.dot else app.graph.dump())
+        if args.png:
+            app.graph.picture(f"atmos graph {args.name}: one frame").save(args.png)
+            print(f"wrote {args.png}")
     finally:
         app.close()
         gpu.release()

@@ -50,6 +50,20 @@ def test_graph_text_and_dot(capsys):
     assert code == 0 and out.lstrip().startswith("digraph")
 
 
+def test_graph_picture_draws_a_band_per_phase_and_the_marks(capsys, tmp_path):
+    from atmos.graph.picture import BAND, CREATE, PAD, READ, WRITE
+    path = tmp_path / "frame.png"
+    code, out, _ = run(capsys, "graph", "sunset", "--png", str(path))
+    assert code == 0 and f"wrote {path}" in out
+    order = out.split("culled:")[0]
+    phases = [line.strip() for line in order.splitlines() if line.startswith("  [")]
+    image = np.asarray(Image.open(path).convert("RGB"))
+    edge = np.all(image[:, PAD + 2] == BAND, axis=-1)           # the phase headings' bands, top to bottom
+    assert int(np.count_nonzero(edge[1:] & ~edge[:-1])) == len(phases) == 8
+    colours = {tuple(c) for c in image.reshape(-1, 3)}
+    assert {CREATE, WRITE, READ} <= colours
+
+
 def test_graph_of_the_cloud_demo_runs_no_simulation(capsys, monkeypatch):
     from atmos.slicing import SlicedJob
 

@@ -172,6 +172,11 @@ class RenderGraph:
         """The compiled graph in Graphviz dot."""
         return dump_dot(self.compile())
 
+    def picture(self, title: str = ""):
+        """The compiled graph drawn as a PIL image (:mod:`atmos.graph.picture`)."""
+        from atmos.graph.picture import draw_frame      # Pillow only when a picture is asked for
+        return draw_frame(self.compile(), title)
+
     def release(self) -> None:
         """Release passes' GL objects, the pool's textures, cached framebuffers and timer queries.
 
