@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from atmos.checks import CheckedSettings, bool_field, check_shape, choice_field, int_field, num_field, vec_field
+from atmos.checks import CheckedSettings, bool_field, check_shape, choice_field, int_field, nested_field, num_field, vec_field
 from atmos.lighting import NIGHT_SKY
 from atmos.plugins.sky.atmosphere_settings import AtmosphereSettings
 from atmos.plugins.sky.preetham import TURBIDITY_RANGE, check_turbidity
@@ -15,10 +15,9 @@ MODELS = ("preetham", "physical")
 @dataclass(frozen=True)
 class SkySettings(CheckedSettings):
     """Look of the sky: the model, haze, brightness in the HDR pipeline, sun disc, night and stars
-    (all live). The sun disc, night and stars are the same for both models. Three fields are checked
+    (all live). The sun disc, night and stars are the same for both models. Two fields are checked
     by hand (not in the list below):
 
-    ``atmosphere`` = AtmosphereSettings(): the physical model's atmosphere (an :class:`AtmosphereSettings`).
     ``turbidity`` = 2.5: the Preetham sky's haze, a number in [2, 10] (2 clear .. 10 hazy).
     ``aerial_froxels`` = (32, 32, 64): the aerial perspective's froxel volume (width, height, slices;
     each 1..256) that the pixels read trilinearly, each froxel column's ray marched slice by slice out
@@ -31,7 +30,7 @@ class SkySettings(CheckedSettings):
                               "Hillaire 2020, a Rayleigh, Mie and ozone atmosphere (atmosphere), the sky plugin "
                               "then writing the Sun's colour and ambient from the same model every frame (see "
                               ":mod:`atmos.plugins.sky.sun_light`)")
-    atmosphere: AtmosphereSettings = AtmosphereSettings()
+    atmosphere: AtmosphereSettings = nested_field(AtmosphereSettings(), "the physical model's atmosphere")
     turbidity: float = 2.5
     scale: float = num_field(0.03, 0.0, 1e3, "HDR units per kcd/m² of Preetham luminance (0.03 puts a clear noon "
                              "zenith near 0.25, beside the sun colour ≈ 1 of sky_light)", lo_open=True)
@@ -57,8 +56,6 @@ class SkySettings(CheckedSettings):
     def __post_init__(self):
         super().__post_init__()
         o = _OWNER
-        if not isinstance(self.atmosphere, AtmosphereSettings):
-            raise ValueError(f"{o}.atmosphere must be an AtmosphereSettings, got {type(self.atmosphere).__name__}")
         try:
             turbidity = check_turbidity(self.turbidity)
         except ValueError:

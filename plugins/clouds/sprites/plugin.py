@@ -38,7 +38,7 @@ import moderngl
 import numpy as np
 
 from atmos.camera import Camera, camera_matrices
-from atmos.checks import check_bool, check_int, check_num
+from atmos.checks import bool_field, int_field, num_field
 from atmos.composition import CLOUD_DISTANCE, composition
 from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.plugin import Plugin
@@ -56,47 +56,31 @@ from atmos.gpu.uniforms import bind_textures, write_uniforms
 
 @dataclass(frozen=True)
 class CloudRenderSettings(CloudLightSettings):
-    """How the sprites are drawn (all live: a change shows on the next frame).
-
-    ``base_altitude``: world y of the layer's bottom (None: ``CloudSettings.base_altitude``; placement:
-    :mod:`atmos.plugins.clouds.volume.layout`). ``size_factor``:
-    sprite diameter in cells (>= 0.001): where the mass's Gaussian footprint is cut off (≥ ~3 holds
-    it and the image stays the same; smaller cuts it into a flatter disc). ``sigma``: extinction
-    per cell length at density 1 (None: the simulation's ``CloudSettings.sigma``). ``frustum_culling``
-    and ``empty_space_skipping`` switch the two culling tests; ``max_point_size`` caps sprite pixels
-    (None: the GL limit). ``downsample`` (1..8): draw the sprites off screen at 1/downsample of the
-    frame size and upsample them (:mod:`.offscreen`; 2 fills a quarter of the pixels; read by the
-    pass's ``setup`` every frame, so a change resizes the off-screen targets on the next frame).
-    ``lod_pixels``: level of detail — columns where a block of 2^L cells spans at most this many
-    target pixels are drawn one sprite per block (L ≤ 2, :mod:`.segments`); None: every cell.
-    ``ms_attenuation``, ``ms_contribution``, ``ms_eccentricity``: the multiple-scattering octaves, and
-    ``ms_diffusion`` the diffusion field's weight beside them, inherited from :class:`~atmos.plugins.clouds.volume.light.CloudLightSettings` (shared with the
-    ray-marched clouds). ``enabled`` False declares nothing (the pass is culled, allocates nothing).
-    """
-    base_altitude: float | None = None
-    size_factor: float = 3.0
-    sigma: float | None = None
-    frustum_culling: bool = True
-    empty_space_skipping: bool = True
-    max_point_size: float | None = None
-    downsample: int = 2
-    lod_pixels: float | None = None
-    enabled: bool = True
-
-    def __post_init__(self):
-        o = "CloudRenderSettings"
-        self.store(dict(
-            base_altitude=check_num(o, "base_altitude", self.base_altitude, optional=True),
-            size_factor=check_num(o, "size_factor", self.size_factor, 1e-3, 64.0),   # ~0: NaN sprites; 64 cells: a whole volume
-            sigma=check_num(o, "sigma", self.sigma, 0.0, optional=True),
-            frustum_culling=check_bool(o, "frustum_culling", self.frustum_culling),
-            empty_space_skipping=check_bool(o, "empty_space_skipping", self.empty_space_skipping),
-            max_point_size=check_num(o, "max_point_size", self.max_point_size, 1.0, optional=True),
-            downsample=check_int(o, "downsample", self.downsample, 1, MAX_DOWNSAMPLE),
-            lod_pixels=check_num(o, "lod_pixels", self.lod_pixels, 0.0, lo_open=True, optional=True),
-            enabled=check_bool(o, "enabled", self.enabled),
-            **self.light_checks(),
-        ))
+    """How the sprites are drawn (all live: a change shows on the next frame). The multiple-scattering
+    octaves ``ms_attenuation``, ``ms_contribution``, ``ms_eccentricity`` and the diffusion field's weight
+    ``ms_diffusion`` come first, inherited from :class:`~atmos.plugins.clouds.volume.light.CloudLightSettings`
+    (shared with the ray-marched clouds)."""
+    base_altitude: float | None = num_field(None, doc="world y of the layer's bottom (None: "
+                                            "``CloudSettings.base_altitude``; placement: "
+                                            ":mod:`atmos.plugins.clouds.volume.layout`)", optional=True)
+    size_factor: float = num_field(3.0, 1e-3, 64.0, "sprite diameter in cells: where the mass's Gaussian "
+                                   "footprint is cut off (≥ ~3 holds it and the image stays the same; smaller cuts "
+                                   "it into a flatter disc; ~0 gives NaN sprites, 64 cells a whole volume)")
+    sigma: float | None = num_field(None, 0.0, doc="extinction per cell length at density 1 (None: the "
+                                    "simulation's ``CloudSettings.sigma``)", optional=True)
+    frustum_culling: bool = bool_field(True, "skip columns outside the view frustum (:mod:`.segments`)")
+    empty_space_skipping: bool = bool_field(True, "skip columns and blocks the simulation's max maps show "
+                                            "empty (:mod:`.segments`)")
+    max_point_size: float | None = num_field(None, 1.0, doc="caps sprite pixels (None: the GL limit)",
+                                             optional=True)
+    downsample: int = int_field(2, 1, MAX_DOWNSAMPLE, "draw the sprites off screen at 1/downsample of the frame "
+                                "size and upsample them (:mod:`.offscreen`; 2 fills a quarter of the pixels; read "
+                                "by the pass's ``setup`` every frame, so a change resizes the off-screen targets "
+                                "on the next frame)")
+    lod_pixels: float | None = num_field(None, 0.0, doc="level of detail: columns where a block of 2^L cells "
+                                         "spans at most this many target pixels are drawn one sprite per block "
+                                         "(L ≤ 2, :mod:`.segments`); None: every cell", lo_open=True, optional=True)
+    enabled: bool = bool_field(True, "False declares nothing (the pass is culled, allocates nothing)")
 
 
 class CloudRenderPlugin(Plugin):

@@ -3,7 +3,6 @@
 and the uniforms of J."""
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,7 +25,8 @@ class CloudLightSettings(CheckedSettings):
     ``benchmarks/bench_cloud_light.py --fit`` found against the path tracer on the bench's two volumes,
     scoring both renderers in the goal's four views and a low sun (README "Cloud light"). The 2D far
     field is lit with the drawing renderer's settings (``CloudFarFieldPlugin.light_settings``). A
-    subclass with its own ``__post_init__`` stores :meth:`light_checks` beside its own checks."""
+    subclass declares its own fields after these four; ``CheckedSettings.__post_init__`` checks all of
+    them, naming the subclass."""
     ms_attenuation: float = num_field(DEFAULT_OCTAVES[0], 0.0, 1.0, "a: the share of scatterings that turn "
                                       "light aside (the octaves' Poisson mean (1 - a) tau)")
     ms_contribution: float = num_field(DEFAULT_OCTAVES[1], 0.0, 1.0, "b: octave i's weight b^i")
@@ -36,16 +36,6 @@ class CloudLightSettings(CheckedSettings):
                                     "sun_source beta max(phi - 3 g F.ray, -cos 2 H phi, 0) / 4pi, cos = ray . sun); "
                                     "0 turns the term off (and, with no other reader, the field's solve: "
                                     "``plugins/clouds/volume/field_demand.py``)")
-
-    def light_checks(self) -> dict:
-        """The checked octave fields, named after the concrete settings class (what
-        ``CheckedSettings.__post_init__`` checks of them)."""
-        o = type(self).__name__
-        checked = {}
-        for f in dataclasses.fields(CloudLightSettings):
-            check, args = f.metadata["check"]
-            checked[f.name] = check(o, f.name, getattr(self, f.name), **args)
-        return checked
 
     @property
     def octaves(self) -> tuple:
