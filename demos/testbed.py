@@ -1,4 +1,4 @@
-"""testbed: ground plane, sky gradient and an animated test volume through the sliced scheduler."""
+"""testbed: ground plane, sky gradient and an animated template volume through the sliced scheduler."""
 
 import numpy as np
 
@@ -8,7 +8,7 @@ from atmos.demo_registry import DemoSettings
 from atmos.lighting import Sun
 from atmos.plugins.ground import GroundPlugin
 from atmos.plugins.sky_gradient import SkyGradientPlugin
-from atmos.plugins.test_volume import TestVolumePlugin
+from atmos.plugins.template_volume import TemplateVolumePlugin
 
 TITLE = "ground, sky gradient and an animated volume updated over frames through three texture sets"
 DEFAULT_FRAMES = 90
@@ -24,7 +24,7 @@ def orbit_camera(app) -> None:
 def build(app, settings) -> None:
     app.insert_resource(Sun.from_angles(elevation_deg=35.0, azimuth_deg=40.0))
     app.add_plugins(DefaultPlugins(overlay=not settings.headless), SkyGradientPlugin(), GroundPlugin(),
-                    TestVolumePlugin())
+                    TemplateVolumePlugin())
     cam = app.resource(Camera)
     cam.position = np.array([20.0, 12.0, 30.0])
     cam.look_at((0.0, 6.0, 0.0))

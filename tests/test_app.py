@@ -100,5 +100,5 @@ def test_missing_resource_is_a_clear_error():
 def test_entry_point_discovery_finds_the_shipped_plugins():
     found = discover_plugins()
     assert {"ground", "sky_gradient", "overlay", "clouds", "cloud_render", "weather"} <= set(found)
-    assert "test_volume" not in found, "the testbed's template volume is not a shipped effect"
+    assert "template_volume" not in found, "the testbed's template volume is not a shipped effect"
     assert all(issubclass(cls, Plugin) for cls in found.values())

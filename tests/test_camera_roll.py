@@ -74,7 +74,7 @@ SCENES = {
     "sky_day": ("sky stars at night over the ground plane", night),
     "fog_valley": ("heterogeneous fog over terrain", None),
     "volumetric_fog": ("ray-marched volume (view_basis)", None),
-    "testbed": ("test volume, ground, sky gradient", None),
+    "testbed": ("template volume, ground, sky gradient", None),
     "sky_layer": ("2D cloud layer on the sky dome", None),
 }
 

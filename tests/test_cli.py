@@ -45,7 +45,7 @@ def test_info_into_a_closed_pipe_is_not_an_error():
 
 def test_graph_text_and_dot(capsys):
     code, out, _ = run(capsys, "graph", "testbed")
-    assert code == 0 and "present" in out and "test_volume" in out
+    assert code == 0 and "present" in out and "template_volume" in out
     code, out, _ = run(capsys, "graph", "testbed", "--dot")
     assert code == 0 and out.lstrip().startswith("digraph")
 

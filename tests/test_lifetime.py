@@ -110,12 +110,12 @@ class Half(Plugin):
         self.cleaned = False
 
     def build(self, app):
-        from atmos.plugins.test_volume import TestVolumePlugin
+        from atmos.plugins.template_volume import TemplateVolumePlugin
         app.add_system(lambda a: None, "update", label="half_system")
         app.graph.add_pass(HalfPass())
         app.graph.import_resource("half_import", object())
         app.insert_resource(HalfResource())
-        app.add_plugins(TestVolumePlugin(resolution=(8, 8, 8), slices=2))   # a plugin its build adds
+        app.add_plugins(TemplateVolumePlugin(resolution=(8, 8, 8), slices=2))   # a plugin its build adds
         if self.fail:
             raise ValueError("Half: bad build")
 

@@ -16,7 +16,7 @@ from atmos.plugins.light_shafts.plugin import MASK
 from atmos.plugins.sky import SkyPlugin
 from atmos.plugins.sky_gradient import SkyGradientPlugin
 from atmos.plugins.terrain import TerrainPlugin
-from atmos.plugins.test_volume import TestVolumePlugin, VolumeBox
+from atmos.plugins.template_volume import TemplateVolumePlugin, VolumeBox
 from atmos.render_core import COLOR, DEPTH, CapturePass
 from test_cloud_shadows import FillPass, pass_plugin, save_png
 from fullscreen_probe import run_fullscreen
@@ -333,7 +333,7 @@ def test_shafts_around_clouds_at_sunset_look_right():
     plugin = LightShaftsPlugin(params)
     app = App(gpu).add_plugins(DefaultPlugins(overlay=False),
                                SkyGradientPlugin(zenith=(0.06, 0.1, 0.25), horizon=(0.55, 0.4, 0.3)), GroundPlugin(),
-                               TestVolumePlugin(resolution=(32, 16, 32), slices=4, box=box), plugin, pass_plugin(probe))
+                               TemplateVolumePlugin(resolution=(32, 16, 32), slices=4, box=box), plugin, pass_plugin(probe))
     app.startup()
     cam = app.resource(Camera)
     cam.position = np.array([0.0, 3.0, 20.0])

@@ -48,7 +48,7 @@ from atmos.plugins.sky import SkyPlugin
 from atmos.plugins.sky_gradient import SkyGradientPlugin
 from atmos.plugins.sky_layer import SkyLayerPlugin
 from atmos.plugins.terrain import TerrainPlugin
-from atmos.plugins.test_volume import TestVolumePlugin, VolumeBox
+from atmos.plugins.template_volume import TemplateVolumePlugin, VolumeBox
 from atmos.plugins.volumetric_fog import VolumetricFogPlugin
 from atmos.plugins.clouds.weather import WeatherPlugin
 from atmos.plugins.clouds.light.scattering import Scattering
@@ -327,9 +327,9 @@ SPECS = {
                                                     "phase.g2", "phase.w", "sun_intensity")}},
         # fog_sun_share acts only with a FogPlugin (tests/test_light_shafts_fog.py renders it): the setting read
         observe={"downsample": resource_size(MASK), "fog_sun_share": lambda app, plugin: plugin.settings.fog_sun_share}),
-    "test_volume": Spec(
+    "template_volume": Spec(
         lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(),
-                 TestVolumePlugin(resolution=(16, 8, 16), slices=4, march_steps=24)], TestVolumePlugin,
+                 TemplateVolumePlugin(resolution=(16, 8, 16), slices=4, march_steps=24)], TemplateVolumePlugin,
         look((0.0, 8.0, 30.0), target=(0.0, 7.0, 0.0)),
         {"step_seconds": 1.0, "box.center": (4.0, 9.0, 2.0), "box.size": (10.0, 4.0, 20.0), "march_steps": 4},
         # the sliced job is paused: step_seconds drives the animation time of the next step it begins
@@ -573,8 +573,8 @@ REJECTED = [
     ("overlay", dict(visible="yes"), "OverlaySettings.visible must be True or False"),
     ("cloud_render", dict(size_factor=2.0, lod_pixels=0.0), "CloudRenderSettings.lod_pixels"),
     ("daylight", dict(latitude=95.0), "DaylightSettings.latitude must be a finite number >= -90.0 and <= 90.0"),
-    ("test_volume", dict(march_steps=8, resolution=(32, 8, 16)), "TestVolumeSettings.resolution cannot change"),
-    ("test_volume", dict(slices=2), "TestVolumeSettings.slices cannot change"),
+    ("template_volume", dict(march_steps=8, resolution=(32, 8, 16)), "TemplateVolumeSettings.resolution cannot change"),
+    ("template_volume", dict(slices=2), "TemplateVolumeSettings.slices cannot change"),
 ]
 
 
@@ -597,10 +597,10 @@ def test_a_rejected_change_raises_and_leaves_everything_as_it_was(scenes, name, 
 
 
 def test_fixed_settings_are_documented_and_refused_by_name():
-    plugin = TestVolumePlugin(resolution=(16, 8, 16), slices=4)
+    plugin = TemplateVolumePlugin(resolution=(16, 8, 16), slices=4)
     assert type(plugin.settings).FIXED == ("resolution", "slices")
     assert plugin.configure(resolution=(16, 8, 16)).resolution == (16, 8, 16)   # not a change
-    with pytest.raises(ValueError, match=r"TestVolumeSettings\.resolution, TestVolumeSettings\.slices cannot change"):
+    with pytest.raises(ValueError, match=r"TemplateVolumeSettings\.resolution, TemplateVolumeSettings\.slices cannot change"):
         plugin.configure(resolution=(8, 8, 8), slices=2)
 
 

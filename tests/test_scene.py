@@ -7,7 +7,7 @@ from atmos.defaults import DefaultPlugins
 from atmos.gpu import create_headless
 from atmos.plugins.ground import GroundPlugin
 from atmos.plugins.sky_gradient import SkyGradientPlugin
-from atmos.plugins.test_volume import TestVolumePlugin
+from atmos.plugins.template_volume import TemplateVolumePlugin
 
 
 def scene(gpu, *plugins):
@@ -20,21 +20,21 @@ def test_scene_without_an_effect_runs_compiles_and_allocates_none_of_it(fresh_gp
     app = scene(fresh_gpu)
     app.run_frames(3)
     dump = app.graph.dump()
-    assert "test_volume" not in dump
-    assert not any(f.startswith("test_volume/") for f in fresh_gpu.compiled_files)
+    assert "template_volume" not in dump
+    assert not any(f.startswith("template_volume/") for f in fresh_gpu.compiled_files)
     allocated = app.graph.pool.allocations
     app.close()
 
-    app = scene(fresh_gpu, TestVolumePlugin(resolution=(16, 8, 16), slices=4))
+    app = scene(fresh_gpu, TemplateVolumePlugin(resolution=(16, 8, 16), slices=4))
     app.run_frames(3)
-    assert "test_volume" in app.graph.dump()
-    assert {"test_volume/density.comp", "test_volume/march.frag"} <= fresh_gpu.compiled_files
+    assert "template_volume" in app.graph.dump()
+    assert {"template_volume/density.comp", "template_volume/march.frag"} <= fresh_gpu.compiled_files
     assert app.graph.pool.allocations >= allocated
     app.close()
 
 
 def test_long_run_allocates_nothing_per_frame(fresh_gpu):
-    app = scene(fresh_gpu, TestVolumePlugin(resolution=(16, 8, 16), slices=4))
+    app = scene(fresh_gpu, TemplateVolumePlugin(resolution=(16, 8, 16), slices=4))
     app.run_frames(5)
     pool, tracked, programs = app.graph.pool.allocations, len(fresh_gpu._tracked), len(fresh_gpu._programs)
     app.run_frames(200)
@@ -44,7 +44,7 @@ def test_long_run_allocates_nothing_per_frame(fresh_gpu):
 
 
 def test_volume_animates_through_the_three_sets(fresh_gpu):
-    plugin = TestVolumePlugin(resolution=(16, 8, 16), slices=4)
+    plugin = TemplateVolumePlugin(resolution=(16, 8, 16), slices=4)
     app = scene(fresh_gpu, plugin)
     seen = []
     for _ in range(12):

@@ -15,7 +15,7 @@ from atmos.plugins.ground import GroundPlugin
 from atmos.plugins.light_shafts import LightShaftsPlugin
 from atmos.plugins.sky_gradient import SkyGradientPlugin
 from atmos.plugins.sky_layer import SkyLayerPlugin
-from atmos.plugins.test_volume import TestVolumePlugin, VolumeBox
+from atmos.plugins.template_volume import TemplateVolumePlugin, VolumeBox
 from atmos.plugins.volumetric_fog import VolumetricFogPlugin
 from atmos.render_core import CapturePass
 from fullscreen_probe import run_fullscreen
@@ -157,7 +157,7 @@ def render_scene(size, near, far):
     try:
         app = App(gpu).add_plugins(
             DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(),
-            TestVolumePlugin(resolution=(16, 8, 16), slices=4, box=VolumeBox(center=(0.0, 6.0, -40.0))),
+            TemplateVolumePlugin(resolution=(16, 8, 16), slices=4, box=VolumeBox(center=(0.0, 6.0, -40.0))),
             VolumetricFogPlugin(center=(14.0, 1.0, -30.0), scale=(8.0, 2.0, 8.0), falloff=0.5, bias=0.3,
                                 animate=False),
             SkyLayerPlugin(size=16, animate=False), LightShaftsPlugin())
@@ -177,7 +177,7 @@ def render_scene(size, near, far):
 
 
 def test_scene_passes_at_near_0_1_far_1e10_match_an_ordinary_far_plane():
-    """Sky gradient, ground, test volume, volumetric fog, sky layer and light shafts with far/near =
+    """Sky gradient, ground, template volume, volumetric fog, sky layer and light shafts with far/near =
     1e11: finite, and the same picture as with far 2000 wherever both drew the same surface."""
     size = (96, 54)
     color, depth = render_scene(size, 0.1, 1e10)

@@ -1,10 +1,10 @@
-"""TestVolumePlugin: sliced density generation into three texture sets, and its ray-march pass."""
+"""TemplateVolumePlugin: sliced density generation into three texture sets, and its ray-march pass."""
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
 
-from atmos.checks import CheckedSettings, check_int, check_num, check_shape, check_vec
+from atmos.checks import CheckedSettings, check_int, check_shape, int_field, num_field, vec_field
 from atmos.slicing import SlicedJob, SliceTask, TripleSet
 from atmos.graph import FullscreenPass, PassContext, TextureDesc
 from atmos.scene_uniforms import set_scene_uniforms
@@ -12,55 +12,56 @@ from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
 from atmos.gpu.uniforms import bind_images, bind_textures
 
-TEST_VOLUME_SETS = "test_volume_sets"     # the imported (A, B, t) of the test volume's texture sets
+TEMPLATE_VOLUME_SETS = "template_volume_sets"     # the imported (A, B, t) of the template volume's texture sets
 
 
 @dataclass(frozen=True)
 class VolumeBox(CheckedSettings):
-    """Where the volume sits in the world: centre and full size in metres (y is up)."""
-    center: tuple = (0.0, 7.0, 0.0)
-    size: tuple = (28.0, 8.0, 28.0)
-
-    def __post_init__(self):
-        self.store(dict(center=check_vec("VolumeBox", "center", self.center, 3),
-                        size=check_vec("VolumeBox", "size", self.size, 3, "positive")))
+    """Where the volume sits in the world, in metres (y is up)."""
+    center: tuple = vec_field((0.0, 7.0, 0.0), 3, doc="the box's centre (x, y, z)")
+    size: tuple = vec_field((28.0, 8.0, 28.0), 3, "positive", "the box's full size (x, y, z)")
 
 
 @dataclass(frozen=True)
-class TestVolumeSettings(CheckedSettings):
-    """``resolution`` cells (x, y, z) and ``slices`` slices per step (a divisor of z) size the texture
-    sets and the sliced job: FIXED (``configure`` refuses them). Live: ``step_seconds`` animation
-    time per step, ``box`` (a :class:`VolumeBox`) where it is drawn, ``march_steps`` (1..1024, a
-    shader define: the pass fetches that program variant on the next frame)."""
+class TemplateVolumeSettings(CheckedSettings):
+    """The template volume: a sliced job fills its texture sets, a pass marches it. ``resolution`` and
+    ``slices`` size the texture sets and the job: FIXED (``configure`` refuses them); the others are live.
+
+    Checked by hand (not in the list below):
+
+    ``resolution`` = (64, 32, 64): cells (x, y, z) of the texture sets (three positive ints; fixed).
+    ``slices`` = 8: slices the job fills per step, a divisor of the z resolution (1..z; fixed).
+    ``box`` = VolumeBox(): where the volume is drawn (a :class:`VolumeBox`).
+    """
     __test__ = False  # not a pytest test class despite the name
     FIXED = ("resolution", "slices")
 
     resolution: tuple = (64, 32, 64)
     slices: int = 8
-    step_seconds: float = 0.25
+    step_seconds: float = num_field(0.25, 0.0, doc="animation time per step", lo_open=True)
     box: VolumeBox = VolumeBox()
-    march_steps: int = 48
+    march_steps: int = int_field(48, 1, 1024, "samples per ray, a shader define: the pass fetches that "
+                                 "program variant on the next frame")
 
     def __post_init__(self):
-        o = "TestVolumeSettings"
+        super().__post_init__()
+        o = "TemplateVolumeSettings"
         resolution = check_shape(self.resolution, f"{o}.resolution")
         slices = check_int(o, "slices", self.slices, 1, resolution[2])
         if resolution[2] % slices:
             raise ValueError(f"{o}.slices must divide the z resolution {resolution[2]}, got {self.slices!r}")
         if not isinstance(self.box, VolumeBox):
             raise ValueError(f"{o}.box must be a VolumeBox, got {self.box!r}")
-        self.store(dict(resolution=resolution, slices=slices,
-                        step_seconds=check_num(o, "step_seconds", self.step_seconds, 0.0, lo_open=True),
-                        march_steps=check_int(o, "march_steps", self.march_steps, 1, 1024)))
+        self.store(dict(resolution=resolution, slices=slices))
 
 
-class TestVolumePlugin(Plugin):
-    """``TestVolumePlugin(settings=None, **fields)`` with :class:`TestVolumeSettings`;
+class TemplateVolumePlugin(Plugin):
+    """``TemplateVolumePlugin(settings=None, **fields)`` with :class:`TemplateVolumeSettings`;
     ``configure(**changes)`` changes the live ones on the next frame."""
     __test__ = False  # not a pytest test class despite the name
-    settings_class = TestVolumeSettings
+    settings_class = TemplateVolumeSettings
 
-    def __init__(self, settings: TestVolumeSettings | None = None, **fields):
+    def __init__(self, settings: TemplateVolumeSettings | None = None, **fields):
         super().__init__(settings, **fields)
         self.triple = self.job = None
         self._time = 0.0
@@ -69,13 +70,13 @@ class TestVolumePlugin(Plugin):
         s = self.settings
         desc = TextureDesc(s.resolution, components=1, dtype="f2")
         self.triple = TripleSet(app.gpu, {"density": desc})
-        self.program = app.gpu.program(compute_shader="test_volume/density.comp")
-        self.job = SlicedJob("test_volume", [SliceTask("density", s.slices, self._fill_slice)],
+        self.program = app.gpu.program(compute_shader="template_volume/density.comp")
+        self.job = SlicedJob("template_volume", [SliceTask("density", s.slices, self._fill_slice)],
                              self.triple, begin=self._begin_step)
-        app.add_system(lambda app: self.job.prime(), "startup", label="test_volume_prime")
+        app.add_system(lambda app: self.job.prime(), "startup", label="template_volume_prime")
         app.frames.add(self.job)
-        app.graph.import_resource(TEST_VOLUME_SETS, self.job.view)
-        app.graph.add_pass(TestVolumePass(self))
+        app.graph.import_resource(TEMPLATE_VOLUME_SETS, self.job.view)
+        app.graph.add_pass(TemplateVolumePass(self))
 
     def _begin_step(self, step: int) -> None:
         self._time = step * self.settings.step_seconds
@@ -97,20 +98,20 @@ class TestVolumePlugin(Plugin):
             self.triple = None
 
 
-class TestVolumePass(FullscreenPass):
+class TemplateVolumePass(FullscreenPass):
     """Ray-marches mix(A, B, t) inside the box, occluded by scene depth, blended over the colour
     premultiplied (:meth:`PassContext.blend_over`): it covers the sky like a cloud."""
-    name = "test_volume"
+    name = "template_volume"
     phase = "translucent"
-    fragment = "test_volume/march.frag"
-    reads = (COLOR, DEPTH, TEST_VOLUME_SETS)
+    fragment = "template_volume/march.frag"
+    reads = (COLOR, DEPTH, TEMPLATE_VOLUME_SETS)
 
     def defines(self) -> dict:
         return {"MARCH_STEPS": self.plugin.settings.march_steps}
 
     def execute(self, frame: PassContext) -> None:
         p = self.program
-        a, b, t = frame.resource(TEST_VOLUME_SETS)
+        a, b, t = frame.resource(TEMPLATE_VOLUME_SETS)
         frame.framebuffer(color=[COLOR]).use()
         frame.blend_over()
         bind_textures(p, density_a=a["density"], density_b=b["density"], scene_depth=frame.resource(DEPTH))
