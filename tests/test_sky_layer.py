@@ -10,7 +10,7 @@ from atmos.defaults import DefaultPlugins
 from atmos.lighting import Sun
 from atmos.plugins.ground import GroundPlugin
 from atmos.plugins.sky_layer import SkyLayerSettings, SkyLayerPlugin, reference
-from atmos.plugins.sky_layer.octaves import OctaveTextures
+from atmos.tile_octaves import OctaveTextures
 from atmos.plugins.sky_layer.plugin import layer_light, scroll_offsets
 from atmos.render_core import CapturePass
 from atmos.gpu.uniforms import bind_buffers

@@ -12,10 +12,11 @@ from atmos.plugins.clouds.simulation.chain import CloudSettings, CloudSimulation
 from atmos.plugins.clouds.simulation.density_maps import DensityMaps
 from atmos.plugins.clouds.simulation.plugin import CloudsPlugin
 from atmos.plugins.clouds.simulation.smoothing import FORMATS, Smoother, read_volume, slice_range
-from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CloudSets
+from atmos.plugins.clouds.volume.column import column_uniforms
+from atmos.plugins.clouds.volume.sets import CLOUD_SETS, FAR_FIELD, CloudSets
 
-__all__ = ["CLOUD_SETS", "CloudSets", "CloudSettings", "CloudSimulation", "CloudSky", "CloudTopViewPlugin", "CloudsPlugin",
-           "DensityMaps", "FORMATS", "Smoother", "read_volume", "reference", "slice_range"]
+__all__ = ["CLOUD_SETS", "FAR_FIELD", "CloudSets", "CloudSettings", "CloudSimulation", "CloudSky", "CloudTopViewPlugin", "CloudsPlugin",
+           "DensityMaps", "FORMATS", "Smoother", "column_uniforms", "read_volume", "reference", "slice_range"]
 
 _LAZY = {"CloudSky": "atmos.plugins.clouds.presets", "CloudTopViewPlugin": "atmos.plugins.clouds.simulation.top_view"}
 

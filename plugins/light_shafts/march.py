@@ -11,9 +11,7 @@ from atmos.scene_uniforms import set_camera_uniforms
 from atmos.composition import CLOUD_DISTANCE
 from atmos.graph import PassBuilder, PassContext
 from atmos.lighting import unit_sun
-from atmos.plugins.clouds import CLOUD_SETS, CloudSets
-from atmos.plugins.clouds.far_field import FAR_FIELD
-from atmos.plugins.clouds.shadows import column_uniforms
+from atmos.plugins.clouds import CLOUD_SETS, FAR_FIELD, CloudSets, column_uniforms
 from atmos.offscreen import OffscreenLayer
 from atmos.plugins.light_shafts.settings import FLOAT32_MAX
 from atmos.render_core import COLOR, DEPTH

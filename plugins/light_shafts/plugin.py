@@ -6,8 +6,7 @@ import math
 
 from atmos.graph import PassBuilder, PassContext, RenderPass, TextureDesc
 from atmos.plugin import Plugin
-from atmos.plugins.clouds import CLOUD_SETS
-from atmos.plugins.clouds.far_field import FAR_FIELD
+from atmos.plugins.clouds import CLOUD_SETS, FAR_FIELD
 from atmos.plugins.fog import FogMedium
 from atmos.plugins.light_shafts.march import MarchedShafts
 from atmos.plugins.light_shafts.settings import LightShaftSettings, blur_scale

@@ -9,7 +9,7 @@ from atmos.lighting import Sun, sun_and_day
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
 from atmos.gpu.uniforms import bind_textures
-from atmos.plugins.sky_layer.octaves import OctaveTextures
+from atmos.tile_octaves import OctaveTextures
 from atmos.plugins.sky_layer.settings import SkyLayerSettings
 
 

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.plugins.sky_layer.octaves import WEIGHTS, light_shift, octave_key, tile_noise  # noqa: F401  (the GPU side's own)
+from atmos.tile_octaves import WEIGHTS, light_shift, octave_key, tile_noise  # noqa: F401  (the GPU side's own)
 
 RAY = np.array([0.0, 0.2, 0.4, 0.6])
 

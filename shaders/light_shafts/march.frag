@@ -3,7 +3,7 @@
 // low-res texel (the centre of its block) to the block's farthest scene depth (the sky: max_distance),
 // `steps` samples from a jittered start gather the sun light a thin haze scatters toward the eye,
 //   L = sum_i scattering * phase(cos) * E * exp(-tau_sun(p_i)) * exp(-scattering * s_i) * ds,
-// tau_sun through the clouds from the density maps (clouds/shadows/column.glsl; has_clouds 0: none;
+// tau_sun through the clouds from the density maps (clouds/volume/column.glsl; has_clouds 0: none;
 // with CLOUD_FAR_FIELD also the far field's columns beyond the volume: rays between far clouds).
 // Output (L, T = exp(-scattering * d)), upsampled by core/offscreen_composite.frag and blended
 // rgb = L + T * rgb. plugins/light_shafts/reference.py march_shafts is the same in numpy.
@@ -25,7 +25,7 @@
 #include "lib/hdr_max.glsl"
 #include "lib/view_ray.glsl"
 #include "lib/phase.glsl"
-#include "clouds/shadows/column.glsl"
+#include "clouds/volume/column.glsl"
 layout(binding = 2) uniform sampler2D low_depth;   // the farthest scene depth of each block
 uniform mat3 view_basis;       // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
 uniform vec3 camera_pos;

@@ -9,7 +9,7 @@ repeats nowhere), sized to the volume's clouds and thresholded to the simulation
 and lit by the cloud medium's own light model. References: :mod:`.reference`.
 """
 from atmos.plugins.clouds.far_field.settings import CloudFarFieldSettings
-from atmos.plugins.clouds.far_field.layer import FAR_FIELD
+from atmos.plugins.clouds.volume.sets import FAR_FIELD
 from atmos.plugins.clouds.far_field.plugin import CloudFarFieldPass, CloudFarFieldPlugin
 
 __all__ = ["FAR_FIELD", "CloudFarFieldSettings", "CloudFarFieldPlugin", "CloudFarFieldPass"]

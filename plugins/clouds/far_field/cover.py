@@ -23,7 +23,7 @@ from functools import lru_cache
 import numpy as np
 
 from atmos.plugins.clouds.far_field.pattern import PERIODS, octave_frequencies, octave_uv
-from atmos.plugins.sky_layer.octaves import OCTAVES, WEIGHTS, octave_key, tile_noise
+from atmos.tile_octaves import OCTAVES, WEIGHTS, octave_key, tile_noise
 
 QUANTILES = 33          # table entries: quantiles at 0, 1/32, ..., 1
 GRID = 256              # most texels per side of the octave textures the table is measured on

@@ -23,10 +23,9 @@ from atmos.plugins.clouds.far_field.pattern import CHANNEL_STEPS, PERIODS, octav
 from atmos.plugins.clouds.far_field.rank_light import RankLight
 from atmos.plugins.clouds.volume.light import cell_tau, light_uniforms
 from atmos.plugins.clouds.volume.sets import CloudSets
-from atmos.plugins.sky_layer.octaves import OctaveTextures
+from atmos.tile_octaves import OctaveTextures
 from atmos.gpu.uniforms import bind_buffers, bind_images, bind_textures, write_uniforms
 
-FAR_FIELD = "far_field"          # the imported graph resource
 REBAKE_TOLERANCE = 0.05          # re-bake the octaves when the sun moved the light step by this fraction
 MAX_HEIGHTS = 64                 # cover.comp's most height samples
 TILE_TIME = 5.0                  # s: the matched tile follows a change of the volume's with this time constant

@@ -7,7 +7,8 @@ from atmos.scene_uniforms import set_camera_uniforms
 from atmos.composition import CLOUD_DISTANCE, composition
 from atmos.graph import FullscreenPass, PassContext
 from atmos.plugin import Plugin
-from atmos.plugins.clouds.far_field.layer import FAR_FIELD, FarFieldLayer
+from atmos.plugins.clouds.far_field.layer import FarFieldLayer
+from atmos.plugins.clouds.volume.sets import FAR_FIELD
 from atmos.plugins.clouds.far_field.settings import CloudFarFieldSettings
 from atmos.plugins.clouds.volume.light import CloudLightSettings, light_uniforms
 from atmos.plugins.clouds.volume.field_demand import field_demand

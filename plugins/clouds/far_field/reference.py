@@ -200,7 +200,7 @@ def field_fbm(xz, octaves, offsets, tile_size: float, channel: int = 0, weight_b
     ``weight_bits``: filtered as a texture unit with that many bits of sub-texel weight would (:func:`.cover.sample`)."""
     from atmos.plugins.clouds.far_field.cover import sample
     from atmos.plugins.clouds.far_field.pattern import octave_uv
-    from atmos.plugins.sky_layer.octaves import WEIGHTS
+    from atmos.tile_octaves import WEIGHTS
     uv = octave_uv(xz, offsets, tile_size)
     return sum(w * sample(np.asarray(tex, np.float64)[..., channel], uv[k], weight_bits)
                for k, (w, tex) in enumerate(zip(WEIGHTS, octaves)))
@@ -276,6 +276,6 @@ def far_field_alpha(xz, dirs, height: float, octaves, offsets, tile_size: float,
 def far_optical_depth(xz, octaves, offsets, tile_size: float, quantiles, columns, column_tau: float) -> np.ndarray:
     """The far field's vertical optical depth (...,) at world ``xz`` (..., 2), mip 0: ``column_tau`` (optical
     depth per summed cell) × the volume's column sum at the point's rank (far.frag's tau.x; the ground
-    shadows' term beyond the volume, clouds/shadows/column.glsl)."""
+    shadows' term beyond the volume, clouds/volume/column.glsl)."""
     rank = field_rank(field_fbm(xz, octaves, offsets, tile_size), quantiles)
     return float(column_tau) * column_at_rank(rank, columns)

@@ -35,7 +35,7 @@ class CloudFarFieldSettings(CheckedSettings):
     horizon_fade: float = num_field(0.015, 0.0, 1.0, "it fades in while the view ray's height rises from 0 to "
                                     "this (sin of the elevation)", lo_open=True)
     size: int = int_field(256, 16, 2048, "the octave textures' size "
-                          "(:class:`atmos.plugins.sky_layer.octaves.OctaveTextures`; a change re-bakes them)")
+                          "(:class:`atmos.tile_octaves.OctaveTextures`; a change re-bakes them)")
     base_frequency: int = int_field(4, 1, 64, "the octave textures' base frequency (a change re-bakes them)")
     seed: int = int_field(0, 0, 2**32 - 1, "the octave textures' seed (a change re-bakes them)")
     light_step: float = num_field(0.01, 0.0, 0.25, "tiles: the relief's samples lie 2 of these toward the sun "

@@ -24,7 +24,7 @@ from atmos.scene_uniforms import set_camera_uniforms
 from atmos.composition import CLOUD_DISTANCE, composition, distance_desc
 from atmos.graph import PassBuilder, PassContext, RenderPass, TextureDesc
 from atmos.plugin import Plugin
-from atmos.plugins.clouds.far_field.layer import FAR_FIELD
+from atmos.plugins.clouds.volume.sets import FAR_FIELD
 from atmos.plugins.clouds.far_field.plugin import CloudFarFieldPlugin
 from atmos.plugins.clouds.raymarch.far import far_uniforms
 from atmos.plugins.clouds.raymarch.noise import pixel_angle

@@ -7,6 +7,6 @@ renderer's :class:`~atmos.plugins.clouds.volume.layout.CloudLayout`);
 """
 from atmos.plugins.clouds.shadows import reference
 from atmos.plugins.clouds.shadows.settings import CloudShadowSettings
-from atmos.plugins.clouds.shadows.plugin import CloudShadowsPass, CloudShadowsPlugin, cloud_layout, column_uniforms
+from atmos.plugins.clouds.shadows.plugin import CloudShadowsPass, CloudShadowsPlugin, cloud_layout
 
-__all__ = ["CloudShadowSettings", "CloudShadowsPass", "CloudShadowsPlugin", "cloud_layout", "column_uniforms", "reference"]
+__all__ = ["CloudShadowSettings", "CloudShadowsPass", "CloudShadowsPlugin", "cloud_layout", "reference"]

@@ -8,9 +8,10 @@ from atmos.graph import FullscreenPass, PassContext
 from atmos.lighting import unit_sun
 from atmos.plugin import Plugin
 from atmos.plugins.clouds.volume.layout import CloudLayout
-from atmos.plugins.clouds.far_field.layer import FAR_FIELD, column_tau
+from atmos.plugins.clouds.far_field.layer import column_tau
 from atmos.plugins.clouds.shadows.settings import CloudShadowSettings
-from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CloudSets
+from atmos.plugins.clouds.volume.column import column_uniforms
+from atmos.plugins.clouds.volume.sets import CLOUD_SETS, FAR_FIELD, CloudSets
 from atmos.render_core import COLOR, DEPTH
 from atmos.gpu.uniforms import bind_textures
 
@@ -29,18 +30,6 @@ def cloud_layout(sim, settings: CloudShadowSettings) -> CloudLayout:
     """The volume's world placement (``layout()`` of CloudSets or the CloudSimulation), with ``settings.base_altitude``
     and ``settings.cell_size`` where they are set."""
     return sim.layout(settings.base_altitude, settings.cell_size)
-
-
-def column_uniforms(program, sim: CloudSets, layout: CloudLayout, extinction: float) -> None:
-    """Bind mix(A, B, t)'s column sums and set the uniforms of shaders/clouds/shadows/column.glsl."""
-    bind_textures(program, sums_a=sim.maps_of(sim.a).sums, sums_b=sim.maps_of(sim.b).sums)
-    program["extinction"].value = extinction
-    program["t"].value = sim.t
-    program["a_shift"].value = sim.a_shift[0], sim.a_shift[2]
-    program["layer_min"].value = tuple(float(v) for v in layout.lo)
-    program["cell_size"].value = layout.cell
-    program["shape"].value = layout.shape
-    program["edge_fade"].value = float(sim.settings.edge_fade)
 
 
 class CloudShadowsPass(FullscreenPass):

@@ -54,7 +54,7 @@ def shadow_factor(points, sums_a, sums_b, t: float, sun_direction, weight: float
 def sun_optical_depth(points, sums_a, sums_b, t: float, sun_dir, extinction: float, layout: CloudLayout,
                       a_shift=(0, 0, 0), edge_fade: float = 0.0, far=None) -> np.ndarray:
     """Optical depth (...,) from world ``points`` (..., 3) toward the sun (``sun_dir`` unit, y > 0)
-    through the clouds: ``extinction · column · above`` (module docstring; shaders/clouds/shadows/column.glsl);
+    through the clouds: ``extinction · column · above`` (module docstring; shaders/clouds/volume/column.glsl);
     ``far``: None, or a function of world xz (..., 2) giving the far field's column optical depth there
     (``column_tau·strength·column_at_rank(rank)``, the column far.frag draws:
     :func:`atmos.plugins.clouds.far_field.reference.far_field_alpha`),

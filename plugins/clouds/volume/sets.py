@@ -10,6 +10,7 @@ from atmos.plugins.clouds.simulation.density_maps import DensityMaps
 from atmos.plugins.clouds.volume.layout import CloudLayout
 
 CLOUD_SETS = "cloud_sets"
+FAR_FIELD = "far_field"         # the cloud far field's layer (a FarFieldLayer), imported by CloudFarFieldPlugin
 CLOUD_VOLUME = "cloud volume"   # RenderPass.exclusive of the passes that draw the volume: one renderer a frame
 
 

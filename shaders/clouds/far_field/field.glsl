@@ -5,7 +5,7 @@
 // cover.py level_table, a blurred pattern ranked by its own quantiles), and far_quantile(r) the volume's
 // column sum at that rank (column_quantiles, cover.comp), so the far field is clouded as often, and as
 // thick per cover, as the volume. Shared by the far-field pass (far.frag), the ray march's volumetric
-// far field (clouds/raymarch/far.glsl) and the ground shadows and light shafts (clouds/shadows/column.glsl
+// far field (clouds/raymarch/far.glsl) and the ground shadows and light shafts (clouds/volume/column.glsl
 // with CLOUD_FAR_FIELD: field_column_tau × far_quantile); atmos/plugins/clouds/far_field/layer.py binds it.
 #include "sky_layer/layer.glsl"
 layout(binding = 5) uniform sampler2D octave0;

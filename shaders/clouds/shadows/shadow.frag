@@ -5,7 +5,7 @@
 // colour is multiplied by (blend ZERO, SRC_COLOR); plugins/clouds/shadows/reference.py is the same in numpy.
 #include "lib/view_ray.glsl"
 out vec4 frag;
-#include "clouds/shadows/column.glsl"
+#include "clouds/volume/column.glsl"
 layout(binding = 2) uniform sampler2D scene_depth;
 uniform mat3 view_basis;       // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
 uniform vec3 camera_pos;

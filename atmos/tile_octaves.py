@@ -1,4 +1,6 @@
-"""The four tileable octave textures of the cloud layer, baked on the GPU (``sky_layer/octave.comp``)."""
+"""Four tileable octave textures of 2D value noise, baked on the GPU (``core/tile_octave.comp``): the sky
+layer's clouds and the cloud far field's cover both stand on them. Channel c of a texel holds the
+noise ``steps[c]`` light steps toward the sun, so one fetch gives a short light march."""
 from __future__ import annotations
 
 import math
@@ -7,7 +9,6 @@ import moderngl
 import numpy as np
 
 from atmos.gpu.uniforms import bind_images, bind_textures
-from atmos.plugins.sky_layer.settings import SkyLayerSettings
 from atmos.value_noise import key, value_noise
 
 WEIGHTS = np.array([0.5, 0.25, 0.125, 0.0625])      # the octaves' fbm weights
@@ -20,7 +21,7 @@ def octave_key(seed: int, octave: int) -> int:
 
 def tile_noise(uv: np.ndarray, frequency: float, k) -> np.ndarray:
     """4D value noise on two circles of radius frequency/2π: periodic with period 1 in u and v
-    (what ``sky_layer/octaves.comp`` bakes; float64)."""
+    (what ``core/tile_octave.comp`` bakes; float64)."""
     a = 2 * np.pi * np.asarray(uv, np.float64)
     r = frequency / (2 * np.pi)
     x = r * np.stack([np.cos(a[..., 0]), np.sin(a[..., 0]), np.cos(a[..., 1]), np.sin(a[..., 1])], axis=-1)
@@ -49,15 +50,17 @@ class OctaveTextures:
         self.baked_for: tuple | None = None    # (texture settings, light shift) of the last bake
         self._program = None
 
-    def bake(self, settings: SkyLayerSettings, sun_dir, frequencies=None, shift_maps=None,
+    def bake(self, settings, sun_dir, frequencies=None, shift_maps=None,
              steps=(0.0, 1.0, 2.0, 3.0)) -> None:
         """Fill the textures for ``settings`` and the sun direction (re-allocating on a size change).
         ``frequencies`` (4,): cells across each texture (default base_frequency·2^k); ``shift_maps``
         (4, 2, 2): each texture's light shift is shift_maps[k] @ the sun's (default: the same for all);
-        ``steps`` (4,): the light steps toward the sun each channel holds the noise at."""
+        ``steps`` (4,): the light steps toward the sun each channel holds the noise at. ``settings``: any
+        with ``size``, ``base_frequency``, ``seed``, ``light_step`` and ``texture_key()`` (the sky
+        layer's and the far field's)."""
         ctx = self.gpu.ctx
         if self._program is None:
-            self._program = self.gpu.program(compute_shader="sky_layer/octave.comp")
+            self._program = self.gpu.program(compute_shader="core/tile_octave.comp")
         if not self.textures or self.textures[0].size != (settings.size, settings.size):
             self.release()
             for _ in range(OCTAVES):
@@ -83,7 +86,7 @@ class OctaveTextures:
         self.bakes += 1
         self.baked_for = (settings.texture_key(), tuple(shift))
 
-    def needs_bake(self, settings: SkyLayerSettings, sun_dir, tolerance: float) -> bool:
+    def needs_bake(self, settings, sun_dir, tolerance: float) -> bool:
         """True before the first bake, after a texture setting changed, or once the light shift moved by
         more than ``tolerance`` of a light step (the sun turned)."""
         if self.baked_for is None or self.baked_for[0] != settings.texture_key():

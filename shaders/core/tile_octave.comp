@@ -1,5 +1,5 @@
 #version 430
-// One seamlessly tiling octave of the 2D cloud layer (dynamic-2d-clouds-iq.txt): 4D value noise on two
+// One seamlessly tiling octave of 2D value noise (atmos/tile_octaves.py; dynamic-2d-clouds-iq.txt): 4D noise on two
 // circles, u -> (cos, sin)(2πu) and v -> (cos, sin)(2πv) of radius frequency/2π, so the texture repeats
 // with period 1 and has `frequency` noise cells across. Channel c holds the noise channel_steps[c]
 // light steps toward the sun (uv + channel_steps[c] * light_shift): one fetch gives all four samples
