@@ -1,9 +1,8 @@
 """atmos: real-time atmospheric effects for Python games and demo scenes.
 
-What a game or plugin author needs is importable from here::
+What a game or plugin author needs is importable from here, the effects included::
 
-    from atmos import App, DefaultPlugins, create_headless
-    from atmos.plugins.sky import SkyPlugin
+    from atmos import App, DefaultPlugins, SkyPlugin, CloudSky, TerrainPlugin, create_headless
 
 Names load on first use, so ``import atmos`` stays cheap.
 """
@@ -49,6 +48,18 @@ _EXPORTS = {
     # work spread over frames
     "TextureSet": "atmos.slicing", "TripleSet": "atmos.slicing", "SlicedJob": "atmos.slicing",
     "SliceTask": "atmos.slicing", "FrameScheduler": "atmos.slicing",
+    # the effects and game pieces (their own packages stay importable: atmos.plugins.<name>)
+    "CloudSky": "atmos.plugins.clouds", "CloudsPlugin": "atmos.plugins.clouds", "CloudSettings": "atmos.plugins.clouds",
+    "CloudRenderPlugin": "atmos.plugins.clouds.sprites", "RaymarchCloudsPlugin": "atmos.plugins.clouds.raymarch",
+    "CloudFarFieldPlugin": "atmos.plugins.clouds.far_field", "CloudShadowsPlugin": "atmos.plugins.clouds.shadows",
+    "WeatherPlugin": "atmos.plugins.clouds.weather", "DaylightPlugin": "atmos.plugins.daylight",
+    "DaylightSettings": "atmos.plugins.daylight", "TimeOfDay": "atmos.plugins.daylight",
+    "FogPlugin": "atmos.plugins.fog", "FogSettings": "atmos.plugins.fog",
+    "VolumetricFogPlugin": "atmos.plugins.volumetric_fog", "LightShaftsPlugin": "atmos.plugins.light_shafts",
+    "SkyGradientPlugin": "atmos.plugins.sky_gradient", "SkyLayerPlugin": "atmos.plugins.sky_layer",
+    "GroundPlugin": "atmos.plugins.ground", "TerrainPlugin": "atmos.plugins.terrain",
+    "TerrainSettings": "atmos.plugins.terrain", "MeshPlugin": "atmos.plugins.mesh", "Mesh": "atmos.plugins.mesh",
+    "MeshInstance": "atmos.plugins.mesh", "TextPlugin": "atmos.plugins.text", "Label": "atmos.plugins.text",
 }
 
 __all__ = sorted(_EXPORTS)

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import time
+import weakref
 
 import numpy as np
 
@@ -15,6 +16,9 @@ from atmos.render_core import LinearCapturePass
 from atmos.scene_view import SceneView
 from atmos.schedule import Schedule
 from atmos.world import World
+
+
+_OWNERS: "weakref.WeakKeyDictionary[Plugin, weakref.ref]" = weakref.WeakKeyDictionary()   # each plugin's App (weakly)
 
 
 class AppError(RuntimeError):
@@ -56,25 +60,43 @@ class App:
 
     # -- building --------------------------------------------------------------------------
     def add_plugins(self, *plugins: Plugin | PluginGroup) -> "App":
-        """Build plugins (and every plugin of a group) into this App, in order. A plugin whose
-        ``build`` raises is taken out again, with the systems, passes, imports, resources, jobs and
-        plugins it added (and its ``cleanup`` run), so a corrected one can be added after."""
+        """Build plugins (and every plugin of a group) into this App, in order; one call is all or
+        nothing: when a plugin is refused or its ``build`` raises, every plugin of the call is taken out
+        again, with the systems, passes, imports, resources and jobs they added (and their ``cleanup``
+        run), so a corrected call can follow. A plugin instance belongs to one App."""
         self._check_open("add_plugins")
         self._activate()
-        for item in plugins:
-            for plugin in (item if isinstance(item, PluginGroup) else [item]):
-                if not isinstance(plugin, Plugin):
-                    raise TypeError(f"add_plugins takes Plugin or PluginGroup instances, not {type(plugin).__name__}")
-                if any(type(p) is type(plugin) for p in self.plugins):
-                    raise ValueError(f"{plugin.name} was added twice; each plugin type may be added once")
-                mark = self._mark()
-                self.plugins.append(plugin)
-                try:
-                    plugin.build(self)
-                except BaseException as error:
-                    self._undo(mark, error)
-                    raise
+        mark = self._mark()
+        try:
+            for item in plugins:
+                for plugin in (item if isinstance(item, PluginGroup) else [item]):
+                    self._add_one(plugin)
+        except BaseException as error:
+            for plugin in self.plugins[mark[0]:]:
+                _OWNERS.pop(plugin, None)
+            self._undo(mark, error)
+            raise
         return self
+
+    def _add_one(self, plugin) -> None:
+        if not isinstance(plugin, Plugin):
+            raise TypeError(f"add_plugins takes Plugin or PluginGroup instances, not {type(plugin).__name__}")
+        if any(type(p) is type(plugin) for p in self.plugins):
+            raise ValueError(f"{plugin.name} was added twice; each plugin type may be added once")
+        owner = _OWNERS.get(plugin, lambda: None)()
+        if owner is not None and owner is not self:
+            raise ValueError(f"this {plugin.name} belongs to another App (it holds that App's GPU objects and "
+                             f"systems); make a new {plugin.name}(...) for this App")
+        self.plugins.append(plugin)
+        _OWNERS[plugin] = weakref.ref(self)
+        try:
+            plugin.build(self)
+        except AttributeError as error:
+            if self.graph is None and "'NoneType' object has no attribute" in str(error):
+                raise AppError(f"{plugin.name} draws with the GPU and this App has none: make it with a context, "
+                               f"App(atmos.create_headless()) or App(gpu) of a window (App() alone runs systems "
+                               f"only)") from error
+            raise
 
     def _mark(self) -> tuple:
         """What :meth:`_undo` needs to take a failed build out again."""

@@ -12,9 +12,9 @@ from atmos.transform import TransformPlugin
 class DefaultPlugins(PluginGroup):
     """RenderCorePlugin (clear + present), InputPlugin, CameraPlugin, TransformPlugin (interpolation
     between fixed steps), FlyCameraPlugin (WASD; ``fly_camera=False`` leaves it out) and OverlayPlugin
-    (the frame-time bars; ``overlay=False`` starts them hidden, F1 shows them)."""
+    (the frame-time bars: hidden unless ``overlay=True``; F1 shows and hides them)."""
 
-    def __init__(self, overlay: bool = True, fly_camera: bool = True):
+    def __init__(self, overlay: bool = False, fly_camera: bool = True):
         overlay, fly_camera = check_bool("DefaultPlugins", "overlay", overlay), check_bool("DefaultPlugins", "fly_camera", fly_camera)
         plugins = [RenderCorePlugin(), InputPlugin(), CameraPlugin(), TransformPlugin()]
         plugins += [FlyCameraPlugin()] if fly_camera else []

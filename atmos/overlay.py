@@ -29,7 +29,7 @@ class OverlaySettings(CheckedSettings):
 
     ``size`` = (256, 64): (width, height) of the graph in pixels, 1..4096 each (cut to the screen).
     """
-    visible: bool = bool_field(True, "draw the bars (the times are recorded either way)")
+    visible: bool = bool_field(False, "draw the bars (the times are recorded either way; F1 toggles them)")
     size: tuple = (256, 64)
 
     def __post_init__(self):

@@ -102,3 +102,52 @@ def test_entry_point_discovery_finds_the_shipped_plugins():
     assert {"ground", "sky_gradient", "overlay", "clouds", "cloud_render", "weather"} <= set(found)
     assert "template_volume" not in found, "the testbed's template volume is not a shipped effect"
     assert all(issubclass(cls, Plugin) for cls in found.values())
+
+
+class Counts(Plugin):
+    """Adds a system and a resource, so what a failed call leaves behind shows."""
+
+    def build(self, app):
+        app.add_system(lambda app: None, label=f"count_{id(self)}")
+        app.insert_resource(self)
+
+
+class Refuses(Plugin):
+    def build(self, app):
+        raise ValueError("refused on purpose")
+
+
+def test_one_add_plugins_call_is_all_or_nothing():
+    app = App()
+    systems = len(app.schedule.systems)
+    with pytest.raises(ValueError, match="refused on purpose"):
+        app.add_plugins(Counts(), Refuses())
+    assert app.plugins == [] and len(app.schedule.systems) == systems and Counts not in app.resources
+    with pytest.raises(ValueError, match="added twice"):
+        app.add_plugins(Counts(), Counts())                   # the second is refused: the first goes too
+    assert app.plugins == []
+    app.add_plugins(Counts())                                 # a corrected call works
+    assert len(app.plugins) == 1
+    app.close()
+
+
+def test_a_plugin_belongs_to_one_app_and_an_app_without_a_gpu_says_what_it_needs():
+    first, second = App(), App()
+    plugin = Counts()
+    first.add_plugins(plugin)
+    with pytest.raises(ValueError, match="this Counts belongs to another App"):
+        second.add_plugins(plugin)
+    assert second.plugins == []
+    from atmos.plugins.sky import SkyPlugin
+    from atmos.app import AppError
+    with pytest.raises(AppError, match=r"SkyPlugin draws with the GPU and this App has none.*create_headless"):
+        second.add_plugins(SkyPlugin())
+    assert second.plugins == []
+    first.close(), second.close()
+
+
+def test_default_plugins_hide_the_frame_time_overlay_until_asked():
+    from atmos.defaults import DefaultPlugins
+    from atmos.overlay import OverlayPlugin
+    assert DefaultPlugins().get(OverlayPlugin).settings.visible is False
+    assert DefaultPlugins(overlay=True).get(OverlayPlugin).settings.visible is True

@@ -1,4 +1,5 @@
 """The public API: every name a game or plugin author needs comes from ``atmos``; it is typed."""
+import importlib
 import importlib.resources
 import inspect
 import typing
@@ -19,6 +20,19 @@ def test_every_public_name_imports_from_atmos():
         assert needed in atmos.__all__
     with pytest.raises(AttributeError, match="no attribute 'Nope'"):
         atmos.Nope
+
+
+def test_the_effects_a_game_uses_come_from_atmos_and_load_on_first_use():
+    import subprocess
+    import sys
+    for name, module in (("SkyPlugin", "atmos.plugins.sky"), ("CloudSky", "atmos.plugins.clouds"),
+                         ("TerrainPlugin", "atmos.plugins.terrain"), ("FogPlugin", "atmos.plugins.fog"),
+                         ("MeshPlugin", "atmos.plugins.mesh"), ("Label", "atmos.plugins.text"),
+                         ("DaylightPlugin", "atmos.plugins.daylight"), ("VolumetricFogPlugin", "atmos.plugins.volumetric_fog")):
+        assert getattr(atmos, name) is getattr(importlib.import_module(module), name), name   # the documented path too
+    loaded = subprocess.run([sys.executable, "-c", "import atmos, sys; print(sorted(m for m in sys.modules "
+                             "if m.startswith('atmos.plugins')))"], capture_output=True, text=True, check=True)
+    assert loaded.stdout.strip() == "[]", "import atmos loaded effects before they were asked for"
 
 
 def test_the_package_is_typed_and_extension_points_have_annotations():
