@@ -49,6 +49,21 @@ def _out(text: str) -> str:
     return text
 
 
+_VALUED = ("--size", "--frames", "--seed")
+
+
+def _negative_values(argv: list[str]) -> list[str]:
+    """``--size -5x10`` as ``--size=-5x10``: argparse would take a value starting with '-' for an
+    option and say only "expected one argument"; joined, the option's own check names what is allowed."""
+    out = []
+    for token in argv:
+        if out and out[-1] in _VALUED and token[:1] == "-" and token[1:2].isdigit():
+            out[-1] = f"{out[-1]}={token}"
+        else:
+            out.append(token)
+    return out
+
+
 def parser() -> argparse.ArgumentParser:
     top = argparse.ArgumentParser(prog="atmos", description="Real-time atmospheric effects: demos and tools.")
     sub = top.add_subparsers(dest="command", metavar="{info,demo,run,graph}")
@@ -176,7 +191,7 @@ def main(argv: list[str] | None = None) -> int:
     from atmos.gpu import GpuError, ShaderError
     from atmos.output import OutputError
     top = parser()
-    args = top.parse_args(argv)
+    args = top.parse_args(_negative_values(sys.argv[1:] if argv is None else list(argv)))
     haze = getattr(args, "haze", "fog")
     conflict = haze_conflict(haze, getattr(args, "sky", "physical"))
     if conflict:

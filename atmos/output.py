@@ -7,6 +7,7 @@ with an error) deletes what this writer wrote and raises :class:`OutputError`.
 """
 from __future__ import annotations
 
+import io
 import os
 import tempfile
 from pathlib import Path
@@ -182,9 +183,14 @@ class FrameWriter:
         return "png" if self.kind in ("dir", "png") else self.kind
 
     def _write_png(self, frame: np.ndarray) -> Path:
-        import imageio.v2 as imageio
+        """The PNG encoded in memory, then written and closed here: a full disk is one OSError now (an
+        image library's writer left open would raise again when collected, as a stray traceback)."""
+        from PIL import Image
+        buffer = io.BytesIO()
+        Image.fromarray(np.ascontiguousarray(frame, np.uint8)).save(buffer, format="PNG")
         temp = self._temporary()
-        imageio.imwrite(temp, frame, format="PNG")
+        with open(temp, "wb") as file:
+            file.write(buffer.getbuffer())
         return temp
 
     def _complete(self, temp: Path, target: Path) -> None:

@@ -120,6 +120,8 @@ def test_headless_demo_writes_files(tmp_path, capsys, suffix):
     (["demo", "nosuch", "--headless"], "unknown demo 'nosuch'; available: "),
     (["demo", "--size", "big"], "'big' is not WxH"),
     (["demo", "--size", "0x10"], "between 1 and 16384"),
+    (["demo", "--size", "-5x10"], "argument --size: '-5x10': width and height must be between 1 and 16384"),
+    (["demo", "--frames", "-2"], "argument --frames: -2 is not allowed; give 1 or more"),
     (["demo", "--frames", "0"], "0 is not allowed; give 1 or more"),
     (["demo", "--frames", "many"], "'many' is not a whole number"),
     (["demo", "--seed", "-3"], "seeds are 0 .. 4294967295"),

@@ -74,3 +74,29 @@ def test_resize_to_zero_keeps_a_one_pixel_target(gpu, ctx):
     gpu.resize((0, 0))
     assert gpu.size == (1, 1) and gpu.read_pixels().shape == (1, 1, 3)
     gpu.resize(old)
+
+
+def test_a_frame_the_gpu_cannot_make_is_a_clear_error_and_the_old_frame_stays(monkeypatch):
+    """Out of GPU memory at a huge size shows as an incomplete framebuffer: a GpuError naming the size
+    (headless resize) or the pass, instead of moderngl's bare message; nothing is half-applied."""
+    import moderngl
+    from atmos.app import App
+    from atmos.defaults import DefaultPlugins
+    from atmos.gpu import create_headless
+    gpu = create_headless((32, 24))
+    try:
+        def incomplete(self, *args, **kwargs):
+            raise moderngl.Error("the framebuffer is not complete (INCOMPLETE_ATTACHMENT)")
+        with monkeypatch.context() as m:
+            m.setattr(moderngl.Context, "framebuffer", incomplete)
+            with pytest.raises(GpuError, match=r"could not make a 64x48 frame .*INCOMPLETE_ATTACHMENT.*smaller size"):
+                gpu.resize((64, 48))
+        assert gpu.size == (32, 24) and gpu.read_pixels().shape == (24, 32, 3)
+        app = App(gpu).add_plugins(DefaultPlugins())
+        with monkeypatch.context() as m:
+            m.setattr(moderngl.Context, "framebuffer", incomplete)
+            with pytest.raises(GpuError, match=r"pass '\w+': the GPU could not make a 32x24 framebuffer"):
+                app.run_frames(1)
+        app.close()
+    finally:
+        gpu.release()

@@ -159,3 +159,29 @@ def test_the_command_exits_non_zero_on_a_full_disk_and_says_why(tmp_path):
     assert "wrote" not in done.stdout and "Traceback" not in done.stderr
     assert f"atmos: writing {out} failed after" in done.stderr and "nothing was left behind" in done.stderr
     assert left_in(tmp_path) == []
+
+
+@pytest.mark.parametrize("name", ["still.png", "frames"])
+def test_a_full_disk_while_writing_pngs_leaves_no_writer_open(tmp_path, rng, monkeypatch, name):
+    """The PNG goes to /dev/full (every write fails with ENOSPC, as on a full disk): one OutputError,
+    and nothing raises again later when collected (an image writer left open did: a stray traceback)."""
+    from pathlib import Path
+    import gc
+
+    def full_disk(writer):
+        writer._temp = None                          # nothing of ours to delete
+        return Path("/dev/full")
+    monkeypatch.setattr(FrameWriter, "_temporary", full_disk)
+    unraisable, hook = [], sys.unraisablehook
+    sys.unraisablehook = unraisable.append
+    try:
+        writer = FrameWriter(tmp_path / name)
+        with pytest.raises(OutputError, match="No space left on device; nothing was left behind"):
+            for frame in noise(rng, n=2, size=(64, 48)):
+                writer.write(frame)
+            writer.close()
+        del writer
+        gc.collect()
+    finally:
+        sys.unraisablehook = hook
+    assert unraisable == [], [str(u.exc_value) for u in unraisable]

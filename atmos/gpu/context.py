@@ -189,15 +189,23 @@ class GpuContext:
         if size == self.size:
             return
         self.make_current()
-        self.size = size
-        if self.headless:
+        if self.headless:                 # the new target first: if the GPU cannot make it, the old one stays
+            made = []
+            try:
+                made.append(self.ctx.texture(size, 4))
+                made.append(self.ctx.depth_renderbuffer(size))
+                made.insert(0, self.ctx.framebuffer([made[0]], made[1]))
+            except moderngl.Error as error:
+                for obj in made:
+                    release_gl(obj)
+                raise GpuError(f"the GPU could not make a {size[0]}x{size[1]} frame ({error}): most likely out of "
+                               f"GPU memory; try a smaller size (this context allows up to {self.max_size} a side)") from None
             for obj in self._offscreen:
                 release_gl(obj)
-            color = self.ctx.texture(size, 4)
-            depth = self.ctx.depth_renderbuffer(size)
-            self.target = self.ctx.framebuffer([color], depth)
-            self._offscreen = [self.target, color, depth]
+            self.size = size
+            self.target, self._offscreen = made[0], made
         else:
+            self.size = size
             for obj in self._offscreen:          # the read_pixels copy of the old size
                 release_gl(obj)
             self._offscreen = []

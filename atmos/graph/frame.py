@@ -6,7 +6,7 @@ from collections import OrderedDict
 
 import moderngl
 
-from atmos.gpu.context import release_gl
+from atmos.gpu.context import GpuError, release_gl
 from atmos.graph.errors import GraphError
 
 FRAMEBUFFER_CACHE = 64  # framebuffers kept per graph, least recently used dropped first
@@ -86,7 +86,13 @@ class PassContext:
             return self._reset_framebuffer(entry[0])
         if entry is not None:
             self._drop(key)
-        fbo = self.gpu.ctx.framebuffer(attachments, depth_attachment)
+        try:
+            fbo = self.gpu.ctx.framebuffer(attachments, depth_attachment)
+        except moderngl.Error as error:
+            size = "x".join(map(str, (attachments or [depth_attachment])[0].size))
+            raise GpuError(f"pass '{self.pass_name}': the GPU could not make a {size} framebuffer of "
+                           f"{names + ([depth] if depth else [])} ({error}): most likely out of GPU memory at this "
+                           f"frame size; try a smaller one") from None
         # the cache holds the attachments too, so an id() in the key cannot be reused while cached
         self._framebuffers[key] = (fbo, attachments + ([depth_attachment] if depth_attachment else []))
         while len(self._framebuffers) > FRAMEBUFFER_CACHE:
