@@ -91,6 +91,10 @@ def _run_options(command, frames_default: str) -> None:
     command.add_argument("--seed", type=_seed, default=0, help="random seed (default 0)")
     command.add_argument("--out", type=_out, help="FILE.mp4, FILE.gif, FILE.png (last frame) or a folder of PNGs; "
                                                   "headless default: out/NAME.mp4")
+    command.add_argument("--shots", metavar="N,N,...", help="headless: write only these frame numbers (from 0), "
+                                                            "one PNG each into the --out folder")
+    command.add_argument("--script", metavar="FILE.py", help="play the game with FILE.py's step(app, frame), run "
+                                                             "first every frame (press keys through atmos.Input)")
     _clouds_option(command)
     command.add_argument("--quiet", action="store_true", help="no progress bar")
 
@@ -154,11 +158,13 @@ def _play(args, game, stem: str) -> int:
     settings = DemoSettings(size=args.size, seed=args.seed, frames=args.frames, clouds=args.clouds, sky=args.sky,
                             haze=args.haze, headless=args.headless or args.out is not None or problem is not None)   # as atmos.run
     if settings.headless:
-        out = args.out if args.out is not None else f"out/{stem}.mp4"
-        result = run_headless(game, settings, out, progress=not args.quiet)
+        out = args.out if args.out is not None else (f"out/{stem}/" if args.shots else f"out/{stem}.mp4")
+        result = run_headless(game, settings, out, progress=not args.quiet, script=args.script, shots=args.shots)
         print(f"wrote {result['written']} frames to {result['out']}")
     else:
-        run_window(game, settings)
+        if args.shots:
+            raise ValueError("--shots is for headless runs (add --headless)")
+        run_window(game, settings, script=args.script)
     return 0
 
 

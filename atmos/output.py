@@ -87,16 +87,40 @@ def check_output(path: str | Path) -> tuple[Path, str]:
     return path, kind
 
 
+def check_shots(shots, frames: int | None = None) -> tuple[int, ...] | None:
+    """``shots`` (frame numbers, from 0, or text such as "30,150,215") as sorted unique ints; each below
+    ``frames`` when given. None passes."""
+    if shots is None:
+        return None
+    items = shots.split(",") if isinstance(shots, str) else shots
+    try:
+        values = sorted({int(str(s).strip()) for s in items})
+    except (TypeError, ValueError):
+        raise ValueError(f"shots must be frame numbers such as 30,150,215; got {shots!r}") from None
+    if not values or values[0] < 0:
+        raise ValueError(f"shots must be frame numbers >= 0 (the first frame is 0); got {shots!r}")
+    if frames is not None and values[-1] >= frames:
+        raise ValueError(f"shot {values[-1]} is past the last frame ({frames} frames: 0..{frames - 1})")
+    return tuple(values)
+
+
 class FrameWriter:
     """Collects frames (uint8 RGB, top row first) into the file ``path`` names, never half-written
     (the module docstring): :meth:`close` completes the file, :meth:`abort` gives up and deletes what
-    was written. After either, writing is an OutputError."""
+    was written. After either, writing is an OutputError. ``shots`` (a folder only): the frame numbers
+    to keep, each written as ``frame_NNNNN.png`` by its number; the others are skipped unread."""
 
-    def __init__(self, path: str | Path, fps: float = 30.0):
-        folder = Path(path) if output_kind(path) == "dir" else Path(path).parent
+    def __init__(self, path: str | Path, fps: float = 30.0, shots=None):
+        kind = output_kind(path)
+        self.shots = check_shots(shots)
+        if self.shots is not None and kind != "dir":
+            raise OutputError(f"{path}: shots are written one PNG each, so the output must be a folder (end it "
+                              f"with a slash: frames/), not a .{kind} file")
+        folder = Path(path) if kind == "dir" else Path(path).parent
         self._new_folders = [f for f in (folder, *folder.parents) if not f.exists()]   # deepest first
         self.path, self.kind = check_output(path)
         self.fps = check_num("FrameWriter", "fps", fps, 0.0, 1000.0, lo_open=True)
+        self.frame_index = 0                      # frames offered so far (written or skipped)
         self.frames_written = 0
         self.state = "open"                       # then "done" (close) or "failed" (abort, an error)
         self._last: np.ndarray | None = None
@@ -104,12 +128,23 @@ class FrameWriter:
         self._temp: Path | None = None
         self._made: list[Path] = []               # a folder's PNGs written by this writer
 
+    def wants(self) -> bool:
+        """Whether the next frame is written (every frame, or the next one is a shot)."""
+        return self.shots is None or self.frame_index in self.shots
+
+    def skip(self) -> None:
+        """The next frame is not a shot: count it without reading it."""
+        self.frame_index += 1
+
     def write(self, frame: np.ndarray) -> None:
         if self.state != "open":
             raise OutputError(f"{self.path}: this writer is {self.state}; make a new FrameWriter")
+        if not self.wants():
+            self.skip()
+            return
         try:
             if self.kind == "dir":
-                name = self.path / f"frame_{self.frames_written:05d}.png"
+                name = self.path / f"frame_{self.frame_index:05d}.png"
                 self._complete(self._write_png(frame), name)
                 self._made.append(name)
             elif self.kind == "png":
@@ -121,6 +156,7 @@ class FrameWriter:
         except Exception as error:
             self._fail(error)
         self.frames_written += 1
+        self.frame_index += 1
 
     def close(self) -> None:
         """Complete the file (rename it into place); OutputError if that fails. Again: nothing."""
@@ -215,16 +251,20 @@ class EncodePass(RenderPass):
         builder.write(VIDEO)
 
     def execute(self, frame: PassContext) -> None:
-        self.writer.write(frame.gpu.read_pixels())
+        if self.writer.wants():
+            self.writer.write(frame.gpu.read_pixels())
+        else:
+            self.writer.skip()                    # not a shot: no read-back
 
 
 class OutputPlugin(Plugin):
-    """Records every rendered frame to ``path`` (see :func:`output_kind`), checked now (before anything
-    renders); ``App.close`` completes the file (a run that failed calls ``plugin.writer.abort()`` first)."""
+    """Records every rendered frame (or the ``shots``: :class:`FrameWriter`) to ``path`` (see
+    :func:`output_kind`), checked now (before anything renders); ``App.close`` completes the file (a run
+    that failed calls ``plugin.writer.abort()`` first)."""
 
-    def __init__(self, path: str | Path, fps: float = 30.0):
+    def __init__(self, path: str | Path, fps: float = 30.0, shots=None):
         super().__init__()
-        self.writer = FrameWriter(path, fps)
+        self.writer = FrameWriter(path, fps, shots)
 
     def build(self, app) -> None:
         app.graph.import_resource(VIDEO, self.writer)

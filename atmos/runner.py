@@ -95,14 +95,19 @@ def title_of(game) -> str:
     return getattr(module, "TITLE", None) or getattr(module, "__name__", "atmos")
 
 
-def build_app(name, settings: DemoSettings, gpu, *extra_plugins, start: bool = True) -> App:
+def build_app(name, settings: DemoSettings, gpu, *extra_plugins, start: bool = True, script=None) -> App:
     """A started App for ``name`` (a demo, a game file or module, a build function: :func:`load_game`)
     on ``gpu``, with ``extra_plugins`` added after the game's (``start=False``: built and finished,
-    but no system has run — no simulation warm-up)."""
+    but no system has run — no simulation warm-up); ``script``: :mod:`atmos.script`'s step, run first
+    every frame."""
+    from atmos.script import ScriptPlugin
     demo = load_game(name)
+    scripted = ScriptPlugin(script) if script is not None else None      # a bad script fails before the App
     app = App(gpu)
     app.insert_resource(settings)           # demos read it (headless runs script their camera)
     try:
+        if scripted is not None:
+            app.add_plugins(scripted)
         demo.build(app, settings)
         app.add_plugins(*extra_plugins)
         app.startup() if start else app.finish()
@@ -120,15 +125,20 @@ def _close_after(app: App, error: BaseException, note: str) -> None:
         error.add_note(f"{note}: {failure}")
 
 
-def run_headless(name, settings: DemoSettings, out: str | None, progress: bool = True) -> dict:
+def run_headless(name, settings: DemoSettings, out: str | None, progress: bool = True, script=None,
+                 shots=None) -> dict:
     """Render ``settings.frames`` frames of ``name`` (:func:`load_game`) at a fixed 1/30 s step; write
-    them to ``out`` if given."""
-    from atmos.output import OutputPlugin
+    them to ``out`` if given (only the frame numbers ``shots``, into a folder, when given); ``script``:
+    a scripted player (:mod:`atmos.script`)."""
+    from atmos.output import OutputPlugin, check_shots
     frames = settings.frames or getattr(load_game(name), "DEFAULT_FRAMES", 90)
-    output = OutputPlugin(out) if out is not None else None     # the path is checked here, before rendering
+    shots = check_shots(shots, frames)
+    if shots is not None and out is None:
+        raise ValueError("shots need an output folder to write them to (--out frames/)")
+    output = OutputPlugin(out, shots=shots) if out is not None else None   # the path is checked here, before rendering
     gpu = create_headless(settings.size)
     try:
-        app = build_app(name, settings, gpu, *([output] if output else []))
+        app = build_app(name, settings, gpu, *([output] if output else []), script=script)
     except Exception:
         gpu.release()
         raise
@@ -167,7 +177,7 @@ def _label(game) -> str:
     return f"demo {game}" if isinstance(game, str) and not game.endswith(".py") else str(getattr(game, "__name__", game))
 
 
-def run_window(name, settings: DemoSettings, title: str | None = None) -> None:
+def run_window(name, settings: DemoSettings, title: str | None = None, script=None) -> None:
     """``name`` (:func:`load_game`) in a window (:mod:`atmos.window`: ESC quits, F1 the overlay);
     the caption shows the frame times and the slowest passes."""
     from atmos.overlay import FrameTimes
@@ -180,12 +190,13 @@ def run_window(name, settings: DemoSettings, title: str | None = None) -> None:
         if times is not None and frame % 30 == 0:
             window.set_caption(f"{caption} — {times.summary()} — {slowest_passes(app)}")
 
-    window_loop(lambda gpu: build_app(name, settings, gpu), settings.size, caption, settings.frames, show_times)
+    window_loop(lambda gpu: build_app(name, settings, gpu, script=script), settings.size, caption, settings.frames,
+                show_times)
 
 
 def run(game, *, size: tuple[int, int] = (960, 540), title: str | None = None, headless: bool | None = None,
         frames: int | None = None, out: str | None = None, seed: int = 0, clouds: str = "sprites",
-        sky: str = "physical", haze: str = "fog", progress: bool = False) -> dict | None:
+        sky: str = "physical", haze: str = "fog", progress: bool = False, script=None, shots=None) -> dict | None:
     """Run a game: ``game`` is ``build(app, settings)`` (a function, a module that defines it, a path
     to a ``.py`` file, or a demo name). The App is made for you on a window's context (the window must
     exist before the GL context, so atmos makes both), or on a headless one when ``headless`` is True,
@@ -197,11 +208,16 @@ def run(game, *, size: tuple[int, int] = (960, 540), title: str | None = None, h
     ``sky``: "preetham" or "physical", like ``atmos demo --sky`` (the demos with a sky read it);
     ``haze``: "fog", "air" (the physical sky's aerial perspective) or "both", like ``atmos demo --haze``.
     Headless: ``frames`` frames (default the game's ``DEFAULT_FRAMES`` or 90) at 1/30 s, written to
-    ``out`` (``.mp4``, ``.gif``, ``.png`` or a folder) if given; returns what was written. Windowed:
-    until the window closes (or ``frames`` frames); returns None."""
+    ``out`` (``.mp4``, ``.gif``, ``.png`` or a folder) if given, only the frame numbers ``shots`` (into
+    a folder) when given; returns what was written. Windowed: until the window closes (or ``frames``
+    frames); returns None. ``script``: ``step(app, frame)`` or a ``.py`` file defining it, run first every
+    frame to play the game (:mod:`atmos.script`)."""
     from atmos.checks import check_choice
     from atmos.gpu.context import check_frame_size
     load_game(game)                                   # a bad game fails here, before any window
+    if script is not None:
+        from atmos.script import load_script
+        load_script(script)                           # and a bad script
     size = check_frame_size(size, None, "atmos.run size")
     clouds = check_choice("atmos.run", "clouds", clouds, CLOUD_RENDERERS)
     sky = check_choice("atmos.run", "sky", sky, SKY_MODELS)
@@ -217,6 +233,8 @@ def run(game, *, size: tuple[int, int] = (960, 540), title: str | None = None, h
     settings = DemoSettings(size=size, seed=seed, frames=frames, clouds=clouds, sky=sky, haze=haze,
                             headless=bool(headless) or out is not None)
     if settings.headless:
-        return run_headless(game, settings, out, progress=progress)
-    run_window(game, settings, title or title_of(game))
+        return run_headless(game, settings, out, progress=progress, script=script, shots=shots)
+    if shots is not None:
+        raise ValueError("shots are for headless runs into a folder (out='frames/')")
+    run_window(game, settings, title or title_of(game), script=script)
     return None
