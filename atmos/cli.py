@@ -216,8 +216,8 @@ def main(argv: list[str] | None = None) -> int:
             raise
         print(f"atmos: {error}", file=sys.stderr)
         return 1
-    except KeyboardInterrupt:
-        print("atmos: interrupted; no output file was left half-written", file=sys.stderr)
+    except KeyboardInterrupt as interrupt:
+        print(f"atmos: {interrupt or 'interrupted'}", file=sys.stderr)
         return 130
     except BrokenPipeError:
         # The reader closed early (`atmos info | head -3`): that is its choice, not our failure.

@@ -129,7 +129,8 @@ def run_headless(name, settings: DemoSettings, out: str | None, progress: bool =
                  shots=None) -> dict:
     """Render ``settings.frames`` frames of ``name`` (:func:`load_game`) at a fixed 1/30 s step; write
     them to ``out`` if given (only the frame numbers ``shots``, into a folder, when given); ``script``:
-    a scripted player (:mod:`atmos.script`)."""
+    a scripted player (:mod:`atmos.script`). Interrupted (Ctrl-C), the file is completed with the frames
+    rendered so far, as ffmpeg does (:class:`Interrupted` says how many); a failed run leaves none."""
     from atmos.output import OutputPlugin, check_shots
     frames = settings.frames or getattr(load_game(name), "DEFAULT_FRAMES", 90)
     shots = check_shots(shots, frames)
@@ -155,6 +156,14 @@ def run_headless(name, settings: DemoSettings, out: str | None, progress: bool =
             writer.close()                            # completes the output file (OutputError if it cannot)
         return {"frames": frames, "out": str(writer.path) if writer else None,
                 "written": writer.frames_written if writer else 0}
+    except KeyboardInterrupt:
+        if writer is not None and writer.frames_written:
+            writer.close()                            # a valid file of the frames so far (OutputError if not)
+            raise Interrupted(f"interrupted; wrote the {writer.frames_written} frame(s) rendered so far to "
+                              f"{writer.path}") from None
+        if writer is not None:
+            writer.abort()
+        raise Interrupted("interrupted before any frame was written; nothing was left behind") from None
     except BaseException as error:
         if writer is not None:
             writer.abort()                            # a failed run leaves no file behind
@@ -165,6 +174,10 @@ def run_headless(name, settings: DemoSettings, out: str | None, progress: bool =
             app.close()
         finally:
             gpu.release()
+
+
+class Interrupted(KeyboardInterrupt):
+    """A headless run stopped by Ctrl-C; the message says what was written."""
 
 
 def slowest_passes(app, n: int = 3) -> str:

@@ -23,6 +23,17 @@ def is_software(ctx) -> bool:
     return any(name in renderer for name in SOFTWARE_RENDERERS)
 
 
+def trim_heap() -> bool:
+    """Hand the heap's free pages back to the system (glibc ``malloc_trim``): after textures of a size
+    no frame uses any more were released, what the heap kept of them (blocks under the mmap threshold,
+    such as a half-resolution target) stops counting as resident. False where there is no glibc."""
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
+        return bool(libc.malloc_trim(0))
+    except (OSError, AttributeError):
+        return False
+
+
 def return_freed_textures() -> bool:
     """Fix glibc's mmap threshold (once per process is enough); False where there is no glibc."""
     try:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import Any, Callable
 
+from atmos.gpu.host_memory import trim_heap
 from atmos.graph.compiler import CompiledGraph, compile_graph
 from atmos.graph.dump import dump_text, dump_dot
 from atmos.graph.errors import GraphError
@@ -150,6 +151,8 @@ class RenderGraph:
             frame._end_frame()
             if self.pool.end_frame():  # evicted textures: drop the cached framebuffers over them
                 frame.drop_released()
+                if self.gpu.software:  # their storage was host memory: give the heap's free pages back
+                    trim_heap()
 
     def _resolve(self, name: str):
         source = self._imports[name]
