@@ -60,6 +60,8 @@ _EXPORTS = {
     "GroundPlugin": "atmos.plugins.ground", "TerrainPlugin": "atmos.plugins.terrain",
     "TerrainSettings": "atmos.plugins.terrain", "MeshPlugin": "atmos.plugins.mesh", "Mesh": "atmos.plugins.mesh",
     "MeshInstance": "atmos.plugins.mesh", "TextPlugin": "atmos.plugins.text", "Label": "atmos.plugins.text",
+    # game logic: timers, states, scripted play
+    "Timer": "atmos.timers", "States": "atmos.states", "ScriptPlugin": "atmos.script",
 }
 
 __all__ = sorted(_EXPORTS)

@@ -15,6 +15,8 @@ from atmos.plugin import Plugin, PluginGroup
 from atmos.render_core import LinearCapturePass
 from atmos.scene_view import SceneView
 from atmos.schedule import Schedule
+from atmos.states import InState, States
+from atmos.timers import Timer, Timers
 from atmos.world import World
 
 
@@ -30,6 +32,11 @@ class App:
 
     ``gpu`` is an :class:`atmos.gpu.GpuContext` (window or headless); without one the App runs its
     systems only (no render graph), which is what the framework-overhead benchmark and logic tests use.
+
+    Game logic: :meth:`after` / :meth:`every` are timers in game time (:mod:`atmos.timers`: they fire at
+    the start of the ``update`` stage); :meth:`add_state`, :meth:`set_state`, :meth:`on_enter`,
+    :meth:`on_exit`, :attr:`state` and ``add_system(..., in_state=)`` are game states
+    (:mod:`atmos.states`: a change takes effect at the next frame boundary).
 
     Lifetime: :meth:`close` releases everything (``gpu.release()`` closes the Apps on it first); after
     it every other method is an :class:`AppError`. A plugin whose ``build`` raises is taken out again
@@ -47,6 +54,8 @@ class App:
         self.plugins: list[Plugin] = []
         self.graph = RenderGraph(gpu) if gpu is not None else None
         self.frames = FrameScheduler()
+        self.timers = Timers()
+        self.states = States()
         self.running = True
         self._started = self._finished = self._closed = False
         self._finished_plugins: set[int] = set()     # id() of plugins whose finish ran
@@ -54,6 +63,7 @@ class App:
         self._startup_error: BaseException | None = None
         if gpu is not None:
             gpu._apps.add(self)
+        self.add_system(lambda app: app.timers.run(app), "update", label="app.timers")   # first in update
         self.add_system(lambda app: app.frames.tick(), "render", label="frame_scheduler")
         if self.graph is not None:
             self.add_system(App.render, "render", label="render_graph", after="frame_scheduler")
@@ -63,7 +73,7 @@ class App:
         """Build plugins (and every plugin of a group) into this App, in order; one call is all or
         nothing: when a plugin is refused or its ``build`` raises, every plugin of the call is taken out
         again, with the systems, passes, imports, resources and jobs they added (and their ``cleanup``
-        run), so a corrected call can follow. A plugin instance belongs to one App."""
+        run), so a corrected call can follow. A plugin instance belongs to one open App at a time."""
         self._check_open("add_plugins")
         self._activate()
         mark = self._mark()
@@ -84,9 +94,10 @@ class App:
         if any(type(p) is type(plugin) for p in self.plugins):
             raise ValueError(f"{plugin.name} was added twice; each plugin type may be added once")
         owner = _OWNERS.get(plugin, lambda: None)()
-        if owner is not None and owner is not self:
-            raise ValueError(f"this {plugin.name} belongs to another App (it holds that App's GPU objects and "
-                             f"systems); make a new {plugin.name}(...) for this App")
+        if owner is not None and owner is not self and not owner._closed:
+            raise ValueError(f"this {plugin.name} belongs to another App that is still open (it holds that App's "
+                             f"GPU objects and systems); make a new {plugin.name}(...) for this App, or close "
+                             f"the other first")
         self.plugins.append(plugin)
         _OWNERS[plugin] = weakref.ref(self)
         try:
@@ -101,11 +112,11 @@ class App:
     def _mark(self) -> tuple:
         """What :meth:`_undo` needs to take a failed build out again."""
         return (len(self.plugins), len(self.schedule.systems), dict(self.resources), list(self.frames.jobs),
-                self.graph.mark() if self.graph is not None else None)
+                self.graph.mark() if self.graph is not None else None, self.timers.mark(), self.states.mark())
 
     def _undo(self, mark: tuple, error: BaseException) -> None:
         """Remove the plugins (a failed one, and what its build added) and registrations made since ``mark``."""
-        plugins, systems, resources, jobs, graph = mark
+        plugins, systems, resources, jobs, graph, timers, states = mark
         for plugin in reversed(self.plugins[plugins:]):
             try:
                 plugin.cleanup(self)
@@ -119,11 +130,19 @@ class App:
             self.frames.remove(job)
         if self.graph is not None:
             self.graph.undo(graph)
+        self.timers.undo(timers)
+        self.states.undo(states)
 
-    def add_system(self, func, stage: str = "update", label: str | None = None, before=(), after=()) -> "App":
-        """Run ``func(app)`` in ``stage`` every frame (``simulate``: every fixed step)."""
+    def add_system(self, func, stage: str = "update", label: str | None = None, before=(), after=(), *,
+                   in_state: str | None = None) -> "App":
+        """Run ``func(app)`` in ``stage`` every frame (``simulate``: every fixed step); ``in_state``:
+        only while the App is in that state (one declared with :meth:`add_state`)."""
         self._check_open("add_system")
-        self.schedule.add(func, stage, label, before, after)
+        if in_state is not None:
+            self.states.check("App.add_system", in_state, "in_state")
+        system = self.schedule.add(func, stage, label, before, after)
+        if in_state is not None:
+            system.func = InState(func, in_state)
         return self
 
     def insert_resource(self, resource) -> "App":
@@ -145,6 +164,66 @@ class App:
 
     def get_resource(self, kind: type, default=None):
         return self.resources.get(kind, default)
+
+    # -- timers and states ----------------------------------------------------------------
+    def after(self, seconds: float, fn, *, in_state: str | None = None) -> Timer:
+        """Call ``fn(app)`` once, ``seconds`` (finite, > 0) of game time from now, at the start of a
+        frame's ``update`` stage (:mod:`atmos.timers`). ``in_state``: the timer belongs to that state,
+        the current one, and is cancelled when the App leaves it."""
+        self._check_open("after")
+        return self._timer("App.after", seconds, fn, 1, in_state)
+
+    def every(self, seconds: float, fn, times: int | None = None, *, in_state: str | None = None) -> Timer:
+        """Call ``fn(app)`` every ``seconds`` (finite, > 0) of game time, ``times`` times (a whole number
+        >= 1; None: until cancelled); a long frame fires once per missed period (:mod:`atmos.timers`).
+        ``in_state`` as in :meth:`after`."""
+        self._check_open("every")
+        return self._timer("App.every", seconds, fn, times, in_state)
+
+    def _timer(self, owner: str, seconds, fn, times, in_state) -> Timer:
+        if in_state is not None:
+            self.states.check(owner, in_state, "in_state")
+            if in_state != self.states.current:
+                raise ValueError(f"{owner}.in_state {in_state!r} is not the current state "
+                                 f"{self.states.current!r}; make a state's timers while in it, e.g. in "
+                                 f"app.on_enter({in_state!r}, ...)")
+        return self.timers.add(owner, seconds, fn, times, self.clock.frame_time, in_state)
+
+    def add_state(self, *names: str, initial: str | None = None) -> "App":
+        """Declare the game states, once (:mod:`atmos.states`); ``initial`` (default: the first) is
+        entered after the ``startup`` stage."""
+        self._check_open("add_state")
+        self.states.declare("App.add_state", names, initial)
+        return self
+
+    def set_state(self, name: str) -> None:
+        """Change to state ``name`` at the next frame boundary (the end of this frame, or the start of
+        the next when asked between frames): on_exit hooks, the switch, on_enter hooks. The last
+        request before the boundary wins; the current state again restarts it."""
+        self._check_open("set_state")
+        self.states.next = self.states.check("App.set_state", name, "name")
+
+    def on_enter(self, state: str, fn) -> "App":
+        """Run ``fn(app)`` each time the App enters ``state`` (the initial state: after start-up)."""
+        self._check_open("on_enter")
+        self.states.hook("App.on_enter", "enter", state, fn)
+        return self
+
+    def on_exit(self, state: str, fn) -> "App":
+        """Run ``fn(app)`` each time the App leaves ``state`` (before its timers are cancelled)."""
+        self._check_open("on_exit")
+        self.states.hook("App.on_exit", "exit", state, fn)
+        return self
+
+    @property
+    def state(self) -> str | None:
+        """The current game state (None when none were declared); a change shows after its boundary."""
+        return self.states.current
+
+    def _apply_states(self) -> None:
+        """A frame boundary: the state changes asked for (then deleted entities are gone)."""
+        if self.states.apply(self):
+            self.world.clear_dead_entities()
 
     # -- running ---------------------------------------------------------------------------
     def finish(self) -> None:
@@ -176,12 +255,14 @@ class App:
         self._started = True
         try:
             self.schedule.run("startup", self)
+            self._apply_states()                          # the initial state's on_enter hooks
         except BaseException as error:
             self._startup_error = error
             raise
 
     def update(self, frame_dt: float | None = None) -> None:
-        """Run one frame: update, the due fixed ``simulate`` steps, render, last. ``frame_dt``:
+        """Run one frame: update (due timers first), the due fixed ``simulate`` steps, render, last;
+        state changes asked for take effect at its ends (:meth:`set_state`). ``frame_dt``:
         seconds since the last frame (a finite number >= 0; the clock clamps it to ``max_frame_dt``),
         or None to measure it."""
         self._check_open("update")
@@ -194,6 +275,7 @@ class App:
             frame_dt = now - getattr(self, "_last", now)
             self._last = now
         self._activate()
+        self._apply_states()                              # a set_state asked for between frames
         steps = self.clock.advance(frame_dt)
         self._run("update")
         for _ in range(steps):
@@ -201,6 +283,7 @@ class App:
             self.clock.tick()
         self._run("render")
         self._run("last")
+        self._apply_states()
 
     def _run(self, stage: str) -> None:
         """One stage, then the ECS world's deferred deletes: an entity deleted in a stage is gone

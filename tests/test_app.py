@@ -135,7 +135,7 @@ def test_a_plugin_belongs_to_one_app_and_an_app_without_a_gpu_says_what_it_needs
     first, second = App(), App()
     plugin = Counts()
     first.add_plugins(plugin)
-    with pytest.raises(ValueError, match="this Counts belongs to another App"):
+    with pytest.raises(ValueError, match="this Counts belongs to another App that is still open"):
         second.add_plugins(plugin)
     assert second.plugins == []
     from atmos.plugins.sky import SkyPlugin
@@ -143,7 +143,10 @@ def test_a_plugin_belongs_to_one_app_and_an_app_without_a_gpu_says_what_it_needs
     with pytest.raises(AppError, match=r"SkyPlugin draws with the GPU and this App has none.*create_headless"):
         second.add_plugins(SkyPlugin())
     assert second.plugins == []
-    first.close(), second.close()
+    first.close()
+    second.add_plugins(plugin)                                # the first App closed: the plugin is free
+    assert second.plugins == [plugin]
+    second.close()
 
 
 def test_default_plugins_hide_the_frame_time_overlay_until_asked():
