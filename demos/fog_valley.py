@@ -26,6 +26,9 @@ PRESETS = {  # the paper's figures (FogSettings fields): eq. (7) = hetero_exp2, 
     "fig8": dict(mode="hetero_exp2", density=0.044, resolutions=PAPER_RESOLUTIONS["coarse"]),
     "fig9": dict(mode="hetero_exp", density=0.044, resolutions=PAPER_RESOLUTIONS["coarse"]),
     "fig10": dict(mode="hetero_exp", density=0.06, resolutions=PAPER_RESOLUTIONS["coarse"]),
+    # not the paper's: height fog pooled in the valley, thinning upward, with the same turbulence
+    "valley": dict(mode="hetero_height", density=0.15, height_base=0.0, scale_height=2.0,
+                   resolutions=PAPER_RESOLUTIONS["coarse"]),
 }
 TERRAIN_SIZE = 112.0
 NOISE_TILE = 112.0  # metres per noise tile: the lowest octave's 16 cells are 7 m
@@ -62,7 +65,7 @@ def build(app, settings, fog_preset: str | None = None) -> FogPlugin:
 
     def switch_preset(app) -> None:
         keys = app.resource(Input).pressed
-        for number, name in zip((key._1, key._2, key._3, key._4, key._5), PRESETS):
+        for number, name in zip((key._1, key._2, key._3, key._4, key._5, key._6), PRESETS):
             if number in keys:
                 fog.configure(**PRESETS[name])
 

@@ -9,7 +9,7 @@ from atmos.defaults import DefaultPlugins
 from atmos.gpu import create_headless
 from atmos.graph import RenderPass
 from atmos.plugins.fog import FogPlugin, FogSettings, apply_fog
-from atmos.plugins.fog.factors import apply_fog_ref, fog_factor
+from atmos.plugins.fog.factors import apply_fog_ref, fog_factor, height_depth
 from atmos.plugins.fog.noise import (NoiseVolumes, noise_volume_ref, octave_key, periodic_noise,
                                      sample_repeat_trilinear)
 from atmos.plugins.sky_gradient import SkyGradientPlugin
@@ -87,6 +87,50 @@ def test_reference_factor_extremes_stay_in_unit_interval(mode):
                 medium = g * (t if mode.startswith("hetero") else 1.0)
                 if medium == 0 or medium >= 1e-30:
                     assert f[-1] == (1.0 if medium == 0 else 0.0)     # the limit at infinity
+
+
+def test_height_fog_depth_is_the_integral_of_its_density_along_the_ray(rng):
+    """The closed form against a quadrature of g e^(-(y - base)/H) on fresh random rays: climbing,
+    falling, level (slope 1e-9), from below and far above the base, short and long."""
+    for slope in (*rng.uniform(-1, 1, 6), 1e-9, -1e-9, 0.0):
+        d, eye, base, scale, g = rng.uniform(0.5, 3000), rng.uniform(-100, 600), rng.uniform(-30, 60), \
+            rng.uniform(3, 300), rng.uniform(1e-4, 0.05)
+        s = np.linspace(0.0, d, 400001)
+        quad = np.trapezoid(g * np.exp(-(eye + slope * s - base) / scale), s)
+        got = height_depth(d, g, eye, slope, base, scale)
+        assert got == pytest.approx(min(quad, 1e4), rel=1e-6), (slope, d, eye, base, scale)
+
+
+def test_height_fog_is_thick_in_the_valley_and_thin_above_and_never_nan():
+    d = np.array([0.0, 1e-30, 10.0, 1e3, 1e6, 3e38, np.inf])
+    low = fog_factor("height", d, 0.05, eye_y=0.0, slope=0.0, base=0.0, scale=20.0)
+    high = fog_factor("height", d, 0.05, eye_y=200.0, slope=0.0, base=0.0, scale=20.0)
+    assert (high >= low).all() and high[3] > 0.99 and low[3] < 1e-6          # 10 scale heights up: clear
+    up = fog_factor("height", d, 0.05, eye_y=0.0, slope=0.5, base=0.0, scale=20.0)
+    assert up[-1] == pytest.approx(np.exp(-0.05 * 20.0 / 0.5))              # the sky: a finite column above
+    for eye in (-1e6, -50.0, 0.0, 1e6):
+        for g in (0.0, 1e-30, 0.05, 1e30):
+            for slope in (-1.0, -1e-9, 0.0, 0.3):
+                f = fog_factor("height", d, g, eye_y=eye, slope=slope, base=0.0, scale=20.0)
+                assert np.isfinite(f).all() and (f >= 0).all() and (f <= 1).all() and f[0] == 1.0
+
+
+@pytest.mark.parametrize("mode,extra", [("height", {}), ("hetero_height", {"noise": "procedural", "resolutions": SMALL}),
+                                        ("height", {"sky": "keep", "density": 0.2, "scale_height": 4.0})])
+def test_height_fog_on_the_gpu_matches_the_reference(gpu, ctx, rng, mode, extra):
+    color, distance, _ = random_inputs(rng)
+    camera = rng.uniform(-20, 40, 3)
+    dirs = rng.normal(size=color.shape)
+    dirs /= np.linalg.norm(dirs, axis=-1, keepdims=True)
+    reach = np.where(np.isinf(distance), 1e4, distance)[..., None]
+    positions = (camera + dirs * reach).astype(np.float32)
+    kw = {"height_base": float(rng.uniform(-10, 10)), "scale_height": float(rng.uniform(5, 40)), "density": 0.03, **extra}
+    out = apply_fog(gpu, color, distance, mode=mode, positions=positions, camera=tuple(camera), far=500.0, **kw)
+    settings = FogSettings(mode=mode, **kw)
+    ref = apply_fog_ref(color, distance, settings, positions, far=500.0, camera=tuple(camera))
+    assert np.isfinite(out).all()
+    np.testing.assert_allclose(out, ref, atol=TOL)
+    assert np.abs(ref - color).max() > 0.1                     # the fog really changed the picture
 
 
 # -- apply_fog against the reference -------------------------------------------------------------
@@ -251,7 +295,9 @@ def test_terrain_is_about_ten_thousand_triangles_with_unit_normals():
     assert np.ptp(vertices[:, 1]) > 10.0
 
 
-def test_fog_valley_demo_renders_fog_over_terrain(tmp_path, capsys):
+@pytest.mark.parametrize("preset", ["fig6", "valley"])
+def test_fog_valley_demo_renders_fog_over_terrain(tmp_path, capsys, monkeypatch, preset):
+    monkeypatch.setenv("ATMOS_FOG_PRESET", preset)
     path = tmp_path / "fog_valley.png"
     assert cli(["demo", "fog_valley", "--headless", "--frames", "2", "--size", "96x54", "--out", str(path),
                 "--quiet"]) == 0

@@ -70,7 +70,8 @@ def apply_fog(gpu, color, distance, mode: str = "exp2", density: float = 0.044, 
     """Fog ``color`` (float32 (H, W, 3)) at ``distance`` (float32 (H, W), +inf = sky) on the GPU with
     the pass's shader; returns float32 (H, W, 3).
 
-    Heterogeneous modes need ``positions`` (H, W, 3) world positions (finite) and take the noise
+    Heterogeneous and height modes need ``positions`` (H, W, 3) world positions (finite; height fog:
+    each ray's point beyond ``camera``, which gives its slope) and the heterogeneous ones take the noise
     settings of :class:`FogSettings` (``octaves``, ``resolutions``, ``winds``, ``tile_size``,
     ``amplitude``, ``noise``, ``texels_per_cell``, ``seed``) as keywords, plus ``time`` (s);
     ``sky="keep"`` leaves sky pixels alone, else they are fogged at distance ``far``.
@@ -181,9 +182,10 @@ def _check_inputs(color, distance, positions, settings):
         raise ValueError("color must be finite (RGB in [0, 1]); it holds NaN or inf")
     if np.isnan(distance).any() or (distance < 0).any() or np.isneginf(distance).any():
         raise ValueError("distance must be >= 0 metres or +inf (sky); it holds NaN or negative values")
-    if settings.heterogeneous:
+    if settings.heterogeneous or settings.mode == "height":
         if positions is None:
-            raise ValueError(f"mode {settings.mode!r} needs positions=(H, W, 3) world positions for the noise")
+            raise ValueError(f"mode {settings.mode!r} needs positions=(H, W, 3) world positions (for the noise, "
+                             f"and for height fog the ray's end: camera + direction × distance)")
         positions = np.asarray(positions)
         if positions.shape != (h, w, 3):
             raise ValueError(f"positions must be float32 (H, W, 3) = ({h}, {w}, 3), got shape {positions.shape}")

@@ -8,20 +8,38 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.plugins.fog.settings import MODES
+from atmos.plugins.fog.settings import HETEROGENEOUS, MODES
 
 MAX_DISTANCE = 3e38
 MAX_DEPTH = 1e4
 
 
+def height_depth(distance, g, eye_y, slope, base: float, scale: float) -> np.ndarray:
+    """Optical depth of height fog (density g e^(-(y - base)/scale)) along a ray from height ``eye_y``
+    climbing ``slope`` m per m, over ``distance``: g e^(-(y_low - base)/scale) d (1 - e^(-a)) / a with
+    a = |Δy| / scale, in logs (fog/factor.glsl), capped at MAX_DEPTH."""
+    d = np.asarray(distance, np.float64)
+    a = np.abs(np.asarray(slope, np.float64) * d) / scale
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        mean = np.where(a < 1e-8, 1.0 - 0.5 * a, -np.expm1(-a) / np.where(a > 0, a, 1.0))
+        low = np.minimum(eye_y, eye_y + np.asarray(slope, np.float64) * d)
+        log_tau = np.log(g) - (low - base) / scale + np.log(np.maximum(d * mean, 1e-300))
+    return np.where(d * mean > 0, np.exp(np.minimum(log_tau, np.log(MAX_DEPTH))), 0.0)   # no path: no fog
+
+
 def fog_factor(mode: str, distance, density: float = 0.0, start: float = 0.0, end: float = 1.0,
-               turbulence=1.0) -> np.ndarray:
-    """f in [0, 1] (1: no fog). ``turbulence`` scales g in the heterogeneous modes (eq. 6, 7)."""
+               turbulence=1.0, eye_y=0.0, slope=0.0, base: float = 0.0, scale: float = 50.0) -> np.ndarray:
+    """f in [0, 1] (1: no fog). ``turbulence`` scales g in the heterogeneous modes (eq. 6, 7); the
+    height modes take the ray's ``eye_y``, ``slope`` (dy per metre) and the fog's ``base`` and ``scale``
+    height (:func:`height_depth`)."""
     d = np.clip(np.asarray(distance, np.float64), 0.0, MAX_DISTANCE)
     if MODES[mode] == 0:
         return np.clip((end - d) / (end - start), 0.0, 1.0)                        # eq. (2)
-    g = np.float64(density) * (np.asarray(turbulence, np.float64) if MODES[mode] >= 3 else 1.0)
+    g = np.float64(density) * (np.asarray(turbulence, np.float64) if mode in HETEROGENEOUS else 1.0)
     g = np.broadcast_to(g, d.shape)
+    if mode in ("height", "hetero_height"):
+        x = np.where(g > 0, height_depth(d, np.where(g > 0, g, 1.0), eye_y, slope, base, scale), 0.0)
+        return np.where(g > 0, np.clip(np.exp(-x), 0.0, 1.0), 1.0)
     with np.errstate(over="ignore"):
         x = np.minimum(d * g, MAX_DEPTH)
     if mode in ("exp2", "hetero_exp2"):
@@ -50,9 +68,14 @@ def apply_fog_ref(color, distance, settings, positions=None, time: float = 0.0, 
     from atmos.plugins.fog.noise import turbulence_ref
     from atmos.plugins.fog.sky_color import sky_fog_color
 
+    eye = np.asarray(camera, np.float64)
+
     def factor(d, where):
         turbulence = turbulence_ref(where, time, settings, volumes) if settings.heterogeneous else 1.0
-        return fog_factor(settings.mode, d, settings.density, settings.start, settings.end, turbulence)
+        toward = np.asarray(where, np.float64) - eye
+        slope = toward[..., 1] / np.maximum(np.linalg.norm(toward, axis=-1), 1e-30)     # as fog/factor.glsl
+        return fog_factor(settings.mode, d, settings.density, settings.start, settings.end, turbulence,
+                          eye[1], slope, settings.height_base, settings.scale_height)
 
     d = np.asarray(distance, np.float64)
     sky = np.isinf(d)

@@ -37,7 +37,8 @@ def set_fog_uniforms(prog, settings, time: float, horizon=None) -> None:
     if horizon is not None:
         write_uniforms(prog, fog_horizon=np.asarray(horizon, np.float32).tobytes())
     write_uniforms(prog, fog_density=settings.density, fog_start=settings.start, fog_end=settings.end,
-                   fog_color=settings.fog_color, fog_sky_keep=int(settings.sky == "keep"))
+                   fog_color=settings.fog_color, fog_sky_keep=int(settings.sky == "keep"),
+                   fog_height_base=settings.height_base, fog_scale_height=settings.scale_height)
     if not settings.heterogeneous:
         return
     periods = list(settings.resolutions) + [2] * (4 - len(settings.resolutions))

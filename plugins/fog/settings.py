@@ -6,7 +6,8 @@ from dataclasses import dataclass
 
 from atmos.checks import CheckedSettings, check_int, check_vec, choice_field, int_field, num_field, vec_field
 
-MODES = {"linear": 0, "exp": 1, "exp2": 2, "hetero_exp": 3, "hetero_exp2": 4}
+MODES = {"linear": 0, "exp": 1, "exp2": 2, "hetero_exp": 3, "hetero_exp2": 4, "height": 5, "hetero_height": 6}
+HETEROGENEOUS = ("hetero_exp", "hetero_exp2", "hetero_height")
 ALIASES = {"exponential": "exp", "exp_squared": "exp2", "squared_exponential": "exp2",
            "heterogeneous_exp": "hetero_exp", "heterogeneous_exp2": "hetero_exp2"}
 NOISES = ("texture", "procedural")
@@ -29,15 +30,18 @@ class FogSettings(CheckedSettings):
     fetches the program variant and noise volumes it needs). Three fields are checked by hand (not in
     the list below):
 
-    ``mode`` = 'exp2': the fog factor: 'linear', 'exp', 'exp2', 'hetero_exp' (eq. 6) or 'hetero_exp2'
-    (eq. 7); the aliases in ALIASES are resolved. 'linear' needs start < end.
+    ``mode`` = 'exp2': the fog factor: 'linear', 'exp', 'exp2', 'hetero_exp' (eq. 6), 'hetero_exp2'
+    (eq. 7), or 'height': density g e^(-(y - height_base) / scale_height), thick in valleys and thin
+    above (its optical depth along each ray in closed form), 'hetero_height' the same with the noise;
+    the aliases in ALIASES are resolved. 'linear' needs start < end.
     ``resolutions`` = (16, 32, 64, 128): octaves to 4 whole numbers, each 2..MAX_TEXELS // texels_per_cell
     (PAPER_RESOLUTIONS: 'fine' or 'coarse').
     ``winds`` = DEFAULT_WINDS: 4 (x, y, z) velocities in m/s, one per octave.
     """
 
     mode: str = "exp2"
-    density: float = num_field(0.044, 0.0, doc="g, per metre (exp, exp2 and the heterogeneous modes)")
+    density: float = num_field(0.044, 0.0, doc="g, per metre (exp, exp2, height and the heterogeneous modes; "
+                               "height: at height_base)")
     fog_color: tuple = vec_field((0.8, 0.8, 0.8), 3, "non-negative", "linear RGB the colour fades toward")
     start: float = num_field(0.0, doc="metres: linear fog begins here")
     end: float = num_field(100.0, doc="metres: linear fog is full here")
@@ -58,9 +62,13 @@ class FogSettings(CheckedSettings):
                                    ":mod:`atmos.plugins.fog.sky_color`; fog_color=(1, 1, 1) for the sky's own "
                                    "colour)")
 
+    height_base: float = num_field(0.0, doc="height modes: world y (m) where the density is g")
+    scale_height: float = num_field(50.0, 0.0, doc="height modes: metres over which the density falls by e",
+                                    lo_open=True)
+
     @property
     def heterogeneous(self) -> bool:
-        return MODES[self.mode] >= 3
+        return self.mode in HETEROGENEOUS
 
     @property
     def turns(self) -> tuple:

@@ -60,10 +60,10 @@ void main() {
         sky = false;
     }
 #endif
-    float f = sky && fog_sky_keep != 0 ? 1.0 : fog_factor(d, world);
+    float f = sky && fog_sky_keep != 0 ? 1.0 : fog_factor(d, world, eye);
 #if FOG_CLOUDS
     vec2 cloud = cloud_cover_distance(texelFetch(cloud_distance, ivec2(gl_FragCoord.xy), 0).rg);
-    if (cloud.x > 0.0) f = cloud.x * fog_factor(cloud.y, eye + dir * cloud.y) + (1.0 - cloud.x) * f;
+    if (cloud.x > 0.0) f = cloud.x * fog_factor(cloud.y, eye + dir * cloud.y, eye) + (1.0 - cloud.x) * f;
 #endif
     frag = vec4(in_color(dir) * (1.0 - f), f);
     write_media(frag);

@@ -90,10 +90,10 @@ void main() {
     float dm = min(reach, max_distance);
     float dsf = dm / float(steps);
     float lost = 0.0;
-    float f0 = fog_factor(0.0, end);
+    float f0 = fog_factor(0.0, end, camera_pos);
     for (int i = 0; i < steps; ++i) {
         float s0 = float(i) * dsf;
-        float f1 = fog_factor(s0 + dsf, end);
+        float f1 = fog_factor(s0 + dsf, end, camera_pos);
         float s = s0 + j * dsf;
         float w = (s < dc ? a : 0.0) + (s < behind ? 1.0 - a : 0.0);
         float tau = has_clouds != 0 ? sun_optical_depth(camera_pos + dir * s, sun_dir) : 0.0;
@@ -122,7 +122,7 @@ void main() {
         vec3 ext = atm_coefficients(at.x, s_ray, s_mie);
         float fogged = 1.0;                     // the fog in front of s (with a FogPlugin)
 #if SHAFT_FOG
-        fogged = fog_factor(s, end);
+        fogged = fog_factor(s, end, camera_pos);
 #endif
         shadowed += w * exp(-ext * s) * atm_transmittance_to_sun(at.x, at.y) * (s_ray * pr + s_mie * pm)
                     * (1.0 - exp(-tau)) * fogged;
