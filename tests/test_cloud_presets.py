@@ -52,3 +52,37 @@ def test_a_cloud_sky_forms_overhead_and_follows_the_camera():
         plain.close()
     finally:
         gpu.release()
+
+
+def test_the_weather_changes_while_playing_and_shows_within_its_transition():
+    """Fair weather → 'broken' over 6 s of game time (the case that once showed no change in 10 s): the
+    cover aimed at moves there on time, the clouds' settings follow, and the measured cover rises
+    within the transition and goes on rising as the automaton forms the clouds."""
+    from atmos.plugins.clouds import CloudsPlugin
+    gpu = create_headless((32, 18))
+    try:
+        sky = CloudSky("fair_weather", seed=3, warmup_steps=6)
+        app = App(gpu).add_plugins(DefaultPlugins(fly_camera=False), SkyGradientPlugin(), sky)
+        clouds = next(p for p in sky if isinstance(p, CloudsPlugin))
+        app.run_frames(3, 1 / 30)
+        before = clouds.simulation.cover()
+        assert sky.weather.cover == pytest.approx(PRESETS["fair_weather"].cover)
+        sky.weather.configure(preset="broken", transition=6.0)
+        app.run_frames(90, 1 / 30)                                     # half way
+        assert PRESETS["fair_weather"].cover < sky.weather.cover < PRESETS["broken"].cover
+        app.run_frames(95, 1 / 30)                                     # the transition's end
+        assert sky.weather.cover == PRESETS["broken"].cover
+        s, goal = clouds.settings, cloud_settings("broken")
+        assert s.sigma_t == goal.sigma_t and s.base_altitude == goal.base_altitude
+        assert s.weather.cloud_density == goal.weather.cloud_density
+        np.testing.assert_allclose(s.cell_size, goal.cell_size)
+        during = clouds.simulation.cover()
+        app.run_frames(180, 1 / 30)
+        after = clouds.simulation.cover()
+        assert during > before + 0.05 and after > during + 0.1, (before, during, after)   # 0.05, 0.13, 0.30 here
+        with pytest.raises(ValueError, match="CloudWeatherSettings.cover must be a finite number >= 0.0 and <= 1.0"):
+            sky.weather.configure(cover=1.5)
+        assert sky.weather.settings.preset == "broken"                  # a refused change changes nothing
+        app.close()
+    finally:
+        gpu.release()

@@ -37,6 +37,7 @@ from atmos.offscreen import CLOUD_COLOR
 from atmos.plugins.clouds.shadows import CloudShadowsPlugin
 from atmos.plugins.clouds.far_field import CloudFarFieldPlugin
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
+from atmos.plugins.clouds.presets import CloudSky, CloudWeatherPlugin
 from atmos.plugins.clouds.simulation.top_view import CloudTopViewPlugin
 from atmos.plugins.daylight import DaylightPlugin, TimeOfDay
 from atmos.plugins.fog import FogPlugin
@@ -311,8 +312,11 @@ SPECS = {
         look((0.0, 3.0, 10.0), yaw=0.0, pitch=-0.05),
         dict(mode="exp", density=0.01, fog_color=(0.9, 0.1, 0.1), start=5.0, end=30.0, sky="keep", octaves=2,
              resolutions=(2, 4, 8, 8), winds=((5.0, 0.0, 0.0),) * 4, tile_size=64.0, amplitude=0.3,
-             noise="procedural", texels_per_cell=2, seed=11, time_offset=3.0, color_from="sky"),
-        before={"start": configure_first(mode="linear"), "end": configure_first(mode="linear")}),
+             noise="procedural", texels_per_cell=2, seed=11, time_offset=3.0, color_from="sky", height_base=3.0,
+             scale_height=0.5),
+        before={"start": configure_first(mode="linear"), "end": configure_first(mode="linear"),
+                "height_base": configure_first(mode="height", density=0.05),
+                "scale_height": configure_first(mode="height", density=0.05)}),
     "light_shafts": Spec(     # the screen mode; the march's fields under the clouds (march_under_clouds)
         lambda: [DefaultPlugins(overlay=False), clouds(shading=False), SkyGradientPlugin(), GroundPlugin(),
                  LightShaftsPlugin(mode="screen")],
@@ -408,7 +412,19 @@ def _weather_spec():
                 frame_dt={name: 1 / 30 for name in changes})         # one fixed step per frame
 
 
+def _aimed(app, plugin):
+    """Where the weather is (the cover it aims at) and what the clouds were told (their ellipsoids, extinction)."""
+    return plugin.cover, plugin.clouds.settings.weather.cloud_density, plugin.clouds.settings.sigma_t
+
+
 SPECS["clouds"] = _clouds_spec()
+SPECS["cloud_weather"] = Spec(
+    lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), CloudSky("fair_weather", warmup_steps=1)],
+    CloudWeatherPlugin, look((0.0, 300.0, 0.0), pitch=0.9, far=20000.0),
+    dict(preset="overcast", cover=0.9, transition=5.0),
+    observe={"preset": _aimed, "cover": _aimed, "transition": lambda app, plugin: plugin.settings.transition},
+    before={"preset": configure_first(transition=0.0), "cover": configure_first(transition=0.0)},   # settled first
+    frame_dt={"preset": 1 / 30, "cover": 1 / 30})
 SPECS["weather"] = _weather_spec()
 SPECS["cloud_top_view"] = Spec(
     lambda: [DefaultPlugins(overlay=False), clouds(cover=20), CloudTopViewPlugin()], CloudTopViewPlugin,

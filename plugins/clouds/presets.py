@@ -2,9 +2,12 @@
 
 ``CloudSky("fair_weather")`` is the whole cloud chain as one plugin group: the simulation
 (:class:`CloudsPlugin`), its sprites (:class:`CloudRenderPlugin`), their ground shadows
-(:class:`CloudShadowsPlugin`) and :class:`FollowCameraPlugin`, which keeps the volume centred on
+(:class:`CloudShadowsPlugin`), :class:`FollowCameraPlugin`, which keeps the volume centred on
 the camera in whole cells (the automaton advects by the move, so clouds stay where they are in
-the world). ``cloud_settings(preset, cover=..., altitude=..., ...)`` gives the settings alone.
+the world), and :class:`CloudWeatherPlugin` (``sky.weather``), which changes the weather while the
+game runs: ``sky.weather.configure(preset="overcast", transition=30)`` or ``configure(cover=0.6)``
+moves cover, cloud size, darkness, base and thickness there over ``transition`` seconds of game time.
+``cloud_settings(preset, cover=..., altitude=..., ...)`` gives the settings alone.
 """
 from __future__ import annotations
 
@@ -12,7 +15,7 @@ import math
 from dataclasses import dataclass, replace
 
 from atmos.camera import Camera
-from atmos.checks import check_choice, check_num
+from atmos.checks import CheckedSettings, check_choice, check_num, choice_field, num_field
 from atmos.plugin import Plugin, PluginGroup
 from atmos.plugins.clouds.sprites import CloudRenderPlugin
 from atmos.plugins.clouds.weather.example import example_weather
@@ -79,29 +82,124 @@ def follow_origin(camera_position, settings: CloudSettings) -> tuple[float, floa
 
 
 class FollowCameraPlugin(Plugin):
-    """Keeps the cloud volume centred on the Camera (update stage, "clouds_follow_camera", after any
-    camera controller of that stage); needs a CloudsPlugin."""
+    """Keeps the volume of ``clouds`` (a CloudsPlugin of the same App) centred on the Camera (update
+    stage, "clouds_follow_camera", after any camera controller of that stage)."""
+
+    def __init__(self, clouds: CloudsPlugin):
+        super().__init__()
+        if not isinstance(clouds, CloudsPlugin):
+            raise ValueError(f"FollowCameraPlugin moves a CloudsPlugin's volume; got {type(clouds).__name__}")
+        self.clouds = clouds
 
     def build(self, app) -> None:
         app.add_system(self.follow, "update", label="clouds_follow_camera")
 
     def finish(self, app) -> None:
-        if not any(isinstance(p, CloudsPlugin) for p in app.plugins):
-            raise ValueError("FollowCameraPlugin moves the cloud volume, but the App has no CloudsPlugin")
         self.follow(app)                 # centred before the start-up warm-up forms the first clouds
 
     def follow(self, app) -> None:
-        clouds = next(p for p in app.plugins if isinstance(p, CloudsPlugin))
         camera, origin = app.get_resource(Camera), app.get_resource(VolumeOrigin)
         if camera is not None and origin is not None:
-            origin.x, origin.z = follow_origin(camera.position, clouds.settings)
+            origin.x, origin.z = follow_origin(camera.position, self.clouds.settings)
+
+
+@dataclass(frozen=True)
+class CloudWeatherSettings(CheckedSettings):
+    """The weather a CloudSky moves toward (all live: a change starts a transition from where the
+    weather is now)."""
+    preset: str = choice_field("fair_weather", tuple(PRESETS), "the sky's kind: its cover, cloud size, "
+                               "darkness (sigma_t), base altitude and thickness")
+    cover: float | None = num_field(None, 0.0, 1.0, "the fraction of the sky to cover (None: the preset's)",
+                                    optional=True)
+    transition: float = num_field(20.0, 0.0, 3600.0, "seconds of game time a change takes (0: at once; the "
+                                  "clouds themselves still form and dissolve over a few simulation steps)")
+
+
+class CloudWeatherPlugin(Plugin):
+    """Moves a CloudsPlugin's weather toward :class:`CloudWeatherSettings` over ``transition`` seconds
+    (update stage): the cover as the number of weather ellipsoids (added or removed fast enough to get
+    there in time), and cloud size, extinction, base altitude and thickness blended with a smoothstep.
+    ``configure(preset=..., cover=..., transition=...)`` while playing; :attr:`cover` is where the
+    weather is now."""
+
+    settings_class = CloudWeatherSettings
+
+    def __init__(self, settings=None, *, clouds: CloudsPlugin | None = None, **fields):
+        super().__init__(settings, **fields)
+        if clouds is not None and not isinstance(clouds, CloudsPlugin):
+            raise ValueError(f"CloudWeatherPlugin changes a CloudsPlugin's weather (clouds=...); got "
+                             f"{type(clouds).__name__}")
+        self.clouds = clouds
+        self._now = self._target = self._start = self._values(self.settings)
+        self._t0 = self._time = self._duration = 0.0
+        if clouds is not None:
+            self._start_from(clouds.settings)
+
+    def _start_from(self, s) -> None:
+        """Where the weather is: the clouds' own settings."""
+        cx = s.cell_size[0]
+        self._now = {"cover": self._values(self.settings)["cover"], "size": s.weather.cloud_size * cx,
+                     "sigma_t": s.sigma_t, "altitude": s.base_altitude,
+                     "thickness": s.cell_size[1] * s.weather.volume_shape[1]}
+        self._target = dict(self._now)
+        self._start, self._t0, self._time, self._duration = self._now, 0.0, 0.0, 0.0
+
+    @staticmethod
+    def _values(s: CloudWeatherSettings) -> dict:
+        p = PRESETS[s.preset]
+        return {"cover": p.cover if s.cover is None else s.cover, "size": p.size, "sigma_t": p.sigma_t,
+                "altitude": p.altitude, "thickness": p.thickness}
+
+    @property
+    def cover(self) -> float:
+        """The cover the weather aims at now (moving toward the settings' during a transition)."""
+        return self._now["cover"]
+
+    def configure(self, **changes):
+        settings = super().configure(**changes)
+        self._start, self._target = dict(self._now), self._values(self.settings)
+        self._t0, self._duration = self._time, self.settings.transition
+        return settings
+
+    def build(self, app) -> None:
+        if self.clouds is None:
+            raise ValueError("CloudWeatherPlugin needs the CloudsPlugin it changes: CloudWeatherPlugin(clouds=...) "
+                             "(CloudSky makes both)")
+        app.add_system(self.update, "update", label="cloud_weather")
+
+    def update(self, app) -> None:
+        self._time = app.clock.frame_time
+        if self._now == self._target:
+            return
+        s = 1.0 if self._duration <= 0 else min(max((self._time - self._t0) / self._duration, 0.0), 1.0)
+        eased = s * s * (3.0 - 2.0 * s)
+        now = {k: self._start[k] + (self._target[k] - self._start[k]) * (s if k == "cover" else eased)
+               for k in self._target}
+        self._now = self._target if s >= 1.0 else now
+        self._apply()
+
+    def _apply(self) -> None:
+        v, s = self._now, self.clouds.settings
+        cx, _, cz = s.cell_size
+        cell_y = v["thickness"] / s.weather.volume_shape[1]
+        clouds = max(1, int(math.ceil(v["cover"] * FULL_COVER)))
+        goal = max(1, int(math.ceil(self._target["cover"] * FULL_COVER)))
+        steps = max(1.0, self._duration / s.step_seconds)          # weather steps left to get there
+        adaption = max(4, int(math.ceil(abs(goal - s.weather.cloud_density) / steps)), s.weather.density_adaption)
+        self.clouds.configure(sigma_t=v["sigma_t"], base_altitude=v["altitude"], cell_size=(cx, cell_y, cz),
+                              weather={"cloud_density": clouds, "density_adaption": adaption,
+                                       "cloud_size": v["size"] / cx, "cloud_size_variance": 0.3 * v["size"] / cx})
 
 
 class CloudSky(PluginGroup):
     """A cloudy sky for a game: ``CloudSky("fair_weather" | "broken" | "overcast", seed=0,
-    warmup_steps=12, **preset_changes)`` (see :func:`cloud_settings`)."""
+    warmup_steps=12, transition=20, **preset_changes)`` (see :func:`cloud_settings`); ``sky.weather``
+    (:class:`CloudWeatherPlugin`) changes it while playing."""
 
-    def __init__(self, preset: str = "fair_weather", *, seed: int = 0, warmup_steps: int = WARMUP_STEPS, **changes):
+    def __init__(self, preset: str = "fair_weather", *, seed: int = 0, warmup_steps: int = WARMUP_STEPS,
+                 transition: float = 20.0, **changes):
         settings = cloud_settings(preset, **changes)
-        super().__init__(CloudsPlugin(settings, seed=seed, warmup_steps=warmup_steps),
-                         CloudRenderPlugin(size_factor=4.0), CloudShadowsPlugin(), FollowCameraPlugin())
+        clouds = CloudsPlugin(settings, seed=seed, warmup_steps=warmup_steps)
+        self.weather = CloudWeatherPlugin(clouds=clouds, preset=preset, cover=changes.get("cover"), transition=transition)
+        super().__init__(clouds, CloudRenderPlugin(size_factor=4.0), CloudShadowsPlugin(), FollowCameraPlugin(clouds),
+                         self.weather)
