@@ -60,6 +60,15 @@ _EXPORTS = {
     "GroundPlugin": "atmos.plugins.ground", "TerrainPlugin": "atmos.plugins.terrain",
     "TerrainSettings": "atmos.plugins.terrain", "MeshPlugin": "atmos.plugins.mesh", "Mesh": "atmos.plugins.mesh",
     "MeshInstance": "atmos.plugins.mesh", "TextPlugin": "atmos.plugins.text", "Label": "atmos.plugins.text",
+    "box": "atmos.plugins.mesh", "sphere": "atmos.plugins.mesh", "cylinder": "atmos.plugins.mesh",
+    "cone": "atmos.plugins.mesh", "capsule": "atmos.plugins.mesh", "torus": "atmos.plugins.mesh",
+    "plane": "atmos.plugins.mesh", "revolve": "atmos.plugins.mesh", "mesh_bounds": "atmos.plugins.mesh",
+    "raycast_instances": "atmos.plugins.mesh", "Parent": "atmos.transform", "world_matrix": "atmos.transform",
+    # collisions (numpy, float64)
+    "Hit": "atmos.collision", "ray_triangles": "atmos.collision", "ray_box": "atmos.collision",
+    "ray_sphere": "atmos.collision", "ray_heightfield": "atmos.collision", "ray_grid": "atmos.collision",
+    "segment": "atmos.collision", "sphere_sphere": "atmos.collision", "sphere_box": "atmos.collision",
+    "box_box": "atmos.collision", "closest_point_box": "atmos.collision", "bounds": "atmos.collision",
     # game logic: timers, states, scripted play
     "Timer": "atmos.timers", "States": "atmos.states", "ScriptPlugin": "atmos.script",
 }

@@ -2,6 +2,7 @@
 drawing can interpolate between fixed steps by ``clock.alpha`` and simulated motion does not stutter.
 
 Move entities in ``simulate`` systems (fixed step); draw ``transform.interpolated(app.clock.alpha)``.
+An entity with a :class:`Parent` is placed in its parent's frame (:func:`world_matrix`).
 The TransformPlugin keeps ``previous`` by running its snapshot first in every fixed step (its
 ``finish`` orders it before every other ``simulate`` system). A teleport (a reset) calls
 :meth:`Transform.teleport`, so it is not smeared over a step.
@@ -91,6 +92,43 @@ class Transform:
         position = tuple(float(v) for v in np.asarray(p.position) + a * (self.position - np.asarray(p.position)))
         return Pose(position, _turn(p.yaw, self.yaw, a), p.pitch + a * (self.pitch - p.pitch),
                     _turn(p.roll, self.roll, a))
+
+
+@dataclass(frozen=True, slots=True)
+class Parent:
+    """This entity's Transform is relative to entity ``entity``'s (a basket under its balloon): its
+    position, turns and scale are in the parent's frame, and it moves with the parent."""
+    entity: int
+
+    def __post_init__(self):
+        if isinstance(self.entity, bool) or not isinstance(self.entity, (int, np.integer)) or self.entity < 0:
+            raise ValueError(f"Parent.entity must be an entity id (an int >= 0), got {self.entity!r}")
+
+
+MAX_DEPTH = 64          # parents above one entity: deeper is a cycle or a mistake
+
+
+def world_matrix(world, entity: int, alpha: float = 1.0) -> np.ndarray:
+    """The 4×4 model matrix of ``entity`` in the world: its Transform ``alpha`` of the way from its last
+    fixed step, under each :class:`Parent`'s in turn. A parent without a Transform, a missing parent
+    or a cycle is a ValueError naming the entity."""
+    m, seen = np.identity(4), [entity]
+    while True:
+        transform = world.try_component(entity, Transform)
+        if transform is None:
+            raise ValueError(f"entity {seen[0]}: {'its parent ' if len(seen) > 1 else ''}entity {entity} has no "
+                             f"Transform, so it cannot be placed")
+        m = transform.interpolated(alpha).matrix(transform.scale) @ m
+        parent = world.try_component(entity, Parent)
+        if parent is None:
+            return m
+        entity = int(parent.entity)
+        if entity in seen or len(seen) > MAX_DEPTH:
+            raise ValueError(f"entity {seen[0]}: its parents {seen + [entity]} form a cycle (or are deeper than "
+                             f"{MAX_DEPTH})")
+        if not world.has_entity(entity):
+            raise ValueError(f"entity {seen[0]}: its parent entity {entity} does not exist (deleted?)")
+        seen.append(entity)
 
 
 def snapshot_transforms(app) -> None:

@@ -7,25 +7,40 @@ its pose interpolated by ``clock.alpha``, lit by the ``Sun`` and the sky's ambie
     crate = box((2, 2, 2))
     app.world.create_entity(Transform(position=(0, 5, 0)), MeshInstance(crate, color=(0.6, 0.4, 0.2)))
 
+Shapes: :func:`box`, :func:`sphere`, :func:`cylinder`, :func:`cone`, :func:`capsule`, :func:`torus`,
+:func:`plane`, any profile turned about y (:func:`revolve`), files (:meth:`Mesh.load`). An entity
+with a :class:`atmos.transform.Parent` is placed in its parent's frame (a basket under its balloon).
+
 All instances of one :class:`Mesh` are one draw. GPU buffers of a mesh no entity uses for
 ``EVICT_FRAMES`` frames are released.
+
+For game logic, :func:`mesh_bounds` gives a mesh's box (in world space under a Transform) and
+:func:`raycast_instances` the first instance a ray meets (both at the Transform's current pose)::
+
+    found = raycast_instances(app.world, origin, direction, max_distance=100.0)
+    if found is not None:
+        entity, hit = found          # an atmos.collision.Hit: distance, point, normal, triangle
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from atmos.checks import check_vec
+from atmos.collision import Hit, check_ray, bounds, ray_box, ray_triangles
 from atmos.graph import PassContext
 from atmos.plugin import Plugin
-from atmos.plugins.mesh.geometry import Mesh, box, glider
+from atmos.plugins.mesh.geometry import Mesh, box, capsule, cone, cylinder, glider, plane, revolve, sphere, torus
 from atmos.render_core import OpaquePass
-from atmos.transform import Transform
+from atmos.transform import Parent, Transform, world_matrix
 
-__all__ = ["Mesh", "MeshInstance", "MeshPlugin", "box", "glider"]
+__all__ = ["Mesh", "MeshInstance", "MeshPlugin", "Parent", "box", "capsule", "cone", "cylinder", "glider", "mesh_bounds",
+           "plane", "raycast_instances", "revolve", "sphere", "torus"]
 
 EVICT_FRAMES = 120
+_CORNERS = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], np.float64)
 
 
 @dataclass(slots=True)
@@ -41,12 +56,51 @@ class MeshInstance:
         self.color = check_vec("MeshInstance", "color", self.color, 3, "non-negative")
 
 
+def _model(transform) -> np.ndarray | None:
+    if transform is None:
+        return None
+    if isinstance(transform, Transform):
+        return transform.pose().matrix(transform.scale)
+    return np.asarray(transform, np.float64)
+
+
+def mesh_bounds(mesh: Mesh, transform=None) -> tuple[np.ndarray, np.ndarray]:
+    """(box_min, box_max) of ``mesh``'s vertices: in model space, or in world space under
+    ``transform`` (a :class:`atmos.Transform` at its current pose and scale, or a 4×4 model matrix)."""
+    if not isinstance(mesh, Mesh):
+        raise ValueError(f"mesh_bounds: mesh must be an atmos Mesh, got {type(mesh).__name__}")
+    return bounds(mesh.positions, _model(transform))
+
+
+def raycast_instances(world, origin, direction, max_distance=math.inf, ignore=()) -> tuple[int, Hit] | None:
+    """(entity, :class:`~atmos.collision.Hit`) of the nearest mesh instance (entity with a Transform and
+    a MeshInstance, at its current pose: what ``simulate`` systems see) the ray meets, or None;
+    ``Hit.triangle`` is the row of ``mesh.indices``. Entities in ``ignore`` (e.g. the shooter) are
+    skipped. Each instance's world box culls it before its triangles are tested (both faces)."""
+    o, d, max_distance = check_ray("raycast_instances", origin, direction, max_distance)
+    ignore = {ignore} if isinstance(ignore, (int, np.integer)) else set(ignore)
+    best = None
+    for entity, (transform, instance) in world.get_components(Transform, MeshInstance):
+        if entity in ignore:
+            continue
+        m = world_matrix(world, entity)
+        lo, hi = bounds(instance.mesh.positions)
+        if ray_box(o, d, *bounds(lo + _CORNERS * (hi - lo), m), max_distance) is None:
+            continue
+        vertices = instance.mesh.positions @ m[:3, :3].T + m[:3, 3]
+        hit = ray_triangles(o, d, vertices, instance.mesh.indices, max_distance)
+        if hit is not None:
+            best, max_distance = (entity, hit), hit.distance
+    return best
+
+
 def collect_instances(world, alpha: float) -> dict:
     """{mesh: float32 (k, 19) rows of model matrix (column-major) and colour} for every entity with
     a Transform and a MeshInstance, posed ``alpha`` of the way from its last fixed step."""
     groups: dict = {}
     for entity, (transform, instance) in world.get_components(Transform, MeshInstance):
-        m = transform.interpolated(alpha).matrix(transform.scale)
+        m = world_matrix(world, entity, alpha) if world.has_component(entity, Parent) else \
+            transform.interpolated(alpha).matrix(transform.scale)
         groups.setdefault(instance.mesh, []).append((entity, np.concatenate([m.T.ravel(), instance.color])))
     out = {}
     for mesh, rows in groups.items():

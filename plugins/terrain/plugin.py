@@ -1,9 +1,13 @@
 """TerrainPlugin and its pass: draws the heightfield into ``color`` and ``depth``."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from atmos.checks import CheckedSettings, int_field, num_field
+from atmos.collision import Hit, check_ray, height_normal, ray_grid
 from atmos.graph import PassContext
 from atmos.plugin import Plugin
 from atmos.plugins.terrain.heightfield import height, heightfield, triangle_count
@@ -68,6 +72,7 @@ class TerrainPlugin(Plugin):
     ``configure(**changes)`` changes any of them live (the mesh is re-made on the next frame)."""
 
     settings_class = TerrainSettings
+    _collision_grid: tuple | None = None          # (settings.mesh_key(), float64 heights of the drawn mesh)
 
     @property
     def triangles(self) -> int:
@@ -78,6 +83,29 @@ class TerrainPlugin(Plugin):
         vertices the mesh is flat, so it may differ there by a little)."""
         s = self.settings
         return height(x, z, s.relief, s.size)
+
+    def normal_at(self, x, z) -> np.ndarray:
+        """The ground's unit normal(s), shape (..., 3), under world (x, z) (arrays broadcast), from the
+        height formula's slope (smooth, as the mesh's shading normals; a :meth:`raycast` hit carries
+        the flat triangle's normal instead)."""
+        s = self.settings
+        return height_normal(self.height_at, x, z, eps=1e-4 * s.size)
+
+    def raycast(self, origin, direction, max_distance=math.inf) -> Hit | None:
+        """The first point where the ray meets the terrain as drawn (the flat triangles of the current
+        settings' mesh, :func:`atmos.collision.ray_grid`): a :class:`~atmos.collision.Hit` with the
+        distance, the point, the triangle's normal facing the ray and its number in the mesh, or None
+        (beyond ``size``/2 there is no ground). A ray starting at or under the ground over the terrain
+        hits at distance 0. For a segment: ``atmos.collision.segment(terrain.raycast, a, b)``."""
+        origin, direction, max_distance = check_ray("TerrainPlugin.raycast", origin, direction, max_distance)
+        s = self.settings
+        key = s.mesh_key()
+        if self._collision_grid is None or self._collision_grid[0] != key:
+            axis = np.linspace(-s.size / 2, s.size / 2, s.cells + 1)     # heightfield()'s vertex heights
+            x, z = np.meshgrid(axis, axis, indexing="ij")
+            heights = height(x, z, s.relief, s.size).astype(np.float32).astype(np.float64)
+            self._collision_grid = (key, heights)
+        return ray_grid(origin, direction, self._collision_grid[1], s.size, max_distance)
 
     def build(self, app) -> None:
         app.graph.add_pass(TerrainPass(self))
