@@ -98,7 +98,7 @@ def build(app, settings) -> None:
     chase = ChaseCameraPlugin(distance=60.0, height=12.0)
     sky = CloudSky("fair_weather", seed=settings.seed, altitude=900.0, transition=30.0)
     app.add_plugins(DefaultPlugins(fly_camera=False), DaylightPlugin(hours=6.2, speed=0.05),
-                    SkyPlugin(model=settings.sky), terrain, sky, MeshPlugin(), TextPlugin(), chase,
+                    SkyPlugin(model=settings.sky), terrain, sky, MeshPlugin(), TextPlugin(design_height=540), chase,
                     FogPlugin(mode="height", density=0.006, height_base=0.0, scale_height=30.0, sky="keep",
                               color_from="sky", fog_color=(1.0, 1.0, 1.0)))
     cam = app.resource(Camera)

@@ -70,3 +70,31 @@ def test_bad_labels_are_named():
         Label("x", color=(255, 0, 0, 1))
     with pytest.raises(ValueError, match="TextPlugin.font must be a TrueType/OpenType font file or None; cannot load"):
         TextPlugin(font=__file__)
+
+
+def test_labels_laid_out_for_a_design_height_keep_their_size_relative_to_the_frame():
+    """TextPlugin(design_height=90): at 320x180 a label is twice as tall and twice as far from its anchor
+    as at 160x90, so a HUD keeps its place and size when the window grows."""
+    boxes = {}
+    for size in ((160, 90), (320, 180)):
+        gpu = create_headless(size)
+        try:
+            def render(with_label):
+                app = App(gpu).add_plugins(DefaultPlugins(fly_camera=False), SkyGradientPlugin(),
+                                           TextPlugin(design_height=90))
+                if with_label:
+                    app.world.create_entity(Label("HUD 12", x=10, y=8, size=16))
+                app.run_frames(1)
+                pixels = gpu.read_pixels().astype(int)
+                app.close()
+                return pixels
+            changed = np.abs(render(True) - render(False)).sum(-1) > 60
+            rows, cols = np.nonzero(changed)
+            boxes[size] = (rows.min(), rows.max(), cols.min(), cols.max())
+        finally:
+            gpu.release()
+    (t1, b1, l1, r1), (t2, b2, l2, r2) = boxes[(160, 90)], boxes[(320, 180)]
+    assert (b2 - t2) / (b1 - t1) == pytest.approx(2.0, abs=0.25) and (r2 - l2) / (r1 - l1) == pytest.approx(2.0, abs=0.25)
+    assert l2 == pytest.approx(2 * l1, abs=3) and t2 == pytest.approx(2 * t1, abs=3)
+    with pytest.raises(ValueError, match="TextPlugin.design_height must be a whole number 16..16384"):
+        TextPlugin(design_height=0)

@@ -6,7 +6,9 @@ so it looks the same in a window and headless::
     app.world.component_for_entity(score, Label).text = "score 1"      # re-rasterised once
 
 ``anchor`` (ax, ay) in [0, 1] picks the point of the frame and of the label that meet, offset by
-(x, y) pixels (y down): (0, 0) top left, (0.5, 0.5) centred, (1, 1) bottom right.
+(x, y) pixels (y down): (0, 0) top left, (0.5, 0.5) centred, (1, 1) bottom right. With
+``TextPlugin(design_height=540)`` sizes and offsets are pixels of a frame that tall, scaled to the
+frame's height: the HUD keeps its size relative to the window.
 """
 from __future__ import annotations
 
@@ -51,10 +53,12 @@ class Label:
         return self
 
 
-def label_origin(label: Label, shape: tuple[int, int], frame: tuple[int, int]) -> tuple[int, int]:
-    """Top-left pixel (x, y down) of a label whose bitmap is ``shape`` (h, w) in a ``frame`` (w, h)."""
+def label_origin(label: Label, shape: tuple[int, int], frame: tuple[int, int], scale: float = 1.0) -> tuple[int, int]:
+    """Top-left pixel (x, y down) of a label whose bitmap is ``shape`` (h, w) in a ``frame`` (w, h), its
+    offset scaled by ``scale``."""
     ax, ay = label.anchor
-    return (round(ax * frame[0] - ax * shape[1] + label.x), round(ay * frame[1] - ay * shape[0] + label.y))
+    return (round(ax * frame[0] - ax * shape[1] + label.x * scale),
+            round(ay * frame[1] - ay * shape[0] + label.y * scale))
 
 
 class TextPass(FullscreenPass):
@@ -72,11 +76,11 @@ class TextPass(FullscreenPass):
         if self.plugin.labels:
             super().setup(builder)                   # nothing to draw: declares nothing, culled
 
-    def _texture(self, ctx, label: Label):
-        key = (label.text, label.size)
+    def _texture(self, ctx, label: Label, size: int):
+        key = (label.text, size)
         texture = self.textures.get(key)
         if texture is None:
-            coverage = rasterize(label.text, label.size, self.plugin.font)
+            coverage = rasterize(label.text, size, self.plugin.font)
             texture = self.textures[key] = ctx.texture(coverage.shape[::-1], 1, coverage.tobytes(), alignment=1)
             while len(self.textures) > CACHE:
                 self.textures.popitem(last=False)[1].release()
@@ -88,10 +92,11 @@ class TextPass(FullscreenPass):
         frame.resource(SCREEN).use()
         frame.blend_alpha()
         w, h = frame.gpu.size
+        scale = h / self.plugin.design_height if self.plugin.design_height else 1.0
         program = self.program
         for label in self.plugin.labels:
-            texture = self._texture(ctx, label)
-            x, y = label_origin(label, (texture.height, texture.width), (w, h))
+            texture = self._texture(ctx, label, min(max(round(label.size * scale), 4), 512))
+            x, y = label_origin(label, (texture.height, texture.width), (w, h), scale)
             ctx.viewport = (x, h - y - texture.height, texture.width, texture.height)   # the graph resets it
             bind_textures(program, coverage=texture)
             program["color"].value = label.color
@@ -105,15 +110,19 @@ class TextPass(FullscreenPass):
 
 class TextPlugin(Plugin):
     """Draws every :class:`Label` entity over the frame (pass "text", after the frame-time overlay).
-    ``font``: a .ttf/.otf file (checked here), or None for Pillow's bundled font."""
+    ``font``: a .ttf/.otf file (checked here), or None for Pillow's bundled font. ``design_height``:
+    None (labels in frame pixels) or the frame height (pixels) the labels are laid out for; they scale
+    with the frame's height."""
 
-    def __init__(self, font: str | None = None):
+    def __init__(self, font: str | None = None, design_height: int | None = None):
         super().__init__()
         if font is not None and not isinstance(font, str):
             raise ValueError(f"TextPlugin.font must be a font file path or None, got {font!r}")
         if font is not None:
             load_font(font, 12)                      # fails now, naming the file, if it is no font
         self.font = font
+        self.design_height = None if design_height is None else check_int("TextPlugin", "design_height",
+                                                                          design_height, 16, 16384)
 
     def build(self, app) -> None:
         self.labels: list[Label] = []
