@@ -296,15 +296,16 @@ SPECS = {
         # a sun turned by less than the default tolerance: only a tolerance of 0 re-bakes for it
         before={"rebake_tolerance": lambda app, plugin: plugin.configure(rebake_tolerance=1.0)},
         warm=2.0),
-    "volumetric_fog": Spec(
-        lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(),
+    "volumetric_fog": Spec(      # a SkyPlugin: its light is the fog's ambient with ambient_from="sky"
+        lambda: [DefaultPlugins(overlay=False), SkyPlugin(), GroundPlugin(),
                  VolumetricFogPlugin(center=(0.0, 1.0, -10.0), scale=(8.0, 2.0, 8.0), falloff=0.5, bias=0.3,
                                      absorption=0.3, steps=16, light_steps=2, max_distance=60.0, octaves=3)],
         VolumetricFogPlugin,
         look((0.0, 3.0, 10.0), yaw=0.0, pitch=-0.1),
         dict(center=(3.0, 0.0, -12.0), scale=(4.0, 3.0, 4.0), bias=0.6, falloff=0.2, frequency=0.5, octaves=5,
              seed=9, wind=(-4.0, 1.0, 3.0), absorption=0.05, steps=40, light_steps=6, light_step=0.5,
-             max_distance=12.0, ambient=(0.9, 0.1, 0.1), scattering=(0.1, 0.1, 0.9), animate=False)),
+             max_distance=12.0, ambient=(0.9, 0.1, 0.1), scattering=(0.1, 0.1, 0.9), animate=False,
+             ambient_from="sky")),
     "fog": Spec(
         lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(),
                  FogPlugin(mode="hetero_exp2", density=0.06, resolutions=(4, 8, 8, 16), tile_size=32.0)],

@@ -265,3 +265,33 @@ def test_volumetric_fog_demo_runs_headless(tmp_path, capsys):
                  "--out", str(out), "--quiet"]) == 0
     img = np.asarray(Image.open(out / "frame_00002.png"), float)
     assert img.std() > 5, "not a blank frame"
+
+
+def test_the_fog_can_take_its_ambient_light_from_the_sky():
+    """ambient_from="sky": the ambient is the App's sky's mean horizon radiance: the night sky's glow at
+    night (darker than the fixed ambient's tenth), warmer at dawn than at noon; the pass renders with
+    it; without a sky it is a clear error."""
+    from types import SimpleNamespace
+    from atmos.gpu import create_headless
+    from atmos.plugins.sky import SkyPlugin
+    gpu = create_headless((48, 27))
+    try:
+        fog = VolumetricFogPlugin(ambient_from="sky", ambient=(1.0, 1.0, 1.0))
+        app = App(gpu).add_plugins(DefaultPlugins(), SkyPlugin(), GroundPlugin(), fog)
+        app.run_frames(2)
+        cam = app.resource(Camera)
+        light = {name: fog.sky_ambient(SimpleNamespace(sun=Sun.from_angles(elevation_deg=e, azimuth_deg=90.0), camera=cam))
+                 for name, e in (("noon", 60.0), ("dawn", 2.0), ("night", -20.0))}
+        assert all(np.isfinite(v).all() and (v >= 0).all() for v in light.values())
+        assert light["night"].sum() < 0.1 * light["noon"].sum()           # the night sky's faint glow
+        fixed_night = sun_terms(Sun.from_angles(elevation_deg=-20.0, azimuth_deg=90.0), VolumetricFogSettings())[2]
+        assert light["night"].sum() < 0.5 * fixed_night.sum()
+        assert light["dawn"][0] / light["dawn"][2] > 1.2 * light["noon"][0] / light["noon"][2]    # warmer at dawn
+        assert gpu.ctx.error == "GL_NO_ERROR" and np.isfinite(gpu.read_pixels()).all()
+        app.close()
+        bare = App(gpu).add_plugins(DefaultPlugins(), GroundPlugin(), VolumetricFogPlugin(ambient_from="sky"))
+        with pytest.raises(ValueError, match="ambient_from='sky' takes the light of the App's sky"):
+            bare.run_frames(1)
+        bare.close()
+    finally:
+        gpu.release()

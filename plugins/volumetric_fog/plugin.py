@@ -9,21 +9,29 @@ from atmos.graph import FullscreenPass, PassContext
 from atmos.lighting import Sun, sun_and_day
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
+from atmos.plugins.sky import SkyLight
 from atmos.plugins.volumetric_fog.settings import VolumetricFogSettings
+
+HORIZON_SAMPLES = 16      # azimuths of the sky's horizon radiance averaged into the ambient
 from atmos.gpu.uniforms import bind_textures, write_uniforms
 
 
-def sun_terms(sun: Sun, settings: VolumetricFogSettings):
-    """(unit direction toward the sun, sun_light, ambient_light): the sun fades out below the horizon."""
+def sun_terms(sun: Sun, settings: VolumetricFogSettings, sky_ambient=None):
+    """(unit direction toward the sun, sun_light, ambient_light): the sun fades out below the horizon;
+    the ambient follows the day, or is ``settings.ambient`` ⊙ ``sky_ambient`` (the sky's mean horizon
+    radiance, ``ambient_from="sky"``)."""
     s, day = sun_and_day(sun)
     sun_light = np.asarray(sun.color, np.float64) * settings.scattering * day
-    ambient_light = np.asarray(settings.ambient) * (0.1 + 0.9 * day)
+    if sky_ambient is not None:
+        ambient_light = np.asarray(settings.ambient) * np.asarray(sky_ambient, np.float64)
+    else:
+        ambient_light = np.asarray(settings.ambient) * (0.1 + 0.9 * day)
     return s, sun_light, ambient_light
 
 
-def set_medium_uniforms(program, settings: VolumetricFogSettings, sun: Sun, time: float) -> None:
+def set_medium_uniforms(program, settings: VolumetricFogSettings, sun: Sun, time: float, sky_ambient=None) -> None:
     """Write every uniform of ``volumetric_fog/medium.glsl``."""
-    s, sun_light, ambient_light = sun_terms(sun, settings)
+    s, sun_light, ambient_light = sun_terms(sun, settings, sky_ambient)
     values = {"center": settings.center, "scale": settings.scale, "bias": settings.bias, "falloff": settings.falloff,
               "frequency": settings.frequency, "wind": settings.wind, "time": float(time),
               "octaves": settings.octaves, "seed": settings.seed, "absorption": settings.absorption,
@@ -54,7 +62,7 @@ class VolumetricFogPass(FullscreenPass):
         frame.blend_transmittance()
         bind_textures(p, scene_depth=frame.resource(DEPTH))
         set_camera_uniforms(p, view.camera, view.aspect)
-        set_medium_uniforms(p, self.plugin.settings, view.sun, self.plugin.time(view))
+        set_medium_uniforms(p, self.plugin.settings, view.sun, self.plugin.time(view), self.plugin.sky_ambient(view))
         frame.fullscreen(p)
 
 
@@ -65,15 +73,28 @@ class VolumetricFogPlugin(Plugin):
     """
 
     settings_class = VolumetricFogSettings
+    _sky: SkyLight | None = None
 
     def time(self, view) -> float:
         """Seconds the noise has drifted for: the view's frame time (0 unless ``animate``)."""
         return float(view.time) if self.settings.animate else 0.0
 
+    def sky_ambient(self, view):
+        """The sky's mean horizon radiance at the camera's altitude (``ambient_from="sky"``), else None."""
+        if self.settings.ambient_from != "sky":
+            return None
+        if self._sky is None:
+            raise ValueError("VolumetricFogSettings.ambient_from='sky' takes the light of the App's sky, and the "
+                             "App has no SkyPlugin; add one or use ambient_from='fixed'")
+        return self._sky.horizon(view.sun, max(float(view.camera.position[1]), 0.0), HORIZON_SAMPLES).mean(0)
+
     def build(self, app) -> None:
         self.composition = composition(app)
         self.composition.media_writers.add(VolumetricFogPass.name)   # a local medium (atmos.composition)
         app.graph.add_pass(VolumetricFogPass(self))
+
+    def finish(self, app) -> None:
+        self._sky = app.get_resource(SkyLight)      # the sky's published light, if the App has a sky
 
     def cleanup(self, app) -> None:
         self.composition.media_writers.discard(VolumetricFogPass.name)

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from atmos.checks import CheckedSettings, bool_field, int_field, num_field, vec_field
+from atmos.checks import CheckedSettings, bool_field, choice_field, int_field, num_field, vec_field
 
 MAX_OCTAVES = 16
 MAX_STEPS = 1024
@@ -36,3 +36,7 @@ class VolumetricFogSettings(CheckedSettings):
     scattering: tuple = vec_field((1.0, 0.7, 0.4), 3, "non-negative", "colour of scattered sunlight (times "
                                   "the sun colour)")
     animate: bool = bool_field(True, "drift with the App clock (False: frozen at time 0)")
+    ambient_from: str = choice_field("fixed", ("fixed", "sky"), "fixed: ambient × a day factor of the sun's "
+                                     "height; sky: ambient ⊙ the App's sky's mean horizon radiance (a SkyPlugin's "
+                                     "light at the camera's altitude: dawn-coloured at dawn, dark at night; "
+                                     "ambient=(1, 1, 1) for the sky's own colour)")
