@@ -306,3 +306,28 @@ def test_fog_valley_demo_renders_fog_over_terrain(tmp_path, capsys, monkeypatch,
     assert img.std() > 3.0                                       # not a flat picture
     assert img[-10:, :, 1].mean() > img[-10:, :, 0].mean()       # green terrain still shows near the camera
     assert img[:5].mean() > 150                                  # fogged sky is light
+
+
+@pytest.mark.parametrize("color_from", ["fixed", "sky"])
+def test_the_fog_scatters_sunlight_with_its_phase(gpu, ctx, rng, color_from):
+    """sun_scattering > 0: the fog's colour gains Sun.color × sun_scattering × 4π p(θ): brightest toward
+    the sun; the GPU matches the float64 reference; a set sun scatters none."""
+    from atmos.lighting import Sun
+    from atmos.plugins.fog.sky_color import SAMPLES
+    color, distance, positions = random_inputs(rng)
+    dirs = rng.normal(size=color.shape)
+    dirs /= np.linalg.norm(dirs, axis=-1, keepdims=True)
+    sun = Sun.from_angles(elevation_deg=float(rng.uniform(5, 60)), azimuth_deg=float(rng.uniform(0, 360)))
+    dirs[2, 0] = sun.direction / np.linalg.norm(sun.direction)                  # one pixel looks at the sun
+    distance[2] = 300.0                                                         # its row all as deep in fog
+    horizon = rng.uniform(0.1, 1.0, (SAMPLES, 3)) if color_from == "sky" else None
+    kw = dict(mode="exp", density=0.02, sun_scattering=0.3, color_from=color_from, horizon=horizon, directions=dirs)
+    out = apply_fog(gpu, color, distance, sun=sun, **kw)
+    settings = FogSettings(mode="exp", density=0.02, sun_scattering=0.3, color_from=color_from)
+    ref = apply_fog_ref(color, distance, settings, directions=dirs, horizon=horizon, sun=sun)
+    np.testing.assert_allclose(out, ref, atol=TOL)
+    plain = apply_fog(gpu, color, distance, **{**kw, "sun_scattering": 0.0})
+    gain = (out - plain)[2].sum(-1)
+    assert (out >= plain - 1e-6).all() and gain[0] > 3 * np.median(gain[1:]), "brightest toward the sun"
+    night = Sun.from_angles(elevation_deg=-20.0, azimuth_deg=0.0)
+    np.testing.assert_allclose(apply_fog(gpu, color, distance, sun=night, **kw), plain, atol=1e-6)

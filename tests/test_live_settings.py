@@ -314,10 +314,11 @@ SPECS = {
         dict(mode="exp", density=0.01, fog_color=(0.9, 0.1, 0.1), start=5.0, end=30.0, sky="keep", octaves=2,
              resolutions=(2, 4, 8, 8), winds=((5.0, 0.0, 0.0),) * 4, tile_size=64.0, amplitude=0.3,
              noise="procedural", texels_per_cell=2, seed=11, time_offset=3.0, color_from="sky", height_base=3.0,
-             scale_height=0.5),
+             scale_height=0.5, sun_scattering=0.5, **{"phase.g": -0.3, "phase.g2": 0.8, "phase.w": 0.6}),
         before={"start": configure_first(mode="linear"), "end": configure_first(mode="linear"),
                 "height_base": configure_first(mode="height", density=0.05),
-                "scale_height": configure_first(mode="height", density=0.05)}),
+                "scale_height": configure_first(mode="height", density=0.05),
+                **{f"phase.{k}": configure_first(sun_scattering=0.5) for k in ("g", "g2", "w")}}),
     "light_shafts": Spec(     # the screen mode; the march's fields under the clouds (march_under_clouds)
         lambda: [DefaultPlugins(overlay=False), clouds(shading=False), SkyGradientPlugin(), GroundPlugin(),
                  LightShaftsPlugin(mode="screen")],

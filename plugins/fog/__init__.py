@@ -66,7 +66,7 @@ class FogPlugin(Plugin):
 def apply_fog(gpu, color, distance, mode: str = "exp2", density: float = 0.044, fog_color=(0.8, 0.8, 0.8),
               start: float = 0.0, end: float = 100.0, *, positions=None, time: float = 0.0,
               far: float = np.inf, cloud=None, directions=None, camera=(0.0, 0.0, 0.0), horizon=None,
-              color_from: str = "fixed", **noise) -> np.ndarray:
+              color_from: str = "fixed", sun=None, **noise) -> np.ndarray:
     """Fog ``color`` (float32 (H, W, 3)) at ``distance`` (float32 (H, W), +inf = sky) on the GPU with
     the pass's shader; returns float32 (H, W, 3).
 
@@ -78,7 +78,8 @@ def apply_fog(gpu, color, distance, mode: str = "exp2", density: float = 0.044, 
     ``cloud`` (H, W, 2): a layer's premultiplied (coverage × distance, coverage) as in
     :mod:`atmos.composition`, fogged by its own distance at ``camera + directions × distance``;
     ``directions`` (H, W, 3) unit view rays (needed with ``cloud`` or ``color_from="sky"``);
-    ``horizon`` the (SAMPLES, 3) sky colours of ``color_from="sky"`` (:mod:`.sky_color`).
+    ``horizon`` the (SAMPLES, 3) sky colours of ``color_from="sky"`` (:mod:`.sky_color`); ``sun`` (a
+    Sun) the sunlight scattered with ``sun_scattering``.
     ``gpu`` is a GpuContext (the program comes from its cache).
     """
     allowed = [f for f in FogSettings.__dataclass_fields__
@@ -121,7 +122,7 @@ def apply_fog(gpu, color, distance, mode: str = "exp2", density: float = 0.044, 
             volumes = NoiseVolumes(gpu, settings)
             volumes.bind(prog)
         bind_textures(prog, fog_distance=dist_tex, fog_position=pos_tex, cloud_distance=cloud_tex, fog_direction=dir_tex)
-        set_fog_uniforms(prog, settings, time, horizon)
+        set_fog_uniforms(prog, settings, time, horizon, sun)
         write_uniforms(prog, fog_far=far, fog_camera=tuple(float(v) for v in camera))
         fbo.use()
         gl.viewport = (0, 0, w, h)
@@ -141,7 +142,7 @@ def _check_layers(shape, cloud, directions, horizon, settings):
     """apply_fog's cloud layer, view directions and horizon table, checked and made contiguous."""
 
     h, w = shape
-    needs_dirs = cloud is not None or settings.color_from == "sky"
+    needs_dirs = cloud is not None or settings.color_from == "sky" or settings.sun_scattering > 0
     if cloud is not None:
         cloud = np.asarray(cloud)
         if cloud.shape != (h, w, 2) or not np.isfinite(cloud).all():
@@ -152,7 +153,8 @@ def _check_layers(shape, cloud, directions, horizon, settings):
         cloud = np.ascontiguousarray(cloud, np.float32)
     if needs_dirs:
         if directions is None:
-            raise ValueError("directions=(H, W, 3) unit view rays are needed with cloud= or color_from='sky'")
+            raise ValueError("directions=(H, W, 3) unit view rays are needed with cloud=, color_from='sky' or "
+                             "sun_scattering > 0")
         directions = np.asarray(directions)
         if directions.shape != (h, w, 3) or not np.isfinite(directions).all():
             raise ValueError(f"directions must be finite float32 (H, W, 3) = ({h}, {w}, 3), got shape "

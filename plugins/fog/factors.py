@@ -55,7 +55,7 @@ def blend(color, fog_color, f) -> np.ndarray:
 
 def apply_fog_ref(color, distance, settings, positions=None, time: float = 0.0, far: float = np.inf,
                   volumes=None, cloud=None, directions=None, camera=(0.0, 0.0, 0.0), horizon=None,
-                  ground: bool = False) -> np.ndarray:
+                  ground: bool = False, sun=None) -> np.ndarray:
     """float64 reference of :func:`atmos.plugins.fog.apply_fog` (``settings`` validated FogSettings).
 
     Sky pixels (distance +inf) use ``far`` or stay as they are when ``settings.sky == "keep"``.
@@ -97,4 +97,16 @@ def apply_fog_ref(color, distance, settings, positions=None, time: float = 0.0, 
         where = np.asarray(camera, np.float64) + np.asarray(directions, np.float64) * dc[..., None]
         f = np.where(a > 0, a * factor(dc, where) + (1.0 - a) * f, f)
     fog = settings.fog_color if settings.color_from == "fixed" else sky_fog_color(directions, horizon, settings.fog_color)
+    if sun is not None and settings.sun_scattering > 0:
+        fog = fog + fog_light(directions, sun, settings)
     return blend(color, fog, f)
+
+
+def fog_light(directions, sun, settings) -> np.ndarray:
+    """(..., 3) sunlight the fog scatters along unit ``directions``: Sun.color × sun_scattering × daylight
+    × 4π p(θ) with ``settings.phase`` (fog/color.glsl sun_in)."""
+    from atmos.lighting import sun_and_day
+    direction, day = sun_and_day(sun)
+    light = np.asarray(sun.color, np.float64) * settings.sun_scattering * day
+    cos = np.asarray(directions, np.float64) @ np.asarray(direction, np.float64)
+    return light * (4.0 * np.pi * settings.phase(cos))[..., None]

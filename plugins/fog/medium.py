@@ -29,9 +29,10 @@ class FogMedium:
         evaluated procedurally (the fog's noise volumes stay the fog's)."""
         s = self.settings
         return dict(FOG_MODE=MODES[s.mode], FOG_OCTAVES=s.octaves, FOG_PROCEDURAL=1,
-                    FOG_SKY_COLOR=int(s.color_from == "sky"), FOG_HORIZON_SAMPLES=SAMPLES)
+                    FOG_SKY_COLOR=int(s.color_from == "sky"), FOG_HORIZON_SAMPLES=SAMPLES,
+                    FOG_SUN=int(s.sun_scattering > 0))
 
     def set_uniforms(self, program, view) -> None:
         """The factor's and the colour's uniforms at this SceneView's time, sun and camera."""
         s = self.settings
-        set_fog_uniforms(program, s, view.time + s.time_offset, self._plugin.horizon(view))
+        set_fog_uniforms(program, s, view.time + s.time_offset, self._plugin.horizon(view), view.sun)

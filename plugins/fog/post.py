@@ -6,6 +6,7 @@ import math
 import numpy as np
 
 from atmos.scene_uniforms import set_camera_uniforms
+from atmos.lighting import sun_and_day
 from atmos.composition import CLOUD_DISTANCE, MEDIA_LIGHT, blend_onto_media, medium_targets
 from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.graph.frame import BLEND_TRANSMITTANCE, blend
@@ -26,16 +27,28 @@ def fog_program(gpu, settings, from_depth: bool, clouds: bool = False, media: bo
     defines = {"FOG_MODE": MODES[settings.mode], "FOG_OCTAVES": settings.octaves,
                "FOG_PROCEDURAL": int(settings.noise == "procedural"), "FOG_FROM_DEPTH": int(from_depth),
                "FOG_CLOUDS": int(clouds), "FOG_SKY_COLOR": int(settings.color_from == "sky"),
-               "FOG_HORIZON_SAMPLES": SAMPLES, "LOCAL_MEDIA": int(media)}
+               "FOG_HORIZON_SAMPLES": SAMPLES, "LOCAL_MEDIA": int(media), "FOG_SUN": int(settings.sun_scattering > 0)}
     return gpu.program(defines, vertex_shader=VERTEX, fragment_shader=FRAGMENT)
 
 
 
-def set_fog_uniforms(prog, settings, time: float, horizon=None) -> None:
+def sun_light(sun, settings) -> tuple[np.ndarray, np.ndarray]:
+    """(unit direction toward the sun, the light the fog scatters from it: Sun.color × sun_scattering,
+    faded out as the sun sets, :func:`atmos.lighting.sun_and_day`); zeros without a sun."""
+    if sun is None or settings.sun_scattering == 0.0:
+        return np.array([0.0, 1.0, 0.0]), np.zeros(3)
+    direction, day = sun_and_day(sun)
+    return np.asarray(direction, np.float64), np.asarray(sun.color, np.float64) * settings.sun_scattering * day
+
+
+def set_fog_uniforms(prog, settings, time: float, horizon=None, sun=None) -> None:
     """The factor's uniforms (fog/factor.glsl) and the fog colour and sky handling (fog/fog.frag);
-    ``horizon``: the (SAMPLES, 3) sky colours of ``color_from="sky"`` (:mod:`.sky_color`)."""
+    ``horizon``: the (SAMPLES, 3) sky colours of ``color_from="sky"`` (:mod:`.sky_color`); ``sun`` (a
+    Sun; None: none): the sunlight it scatters (``sun_scattering``)."""
     if horizon is not None:
         write_uniforms(prog, fog_horizon=np.asarray(horizon, np.float32).tobytes())
+    direction, light = sun_light(sun, settings)
+    write_uniforms(prog, fog_sun_light=tuple(light), fog_sun_dir=tuple(direction), fog_lobes=settings.phase.lobes)
     write_uniforms(prog, fog_density=settings.density, fog_start=settings.start, fog_end=settings.end,
                    fog_color=settings.fog_color, fog_sky_keep=int(settings.sky == "keep"),
                    fog_height_base=settings.height_base, fog_scale_height=settings.scale_height)
@@ -109,7 +122,7 @@ class FogPass(RenderPass):
         if self.volumes is not None:
             self.volumes.bind(prog)
         set_camera_uniforms(prog, view.camera, view.aspect)
-        set_fog_uniforms(prog, settings, view.time + settings.time_offset, self.plugin.horizon(view))
+        set_fog_uniforms(prog, settings, view.time + settings.time_offset, self.plugin.horizon(view), view.sun)
         frame.fullscreen(prog)
 
     def release(self) -> None:

@@ -4,7 +4,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from atmos.checks import CheckedSettings, check_int, check_vec, choice_field, int_field, num_field, vec_field
+from atmos.checks import CheckedSettings, check_int, check_vec, choice_field, int_field, nested_field, num_field, vec_field
+from atmos.phase import Phase
 
 MODES = {"linear": 0, "exp": 1, "exp2": 2, "hetero_exp": 3, "hetero_exp2": 4, "height": 5, "hetero_height": 6}
 HETEROGENEOUS = ("hetero_exp", "hetero_exp2", "hetero_height")
@@ -65,6 +66,11 @@ class FogSettings(CheckedSettings):
     height_base: float = num_field(0.0, doc="height modes: world y (m) where the density is g")
     scale_height: float = num_field(50.0, 0.0, doc="height modes: metres over which the density falls by e",
                                     lo_open=True)
+    sun_scattering: float = num_field(0.0, 0.0, 100.0, "sunlight the fog scatters toward the eye: "
+                                      "sun_scattering × Sun.color × 4π p(θ) with the fog's phase, θ between the "
+                                      "view ray and the sun, faded out as the sun sets (0: none, no shader code)")
+    phase: Phase = nested_field(Phase(0.7, -0.2, 0.1), "the fog droplets' phase function (with sun_scattering): "
+                                "bright toward the sun")
 
     @property
     def heterogeneous(self) -> bool:
