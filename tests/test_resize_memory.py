@@ -9,8 +9,12 @@ SCENE = f"""
 import gc, sys
 sys.path.insert(0, {str(Path(__file__).parent.parent / "benchmarks")!r})
 from bench_soak import cloud_scene
-from bench_resize_memory import rss_mb
 from atmos.gpu import create_headless
+
+
+def rss_mb():   # anonymous resident MB: heap and textures, not library pages (a late compile pages in more)
+    with open("/proc/self/status") as f:
+        return next(int(line.split()[1]) for line in f if line.startswith("RssAnon:")) / 1024
 gpu = create_headless((320, 180))
 app = cloud_scene(gpu)
 app.run_frames(5)
