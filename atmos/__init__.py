@@ -60,6 +60,7 @@ _EXPORTS = {
     "GroundPlugin": "atmos.plugins.ground", "TerrainPlugin": "atmos.plugins.terrain",
     "TerrainSettings": "atmos.plugins.terrain", "MeshPlugin": "atmos.plugins.mesh", "Mesh": "atmos.plugins.mesh",
     "MeshInstance": "atmos.plugins.mesh", "TextPlugin": "atmos.plugins.text", "Label": "atmos.plugins.text",
+    "AntialiasPlugin": "atmos.plugins.antialias",
     "box": "atmos.plugins.mesh", "sphere": "atmos.plugins.mesh", "cylinder": "atmos.plugins.mesh",
     "cone": "atmos.plugins.mesh", "capsule": "atmos.plugins.mesh", "torus": "atmos.plugins.mesh",
     "plane": "atmos.plugins.mesh", "revolve": "atmos.plugins.mesh", "mesh_bounds": "atmos.plugins.mesh",

@@ -38,6 +38,7 @@ from atmos.plugins.clouds.shadows import CloudShadowsPlugin
 from atmos.plugins.clouds.far_field import CloudFarFieldPlugin
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
 from atmos.plugins.clouds.presets import CloudSky, CloudWeatherPlugin
+from atmos.plugins.antialias import AntialiasPlugin
 from atmos.plugins.clouds.simulation.top_view import CloudTopViewPlugin
 from atmos.plugins.daylight import DaylightPlugin, TimeOfDay
 from atmos.plugins.fog import FogPlugin
@@ -420,6 +421,10 @@ def _aimed(app, plugin):
 
 
 SPECS["clouds"] = _clouds_spec()
+SPECS["antialias"] = Spec(
+    lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(), AntialiasPlugin()],
+    AntialiasPlugin, look((0.0, 3.0, 10.0), yaw=0.3, pitch=0.02),
+    dict(span_max=1.0, reduce_mul=1.0, reduce_min=1.0))
 SPECS["cloud_weather"] = Spec(
     lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), CloudSky("fair_weather", warmup_steps=1)],
     CloudWeatherPlugin, look((0.0, 300.0, 0.0), pitch=0.9, far=20000.0),

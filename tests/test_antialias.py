@@ -1,0 +1,82 @@
+"""FXAA: the shader against its float64 reference on fresh random images with edges; a flat image
+passes unchanged; HDR extremes stay finite; in a scene the stair steps of a mesh's edges soften."""
+import numpy as np
+import pytest
+
+from fullscreen_probe import run_fullscreen
+
+from atmos import App, DefaultPlugins, MeshInstance, MeshPlugin, Transform, box
+from atmos.gpu import create_headless
+from atmos.plugins.antialias import AntialiasPlugin, AntialiasSettings
+from atmos.plugins.antialias.reference import fxaa
+from atmos.plugins.ground import GroundPlugin
+from atmos.plugins.sky_gradient import SkyGradientPlugin
+
+SETTINGS = AntialiasSettings()
+
+
+def gpu_fxaa(gpu, image, settings=SETTINGS):
+    h, w = image.shape[:2]
+
+    def uniforms(program):
+        program["span_max"].value, program["reduce_mul"].value = settings.span_max, settings.reduce_mul
+        program["reduce_min"].value = settings.reduce_min
+    return run_fullscreen(gpu, "antialias/fxaa.frag", (w, h), {"source": image.astype(np.float32)}, uniforms,
+                          nearest=True)
+
+
+def edgy(rng, h=37, w=53):
+    """Random slanted edges between random HDR colours, a little noise, random alpha."""
+    y, x = np.mgrid[0:h, 0:w]
+    image = np.zeros((h, w, 4))
+    for _ in range(3):
+        a, c = rng.uniform(-1, 1, 2), rng.uniform(0, 3, 3)
+        inside = a[0] * (x - rng.uniform(0, w)) + a[1] * (y - rng.uniform(0, h)) > 0
+        image[inside, :3] = c
+    image[..., :3] += rng.uniform(0, 0.05, (h, w, 3))
+    image[..., 3] = rng.uniform(0, 1, (h, w))
+    return image
+
+
+def test_the_shader_matches_the_reference(gpu, ctx, rng):
+    image = edgy(rng)
+    got, want = gpu_fxaa(gpu, image), fxaa(image.astype(np.float32), SETTINGS.reduce_min, SETTINGS.reduce_mul,
+                                           SETTINGS.span_max)
+    close = np.abs(got - want).max(-1) < 1e-4
+    # the one branch (keep the wider blur unless its luma leaves the range) may flip on a float32 tie
+    assert close.mean() > 0.995, (1 - close.mean(), np.abs(got - want).max())
+    np.testing.assert_array_equal(got[..., 3], image[..., 3].astype(np.float32))          # alpha kept
+    assert np.abs(want - image).max() > 0.1                                                 # it did something
+
+
+def test_a_flat_image_is_unchanged_and_extremes_stay_finite(gpu, ctx, rng):
+    flat = np.broadcast_to([0.3, 0.6, 0.9, 1.0], (9, 11, 4)).copy()
+    np.testing.assert_allclose(gpu_fxaa(gpu, flat), flat, atol=1e-6)
+    wild = edgy(rng) * np.array([1e4, 1e-30, 65504.0, 1.0])
+    assert np.isfinite(gpu_fxaa(gpu, wild)).all()
+
+
+def test_in_a_scene_the_stair_steps_of_edges_soften():
+    gpu = create_headless((160, 90))
+    try:
+        def shot(*extra):
+            app = App(gpu).add_plugins(DefaultPlugins(fly_camera=False), SkyGradientPlugin(), GroundPlugin(),
+                                       MeshPlugin(), *extra)
+            app.world.create_entity(Transform((0.0, 2.0, -8.0), yaw=0.5, roll=0.3), MeshInstance(box((3, 3, 3)),
+                                                                                                (0.9, 0.2, 0.1)))
+            app.run_frames(2)
+            pixels = gpu.read_pixels().astype(float)
+            app.close()
+            return pixels
+        plain, smooth = shot(), shot(AntialiasPlugin())
+        def steps(img):   # the energy of jumps between neighbours: a hard step J counts J², two halves J²/2
+            return (np.diff(img, axis=0) ** 2).sum() + (np.diff(img, axis=1) ** 2).sum()
+        assert steps(smooth) < 0.8 * steps(plain), (steps(smooth), steps(plain))
+        assert np.abs(smooth - plain).max() > 40
+    finally:
+        gpu.release()
+
+
+def test_bad_settings_are_named():
+    with pytest.raises(ValueError, match="AntialiasSettings.span_max must be a finite number >= 1.0 and <= 16.0"):
+        AntialiasPlugin(span_max=0.5)
