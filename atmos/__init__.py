@@ -24,7 +24,8 @@ _EXPORTS = {
     # render passes and the graph
     "RenderPass": "atmos.graph", "FullscreenPass": "atmos.graph", "PassBuilder": "atmos.graph",
     "PassContext": "atmos.graph", "RenderGraph": "atmos.graph", "TextureDesc": "atmos.graph",
-    "GraphError": "atmos.graph", "PHASES": "atmos.graph",
+    "GraphError": "atmos.graph", "PHASES": "atmos.graph", "ComputePass": "atmos.graph", "BufferDesc": "atmos.graph",
+    "work_groups": "atmos.graph", "dispatch": "atmos.gpu.hazards",
     "COLOR": "atmos.render_core", "DEPTH": "atmos.render_core", "SCREEN": "atmos.render_core",
     "CapturePass": "atmos.render_core", "OpaquePass": "atmos.render_core", "RenderCorePlugin": "atmos.render_core",
     # what passes see and write

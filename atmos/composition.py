@@ -116,8 +116,8 @@ class ClearMedia(CompositionClear):
 
     def __init__(self, comp: Composition, gpu):
         super().__init__(gpu, lambda: comp.media, lambda size: (
-            (MEDIA_LIGHT, TextureDesc(size, components=4, dtype="f4", filter="nearest"), 0.0),
-            (MEDIA_TRANSMITTANCE, TextureDesc(size, components=1, dtype="f4", filter="nearest"), 1.0)))
+            (MEDIA_LIGHT, TextureDesc(size, components=4, dtype="f4", filter="nearest", storage=True), 0.0),
+            (MEDIA_TRANSMITTANCE, TextureDesc(size, components=1, dtype="f4", filter="nearest", storage=True), 1.0)))
 
 
 def blend_onto_media(builder, comp: Composition) -> None:

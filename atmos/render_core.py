@@ -48,7 +48,8 @@ DEPTH = "depth"
 
 
 def color_desc(gpu) -> TextureDesc:
-    return TextureDesc(gpu.size, components=4, dtype="f2")
+    """The HDR colour: drawn into, blended onto, and read-modified-written by compute passes (an rgba16f image)."""
+    return TextureDesc(gpu.size, components=4, dtype="f2", storage=True)
 
 
 def depth_desc(gpu) -> TextureDesc:

@@ -10,6 +10,7 @@ import numpy as np
 
 from atmos.gpu.uniforms import bind_images, bind_textures
 from atmos.value_noise import key, value_noise
+from atmos.gpu.hazards import dispatch
 
 WEIGHTS = np.array([0.5, 0.25, 0.125, 0.0625])      # the octaves' fbm weights
 
@@ -78,8 +79,7 @@ class OctaveTextures:
                 prog["light_shift"].value = tuple(np.asarray(shift_maps[k], np.float64) @ shift)
             prog["key"].value = octave_key(settings.seed, k)
             bind_images(prog, octave=tex)
-            prog.run(groups, groups)
-        ctx.memory_barrier()
+            dispatch(prog, groups, groups)
         for tex in self.textures:
             tex.build_mipmaps()
             tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)

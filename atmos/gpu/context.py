@@ -9,6 +9,7 @@ import moderngl
 import numpy as np
 
 from atmos.gpu.host_memory import is_software, return_freed_textures
+from atmos.gpu.hazards import Hazards, hazards_of
 from atmos.gpu.queries import QueryPool, query_pool
 from atmos.gpu.portability import check_enabled, check_program
 from atmos.gpu.shaders import ShaderError, compile_program, load_stages
@@ -151,6 +152,7 @@ class GpuContext:
         self.released = False
         self._apps: "weakref.WeakSet" = weakref.WeakSet()   # open Apps on this context (closed first by release)
         self.queries: QueryPool = query_pool(ctx)  # query objects shared by every App on this context
+        self.hazards: Hazards = hazards_of(ctx)    # storage writes not yet visible: barriers come from it
         self.software = is_software(ctx)
         if self.software:
             return_freed_textures()

@@ -261,8 +261,10 @@ def check_units(program, sources: dict[str, GlslSource]) -> None:
     """Every sampler, image and storage block the program uses declares its unit (``layout(binding = N)``:
     the one place a unit is written; Python binds by name, :mod:`atmos.gpu.uniforms`), and no two of a
     kind share one: a ShaderError naming both declarations otherwise. Keeps each image's unit and
-    declared access (readonly, writeonly or both) in ``program.extra["images"]`` for ``bind_images``."""
+    declared access (readonly, writeonly or both) in ``program.extra["images"]`` for ``bind_images``, and
+    the storage blocks it may write (not ``readonly``) in ``program.extra["written"]`` for ``bind_buffers``."""
     images: dict[str, tuple[int, bool, bool]] = {}
+    written: set[str] = set()
     for kind, pattern in _BINDINGS.items():
         seen: dict[int, tuple[str, str]] = {}
         for src in sources.values():
@@ -287,7 +289,9 @@ def check_units(program, sources: dict[str, GlslSource]) -> None:
                 if kind == "image":
                     words = (match.group("before") + match.group("after")).split()
                     images[name] = (units, "writeonly" not in words, "readonly" not in words)
-    program.extra = {"images": images}
+                elif kind == "buffer" and "readonly" not in match.group("before").split():
+                    written.add(name)
+    program.extra = {"images": images, "written": frozenset(written)}
 
 
 def _constant(word: str, text: str, where: str) -> int:

@@ -1,9 +1,13 @@
 """The one uniform writer and the binders: values, textures, images and storage buffers by name into a
 program, skipping what its compiler dropped. A unit is written once, in the GLSL that declares the
-sampler, image or buffer (``layout(binding = N)``); Python binds by name and never names a unit."""
+sampler, image or buffer (``layout(binding = N)``); Python binds by name and never names a unit.
+A bind is also the declaration of a use (:mod:`atmos.gpu.hazards`): it gets the memory barrier the
+use needs after earlier storage writes, and stages its own storage writes for the next dispatch."""
 from __future__ import annotations
 
 from collections.abc import Mapping
+
+from atmos.gpu.hazards import hazards_of
 
 
 def write_uniforms(program, values: Mapping[str, object] | None = None, /, **more) -> None:
@@ -31,6 +35,7 @@ def bind_textures(program, textures: Mapping[str, object] | None = None, /, samp
     Returns the units bound (to clear ``sampler`` from afterwards)."""
     get = program.get
     units = []
+    hazards = hazards_of(program.ctx)
     for name, texture in ({**textures, **more} if textures else more).items():
         member = get(name, None)
         if member is None:
@@ -41,6 +46,8 @@ def bind_textures(program, textures: Mapping[str, object] | None = None, /, samp
         else:
             pairs = ((value, texture),)
         for unit, one in pairs:
+            if hazards._dirty:
+                hazards.use(reads=[(one, "sampled")], defer=True)
             one.use(unit)
             if sampler is not None:
                 sampler.use(unit)
@@ -53,17 +60,30 @@ def bind_images(program, images: Mapping[str, object] | None = None, /, **more) 
     ``layout(binding = N, format)``), for the access its declaration gives (``readonly``,
     ``writeonly`` or both); a name the program does not use is skipped."""
     declared = program.extra["images"]        # (unit, read, write) by name, from the compiler check
+    hazards = hazards_of(program.ctx)
     for name, texture in ({**images, **more} if images else more).items():
         if name in declared:
             unit, read, write = declared[name]
+            if hazards._dirty:
+                hazards.use(reads=[(texture, "storage")], defer=True)
+            if write:
+                hazards.stage(texture)
             texture.bind_to_image(unit, read=read, write=write)
 
 
 def bind_buffers(program, buffers: Mapping[str, object] | None = None, /, **more) -> None:
     """Bind each buffer at the binding of ``program``'s storage block of that name (its
-    ``layout(std430, binding = N) buffer Name``); a name the program does not use is skipped."""
+    ``layout(std430, binding = N) buffer Name``); a name the program does not use is skipped. A
+    block not declared ``readonly`` counts as written by the next dispatch."""
     get = program.get
+    extra = program.extra                        # storage blocks not declared readonly, from the compiler check
+    written = extra.get("written") if isinstance(extra, dict) else None   # unknown: every block may be
+    hazards = hazards_of(program.ctx)
     for name, buffer in ({**buffers, **more} if buffers else more).items():
         member = get(name, None)
         if member is not None:
+            if hazards._dirty:
+                hazards.use(reads=[(buffer, "storage")], defer=True)
+            if written is None or name in written:
+                hazards.stage(buffer)
             buffer.bind_to_storage_buffer(member.binding)

@@ -23,7 +23,7 @@ from atmos.toposort import CycleError, stable_toposort
 from atmos.graph.errors import GraphError
 from atmos.graph.passes import PassBuilder, RenderPass
 from atmos.graph.phases import COMMUTING, PHASE_INDEX, PHASES
-from atmos.graph.resources import TextureDesc
+from atmos.graph.resources import BufferDesc, TextureDesc
 
 
 @dataclass
@@ -31,7 +31,7 @@ class ResourceInfo:
     """One resource of a compiled graph."""
 
     name: str
-    desc: TextureDesc | None          # None for imported resources
+    desc: TextureDesc | BufferDesc | None   # None for imported resources
     imported: bool
     creator: str | None = None
     writers: list[str] = field(default_factory=list)   # passes that write it (not its creator)
@@ -58,6 +58,8 @@ class CompiledGraph:
     reads: dict[str, dict[str, int]] = field(default_factory=dict)   # kept pass -> resource -> version read
     writes: dict[str, dict[str, int]] = field(default_factory=dict)  # kept pass -> resource -> version made
     sources: dict[str, str] = field(default_factory=dict)            # pass name -> "file:line" of its class
+    uses: list[tuple[tuple, tuple, tuple]] = field(default_factory=list)
+    # per kept pass: ((name, read access), ...), ((name, write access), ...), (names it writes as storage)
 
     @property
     def kept(self) -> list[str]:
@@ -93,8 +95,16 @@ def compile_graph(passes: list[RenderPass], builders: dict[str, PassBuilder], im
             release[users[-1]].append(info.name)
     reads, writes = _versions(order, builders, resources)
     declared = [builders[p.name].names for p in order]
+    uses = [_uses(builders[p.name]) for p in order]
     return CompiledGraph(order, sorted_names, culled, resources, builders, edges, acquire, release, imports_used,
-                         declared, phase_of, reads, writes, {p.name: source_of(p) for p in passes})
+                         declared, phase_of, reads, writes, {p.name: source_of(p) for p in passes}, uses)
+
+
+def _uses(b: PassBuilder) -> tuple[tuple, tuple, tuple]:
+    """A pass's declared uses for the barriers before it and the storage writes after it."""
+    reads = tuple((n, b.access.get(n, (None, None))[0]) for n in b.reads if n not in b.creates)
+    writes = tuple((n, b.access.get(n, (None, None))[1]) for n in list(b.creates) + b.writes)
+    return reads, writes, tuple(n for n, access in writes if access == "storage")
 
 
 def source_of(p: RenderPass) -> str:
@@ -137,6 +147,12 @@ def _resources(builders: dict[str, PassBuilder], imports: set[str]) -> dict[str,
                                      f"imported (known resources: {', '.join(sorted(resources)) or 'none'}); "
                                      "is the plugin that provides it added?")
                 info = resources[r]
+                desc = info.desc
+                if (kind == "writes" and b.access.get(r, (None, None))[1] == "storage"
+                        and isinstance(desc, TextureDesc) and not desc.storage):
+                    raise GraphError(f"pass '{name}' writes '{r}' as storage, but '{r}' was created by "
+                                     f"'{info.creator}' with storage=False ({desc}); create it with "
+                                     "TextureDesc(..., storage=True)")
                 if info.creator == name:
                     continue
                 (info.readers if kind == "reads" else info.writers).append(name)

@@ -7,6 +7,8 @@ from collections import OrderedDict
 import moderngl
 
 from atmos.gpu.context import GpuError, release_gl
+from atmos.gpu.hazards import dispatch
+from atmos.gpu.uniforms import bind_buffers, bind_images, bind_textures
 from atmos.graph.errors import GraphError
 
 FRAMEBUFFER_CACHE = 64  # framebuffers kept per graph, least recently used dropped first
@@ -41,6 +43,7 @@ class PassContext:
         self.pass_name = ""
         self._resources: dict[str, object] = {}   # this frame's resolved resources
         self._declared: frozenset[str] = frozenset()
+        self._access: dict[str, tuple] = {}       # the running pass's (read, write) access by name
         self._framebuffers: OrderedDict = OrderedDict()
         self._vaos: dict[int, tuple[object, object]] = {}
         self._fresh: set[int] = set()             # framebuffers already reset in this pass
@@ -79,6 +82,9 @@ class PassContext:
                              "can only be used alone as framebuffer(color=[name])")
         if not attachments and depth_attachment is None:
             raise GraphError(f"pass '{self.pass_name}': framebuffer() needs at least one color or a depth name")
+        hazards = self.gpu.hazards
+        if hazards._dirty:          # a texture a compute pass wrote, now drawn into: its writes first
+            hazards.use(reads=[(a, "attachment") for a in attachments + [depth_attachment] if a is not None])
         key = tuple(id(a) for a in attachments) + (id(depth_attachment),)
         entry = self._framebuffers.get(key)
         if entry is not None and all(_alive(a) for a in entry[1]):
@@ -99,6 +105,28 @@ class PassContext:
             self._drop(next(iter(self._framebuffers)))
         self._fresh.add(id(fbo))
         return fbo
+
+    def image(self, name: str):
+        """The texture ``name`` for image load/store: the pass must have declared it with ``storage`` access."""
+        value = self.resource(name)
+        if "storage" not in self._access.get(name, ()):
+            raise GraphError(f"pass '{self.pass_name}' uses '{name}' as an image but declared it without "
+                             "access='storage' (builder.read/write(name, access='storage'))")
+        return value
+
+    def dispatch(self, program, groups, textures=None, images=None, buffers=None) -> None:
+        """Bind by name and run compute ``program`` over ``groups`` (x[, y[, z]]) work groups.
+
+        ``textures`` (sampler name -> resource name or texture), ``images`` (image name -> resource
+        name, declared with storage access, or texture) and ``buffers`` (storage block name -> resource
+        name or buffer); the binds get the barriers their uses need (:mod:`atmos.gpu.hazards`)."""
+        if textures:
+            bind_textures(program, {k: self.resource(v) if isinstance(v, str) else v for k, v in textures.items()})
+        if images:
+            bind_images(program, {k: self.image(v) if isinstance(v, str) else v for k, v in images.items()})
+        if buffers:
+            bind_buffers(program, {k: self.resource(v) if isinstance(v, str) else v for k, v in buffers.items()})
+        dispatch(program, *groups)
 
     def fullscreen(self, program) -> None:
         """Draw the fullscreen triangle (``lib/fullscreen.vert``) with ``program`` into the bound framebuffer."""
@@ -155,9 +183,10 @@ class PassContext:
         self.view = view
         self._resources = resources
 
-    def _begin_pass(self, name: str, declared: frozenset[str]) -> None:
+    def _begin_pass(self, name: str, declared: frozenset[str], access: dict | None = None) -> None:
         self.pass_name = name
         self._declared = declared
+        self._access = access or {}
         self.reset_state()
 
     def _end_frame(self) -> None:

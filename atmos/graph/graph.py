@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from typing import Any, Callable
 
+import moderngl
+
 from atmos.gpu.host_memory import trim_heap
 from atmos.graph.compiler import CompiledGraph, compile_graph
 from atmos.graph.dump import dump_text, dump_dot
@@ -126,6 +128,7 @@ class RenderGraph:
         transient: dict[str, object] = {}
         frame = self._frame
         frame._begin_frame(view, resources)
+        hazards = self.gpu.hazards
         try:
             for i, p in enumerate(compiled.order):
                 for r in compiled.acquire[i]:
@@ -133,7 +136,11 @@ class RenderGraph:
                 if self._prepared.get(p.name) is not p:
                     p.prepare(self.gpu)
                     self._prepared[p.name] = p
-                frame._begin_pass(p.name, compiled.declared[i])
+                reads, writes, stored = compiled.uses[i]
+                if hazards._dirty:          # the barrier this pass's declared uses need, before it
+                    hazards.use(reads=[_use(resources, n, a, "sampled") for n, a in reads],
+                                writes=[_use(resources, n, a, "attachment") for n, a in writes])
+                frame._begin_pass(p.name, compiled.declared[i], compiled.declarations[p.name].access)
                 if self.timings_enabled:
                     self._timers.begin(p.name)
                     try:
@@ -142,6 +149,8 @@ class RenderGraph:
                         self._timers.end(p.name)
                 else:
                     p.execute(frame)
+                if stored:
+                    hazards.wrote([(resources[n], "storage") for n in stored])
                 for r in compiled.release[i]:
                     del resources[r]
                     self.pool.release(transient.pop(r))
@@ -191,3 +200,9 @@ class RenderGraph:
         self._frame.release()
         self.pool.release_all()
         self._timers.release()
+
+
+def _use(resources: dict, name: str, access: str | None, texture_default: str):
+    """(object, access) of a declared use; an undeclared access is the kind's default (buffers: storage)."""
+    obj = resources[name]
+    return obj, access or ("storage" if isinstance(obj, moderngl.Buffer) else texture_default)

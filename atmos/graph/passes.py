@@ -5,7 +5,8 @@ from atmos.gpu.context import GpuContext
 from atmos.graph.errors import GraphError
 from atmos.graph.frame import PassContext
 from atmos.graph.phases import PHASE_INDEX, PHASES
-from atmos.graph.resources import TextureDesc
+from atmos.gpu.hazards import ACCESS
+from atmos.graph.resources import BufferDesc, TextureDesc
 
 
 class RenderPass:
@@ -61,37 +62,65 @@ class PassBuilder:
     ``read(name)`` reads the version of ``name`` current when the pass runs; ``read(name, at=phase)``
     names the version left at the end of an earlier phase (the compiler checks that nothing writes
     it in between). A pass that blends onto a resource reads and writes it.
+
+    Each declaration says how (``access``, one of :data:`atmos.gpu.hazards.ACCESS`): reads default to
+    ``sampled`` (``storage`` for buffers), writes to ``attachment`` (``storage`` for buffers); a compute
+    pass writes ``storage``. Before a pass runs, the graph issues the memory barrier its declared uses
+    need after earlier storage writes (:mod:`atmos.gpu.hazards`); a storage write of a created texture
+    needs a ``TextureDesc(storage=True)``.
     """
 
     def __init__(self, pass_name: str):
         self.pass_name = pass_name
-        self.creates: dict[str, TextureDesc] = {}
+        self.creates: dict[str, TextureDesc | BufferDesc] = {}
         self.reads: dict[str, str | None] = {}      # name -> the phase whose version is read (None: current)
         self.writes: list[str] = []
+        self.access: dict[str, tuple[str | None, str | None]] = {}   # name -> (read access, write access)
         self.has_side_effect = False
 
-    def create(self, name: str, desc: TextureDesc) -> None:
-        """A transient texture this pass creates (its first writer); the pool provides it."""
+    def create(self, name: str, desc: TextureDesc | BufferDesc, access: str | None = None) -> None:
+        """A transient texture or buffer this pass creates (its first writer, with ``access``); the pool provides it."""
         self._check(name)
-        if not isinstance(desc, TextureDesc):
-            raise GraphError(f"pass '{self.pass_name}' creates '{name}' with {desc!r}; a TextureDesc is required")
+        if not isinstance(desc, (TextureDesc, BufferDesc)):
+            raise GraphError(f"pass '{self.pass_name}' creates '{name}' with {desc!r}; a TextureDesc or "
+                             "BufferDesc is required")
         if name in self.creates:
             raise GraphError(f"pass '{self.pass_name}' creates '{name}' twice")
+        access = self._access(name, access, "storage" if isinstance(desc, BufferDesc) else "attachment")
+        if access == "storage" and isinstance(desc, TextureDesc) and not desc.storage:
+            raise GraphError(f"pass '{self.pass_name}' creates '{name}' for storage writes, but its TextureDesc "
+                             f"({desc}) has storage=False; give TextureDesc(..., storage=True)")
+        if isinstance(desc, BufferDesc) and access not in ("storage", "copy"):
+            raise GraphError(f"pass '{self.pass_name}' creates buffer '{name}' with access {access!r}; "
+                             "a pass writes a buffer with 'storage' or 'copy'")
         self.creates[name] = desc
+        self.access[name] = (self.access.get(name, (None, None))[0], access)
 
-    def read(self, name: str, at: str | None = None) -> None:
-        """This pass samples (or blends onto) ``name``; ``at``: the phase whose final version it needs."""
+    def read(self, name: str, at: str | None = None, access: str | None = None) -> None:
+        """This pass samples (or blends onto) ``name``; ``at``: the phase whose final version it needs;
+        ``access``: how it reads it (default ``sampled``; ``storage`` for image loads and storage blocks)."""
         self._check(name)
         if at is not None and at not in PHASE_INDEX:
             raise GraphError(f"pass '{self.pass_name}' reads '{name}' at phase {at!r}; "
                              f"allowed: {', '.join(PHASES)}")
         self.reads[name] = at
+        self.access[name] = (self._access(name, access, None), self.access.get(name, (None, None))[1])
 
-    def write(self, name: str) -> None:
-        """This pass modifies an existing resource (read-modify-write passes also call ``read``)."""
+    def write(self, name: str, access: str | None = None) -> None:
+        """This pass modifies an existing resource (read-modify-write passes also call ``read``);
+        ``access``: how it writes it (default ``attachment``; ``storage`` for image stores)."""
         self._check(name)
         if name not in self.writes:
             self.writes.append(name)
+        self.access[name] = (self.access.get(name, (None, None))[0], self._access(name, access, None))
+
+    def _access(self, name: str, access: str | None, default: str | None) -> str | None:
+        if access is None:
+            return default
+        if access not in ACCESS:
+            raise GraphError(f"pass '{self.pass_name}' declares '{name}' with access {access!r}; "
+                             f"allowed: {', '.join(ACCESS)}")
+        return access
 
     def side_effect(self) -> None:
         """Keep this pass even if nothing reads its outputs."""
@@ -104,7 +133,8 @@ class PassBuilder:
 
     def key(self) -> tuple:
         """The declarations as a comparable value: the graph recompiles when a pass's key changes."""
-        return (tuple(self.creates.items()), tuple(self.reads.items()), tuple(self.writes), self.has_side_effect)
+        return (tuple(self.creates.items()), tuple(self.reads.items()), tuple(self.writes),
+                tuple(self.access.items()), self.has_side_effect)
 
     def uses(self, name: str) -> str:
         """How this pass uses ``name``: 'create', 'read', 'write', 'read/write' or ''."""

@@ -1,4 +1,4 @@
-"""Transient texture descriptions and the pool that recycles textures between passes and frames."""
+"""Transient texture and buffer descriptions and the pool that recycles them between passes and frames."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -14,7 +14,10 @@ class TextureDesc:
     """What a transient texture looks like; equal descs share pooled textures (it is the pool key).
 
     ``size`` is (w, h) or (w, h, d) for a 3D texture. A ``depth`` texture must be 2D and ignores
-    ``components``/``dtype``. Integer dtypes (``u*``, ``i*``) need ``filter="nearest"``.
+    ``components``/``dtype``. Integer dtypes (``u*``, ``i*``) need ``filter="nearest"``. ``storage``:
+    a compute pass writes it as an image (``layout(r32f)``, ``rgba16f``...): 1, 2 or 4 components
+    (image formats have no 3-component kind), not depth — a depth made by compute is ``components=1,
+    dtype="f4"`` (``r32f``).
     """
 
     size: tuple[int, ...]
@@ -22,6 +25,7 @@ class TextureDesc:
     dtype: str = "f2"
     depth: bool = False
     filter: str = "linear"
+    storage: bool = False
 
     def __post_init__(self):
         try:
@@ -42,6 +46,18 @@ class TextureDesc:
         if not self.depth and self.dtype[0] in "ui" and self.filter != "nearest":
             raise ValueError(f"integer TextureDesc dtype {self.dtype!r} needs filter='nearest' "
                              "(OpenGL cannot filter integer textures linearly)")
+        if self.storage and (self.depth or self.components == 3):
+            raise ValueError(f"a storage TextureDesc (written as an image) must have 1, 2 or 4 components and "
+                             f"not be depth, got components={self.components}, depth={self.depth}; a depth "
+                             "made by compute is components=1, dtype='f4' (r32f)")
+
+    @property
+    def nbytes(self) -> int:
+        """GL memory of one such texture in bytes (approximate for depth)."""
+        texels = 1
+        for s in self.size:
+            texels *= s
+        return texels * (4 if self.depth else self.components * int(self.dtype[1]))
 
     def create(self, ctx: moderngl.Context, clear: bool = False):
         """A new moderngl texture of this description (colour textures zero-filled when ``clear``)."""
@@ -65,11 +81,38 @@ class TextureDesc:
         size = "x".join(map(str, self.size))
         if self.depth:
             return f"{size} depth {self.filter}"
-        return f"{size} {self.components}x{self.dtype} {self.filter}"
+        return f"{size} {self.components}x{self.dtype} {self.filter}" + (" storage" if self.storage else "")
+
+
+@dataclass(frozen=True)
+class BufferDesc:
+    """A transient GPU buffer of ``size`` bytes (a compute pass's list, counters or indirect arguments);
+    equal descs share pooled buffers. ``clear``: zero-filled each time a pass creates it."""
+
+    size: int
+    clear: bool = False
+
+    def __post_init__(self):
+        if isinstance(self.size, bool) or not isinstance(self.size, int) or self.size < 1:
+            raise ValueError(f"BufferDesc.size must be a positive int (bytes), got {self.size!r}")
+        if not isinstance(self.clear, bool):
+            raise ValueError(f"BufferDesc.clear must be True or False, got {self.clear!r}")
+
+    @property
+    def nbytes(self) -> int:
+        return self.size
+
+    def create(self, ctx: moderngl.Context, clear: bool = False):
+        """A new moderngl buffer of this size (zero-filled)."""
+        return ctx.buffer(reserve=self.size)
+
+    def __str__(self) -> str:
+        return f"buffer {self.size} B" + (" cleared" if self.clear else "")
 
 
 class TexturePool:
-    """Textures keyed by :class:`TextureDesc`: ``acquire`` reuses a free one of an equal desc, else creates one.
+    """Textures and buffers keyed by :class:`TextureDesc` / :class:`BufferDesc`: ``acquire`` reuses a
+    free one of an equal desc, else creates one.
 
     :meth:`end_frame` (the graph calls it after each frame) releases the GL memory of free textures
     that no frame acquired or released during the last ``keep_frames`` frames, so descs that stop
@@ -90,10 +133,12 @@ class TexturePool:
         self._in_use: set[int] = set()
         self._used: dict[int, int] = {}  # id(texture) -> frame it was last acquired or released
 
-    def acquire(self, desc: TextureDesc):
-        """A texture matching ``desc``, free until :meth:`release` gives it back."""
+    def acquire(self, desc: TextureDesc | BufferDesc):
+        """A texture (or buffer) matching ``desc``, free until :meth:`release` gives it back."""
         free = self._free.get(desc)
         texture = free.pop() if free else self._create(desc)
+        if isinstance(desc, BufferDesc) and desc.clear:
+            texture.clear()
         key = id(texture)
         self._in_use.add(key)
         self._used[key] = self.frame
@@ -143,13 +188,7 @@ class TexturePool:
     @property
     def bytes(self) -> int:
         """GL memory of the textures the pool holds now (free and in use), in bytes (approximate for depth)."""
-        total = 0
-        for desc, _ in self._desc.values():
-            texels = 1
-            for s in desc.size:
-                texels *= s
-            total += texels * (4 if desc.depth else desc.components * int(desc.dtype[1]))
-        return total
+        return sum(desc.nbytes for desc, _ in self._desc.values())
 
     def release_all(self) -> None:
         """Free the GL memory of every pooled texture, free or in use; the pool starts empty again."""

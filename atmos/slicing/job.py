@@ -227,8 +227,6 @@ class SlicedJob:
 
         def run() -> None:
             task.run(job_ctx.slice, job_ctx)
-            # image writes must be visible to the next slice and, after rotation, to texture reads
-            self.triple.gpu.ctx.memory_barrier()
 
         ms = measure(run)
         stats = self.stats

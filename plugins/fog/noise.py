@@ -18,6 +18,7 @@ from atmos.gpu.context import GpuContext, require_gpu
 from atmos.gradient_noise import periodic_noise, sample_repeat_trilinear
 from atmos.hashing import stream_key
 from atmos.gpu.uniforms import bind_images, bind_textures
+from atmos.gpu.hazards import dispatch
 
 FOG_RULE = 0xF06  # stream id of the fog gradients: stream_key(seed, 0, FOG_RULE, octave)
 @lru_cache(maxsize=64)
@@ -85,8 +86,7 @@ class NoiseVolumes:
                 shader["texels_per_cell"].value = tpc
                 shader["key"].value = octave_key(settings.seed, i)
                 groups = math.ceil(n / 4)
-                shader.run(groups, groups, groups)
-            ctx.memory_barrier()
+                dispatch(shader, groups, groups, groups)
         except Exception:
             self.release()
             raise

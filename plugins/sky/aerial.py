@@ -32,6 +32,7 @@ from atmos.lighting import unit_sun
 from atmos.plugins.sky.luts import SKY_LUTS, atmosphere_defines, set_atmosphere_uniforms, view_radius
 from atmos.render_core import COLOR, DEPTH
 from atmos.gpu.uniforms import bind_images, bind_textures, write_uniforms
+from atmos.gpu.hazards import dispatch
 
 AERIAL = "aerial_perspective"
 AERIAL_VOLUME = "aerial_volume"          # the froxel volume (a transient of this pass)
@@ -137,5 +138,4 @@ class AerialPerspectivePass(FullscreenPass):
         write_uniforms(c, values)
         bind_images(c, aerial_volume=volume)
         w, h, _ = volume.size
-        c.run(-(-w // GROUP), -(-h // GROUP), 1)
-        self.gpu.ctx.memory_barrier()
+        dispatch(c, -(-w // GROUP), -(-h // GROUP), 1)

@@ -18,6 +18,7 @@ import numpy as np
 import atmos.plugins.sky.atmosphere as ref
 from atmos.plugins.sky.atmosphere_settings import AtmosphereSettings
 from atmos.gpu.uniforms import bind_images, bind_textures, write_uniforms
+from atmos.gpu.hazards import dispatch
 
 SUN_TOLERANCE = 5e-4          # the sky view is remade when the sun's height (y) moved more (≈ 0.03° near the horizon)
 ALTITUDE_TOLERANCE = (1.0, 0.01)   # ... or the camera's altitude by more than max(1 m, 1 %)
@@ -111,8 +112,7 @@ class AtmosphereLuts:
             self.bind(program)
         tex = self.textures[name]
         bind_images(program, lut=tex)
-        program.run(math.ceil(tex.width / 8), math.ceil(tex.height / 8))
-        self.gpu.ctx.memory_barrier()
+        dispatch(program, math.ceil(tex.width / 8), math.ceil(tex.height / 8))
 
     def bind(self, program) -> None:
         """Bind the textures ``program`` samples (``atm_transmittance``, ``atm_multiscattering``, ``sky_view``)."""

@@ -10,6 +10,7 @@ import atmos.plugins.sky.stars as stars
 from atmos.plugins.sky.settings import SkySettings
 from atmos.plugins.sky.preetham import COS_FLOOR, unit_vectors
 from atmos.gpu.uniforms import bind_buffers, write_uniforms
+from atmos.gpu.hazards import dispatch
 
 DAY_FADE = (-0.2, 0.02)      # sun height (sin elevation): night below the first, full Preetham day above the second
 GROUND_DIM = 0.3
@@ -80,8 +81,7 @@ def evaluate_sky(gpu, view_dirs, sun_dir, sun_color, settings: SkySettings | Non
     out = ctx.buffer(np.full((n, 4), np.nan, np.float32).tobytes())
     try:
         bind_buffers(prog, Directions=src, Colors=out)
-        prog.run(math.ceil(n / 64))
-        ctx.memory_barrier()
+        dispatch(prog, math.ceil(n / 64))
         result = np.frombuffer(out.read(), np.float32).reshape(n, 4)
     finally:
         src.release()

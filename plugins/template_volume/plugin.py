@@ -11,6 +11,7 @@ from atmos.scene_uniforms import set_scene_uniforms
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
 from atmos.gpu.uniforms import bind_images, bind_textures
+from atmos.gpu.hazards import dispatch
 
 TEMPLATE_VOLUME_SETS = "template_volume_sets"     # the imported (A, B, t) of the template volume's texture sets
 
@@ -87,8 +88,7 @@ class TemplateVolumePlugin(Plugin):
         bind_images(self.program, density=job.target["density"])
         self.program["time"].value = self._time
         self.program["z0"].value = index * layers
-        self.program.run(math.ceil(nx / 8), math.ceil(ny / 4), math.ceil(layers / 4))
-        self.program.ctx.memory_barrier()
+        dispatch(self.program, math.ceil(nx / 8), math.ceil(ny / 4), math.ceil(layers / 4))
 
     def cleanup(self, app) -> None:
         if self.triple is not None:

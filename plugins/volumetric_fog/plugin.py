@@ -4,8 +4,8 @@ from __future__ import annotations
 import numpy as np
 
 from atmos.scene_uniforms import set_camera_uniforms
-from atmos.composition import blend_onto_media, composition, medium_targets
-from atmos.graph import FullscreenPass, PassContext
+from atmos.composition import MEDIA_LIGHT, MEDIA_TRANSMITTANCE, composition
+from atmos.graph import ComputePass, PassContext
 from atmos.lighting import Sun, sun_and_day
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
@@ -13,7 +13,7 @@ from atmos.plugins.sky import SkyLight
 from atmos.plugins.volumetric_fog.settings import VolumetricFogSettings
 
 HORIZON_SAMPLES = 16      # azimuths of the sky's horizon radiance averaged into the ambient
-from atmos.gpu.uniforms import bind_textures, write_uniforms
+from atmos.gpu.uniforms import write_uniforms
 
 
 def sun_terms(sun: Sun, settings: VolumetricFogSettings, sky_ambient=None):
@@ -41,29 +41,36 @@ def set_medium_uniforms(program, settings: VolumetricFogSettings, sun: Sun, time
     write_uniforms(program, values)
 
 
-class VolumetricFogPass(FullscreenPass):
-    """Reads ``depth``, blends (in-scattered light, transmittance) over ``color`` with ONE, SRC_ALPHA;
-    alpha (the sky occlusion of :mod:`atmos.render_core`) kept: the medium tints the sky, it does not hide it."""
+class VolumetricFogPass(ComputePass):
+    """A compute pass, one invocation per pixel: reads ``depth``, composites (in-scattered light,
+    transmittance) onto ``color`` in place, rgb = light + T · rgb, alpha (the sky occlusion of
+    :mod:`atmos.render_core`) kept: the medium tints the sky, it does not hide it. Where the aerial
+    perspective mixes the air with the local media, onto the media targets too."""
     name = "volumetric_fog"
     phase = "media"
-    fragment = "volumetric_fog/fog.frag"
+    compute = "volumetric_fog/fog.comp"
     reads = (COLOR, DEPTH)
+    writes = (COLOR,)
 
     def setup(self, builder) -> None:
         super().setup(builder)
-        blend_onto_media(builder, self.plugin.composition)   # the aerial perspective mixes the air with it
+        if self.plugin.composition.media:          # the aerial perspective mixes the air with it
+            for name in (MEDIA_LIGHT, MEDIA_TRANSMITTANCE):
+                builder.read(name, access="storage")
+                builder.write(name, access="storage")
 
     def defines(self) -> dict:
         return {"LOCAL_MEDIA": int(self.plugin.composition.media)}
 
     def execute(self, frame: PassContext) -> None:
         view, p = frame.view, self.program
-        frame.framebuffer(color=medium_targets(frame, COLOR)).use()
-        frame.blend_transmittance()
-        bind_textures(p, scene_depth=frame.resource(DEPTH))
         set_camera_uniforms(p, view.camera, view.aspect)
         set_medium_uniforms(p, self.plugin.settings, view.sun, self.plugin.time(view), self.plugin.sky_ambient(view))
-        frame.fullscreen(p)
+        images = {"color_image": COLOR}
+        if frame.declares(MEDIA_LIGHT):
+            images.update(media_light_image=MEDIA_LIGHT, media_transmittance_image=MEDIA_TRANSMITTANCE)
+        color = frame.image(COLOR)
+        frame.dispatch(p, self.groups(color.size), textures={"scene_depth": DEPTH}, images=images)
 
 
 class VolumetricFogPlugin(Plugin):

@@ -50,6 +50,7 @@ from atmos.checks import check_shape, is_int
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.hashing import stream_key
 from atmos.gpu.uniforms import bind_buffers, bind_textures, write_uniforms
+from atmos.gpu.hazards import dispatch
 
 PRECISION_BITS = 16
 MAX_LAYERS = 128        # layers (ny) the advection takes shifts for (common.glsl: a uniform array)
@@ -175,7 +176,6 @@ class CloudAutomaton:
     def download(self):
         """The current state as bool arrays ``(hum, act, cld)`` of shape ``(nx, ny, nz)``."""
         self._check_alive()
-        self.ctx.memory_barrier(moderngl.BUFFER_UPDATE_BARRIER_BIT)
         raw = np.frombuffer(self._state[self._current].read(), dtype="<u4")
         nx, ny, nz = self.shape
         if self.layout == "packed":
@@ -216,14 +216,14 @@ class CloudAutomaton:
         ka, kb = stream_key(self.seed, self.step_count, _RULE_IDS, _PLANE_IDS)
         keys = np.stack([ka, kb], axis=-1).astype("<u4").tobytes()
 
-        ctx, prog = self.ctx, self._prog_step
+        prog = self._prog_step
         self._set_grid(prog)
         write_uniforms(prog, u_mode=tuple(modes), u_threshold=tuple(thresholds), u_keys=keys)
         src, dst = self._state[self._current], self._state[1 - self._current]
         per_cell = "Prob" if self.layout == "cell" else "Planes"     # the step's probability blocks, by rule
         bind_buffers(prog, {f"{per_cell}{name}": self._prob_buffers[rule] if modes[rule] == 2 else self._dummy
                             for rule, name in enumerate(("Ext", "Hum", "Act"))}, Src=src, Dst=dst)
-        prog.run(*self._grid)
+        dispatch(prog, *self._grid)
         self._current = 1 - self._current
 
         if shifts.any():
@@ -232,14 +232,12 @@ class CloudAutomaton:
                 padded = np.zeros((MAX_LAYERS, 2), "<i4")
                 padded[: len(shifts)] = shifts
                 self._shift_bytes = padded.tobytes()
-            ctx.memory_barrier(moderngl.SHADER_STORAGE_BARRIER_BIT)
             src, dst = self._state[self._current], self._state[1 - self._current]
             bind_buffers(self._prog_advect, Src=src, Dst=dst)
             self._set_grid(self._prog_advect)
             write_uniforms(self._prog_advect, u_shifts=self._shift_bytes)   # per run: the program is shared
-            self._prog_advect.run(*self._grid)
+            dispatch(self._prog_advect, *self._grid)
             self._current = 1 - self._current
-        ctx.memory_barrier(moderngl.ALL_BARRIER_BITS)
         self.step_count += 1
 
     def forget_probabilities(self) -> None:
@@ -356,8 +354,7 @@ class CloudAutomaton:
         fill(self._staging)
         bind_buffers(self._prog_pack, Prob=self._staging, Planes=self._prob_buffers[rule])
         self._set_grid(self._prog_pack, count=self._words)
-        self._prog_pack.run(*self._grid)
-        self.ctx.memory_barrier(moderngl.SHADER_STORAGE_BARRIER_BIT)
+        dispatch(self._prog_pack, *self._grid)
 
     def step_with_texture(self, probabilities, shift=(0, 0)) -> None:
         """One step with per-cell probabilities read on the GPU from a 3D texture of ``shape``
@@ -381,8 +378,7 @@ class CloudAutomaton:
                 bind_textures(cells, u_probabilities=probabilities)
                 bind_buffers(cells, Prob=buffer)
                 write_uniforms(cells, u_size=self.shape, u_channel=channel)
-                cells.run(*grid)
-                self.ctx.memory_barrier(moderngl.SHADER_STORAGE_BARRIER_BIT)
+                dispatch(cells, *grid)
             return fill
         for rule, channel in zip(range(3), (2, 0, 1)):      # RULES order: ext, hum, act
             self._store_probability(rule, fill_from(channel))

@@ -25,6 +25,7 @@ from atmos.plugins.clouds.volume.light import cell_tau, light_uniforms
 from atmos.plugins.clouds.volume.sets import CloudSets
 from atmos.tile_octaves import OctaveTextures
 from atmos.gpu.uniforms import bind_buffers, bind_images, bind_textures, write_uniforms
+from atmos.gpu.hazards import dispatch
 
 REBAKE_TOLERANCE = 0.05          # re-bake the octaves when the sun moved the light step by this fraction
 MAX_HEIGHTS = 64                 # cover.comp's most height samples
@@ -129,6 +130,7 @@ class FarFieldLayer:
             return None
         first = self._staged_for is None
         measured = None if first else _transitions(self._staged)
+        self.gpu.hazards.use(reads=[(self.cover, "copy")], writes=[(self._staged, "copy")])
         self.gpu.ctx.copy_buffer(self._staged, self.cover)
         self._staged_for = sim.b
         return _transitions(self._staged) if first else measured
@@ -147,8 +149,7 @@ class FarFieldLayer:
         c["threshold"].value = float(sim.settings.cover_threshold)
         c["max_sum"].value = float(sim.shape[1])
         bind_buffers(c, Cover=self.cover)
-        c.run(1)
-        self.gpu.ctx.memory_barrier()
+        dispatch(c, 1)
 
     def _profile_texture(self, heights: int):
         if self.profile is None or self.profile.size[1] != heights:
@@ -163,7 +164,6 @@ class FarFieldLayer:
         if self.profile is None:
             raise RuntimeError("FarFieldLayer.read_profile: no profile measured yet; it is measured while a ray "
                                "march draws the far field, or by measure_cover(sim, profile=True)")
-        self.gpu.ctx.memory_barrier()
         return read_rank_texture(self.profile)
 
     def read_cover(self) -> tuple[float, np.ndarray]:

@@ -15,6 +15,7 @@ from __future__ import annotations
 from atmos.plugins.clouds.far_field.columns import INTERVALS, rank_texture, read_rank_texture, use_columns
 from atmos.plugins.clouds.volume.light import cell_tau
 from atmos.plugins.clouds.light.diffusion import DIFFUSION
+from atmos.gpu.hazards import dispatch
 from atmos.gpu.uniforms import bind_buffers, bind_images, bind_textures
 
 READS = {"transmittance": "trans", DIFFUSION: "diffusion"}   # light_by_rank.comp's inputs beside columns.glsl's
@@ -60,8 +61,7 @@ class RankLight:
                             sun_profile=self.sun_profile)
                 if self.has_field:
                     bind_images(c, field_column=self.field, field_profile=self.field_profile)
-            c.run(groups)
-            self.gpu.ctx.memory_barrier()
+            dispatch(c, groups)
 
     def _allocate(self, bins: int) -> None:
         if self.sun is None:
@@ -93,7 +93,6 @@ class RankLight:
         (INTERVALS, bins, 4) per height bin."""
         if self.sun is None:
             raise RuntimeError("RankLight.read: nothing measured yet (FarFieldLayer.prepare measures it)")
-        self.gpu.ctx.memory_barrier()
         out = {"sun": read_rank_texture(self.sun), "thickness": read_rank_texture(self.thickness)[:, 0, 0],
                "height": read_rank_texture(self.height)[:, :, 0],
                "sun_profile": read_rank_texture(self.sun_profile)}

@@ -20,6 +20,7 @@ from atmos.plugins.clouds.light.scattering import LightVolumeShader, Scattering,
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.plugins.clouds.light.shear_warp import ShadingTask, ShearWarpShader, groups, program, read_volume, upload_volume
 from atmos.gpu.uniforms import bind_images, bind_textures
+from atmos.gpu.hazards import dispatch
 
 METHODS = ("shear-warp", "raymarch")
 
@@ -63,8 +64,7 @@ def compute_transmittance(gpu: GpuContext, density, sun_dir, sigma, method: str 
         bind_textures(prog, coarse=shader.result)
         prog["coarse_size"].value = shader.shading_shape
         bind_images(prog, fine=out)
-        prog.run(*(groups(n, 4) for n in density.shape))
-        ctx.memory_barrier()
+        dispatch(prog, *(groups(n, 4) for n in density.shape))
         return read_volume(out)
     finally:
         for obj in made:

@@ -21,6 +21,7 @@ import atmos.plugins.clouds.light.grid as grid
 from atmos.plugins.clouds.light.reference import lerp_matrix, multilinear
 from atmos.plugins.clouds.light.shear_warp import check_volume_texture, groups, program
 from atmos.gpu.uniforms import bind_images, bind_textures
+from atmos.gpu.hazards import dispatch
 
 COLUMNS = "columns"          # the texture set's name for it
 STORE_MAX = 65000.0          # rg16f's range (columns.comp): an optical depth this large is opaque anyway
@@ -88,8 +89,7 @@ class ColumnShader:
         prog["fine_size"].value = self.shape
         prog["z0"].value = z0
         bind_images(prog, columns=target)
-        prog.run(groups(self.shading_shape[0], 8), groups(z1 - z0, 8))
-        self.gpu.ctx.memory_barrier()
+        dispatch(prog, groups(self.shading_shape[0], 8), groups(z1 - z0, 8))
 
 
 class ColumnTask(SliceTask):

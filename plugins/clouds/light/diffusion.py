@@ -37,6 +37,7 @@ from atmos.phase import Phase
 from atmos.plugins.clouds.light.reference import multilinear
 from atmos.plugins.clouds.light.shear_warp import check_volume_texture, groups, program
 from atmos.gpu.uniforms import bind_buffers, bind_images, bind_textures, write_uniforms
+from atmos.gpu.hazards import dispatch, dispatch_indirect
 
 FLOOR = 1e-3               # 1/m: transport extinction floor (empty cells still conduct, finitely)
 TOLERANCE = 1e-4           # relative residual |b - A phi| / |b| the GPU solve stops at
@@ -240,10 +241,9 @@ class DiffusionSolver:
         write_uniforms(prog, values, stage=stage, cur=self._cur, first=int(self._first))
         bind_buffers(prog, Cells=self._cells, Parts=self._parts, Args=self._args)
         if stage in (2, 3):
-            prog.run_indirect(self._args)
+            dispatch_indirect(prog, self._args)
         else:
-            prog.run(self.groups)
-        self.gpu.ctx.memory_barrier()
+            dispatch(prog, self.groups)
 
     def begin(self, density, transmittance, sigma_t: float, albedo: float, g: float, cell, sun_dir,
               warm: bool = True) -> None:

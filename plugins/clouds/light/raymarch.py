@@ -12,12 +12,13 @@ import atmos.plugins.clouds.light.grid as grid
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.plugins.clouds.light.shear_warp import _RESULT_FORMATS, check_volume_texture, groups, program
 from atmos.gpu.uniforms import bind_images, bind_textures
+from atmos.gpu.hazards import dispatch
 
 
 def raymarch(gpu: GpuContext, density_texture, sun_dir, sigma, target) -> None:
     """Write ``exp(-sigma * optical depth)`` of every voxel of ``density_texture`` into ``target``
     (a 1-component ``f2``/``f4`` 3D texture of the same size)."""
-    ctx = require_gpu(gpu).ctx
+    require_gpu(gpu)
     shape = tuple(density_texture.size)
     check_volume_texture(density_texture, shape, "density_texture")
     check_volume_texture(target, shape, "target", dtypes=tuple(_RESULT_FORMATS))
@@ -28,5 +29,4 @@ def raymarch(gpu: GpuContext, density_texture, sun_dir, sigma, target) -> None:
     prog["sun_dir"].value = tuple(float(x) for x in u)
     prog["sigma"].value = sigma
     bind_images(prog, result=target)
-    prog.run(*(groups(n, 4) for n in shape))
-    ctx.memory_barrier()
+    dispatch(prog, *(groups(n, 4) for n in shape))

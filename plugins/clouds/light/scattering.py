@@ -25,6 +25,7 @@ import atmos.plugins.clouds.light.grid as grid
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.plugins.clouds.light.shear_warp import _RESULT_FORMATS, check_volume_texture, groups, program
 from atmos.gpu.uniforms import bind_images, bind_textures
+from atmos.gpu.hazards import dispatch
 
 MODES = ("single", "multiple-forward")
 
@@ -103,5 +104,4 @@ class LightVolumeShader:
         bind_textures(prog, transmittance=transmittance)
         prog["sun_color"].value, prog["ambient"].value = colors
         bind_images(prog, light=target)
-        prog.run(*(groups(n, 4) for n in shape))
-        self.ctx.memory_barrier()
+        dispatch(prog, *(groups(n, 4) for n in shape))

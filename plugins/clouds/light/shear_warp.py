@@ -26,6 +26,7 @@ from atmos.slicing import SliceTask
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.gpu.uniforms import bind_images, bind_textures, write_uniforms
 import atmos.plugins.clouds.light.grid as grid
+from atmos.gpu.hazards import dispatch
 
 _RESULT_FORMATS = {"f4": "r32f", "f2": "r16f"}
 
@@ -111,8 +112,7 @@ class ShearWarpShader:
             bind_textures(prog, fine=density_texture)
             prog["fine_size"].value = self.shape
             bind_images(prog, coarse=self._coarse)
-            prog.run(*(groups(n, 4) for n in self.shading_shape))
-            self.ctx.memory_barrier()
+            dispatch(prog, *(groups(n, 4) for n in self.shading_shape))
             density_texture = self._coarse
         spacing = np.array(self.shape) / np.array(self.shading_shape)
         self._plan = grid.SlicePlan(self.shading_shape, u, spacing)
@@ -170,8 +170,7 @@ class ShearWarpShader:
             bind_images(prog, prev_slice=src, next_slice=dst)
             prog["slice"].value = plan.order[i]
             prog["first"].value = int(i == 0)
-            prog.run(groups(nb, 8), groups(nc, 8))
-            self.ctx.memory_barrier()
+            dispatch(prog, groups(nb, 8), groups(nc, 8))
         self._next = i1
 
     def run_all(self) -> None:

@@ -29,6 +29,7 @@ import numpy as np
 
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.gpu.uniforms import bind_images, bind_textures, write_uniforms
+from atmos.gpu.hazards import dispatch
 
 NOISE_RULE = 0xC1D           # stream id of the noise's hashes: stream_key(seed, 0, NOISE_RULE, plane)
 PERLIN_GAIN = 1.5            # Perlin FBM -> [0, 1]: clamp(0.5 + 0.5 GAIN fbm)
@@ -129,8 +130,7 @@ class DetailNoise:
                 program["perlin_frequency"].value = perlin
                 program["worley_frequency"].value = worley
                 groups = math.ceil(size / 4)
-                program.run(groups, groups, groups)
-            gpu.ctx.memory_barrier()
+                dispatch(program, groups, groups, groups)
             gpu.ctx.finish()
         except Exception:
             for tex in made:

@@ -31,6 +31,7 @@ from atmos.checks import check_shape, is_int
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.plugins.clouds.simulation.smoothing import check_texture_limit, check_volume_texture, check_z_range
 from atmos.gpu.uniforms import bind_images, bind_textures, write_uniforms
+from atmos.gpu.hazards import dispatch
 
 
 def group_grid(nx: int, nz: int, group_size) -> tuple[int, int]:
@@ -55,7 +56,6 @@ def _read_array(texture, data: bytes | None = None) -> np.ndarray:
     (its bytes, copied earlier into a pixel buffer)."""
     w, h, layers = texture.size
     if data is None:
-        texture.ctx.memory_barrier(moderngl.TEXTURE_UPDATE_BARRIER_BIT)
         data = texture.read()
     raw = np.frombuffer(data, dtype="<f4").reshape(layers, h, w)
     return np.ascontiguousarray(raw.transpose(0, 2, 1))
@@ -113,8 +113,7 @@ class DensityMaps:
         # the programs are shared with other DensityMaps on the GpuContext: this one's uniforms each run
         write_uniforms(self._sum_prog, u_size=self.shape, u_band_height=self.band_height)
         self._sum_prog["u_z0"].value = z0
-        self._sum_prog.run(-(-nx // 64), z1 - z0, 1)
-        self.ctx.memory_barrier()
+        dispatch(self._sum_prog, -(-nx // 64), z1 - z0, 1)
         gz0 = z0 // self.group_size[1]
         gz1 = self.grid[1] if z1 == nz else z1 // self.group_size[1]
         if gz1 > gz0:
@@ -122,8 +121,7 @@ class DensityMaps:
             bind_images(self._max_prog, u_max=self.max_maps)
             write_uniforms(self._max_prog, u_extent=(nx, nz), u_group=self.group_size, u_grid=self.grid)
             self._max_prog["u_gz0"].value = gz0
-            self._max_prog.run(-(-self.grid[0] // 8), -(-(gz1 - gz0) // 8), 1 + self.bands)
-            self.ctx.memory_barrier()
+            dispatch(self._max_prog, -(-self.grid[0] // 8), -(-(gz1 - gz0) // 8), 1 + self.bands)
 
     def read_max_maps(self) -> np.ndarray:
         """The max maps as float32 ``(1 + bands, gx, gz)``: [0] all heights, [1 + b] band b. Waits for
@@ -134,7 +132,6 @@ class DensityMaps:
         """Queue a copy of the max maps as they are now into a pixel buffer (GPU side: nothing waits)."""
         if self._released:
             raise RuntimeError("these DensityMaps were released")
-        self.ctx.memory_barrier(moderngl.TEXTURE_UPDATE_BARRIER_BIT)
         self.max_maps.read_into(self._pixels)
         self._requested = True
 

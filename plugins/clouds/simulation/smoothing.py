@@ -26,6 +26,7 @@ from atmos.checks import check_shape, is_int
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.plugins.clouds.automaton import LAYOUTS
 from atmos.gpu.uniforms import bind_buffers, bind_images, write_uniforms
+from atmos.gpu.hazards import dispatch
 
 WEIGHTS = ("tent", "box")
 MAX_RADIUS = 8
@@ -102,7 +103,6 @@ def read_volume(texture) -> np.ndarray:
     """A 1-component float Texture3D as float32 ``[x, y, z]`` (a GPU → CPU copy: for tests and tools)."""
     nx, ny, nz = texture.size
     dtype = check_volume_texture(texture, (nx, ny, nz))
-    texture.ctx.memory_barrier(moderngl.TEXTURE_UPDATE_BARRIER_BIT)
     raw = np.frombuffer(texture.read(), dtype=_NUMPY[dtype]).reshape(nz, ny, nx)
     return np.ascontiguousarray(raw.transpose(2, 1, 0), dtype=np.float32)
 
@@ -175,8 +175,7 @@ class Smoother:
         bind_buffers(program, State=state_buffer)
         bind_images(program, u_density=texture)
         nx, ny, _ = self.shape
-        program.run(-(-nx // _LOCAL[0]), -(-ny // _LOCAL[1]), z1 - z0)
-        self.ctx.memory_barrier()
+        dispatch(program, -(-nx // _LOCAL[0]), -(-ny // _LOCAL[1]), z1 - z0)
 
     def release(self) -> None:
         """The Smoother cannot be used afterwards (it owns no GL objects: its program is the GpuContext's)."""

@@ -24,6 +24,7 @@ from atmos.checks import check_shape
 from atmos.gpu.context import GpuContext, require_gpu
 from atmos.plugins.clouds.weather.components import check_ellipsoid_array
 from atmos.gpu.uniforms import bind_buffers, bind_images, bind_textures, write_uniforms
+from atmos.gpu.hazards import dispatch
 
 CHUNK = 256
 _FORMATS = {"f4": ("r32f", "rgba32f", np.float32), "f2": ("r16f", "rgba16f", np.float16)}
@@ -84,13 +85,11 @@ class RegionVolume:
             write_uniforms(self._scatter, size=self.shape, item_count=len(items), groups_x=gx)
             bind_buffers(self._scatter, Ellipsoids=self._buffers["ellipsoids"], Boxes=self._buffers["boxes"],
                          Items=self._buffers["items"], Region=self._cells)
-            self._scatter.run(gx, gy, 1)
-            self.ctx.memory_barrier()
+            dispatch(self._scatter, gx, gy, 1)
         bind_buffers(self._resolve, Region=self._cells)
         bind_images(self._resolve, region=self.texture)
         write_uniforms(self._resolve, size=self.shape)
-        self._resolve.run(-(-nx // 8), -(-ny // 8), -(-nz // 4))
-        self.ctx.memory_barrier()
+        dispatch(self._resolve, -(-nx // 8), -(-ny // 8), -(-nz // 4))
         return self.texture
 
     def download(self) -> np.ndarray:
@@ -117,8 +116,7 @@ class RegionVolume:
         bind_images(self._probs, probs=self.prob_texture)
         write_uniforms(self._probs, size=self.shape,
                        scales=(hum_scale, act_scale, ext_scale, vanish_threshold))
-        self._probs.run(-(-nx // 8), -(-ny // 8), -(-nz // 4))
-        self.ctx.memory_barrier()
+        dispatch(self._probs, -(-nx // 8), -(-ny // 8), -(-nz // 4))
         return self.prob_texture
 
     def download_probabilities(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

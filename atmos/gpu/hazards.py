@@ -1,0 +1,273 @@
+"""Memory barriers from declared access, never by hand.
+
+OpenGL makes a shader's image stores and storage-buffer writes ("storage" writes) visible to later
+commands only after ``glMemoryBarrier`` with the bit of the way they are read next. :class:`Hazards`
+remembers which GL objects (textures, buffers) were written that way and, when work that declared
+how it uses them is about to run, issues one barrier with exactly the bits those uses need — once
+per write and kind of use. Draws into attachments, uploads and copies are ordered by GL itself.
+
+Uses are declared where they are made: :mod:`atmos.gpu.uniforms` binds samplers (``sampled``), images
+and storage blocks (``storage``, writes taken from the GLSL's ``readonly``/``writeonly``) by name, and
+each bind asks here for the barrier its use needs; :func:`dispatch` runs a compute program and marks
+what it was bound to write as written; reads and uploads through moderngl (``texture.read``,
+``buffer.write``...) and framebuffers the graph makes declare ``copy`` and ``attachment`` uses. No
+code issues ``glMemoryBarrier`` itself.
+
+Access kinds (also what :class:`atmos.graph.PassBuilder` declares):
+
+==============  =======================================================================
+``sampled``     read through a sampler (``texture``, ``texelFetch``)
+``storage``     image load/store, a storage buffer (read, write or atomics)
+``attachment``  a framebuffer attachment (drawn into, blended onto, depth-tested)
+``copy``        read or written by a copy or an upload/readback (``texture.read``, ``buffer.write``)
+``indirect``    a buffer of indirect draw/dispatch arguments
+``uniform``     a buffer bound as a uniform block
+``vertex``      a vertex or index buffer
+==============  =======================================================================
+"""
+from __future__ import annotations
+
+import weakref
+
+import moderngl
+
+ACCESS = ("sampled", "storage", "attachment", "copy", "indirect", "uniform", "vertex")
+
+# (what is read: "texture" or "buffer", how) -> the barrier bit that makes earlier storage writes visible to it
+_BITS = {
+    ("texture", "sampled"): moderngl.TEXTURE_FETCH_BARRIER_BIT,
+    ("texture", "storage"): moderngl.SHADER_IMAGE_ACCESS_BARRIER_BIT,
+    ("texture", "attachment"): moderngl.FRAMEBUFFER_BARRIER_BIT,
+    ("texture", "copy"): moderngl.TEXTURE_UPDATE_BARRIER_BIT,
+    ("buffer", "sampled"): moderngl.TEXTURE_FETCH_BARRIER_BIT,            # a texel buffer
+    ("buffer", "storage"): moderngl.SHADER_STORAGE_BARRIER_BIT,
+    ("buffer", "copy"): moderngl.BUFFER_UPDATE_BARRIER_BIT | moderngl.PIXEL_BUFFER_BARRIER_BIT,
+    ("buffer", "indirect"): moderngl.COMMAND_BARRIER_BIT,
+    ("buffer", "uniform"): moderngl.UNIFORM_BARRIER_BIT,
+    ("buffer", "vertex"): moderngl.VERTEX_ATTRIB_ARRAY_BARRIER_BIT | moderngl.ELEMENT_ARRAY_BARRIER_BIT,
+}
+_ALL = {kind: sum({bits for (k, _), bits in _BITS.items() if k == kind}) for kind in ("texture", "buffer")}
+
+BIT_NAMES = {bit: name.removesuffix("_BARRIER_BIT").lower() for name in dir(moderngl)
+             if name.endswith("_BARRIER_BIT") and (bit := getattr(moderngl, name))}
+
+
+def kind_of(obj) -> str | None:
+    """'texture' or 'buffer' for a moderngl texture or buffer, None for anything else (no hazards)."""
+    if isinstance(obj, moderngl.Buffer):
+        return "buffer"
+    if isinstance(obj, (moderngl.Texture, moderngl.Texture3D, moderngl.TextureArray, moderngl.TextureCube)):
+        return "texture"
+    return None
+
+
+def barrier_bit(kind: str, access: str) -> int:
+    """The barrier bit a use of ``access`` of a ``kind`` ('texture'/'buffer') needs after a storage
+    write (0 where the pair cannot occur: a buffer attachment)."""
+    if access not in ACCESS:
+        raise ValueError(f"access {access!r} is not one of: {', '.join(ACCESS)}")
+    return _BITS.get((kind, access), 0)
+
+
+def bit_names(bits: int) -> list[str]:
+    """The names of the barrier bits in ``bits`` (for dumps and tests)."""
+    return [name for bit, name in sorted(BIT_NAMES.items()) if bits & bit]
+
+
+def _uses(items, default_texture: str, default_buffer: str):
+    """(obj, kind, access) for each item: an object (default access by kind) or an (obj, access) pair."""
+    for item in items:
+        obj, access = item if isinstance(item, tuple) else (item, None)
+        kind = kind_of(obj)
+        if kind is None:
+            continue
+        access = access or (default_texture if kind == "texture" else default_buffer)
+        if access not in ACCESS:
+            raise ValueError(f"access {access!r} is not one of: {', '.join(ACCESS)}")
+        yield obj, kind, access
+
+
+class Hazards:
+    """The storage writes of one context not yet made visible to every kind of use.
+
+    ``use(reads, writes)`` before work, ``wrote(writes)`` after it; or :meth:`dispatch`, which does
+    both around a compute dispatch. ``barriers`` counts the glMemoryBarrier calls issued and
+    ``bits_issued`` how often each bit was in one (tests, benchmarks).
+    """
+
+    def __init__(self, ctx):
+        self._ctx = weakref.ref(ctx)          # the registry is keyed by ctx: a strong ref would keep it alive
+        self.barriers = 0
+        self.bits_issued: dict[str, int] = {}
+        self._dirty: dict[int, list] = {}     # id(obj) -> [weakref, kind, bits still to issue]
+        self._staged: dict[int, tuple] = {}   # bound for a storage write by the coming dispatch: id -> (ref, kind)
+        self._need = 0                        # bits the binds of the coming work asked for (issued by flush)
+
+    def stage(self, obj) -> None:
+        """``obj`` is bound for a storage write by the next :meth:`commit`-ed work (a bind does this)."""
+        kind = kind_of(obj)
+        if kind is not None:
+            self._staged[id(obj)] = (weakref.ref(obj), kind)
+
+    def commit(self) -> None:
+        """The work just recorded ran: what was staged for writing is now dirty."""
+        for key, (ref, kind) in self._staged.items():
+            self._dirty[key] = [ref, kind, _ALL[kind]]
+        self._staged.clear()
+
+    def use(self, reads=(), writes=(), defer: bool = False) -> int:
+        """Issue the barrier the coming work needs: ``reads`` and ``writes`` are GL objects (textures
+        default to ``sampled`` reads, buffers to ``storage``; writes default to ``storage``) or
+        (obj, access) pairs. ``defer``: only add the bits to the next :meth:`flush` (what binds do, so
+        the binds of one dispatch or draw share one barrier). Returns the bits needed (0: none)."""
+        need = 0
+        dirty = self._dirty
+        for obj, kind, access in _uses(reads, "sampled", "storage"):
+            entry = dirty.get(id(obj))
+            if entry is not None and entry[0]() is obj:
+                need |= entry[2] & _BITS.get((kind, access), 0)
+        for obj, kind, access in _uses(writes, "storage", "storage"):
+            entry = dirty.get(id(obj))
+            if entry is not None and entry[0]() is obj:   # write after a storage write: order the two
+                need |= entry[2] & _BITS.get((kind, access), 0)
+        if defer:
+            self._need |= need
+        elif need or self._need:
+            self.issue(need | self._need)
+        return need
+
+    def flush(self) -> None:
+        """Issue what the binds of the coming work asked for (dispatches and draws call this)."""
+        if self._need:
+            self.issue(self._need)
+
+    def wrote(self, writes=()) -> None:
+        """The work just recorded wrote ``writes``; those with ``storage`` access are now dirty."""
+        for obj, kind, access in _uses(writes, "storage", "storage"):
+            if access == "storage":
+                self._dirty[id(obj)] = [weakref.ref(obj), kind, _ALL[kind]]
+
+    def dispatch(self, program, groups=(1, 1, 1), reads=(), writes=()) -> None:
+        """Run compute ``program`` over ``groups`` (x, y, z work groups) after the barrier its
+        ``reads``/``writes`` (beyond what its binds declared) need; what it wrote is then dirty."""
+        self.use(reads, writes)
+        for obj, kind, access in _uses(writes, "storage", "storage"):
+            if access == "storage":
+                self.stage(obj)
+        self.flush()
+        program.run(*groups)
+        self.commit()
+
+    def issue(self, bits: int) -> None:
+        """One glMemoryBarrier with ``bits``; every pending write is then visible to those uses."""
+        self._ctx().memory_barrier(bits)
+        self._need = 0
+        self.barriers += 1
+        for name in bit_names(bits):
+            self.bits_issued[name] = self.bits_issued.get(name, 0) + 1
+        for key, entry in list(self._dirty.items()):
+            entry[2] &= ~bits
+            if not entry[2] or entry[0]() is None:
+                del self._dirty[key]
+
+    def settle(self) -> int:
+        """Make every pending write visible to every use (for readers that declare nothing: a frame's
+        end, a test reading back). Returns the bits issued."""
+        need = 0
+        for entry in self._dirty.values():
+            if entry[0]() is not None:
+                need |= entry[2]
+        if need:
+            self.issue(need)
+        else:
+            self._dirty.clear()
+        return need
+
+    def pending(self, obj) -> list[str]:
+        """The uses ``obj``'s last storage write is not yet visible to (bit names; [] when clean)."""
+        entry = self._dirty.get(id(obj))
+        return bit_names(entry[2]) if entry is not None and entry[0]() is obj else []
+
+
+_TRACKERS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()   # moderngl.Context -> Hazards
+
+
+def hazards_of(ctx) -> Hazards:
+    """The one :class:`Hazards` of a moderngl context (``GpuContext.hazards`` is the same object)."""
+    tracker = _TRACKERS.get(ctx)
+    if tracker is None:
+        tracker = _TRACKERS[ctx] = Hazards(ctx)
+        _guard_transfers()
+    return tracker
+
+
+def dispatch(program, *groups: int) -> None:
+    """Run compute ``program`` over ``groups`` work groups (x[, y[, z]]); what its binds staged for a
+    storage write is dirty afterwards (:class:`Hazards`). The one way atmos runs a compute program."""
+    hazards = hazards_of(program.ctx)
+    hazards.flush()
+    program.run(*groups)
+    hazards.commit()
+
+
+def dispatch_indirect(program, args, offset: int = 0) -> None:
+    """Run compute ``program`` with its group counts read on the GPU from buffer ``args`` (3 uints at
+    ``offset``), after the barrier that makes a shader's write of ``args`` visible as indirect arguments."""
+    hazards = hazards_of(program.ctx)
+    hazards.use(reads=[(args, "indirect")])       # with what the binds asked for: one barrier
+    program.run_indirect(args, offset)
+    hazards.commit()
+
+
+_GUARDED = False
+_TRANSFERS = {   # moderngl methods that read or write an object's memory from the CPU side: 'copy' uses
+    moderngl.Buffer: ("read", "read_into", "write", "write_chunks", "clear", "orphan"),
+    **{cls: ("read", "read_into", "write") for cls in
+       (moderngl.Texture, moderngl.Texture3D, moderngl.TextureArray, moderngl.TextureCube)},
+}
+_BUILD_MIPMAPS = {cls: ("build_mipmaps",) for cls in
+                  (moderngl.Texture, moderngl.Texture3D, moderngl.TextureArray, moderngl.TextureCube)}
+
+
+def _guard_transfers() -> None:
+    """Wrap moderngl's CPU transfers once per process so that each is a declared ``copy`` use: a
+    readback (the game's or a test's included) sees the storage writes before it, an upload waits for them."""
+    global _GUARDED
+    if _GUARDED:
+        return
+    _GUARDED = True
+    for name in ("render", "render_indirect"):
+        method = getattr(moderngl.VertexArray, name)
+        if not getattr(method, "_atmos_copy_use", False):
+            setattr(moderngl.VertexArray, name, _flushing(method))
+    for table, uses in ((_TRANSFERS, ("copy",)), (_BUILD_MIPMAPS, ("copy", "sampled"))):
+        for cls, names in table.items():
+            for name in names:
+                method = getattr(cls, name, None)
+                if method is not None and not getattr(method, "_atmos_copy_use", False):
+                    setattr(cls, name, _copy_use(method, uses))
+
+
+def _flushing(method):
+    """A draw: the barrier its binds asked for, then the draw."""
+    def draw(self, *args, **kwargs):
+        tracker = _TRACKERS.get(self.ctx)
+        if tracker is not None and tracker._need:
+            tracker.flush()
+        return method(self, *args, **kwargs)
+    draw._atmos_copy_use = True
+    draw.__name__, draw.__qualname__, draw.__doc__ = method.__name__, method.__qualname__, method.__doc__
+    draw.__wrapped__ = method
+    return draw
+
+
+def _copy_use(method, uses):
+    def transfer(self, *args, **kwargs):
+        tracker = _TRACKERS.get(self.ctx)
+        if tracker is not None and tracker._dirty:
+            tracker.use(reads=[(self, access) for access in uses])
+        return method(self, *args, **kwargs)
+    transfer._atmos_copy_use = True
+    transfer.__name__, transfer.__qualname__, transfer.__doc__ = method.__name__, method.__qualname__, method.__doc__
+    transfer.__wrapped__ = method
+    return transfer
