@@ -6,7 +6,8 @@ columns that are covered (summed density of mix(A, B, t) above ``CloudSettings.c
 at the column's centre; :func:`.reference.volume_cover` is it in float64; and how often the cover
 changes from one column to the next (:func:`.reference.volume_transitions`), which sizes the far
 field's tile (:func:`matched_tile_size`: its cover then changes along a line as often per metre). The far-field shader ranks each
-point's fbm among the layer's (the quantile table :func:`level_table` makes once per texture setting)
+point's fbm among the layer's (the quantile table :func:`level_table` makes once per texture setting,
+baked by :func:`rank_table` into a texture of the rank as a function of fbm and level: one filtered fetch)
 and takes the volume's column sum at that rank, so the same fraction of its layer is clouded.
 
 Per detail level: far away the shader samples blurred mip levels of the octaves, whose fbm has a
@@ -31,6 +32,7 @@ LEVELS = 8              # table rows: mip levels 0..7 of the table's grid (field
 SPAN = 40.0             # tiles per side of the world square the quantiles are measured over
 SAMPLES = 384           # samples per side of it (the octaves' phases are unrelated there: their joint spread)
 LINES, LINE_TILES, LINE_STEP = 48, 8.0, 1.0 / 256.0     # the crossing rate: lines along x and z, tiles, spacing
+RANK_COLUMNS = 2048     # rank table texels per level (field.glsl far_rank_table): reference.rank_table_error
 
 
 def mip_chain(texture: np.ndarray) -> list:
@@ -104,6 +106,31 @@ def level_table(base_frequency: int, seed: int, size: int = GRID) -> tuple:
     trilinear), and ``first`` = log2(size / grid): texture mip level L reads row L − first (clamped)."""
     rows, first, _ = _measure(int(base_frequency), int(seed), int(size))
     return rows, first
+
+
+def rank_table(quantiles, columns: int = RANK_COLUMNS) -> tuple:
+    """(table (levels, columns), span) of field.glsl's far_rank_table: row m holds the rank of level m
+    (linear between its ``quantiles`` row, 0 below, 1 above) at ``columns`` fbm values evenly spanning
+    all rows' quantiles, one per texel centre; span = (fbm at the texture's left edge, texture widths per
+    unit fbm), so the texture x of fbm f is (f - span[0]) * span[1]. Between two columns the texture's
+    linear filter is the rank itself except in the cells holding a quantile (reference.rank_table_error)."""
+    q = np.asarray(quantiles, np.float64)
+    lo, hi = float(q[:, 0].min()), float(q[:, -1].max())
+    hi = max(hi, lo + 1e-9)
+    f = np.linspace(lo, hi, int(columns))
+    ranks = np.linspace(0.0, 1.0, q.shape[1])
+    table = np.array([np.interp(f, row, ranks) for row in q])
+    scale = (int(columns) - 1) / (int(columns) * (hi - lo))
+    return table, (lo - 0.5 / (int(columns) * scale), scale)
+
+
+@lru_cache(maxsize=8)
+def level_ranks(base_frequency: int, seed: int, size: int = GRID) -> tuple:
+    """(table, span, first level): :func:`rank_table` of :func:`level_table`'s rows, what the far field
+    binds once per texture setting."""
+    rows, first = level_table(base_frequency, seed, size)
+    table, span = rank_table(rows)
+    return table, span, first
 
 
 def pattern_crossings(base_frequency: int, seed: int, size: int = GRID) -> np.ndarray:

@@ -15,10 +15,11 @@ far field takes its density from; a second dispatch its light by rank (:attr:`Fa
 """
 from __future__ import annotations
 
+import moderngl
 import numpy as np
 
 from atmos.plugins.clouds.far_field.columns import rank_texture, read_rank_texture, use_columns
-from atmos.plugins.clouds.far_field.cover import QUANTILES, level_table, matched_tile_size, pattern_crossings
+from atmos.plugins.clouds.far_field.cover import LEVELS, QUANTILES, level_ranks, matched_tile_size, pattern_crossings
 from atmos.plugins.clouds.far_field.pattern import CHANNEL_STEPS, PERIODS, octave_frequencies, octave_offsets, rotations
 from atmos.plugins.clouds.far_field.rank_light import RankLight
 from atmos.plugins.clouds.volume.light import cell_tau, light_uniforms
@@ -59,6 +60,18 @@ def column_tau(settings, sets: CloudSets) -> float:
     return float(settings.thickness) * cell_tau(sets.settings)
 
 
+def rank_table_texture(gpu, table):
+    """field.glsl's far_rank_table: ``table`` (LEVELS, columns) (:func:`.cover.rank_table`) as an R32F
+    texture, linear, clamped to the edge (fbm beyond the table: rank 0 or 1)."""
+    table = np.asarray(table, np.float64)
+    if table.shape[0] != LEVELS:
+        raise ValueError(f"rank_table_texture: {table.shape[0]} rows, field.glsl reads FIELD_LEVELS = {LEVELS}")
+    texture = gpu.track(gpu.ctx.texture(table.shape[::-1], 1, np.ascontiguousarray(table, "f4").tobytes(), dtype="f4"))
+    texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
+    texture.repeat_x = texture.repeat_y = False
+    return texture
+
+
 class FarFieldLayer:
     """The octave textures and the measured cover of the far field (GL objects of one GpuContext)."""
 
@@ -75,6 +88,8 @@ class FarFieldLayer:
         self.profile = None                  # (INTERVALS, heights) rg32f: the volume's shape by rank (cover.comp)
         self.light = RankLight(gpu)          # the volume's light by rank (light_by_rank.comp)
         self._prepared = None                # the SceneView of the frame prepared last (held: never a reused id)
+        self.ranks = None                    # far_rank_table (rank_table_texture) of the texture setting _ranks_for
+        self._ranks_for = None
 
     @property
     def settings(self):
@@ -192,12 +207,24 @@ class FarFieldLayer:
                       field_lod_shift=tuple(np.log2(PERIODS)),
                       field_mid_height=float(0.5 * (layout.lo[1] + layout.hi[1])),
                       field_column_tau=column_tau(params, sim))
-        quantiles, first = level_table(params.base_frequency, params.seed, params.size)
+        span, first = self._rank_table()
+        bind_textures(program, far_rank_table=self.ranks)
         crossings = pattern_crossings(params.base_frequency, params.seed, params.size)   # far.frag's slant_rank
         write_uniforms(program, values, field_offsets=offsets.astype("f4").tobytes(),
                        field_turns=np.transpose(rotations(), (0, 2, 1)).astype("f4").tobytes(),   # column-major
-                       field_quantiles=np.asarray(quantiles, "f4").tobytes(), field_first_level=first,
+                       far_rank_span=tuple(span), field_first_level=first,
                        field_crossings=np.asarray(crossings, "f4").tobytes())
+
+    def _rank_table(self) -> tuple:
+        """(span, first level) of :attr:`ranks`, baked anew when the texture setting changed."""
+        params = self.settings
+        key = (int(params.base_frequency), int(params.seed), int(params.size))
+        table, span, first = level_ranks(*key)
+        if key != self._ranks_for:
+            if self.ranks is not None:
+                self.ranks.release()
+            self.ranks, self._ranks_for = rank_table_texture(self.gpu, table), key
+        return span, first
 
     def release(self) -> None:
         if self.octaves is not None:
@@ -213,6 +240,9 @@ class FarFieldLayer:
         if self.light is not None:
             self.light.release()
             self.light = None
+        if self.ranks is not None:
+            self.ranks.release()
+            self.ranks = self._ranks_for = None
 
 
 def _transitions(buffer) -> tuple[float, float]:

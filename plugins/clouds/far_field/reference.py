@@ -207,10 +207,72 @@ def field_fbm(xz, octaves, offsets, tile_size: float, channel: int = 0, weight_b
 
 
 def field_rank(fbm, quantiles) -> np.ndarray:
-    """field.glsl's field_rank: the fraction of the layer's fbm at or below ``fbm`` (linear between the
-    ``quantiles``, 0 below the first, 1 above the last)."""
+    """The exact rank of one table level (field.glsl's far_rank_table row): the fraction of the layer's
+    fbm at or below ``fbm`` (linear between the ``quantiles``, 0 below the first, 1 above the last)."""
     q = np.asarray(quantiles, np.float64)
     return np.interp(fbm, q, np.linspace(0.0, 1.0, len(q)))
+
+
+def level_rank(fbm, level, quantiles) -> np.ndarray:
+    """The exact rank of field.glsl's fbm_rank: :func:`field_rank` in table rows m0 = min(floor(m), L − 2)
+    and m0 + 1 of ``quantiles`` (L, QUANTILES) mixed by m − m0, m = ``level`` clamped to 0 .. L − 1 (field_level)."""
+    q = np.asarray(quantiles, np.float64)
+    fbm, level = np.broadcast_arrays(np.asarray(fbm, np.float64), np.asarray(level, np.float64))
+    m = np.clip(level, 0.0, len(q) - 1.0)
+    m0 = np.minimum(np.floor(m).astype(np.int64), len(q) - 2)
+    t = m - m0
+    out = np.empty(fbm.shape)
+    for k in range(len(q) - 1):
+        at = m0 == k
+        out[at] = (1.0 - t[at]) * field_rank(fbm[at], q[k]) + t[at] * field_rank(fbm[at], q[k + 1])
+    return out
+
+
+def table_rank(fbm, level, table, span, weight_bits: int | None = None, dtype=np.float32) -> np.ndarray:
+    """fbm_rank's lookup: far_rank_table (:func:`.cover.rank_table`'s ``table``, stored as ``dtype``) read
+    bilinear, clamped to the edge, at x = (fbm − span[0]) · span[1], y = (m + 0.5) / rows (m: ``level``
+    clamped as field_level); ``weight_bits``: float32 coordinates and sub-texel weights rounded to that
+    many bits (:func:`.cover.sample`), None: exact."""
+    t = np.asarray(np.asarray(table, np.float64).astype(dtype), np.float64)
+    rows, cols = t.shape
+    fbm, level = np.broadcast_arrays(np.asarray(fbm, np.float64), np.asarray(level, np.float64))
+    m = np.clip(level, 0.0, rows - 1.0)
+    if weight_bits is None:
+        p = np.stack([(fbm - span[0]) * span[1] * cols - 0.5, m], -1)
+    else:
+        f32 = np.float32
+        x = (fbm.astype(f32) - f32(span[0])) * f32(span[1])
+        y = (m.astype(f32) + f32(0.5)) / f32(rows)
+        p = np.stack([x * f32(cols) - f32(0.5), y * f32(rows) - f32(0.5)], -1).astype(np.float64)
+    i0 = np.floor(p).astype(np.int64)
+    w = p - i0
+    if weight_bits is not None:
+        w = np.round(w * 2.0 ** int(weight_bits)) / 2.0 ** int(weight_bits)
+    at = lambda di, dj: t[np.clip(i0[..., 1] + dj, 0, rows - 1), np.clip(i0[..., 0] + di, 0, cols - 1)]
+    return ((1 - w[..., 1]) * ((1 - w[..., 0]) * at(0, 0) + w[..., 0] * at(1, 0))
+            + w[..., 1] * ((1 - w[..., 0]) * at(0, 1) + w[..., 0] * at(1, 1)))
+
+
+def rank_table_error(quantiles, table, span, weight_bits: int | None = None, dtype=np.float32) -> tuple[float, float]:
+    """(resampling, lookup) bounds on |:func:`table_rank` − :func:`level_rank`|: their sum bounds it.
+    Resampling: a row's linear interpolation between columns is the rank itself except in a cell that
+    holds quantiles; the error is linear between them and the cell's ends, so its most is at one of
+    them (evaluated at each). Lookup, with D = the table's largest step between columns and E between
+    rows: storage (half an ulp of ``dtype`` below 1), float32 coordinates (a few ulps of the texture
+    coordinate: 4 · 2^-24 texels per column and per row, times D and E) and, with ``weight_bits`` b, a
+    weight off by up to 2^-(b+1) along each axis (a sample moves by 2^-(b+1) · (D + E) at most)."""
+    q, t = np.asarray(quantiles, np.float64), np.asarray(table, np.float64)
+    rows, cols = t.shape
+    columns = span[0] + (np.arange(cols) + 0.5) / (cols * span[1])
+    ranks = np.linspace(0.0, 1.0, q.shape[1])
+    resample = max(float(np.abs(np.interp(row, columns, t[m]) - np.interp(row, row, ranks)).max())
+                   for m, row in enumerate(q))
+    d = float(np.abs(np.diff(t, axis=1)).max())
+    e = float(np.abs(np.diff(t, axis=0)).max()) if rows > 1 else 0.0
+    lookup = np.finfo(dtype).eps / 4.0 + 4.0 * 2.0 ** -24 * (cols * d + rows * e)
+    if weight_bits is not None:
+        lookup += 2.0 ** -(int(weight_bits) + 1) * (d + e)
+    return resample, float(lookup)
 
 
 def column_at_rank(rank, columns) -> np.ndarray:

@@ -2,7 +2,8 @@
 // atmos/plugins/clouds/far_field/reference.py): four scrolling tileable octaves, each turned and with
 // its own period, give fbm;
 // far_field_rank(xz, lod) is the fraction of the layer whose fbm lies below this point's (per mip level:
-// cover.py level_table, a blurred pattern ranked by its own quantiles), and far_quantile(r) the volume's
+// cover.py level_table, a blurred pattern ranked by its own quantiles; one fetch of far_rank_table, the
+// rank baked as a function of fbm and level: cover.rank_table), and far_quantile(r) the volume's
 // column sum at that rank (column_quantiles, cover.comp), so the far field is clouded as often, and as
 // thick per cover, as the volume. Shared by the far-field pass (far.frag), the ray march's volumetric
 // far field (clouds/raymarch/far.glsl) and the ground shadows and light shafts (clouds/volume/column.glsl
@@ -12,32 +13,20 @@ layout(binding = 5) uniform sampler2D octave0;
 layout(binding = 6) uniform sampler2D octave1;
 layout(binding = 7) uniform sampler2D octave2;
 layout(binding = 8) uniform sampler2D octave3;
+layout(binding = 25) uniform sampler2D far_rank_table;   // R32F (fbm, level) -> rank: cover.rank_table, linear, clamped
 layout(std430, binding = 0) readonly buffer Cover { float cover; float column_quantiles[33]; };
 uniform vec2 field_origin;         // a world xz near the view (the camera's)
 uniform vec2 field_offsets[4];     // each octave's uv there, drift included (wrapped, float64 on the CPU)
 uniform mat2 field_turns[4];       // world tiles -> octave k's uv: its turn / its period (clouds/far_field/pattern.py)
 uniform vec4 field_lod_shift;      // log2 of each octave's period in tiles (its texels are that much larger)
-#define FIELD_LEVELS 8
-uniform float field_quantiles[FIELD_LEVELS * 33]; // cover.level_table: 33 per level
-uniform float field_first_level;                  // the mip level of table row 0
+#define FIELD_LEVELS 8     // far_rank_table's rows (cover.LEVELS)
+uniform vec2 far_rank_span;        // far_rank_table's x of fbm f: (f - span.x) * span.y
+uniform float field_first_level;   // the mip level of table row 0
 uniform float field_tile_size;
 uniform float field_mid_height;    // the layer's middle plane (world y)
 uniform float field_column_tau;    // thickness · sigma_t · cell height: optical depth per summed cell
 uniform float field_crossings[33]; // cover.pattern_crossings: the pattern's crossings of quantile k per tile
 const float MIN_SLANT = 0.1;       // the cap on a slant's sin (about 6 degrees): the view's at the horizon, the sun's
-
-// The fraction of level `level`'s fbm at or below f (binary search, linear between the 33 quantiles).
-float field_rank(float f, int level) {
-    int base = 33 * level, lo = 0, hi = 32;
-    if (f <= field_quantiles[base]) return 0.0;
-    if (f >= field_quantiles[base + 32]) return 1.0;
-    for (int k = 0; k < 5; ++k) {           // 2^5 = 32 intervals
-        int mid = (lo + hi) / 2;
-        if (field_quantiles[base + mid] <= f) lo = mid; else hi = mid;
-    }
-    float a = field_quantiles[base + lo], b = field_quantiles[base + hi];
-    return (float(lo) + (b > a ? (f - a) / (b - a) : 0.5)) / 32.0;
-}
 
 // The volume's column sum (cells) at rank r (column_quantiles, linear between the 33): what the 2D far
 // field (far.frag) and the march's (clouds/raymarch/far.glsl) take at a point of rank far_field_rank.
@@ -65,15 +54,19 @@ float field_level(float lod) {
     return clamp(lod - field_first_level, 0.0, float(FIELD_LEVELS - 1));
 }
 
-// The rank (field_rank) of the point's fbm at world xz among its level's, per channel.
+// The rank of fbm f (per channel) among table level m = field_level(lod)'s: the fraction of its fbm at
+// or below f, linear between its 33 quantiles, mixed between rows floor(m) and the next by the filter
+// (texel centres: row k at y = (k + 0.5) / FIELD_LEVELS; the last row alone at m = FIELD_LEVELS - 1).
+vec4 fbm_rank(vec4 f, float lod) {
+    float y = (field_level(lod) + 0.5) / float(FIELD_LEVELS);
+    vec4 x = (f - far_rank_span.x) * far_rank_span.y;
+    return vec4(textureLod(far_rank_table, vec2(x.x, y), 0.0).r, textureLod(far_rank_table, vec2(x.y, y), 0.0).r,
+                textureLod(far_rank_table, vec2(x.z, y), 0.0).r, textureLod(far_rank_table, vec2(x.w, y), 0.0).r);
+}
+
+// The rank (fbm_rank) of the point's fbm at world xz among its level's, per channel.
 vec4 far_field_rank(vec2 xz, float lod) {
-    vec4 fbm = field_fbm(xz, lod);
-    float m = field_level(lod);
-    int m0 = min(int(m), FIELD_LEVELS - 2);
-    float t = m - float(m0);
-    vec4 r;
-    for (int k = 0; k < 4; ++k) r[k] = mix(field_rank(fbm[k], m0), field_rank(fbm[k], m0 + 1), t);
-    return r;
+    return fbm_rank(field_fbm(xz, lod), lod);
 }
 
 // The relief at a point of ranks r (far_field_rank): the sun's extra optical depth through the layer's
