@@ -358,6 +358,7 @@ class App:
             attempt(f"{plugin.name}.cleanup", plugin.cleanup, self)
         if self.graph is not None:
             attempt("the render graph's release", self.graph.release)
+        attempt("the frame scheduler's release", self.frames.release)
         attempt("the ECS world's close", self.world.close)
         if self.gpu is not None:
             self.gpu._apps.discard(self)

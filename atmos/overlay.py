@@ -1,8 +1,9 @@
 """Frame-time overlay: a bar graph of recent frame times (green < 16.7 ms, yellow < 33.3 ms, red above).
 
 F1 shows or hides it (its own system reads :class:`atmos.Input`; or ``OverlayPlugin.configure(visible=...)``).
-The numbers are kept even when hidden, for the window caption and for benchmarks; per-pass timings
-come from the render graph's timer queries.
+The frame times are kept even when hidden, for the window caption and for benchmarks. While the
+bars show, the overlay asks the render graph for per-pass timings (``graph.want_timings``; the window
+caption lists the slowest passes); hidden, it stops asking and frames make no timer queries.
 """
 from __future__ import annotations
 
@@ -121,9 +122,17 @@ class OverlayPlugin(Plugin):
         app.add_system(self.toggle, "update", label="overlay_toggle")
         if app.graph is not None:
             app.graph.add_pass(OverlayPass(self))
+            app.graph.want_timings(self, self.settings.visible)
 
     def toggle(self, app) -> None:
-        """F1 pressed this frame (in the App's :class:`atmos.Input`, if it has one): show or hide."""
+        """F1 pressed this frame (in the App's :class:`atmos.Input`, if it has one): show or hide;
+        per-pass timings are wanted while shown."""
         inp = app.get_resource(Input)
         if inp is not None and key.F1 in inp.pressed:
             self.configure(visible=not self.settings.visible)
+        if app.graph is not None:
+            app.graph.want_timings(self, self.settings.visible)
+
+    def cleanup(self, app) -> None:
+        if app.graph is not None:
+            app.graph.want_timings(self, False)

@@ -181,7 +181,8 @@ class Interrupted(KeyboardInterrupt):
 
 
 def slowest_passes(app, n: int = 3) -> str:
-    """The ``n`` render passes with the most GPU time (timer queries), e.g. 'clouds 4.1 ms, sky 0.8 ms'."""
+    """The ``n`` render passes with the most GPU time (timer queries), e.g. 'clouds 4.1 ms, sky 0.8 ms';
+    empty while nothing turns timings on (``app.graph.timings_enabled``, the overlay when shown)."""
     timings = sorted(app.graph.timings.items(), key=lambda kv: -kv[1][0])[:n]
     return ", ".join(f"{name} {gpu_ms:.1f} ms" for name, (gpu_ms, _) in timings)
 
@@ -192,7 +193,7 @@ def _label(game) -> str:
 
 def run_window(name, settings: DemoSettings, title: str | None = None, script=None) -> None:
     """``name`` (:func:`load_game`) in a window (:mod:`atmos.window`: ESC quits, F1 the overlay);
-    the caption shows the frame times and the slowest passes."""
+    the caption shows the frame times, and the slowest passes while the overlay shows."""
     from atmos.overlay import FrameTimes
     from atmos.window import run_window as window_loop
 
@@ -201,7 +202,8 @@ def run_window(name, settings: DemoSettings, title: str | None = None, script=No
     def show_times(app, window, frame):
         times = app.get_resource(FrameTimes)
         if times is not None and frame % 30 == 0:
-            window.set_caption(f"{caption} — {times.summary()} — {slowest_passes(app)}")
+            passes = slowest_passes(app)
+            window.set_caption(f"{caption} — {times.summary()}" + (f" — {passes}" if passes else ""))
 
     window_loop(lambda gpu: build_app(name, settings, gpu, script=script), settings.size, caption, settings.frames,
                 show_times)

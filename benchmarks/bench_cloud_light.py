@@ -255,7 +255,7 @@ def sprite_pass_cost(rounds=5, frames=9):
                     app.render()
                     gpu.ctx.finish()
                     t = app.graph.timings.get("cloud_render")
-                    if t and i >= 3:                # results lag RING - 1 frames: skip the other's
+                    if t and i >= 3:                # results lag a frame or two: skip the other's
                         ms[label].append(t[0])
         sprite.program = new
         sprite._release_buffers()

@@ -232,7 +232,7 @@ def sunset_rows(size=(1024, 768), rounds=2, frames=6) -> list[dict]:
                 for label, on, off in (("sprites", sprites, march), ("march", march, sprites)):
                     off.configure(enabled=False)
                     on.configure(enabled=True)
-                    app.run_frames(RING + 1, 1 / 30)     # the switch, compiles, the timer ring refilled
+                    app.run_frames(RING + 1, 1 / 30)     # the switch, compiles, the timer queries read again
                     for _ in range(frames):
                         ctx.finish()
                         start = time.perf_counter()

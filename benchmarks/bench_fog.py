@@ -37,6 +37,7 @@ def render(gpu, size, frames, preset="fig6", **fields):
     app.insert_resource(settings)           # the demo's systems read it, as under build_app
     fog = fog_valley.build(app, settings, fog_preset=preset)
     fog.configure(**fields)
+    app.graph.timings_enabled = True        # the fog pass's timer query
     app.run_frames(3, dt=0.0)           # compile, make noise volumes
     gpu.ctx.finish()
     fog_ms, wall = [], []

@@ -22,6 +22,7 @@ def pass_ms(mode: str, frames: int = 30) -> float:
     gpu = create_headless(SIZE)
     app = build_app("sunset", DemoSettings(size=SIZE, headless=True), gpu)
     next(p for p in app.graph.passes if isinstance(p, LightShaftsPass)).plugin.configure(mode=mode)
+    app.graph.timings_enabled = True
     app.run_frames(5, 1 / 30)
     total = 0.0
     for _ in range(frames):

@@ -214,7 +214,6 @@ def main(argv=None) -> int:
         baseline = measure_tree(baseline_tree(args.baseline, keep), names, args.frames, size)
     rows = [measure(name, args.frames, size) for name in names]
     from atmos.gpu import create_headless
-    from atmos.graph.timing import RING
     gpu = create_headless((16, 16))
     renderer = gpu.info().get("GL_RENDERER")
     gpu.release()
@@ -224,7 +223,7 @@ def main(argv=None) -> int:
           "subtracted: with the work done, minus the CPU time inside the work calls")
     print(table(rows, baseline))
     for row in rows:
-        print(f"{row['scene']}: GPU->CPU readbacks per frame (a timer query is read {RING - 1} frames after it was issued)")
+        print(f"{row['scene']}: GPU->CPU readbacks per frame")
         for where, n in row["readbacks_per_frame"].items():
             print(f"  {n:6.2f}  {where}")
     if args.json:

@@ -69,6 +69,7 @@ def _measure(gpu, model: str, frames: int) -> dict:
     app = App(gpu).add_plugins(DefaultPlugins(overlay=False), SkyPlugin(model=model, stars=False), GroundPlugin())
     app.insert_resource(Sun.from_angles(5.0, 0.0))
     app.startup()
+    app.graph.timings_enabled = True
     cam = app.resource(Camera)
     cam.position, cam.pitch = np.array([0.0, 2.0, 0.0]), 0.3
     app.run_frames(3, 1 / 30)
@@ -136,6 +137,7 @@ def aerial(size, frames: int, steps=(1, 2, 4, 8, 12, 24, 48), froxels=FROXELS) -
         app = App(gpu).add_plugins(DefaultPlugins(overlay=False), sky, GroundPlugin(half_size=1e6))
         app.insert_resource(Sun.from_angles(8.0, 30.0))
         app.startup()
+        app.graph.timings_enabled = True
         cam = app.resource(Camera)
         cam.position, cam.pitch, cam.near, cam.far = np.array([0.0, altitude, 0.0]), pitch, 1.0, 2e6
         plain = app.read_linear()[::-1].astype(np.float64)[..., :3]

@@ -474,6 +474,7 @@ def test_framebuffers_are_cached(graph, screen):
 
 # -- timings, dumps, lifetime --------------------------------------------------------------------
 def test_timings_cover_kept_passes_only(graph, screen):
+    graph.timings_enabled = True
     graph.import_resource("screen", screen)
     graph.add_pass(P("a", creates={"x": SMALL}))
     graph.add_pass(P("b", reads=["x"], writes=["screen"]))

@@ -7,9 +7,12 @@ block runs and records, per call kind:
   software rasterizer their time is the GPU's time, so *Python time = wall time - work time -
   readback time* is what a frame costs the CPU without the GPU (benchmarks/bench_python_frame.py);
 * ``readback`` — calls that make the CPU wait for GPU results: reads of textures, buffers and
-  framebuffers into memory, a timer query's ``elapsed`` and ``ctx.finish()``; each is recorded with
-  the atmos source line that made it (``meter.readbacks``), so a test can say exactly which ones a
-  frame makes. A ``read_into`` a moderngl Buffer (a pixel-buffer copy, asynchronous) is work.
+  framebuffers into memory, a moderngl timer query's ``elapsed``, :meth:`TimerQuery.result
+  <atmos.gpu.queries.TimerQuery.result>` and ``ctx.finish()``; each is recorded with the atmos
+  source line that made it (``meter.readbacks``), so a test can say exactly which ones a frame
+  makes. A ``read_into`` a moderngl Buffer (a pixel-buffer copy, asynchronous) is work;
+* ``query`` — atmos's own timer queries begun (``TimerQuery.begin``) and polled
+  (``TimerQuery.poll``: the result only once it is in, so no wait) are counted, not readbacks.
 
 Times come from ``clock`` (default ``time.perf_counter``; ``time.thread_time`` gives the calling
 thread's CPU time, which leaves out waits and other processes). Nothing else changes: every
@@ -29,6 +32,8 @@ from typing import Callable
 
 import moderngl
 
+from atmos.gpu.queries import TimerQuery
+
 _TEXTURES = ("Texture", "Texture3D", "TextureArray", "TextureCube")
 WORK = {
     "VertexArray": ("render", "render_indirect", "transform"),
@@ -45,6 +50,7 @@ READBACK = {
     **{name: ("read", "read_into") for name in _TEXTURES},
 }
 READBACK_PROPERTIES = {"Query": ("elapsed",)}
+OWN = {TimerQuery: {"begin": "query", "poll": "query", "result": "readback"}}
 _PACKAGE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))   # atmos/
 _ROOT = os.path.dirname(_PACKAGE)
 
@@ -111,6 +117,11 @@ class GLMeter:
                 self._saved.append((cls, name, original))
                 getter = self._wrap(original.fget, f"{cls_name}.{name}", "readback")
                 setattr(cls, name, property(getter, original.fset, original.fdel, original.__doc__))
+        for cls, methods in OWN.items():
+            for method, kind in methods.items():
+                original = cls.__dict__[method]
+                self._saved.append((cls, method, original))
+                setattr(cls, method, self._wrap(original, f"{cls.__name__}.{method}", kind))
         return self
 
     def __exit__(self, *exc) -> None:

@@ -24,12 +24,18 @@ class RenderGraph:
     passes by phase and data, versions every write, culls those whose outputs nothing needs
     (writing an imported resource is a side effect) and plans when each transient texture is taken
     from and given back to :attr:`pool`, so textures alias across the frame.
+
+    Per-pass timings (:attr:`timings`) are off by default: a frame then makes no timer query. Turn
+    them on with ``graph.timings_enabled = True`` (a benchmark, a tool), or let whatever shows them
+    ask with ``graph.want_timings(owner)`` and ``graph.want_timings(owner, False)`` (the overlay does
+    while it is visible); they run while either is on.
     """
 
     def __init__(self, gpu):
         self.gpu = gpu
         self.pool = TexturePool(gpu)
-        self.timings_enabled = True
+        self._timings_on = False
+        self._timings_wanted: set = set()
         self.compiles = 0                       # how often the declarations changed (tests, benchmarks)
         self._passes: dict[str, RenderPass] = {}
         self._imports: dict[str, object] = {}
@@ -127,6 +133,9 @@ class RenderGraph:
             resources[name] = self._resolve(name)
         transient: dict[str, object] = {}
         frame = self._frame
+        timed = self.timings_enabled
+        if not timed and self._timers.held:
+            self._timers.stop()                  # timing turned off: its queries go back to the pool
         frame._begin_frame(view, resources)
         hazards = self.gpu.hazards
         try:
@@ -141,7 +150,7 @@ class RenderGraph:
                     hazards.use(reads=[_use(resources, n, a, "sampled") for n, a in reads],
                                 writes=[_use(resources, n, a, "attachment") for n, a in writes])
                 frame._begin_pass(p.name, compiled.declared[i], compiled.declarations[p.name].access)
-                if self.timings_enabled:
+                if timed:
                     self._timers.begin(p.name)
                     try:
                         p.execute(frame)
@@ -157,6 +166,8 @@ class RenderGraph:
         finally:
             for texture in transient.values():  # only after an exception
                 self.pool.release(texture)
+            if timed:
+                self._timers.end_frame()
             frame._end_frame()
             if self.pool.end_frame():  # evicted textures: drop the cached framebuffers over them
                 frame.drop_released()
@@ -172,8 +183,26 @@ class RenderGraph:
 
     @property
     def timings(self) -> dict[str, tuple[float, float]]:
-        """Pass name -> (gpu_ms, cpu_ms) of the latest read-back measurement (kept passes only)."""
+        """Pass name -> (gpu_ms, cpu_ms) of the latest measurement whose GPU result came in (kept
+        passes only; a frame or two behind; empty until timings are on, see :attr:`timings_enabled`)."""
         return self._timers.results
+
+    @property
+    def timings_enabled(self) -> bool:
+        """Whether frames time their passes: set True or False by hand, or on while anyone
+        :meth:`want_timings`."""
+        return self._timings_on or bool(self._timings_wanted)
+
+    @timings_enabled.setter
+    def timings_enabled(self, on: bool) -> None:
+        self._timings_on = bool(on)
+
+    def want_timings(self, owner, wanted: bool = True) -> None:
+        """``owner`` (any hashable, e.g. a plugin) shows or records timings (``wanted``) or no longer does."""
+        if wanted:
+            self._timings_wanted.add(owner)
+        else:
+            self._timings_wanted.discard(owner)
 
     # -- inspection and cleanup ----------------------------------------------------------------
     def dump(self) -> str:

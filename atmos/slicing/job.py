@@ -9,6 +9,7 @@ never see a half-written set.
 from __future__ import annotations
 
 import time
+from collections import deque
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -41,29 +42,85 @@ def synced_measure(ctx) -> Measure:
     return measure
 
 
-def timer_query_measure(ctx) -> Measure:
-    """A measure from an OpenGL timer query around the slice: the GPU's own time for its commands.
+class TimerQueryMeasure:
+    """A measure from an OpenGL timer query around each slice: the GPU's own time for its commands.
 
-    Reading the result waits for the slice to finish on the GPU, which the budget needs anyway.
-    Each call borrows a query from the context's :func:`~atmos.gpu.queries.query_pool` and gives
-    it back once read, so measures hold no query between slices and make none in steady state.
+    Called as a :data:`Measure` it waits for the result. A :class:`SlicedJob` calls :meth:`submit`
+    instead (when ``late``): the slice runs inside a query of a ring of ``depth``, and ``done(ms)``
+    is called once its result is in, from a later :meth:`submit` or :meth:`poll` — no wait; with
+    every query of the ring still in flight the slice goes unmeasured (``dropped``). Queries come
+    from the context's :func:`~atmos.gpu.queries.query_pool`: at most ``depth`` are made.
     """
-    pool = query_pool(ctx)
 
-    def measure(run: Callable[[], None]) -> float:
-        query = pool.acquire(time=True)
+    DEPTH = 16
+
+    def __init__(self, ctx, late: bool = True, depth: int = DEPTH):
+        self.pool = query_pool(ctx)
+        self.late = late
+        self.depth = depth
+        self.dropped = 0
+        self._pending: deque = deque()       # (query, done) in the order issued
+        self._spare: list = []               # queries of the ring not in flight
+
+    def __call__(self, run: Callable[[], None]) -> float:
+        query = self.pool.timer()
         try:
-            with query:
+            query.begin()
+            try:
                 run()
-            return query.elapsed / 1e6
+            finally:
+                query.end()
+            return query.result()
         finally:
-            pool.release(query)
-    return measure
+            self.pool.release(query)
+
+    def submit(self, run: Callable[[], None], done: Callable[[float], None]) -> None:
+        """Run the slice in a timer query; ``done(ms)`` once its result is in (never waits)."""
+        self.poll()
+        if self._spare:
+            query = self._spare.pop()
+        elif len(self._pending) < self.depth:
+            query = self.pool.timer()
+        else:
+            self.dropped += 1
+            run()
+            return
+        query.begin()
+        try:
+            run()
+        finally:
+            query.end()
+            query.flush()
+            self._pending.append((query, done))
+
+    def poll(self) -> None:
+        """Hand the results that came in to their ``done``, oldest first; never waits."""
+        while self._pending:
+            query, done = self._pending[0]
+            ms = query.poll()
+            if ms is None:
+                return
+            self._pending.popleft()
+            self._spare.append(query)
+            done(ms)
+
+    def release(self) -> None:
+        """Give the ring's queries back to the pool (their results are dropped)."""
+        for query in self._spare + [query for query, _ in self._pending]:
+            self.pool.release(query)
+        self._spare.clear()
+        self._pending.clear()
+
+
+def timer_query_measure(ctx, late: bool = True) -> TimerQueryMeasure:
+    """A :class:`TimerQueryMeasure` of ``ctx``: read without waiting by a SlicedJob when ``late``,
+    at once (waiting) otherwise."""
+    return TimerQueryMeasure(ctx, late)
 
 
 def gpu_measure(ctx) -> Measure:
-    """The best GPU-cost measure for ``ctx``: timer queries on a real GPU, synced wall time on a
-    software rasterizer (llvmpipe reports meaningless timer-query results)."""
+    """The best GPU-cost measure for ``ctx``: timer queries on a real GPU (read late by a job, without
+    waiting), synced wall time on a software rasterizer (llvmpipe reports meaningless timer-query results)."""
     return synced_measure(ctx) if is_software(ctx) else timer_query_measure(ctx)
 
 
@@ -129,11 +186,12 @@ class JobStats:
     steps: int = 0
     slices_total: int = 0
     ms_total: float = 0.0
+    slices_measured: int = 0                      # slices whose cost came in (late measures: fewer)
     task_ms: dict = field(default_factory=dict)   # task name → moving average of its slice cost (ms)
 
     @property
     def mean_slice_ms(self) -> float:
-        return self.ms_total / self.slices_total if self.slices_total else 0.0
+        return self.ms_total / self.slices_measured if self.slices_measured else 0.0
 
 
 class SlicedJob:
@@ -228,14 +286,17 @@ class SlicedJob:
         def run() -> None:
             task.run(job_ctx.slice, job_ctx)
 
-        ms = measure(run)
         stats = self.stats
+        if getattr(measure, "late", False):   # the cost comes in later; this frame counts the estimate
+            estimate = self.expected_slice_ms(task) or 0.0
+            measure.submit(run, lambda ms, name=task.name: self._measured(name, ms))
+            ms = estimate
+        else:
+            ms = measure(run)
+            self._measured(task.name, ms)
         stats.slices_last_frame += 1
         stats.ms_last_frame += ms
         stats.slices_total += 1
-        stats.ms_total += ms
-        previous = stats.task_ms.get(task.name)
-        stats.task_ms[task.name] = ms if previous is None else previous + self.EMA * (ms - previous)
 
         self._done += 1
         self._slice += 1
@@ -275,10 +336,18 @@ class SlicedJob:
         while self.step < 2:
             self.run_step(measure=measure)
 
-    def expected_slice_ms(self) -> float | None:
-        """Estimated cost of the next slice from its task's measured costs (None before any measurement)."""
-        estimate = self.stats.task_ms.get(self.next_task.name)
-        if estimate is None and self.stats.slices_total:
+    def _measured(self, task_name: str, ms: float) -> None:
+        stats = self.stats
+        stats.ms_total += ms
+        stats.slices_measured += 1
+        previous = stats.task_ms.get(task_name)
+        stats.task_ms[task_name] = ms if previous is None else previous + self.EMA * (ms - previous)
+
+    def expected_slice_ms(self, task: SliceTask | None = None) -> float | None:
+        """Estimated cost of the next slice (or one of ``task``) from its task's measured costs
+        (None before any measurement)."""
+        estimate = self.stats.task_ms.get((task or self.next_task).name)
+        if estimate is None and self.stats.slices_measured:
             estimate = self.stats.mean_slice_ms
         return estimate
 

@@ -38,8 +38,10 @@ class FrameScheduler:
 
     ``measure`` times one slice (a callable that runs its argument and returns milliseconds): by
     default ``time.perf_counter`` around the slice, or, when ``sync`` is true, the GPU's cost of the
-    slice (:func:`~atmos.slicing.job.gpu_measure`: timer queries on a GPU, synced wall time on llvmpipe). ``sync`` defaults to true exactly when a time budget is in use (the budget
-    needs the GPU cost; without one, syncing would only stall the pipeline).
+    slice (:func:`~atmos.slicing.job.gpu_measure`: timer queries on a GPU, read once their results are
+    in, so the budget uses each task's cost from a frame or two before; synced wall time on llvmpipe).
+    ``sync`` defaults to true exactly when a time budget is in use (the budget needs the GPU cost;
+    without one, syncing would only stall the pipeline).
     """
 
     def __init__(self, mode: str = "sliced", slices_per_frame: int = 1, time_budget_ms: float | None = None,
@@ -132,6 +134,10 @@ class FrameScheduler:
     def tick(self) -> None:
         """Run one frame's worth of slices."""
         self.frame += 1
+        for measure in list(self._gpu_measures.values()) + [self.measure]:
+            poll = getattr(measure, "poll", None)
+            if poll is not None:
+                poll()                       # late timer-query results that came in since the last tick
         for job in self.jobs:
             job.stats.slices_last_frame = 0
             job.stats.ms_last_frame = 0.0
@@ -162,6 +168,9 @@ class FrameScheduler:
                         return
                 elif ran:
                     expected = job.expected_slice_ms()
+                    if expected is None and job.stats.slices_total and ran >= self.slices_per_frame:
+                        active.remove(job)   # its costs are still on their way (a late measure)
+                        continue
                     if expected is not None and spent + expected > budget:
                         active.remove(job)   # does not fit; a job with cheaper slices still may
                         continue
@@ -169,6 +178,14 @@ class FrameScheduler:
                 job.run_slices(1, measure=self._measure_for(job))
                 spent += job.stats.ms_last_frame - before
                 ran += 1
+
+    def release(self) -> None:
+        """Give the queries of the timer-query measures it made back to their pools (App.close)."""
+        for measure in list(self._gpu_measures.values()):
+            release = getattr(measure, "release", None)
+            if release is not None:
+                release()
+        self._gpu_measures.clear()
 
     @property
     def stats(self) -> dict[str, FrameStats]:
