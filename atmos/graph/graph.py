@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import Any, Callable
 
+from atmos.frame_constants import frame_constants, view_frame
 from atmos.gpu.host_memory import trim_heap
 from atmos.graph.compiler import CompiledGraph, compile_graph
 from atmos.graph.dump import dump_text, dump_dot
@@ -118,7 +119,9 @@ class RenderGraph:
 
     def execute(self, view=None) -> None:
         """Run one frame: kept passes in order; ``view`` (an :class:`atmos.SceneView`: camera, sun,
-        clock, size) is what passes see as ``frame.view``."""
+        clock, size) is what passes see as ``frame.view``, and what the frame block
+        (``lib/frame.glsl``, :mod:`atmos.frame_constants`) holds while the frame runs: written and
+        bound here, once."""
         compiled = self.compile()
         resources: dict[str, object] = {}
         for name in compiled.imports_used:
@@ -126,6 +129,9 @@ class RenderGraph:
         transient: dict[str, object] = {}
         frame = self._frame
         frame._begin_frame(view, resources)
+        block = frame_constants(self.gpu) if view is not None else None
+        if block is not None:
+            block.begin(view_frame(view))
         try:
             for i, p in enumerate(compiled.order):
                 for r in compiled.acquire[i]:
@@ -149,6 +155,8 @@ class RenderGraph:
             for texture in transient.values():  # only after an exception
                 self.pool.release(texture)
             frame._end_frame()
+            if block is not None:
+                block.end()                # inside another graph's pass: that frame's block again
             if self.pool.end_frame():  # evicted textures: drop the cached framebuffers over them
                 frame.drop_released()
                 if self.gpu.software:  # their storage was host memory: give the heap's free pages back
