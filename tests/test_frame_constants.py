@@ -9,7 +9,7 @@ import pytest
 from atmos import Camera, Sun
 from atmos.camera import camera_matrices
 from atmos.frame_constants import FRAME_BINDING, FRAME_SIZE, LAYOUT, bind_frame, frame_constants, pack_frame
-from atmos.gpu.shaders import ShaderError, check_units, compile_program, load_source
+from atmos.gpu.shaders import ShaderError, compile_program, load_source
 
 COPY = """#version 430
 #include "lib/frame.glsl"
