@@ -129,9 +129,10 @@ class RenderGraph:
         transient: dict[str, object] = {}
         frame = self._frame
         frame._begin_frame(view, resources)
-        block = frame_constants(self.gpu) if view is not None else None
+        data = view_frame(view) if view is not None else None
+        block = frame_constants(self.gpu) if data is not None else None
         if block is not None:
-            block.begin(view_frame(view))
+            block.begin(data)
         try:
             for i, p in enumerate(compiled.order):
                 for r in compiled.acquire[i]:
