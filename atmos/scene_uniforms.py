@@ -1,8 +1,11 @@
-"""The uniforms every pass that draws the scene writes: the camera's and the sun's, from the scene's
-data (:class:`atmos.Camera`, :class:`atmos.Sun`, :class:`atmos.SceneView`) through the one uniform writer."""
+"""The camera's and the sun's uniforms of a program that declares them itself, from the scene's
+data (:class:`atmos.Camera`, :class:`atmos.Sun`, :class:`atmos.SceneView`) through the one uniform
+writer. A program that includes ``lib/frame.glsl`` reads them from the frame block instead
+(:mod:`atmos.frame_constants`): the writers here do nothing for it."""
 from __future__ import annotations
 
 from atmos.camera import Camera, camera_matrices
+from atmos.frame_constants import FRAME_BLOCK
 from atmos.gpu.uniforms import write_uniforms
 from atmos.lighting import Sun
 
@@ -15,14 +18,20 @@ def set_camera_uniforms(program, camera: Camera, aspect: float) -> None:
 
     ``view_basis``, ``camera_pos``, ``near`` and ``far`` are what ``lib/view_ray.glsl`` needs for
     view rays and distances from depth at any far/near ratio; prefer them to ``inv_view_proj``.
-    The matrices come from :func:`atmos.camera.camera_matrices`: computed once per frame, whatever the passes."""
+    The matrices come from :func:`atmos.camera.camera_matrices`: computed once per frame, whatever the passes.
+    Nothing for a program with the frame block (``lib/frame.glsl``)."""
+    if FRAME_BLOCK in program:
+        return
     matrices = camera_matrices(camera, aspect)
     write_uniforms(program, {name: matrices.gl(name) for name in MATRICES if name in program},
                    camera_pos=matrices.camera_pos, near=float(camera.near), far=float(camera.far))
 
 
 def set_sun_uniforms(program, sun: Sun) -> None:
-    """Write ``sun_dir``, ``sun_color`` and ``sky_ambient`` (the Sun's ambient) where the program has them."""
+    """Write ``sun_dir``, ``sun_color`` and ``sky_ambient`` (the Sun's ambient) where the program has them
+    (nothing for a program with the frame block)."""
+    if FRAME_BLOCK in program:
+        return
     write_uniforms(program, **{name: tuple(float(v) for v in value) for name, value in
                                (("sun_dir", sun.direction), ("sun_color", sun.color), ("sky_ambient", sun.ambient))})
 

@@ -9,7 +9,7 @@ from PIL import Image
 
 from atmos.app import App
 from atmos.camera import Camera, view_basis
-from atmos.scene_uniforms import set_camera_uniforms
+from atmos.frame_constants import bind_frame
 from atmos.cli import main
 from atmos.defaults import DefaultPlugins
 from atmos.gpu import create_headless
@@ -97,7 +97,7 @@ def render_sky(gpu, camera: Camera, size, params: SkySettings, sun, sun_color, t
     w, h = size
 
     def uniforms(prog):
-        set_camera_uniforms(prog, camera, w / h)      # view_basis
+        bind_frame(gpu, camera, size=(w, h))          # view_basis: the frame block, outside a graph
         set_sky_uniforms(prog, params, sun, sun_color, time, camera.fov_y / h)
     return run_fullscreen(gpu, "sky/sky.frag", size, None, uniforms, defines=sky_defines())
 

@@ -41,8 +41,11 @@ _BINDINGS = {   # what a program binds by name, and the unit namespace each kind
     "sampler": re.compile(_LAYOUT + _UNIFORM + r"[iu]?sampler\w*\s+(?P<name>\w+)", re.M),
     "image": re.compile(_LAYOUT + _UNIFORM + r"[iu]?image\w*\s+(?P<name>\w+)", re.M),
     "buffer": re.compile(_LAYOUT + r"(?P<before>" + _WORDS + r")buffer\s+(?P<name>\w+)\s*\{", re.M),
+    "uniform block": re.compile(_LAYOUT + _UNIFORM + r"(?P<name>\w+)\s*\{", re.M),
 }
-_UNIT_WORD = {"sampler": "texture unit", "image": "image unit", "buffer": "storage buffer binding"}
+_UNIT_WORD = {"sampler": "texture unit", "image": "image unit", "buffer": "storage buffer binding",
+              "uniform block": "uniform buffer binding"}
+FRAME_BLOCK, FRAME_BINDING = "Frame", 0   # lib/frame.glsl's block (atmos.frame_constants): its binding is its alone
 _MESSAGES = (re.compile(r"^(?P<where>\d+):(?P<line>\d+)\(\d+\):\s*(?P<text>.*)$"),       # Mesa: 0:14(7): error: ...
              re.compile(r"^(?P<where>\d+)\((?P<line>\d+)\)\s*:\s*(?P<text>.*)$"),         # NVIDIA: 0(14) : error C0000: ...
              re.compile(r"^(?P<kind>ERROR|WARNING):\s*(?P<where>[^:\s]+):(?P<line>\d+):\s*(?P<text>.*)$"))  # glslang, AMD
@@ -258,11 +261,13 @@ def compile_program(ctx: moderngl.Context, sources: dict[str, GlslSource]):
 
 
 def check_units(program, sources: dict[str, GlslSource]) -> None:
-    """Every sampler, image and storage block the program uses declares its unit (``layout(binding = N)``:
-    the one place a unit is written; Python binds by name, :mod:`atmos.gpu.uniforms`), and no two of a
-    kind share one: a ShaderError naming both declarations otherwise. Keeps each image's unit and
-    declared access (readonly, writeonly or both) in ``program.extra["images"]`` for ``bind_images``, and
-    the storage blocks it may write (not ``readonly``) in ``program.extra["written"]`` for ``bind_buffers``."""
+    """Every sampler, image, storage block and uniform block the program uses declares its unit
+    (``layout(binding = N)``: the one place a unit is written; Python binds by name,
+    :mod:`atmos.gpu.uniforms`), and no two of a kind share one, nor any other uniform block the frame
+    block's binding 0 (``lib/frame.glsl``): a ShaderError naming both declarations otherwise. Keeps each
+    image's unit and declared access (readonly, writeonly or both) in ``program.extra["images"]`` for
+    ``bind_images``, and the storage blocks it may write (not ``readonly``) in ``program.extra["written"]``
+    for ``bind_buffers``."""
     images: dict[str, tuple[int, bool, bool]] = {}
     written: set[str] = set()
     for kind, pattern in _BINDINGS.items():
@@ -280,7 +285,10 @@ def check_units(program, sources: dict[str, GlslSource]) -> None:
                 if kind == "image":          # (an image uniform's value does not read back on every driver)
                     units = _constant(binding.group(1), src.text, where)
                 else:
-                    units = member.binding if kind == "buffer" else member.value   # a sampler array: its units
+                    units = member.binding if kind in ("buffer", "uniform block") else member.value   # a sampler array: its units
+                if kind == "uniform block" and units == FRAME_BINDING and name != FRAME_BLOCK:
+                    raise ShaderError(f"{where}: uniform block {name} is at {_UNIT_WORD[kind]} {FRAME_BINDING}, the "
+                                      f"frame block's (lib/frame.glsl): give it another binding")
                 for unit in units if isinstance(units, list) else [units]:
                     if unit in seen and seen[unit][0] != name:
                         raise ShaderError(f"{where}: {kind} {name} and {seen[unit][0]} ({seen[unit][1]}) share "

@@ -6,6 +6,7 @@ from typing import Any, Callable
 
 import moderngl
 
+from atmos.frame_constants import frame_constants, view_frame
 from atmos.gpu.host_memory import trim_heap
 from atmos.graph.compiler import CompiledGraph, compile_graph
 from atmos.graph.dump import dump_text, dump_dot
@@ -126,7 +127,9 @@ class RenderGraph:
 
     def execute(self, view=None) -> None:
         """Run one frame: kept passes in order; ``view`` (an :class:`atmos.SceneView`: camera, sun,
-        clock, size) is what passes see as ``frame.view``."""
+        clock, size) is what passes see as ``frame.view``, and what the frame block
+        (``lib/frame.glsl``, :mod:`atmos.frame_constants`) holds while the frame runs: written and
+        bound here, once."""
         compiled = self.compile()
         resources: dict[str, object] = {}
         for name in compiled.imports_used:
@@ -138,6 +141,10 @@ class RenderGraph:
             self._timers.stop()                  # timing turned off: its queries go back to the pool
         frame._begin_frame(view, resources)
         hazards = self.gpu.hazards
+        data = view_frame(view) if view is not None else None
+        block = frame_constants(self.gpu) if data is not None else None
+        if block is not None:
+            block.begin(data)
         try:
             for i, p in enumerate(compiled.order):
                 for r in compiled.acquire[i]:
@@ -169,6 +176,8 @@ class RenderGraph:
             if timed:
                 self._timers.end_frame()
             frame._end_frame()
+            if block is not None:
+                block.end()                # inside another graph's pass: that frame's block again
             if self.pool.end_frame():  # evicted textures: drop the cached framebuffers over them
                 frame.drop_released()
                 if self.gpu.software:  # their storage was host memory: give the heap's free pages back

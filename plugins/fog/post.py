@@ -5,7 +5,6 @@ import math
 
 import numpy as np
 
-from atmos.scene_uniforms import set_camera_uniforms
 from atmos.lighting import sun_and_day
 from atmos.composition import CLOUD_DISTANCE, MEDIA_LIGHT, blend_onto_media, medium_targets
 from atmos.graph import PassBuilder, PassContext, RenderPass
@@ -121,7 +120,6 @@ class FogPass(RenderPass):
             bind_textures(prog, cloud_distance=frame.resource(CLOUD_DISTANCE))
         if self.volumes is not None:
             self.volumes.bind(prog)
-        set_camera_uniforms(prog, view.camera, view.aspect)
         set_fog_uniforms(prog, settings, view.time + settings.time_offset, self.plugin.horizon(view), view.sun)
         frame.fullscreen(prog)
 

@@ -7,7 +7,6 @@ from __future__ import annotations
 import numpy as np
 
 from atmos.blue_noise import blue_noise_texture
-from atmos.scene_uniforms import set_camera_uniforms
 from atmos.composition import CLOUD_DISTANCE
 from atmos.graph import PassBuilder, PassContext
 from atmos.lighting import unit_sun
@@ -101,8 +100,7 @@ class MarchedShafts:
                 layer = frame.resource(FAR_FIELD)
                 layer.prepare(view, sim)
                 layer.use(p, view, sim)
-        set_camera_uniforms(p, view.camera, view.aspect)
-        values = dict(has_clouds=int(clouds), sun_dir=tuple(unit_sun(view.sun.direction)),
+        values = dict(has_clouds=int(clouds),
                       irradiance=tuple(float(v) for v in irradiance),
                       lobes=settings.phase.lobes, scattering=settings.scattering,
                       max_distance=settings.max_distance, steps=settings.steps, factor=factor,

@@ -24,11 +24,9 @@ import math
 import numpy as np
 
 from atmos.camera import view_basis
-from atmos.scene_uniforms import set_camera_uniforms
 from atmos.composition import CLOUD_DISTANCE, MEDIA_LIGHT, MEDIA_TRANSMITTANCE
 from atmos.gpu import clamp_sampler
 from atmos.graph import FullscreenPass, PassContext, TextureDesc
-from atmos.lighting import unit_sun
 from atmos.plugins.sky.luts import SKY_LUTS, atmosphere_defines, set_atmosphere_uniforms, view_radius
 from atmos.render_core import COLOR, DEPTH
 from atmos.gpu.uniforms import bind_images, bind_textures, write_uniforms
@@ -110,8 +108,7 @@ class AerialPerspectivePass(FullscreenPass):
         view, p = frame.view, self.program
         settings = self.plugin.settings
         frame.resource(SKY_LUTS).bind(p)
-        values = dict(sun_dir=tuple(float(v) for v in unit_sun(view.sun.direction)),
-                      view_r=view_radius(settings.atmosphere, view.camera),
+        values = dict(view_r=view_radius(settings.atmosphere, view.camera),
                       aerial_range=volume_range(view.camera, view.aspect, settings.atmosphere))
         volume = frame.resource(AERIAL_VOLUME) if frame.declares(AERIAL_VOLUME) else None
         if volume is not None:
@@ -123,7 +120,6 @@ class AerialPerspectivePass(FullscreenPass):
         # graph resources under the names the shader's samplers carry (atmos.composition)
         bind_textures(p, {name: frame.resource(name) for name in (CLOUD_DISTANCE, MEDIA_LIGHT, MEDIA_TRANSMITTANCE)
                           if frame.declares(name)})
-        set_camera_uniforms(p, view.camera, view.aspect)
         set_atmosphere_uniforms(p, settings.atmosphere)
         write_uniforms(p, values)
         frame.fullscreen(p)
@@ -133,7 +129,6 @@ class AerialPerspectivePass(FullscreenPass):
     def _fill(self, volume, view, values) -> None:
         """The froxel volume: one invocation per froxel column, marching through the slices (aerial_volume.comp)."""
         c = self.gpu.program(compute_shader="sky/aerial_volume.comp", defines=atmosphere_defines())
-        set_camera_uniforms(c, view.camera, view.aspect)
         set_atmosphere_uniforms(c, self.plugin.settings.atmosphere)
         write_uniforms(c, values)
         bind_images(c, aerial_volume=volume)

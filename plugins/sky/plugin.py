@@ -5,7 +5,6 @@ from __future__ import annotations
 import numpy as np
 
 from atmos.camera import Camera
-from atmos.scene_uniforms import set_camera_uniforms
 from atmos.composition import composition
 from atmos.graph import FullscreenPass, PassContext, RenderPass
 from atmos.lighting import Sun
@@ -72,7 +71,6 @@ class SkyPass(FullscreenPass):
         where_nothing_was_drawn(frame)
         camera = view.camera
         settings = self.plugin.settings
-        set_camera_uniforms(p, camera, view.aspect)      # view_basis
         set_sky_uniforms(p, settings, view.sun.direction, view.sun.color, view.time,
                          camera.fov_y / max(1, view.size[1]))
         if self.physical:

@@ -3,7 +3,6 @@ from dataclasses import dataclass
 
 from atmos.checks import CheckedSettings, vec_field
 from atmos.graph import FullscreenPass, PassContext
-from atmos.scene_uniforms import set_scene_uniforms
 from atmos.plugin import Plugin
 from atmos.render_core import DEPTH, where_nothing_was_drawn
 
@@ -26,7 +25,6 @@ class SkyGradientPass(FullscreenPass):
 
     def execute(self, frame: PassContext) -> None:
         where_nothing_was_drawn(frame)
-        set_scene_uniforms(self.program, frame.view)
         settings = self.plugin.settings
         self.program["zenith"].value = settings.zenith
         self.program["horizon"].value = settings.horizon

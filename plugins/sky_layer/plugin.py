@@ -3,7 +3,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.scene_uniforms import set_camera_uniforms
 from atmos.graph import FullscreenPass, PassContext
 from atmos.lighting import Sun, sun_and_day
 from atmos.plugin import Plugin
@@ -47,7 +46,6 @@ class SkyLayerPass(FullscreenPass):
         frame.blend_over()
         plugin.octaves.bind(p)
         bind_textures(p, scene_depth=frame.resource(DEPTH))
-        set_camera_uniforms(p, view.camera, view.aspect)
         p["offsets"].write(scroll_offsets(params.wind, plugin.time(view)).astype("f4").tobytes())
         for name in ("altitude", "tile_size", "horizon_fade", "emptiness", "sharpness", "thickness",
                      "color", "lit_color"):

@@ -7,7 +7,6 @@ from dataclasses import dataclass
 from atmos.checks import CheckedSettings, check_int, check_shape, int_field, num_field, vec_field
 from atmos.slicing import SlicedJob, SliceTask, TripleSet
 from atmos.graph import FullscreenPass, PassContext, TextureDesc
-from atmos.scene_uniforms import set_scene_uniforms
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
 from atmos.gpu.uniforms import bind_images, bind_textures
@@ -115,7 +114,6 @@ class TemplateVolumePass(FullscreenPass):
         frame.framebuffer(color=[COLOR]).use()
         frame.blend_over()
         bind_textures(p, density_a=a["density"], density_b=b["density"], scene_depth=frame.resource(DEPTH))
-        set_scene_uniforms(p, frame.view)
         p["t"].value = t
         box = self.plugin.settings.box
         p["box_min"].value = tuple(c - s / 2 for c, s in zip(box.center, box.size))

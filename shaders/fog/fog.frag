@@ -7,6 +7,8 @@
 // their own distance: f = a f(d_cloud) + (1 - a) f(d_behind). FOG_SKY_COLOR 1: the fog colour is
 // fog_color × the sky's horizon radiance in the ray's azimuth (plugins/fog/sky_color.py). LOCAL_MEDIA 1:
 // the same onto the media targets (lib/media_out.glsl).
+// view_basis, camera_pos, near, far: the frame block (lib/frame.glsl)
+#include "lib/frame.glsl"
 in vec2 v_uv;
 out vec4 frag;
 #include "lib/media_out.glsl"
@@ -20,10 +22,6 @@ layout(binding = 2) uniform sampler2D cloud_distance;
 #if FOG_FROM_DEPTH
 #include "lib/view_ray.glsl"
 layout(binding = 0) uniform sampler2D scene_depth;
-uniform mat3 view_basis;     // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
-uniform vec3 camera_pos;
-uniform float near;
-uniform float far;
 #else
 layout(binding = 0) uniform sampler2D fog_distance;
 layout(binding = 1) uniform sampler2D fog_position;

@@ -1,12 +1,10 @@
 #version 430
 // Ground: anti-aliased checker in albedo, Lambert sun light plus the Sun's sky ambient, distance haze.
 // Alpha 1: opaque, hides the sky (color.a is the sky occlusion, atmos/render_core.py).
+// camera_pos, sun_dir, sun_color, sky_ambient: the frame block (lib/frame.glsl)
+#include "lib/frame.glsl"
 in vec3 v_world;
 out vec4 frag;
-uniform vec3 camera_pos;
-uniform vec3 sun_dir;
-uniform vec3 sun_color;
-uniform vec3 sky_ambient;
 uniform vec3 albedo;
 uniform float tile;
 

@@ -22,16 +22,13 @@
 // Both (a fog under the aerial perspective, mixed along the ray: atmos/composition.py): both sums, each
 // medium's in-scatter at s dimmed by the other in front of s too (the fog's by the air's grey
 // transmittance exp(-ext s), the air's by the fog's f(s)).
+// view_basis, camera_pos, near, far, sun_dir: the frame block (lib/frame.glsl)
+#include "lib/frame.glsl"
 #include "lib/hdr_max.glsl"
 #include "lib/view_ray.glsl"
 #include "lib/phase.glsl"
 #include "clouds/volume/column.glsl"
 layout(binding = 2) uniform sampler2D low_depth;   // the farthest scene depth of each block
-uniform mat3 view_basis;       // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
-uniform vec3 camera_pos;
-uniform float near;
-uniform float far;
-uniform vec3 sun_dir;          // unit, toward the sun
 uniform vec3 irradiance;       // sun_intensity * Sun.color * horizon fade, at most float32's largest
 uniform vec3 lobes;            // phase_g, phase_g2, phase_w
 uniform float scattering;      // 1/m
@@ -59,7 +56,7 @@ uniform float view_r;          // the camera's radius from the planet's centre
 
 // Per-texel start offset in [0, 1): the tiled blue noise (atmos/blue_noise.py; white noise clumped).
 layout(binding = 23) uniform sampler2D blue_noise;
-float jitter(ivec2 q) {
+float start_jitter(ivec2 q) {
     return texelFetch(blue_noise, q % textureSize(blue_noise, 0), 0).r;
 }
 
@@ -70,7 +67,7 @@ void main() {
     vec3 dir = normalize(ray);
     float d = min(view_ray_distance(uv, texelFetch(low_depth, q, 0).r, view_basis, near, far, max_distance),
                   max_distance);
-    float j = jitter(q);
+    float j = start_jitter(q);
 #if SHAFT_FOG || SHAFT_AERIAL
     vec2 cloud = cloud_cover_distance(has_cloud_distance != 0 ? texture(cloud_distance, uv).rg : vec2(0.0));
     float a = cloud.x, dc = cloud.y;            // the clouds' coverage and own distance

@@ -2,12 +2,11 @@
 // Instanced meshes lit by the sun (Lambert) and the sky's ambient light, weighted toward normals that
 // face up; numpy reference: atmos.plugins.mesh.reference.mesh_color. Alpha 1: opaque (the sky
 // occlusion, atmos/render_core.py). Cloud shadows and fog come after, from the depth written here.
+// sun_dir, sun_color, sky_ambient: the frame block (lib/frame.glsl)
+#include "lib/frame.glsl"
 in vec3 v_normal;
 in vec3 v_color;
 out vec4 frag;
-uniform vec3 sun_dir;
-uniform vec3 sun_color;
-uniform vec3 sky_ambient;
 
 void main() {
     vec3 n = normalize(v_normal);

@@ -1,13 +1,14 @@
 #version 430
 // Instanced meshes (atmos.plugins.mesh): per vertex a position and normal in model space, per instance
 // a model matrix and a colour.
+// view_proj: the frame block (lib/frame.glsl)
+#include "lib/frame.glsl"
 in vec3 in_position;
 in vec3 in_normal;
 in mat4 in_model;
 in vec3 in_color;
 out vec3 v_normal;
 out vec3 v_color;
-uniform mat4 view_proj;
 
 void main() {
     vec4 world = in_model * vec4(in_position, 1.0);

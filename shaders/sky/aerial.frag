@@ -13,6 +13,8 @@
 // AERIAL_MEDIA 1: a local medium (the fog) has blended its (L_l, T_l) over the colour already, C1 =
 // C T_l + L_l, and left them in "media_light"/"media_transmittance" (atmos/composition.py): the air and
 // it mixed along the ray give C T_l T_a + media_mix(air, local), i.e. media_mix - T_a L_l blended over C1.
+// view_basis, near, far, sun_dir: the frame block (lib/frame.glsl)
+#include "lib/frame.glsl"
 in vec2 v_uv;
 out vec4 frag;
 layout(binding = 0) uniform sampler2D scene_depth;
@@ -20,11 +22,7 @@ layout(binding = 0) uniform sampler2D scene_depth;
 #include "lib/cloud_distance.glsl"
 layout(binding = 2) uniform sampler2D cloud_distance;
 #endif
-uniform mat3 view_basis;       // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
-uniform float near;
-uniform float far;
 uniform float view_r;          // the camera's radius from the planet's centre
-uniform vec3 sun_dir;          // unit, toward the sun
 #include "lib/view_ray.glsl"
 #include "sky/atmosphere.glsl"
 

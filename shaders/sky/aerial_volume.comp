@@ -11,11 +11,11 @@
 // its colour and extinction (L and 1 - T fall to 0 with the distance). float64 reference:
 // plugins/sky/atmosphere.py aerial_perspective (tests and benchmarks/bench_sky.py compare with its
 // 96-step march).
+// view_basis, sun_dir: the frame block (lib/frame.glsl)
+#include "lib/frame.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(rgba32f, binding = 0) writeonly uniform image3D aerial_volume;
-uniform mat3 view_basis;       // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
 uniform float view_r;          // the camera's radius from the planet's centre
-uniform vec3 sun_dir;          // unit, toward the sun
 uniform float aerial_range;    // m: the last slice's reach (plugins/sky/aerial.py volume_range)
 #include "lib/view_ray.glsl"
 #include "sky/atmosphere.glsl"

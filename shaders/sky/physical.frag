@@ -2,9 +2,10 @@
 // The physical sky pass (SkySettings.model = "physical"): the sky-view LUT along each pixel's view ray,
 // `night` (the airglow and starlight the model leaves out) faded in over twilight, the sun disc and
 // stars of sky/extras.glsl. float64 reference: plugins/sky/radiance.py:physical_sky_color.
+// view_basis: the frame block (lib/frame.glsl)
+#include "lib/frame.glsl"
 in vec2 v_uv;
 out vec4 frag;
-uniform mat3 view_basis;
 layout(binding = 12) uniform sampler2D sky_view;
 uniform float view_r;          // the camera's radius from the planet's centre
 #include "lib/view_ray.glsl"

@@ -1,12 +1,11 @@
 #version 430
 // Sky gradient: zenith/horizon blend, sun disc and glow along each pixel's view ray.
 // Alpha 0: open sky (color.a is the sky occlusion, atmos/render_core.py).
+// view_basis, sun_dir, sun_color: the frame block (lib/frame.glsl)
+#include "lib/frame.glsl"
 #include "lib/view_ray.glsl"
 in vec2 v_uv;
 out vec4 frag;
-uniform mat3 view_basis;       // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
-uniform vec3 sun_dir;
-uniform vec3 sun_color;
 uniform vec3 zenith;
 uniform vec3 horizon;
 uniform vec3 ground;

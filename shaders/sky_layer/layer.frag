@@ -3,6 +3,8 @@
 // y = altitude; the four scrolling octaves give fbm (one fetch each), shaded by sky_layer/layer.glsl.
 // Premultiplied (light, coverage), blended ONE, ONE_MINUS_SRC_ALPHA on colour and alpha: the layer
 // adds its cover to color.a, the sky occlusion (atmos/render_core.py).
+// view_basis, camera_pos: the frame block (lib/frame.glsl)
+#include "lib/frame.glsl"
 #include "lib/view_ray.glsl"
 #include "sky_layer/layer.glsl"
 in vec2 v_uv;
@@ -12,8 +14,6 @@ layout(binding = 1) uniform sampler2D octave1;
 layout(binding = 2) uniform sampler2D octave2;
 layout(binding = 3) uniform sampler2D octave3;
 layout(binding = 4) uniform sampler2D scene_depth;
-uniform mat3 view_basis;       // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
-uniform vec3 camera_pos;
 uniform vec2 offsets[4];       // scroll of each octave (tiles, wrapped to [0, 1))
 uniform float altitude;
 uniform float tile_size;

@@ -3,17 +3,13 @@
 // the sun, stopped at scene depth. Output premultiplied: rgb = in-scattered light, a = coverage
 // 1 - transmittance (PassContext.blend_over gives light + transmittance * scene, and adds the
 // coverage to color.a, the sky occlusion of atmos/render_core.py: the volume is a cloud).
+// view_basis, camera_pos, near, far, sun_dir, sun_color: the frame block (lib/frame.glsl)
+#include "lib/frame.glsl"
 in vec2 v_uv;
 out vec4 frag;
 layout(binding = 0) uniform sampler3D density_a;
 layout(binding = 1) uniform sampler3D density_b;
 layout(binding = 2) uniform sampler2D scene_depth;
-uniform mat3 view_basis;       // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
-uniform vec3 camera_pos;
-uniform float near;
-uniform float far;
-uniform vec3 sun_dir;
-uniform vec3 sun_color;
 uniform vec3 box_min;
 uniform vec3 box_max;
 uniform float t;

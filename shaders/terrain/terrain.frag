@@ -2,12 +2,11 @@
 // Terrain: grass on flat ground, rock on slopes, lighter tops; Lambert sun light plus the Sun's sky ambient
 // (weighted toward upward normals, as the meshes are: plugins/mesh/reference.py).
 // Alpha 1: opaque, hides the sky (color.a is the sky occlusion, atmos/render_core.py).
+// sun_dir, sun_color, sky_ambient: the frame block (lib/frame.glsl)
+#include "lib/frame.glsl"
 in vec3 v_world;
 in vec3 v_normal;
 out vec4 frag;
-uniform vec3 sun_dir;
-uniform vec3 sun_color;
-uniform vec3 sky_ambient;
 uniform float relief;
 
 void main() {

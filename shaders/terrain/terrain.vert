@@ -1,10 +1,11 @@
 #version 430
 // Terrain vertices: world position and normal straight through (the heightfield is in world space).
+// view_proj: the frame block (lib/frame.glsl)
+#include "lib/frame.glsl"
 in vec3 in_position;
 in vec3 in_normal;
 out vec3 v_world;
 out vec3 v_normal;
-uniform mat4 view_proj;
 void main() {
     v_world = in_position;
     v_normal = in_normal;

@@ -3,7 +3,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.scene_uniforms import set_camera_uniforms
 from atmos.graph import FullscreenPass, PassContext
 from atmos.lighting import unit_sun
 from atmos.plugin import Plugin
@@ -66,8 +65,6 @@ class CloudShadowsPass(FullscreenPass):
         ctx.enable(ctx.BLEND)
         ctx.blend_func = ctx.ZERO, ctx.SRC_COLOR, ctx.ZERO, ctx.ONE    # alpha (sky occlusion) kept
         bind_textures(p, scene_depth=frame.resource(DEPTH))
-        set_camera_uniforms(p, view.camera, view.aspect)
-        p["sun_dir"].value = tuple(unit_sun(sun.direction))
         p["weight"].value = weight
         column_uniforms(p, sim, layout, sigma * params.strength)
         if frame.declares(FAR_FIELD):

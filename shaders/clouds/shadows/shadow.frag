@@ -3,15 +3,12 @@
 // direction toward the sun onto the middle of the cloud layer, where the top-view summed density
 // mix(A, B, t) (layer 0 of the density maps, each set at its own placement) gives the optical depth. Output is the factor the
 // colour is multiplied by (blend ZERO, SRC_COLOR); plugins/clouds/shadows/reference.py is the same in numpy.
+// view_basis, camera_pos, near, far, sun_dir: the frame block (lib/frame.glsl)
+#include "lib/frame.glsl"
 #include "lib/view_ray.glsl"
 out vec4 frag;
 #include "clouds/volume/column.glsl"
 layout(binding = 2) uniform sampler2D scene_depth;
-uniform mat3 view_basis;       // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
-uniform vec3 camera_pos;
-uniform float near;
-uniform float far;
-uniform vec3 sun_dir;          // unit, toward the sun
 uniform float weight;          // direct_fraction × horizon fade (reference.direct_weight)
 
 void main() {
