@@ -44,15 +44,18 @@ class OffscreenLayer:
 
     @staticmethod
     def declare(builder: PassBuilder, size, factor: int, distance: bool = False, color: str = CLOUD_COLOR,
-                depth: str = CLOUD_DEPTH) -> None:
+                depth: str = CLOUD_DEPTH, storage: bool = False) -> None:
+        """``storage``: a compute pass writes the low-res colour as an image (it then needs no clear)."""
         low = low_size(size, factor)
-        builder.create(color, TextureDesc(low, components=4, dtype="f2", filter="nearest"))
+        builder.create(color, TextureDesc(low, components=4, dtype="f2", filter="nearest", storage=storage),
+                       access="storage" if storage else None)
         builder.create(depth, TextureDesc(low, depth=True, filter="nearest"))
         if distance:
             builder.create(CLOUD_LOW_DISTANCE, distance_desc(low))
 
-    def begin(self, frame: PassContext, factor: int, distance: bool = False):
-        """Write the low-res depth, clear the low-res colour; returns the framebuffer to draw sprites into."""
+    def begin(self, frame: PassContext, factor: int, distance: bool = False, clear: bool = True):
+        """Write the low-res depth, clear the low-res colour (``clear``; a compute pass that writes every
+        texel leaves it); returns the framebuffer to draw sprites into (None without ``clear``)."""
         ctx = frame.gpu.ctx
         frame.framebuffer(depth=self.depth).use()
         bind_textures(self.far_depth, scene_depth=frame.resource(DEPTH))
@@ -60,6 +63,8 @@ class OffscreenLayer:
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "1"                # always: the shader writes the block's farthest depth
         frame.fullscreen(self.far_depth)
+        if not clear:
+            return None
         fbo = frame.framebuffer(color=[self.color, self.distance] if distance else [self.color],
                                 depth=self.depth)
         fbo.depth_mask = False              # clear the colour only: the sprites test the depth just written

@@ -297,3 +297,20 @@ def test_the_volumetric_fog_runs_as_one_compute_dispatch_per_frame(gpu):
     assert meter.calls["ComputeShader.run"] == 1 and meter.calls["VertexArray.render"] <= 2   # clear/present
     assert "volumetric_fog" in app.graph.compile().kept
     app.close()
+
+
+def test_the_light_shafts_march_is_a_compute_dispatch_into_a_storage_target(gpu):
+    from atmos.gpu.gl_meter import GLMeter
+    from atmos.plugins.light_shafts import LightShaftsPlugin
+    runs = []
+    for plugins in ((), (LightShaftsPlugin(mode="march"),)):
+        app = atmos.App(gpu).add_plugins(atmos.DefaultPlugins(overlay=False), *plugins)
+        app.update(1 / 60)
+        with GLMeter() as meter:
+            app.update(1 / 60)
+        runs.append((meter.calls["ComputeShader.run"], meter.calls["VertexArray.render"]))
+        dump = app.graph.dump()
+        app.close()
+    assert runs[1][0] == runs[0][0] + 1                 # the march: one dispatch
+    assert runs[1][1] == runs[0][1] + 2                 # the low-res far depth and the upsampling composite
+    assert "light_shafts_march  transient" in dump and "storage" in dump

@@ -1,6 +1,6 @@
 """The march mode of the light shafts: sun light scattered by a thin haze along each view ray,
-shadowed by the clouds through the ground shadows' density maps (shaders/light_shafts/march.frag),
-at low resolution and upsampled by depth with the off-screen clouds' draws
+shadowed by the clouds through the ground shadows' density maps (shaders/light_shafts/march.comp,
+a compute pass), at low resolution and upsampled by depth with the off-screen clouds' draws
 (:class:`~atmos.offscreen.OffscreenLayer`). Reference: :func:`.reference.march_shafts`."""
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 
 from atmos.blue_noise import blue_noise_texture
 from atmos.composition import CLOUD_DISTANCE
-from atmos.graph import PassBuilder, PassContext
+from atmos.graph import PassBuilder, PassContext, work_groups
 from atmos.lighting import unit_sun
 from atmos.plugins.clouds import CLOUD_SETS, FAR_FIELD, CloudSets, column_uniforms
 from atmos.offscreen import OffscreenLayer
@@ -54,8 +54,7 @@ class MarchedShafts:
             defines.update(SHAFT_AERIAL=1, **aerial.aerial_defines())
         if fog is not None:
             defines.update(SHAFT_FOG=1, **fog.defines())
-        return self.gpu.program(defines or None, vertex_shader="lib/fullscreen.vert",
-                                fragment_shader="light_shafts/march.frag")
+        return self.gpu.program(defines or None, compute_shader="light_shafts/march.comp")
 
     @staticmethod
     def declare(builder: PassBuilder, size, factor: int, clouds: bool, far_field: bool = False, fog=None,
@@ -64,7 +63,7 @@ class MarchedShafts:
         ``fog``: the App's FogMedium; its clouds' own distance is read when the fog reads one.
         ``aerial``: the SkyLight whose aerial perspective the march shadows (its LUTs are read, and the
         clouds' own distance when its pass reads one)."""
-        OffscreenLayer.declare(builder, size, factor, color=SHAFT_COLOR, depth=SHAFT_DEPTH)
+        OffscreenLayer.declare(builder, size, factor, color=SHAFT_COLOR, depth=SHAFT_DEPTH, storage=True)
         builder.read(DEPTH)
         builder.read(COLOR)
         builder.write(COLOR)
@@ -85,9 +84,8 @@ class MarchedShafts:
         if irradiance is None:
             return
         factor = settings.downsample
-        self.offscreen.begin(frame, factor)
+        self.offscreen.begin(frame, factor, clear=False)      # the march writes every low-res texel
         frame.reset_state()
-        frame.framebuffer(color=[SHAFT_COLOR]).use()
         far_field = clouds and frame.declares(FAR_FIELD)
         p = self.program(far_field, fog, aerial)
         if self.jitter is None:
@@ -110,7 +108,8 @@ class MarchedShafts:
         if aerial is not None:
             self.aerial_uniforms(frame, p, aerial)
         write_uniforms(p, values)
-        frame.fullscreen(p)
+        shafts = frame.image(SHAFT_COLOR)
+        frame.dispatch(p, work_groups(shafts.size, (8, 8)), images={"shafts": shafts})
         self.offscreen.end(frame, factor, view.camera.near, view.camera.far, medium=True)
 
     @staticmethod

@@ -58,7 +58,7 @@ def radial_blur(mask, sun_uv, settings, strength: float = 1.0) -> np.ndarray:
 
 
 def march_jitter(w: int, h: int) -> np.ndarray:
-    """(h, w) start offsets in [0, 1) of the marched shafts' low-res texels (shaders/light_shafts/march.frag):
+    """(h, w) start offsets in [0, 1) of the marched shafts' low-res texels (shaders/light_shafts/march.comp):
     the blue-noise tile (atmos.blue_noise), row 0 at the bottom."""
     tile = blue_noise().astype(np.float64)
     return np.tile(tile, (-(-h // tile.shape[0]), -(-w // tile.shape[1])))[:h, :w]

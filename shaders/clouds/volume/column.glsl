@@ -6,7 +6,7 @@
 // with the complementary weight, so shadows continue past the volume: the column the far field draws
 // (far.frag), field_column_tau (thickness · sigma_t · cell height) × the volume's column sum at the
 // rank of the point where the sun's ray meets the middle plane (far_quantile(far_field_rank)). Shared by the
-// ground shadows (shadow.frag) and the marched light shafts (light_shafts/march.frag);
+// ground shadows (shadow.frag) and the marched light shafts (light_shafts/march.comp);
 // plugins/clouds/shadows/reference.py sun_optical_depth is the same in numpy.
 layout(binding = 0) uniform sampler2DArray sums_a;
 layout(binding = 1) uniform sampler2DArray sums_b;

@@ -1,5 +1,6 @@
 #version 430
-// Light shafts marched through the cloud shadow map, at low resolution: along the view ray of each
+// Light shafts marched through the cloud shadow map, at low resolution, one compute invocation per
+// low-res texel (written to the image `shafts`): along the view ray of each
 // low-res texel (the centre of its block) to the block's farthest scene depth (the sky: max_distance),
 // `steps` samples from a jittered start gather the sun light a thin haze scatters toward the eye,
 //   L = sum_i scattering * phase(cos) * E * exp(-tau_sun(p_i)) * exp(-scattering * s_i) * ds,
@@ -28,6 +29,8 @@
 #include "lib/view_ray.glsl"
 #include "lib/phase.glsl"
 #include "clouds/volume/column.glsl"
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(binding = 0, rgba16f) writeonly uniform image2D shafts;   // (L, T) per low-res texel
 layout(binding = 2) uniform sampler2D low_depth;   // the farthest scene depth of each block
 uniform vec3 irradiance;       // sun_intensity * Sun.color * horizon fade, at most float32's largest
 uniform vec3 lobes;            // phase_g, phase_g2, phase_w
@@ -37,7 +40,6 @@ uniform int steps;
 uniform int has_clouds;
 uniform int factor;
 uniform vec2 frame_size;
-out vec4 frag;
 #if SHAFT_FOG || SHAFT_AERIAL
 #include "lib/cloud_distance.glsl"
 uniform int has_cloud_distance;   // 1: cloud_distance is bound
@@ -60,8 +62,7 @@ float start_jitter(ivec2 q) {
     return texelFetch(blue_noise, q % textureSize(blue_noise, 0), 0).r;
 }
 
-void main() {
-    ivec2 q = ivec2(gl_FragCoord.xy);
+vec4 march(ivec2 q) {
     vec2 uv = (vec2(q) + 0.5) * float(factor) / frame_size;
     vec3 ray = view_ray(uv, view_basis);
     vec3 dir = normalize(ray);
@@ -127,8 +128,7 @@ void main() {
     taken += shadowed * dsa * atm_sun;
 #endif
 #if SHAFT_FOG || SHAFT_AERIAL
-    frag = vec4(-taken, 1.0);
-    return;
+    return vec4(-taken, 1.0);
 #endif
     float ds = d / float(steps);
     float sum = 0.0;
@@ -138,5 +138,11 @@ void main() {
         sum += exp(-tau - scattering * s);
     }
     vec3 light = irradiance * (scattering * phase2(dot(dir, sun_dir), lobes) * sum * ds);
-    frag = vec4(min(light, vec3(HDR_MAX)), exp(-scattering * d));   // blended onto the float16 colour
+    return vec4(min(light, vec3(HDR_MAX)), exp(-scattering * d));   // blended onto the float16 colour
+}
+
+void main() {
+    ivec2 q = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(q, imageSize(shafts)))) return;
+    imageStore(shafts, q, march(q));
 }
