@@ -177,7 +177,9 @@ def test_pass_timers_of_two_graphs_share_the_context_queries(fresh_gpu, count_qu
         for name in ("b", "c"):
             with second.measure(name):
                 pass
-    assert len(count_queries) == made
+    # the second graph takes the first's queries back from the pool: together never more than one
+    # graph's worth (two passes of RING); how many a ring uses depends on when results come in
+    assert made <= len(count_queries) <= 2 * RING
     second.release()
 
 
