@@ -136,6 +136,13 @@ class Hazards:
             self.issue(need | self._need)
         return need
 
+    def need(self, obj, bit: int) -> None:
+        """The fast form of a deferred :meth:`use` (what binds call): ``obj`` is used in the way whose
+        barrier bit is ``bit`` (:func:`barrier_bit`) by the coming work."""
+        entry = self._dirty.get(id(obj))
+        if entry is not None and entry[0]() is obj:
+            self._need |= entry[2] & bit
+
     def flush(self) -> None:
         """Issue what the binds of the coming work asked for (dispatches and draws call this)."""
         if self._need:
@@ -214,7 +221,8 @@ def dispatch_indirect(program, args, offset: int = 0) -> None:
     """Run compute ``program`` with its group counts read on the GPU from buffer ``args`` (3 uints at
     ``offset``), after the barrier that makes a shader's write of ``args`` visible as indirect arguments."""
     hazards = hazards_of(program.ctx)
-    hazards.use(reads=[(args, "indirect")])       # with what the binds asked for: one barrier
+    hazards.need(args, moderngl.COMMAND_BARRIER_BIT)     # with what the binds asked for: one barrier
+    hazards.flush()
     program.run_indirect(args, offset)
     hazards.commit()
 
@@ -264,7 +272,7 @@ def _flushing(method):
 def _copy_use(method, uses):
     def transfer(self, *args, **kwargs):
         tracker = _TRACKERS.get(self.ctx)
-        if tracker is not None and tracker._dirty:
+        if tracker is not None and id(self) in tracker._dirty:
             tracker.use(reads=[(self, access) for access in uses])
         return method(self, *args, **kwargs)
     transfer._atmos_copy_use = True

@@ -32,6 +32,8 @@ from pathlib import Path
 
 import moderngl
 
+from atmos.gpu.hazards import hazards_of
+
 _INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*$')
 _VERSION = re.compile(r"^\s*#version\b")
 _LAYOUT = r"^[ \t]*(?:layout\s*\((?P<layout>[^)]*)\)\s*)?"
@@ -299,7 +301,7 @@ def check_units(program, sources: dict[str, GlslSource]) -> None:
                     images[name] = (units, "writeonly" not in words, "readonly" not in words)
                 elif kind == "buffer" and "readonly" not in match.group("before").split():
                     written.add(name)
-    program.extra = {"images": images, "written": frozenset(written)}
+    program.extra = {"images": images, "written": frozenset(written), "hazards": hazards_of(program.ctx)}
 
 
 def _constant(word: str, text: str, where: str) -> int:

@@ -7,7 +7,16 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
+import moderngl
+
 from atmos.gpu.hazards import hazards_of
+
+
+def _hazards(program):
+    """The program's context's Hazards (kept in ``program.extra`` by the compiler check)."""
+    extra = program.extra
+    hazards = extra.get("hazards") if isinstance(extra, dict) else None
+    return hazards if hazards is not None else hazards_of(program.ctx)
 
 
 def write_uniforms(program, values: Mapping[str, object] | None = None, /, **more) -> None:
@@ -35,7 +44,7 @@ def bind_textures(program, textures: Mapping[str, object] | None = None, /, samp
     Returns the units bound (to clear ``sampler`` from afterwards)."""
     get = program.get
     units = []
-    hazards = hazards_of(program.ctx)
+    dirty = (hazards := _hazards(program))._dirty
     for name, texture in ({**textures, **more} if textures else more).items():
         member = get(name, None)
         if member is None:
@@ -46,8 +55,8 @@ def bind_textures(program, textures: Mapping[str, object] | None = None, /, samp
         else:
             pairs = ((value, texture),)
         for unit, one in pairs:
-            if hazards._dirty:
-                hazards.use(reads=[(one, "sampled")], defer=True)
+            if id(one) in dirty:
+                hazards.need(one, moderngl.TEXTURE_FETCH_BARRIER_BIT)
             one.use(unit)
             if sampler is not None:
                 sampler.use(unit)
@@ -60,12 +69,12 @@ def bind_images(program, images: Mapping[str, object] | None = None, /, **more) 
     ``layout(binding = N, format)``), for the access its declaration gives (``readonly``,
     ``writeonly`` or both); a name the program does not use is skipped."""
     declared = program.extra["images"]        # (unit, read, write) by name, from the compiler check
-    hazards = hazards_of(program.ctx)
+    dirty = (hazards := _hazards(program))._dirty
     for name, texture in ({**images, **more} if images else more).items():
         if name in declared:
             unit, read, write = declared[name]
-            if hazards._dirty:
-                hazards.use(reads=[(texture, "storage")], defer=True)
+            if id(texture) in dirty:
+                hazards.need(texture, moderngl.SHADER_IMAGE_ACCESS_BARRIER_BIT)
             if write:
                 hazards.stage(texture)
             texture.bind_to_image(unit, read=read, write=write)
@@ -78,12 +87,12 @@ def bind_buffers(program, buffers: Mapping[str, object] | None = None, /, **more
     get = program.get
     extra = program.extra                        # storage blocks not declared readonly, from the compiler check
     written = extra.get("written") if isinstance(extra, dict) else None   # unknown: every block may be
-    hazards = hazards_of(program.ctx)
+    dirty = (hazards := _hazards(program))._dirty
     for name, buffer in ({**buffers, **more} if buffers else more).items():
         member = get(name, None)
         if member is not None:
-            if hazards._dirty:
-                hazards.use(reads=[(buffer, "storage")], defer=True)
+            if id(buffer) in dirty:
+                hazards.need(buffer, moderngl.SHADER_STORAGE_BARRIER_BIT)
             if written is None or name in written:
                 hazards.stage(buffer)
             buffer.bind_to_storage_buffer(member.binding)

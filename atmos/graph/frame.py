@@ -83,7 +83,8 @@ class PassContext:
         if not attachments and depth_attachment is None:
             raise GraphError(f"pass '{self.pass_name}': framebuffer() needs at least one color or a depth name")
         hazards = self.gpu.hazards
-        if hazards._dirty:          # a texture a compute pass wrote, now drawn into: its writes first
+        dirty = hazards._dirty      # a texture a compute pass wrote, now drawn into: its writes first
+        if dirty and any(id(a) in dirty for a in attachments + [depth_attachment]):
             hazards.use(reads=[(a, "attachment") for a in attachments + [depth_attachment] if a is not None])
         key = tuple(id(a) for a in attachments) + (id(depth_attachment),)
         entry = self._framebuffers.get(key)

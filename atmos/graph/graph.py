@@ -153,7 +153,8 @@ class RenderGraph:
                     p.prepare(self.gpu)
                     self._prepared[p.name] = p
                 reads, writes, stored = compiled.uses[i]
-                if hazards._dirty:          # the barrier this pass's declared uses need, before it
+                dirty = hazards._dirty      # the barrier this pass's declared uses need, before it
+                if dirty and any(id(resources[n]) in dirty for n, _ in reads + writes):
                     hazards.use(reads=[_use(resources, n, a, "sampled") for n, a in reads],
                                 writes=[_use(resources, n, a, "attachment") for n, a in writes])
                 frame._begin_pass(p.name, compiled.declared[i], compiled.declarations[p.name].access)
