@@ -190,7 +190,8 @@ def test_march_extremes_finite_and_as_reference(gpu, ctx, rng, change):
     (dict(octaves=0), "VolumetricFogSettings.octaves must be a whole number 1..16, got 0"),
     (dict(octaves=17), "1..16"), (dict(octaves=2.5), "whole number"), (dict(octaves=True), "whole number"),
     (dict(steps=0), "VolumetricFogSettings.steps must be a whole number 1..1024"), (dict(steps=2000), "1..1024"),
-    (dict(light_steps=-1), "0..32"), (dict(light_step=0), "light_step must be a finite number > 0"), (dict(absorption=-1), "VolumetricFogSettings.absorption must be a finite number >= 0"),
+    (dict(light_steps=-1), "0..32"), (dict(froxels=(0, 4, 4)), "froxels must be None or three ints in \\[1, 256\\]"),
+    (dict(froxels=(8, 8)), "froxels must be None or three ints"), (dict(light_step=0), "light_step must be a finite number > 0"), (dict(absorption=-1), "VolumetricFogSettings.absorption must be a finite number >= 0"),
     (dict(absorption=math.nan), "absorption"), (dict(frequency=0), "frequency must be a finite number > 0"),
     (dict(scale=(1, 0, 1)), "VolumetricFogSettings.scale must be 3 positive numbers"), (dict(center=(1, 2)), "center"),
     (dict(ambient=(-1, 0, 0)), "non-negative"), (dict(max_distance=math.inf), "max_distance"),
@@ -295,3 +296,107 @@ def test_the_fog_can_take_its_ambient_light_from_the_sky():
         bare.close()
     finally:
         gpu.release()
+
+
+# -- the froxel volume (VolumetricFogSettings.froxels) ------------------------------------------------
+def gpu_froxels(gpu, camera, aspect, froxels, params, sun, time=0.0):
+    """(W, H, D + 1, 4): volumetric_fog/froxels.comp for ``camera`` (read back as float64)."""
+    from atmos.gpu.hazards import dispatch
+    from atmos.gpu.uniforms import bind_images, write_uniforms
+    from atmos.plugins.volumetric_fog.plugin import froxel_knee
+    from atmos.scene_uniforms import set_camera_uniforms
+    w, h, d = froxels
+    prog = gpu.program(compute_shader="volumetric_fog/froxels.comp")
+    volume = gpu.ctx.texture3d((w, h, d + 1), 4, dtype="f2")
+    try:
+        set_camera_uniforms(prog, camera, aspect)
+        set_medium_uniforms(prog, params, sun, time)
+        write_uniforms(prog, froxel_knee=froxel_knee(params))
+        bind_images(prog, fog_volume=volume)
+        dispatch(prog, -(-w // 8), -(-h // 8))
+        data = np.frombuffer(volume.read(), np.float16).astype(np.float64)
+        return data.reshape(d + 1, h, w, 4).transpose(2, 1, 0, 3)
+    finally:
+        volume.release()
+
+
+def ref_froxels(camera, aspect, froxels, params, sun, time=0.0):
+    from atmos.camera import view_basis
+    from atmos.plugins.volumetric_fog.plugin import froxel_knee
+    s, sun_light, ambient_light = sun_terms(sun, params)
+    return reference.froxel_volume(camera.position, view_basis(camera, aspect), froxels, params, s, sun_light,
+                                   ambient_light, froxel_knee(params), time)
+
+
+def froxel_camera(rng, params):
+    cam = Camera()
+    radius = (params.bias + 1) / params.falloff
+    cam.position = np.asarray(params.center) + np.array([rng.uniform(-1, 1), 0.3, 1.6]) * radius * np.asarray(params.scale)
+    cam.look_at(tuple(np.asarray(params.center) + rng.uniform(-0.2, 0.2, 3) * radius))
+    return cam
+
+
+def test_gpu_froxel_volume_matches_its_float64_twin(gpu, ctx, rng):
+    params = VolumetricFogSettings(center=tuple(rng.uniform(-5, 5, 3)), scale=(1.5, 0.6, 1.2), bias=0.1, falloff=0.05,
+                                   frequency=float(rng.uniform(0.1, 0.3)), octaves=5, seed=int(rng.integers(0, 2**32)),
+                                   absorption=float(rng.uniform(0.1, 0.4)), light_steps=4, light_step=2.5,
+                                   max_distance=150.0, froxels=(24, 14, 40))
+    sun = Sun.from_angles(float(rng.uniform(10, 70)), float(rng.uniform(0, 360)))
+    cam = froxel_camera(rng, params)
+    got = gpu_froxels(gpu, cam, 16 / 9, params.froxels, params, sun, time=0.75)
+    want = ref_froxels(cam, 16 / 9, params.froxels, params, sun, time=0.75)
+    assert np.isfinite(got).all() and got.shape == want.shape == (24, 14, 41, 4)
+    assert (want[..., -1, 3] < 0.9).sum() > 20 and (want[..., -1, 3] > 0.999).sum() > 5, "columns in and past the fog"
+    assert np.allclose(got[:, :, 0], [0, 0, 0, 1]), "layer 0 is the camera"
+    # the march's float32 tolerance (early exits at 0.01 may flip) plus float16 storage (2^-11 relative)
+    tol = 2e-3 + 1.5e-2 * np.abs(want).max(axis=(0, 1, 2)) + 2.0 ** -11 * np.abs(want)
+    err = np.abs(got - want)
+    assert (err <= tol).all(), f"max error {err.max(axis=(0, 1, 2))}"
+    assert np.median(err[..., :3]) < 2e-4
+
+
+def test_froxels_converge_to_the_per_pixel_march_with_slices():
+    params = VolumetricFogSettings(center=(0, 0, 0), scale=(1.5, 0.6, 1.2), octaves=4, absorption=0.2, light_steps=3,
+                                   max_distance=120.0)
+    sun = Sun.from_angles(35, 40)
+    cam = Camera()
+    cam.position = np.array([6.0, 2.0, 40.0])
+    cam.look_at((0.0, 0.0, 0.0))
+    from atmos.camera import view_basis
+    from atmos.plugins.volumetric_fog.plugin import froxel_knee
+    w, h = 12, 8
+    uv = np.stack(np.meshgrid((np.arange(w) + 0.5) / w, (np.arange(h) + 0.5) / h, indexing="ij"), -1).reshape(-1, 2)
+    rays = np.c_[uv * 2 - 1, np.ones(len(uv))] @ view_basis(cam, 1.5).T
+    dists = np.linspace(5.0, 200.0, len(uv))                   # scene distances from near to beyond the fog
+    exact = ref_march(np.tile(cam.position, (len(uv), 1)), rays, dists, params.replace(steps=256), sun)
+    errors = []
+    for slices in (8, 32, 128):
+        volume = ref_froxels(cam, 1.5, (w, h, slices), params, sun)
+        got = reference.froxel_lookup(volume, uv, dists, params, froxel_knee(params))
+        errors.append(np.abs(got - exact).max())
+    assert errors[0] > errors[1] > errors[2] and errors[2] < 0.25 * errors[0], errors
+    assert errors[2] < 0.02
+
+
+def test_a_scene_with_froxel_fog_is_the_twin_read_at_each_pixel(fresh_gpu):
+    from atmos.camera import view_basis
+    from atmos.plugins.volumetric_fog.plugin import froxel_knee
+    params = VolumetricFogSettings(octaves=4, light_steps=3, absorption=0.15, froxels=(32, 18, 48), animate=False)
+    bg, cam = render(fresh_gpu)
+    fog, _ = render(fresh_gpu, VolumetricFogPlugin(params))
+    h, w = fog.depth.shape
+    ys, xs = np.meshgrid(np.arange(0, h, 3), np.arange(0, w, 3), indexing="ij")
+    ys, xs = ys.ravel(), xs.ravel()
+    uv = np.c_[(xs + 0.5) / w, (ys + 0.5) / h]
+    rays = np.c_[uv * 2 - 1, np.ones(len(uv))] @ view_basis(cam, w / h).T
+    z = bg.depth[ys, xs].astype(np.float64)
+    view_z = cam.near / ((1 - z) + z * cam.near / cam.far)
+    dists = np.where(z >= 1, 1e30, view_z * np.linalg.norm(rays, axis=1))
+    volume = ref_froxels(cam, w / h, params.froxels, params, Sun.from_angles(30.0, 60.0))
+    medium = reference.froxel_lookup(volume, uv, dists, params, froxel_knee(params))
+    want = medium[:, :3] + medium[:, 3:] * bg.color[ys, xs, :3]
+    got = fog.color[ys, xs, :3]
+    assert (medium[:, 3] < 0.8).sum() > 10, "the fog is visible"
+    # float16 volume and colour, float32 noise; filter weights: 1/256 of the neighbours' spread on any GPU
+    spread = np.abs(np.diff(volume, axis=2)).max() / 256
+    assert np.allclose(got, want, atol=4e-3 + spread, rtol=2e-2), np.abs(got - want).max()

@@ -82,7 +82,8 @@ class AerialPerspectivePass(FullscreenPass):
         if not active(self.plugin.settings):
             return                              # declares nothing: culled, nothing allocated
         if self.froxels() is not None:
-            builder.create(AERIAL_VOLUME, TextureDesc(tuple(self.froxels()), components=4, dtype="f4"))
+            builder.create(AERIAL_VOLUME, TextureDesc(tuple(self.froxels()), components=4, dtype="f4", storage=True),
+                           access="storage")
         builder.read(DEPTH)
         builder.read(COLOR)                     # blends onto it
         builder.write(COLOR)

@@ -5,7 +5,7 @@ import numpy as np
 
 from atmos.scene_uniforms import set_camera_uniforms
 from atmos.composition import MEDIA_LIGHT, MEDIA_TRANSMITTANCE, composition
-from atmos.graph import ComputePass, PassContext
+from atmos.graph import ComputePass, PassContext, TextureDesc, work_groups
 from atmos.lighting import Sun, sun_and_day
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
@@ -13,6 +13,13 @@ from atmos.plugins.sky import SkyLight
 from atmos.plugins.volumetric_fog.settings import VolumetricFogSettings
 
 HORIZON_SAMPLES = 16      # azimuths of the sky's horizon radiance averaged into the ambient
+FOG_VOLUME = "volumetric_fog_volume"     # the froxel volume (a transient of the pass; settings.froxels)
+KNEE_SHARE = 1.0 / 32.0   # froxel slices: even inside max_distance · KNEE_SHARE, logarithmic beyond
+
+
+def froxel_knee(settings: VolumetricFogSettings) -> float:
+    """m: the froxel slices' knee (lib/froxel_slices.glsl)."""
+    return settings.max_distance * KNEE_SHARE
 from atmos.gpu.uniforms import write_uniforms
 
 
@@ -54,6 +61,11 @@ class VolumetricFogPass(ComputePass):
 
     def setup(self, builder) -> None:
         super().setup(builder)
+        froxels = self.plugin.settings.froxels
+        if froxels is not None:                    # layer 0 is the camera: D slices, D + 1 layers
+            w, h, d = froxels
+            builder.create(FOG_VOLUME, TextureDesc((w, h, d + 1), components=4, dtype="f2", storage=True),
+                           access="storage")
         if self.plugin.composition.media:          # the aerial perspective mixes the air with it
             for name in (MEDIA_LIGHT, MEDIA_TRANSMITTANCE):
                 builder.read(name, access="storage")
@@ -63,14 +75,29 @@ class VolumetricFogPass(ComputePass):
         return {"LOCAL_MEDIA": int(self.plugin.composition.media)}
 
     def execute(self, frame: PassContext) -> None:
-        view, p = frame.view, self.program
-        set_camera_uniforms(p, view.camera, view.aspect)
-        set_medium_uniforms(p, self.plugin.settings, view.sun, self.plugin.time(view), self.plugin.sky_ambient(view))
+        view, settings = frame.view, self.plugin.settings
         images = {"color_image": COLOR}
         if frame.declares(MEDIA_LIGHT):
             images.update(media_light_image=MEDIA_LIGHT, media_transmittance_image=MEDIA_TRANSMITTANCE)
         color = frame.image(COLOR)
-        frame.dispatch(p, self.groups(color.size), textures={"scene_depth": DEPTH}, images=images)
+        if settings.froxels is None:
+            p = self.program
+            set_camera_uniforms(p, view.camera, view.aspect)
+            set_medium_uniforms(p, settings, view.sun, self.plugin.time(view), self.plugin.sky_ambient(view))
+            frame.dispatch(p, self.groups(color.size), textures={"scene_depth": DEPTH}, images=images)
+            return
+        defines = self.defines()
+        fill = self.gpu.program(compute_shader="volumetric_fog/froxels.comp")
+        apply = self.gpu.program(compute_shader="volumetric_fog/froxel_apply.comp", defines=defines)
+        volume = frame.image(FOG_VOLUME)
+        volume.repeat_x = volume.repeat_y = volume.repeat_z = False     # read clamped to its edge texels
+        for p in (fill, apply):
+            set_camera_uniforms(p, view.camera, view.aspect)
+            write_uniforms(p, froxel_knee=froxel_knee(settings), max_distance=settings.max_distance)
+        set_medium_uniforms(fill, settings, view.sun, self.plugin.time(view), self.plugin.sky_ambient(view))
+        frame.dispatch(fill, work_groups(volume.size[:2], (8, 8)), images={"fog_volume": volume})
+        frame.dispatch(apply, self.groups(color.size), images=images,
+                       textures={"scene_depth": DEPTH, "fog_volume": volume})
 
 
 class VolumetricFogPlugin(Plugin):

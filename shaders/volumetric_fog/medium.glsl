@@ -41,6 +41,19 @@ vec2 fog_range(vec3 ro, vec3 dir, float limit) {
     return vec2(max((-b - r) / a, 0.0), min((-b + r) / a, limit));
 }
 
+// The sun's transmittance from p: light_steps samples light_step apart toward the sun (stops at 0.01).
+float fog_sun_transmittance(vec3 p, uint key) {
+    float tl = 1.0;
+    for (int j = 0; j < light_steps; ++j) {
+        float dl = fog_density(p + sun_dir * (float(j) * light_step), key);
+        if (dl > 0.0) {
+            tl *= exp(-absorption * dl * light_step);
+            if (tl <= 0.01) break;
+        }
+    }
+    return tl;
+}
+
 // Premultiplied result: rgb = in-scattered light, a = transmittance along the ray up to `limit`.
 vec4 fog_march(vec3 ro, vec3 dir, float limit) {
     uint key = vn_key(seed);
@@ -54,15 +67,7 @@ vec4 fog_march(vec3 ro, vec3 dir, float limit) {
         float d = fog_density(p, key);
         if (d <= 0.0) continue;
         float step_t = exp(-absorption * d * dt);
-        float tl = 1.0;
-        for (int j = 0; j < light_steps; ++j) {
-            float dl = fog_density(p + sun_dir * (float(j) * light_step), key);
-            if (dl > 0.0) {
-                tl *= exp(-absorption * dl * light_step);
-                if (tl <= 0.01) break;
-            }
-        }
-        light += trans * (1.0 - step_t) * (ambient_light + sun_light * tl);
+        light += trans * (1.0 - step_t) * (ambient_light + sun_light * fog_sun_transmittance(p, key));
         trans *= step_t;
         if (trans <= 0.01) break;
     }
