@@ -120,20 +120,6 @@ class ClearMedia(CompositionClear):
             (MEDIA_TRANSMITTANCE, TextureDesc(size, components=1, dtype="f4", filter="nearest", storage=True), 1.0)))
 
 
-def blend_onto_media(builder, comp: Composition) -> None:
-    """In a local medium's ``setup``: where the aerial perspective reads the media, read and write both
-    targets too (the pass blends onto them as onto the colour, ``lib/media_out.glsl``, LOCAL_MEDIA 1)."""
-    if comp.media:
-        for name in (MEDIA_LIGHT, MEDIA_TRANSMITTANCE):
-            builder.read(name)
-            builder.write(name)
-
-
-def medium_targets(frame, color: str) -> list:
-    """The colour targets a local medium draws to: ``color``, and the media targets where it declared them."""
-    return [color, MEDIA_LIGHT, MEDIA_TRANSMITTANCE] if frame.declares(MEDIA_LIGHT) else [color]
-
-
 def composition(app) -> Composition:
     """The App's :class:`Composition` (made on first use, with its :class:`ClearDistance` and
     :class:`ClearMedia` passes)."""

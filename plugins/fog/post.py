@@ -6,16 +6,17 @@ import math
 import numpy as np
 
 from atmos.lighting import sun_and_day
-from atmos.composition import CLOUD_DISTANCE, MEDIA_LIGHT, blend_onto_media, medium_targets
-from atmos.graph import PassBuilder, PassContext, RenderPass
+from atmos.composition import CLOUD_DISTANCE, MEDIA_LIGHT, MEDIA_TRANSMITTANCE
+from atmos.graph import PassBuilder, PassContext, RenderPass, work_groups
 from atmos.graph.frame import BLEND_TRANSMITTANCE, blend
 from atmos.plugins.fog.noise import NoiseVolumes, octave_key
 from atmos.plugins.fog.settings import MODES
 from atmos.plugins.fog.sky_color import SAMPLES
 from atmos.render_core import COLOR, DEPTH
-from atmos.gpu.uniforms import bind_textures, write_uniforms
+from atmos.gpu.uniforms import write_uniforms
 
 FRAGMENT = "fog/fog.frag"
+COMPUTE = "fog/fog.comp"
 VERTEX = "lib/fullscreen.vert"
 
 
@@ -27,6 +28,8 @@ def fog_program(gpu, settings, from_depth: bool, clouds: bool = False, media: bo
                "FOG_PROCEDURAL": int(settings.noise == "procedural"), "FOG_FROM_DEPTH": int(from_depth),
                "FOG_CLOUDS": int(clouds), "FOG_SKY_COLOR": int(settings.color_from == "sky"),
                "FOG_HORIZON_SAMPLES": SAMPLES, "LOCAL_MEDIA": int(media), "FOG_SUN": int(settings.sun_scattering > 0)}
+    if from_depth:                           # the graph's pass: a compute pass compositing in place
+        return gpu.program(defines, compute_shader=COMPUTE)
     return gpu.program(defines, vertex_shader=VERTEX, fragment_shader=FRAGMENT)
 
 
@@ -76,7 +79,8 @@ def restore_state(ctx) -> None:
 
 
 class FogPass(RenderPass):
-    """Fullscreen fog over the scene: distance from depth via the inverse view-projection."""
+    """The fog over the scene, one compute invocation per pixel composited onto the colour in place
+    (fog/fog.comp): distance and position from the scene depth and the camera."""
     name = "fog"
     phase = "media"
 
@@ -87,11 +91,14 @@ class FogPass(RenderPass):
 
     def setup(self, builder: PassBuilder) -> None:
         builder.read(DEPTH)
-        builder.read(COLOR)                 # blends onto it
-        builder.write(COLOR)
+        builder.read(COLOR, access="storage")          # composites onto it in place
+        builder.write(COLOR, access="storage")
         if self.plugin.composition.distance:   # the clouds' own distance (atmos.composition)
             builder.read(CLOUD_DISTANCE)
-        blend_onto_media(builder, self.plugin.composition)   # the aerial perspective mixes the air with it
+        if self.plugin.composition.media:      # the aerial perspective mixes the air with it
+            for name in (MEDIA_LIGHT, MEDIA_TRANSMITTANCE):
+                builder.read(name, access="storage")
+                builder.write(name, access="storage")
 
     def prepare(self, gpu) -> None:
         self.gpu = gpu
@@ -113,15 +120,17 @@ class FogPass(RenderPass):
         settings = self.plugin.settings
         clouds, media = frame.declares(CLOUD_DISTANCE), frame.declares(MEDIA_LIGHT)
         prog = self._sync(settings, clouds, media)
-        frame.framebuffer(color=medium_targets(frame, COLOR)).use()
-        frame.blend_transmittance()
-        bind_textures(prog, scene_depth=frame.resource(DEPTH))
+        textures = {"scene_depth": DEPTH}
         if clouds:
-            bind_textures(prog, cloud_distance=frame.resource(CLOUD_DISTANCE))
+            textures["cloud_distance"] = CLOUD_DISTANCE
         if self.volumes is not None:
             self.volumes.bind(prog)
         set_fog_uniforms(prog, settings, view.time + settings.time_offset, self.plugin.horizon(view), view.sun)
-        frame.fullscreen(prog)
+        images = {"color_image": COLOR}
+        if media:
+            images.update(media_light_image=MEDIA_LIGHT, media_transmittance_image=MEDIA_TRANSMITTANCE)
+        color = frame.image(COLOR)
+        frame.dispatch(prog, work_groups(color.size, (8, 8)), textures=textures, images=images)
 
     def release(self) -> None:
         if self.volumes is not None:
