@@ -3,7 +3,7 @@
 With ``SkySettings.model = "physical"`` and ``aerial_perspective`` on, every pixel that shows the scene
 (terrain, ground, meshes) gets the sunlight the air between it and the camera scatters toward the
 camera, and loses what that air absorbs and scatters away: ``C → L + T·C``, both marched through the
-sky's own atmosphere and LUTs (``shaders/sky/aerial.frag``; float64:
+sky's own atmosphere and LUTs (``shaders/sky/aerial.comp``; float64:
 :func:`atmos.plugins.sky.atmosphere.aerial_perspective`). Distant hills turn the sky's blue by day and
 its orange at sunset, with no fog colour to choose. Clouds that give the media passes their own distance
 (:mod:`atmos.composition`) are hazed by it. It runs after the other media passes (local fog lies in
@@ -26,7 +26,7 @@ import numpy as np
 from atmos.camera import view_basis
 from atmos.composition import CLOUD_DISTANCE, MEDIA_LIGHT, MEDIA_TRANSMITTANCE
 from atmos.gpu import clamp_sampler
-from atmos.graph import FullscreenPass, PassContext, TextureDesc
+from atmos.graph import ComputePass, PassContext, TextureDesc
 from atmos.plugins.sky.luts import SKY_LUTS, atmosphere_defines, set_atmosphere_uniforms, view_radius
 from atmos.render_core import COLOR, DEPTH
 from atmos.gpu.uniforms import bind_images, bind_textures, write_uniforms
@@ -53,11 +53,11 @@ def active(settings) -> bool:
     return settings.model == "physical" and settings.aerial_perspective
 
 
-class AerialPerspectivePass(FullscreenPass):
+class AerialPerspectivePass(ComputePass):
     """See the module docstring; ``plugin`` is the SkyPlugin (its settings, composition and graph)."""
     name = AERIAL
     phase = "media"
-    fragment = "sky/aerial.frag"
+    compute = "sky/aerial.comp"
 
     @property
     def after(self) -> tuple[str, ...]:
@@ -85,8 +85,8 @@ class AerialPerspectivePass(FullscreenPass):
             builder.create(AERIAL_VOLUME, TextureDesc(tuple(self.froxels()), components=4, dtype="f4", storage=True),
                            access="storage")
         builder.read(DEPTH)
-        builder.read(COLOR)                     # blends onto it
-        builder.write(COLOR)
+        builder.read(COLOR, access="storage")   # composites onto it in place
+        builder.write(COLOR, access="storage")
         builder.read(SKY_LUTS)
         if self.clouds():
             builder.read(CLOUD_DISTANCE)
@@ -115,15 +115,13 @@ class AerialPerspectivePass(FullscreenPass):
         if volume is not None:
             self._fill(volume, view, values)
         units = bind_textures(p, sampler=self.sampler, aerial_volume=volume) if volume is not None else []
-        frame.framebuffer(color=[COLOR]).use()
-        frame.blend_transmittance()
-        bind_textures(p, scene_depth=frame.resource(DEPTH))
-        # graph resources under the names the shader's samplers carry (atmos.composition)
-        bind_textures(p, {name: frame.resource(name) for name in (CLOUD_DISTANCE, MEDIA_LIGHT, MEDIA_TRANSMITTANCE)
-                          if frame.declares(name)})
         set_atmosphere_uniforms(p, settings.atmosphere)
         write_uniforms(p, values)
-        frame.fullscreen(p)
+        # graph resources under the names the shader's samplers carry (atmos.composition)
+        textures = {name: name for name in (DEPTH, CLOUD_DISTANCE, MEDIA_LIGHT, MEDIA_TRANSMITTANCE)
+                    if frame.declares(name)}
+        textures["scene_depth"] = textures.pop(DEPTH)
+        frame.dispatch(p, self.groups(frame.image(COLOR).size), textures=textures, images={"color_image": COLOR})
         for unit in units:
             self.sampler.clear(unit)
 

@@ -15,7 +15,7 @@
 // 1 - f), V = exp(-tau_sun) the sun's visibility through the clouds, w the share of the fog in front of
 // s_i (a cloud in front, "cloud_distance": a before it, 1 - a behind; sky="keep" sky: none). It never
 // exceeds the fog's in-scatter (tests/test_light_shafts_fog.py).
-// SHAFT_AERIAL 1 (no fog; the sky's aerial perspective owns the air's light, sky/aerial.frag): the same,
+// SHAFT_AERIAL 1 (no fog; the sky's aerial perspective owns the air's light, sky/aerial.comp): the same,
 // for the atmosphere's single-scattered sunlight, lost where the clouds shadow the air,
 //   L = -sum_i w(s_i) T(s_i) E_sun(p_i) [s_ray(p_i) p_R(cos) + s_mie(p_i) p_M(cos)] (1 - V(s_i)) ds,  T = 1,
 // T(s) ~ exp(-ext(p) s) the air's transmittance from the eye, E_sun = atm_sun × its transmittance to the

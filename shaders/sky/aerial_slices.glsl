@@ -1,4 +1,4 @@
-// The aerial perspective's froxel slices (sky/aerial_volume.comp writes them, sky/aerial.frag reads
+// The aerial perspective's froxel slices (sky/aerial_volume.comp writes them, sky/aerial.comp reads
 // them): lib/froxel_slices.glsl with a knee of AERIAL_KNEE — even steps of the distance's ratio far out,
 // where the air's colour and extinction change with the altitudes the ray crosses, and no slice wasted
 // near the camera, where they are constant.

@@ -5,7 +5,7 @@
 // slice sampled at its middle (sky/atmosphere.glsl atm_segment), stopping where the ray leaves the air.
 // Texel z holds what varies slowly along the ray: (L / (1 - T), -ln(T) / path), the light per unit of
 // opacity (the air's colour; L the in-scattered light, T the mean RGB transmittance) and the mean
-// extinction over the path taken (the slice's distance, or the ray's end if nearer). sky/aerial.frag
+// extinction over the path taken (the slice's distance, or the ray's end if nearer). sky/aerial.comp
 // reads it trilinearly at (uv, aerial_slice_w(distance)) and rebuilds T = exp(-a distance),
 // L = rgb (1 - T): the march's own values at the slices, and a ray nearer than the first slice keeps
 // its colour and extinction (L and 1 - T fall to 0 with the distance). float64 reference:
