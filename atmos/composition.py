@@ -39,8 +39,9 @@ MEDIA_TRANSMITTANCE = "media_transmittance"    # and their transmittance (R)
 
 
 def distance_desc(size) -> TextureDesc:
-    """The distance target at ``size`` (width, height): RG float32 (premultiplied distance, coverage)."""
-    return TextureDesc(tuple(size), components=2, dtype="f4", filter="nearest")
+    """The distance target at ``size`` (width, height): RG float32 (premultiplied distance, coverage),
+    drawn into or composited onto in place (an rg32f image)."""
+    return TextureDesc(tuple(size), components=2, dtype="f4", filter="nearest", storage=True)
 
 
 def media_mix(light_a, t_a, light_b, t_b) -> np.ndarray:

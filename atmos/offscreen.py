@@ -4,9 +4,9 @@ what the cloud renderers draw their clouds into and the light shafts their march
 Filling sprite pixels is most of the cloud pass's cost; at factor 2 the sprites fill a quarter of
 the pixels. Three draws: ``core/offscreen_far_depth.frag`` writes each block's farthest scene depth
 into the low-res depth target (so a sprite seen through any pixel of the block is drawn); the layer is
-drawn into the cleared low-res colour target against it; ``core/offscreen_composite.frag`` blends the
-result onto the frame — bilinear inside surfaces, nearest-depth at geometry edges
-(``lib/upsample.glsl``). References: :mod:`atmos.offscreen_reference`.
+drawn into the cleared low-res colour target against it; ``core/offscreen_composite.comp`` (compute)
+composites the result onto the frame in place — bilinear inside surfaces, nearest-depth at geometry
+edges (``lib/upsample.glsl``). References: :mod:`atmos.offscreen_reference`.
 """
 from __future__ import annotations
 
@@ -15,9 +15,9 @@ import math
 import moderngl
 
 from atmos.composition import CLOUD_DISTANCE, distance_desc
-from atmos.graph import PassBuilder, PassContext, TextureDesc
+from atmos.graph import PassBuilder, PassContext, TextureDesc, work_groups
 from atmos.render_core import COLOR, DEPTH
-from atmos.gpu.uniforms import bind_textures
+from atmos.gpu.uniforms import bind_textures, write_uniforms
 
 CLOUD_COLOR = "cloud_color"
 CLOUD_DEPTH = "cloud_depth"
@@ -38,9 +38,8 @@ class OffscreenLayer:
     def __init__(self, gpu, color: str = CLOUD_COLOR, depth: str = CLOUD_DEPTH, distance: str = CLOUD_LOW_DISTANCE):
         self.color, self.depth = color, depth         # the low-res targets' names (another pass: its own)
         self.distance = distance
-        fullscreen = "lib/fullscreen.vert"
-        self.far_depth = gpu.program(vertex_shader=fullscreen, fragment_shader="core/offscreen_far_depth.frag")
-        self.composite = gpu.program(vertex_shader=fullscreen, fragment_shader="core/offscreen_composite.frag")
+        self.gpu = gpu
+        self.far_depth = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="core/offscreen_far_depth.frag")
 
     @staticmethod
     def declare(builder: PassBuilder, size, factor: int, distance: bool = False, color: str = CLOUD_COLOR,
@@ -74,22 +73,22 @@ class OffscreenLayer:
 
     def end(self, frame: PassContext, factor: int, near: float, far: float, distance: bool = False,
             medium: bool = False, offset=None) -> None:
-        """Blend the low-res clouds onto "color" (premultiplied, :meth:`PassContext.blend_over`), and
-        their distance onto the cleared "cloud_distance" with the same weights when ``distance``;
-        ``medium``: the low-res target holds (in-scattered light, transmittance) of a medium instead,
-        blended by :meth:`PassContext.blend_transmittance` (alpha kept). ``offset`` (ox, oy): low-res
-        texel (i, j) holds the frame's pixel (i·factor + ox, j·factor + oy); None: the block's centre."""
+        """Composite the low-res clouds onto "color" in place (premultiplied: layer + (1 − a) · colour,
+        as :meth:`PassContext.blend_over` would), and their distance onto the cleared "cloud_distance"
+        with the same weights when ``distance``; ``medium``: the low-res target holds (in-scattered light,
+        transmittance) of a medium instead (L + T · colour, alpha kept). ``offset`` (ox, oy): low-res
+        texel (i, j) holds the frame's pixel (i·factor + ox, j·factor + oy); None: the block's centre.
+        One compute dispatch (``core/offscreen_composite.comp``)."""
         frame.reset_state()                 # the sprites' depth test and point size are done
-        frame.framebuffer(color=[COLOR, CLOUD_DISTANCE] if distance else [COLOR]).use()
-        p = self.composite
-        bind_textures(p, clouds=frame.resource(self.color), cloud_depth=frame.resource(self.depth),
-                      scene_depth=frame.resource(DEPTH))
-        if distance:
-            bind_textures(p, cloud_distance=frame.resource(self.distance))
-        p["factor"].value = factor
-        p["inv_near_far"].value = (1.0 / near, 1.0 / far)
-        p["edge"].value = EDGE
+        p = self.gpu.program(compute_shader="core/offscreen_composite.comp",
+                             defines={"COMPOSITE_MEDIUM": int(medium), "COMPOSITE_DISTANCE": int(distance)})
         centre = 0.5 * (factor - 1)
-        p["sample_offset"].value = (centre, centre) if offset is None else tuple(float(v) for v in offset)
-        frame.blend_transmittance() if medium else frame.blend_over()
-        frame.fullscreen(p)
+        write_uniforms(p, factor=factor, inv_near_far=(1.0 / near, 1.0 / far), edge=EDGE,
+                       sample_offset=(centre, centre) if offset is None else tuple(float(v) for v in offset))
+        color = frame.resource(COLOR)
+        textures = {"clouds": self.color, "cloud_depth": self.depth, "scene_depth": DEPTH}
+        images = {"color_image": color}
+        if distance:
+            textures["cloud_distance"] = self.distance
+            images["distance_image"] = frame.resource(CLOUD_DISTANCE)
+        frame.dispatch(p, work_groups(color.size, (8, 8)), textures=textures, images=images)

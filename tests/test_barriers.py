@@ -311,6 +311,6 @@ def test_the_light_shafts_march_is_a_compute_dispatch_into_a_storage_target(gpu)
         runs.append((meter.calls["ComputeShader.run"], meter.calls["VertexArray.render"]))
         dump = app.graph.dump()
         app.close()
-    assert runs[1][0] == runs[0][0] + 1                 # the march: one dispatch
-    assert runs[1][1] == runs[0][1] + 2                 # the low-res far depth and the upsampling composite
+    assert runs[1][0] == runs[0][0] + 2                 # the march and the upsampling composite: dispatches
+    assert runs[1][1] == runs[0][1] + 1                 # the low-res far depth: one draw
     assert "light_shafts_march  transient" in dump and "storage" in dump

@@ -6,7 +6,7 @@
 //   L = sum_i scattering * phase(cos) * E * exp(-tau_sun(p_i)) * exp(-scattering * s_i) * ds,
 // tau_sun through the clouds from the density maps (clouds/volume/column.glsl; has_clouds 0: none;
 // with CLOUD_FAR_FIELD also the far field's columns beyond the volume: rays between far clouds).
-// Output (L, T = exp(-scattering * d)), upsampled by core/offscreen_composite.frag and blended
+// Output (L, T = exp(-scattering * d)), upsampled and composited by core/offscreen_composite.comp:
 // rgb = L + T * rgb. plugins/light_shafts/reference.py march_shafts is the same in numpy.
 // SHAFT_FOG 1 (a FogPlugin owns the air's in-scattering, so the haze is counted once): no light and no
 // extinction of the shafts' own; they take away the fog's in-scatter lost in cloud shadow,
