@@ -6,7 +6,7 @@ import numpy as np
 
 from atmos.camera import Camera
 from atmos.composition import composition
-from atmos.graph import FullscreenPass, PassContext, RenderPass
+from atmos.graph import ComputePass, PassContext, RenderPass
 from atmos.lighting import Sun
 from atmos.plugin import Plugin
 import atmos.plugins.sky.sun_light as sun_light
@@ -16,7 +16,7 @@ from atmos.plugins.sky.luts import (SKY_LUTS, AtmosphereLuts, atmosphere_defines
 from atmos.plugins.sky.light import SkyLight
 from atmos.plugins.sky.settings import SkySettings
 from atmos.plugins.sky.shader import set_sky_uniforms, sky_defines
-from atmos.render_core import DEPTH, where_nothing_was_drawn
+from atmos.render_core import COLOR, DEPTH
 
 
 class SkyLutsPass(RenderPass):
@@ -42,24 +42,24 @@ class SkyLutsPass(RenderPass):
                                         float(view.sun.direction[1]))
 
 
-class SkyPass(FullscreenPass):
+class SkyPass(ComputePass):
     """Writes the sky into every pixel of ``color`` where nothing was drawn (depth 1; later passes draw
-    over it), from the Sun resource: Preetham's formula, or the physical sky's sky-view LUT."""
+    over it), from the Sun resource: Preetham's formula, or the physical sky's sky-view LUT; one
+    compute invocation per pixel (``sky/sky.comp``)."""
     name = "sky"
     phase = "sky"
-    vertex = "lib/fullscreen_far.vert"
+    compute = "sky/sky.comp"
     reads = (DEPTH,)
+    writes = (COLOR,)
 
     @property
     def physical(self) -> bool:
         return self.plugin.settings.model == "physical"
 
-    @property
-    def fragment(self) -> str:
-        return "sky/physical.frag" if self.physical else "sky/sky.frag"
-
     def defines(self) -> dict:
-        return {**sky_defines(), **atmosphere_defines()} if self.physical else sky_defines()
+        if self.physical:
+            return {**sky_defines(), **atmosphere_defines(), "SKY_PHYSICAL": 1}
+        return sky_defines()
 
     def setup(self, builder) -> None:
         super().setup(builder)
@@ -68,7 +68,6 @@ class SkyPass(FullscreenPass):
 
     def execute(self, frame: PassContext) -> None:
         view, p = frame.view, self.program
-        where_nothing_was_drawn(frame)
         camera = view.camera
         settings = self.plugin.settings
         set_sky_uniforms(p, settings, view.sun.direction, view.sun.color, view.time,
@@ -77,7 +76,8 @@ class SkyPass(FullscreenPass):
             frame.resource(SKY_LUTS).bind(p)
             set_atmosphere_uniforms(p, settings.atmosphere)
             p["view_r"].value = view_radius(settings.atmosphere, camera)
-        frame.fullscreen(p)
+        color = frame.image(COLOR)
+        frame.dispatch(p, self.groups(color.size), textures={"scene_depth": DEPTH}, images={"color_image": color})
 
 
 class SkyPlugin(Plugin):

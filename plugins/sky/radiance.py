@@ -95,7 +95,7 @@ def extras(v, s, sun_color, p: SkySettings, time: float, pixel_angle: float) -> 
 
 def physical_sky_color(view_dir, sun_dir, sun_color, sky_view_lut, altitude: float = 0.0,
                        settings: SkySettings | None = None, time: float = 0.0, pixel_angle: float = 0.0) -> np.ndarray:
-    """(..., 3) what the physical sky pass (``shaders/sky/physical.frag``) writes: the sky-view LUT
+    """(..., 3) what the physical sky pass (``shaders/sky/physical_pixel.glsl``) writes: the sky-view LUT
     ``sky_view_lut`` (from :func:`atmos.plugins.sky.atmosphere.sky_view_lut`, or read back from the
     GPU) along ``view_dir``, ``night`` × (1 − :func:`daylight`), and the :func:`extras`."""
     from atmos.plugins.sky.atmosphere import sample_sky_view

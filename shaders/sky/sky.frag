@@ -1,13 +1,11 @@
 #version 430
-// The sky pass: a full-screen background of sky/sky.glsl along each pixel's view ray.
-// Alpha 0: open sky (color.a is the sky occlusion, atmos/render_core.py).
-// view_basis: the frame block (lib/frame.glsl)
+// The analytic sky over a fullscreen triangle (sky/sky_pixel.glsl): what tests draw directly; the
+// graph's sky pass is sky/sky.comp.
 #include "lib/frame.glsl"
 in vec2 v_uv;
 out vec4 frag;
-#include "lib/view_ray.glsl"
-#include "sky/sky.glsl"
+#include "sky/sky_pixel.glsl"
 
 void main() {
-    frag = vec4(sky_color(view_ray_dir(v_uv, view_basis)), 0.0);
+    frag = sky_pixel(v_uv);
 }
