@@ -234,7 +234,7 @@ def correlation(a, b) -> float:
 
 @pytest.mark.parametrize("pitch", [0.25, 0.7])
 def test_the_far_fields_opacity_matches_float64(gpu, ctx, filter_bits, pitch):
-    """far.frag's alpha outside the volume (mip 0: a 64-texel, 20 km tile) against far_field_alpha: the
+    """far.comp's alpha outside the volume (mip 0: a 64-texel, 20 km tile) against far_field_alpha: the
     column optical depth at the middle plane's hit, at the rank and scale slant_rank gives for clouds of
     the measured height (RankLight's thickness at the median covered rank) at the ray's slant, over the
     slant, times the horizon fade; as a flat layer (height 0) it is far off (the test can fail)."""
@@ -267,7 +267,7 @@ def test_the_far_fields_opacity_matches_float64(gpu, ctx, filter_bits, pitch):
         want = far_field_alpha(xz, dirs, height, *args, weight_bits=filter_bits) * fade   # as this GPU filters
         flat = far_field_alpha(xz, dirs, 0.0, *args) * fade
         texels = params.size / layer.tile_size * 2.0 * math.tan(cam.fov_y / 2) / gpu.size[1] * s / np.abs(dirs[..., 1])
-        mip0 = (s > 0.0) & (texels < 1.0)                   # far.frag's footprint: mip 0 (nearer the horizon coarser)
+        mip0 = (s > 0.0) & (texels < 1.0)                   # far.comp's footprint: mip 0 (nearer the horizon coarser)
         assert mip0.mean() > 0.3 and 0.2 < (want[mip0] > 0.05).mean() < 0.95, "the view holds far clouds and gaps"
         err = np.abs(alpha - want)[mip0]
         assert np.percentile(err, 99) < 0.02 and err.mean() < 0.004, (err.mean(), np.percentile(err, 99))
@@ -282,7 +282,7 @@ def test_the_far_fields_opacity_matches_float64(gpu, ctx, filter_bits, pitch):
 
 
 def test_a_sun_and_sky_of_1e30_saturate_the_far_field_below_float16s_largest(gpu, ctx):
-    """CloudSettings.sun_intensity and sky_intensity have no upper bound: at 1e30 far.frag's light is held
+    """CloudSettings.sun_intensity and sky_intensity have no upper bound: at 1e30 far.comp's light is held
     at HDR_MAX (lib/hdr_max.glsl), below float16's 65504, so the colour target stays finite (a machine
     with an NVIDIA GPU rounds past 65504 to inf; Mesa's llvmpipe toward zero, to 65504: caught here)."""
     from test_cloud_render import assert_a_1e30_sun_and_sky_saturate

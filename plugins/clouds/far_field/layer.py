@@ -56,7 +56,7 @@ def drift(settings, sets: CloudSets, time: float, tile_size: float) -> np.ndarra
 
 def column_tau(settings, sets: CloudSets) -> float:
     """field.glsl's field_column_tau: optical depth per cell of a column sum, ``thickness · sigma_t ·
-    cell height`` (the column far.frag draws and the ground shadows take beyond the volume)."""
+    cell height`` (the column far.comp draws and the ground shadows take beyond the volume)."""
     return float(settings.thickness) * cell_tau(sets.settings)
 
 
@@ -209,7 +209,7 @@ class FarFieldLayer:
                       field_column_tau=column_tau(params, sim))
         span, first = self._rank_table()
         bind_textures(program, far_rank_table=self.ranks)
-        crossings = pattern_crossings(params.base_frequency, params.seed, params.size)   # far.frag's slant_rank
+        crossings = pattern_crossings(params.base_frequency, params.seed, params.size)   # far.comp's slant_rank
         write_uniforms(program, values, field_offsets=offsets.astype("f4").tobytes(),
                        field_turns=np.transpose(rotations(), (0, 2, 1)).astype("f4").tobytes(),   # column-major
                        far_rank_span=tuple(span), field_first_level=first,

@@ -5,7 +5,7 @@ import numpy as np
 
 from atmos.scene_uniforms import set_camera_uniforms
 from atmos.composition import CLOUD_DISTANCE, composition
-from atmos.graph import FullscreenPass, PassContext
+from atmos.graph import ComputePass, PassContext
 from atmos.plugin import Plugin
 from atmos.plugins.clouds.far_field.layer import FarFieldLayer
 from atmos.plugins.clouds.volume.sets import FAR_FIELD
@@ -14,25 +14,30 @@ from atmos.plugins.clouds.volume.light import CloudLightSettings, light_uniforms
 from atmos.plugins.clouds.volume.field_demand import field_demand
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CloudSets
 from atmos.render_core import COLOR, DEPTH
-from atmos.gpu.uniforms import bind_textures, write_uniforms
+from atmos.gpu.uniforms import write_uniforms
 
 
-class CloudFarFieldPass(FullscreenPass):
-    """Phase translucent, before the cloud renderers (its clouds are behind theirs): blends the far
-    field onto ``color`` (premultiplied) where the layer's middle plane is in front of ``depth``, and
-    its distance onto ``"cloud_distance"`` when a media pass reads it (:mod:`atmos.composition`)."""
+class CloudFarFieldPass(ComputePass):
+    """Phase translucent, before the cloud renderers (its clouds are behind theirs): composites the far
+    field onto ``color`` in place (premultiplied, one compute invocation per pixel) where the layer's
+    middle plane is in front of ``depth``, and its distance onto ``"cloud_distance"`` when a media pass
+    reads it (:mod:`atmos.composition`)."""
     name = "cloud_far_field"
     phase = "translucent"
-    fragment = "clouds/far_field/far.frag"
+    compute = "clouds/far_field/far.comp"
     reads = (COLOR, DEPTH, CLOUD_SETS, FAR_FIELD)
+    writes = (COLOR,)
 
     def setup(self, builder) -> None:
         if self.plugin.drawn_by_march():
             return                          # a ray march draws the far field volumetrically: culled
         super().setup(builder)
         if self.plugin.composition.distance:
-            builder.read(CLOUD_DISTANCE)
-            builder.write(CLOUD_DISTANCE)
+            builder.read(CLOUD_DISTANCE, access="storage")
+            builder.write(CLOUD_DISTANCE, access="storage")
+
+    def defines(self) -> dict:
+        return {"FAR_DISTANCE": int(self.plugin.composition.distance)}
 
     def execute(self, frame: PassContext) -> None:
         params = self.plugin.settings
@@ -44,10 +49,7 @@ class CloudFarFieldPass(FullscreenPass):
         layer.prepare(view, sim)
         layout = sim.layout()
         distance = frame.declares(CLOUD_DISTANCE)
-        frame.framebuffer(color=[COLOR, CLOUD_DISTANCE] if distance else [COLOR]).use()
-        frame.blend_over()
         layer.use(p, view, sim)
-        bind_textures(p, scene_depth=frame.resource(DEPTH))
         set_camera_uniforms(p, view.camera, view.aspect)
         light = self.plugin.light_settings()       # the renderer's octaves; its field's weight where measured
         diffusion = light.ms_diffusion if layer.light.has_field else 0.0
@@ -59,7 +61,8 @@ class CloudFarFieldPass(FullscreenPass):
                       **{name: float(getattr(params, name)) for name in
                          ("thickness", "horizon_fade")})
         write_uniforms(p, values)
-        frame.fullscreen(p)
+        images = {"color_image": COLOR, **({"distance_image": CLOUD_DISTANCE} if distance else {})}
+        frame.dispatch(p, self.groups(frame.image(COLOR).size), textures={"scene_depth": DEPTH}, images=images)
 
 
 class CloudFarFieldPlugin(Plugin):

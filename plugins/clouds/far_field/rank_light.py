@@ -7,7 +7,7 @@ transmittances of the octaves (``medium.octave_transmittances``) and, where the 
 (phi, F), each as seen from above and from below; both per height bin for the ray march's
 volumetric far field; the height their light comes from (where the 2D far field takes the sun's
 colour); and the clouds' thickness (the height their density spans), how high the 2D
-far field's clouds stand when seen at a slant (``far.frag`` slant_rank). So the far field is as bright per cover as the volume at every sun, not a guess
+far field's clouds stand when seen at a slant (``far.comp`` slant_rank). So the far field is as bright per cover as the volume at every sun, not a guess
 from a slanted column. Two small dispatches per frame after the cover (:meth:`FarFieldLayer.prepare`).
 """
 from __future__ import annotations

@@ -301,7 +301,7 @@ def relief_light(s, d) -> np.ndarray:
 
 
 def slant_rank(rank, height: float, cot, cover: float, crossings, tile_size: float) -> tuple[np.ndarray, np.ndarray]:
-    """far.frag's slant_rank: (rank, optical depth factor) of points of ``rank`` (...,) of a layer of
+    """far.comp's slant_rank: (rank, optical depth factor) of points of ``rank`` (...,) of a layer of
     clouds ``height`` (m) high seen with cot(elevation) ``cot`` (...,): the pattern crosses its cover n
     times per metre (``crossings`` per tile at quantile 1 − cover, :func:`.cover.pattern_crossings`); a
     cloud as a spheroid of radii a = cover / n across and b = height / 2 up widens by 2 (√(a² + b²
@@ -322,7 +322,7 @@ def slant_rank(rank, height: float, cot, cover: float, crossings, tile_size: flo
 def far_field_alpha(xz, dirs, height: float, octaves, offsets, tile_size: float, quantiles, columns,
                     column_tau: float, cover: float, crossings, thickness: float = 1.0,
                     weight_bits: int | None = None) -> np.ndarray:
-    """far.frag's opacity (...,) where the view ``dirs`` (..., 3, unit) meet the middle plane at world
+    """far.comp's opacity (...,) where the view ``dirs`` (..., 3, unit) meet the middle plane at world
     ``xz`` (..., 2), mip 0, before the edge, horizon and scene fades: thickness · column_tau (sigma_t ·
     cell height) · the volume's column sum at the point's rank, both as :func:`slant_rank` gives them
     for clouds ``height`` (m) high at the ray's slant (``cover``, ``crossings``: the layer's), seen along
@@ -337,7 +337,7 @@ def far_field_alpha(xz, dirs, height: float, octaves, offsets, tile_size: float,
 
 def far_optical_depth(xz, octaves, offsets, tile_size: float, quantiles, columns, column_tau: float) -> np.ndarray:
     """The far field's vertical optical depth (...,) at world ``xz`` (..., 2), mip 0: ``column_tau`` (optical
-    depth per summed cell) × the volume's column sum at the point's rank (far.frag's tau.x; the ground
+    depth per summed cell) × the volume's column sum at the point's rank (far.comp's tau.x; the ground
     shadows' term beyond the volume, clouds/volume/column.glsl)."""
     rank = field_rank(field_fbm(xz, octaves, offsets, tile_size), quantiles)
     return float(column_tau) * column_at_rank(rank, columns)

@@ -56,7 +56,7 @@ def sun_optical_depth(points, sums_a, sums_b, t: float, sun_dir, extinction: flo
     """Optical depth (...,) from world ``points`` (..., 3) toward the sun (``sun_dir`` unit, y > 0)
     through the clouds: ``extinction · column · above`` (module docstring; shaders/clouds/volume/column.glsl);
     ``far``: None, or a function of world xz (..., 2) giving the far field's column optical depth there
-    (``column_tau·strength·column_at_rank(rank)``, the column far.frag draws:
+    (``column_tau·strength·column_at_rank(rank)``, the column far.comp draws:
     :func:`atmos.plugins.clouds.far_field.reference.far_field_alpha`),
     added with the complementary edge weight ``(1 − edge)·above``."""
     points, s = np.asarray(points, np.float64), np.asarray(sun_dir, np.float64)

@@ -5,7 +5,7 @@
 // cover.py level_table, a blurred pattern ranked by its own quantiles; one fetch of far_rank_table, the
 // rank baked as a function of fbm and level: cover.rank_table), and far_quantile(r) the volume's
 // column sum at that rank (column_quantiles, cover.comp), so the far field is clouded as often, and as
-// thick per cover, as the volume. Shared by the far-field pass (far.frag), the ray march's volumetric
+// thick per cover, as the volume. Shared by the far-field pass (far.comp), the ray march's volumetric
 // far field (clouds/raymarch/far.glsl) and the ground shadows and light shafts (clouds/volume/column.glsl
 // with CLOUD_FAR_FIELD: field_column_tau × far_quantile); atmos/plugins/clouds/far_field/layer.py binds it.
 #include "sky_layer/layer.glsl"
@@ -29,7 +29,7 @@ uniform float field_crossings[33]; // cover.pattern_crossings: the pattern's cro
 const float MIN_SLANT = 0.1;       // the cap on a slant's sin (about 6 degrees): the view's at the horizon, the sun's
 
 // The volume's column sum (cells) at rank r (column_quantiles, linear between the 33): what the 2D far
-// field (far.frag) and the march's (clouds/raymarch/far.glsl) take at a point of rank far_field_rank.
+// field (far.comp) and the march's (clouds/raymarch/far.glsl) take at a point of rank far_field_rank.
 float far_quantile(float r) {
     float x = clamp(r, 0.0, 1.0) * 32.0;
     int k = min(int(x), 31);

@@ -9,7 +9,7 @@
 //   sun_by_rank (k, v):   the octaves' transmittances (lib/octaves.glsl) of T (the sun transmittance of the
 //                         shading volume, nearest texel; 1 without one), v = 0 seen from above, 1 from
 //                         below: those (volume.glsl octave_weights_of) of the volume's columns of that
-//                         rank, which the 2D far field (far.frag) lights its columns with;
+//                         rank, which the 2D far field (far.comp) lights its columns with;
 //   sun_profile (k, q):  per height bin q of Q (sample j in bin j Q / P) the columns' density-weighted
 //                         mean octave transmittances there (no transmittance weight), which the ray
 //                         march's volumetric far field (clouds/raymarch/far.glsl) lights its density with;
@@ -19,7 +19,7 @@
 //   thickness (k):       the clouds' height as a fraction of the layer: per column sqrt(12 var + 1/P^2) of
 //                         its density's height (var in layer fractions; a uniform slab's thickness), mean
 //                         over the interval's columns weighted by w: how high the 2D far field's clouds
-//                         stand when seen at a slant (far.frag slant_rank);
+//                         stand when seen at a slant (far.comp slant_rank);
 // and with FIELD (the sets carry a diffusion field, plugins/clouds/light/diffusion.py):
 //   field_column (k, v):  the field's (phi, F) likewise (nearest field cell);
 //   field_profile (k, q): likewise the field's mean (phi, F) per height bin, for the same.

@@ -4,7 +4,7 @@
 // bilinearly, zero outside the volume, times the volume's edge fade there, times the fraction of the layer above the point;
 // with CLOUD_FAR_FIELD defined the far field's column (clouds/far_field/field.glsl) adds its optical depth
 // with the complementary weight, so shadows continue past the volume: the column the far field draws
-// (far.frag), field_column_tau (thickness · sigma_t · cell height) × the volume's column sum at the
+// (far.comp), field_column_tau (thickness · sigma_t · cell height) × the volume's column sum at the
 // rank of the point where the sun's ray meets the middle plane (far_quantile(far_field_rank)). Shared by the
 // ground shadows (shadow.frag) and the marched light shafts (light_shafts/march.comp);
 // plugins/clouds/shadows/reference.py sun_optical_depth is the same in numpy.

@@ -16,14 +16,17 @@
 // (optical depths scale with it), moved by the relief toward the sun (field.glsl far_relief,
 // relief_light: lit edges facing the sun, shaded ones behind, no light added), and, where the sets
 // carry a diffusion field, its light from their mean (phi, F); sky light with tau half above, half below.
-// Premultiplied (blend_over).
-// frag_distance: (alpha * distance to the hit, alpha), "cloud_distance" when attached (atmos/composition.py).
+// One compute invocation per pixel composites the premultiplied result onto the colour in place (as
+// blend_over would: layer + (1 - alpha) colour, alpha too) and, FAR_DISTANCE 1, its distance (alpha *
+// distance to the hit, alpha) onto "cloud_distance" (atmos/composition.py) with the same weights.
 #include "lib/view_ray.glsl"
 #include "clouds/far_field/field.glsl"
 #include "clouds/volume/volume.glsl"
-in vec2 v_uv;
-out vec4 frag;
-layout(location = 1) out vec4 frag_distance;   // blends by its own alpha
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(binding = 0, rgba16f) uniform image2D color_image;
+#if FAR_DISTANCE
+layout(binding = 1, rg32f) uniform image2D distance_image;
+#endif
 layout(binding = 9) uniform sampler2D scene_depth;
 uniform mat3 view_basis;
 uniform vec3 camera_pos;
@@ -73,7 +76,8 @@ vec2 slant_rank(float r, float height, float cot) {
     return vec2(1.0 - c + (r - (1.0 - c2)) * c / c2, c / c2);
 }
 
-void main() {
+// The far field over the pixel at v_uv: (premultiplied light, alpha) and (alpha * distance, alpha, 0, alpha).
+void far_pixel(vec2 v_uv, out vec4 frag, out vec4 frag_distance) {
     frag = vec4(0.0);
     frag_distance = vec4(0.0);
     vec3 ray = view_ray(v_uv, view_basis);
@@ -111,4 +115,18 @@ void main() {
                + (ms_diffusion > 0.0 ? diffusion_light(rank_lookup(far_field_light, at), dir, source) : vec3(0.0));
     frag = vec4(min(light, vec3(HDR_MAX)) * alpha, alpha);   // volume.glsl: never inf in float16
     frag_distance = vec4(alpha * length(hit - camera_pos), alpha, 0.0, alpha);
+}
+
+void main() {
+    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 size = imageSize(color_image);
+    if (any(greaterThanEqual(px, size))) return;
+    vec4 layer, distance;
+    far_pixel((vec2(px) + 0.5) / vec2(size), layer, distance);
+    if (!(layer.a > 0.0)) return;                        // nothing in front: the pixel stays as it is
+    imageStore(color_image, px, layer + (1.0 - layer.a) * imageLoad(color_image, px));
+#if FAR_DISTANCE
+    vec2 d = imageLoad(distance_image, px).rg;
+    imageStore(distance_image, px, vec4(distance.rg + (1.0 - distance.a) * d, 0.0, 0.0));
+#endif
 }
