@@ -15,6 +15,7 @@ from atmos.demo_registry import DemoSettings
 from atmos.lighting import Sun, unit_sun
 from atmos.plugins.clouds.shadows import CloudShadowsPass
 from atmos.plugins.clouds.shadows.probe import ShadowMapProbe
+from atmos.plugins.clouds.shadows.shadow_map import MAP_SIZE
 from atmos.plugins.light_shafts import LightShaftSettings
 from atmos.plugins.light_shafts.march import MarchedShafts
 from atmos.runner import build_app
@@ -80,7 +81,7 @@ def in_near(space, pts, sun) -> np.ndarray:
 
 def work() -> None:
     steps = LightShaftSettings().steps
-    n = 1024
+    n = MAP_SIZE
     print("work per frame (sunset, far field on): texture fetches per tau lookup")
     print(f"  exact: 8 column fetches (4 bilinear taps x A, B) + 4 octaves + 1 rank table = 13; "
           f"per shaft texel x {steps} steps = {13 * steps}")

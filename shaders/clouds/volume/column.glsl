@@ -5,8 +5,9 @@
 // with CLOUD_FAR_FIELD defined the far field's column (clouds/far_field/field.glsl) adds its optical depth
 // with the complementary weight, so shadows continue past the volume: the column the far field draws
 // (far.frag), field_column_tau (thickness · sigma_t · cell height) × the volume's column sum at the
-// rank of the point where the sun's ray meets the middle plane (far_quantile(far_field_rank)). Shared by the
-// ground shadows (shadow.frag) and the marched light shafts (light_shafts/march.comp);
+// rank of the point where the sun's ray meets the middle plane (far_quantile(far_field_rank)). Baked per frame
+// into the cloud shadow map (clouds/shadows/bake.comp), which the ground shadows and light shafts read;
+// their exact paths (CLOUD_SHADOW_EXACT, SHAFT_EXACT_SHADOWS) still call it;
 // plugins/clouds/shadows/reference.py sun_optical_depth is the same in numpy.
 layout(binding = 0) uniform sampler2DArray sums_a;
 layout(binding = 1) uniform sampler2DArray sums_b;
