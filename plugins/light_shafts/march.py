@@ -11,6 +11,8 @@ from atmos.composition import CLOUD_DISTANCE
 from atmos.graph import PassBuilder, PassContext, work_groups
 from atmos.lighting import unit_sun
 from atmos.plugins.clouds import CLOUD_SETS, FAR_FIELD, CloudSets, column_uniforms
+from atmos.plugins.clouds.far_field.layer import column_tau
+from atmos.plugins.clouds.shadows.shadow_map import SHADOW_MAP, SHADOW_SPACE, use_shadow_map
 from atmos.offscreen import OffscreenLayer
 from atmos.plugins.light_shafts.settings import FLOAT32_MAX
 from atmos.render_core import COLOR, DEPTH
@@ -35,6 +37,8 @@ def march_irradiance(sun, settings) -> np.ndarray | None:
 class MarchedShafts:
     """The march's declarations and draws for a LightShaftsPass (programs belong to the GpuContext)."""
 
+    exact = False       # True: the column sums at every step instead of the cloud shadow map (benchmarks)
+
     def __init__(self, gpu):
         self.gpu = gpu
         self.offscreen = OffscreenLayer(gpu, SHAFT_COLOR, SHAFT_DEPTH)
@@ -49,15 +53,17 @@ class MarchedShafts:
         """The march, with the far field's shadows beyond the volume (column.glsl's CLOUD_FAR_FIELD) or
         without; ``fog`` (the FogMedium): the variant that shadows the fog's in-scatter (SHAFT_FOG);
         ``aerial`` (the SkyLight): the variant that shadows the sky's aerial perspective (SHAFT_AERIAL)."""
-        defines = {"CLOUD_FAR_FIELD": 1} if far_field else {}
+        defines = {}
+        if self.exact:
+            defines.update(SHAFT_EXACT_SHADOWS=1, **({"CLOUD_FAR_FIELD": 1} if far_field else {}))
         if aerial is not None:
             defines.update(SHAFT_AERIAL=1, **aerial.aerial_defines())
         if fog is not None:
             defines.update(SHAFT_FOG=1, **fog.defines())
         return self.gpu.program(defines or None, compute_shader="light_shafts/march.comp")
 
-    @staticmethod
-    def declare(builder: PassBuilder, size, factor: int, clouds: bool, far_field: bool = False, fog=None,
+    @classmethod
+    def declare(cls, builder: PassBuilder, size, factor: int, clouds: bool, far_field: bool = False, fog=None,
                 aerial=None) -> None:
         """``far_field``: the graph imports a CloudFarFieldPlugin's layer; the rays see its shadows too.
         ``fog``: the App's FogMedium; its clouds' own distance is read when the fog reads one.
@@ -69,6 +75,9 @@ class MarchedShafts:
         builder.write(COLOR)
         if clouds:
             builder.read(CLOUD_SETS)
+            if not cls.exact:
+                builder.read(SHADOW_MAP)
+                builder.read(SHADOW_SPACE)
             if far_field:
                 builder.read(FAR_FIELD)
         if fog is not None and fog.reads_cloud_distance:
@@ -91,7 +100,11 @@ class MarchedShafts:
         if self.jitter is None:
             self.jitter = blue_noise_texture(self.gpu.ctx)
         bind_textures(p, low_depth=frame.resource(SHAFT_DEPTH), blue_noise=self.jitter)
-        if clouds:
+        if clouds and frame.declares(SHADOW_MAP):
+            sim: CloudSets = frame.resource(CLOUD_SETS)
+            field_tau = column_tau(frame.resource(FAR_FIELD).settings, sim) if far_field else 0.0
+            use_shadow_map(frame, p, sim.settings.sigma, field_tau)
+        elif clouds:
             sim: CloudSets = frame.resource(CLOUD_SETS)
             column_uniforms(p, sim, sim.layout(), sim.settings.sigma)
             if far_field:

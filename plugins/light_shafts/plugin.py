@@ -7,6 +7,7 @@ import math
 from atmos.graph import PassBuilder, PassContext, RenderPass, TextureDesc
 from atmos.plugin import Plugin
 from atmos.plugins.clouds import CLOUD_SETS, FAR_FIELD
+from atmos.plugins.clouds.shadows.shadow_map import shadow_map_pass
 from atmos.plugins.fog import FogMedium
 from atmos.plugins.light_shafts.march import MarchedShafts
 from atmos.plugins.light_shafts.settings import LightShaftSettings, blur_scale
@@ -127,6 +128,7 @@ class LightShaftsPlugin(Plugin):
         if app.graph is None:
             raise ValueError("LightShaftsPlugin needs an App with a GPU context (App(gpu))")
         self.gpu, self.graph = app.gpu, app.graph
+        shadow_map_pass(app.graph)
         app.graph.add_pass(LightShaftsPass(self))
 
     def finish(self, app) -> None:

@@ -4,8 +4,9 @@
 // low-res texel (the centre of its block) to the block's farthest scene depth (the sky: max_distance),
 // `steps` samples from a jittered start gather the sun light a thin haze scatters toward the eye,
 //   L = sum_i scattering * phase(cos) * E * exp(-tau_sun(p_i)) * exp(-scattering * s_i) * ds,
-// tau_sun through the clouds from the density maps (clouds/volume/column.glsl; has_clouds 0: none;
-// with CLOUD_FAR_FIELD also the far field's columns beyond the volume: rays between far clouds).
+// tau_sun through the clouds from the cloud shadow map, one fetch per step (clouds/shadows/shadow_map.glsl,
+// the volume's and the far field's columns; has_clouds 0: none), or with SHAFT_EXACT_SHADOWS from the
+// density maps themselves (clouds/volume/column.glsl, with CLOUD_FAR_FIELD the far field's columns too).
 // Output (L, T = exp(-scattering * d)), upsampled and composited by core/offscreen_composite.comp:
 // rgb = L + T * rgb. plugins/light_shafts/reference.py march_shafts is the same in numpy.
 // SHAFT_FOG 1 (a FogPlugin owns the air's in-scattering, so the haze is counted once): no light and no
@@ -28,7 +29,13 @@
 #include "lib/hdr_max.glsl"
 #include "lib/view_ray.glsl"
 #include "lib/phase.glsl"
+#if SHAFT_EXACT_SHADOWS
 #include "clouds/volume/column.glsl"
+#define SUN_TAU sun_optical_depth
+#else
+#include "clouds/shadows/shadow_map.glsl"
+#define SUN_TAU cloud_shadow_tau
+#endif
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0, rgba16f) writeonly uniform image2D shafts;   // (L, T) per low-res texel
 layout(binding = 2) uniform sampler2D low_depth;   // the farthest scene depth of each block
@@ -94,7 +101,7 @@ vec4 march(ivec2 q) {
         float f1 = fog_factor(s0 + dsf, end, camera_pos);
         float s = s0 + j * dsf;
         float w = (s < dc ? a : 0.0) + (s < behind ? 1.0 - a : 0.0);
-        float tau = has_clouds != 0 ? sun_optical_depth(camera_pos + dir * s, sun_dir) : 0.0;
+        float tau = has_clouds != 0 ? SUN_TAU(camera_pos + dir * s, sun_dir) : 0.0;
         float air = 1.0;                        // the air in front of s (with the aerial perspective)
 #if SHAFT_AERIAL
         vec3 s_ray0, s_mie0;
@@ -113,7 +120,7 @@ vec4 march(ivec2 q) {
     for (int i = 0; i < steps; ++i) {
         float s = (float(i) + j) * dsa;
         float w = (s < dc ? a : 0.0) + (s < d ? 1.0 - a : 0.0);
-        float tau = has_clouds != 0 ? sun_optical_depth(camera_pos + dir * s, sun_dir) : 0.0;
+        float tau = has_clouds != 0 ? SUN_TAU(camera_pos + dir * s, sun_dir) : 0.0;
         if (w <= 0.0 || tau <= 0.0) continue;
         vec2 at = atm_point(r, dir.y, sun_dir.y, nu, s);
         vec3 s_ray, s_mie;
@@ -134,7 +141,7 @@ vec4 march(ivec2 q) {
     float sum = 0.0;
     for (int i = 0; i < steps; ++i) {
         float s = (float(i) + j) * ds;
-        float tau = has_clouds != 0 ? sun_optical_depth(camera_pos + dir * s, sun_dir) : 0.0;
+        float tau = has_clouds != 0 ? SUN_TAU(camera_pos + dir * s, sun_dir) : 0.0;
         sum += exp(-tau - scattering * s);
     }
     vec3 light = irradiance * (scattering * phase2(dot(dir, sun_dir), lobes) * sum * ds);

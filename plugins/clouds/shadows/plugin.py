@@ -9,6 +9,7 @@ from atmos.plugin import Plugin
 from atmos.plugins.clouds.volume.layout import CloudLayout
 from atmos.plugins.clouds.far_field.layer import column_tau
 from atmos.plugins.clouds.shadows.settings import CloudShadowSettings
+from atmos.plugins.clouds.shadows.shadow_map import SHADOW_MAP, SHADOW_SPACE, shadow_map_pass, use_shadow_map
 from atmos.plugins.clouds.volume.column import column_uniforms
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS, FAR_FIELD, CloudSets
 from atmos.render_core import COLOR, DEPTH
@@ -32,22 +33,37 @@ def cloud_layout(sim, settings: CloudShadowSettings) -> CloudLayout:
 
 
 class CloudShadowsPass(FullscreenPass):
-    """Multiplies "color" by the shadow factor where "depth" has geometry (blend ZERO, SRC_COLOR)."""
+    """Multiplies "color" by the shadow factor where "depth" has geometry (blend ZERO, SRC_COLOR): the
+    optical depth read from the cloud shadow map, or (``exact``, or settings placing the shadows apart
+    from the volume: ``base_altitude``/``cell_size``) summed from the density maps per pixel."""
     name = "cloud_shadows"
     phase = "shadows"
     fragment = "clouds/shadows/shadow.frag"
     reads = (COLOR, DEPTH, CLOUD_SETS)
+    exact = False               # True: always the column sums (benchmarks, references)
 
     def far_field(self) -> bool:
         """Whether the shadows continue with a far field's cover (one is imported, ``settings.far_field``)."""
         return self.plugin.settings.far_field and self.plugin.graph.imports(FAR_FIELD)
 
+    def uses_map(self) -> bool:
+        """Whether the optical depth comes from the shadow map (baked for the volume's own placement)."""
+        params = self.plugin.settings
+        return not self.exact and params.base_altitude is None and params.cell_size is None
+
     def defines(self) -> dict:
-        return {"CLOUD_FAR_FIELD": 1} if self.far_field() else {}
+        if self.uses_map():
+            return {}
+        return {"CLOUD_SHADOW_EXACT": 1, **({"CLOUD_FAR_FIELD": 1} if self.far_field() else {})}
 
     def setup(self, builder) -> None:
         super().setup(builder)
-        if self.far_field():
+        if self.uses_map():
+            builder.read(SHADOW_MAP)
+            builder.read(SHADOW_SPACE)
+            if self.far_field():
+                builder.read(FAR_FIELD)      # its column optical depth (the map holds its columns)
+        elif self.far_field():
             builder.read(FAR_FIELD)
 
     def execute(self, frame: PassContext) -> None:
@@ -66,6 +82,11 @@ class CloudShadowsPass(FullscreenPass):
         ctx.blend_func = ctx.ZERO, ctx.SRC_COLOR, ctx.ZERO, ctx.ONE    # alpha (sky occlusion) kept
         bind_textures(p, scene_depth=frame.resource(DEPTH))
         p["weight"].value = weight
+        if frame.declares(SHADOW_MAP):
+            field_tau = column_tau(frame.resource(FAR_FIELD).settings, sim) if frame.declares(FAR_FIELD) else 0.0
+            use_shadow_map(frame, p, sigma * params.strength, field_tau * params.strength)
+            frame.fullscreen(p)
+            return
         column_uniforms(p, sim, layout, sigma * params.strength)
         if frame.declares(FAR_FIELD):
             layer = frame.resource(FAR_FIELD)
@@ -86,4 +107,5 @@ class CloudShadowsPlugin(Plugin):
         if app.graph is None:
             raise ValueError("CloudShadowsPlugin needs an App with a GPU context (App(gpu))")
         self.graph = app.graph
+        shadow_map_pass(app.graph)
         app.graph.add_pass(CloudShadowsPass(self))

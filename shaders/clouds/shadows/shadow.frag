@@ -3,11 +3,19 @@
 // direction toward the sun onto the middle of the cloud layer, where the top-view summed density
 // mix(A, B, t) (layer 0 of the density maps, each set at its own placement) gives the optical depth. Output is the factor the
 // colour is multiplied by (blend ZERO, SRC_COLOR); plugins/clouds/shadows/reference.py is the same in numpy.
+// The optical depth comes from the cloud shadow map (clouds/shadows/shadow_map.glsl, one fetch), or with
+// CLOUD_SHADOW_EXACT (the shadows placed apart from the volume) from the column sums themselves.
 // view_basis, camera_pos, near, far, sun_dir: the frame block (lib/frame.glsl)
 #include "lib/frame.glsl"
 #include "lib/view_ray.glsl"
 out vec4 frag;
+#if CLOUD_SHADOW_EXACT
 #include "clouds/volume/column.glsl"
+#define SUN_TAU sun_optical_depth
+#else
+#include "clouds/shadows/shadow_map.glsl"
+#define SUN_TAU cloud_shadow_tau
+#endif
 layout(binding = 2) uniform sampler2D scene_depth;
 uniform float weight;          // direct_fraction × horizon fade (reference.direct_weight)
 
@@ -20,6 +28,6 @@ void main() {
     }
     vec2 uv = gl_FragCoord.xy / vec2(textureSize(scene_depth, 0));
     vec3 p = camera_pos + view_ray(uv, view_basis) * view_depth(depth, near, far);
-    float tau = sun_optical_depth(p, sun_dir);
+    float tau = SUN_TAU(p, sun_dir);
     frag = vec4(vec3(1.0 - weight * (1.0 - exp(-tau))), 1.0);
 }

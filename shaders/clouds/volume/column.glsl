@@ -5,8 +5,9 @@
 // with CLOUD_FAR_FIELD defined the far field's column (clouds/far_field/field.glsl) adds its optical depth
 // with the complementary weight, so shadows continue past the volume: the column the far field draws
 // (far.comp), field_column_tau (thickness · sigma_t · cell height) × the volume's column sum at the
-// rank of the point where the sun's ray meets the middle plane (far_quantile(far_field_rank)). Shared by the
-// ground shadows (shadow.frag) and the marched light shafts (light_shafts/march.comp);
+// rank of the point where the sun's ray meets the middle plane (far_quantile(far_field_rank)). Baked per frame
+// into the cloud shadow map (clouds/shadows/bake.comp), which the ground shadows and light shafts read;
+// their exact paths (CLOUD_SHADOW_EXACT, SHAFT_EXACT_SHADOWS) still call it;
 // plugins/clouds/shadows/reference.py sun_optical_depth is the same in numpy.
 layout(binding = 0) uniform sampler2DArray sums_a;
 layout(binding = 1) uniform sampler2DArray sums_b;
@@ -46,6 +47,19 @@ float column_sum(vec2 p) {
                mix(column(i + ivec2(0, 1)), column(i + ivec2(1, 1)), f.x), f.y);
 }
 
+// The sun's columns over volume texel v (texel i centred at i) whose middle-plane point is world xz:
+// (column sum × edge fade, far-field column sum × (1 − fade)), per unit extinction; the cloud shadow
+// map (clouds/shadows/bake.comp) bakes exactly this.
+vec2 sun_columns(vec2 v, vec2 xz) {
+    float fade = cloud_edge_weight((v + 0.5) / vec2(shape.xz), edge_fade);
+    vec2 c = vec2(column_sum(v) * fade, 0.0);
+#ifdef CLOUD_FAR_FIELD
+    // beyond the volume the far field's cover continues with the complementary weight (field.glsl)
+    c.y = far_quantile(far_field_rank(xz, 0.0).x) * (1.0 - fade);
+#endif
+    return c;
+}
+
 // Optical depth between world point p and the sun (sun_dir unit, toward the sun) through the clouds.
 float sun_optical_depth(vec3 p, vec3 sun_dir) {
     float thickness = float(shape.y) * cell_size.y;
@@ -53,11 +67,10 @@ float sun_optical_depth(vec3 p, vec3 sun_dir) {
     vec3 q = p + run * sun_dir;
     vec2 texel = (q.xz - layer_min.xz) / cell_size.xz - 0.5;
     float above = clamp((layer_min.y + thickness - p.y) / thickness, 0.0, 1.0);
-    float fade = cloud_edge_weight((texel + 0.5) / vec2(shape.xz), edge_fade);
-    float tau = extinction * column_sum(texel) * fade * above;
+    vec2 c = sun_columns(texel, q.xz);
 #ifdef CLOUD_FAR_FIELD
-    // beyond the volume the far field's cover continues with the complementary weight (field.glsl)
-    tau += field_column_tau * far_quantile(far_field_rank(q.xz, 0.0).x) * (1.0 - fade) * above;
+    return (extinction * c.x + field_column_tau * c.y) * above;
+#else
+    return extinction * c.x * above;
 #endif
-    return tau;
 }

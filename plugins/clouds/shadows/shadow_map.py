@@ -1,0 +1,215 @@
+"""The cloud shadow map: the sun's optical depth through the clouds baked once per frame, read with one fetch.
+
+``sun_optical_depth`` (:mod:`.reference`, ``clouds/volume/column.glsl``) is ``above(p.y) · T(q)``: ``q``
+the point's projection along the sun onto the layer's middle plane, ``above`` the fraction of the
+layer over the point, and ``T(q) = extinction · column(q) · fade(q) + field_tau · far(q) · (1 − fade(q))``.
+So the map stores, over the middle plane (the image plane of a parallel projection along the sun),
+the two columns per unit extinction (rg16f: volume, far field); a lookup projects the point as the
+exact form does, reads both with one bilinear fetch, weights them by the caller's extinctions and
+multiplies by ``above``: the height handling is exact, the only errors are the map's sampling and
+format.
+
+Grid: one ``N × 2N`` image (``N = MAP_SIZE``), rows [0, N) the near cascade, [N, 2N) the far one.
+Near: ``r`` map texels per volume cell (the largest integer fitting the volume and a margin), texel
+centres on the column centres, so the piecewise-bilinear column sums are reproduced exactly (only the
+edge fade and the far field between texels are interpolated). Far: centred on the camera's own
+projection, ``FAR_REACH × camera.far`` each way (lookups past it clamp to its edge): the far field at
+coarse resolution. Format: rg16f, relative rounding 2⁻¹¹, so ``|Δ exp(−τ)| ≤ τ e^{−τ} 2⁻¹¹ ≤ 2⁻¹¹/e``
+(1.8e-4, far below the 8-bit output step); sums of up to thousands of cells fit its range (65504).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from atmos.graph import ComputePass, TextureDesc
+from atmos.gpu.uniforms import write_uniforms
+from atmos.plugins.clouds.volume.column import column_uniforms
+from atmos.plugins.clouds.volume.sets import CLOUD_SETS, FAR_FIELD
+
+SHADOW_MAP = "cloud_shadow_map"        # rg16f (N, 2N): near and far cascades of the sun's columns
+SHADOW_SPACE = "cloud_shadow_space"    # the map's ShadowMapSpace (imported; the bake updates it)
+MAP_SIZE = 1024                        # N: texels per cascade side
+FAR_REACH = 1.25                       # the far cascade reaches this × camera.far from the camera's projection
+MIN_SUN_HEIGHT = 1e-4                  # as column.glsl's
+FORMAT_ERROR = 2.0 ** -11              # rg16f's relative rounding (half an ulp of an 11-bit significand)
+
+
+@dataclass
+class ShadowMapSpace:
+    """Where the map lies: ``cascades`` (2, 4) per cascade the volume texel coordinate of its texel
+    (0, 0) and its volume texels per map texel (x, z); the layer's heights and placement."""
+    size: int = MAP_SIZE
+    cascades: np.ndarray = field(default_factory=lambda: np.zeros((2, 4)))
+    lo: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    cell: np.ndarray = field(default_factory=lambda: np.ones(3))
+    shape: tuple = (1, 1, 1)
+    frame: int = -1                    # bumped by every bake
+
+    @property
+    def mid(self) -> float:
+        return float(self.lo[1] + 0.5 * self.shape[1] * self.cell[1])
+
+    @property
+    def thickness(self) -> float:
+        return float(self.shape[1] * self.cell[1])
+
+    def matches(self, layout) -> bool:
+        """Whether the map was baked for ``layout`` (a consumer with its own placement reads the exact columns)."""
+        return (tuple(layout.shape) == tuple(self.shape) and np.array_equal(layout.lo, self.lo)
+                and np.array_equal(np.asarray(layout.cell, np.float64), self.cell))
+
+    def uniforms(self, program, extinction: float, field_tau: float = 0.0) -> None:
+        """Set ``clouds/shadows/shadow_map.glsl``'s uniforms (the map itself is bound by the caller)."""
+        c = self.cascades
+        lookup = np.concatenate([c[:, :2], 1.0 / c[:, 2:]], axis=1).astype("f4")
+        write_uniforms(program, shadow_cascades=lookup.tobytes(),
+                       shadow_plane=(float(self.lo[0]), float(self.lo[2]), 1.0 / self.cell[0], 1.0 / self.cell[2]),
+                       shadow_heights=(self.mid, float(self.lo[1]) + self.thickness, 1.0 / self.thickness),
+                       shadow_weights=(float(extinction), float(field_tau)))
+
+
+def near_ratio(shape, size: int, pad: int) -> int:
+    """Map texels per volume cell of the near cascade: the largest integer with the volume and ``pad``
+    cells each side within ``size`` texels (1 when even that does not fit)."""
+    return max(1, (size - 1) // (max(shape[0], shape[2]) + 1 + 2 * pad))
+
+
+def shadow_space(layout, camera_position, sun_dir, camera_far: float, size: int = MAP_SIZE,
+                 reach: float = FAR_REACH, space: ShadowMapSpace | None = None) -> ShadowMapSpace:
+    """The map's cascades for ``layout`` (the volume's placement) seen from ``camera_position`` with the
+    sun toward ``sun_dir`` (unit): near on the volume's columns, far around the camera's projection."""
+    space = space or ShadowMapSpace()
+    lo, cell = np.asarray(layout.lo, np.float64), np.asarray(layout.cell, np.float64)
+    shape = tuple(int(s) for s in layout.shape)
+    space.size, space.lo, space.cell, space.shape = int(size), lo, cell, shape
+    mid = lo[1] + 0.5 * shape[1] * cell[1]
+    cam, s = np.asarray(camera_position, np.float64), np.asarray(sun_dir, np.float64)
+    q = cam[[0, 2]] + max(mid - cam[1], 0.0) / max(s[1], MIN_SUN_HEIGHT) * s[[0, 2]]
+    half = reach * float(camera_far)
+    far_step = 2.0 * half / (size - 1) / cell[[0, 2]]                   # volume texels per far texel
+    pad = 1 + int(np.ceil(far_step.max()))           # far lookups past the near cascade never reach the volume
+    r = near_ratio(shape, size, pad)
+    centre = (np.array([shape[0], shape[2]], np.float64) - 1.0) / 2.0
+    near0 = np.floor(centre - (size - 1) / (2.0 * r))                   # integer: texel centres on columns
+    far0 = (q - lo[[0, 2]]) / cell[[0, 2]] - 0.5 - 0.5 * (size - 1) * far_step
+    space.cascades = np.array([[near0[0], near0[1], 1.0 / r, 1.0 / r],
+                               [far0[0], far0[1], far_step[0], far_step[1]]])
+    return space
+
+
+class CloudShadowMapPass(ComputePass):
+    """Bakes "cloud_shadow_map" (phase shadows, before its readers) from "cloud_sets" and, when imported,
+    the far field; culled when nothing reads it."""
+    name = "cloud_shadow_map"
+    phase = "shadows"
+    compute = "clouds/shadows/bake.comp"
+
+    def __init__(self, graph, size: int = MAP_SIZE):
+        super().__init__()
+        self.graph, self.size = graph, int(size)
+        self.space = ShadowMapSpace(size=self.size)
+
+    def far_field(self) -> bool:
+        return self.graph.imports(FAR_FIELD)
+
+    def defines(self) -> dict:
+        return {"CLOUD_FAR_FIELD": 1} if self.far_field() else {}
+
+    def setup(self, builder) -> None:
+        if not self.graph.imports(CLOUD_SETS):
+            return
+        builder.create(SHADOW_MAP, TextureDesc((self.size, 2 * self.size), components=2, dtype="f2", storage=True),
+                       access="storage")
+        builder.read(CLOUD_SETS)
+        if self.far_field():
+            builder.read(FAR_FIELD)
+
+    def execute(self, frame) -> None:
+        from atmos.lighting import unit_sun
+        view, p = frame.view, self.program
+        sim = frame.resource(CLOUD_SETS)
+        layout = sim.layout()
+        sun = unit_sun(view.sun.direction)
+        sun = np.array([0.0, 1.0, 0.0]) if sun is None else sun
+        shadow_space(layout, view.camera.position, sun, view.camera.far, self.size, space=self.space)
+        self.space.frame += 1
+        column_uniforms(p, sim, layout, 1.0)
+        if frame.declares(FAR_FIELD):
+            layer = frame.resource(FAR_FIELD)
+            layer.prepare(view, sim)
+            layer.use(p, view, sim)
+        write_uniforms(p, cascades=self.space.cascades.astype("f4").tobytes())
+        image = frame.image(SHADOW_MAP)
+        frame.dispatch(p, self.groups(image.size), images={"shadow_map": image})
+
+
+def shadow_map_pass(graph) -> CloudShadowMapPass:
+    """The graph's CloudShadowMapPass, added (with its SHADOW_SPACE import) by the first reader."""
+    for p in graph.passes:
+        if isinstance(p, CloudShadowMapPass):
+            return p
+    p = CloudShadowMapPass(graph)
+    graph.add_pass(p)
+    graph.import_resource(SHADOW_SPACE, p.space)
+    return p
+
+
+def use_shadow_map(frame, program, extinction: float, field_tau: float = 0.0) -> None:
+    """Bind the map and set shadow_map.glsl's uniforms in a pass that declared SHADOW_MAP and SHADOW_SPACE."""
+    from atmos.gpu.uniforms import bind_textures
+    bind_textures(program, cloud_shadow_map=frame.resource(SHADOW_MAP))
+    frame.resource(SHADOW_SPACE).uniforms(program, extinction, field_tau)
+
+
+# float64 reference ------------------------------------------------------------------------------------
+
+def texel_positions(space: ShadowMapSpace) -> np.ndarray:
+    """(2N, N, 2) volume texel coordinates (x, z) of every map texel centre, rows as the image's."""
+    n = space.size
+    j = np.arange(n, dtype=np.float64)
+    out = np.empty((2 * n, n, 2))
+    for k in range(2):
+        c = space.cascades[k]
+        out[k * n:(k + 1) * n, :, 0] = c[0] + j[None, :] * c[2]
+        out[k * n:(k + 1) * n, :, 1] = c[1] + j[:, None] * c[3]
+    return out
+
+
+def bake_reference(space: ShadowMapSpace, sums_a, sums_b, t: float, layout, a_shift=(0, 0, 0),
+                   edge_fade: float = 0.0, far=None) -> np.ndarray:
+    """The map (2N, N, 2) in float64: per texel (column sum × fade, far(xz) × (1 − fade)); ``far``: None
+    or the far field's column per unit optical depth at world xz (..., 2)."""
+    from atmos.plugins.clouds.shadows.reference import shifted, zero_border_bilinear
+    from atmos.plugins.clouds.volume.edge import edge_weight
+    v = texel_positions(space)
+    sums = (1.0 - t) * shifted(np.asarray(sums_a, np.float64), a_shift) + t * np.asarray(sums_b, np.float64)
+    shape = np.array([space.shape[0], space.shape[2]], np.float64)
+    fade = edge_weight((v + 0.5) / shape, edge_fade)
+    out = np.zeros(v.shape)
+    out[..., 0] = zero_border_bilinear(sums, v) * fade
+    if far is not None:
+        out[..., 1] = far(space.lo[[0, 2]] + (v + 0.5) * space.cell[[0, 2]]) * (1.0 - fade)
+    return out
+
+
+def lookup_reference(space: ShadowMapSpace, baked: np.ndarray, points, sun_dir, weights) -> np.ndarray:
+    """shadow_map.glsl in float64: the optical depth (...,) at world ``points`` (..., 3) from map ``baked``
+    (2N, N, 2), with ``weights`` (volume extinction, far field's column optical depth)."""
+    p, s = np.asarray(points, np.float64), np.asarray(sun_dir, np.float64)
+    n = space.size
+    run = np.maximum(space.mid - p[..., 1], 0.0) / max(s[1], MIN_SUN_HEIGHT)
+    v = (p[..., [0, 2]] + run[..., None] * s[[0, 2]] - space.lo[[0, 2]]) / space.cell[[0, 2]] - 0.5
+    above = np.clip((space.lo[1] + space.thickness - p[..., 1]) / space.thickness, 0.0, 1.0)
+    c = space.cascades
+    j = (v - c[0, :2]) / c[0, 2:]
+    near = np.all((j >= 0.0) & (j <= n - 1.0), axis=-1)
+    j = np.where(near[..., None], j, np.clip((v - c[1, :2]) / c[1, 2:], 0.0, n - 1.0))
+    row0 = np.where(near, 0, n)
+    i0 = np.minimum(np.floor(j).astype(np.int64), n - 2)
+    f = j - i0
+    x0, z0 = i0[..., 0], i0[..., 1] + row0
+    col = ((1 - f[..., 1:]) * ((1 - f[..., :1]) * baked[z0, x0] + f[..., :1] * baked[z0, x0 + 1])
+           + f[..., 1:] * ((1 - f[..., :1]) * baked[z0 + 1, x0] + f[..., :1] * baked[z0 + 1, x0 + 1]))
+    return (col @ np.asarray(weights, np.float64)) * above

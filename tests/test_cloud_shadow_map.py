@@ -1,0 +1,147 @@
+"""The cloud shadow map (plugins/clouds/shadows/shadow_map.py): its float64 lookup against the exact
+sun_optical_depth within the derived interpolation bound, and the GPU's bake and lookup against float64."""
+import math
+
+import numpy as np
+
+from atmos.camera import Camera
+from atmos.graph import RenderPass
+from atmos.lighting import Sun, unit_sun
+from atmos.plugins.clouds.shadows import CloudShadowSettings, reference
+from atmos.plugins.clouds.shadows.probe import ShadowMapProbe
+from atmos.plugins.clouds.shadows.shadow_map import (FORMAT_ERROR, SHADOW_MAP, SHADOW_SPACE, bake_reference,
+                                                     lookup_reference, shadow_space)
+from atmos.plugins.clouds.volume.layout import CloudLayout
+from test_cloud_shadows import shadow_app, write_sums
+
+
+def edge_derivatives(shape, fade: float):
+    """Bounds on the edge weight's first and second derivatives per volume texel, per axis (x, z):
+    f = 1 - smoothstep(1 - fade, 1, r), r = |2 uv - 1|, uv = (v + 0.5) / shape."""
+    d = 2.0 / np.array([shape[0], shape[2]], np.float64)            # |dr/dv| per axis
+    first = 1.5 / fade * d
+    second = 6.0 / fade ** 2 * d ** 2 + 1.5 / fade * d ** 2 / (1.0 - fade)   # r's curvature: d² / r, r >= 1 - fade
+    return first, second
+
+
+def test_float64_lookup_matches_sun_optical_depth_within_the_derived_bound(rng):
+    """Bilinear interpolation on a map cell of h volume texels errs by at most h²/8 · Σ_axes max|g_aa|;
+    the volume's columns c are bilinear on every map cell (texel centres on the columns), so for
+    g = c · f only 2 c_a f_a + c f_aa is left; the far column F · (1 - f) (here a smooth pattern of
+    amplitude A, wavenumber k) adds F_aa + 2 F_a f_a + F f_aa."""
+    shape = (int(rng.integers(16, 48)), 6, int(rng.integers(16, 48)))
+    cell = tuple(rng.uniform([20.0, 10.0, 20.0], [60.0, 50.0, 60.0]))
+    layout = CloudLayout(shape, cell, (float(rng.integers(-40, 0)), float(rng.integers(-40, 0))),
+                         rng.uniform(500, 1500), (8, 8), 0.0)
+    sums_a, sums_b = (rng.uniform(0, shape[1], (shape[0], shape[2])) for _ in range(2))
+    t, fade = rng.uniform(), rng.uniform(0.2, 0.5)
+    a_shift = (int(rng.integers(-3, 4)), 0, int(rng.integers(-3, 4)))
+    sun = unit_sun(Sun.from_angles(rng.uniform(4, 60), rng.uniform(0, 360)).direction)
+    ext, field_tau, amp, k = rng.uniform(0.05, 0.5), rng.uniform(0.05, 0.5), rng.uniform(1, 4), 2 * math.pi / 600.0
+    far = lambda xz: amp * (1.0 + np.sin(k * xz[..., 0]) * np.cos(k * xz[..., 1]))
+    centre = layout.lo + 0.5 * (layout.hi - layout.lo)
+    cam = centre + np.array([rng.uniform(-300, 300), -centre[1] + rng.uniform(50, 400), rng.uniform(-300, 300)])
+    space = shadow_space(layout, cam, sun, 6000.0, size=256)
+    baked = bake_reference(space, sums_a, sums_b, t, layout, a_shift, fade, far)
+    n = 20000
+    pts = cam + np.stack([rng.uniform(-5000, 5000, n), rng.uniform(-cam[1], layout.hi[1] + 50 - cam[1], n),
+                          rng.uniform(-5000, 5000, n)], -1)
+    exact = reference.sun_optical_depth(pts, sums_a, sums_b, t, sun, ext, layout, a_shift, fade,
+                                        far=lambda xz: field_tau * far(xz))
+    got = lookup_reference(space, baked, pts, sun, (ext, field_tau))
+    # which cascade each point read, and its texel size h (volume texels); points past the far one clamp
+    run = np.maximum(space.mid - pts[:, 1], 0.0) / sun[1]
+    v = (pts[:, [0, 2]] + run[:, None] * sun[[0, 2]] - space.lo[[0, 2]]) / space.cell[[0, 2]] - 0.5
+    j = [(v - c[:2]) / c[2:] for c in space.cascades]
+    near = np.all((j[0] >= 0) & (j[0] <= space.size - 1), axis=-1)
+    inside = near | np.all((j[1] >= 0) & (j[1] <= space.size - 1), axis=-1)
+    h = np.where(near[:, None], space.cascades[0, 2:], space.cascades[1, 2:])
+    sums = (1 - t) * reference.shifted(sums_a, a_shift) + t * sums_b
+    c_max = sums.max()
+    c_a = np.array([np.abs(np.diff(sums, axis=0)).max(), np.abs(np.diff(sums, axis=1)).max()])
+    f_a, f_aa = edge_derivatives(shape, fade)
+    cell_xz = np.array([cell[0], cell[2]])
+    F, F_a, F_aa = 2 * amp, amp * k * cell_xz, amp * (k * cell_xz) ** 2
+    g_aa = ext * (2 * c_a * f_a + c_max * f_aa) + field_tau * (F_aa + 2 * F_a * f_a + F * f_aa)
+    above = np.clip((layout.hi[1] - pts[:, 1]) / (layout.hi[1] - layout.lo[1]), 0, 1)
+    bound = (h ** 2 / 8.0 * g_aa).sum(-1) * above + 1e-12
+    err = np.abs(got - exact)
+    assert inside.mean() > 0.5          # the rest project past the far cascade (clamped)
+    assert np.all(err[inside] <= bound[inside]), f"worst ratio {(err / bound)[inside].max()}"
+    e = np.abs(np.exp(-got) - np.exp(-exact))[inside]
+    print(f"near {near.mean():.2f}; exp(-tau) max {e.max():.2e}, rms {np.sqrt(np.mean(e * e)):.2e}; "
+          f"error / bound max {(err / bound)[inside].max():.2f}")
+
+
+class MapCapture(RenderPass):
+    """Reads the shadow map and its space back after the bake."""
+    name = "shadow_map_capture"
+    phase = "post"
+
+    def __init__(self):
+        self.map = self.space = None
+
+    def setup(self, builder) -> None:
+        builder.read(SHADOW_MAP)
+        builder.read(SHADOW_SPACE)
+        builder.side_effect()
+
+    def execute(self, frame) -> None:
+        texture = frame.resource(SHADOW_MAP)
+        w, h = texture.size
+        self.map = np.frombuffer(texture.read(), "f2").reshape(h, w, 2).astype(np.float64)
+        s = frame.resource(SHADOW_SPACE)
+        self.space = type(s)(s.size, s.cascades.copy(), s.lo.copy(), s.cell.copy(), s.shape, s.frame)
+
+
+def test_gpu_bake_and_lookup_match_float64(gpu, ctx, rng):
+    """The bake against bake_reference within rg16f's rounding (2^-11 relative) and float32's; the GPU
+    lookup (one bilinear fetch) against lookup_reference on the GPU's own map within the filter's
+    weight precision (8 fractional bits on some GPUs: 2^-9 of the largest neighbour difference)."""
+    cell = tuple(rng.uniform([3.0, 1.0, 3.0], [8.0, 3.0, 8.0]))
+    app, sim, fill, _ = shadow_app(gpu, CloudShadowSettings(), cell_size=cell)
+    capture, probe = MapCapture(), ShadowMapProbe(app.graph)
+    app.graph.add_pass(capture)
+    app.graph.add_pass(probe)
+    for _ in range(2):
+        app.update(1 / 30)
+    a, b, t = sim.view()
+    nx, ny, nz = sim.shape
+    layers = 1 + sim.maps_of(a).bands
+    sums = [rng.uniform(0, ny, (layers, nx, nz)) for _ in range(2)]
+    write_sums(sim, a, sums[0])
+    write_sums(sim, b, sums[1])
+    sets = sim.sets()
+    layout = sets.layout()
+    sun = Sun.from_angles(rng.uniform(10, 80), rng.uniform(0, 360))
+    app.insert_resource(sun)
+    s = unit_sun(sun.direction)
+    cam = app.resource(Camera)
+    centre = layout.lo + 0.5 * (layout.hi - layout.lo)
+    cam.position = centre - s * 50.0
+    n = 20000
+    # points on sun rays through the volume's middle plane, from a little above it down to the ground
+    mid = np.stack([layout.lo[0] + rng.uniform(-0.2, 1.2, n) * nx * cell[0], np.full(n, centre[1]),
+                    layout.lo[2] + rng.uniform(-0.2, 1.2, n) * nz * cell[2]], -1)
+    probe.points = mid - s * (rng.uniform(-0.1, 1.0, n) * centre[1] / s[1])[:, None]
+    points = probe.points
+    app.render()
+    space = capture.space
+    want = bake_reference(space, sums[0][0], sums[1][0], t, layout, sets.a_shift, sim.settings.edge_fade)
+    scale = want[..., 0].max()
+    # float32 texel positions (v0 + j step, up to |v| volume texels) move a sample by a few ulps of |v|:
+    # times the columns' steepest slope per texel (their largest neighbour difference)
+    from atmos.plugins.clouds.shadows.shadow_map import texel_positions
+    slope = max(np.abs(np.diff(m[0], axis=a)).max() for m in sums for a in (0, 1))
+    moved = 4 * 2.0 ** -24 * np.abs(texel_positions(space)).max(-1, keepdims=True) * slope
+    error = np.abs(capture.map - want) - 2 * FORMAT_ERROR * np.abs(want) - 1e-5 * scale - moved
+    assert error.max() <= 0.0, f"bake error over the bound by {error.max()} at {np.unravel_index(error.argmax(), error.shape)}"
+    exact, got = probe.result[:, 0], probe.result[:, 1]
+    mine = lookup_reference(space, capture.map, points, s, probe.weights)
+    step = max(np.abs(np.diff(capture.map[..., 0], axis=a)).max() for a in (0, 1)) * probe.weights[0]
+    assert np.all(np.abs(got - mine) <= 2.0 ** -9 * 2 * step + 1e-5 * scale * probe.weights[0])
+    # the map against the exact sums on the GPU: edge fade off (sim's default), the columns are exact
+    assert np.all(np.abs(got - exact) <= 2.0 ** -9 * 2 * step + 2 * FORMAT_ERROR * np.abs(exact)
+                  + 1e-5 * scale * probe.weights[0])
+    assert (exact > 0.1).mean() > 0.1, "the points are under clouds"
+    app.close()
