@@ -10,6 +10,7 @@ import gc, sys
 sys.path.insert(0, {str(Path(__file__).parent.parent / "benchmarks")!r})
 from bench_soak import cloud_scene
 from atmos.gpu import create_headless
+from atmos.gpu.host_memory import trim_heap
 
 
 def rss_mb():   # anonymous resident MB: heap and textures, not library pages (a late compile pages in more)
@@ -23,15 +24,23 @@ def drag(first, n):
         gpu.resize((320 + 7 * k, 180 + 5 * k)); app.run_frames(2)
     gpu.resize((320, 180)); app.run_frames(6)
     gc.collect()
+    gpu.ctx.finish()       # measured at rest: work still in flight holds what it was given
+    trim_heap()            # and what the driver freed since the pool's own trim goes back too
 drag(0, 12)                               # programs, caches and the allocator's own pools made once
-before = rss_mb()
-drag(12, 20)                              # 20 sizes never seen before
-print(gpu.software, rss_mb() - before)
+windows = []                              # three windows of 10 sizes never seen before
+for first in (12, 22, 32):
+    before = rss_mb()
+    drag(first, 10)
+    windows.append(rss_mb() - before)
+print(gpu.software, min(windows), max(windows))
 """
 
 
 def test_resizing_the_cloud_scene_keeps_no_memory_per_size():
     done = subprocess.run([sys.executable, "-c", SCENE], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
-    software, growth = done.stdout.split()
-    assert float(growth) < 1.0, f"resident memory grew by {float(growth):.2f} MB over 20 new sizes"
+    software, growth, largest = done.stdout.split()
+    # memory kept per size grows in every window; a one-time allocation (a shader variant, a cache made
+    # when a busy machine's scheduler first gets there) shows in one window only
+    assert float(growth) < 0.5, (f"resident memory grew by {float(growth):.2f} MB (up to {float(largest):.2f}) "
+                                 "in each window of 10 new sizes")
