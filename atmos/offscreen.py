@@ -17,7 +17,7 @@ import moderngl
 from atmos.composition import CLOUD_DISTANCE, distance_desc
 from atmos.graph import PassBuilder, PassContext, TextureDesc
 from atmos.render_core import COLOR, DEPTH
-from atmos.gpu.uniforms import bind_textures
+from atmos.gpu.uniforms import bind_textures, write_uniforms
 
 CLOUD_COLOR = "cloud_color"
 CLOUD_DEPTH = "cloud_depth"
@@ -59,7 +59,7 @@ class OffscreenLayer:
         ctx = frame.gpu.ctx
         frame.framebuffer(depth=self.depth).use()
         bind_textures(self.far_depth, scene_depth=frame.resource(DEPTH))
-        self.far_depth["factor"].value = factor
+        write_uniforms(self.far_depth, factor=factor)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "1"                # always: the shader writes the block's farthest depth
         frame.fullscreen(self.far_depth)
@@ -86,10 +86,8 @@ class OffscreenLayer:
                       scene_depth=frame.resource(DEPTH))
         if distance:
             bind_textures(p, cloud_distance=frame.resource(self.distance))
-        p["factor"].value = factor
-        p["inv_near_far"].value = (1.0 / near, 1.0 / far)
-        p["edge"].value = EDGE
         centre = 0.5 * (factor - 1)
-        p["sample_offset"].value = (centre, centre) if offset is None else tuple(float(v) for v in offset)
+        write_uniforms(p, factor=factor, inv_near_far=(1.0 / near, 1.0 / far), edge=EDGE,
+                       sample_offset=(centre, centre) if offset is None else tuple(float(v) for v in offset))
         frame.blend_transmittance() if medium else frame.blend_over()
         frame.fullscreen(p)

@@ -8,6 +8,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 import moderngl
+import numpy as np
 
 from atmos.gpu.hazards import hazards_of
 
@@ -19,22 +20,64 @@ def _hazards(program):
     return hazards if hazards is not None else hazards_of(program.ctx)
 
 
+_SCALARS = frozenset((float, int, bool, tuple, bytes, np.float64, np.float32, np.int64, np.int32, np.bool_))
+# values compared with the last one written (a cheap ==); a 1-D numpy array is compared as a tuple
+
+
+def _tables(program):
+    """(members, written) of ``program``: its uniforms by name (None where the compiler dropped the
+    name) and the last value :func:`write_uniforms` wrote to each, kept in ``program.extra`` (None,
+    None for a program without it: nothing cached)."""
+    extra = program.extra
+    if type(extra) is not dict:
+        return None, None
+    try:
+        return extra["members"], extra["last"]
+    except KeyError:
+        extra["members"], extra["last"] = {}, {}
+        return extra["members"], extra["last"]
+
+
 def write_uniforms(program, values: Mapping[str, object] | None = None, /, **more) -> None:
     """Write each value to ``program``'s uniform of that name; a name the program does not have (the
     compiler drops uniforms it proves unused, and shader variants use different ones) is skipped.
     ``bytes`` are written as they are (matrices, arrays); a ``list`` fills an array uniform, cut to the
-    length the compiler kept (a tuple is one vector); anything else is the uniform's ``value``."""
-    get = program.get
+    length the compiler kept (a tuple is one vector); anything else is the uniform's ``value``.
+    A program keeps its uniforms' values: a number, tuple or ``bytes`` equal to the one this wrote
+    last is not written again (a uniform written past this function is written here every time)."""
+    members, last = _tables(program)
+    if members is None:
+        members, last = {}, None
     for name, value in ({**values, **more} if values else more).items():
-        member = get(name, None)
+        try:
+            member = members[name]
+        except KeyError:
+            member = members[name] = program.get(name, None)
         if member is None:
             continue
-        if isinstance(value, (bytes, bytearray, memoryview)):
+        kind = type(value)
+        if kind is np.ndarray and value.ndim == 1:
+            value = tuple(value.tolist())
+            kind = tuple
+        if kind in _SCALARS and last is not None:
+            if name in last and last[name] == value and (value or kind is not float):   # -0.0 is written
+                continue
+            last[name] = value
+        elif last is not None and name in last:
+            del last[name]
+        if kind is bytes or kind is bytearray or kind is memoryview:
             member.write(value)
-        elif isinstance(value, list):
+        elif kind is list:
             member.value = value[:member.array_length] if member.array_length > 1 else value[0]
         else:
             member.value = value
+
+
+def forget_uniform(program, name: str) -> None:
+    """``name`` was written past :func:`write_uniforms`: its next value there is written whatever it is."""
+    members, last = _tables(program)
+    if last is not None and name in last:
+        del last[name]
 
 
 def bind_textures(program, textures: Mapping[str, object] | None = None, /, sampler=None, **more) -> list[int]:
@@ -42,16 +85,27 @@ def bind_textures(program, textures: Mapping[str, object] | None = None, /, samp
     of its declaration; a sequence of textures to a sampler array, element by element); a name the
     program does not use is skipped. ``sampler`` (a moderngl Sampler) is bound at those units too.
     Returns the units bound (to clear ``sampler`` from afterwards)."""
-    get = program.get
+    extra = program.extra
+    if type(extra) is dict:
+        try:
+            units_of, hazards = extra["units"], extra["hazards"]
+        except KeyError:
+            units_of = extra["units"] = {}
+            hazards = _hazards(program)
+    else:
+        units_of, hazards = {}, _hazards(program)
     units = []
-    dirty = (hazards := _hazards(program))._dirty
+    dirty = hazards._dirty
     for name, texture in ({**textures, **more} if textures else more).items():
-        member = get(name, None)
-        if member is None:
+        try:
+            value = units_of[name]
+        except KeyError:
+            member = program.get(name, None)   # a sampler array: its units (one int where one element is used)
+            value = units_of[name] = None if member is None else member.value
+        if value is None:
             continue
-        value = member.value                 # a sampler array: its units (one int where one element is used)
-        if isinstance(texture, (list, tuple)):
-            pairs = zip(value if isinstance(value, list) else [value], texture)
+        if type(texture) is list or type(texture) is tuple:
+            pairs = zip(value if type(value) is list else [value], texture)
         else:
             pairs = ((value, texture),)
         for unit, one in pairs:
@@ -84,15 +138,25 @@ def bind_buffers(program, buffers: Mapping[str, object] | None = None, /, **more
     """Bind each buffer at the binding of ``program``'s storage block of that name (its
     ``layout(std430, binding = N) buffer Name``); a name the program does not use is skipped. A
     block not declared ``readonly`` counts as written by the next dispatch."""
-    get = program.get
     extra = program.extra                        # storage blocks not declared readonly, from the compiler check
-    written = extra.get("written") if isinstance(extra, dict) else None   # unknown: every block may be
-    dirty = (hazards := _hazards(program))._dirty
+    if type(extra) is dict:
+        written, hazards = extra.get("written"), extra.get("hazards") or hazards_of(program.ctx)
+        try:
+            bindings = extra["bindings"]
+        except KeyError:
+            bindings = extra["bindings"] = {}
+    else:
+        written, hazards, bindings = None, hazards_of(program.ctx), {}   # unknown: every block may be written
+    dirty = hazards._dirty
     for name, buffer in ({**buffers, **more} if buffers else more).items():
-        member = get(name, None)
-        if member is not None:
+        try:
+            binding = bindings[name]
+        except KeyError:
+            member = program.get(name, None)
+            binding = bindings[name] = None if member is None else member.binding
+        if binding is not None:
             if id(buffer) in dirty:
                 hazards.need(buffer, moderngl.SHADER_STORAGE_BARRIER_BIT)
             if written is None or name in written:
                 hazards.stage(buffer)
-            buffer.bind_to_storage_buffer(member.binding)
+            buffer.bind_to_storage_buffer(binding)

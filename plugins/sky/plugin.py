@@ -8,6 +8,7 @@ from atmos.camera import Camera
 from atmos.composition import composition
 from atmos.graph import FullscreenPass, PassContext, RenderPass
 from atmos.lighting import Sun
+from atmos.gpu.uniforms import write_uniforms
 from atmos.plugin import Plugin
 import atmos.plugins.sky.sun_light as sun_light
 from atmos.plugins.sky.aerial import AERIAL, AerialPerspectivePass, active
@@ -76,7 +77,7 @@ class SkyPass(FullscreenPass):
         if self.physical:
             frame.resource(SKY_LUTS).bind(p)
             set_atmosphere_uniforms(p, settings.atmosphere)
-            p["view_r"].value = view_radius(settings.atmosphere, camera)
+            write_uniforms(p, view_r=view_radius(settings.atmosphere, camera))
         frame.fullscreen(p)
 
 

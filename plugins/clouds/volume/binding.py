@@ -28,10 +28,9 @@ def bind_volume(program, sim, sampler, sun: Sun | None, octaves=DEFAULT_OCTAVES,
     bind_textures(program, sampler=sampler, density_a=a["density"], density_b=b["density"], trans_a=a[light],
                   trans_b=b[light], columns_a=a[COLUMNS], columns_b=b[COLUMNS], diffusion_a=a[spread],
                   diffusion_b=b[spread])
-    program["t"].value = float(t)
     write_uniforms(program, light_uniforms(sim.settings, sun, octaves, diffusion if field else 0.0, layer),
                    a_shift=(sim if isinstance(sim, CloudSets) else sim.sets()).a_shift, has_shading=int(shading),
-                   edge_fade=float(sim.settings.edge_fade))
+                   edge_fade=float(sim.settings.edge_fade), t=float(t))
     return float(t)
 
 
