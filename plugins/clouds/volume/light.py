@@ -107,7 +107,25 @@ def light_uniforms(cloud_settings, sun: Sun | None, octaves=DEFAULT_OCTAVES, dif
     """The light uniforms of ``volume.glsl`` for a ``CloudSettings`` medium, the ``Sun``, the
     multiple-scattering octaves (a, b, c), the diffusion field's weight and the layer (base, top) world
     y (m) over which the clouds take the sun's colour (``sun_sources``: :func:`sun_colors`; the ground's
-    light takes the middle's; None: the camera's colour everywhere)."""
+    light takes the middle's; None: the camera's colour everywhere). The last few results are kept,
+    keyed by the identity of the settings, the Sun and its (immutable, assigned-anew) fields and by
+    the values of the rest: every renderer of a frame asks for the same."""
+    sun = sun or Sun()
+    key = (cloud_settings, sun, sun.direction, sun.color, sun.ambient, sun.color_by_altitude)
+    rest = (tuple(octaves), diffusion, None if layer is None else tuple(layer))
+    for held, held_rest, values in _LIGHT_MEMO:
+        if held_rest == rest and all(a is b for a, b in zip(held, key)):
+            return dict(values)
+    values = _light_uniforms(cloud_settings, sun, octaves, diffusion, layer)
+    _LIGHT_MEMO.insert(0, (key, rest, values))
+    del _LIGHT_MEMO[4:]
+    return dict(values)
+
+
+_LIGHT_MEMO: list = []      # (identities, values, uniforms), newest first
+
+
+def _light_uniforms(cloud_settings, sun: Sun, octaves, diffusion: float, layer) -> dict:
     colors, middle, ambient = layer_sun(sun, layer)
     direction = unit_direction(sun)
     e, sky, ground = environment(cloud_settings, middle, ambient, direction)
