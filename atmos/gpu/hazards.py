@@ -221,16 +221,20 @@ def hazards_of(ctx) -> Hazards:
 def dispatch(program, *groups: int) -> None:
     """Run compute ``program`` over ``groups`` work groups (x[, y[, z]]); what its binds staged for a
     storage write is dirty afterwards (:class:`Hazards`). The one way atmos runs a compute program."""
-    hazards = hazards_of(program.ctx)
-    hazards.flush()
+    extra = program.extra
+    hazards = extra["hazards"] if type(extra) is dict and "hazards" in extra else hazards_of(program.ctx)
+    if hazards._need:
+        hazards.flush()
     program.run(*groups)
-    hazards.commit()
+    if hazards._staged:
+        hazards.commit()
 
 
 def dispatch_indirect(program, args, offset: int = 0) -> None:
     """Run compute ``program`` with its group counts read on the GPU from buffer ``args`` (3 uints at
     ``offset``), after the barrier that makes a shader's write of ``args`` visible as indirect arguments."""
-    hazards = hazards_of(program.ctx)
+    extra = program.extra
+    hazards = extra["hazards"] if type(extra) is dict and "hazards" in extra else hazards_of(program.ctx)
     hazards.need(args, moderngl.COMMAND_BARRIER_BIT)     # with what the binds asked for: one barrier
     hazards.flush()
     program.run_indirect(args, offset)

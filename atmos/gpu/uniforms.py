@@ -73,6 +73,31 @@ def write_uniforms(program, values: Mapping[str, object] | None = None, /, **mor
             member.value = value
 
 
+def has_member(program, name: str) -> bool:
+    """Whether ``program`` has a uniform, sampler or block ``name`` (``name in program`` walks every member)."""
+    members, _ = _tables(program)
+    if members is None:
+        return program.get(name, None) is not None
+    try:
+        return members[name] is not None
+    except KeyError:
+        member = members[name] = program.get(name, None)
+        return member is not None
+
+
+def sampler_units(program, name: str):
+    """The unit of ``program``'s sampler ``name`` (a list of units for a sampler array; None where it has
+    none), as :func:`bind_textures` binds it."""
+    extra = program.extra
+    units_of = extra.setdefault("units", {}) if type(extra) is dict else {}
+    try:
+        return units_of[name]
+    except KeyError:
+        member = program.get(name, None)
+        value = units_of[name] = None if member is None else member.value
+        return value
+
+
 def forget_uniform(program, name: str) -> None:
     """``name`` was written past :func:`write_uniforms`: its next value there is written whatever it is."""
     members, last = _tables(program)
@@ -122,8 +147,10 @@ def bind_images(program, images: Mapping[str, object] | None = None, /, **more) 
     """Bind each texture as an image at the unit of ``program``'s image uniform of that name (its
     ``layout(binding = N, format)``), for the access its declaration gives (``readonly``,
     ``writeonly`` or both); a name the program does not use is skipped."""
-    declared = program.extra["images"]        # (unit, read, write) by name, from the compiler check
-    dirty = (hazards := _hazards(program))._dirty
+    extra = program.extra
+    declared = extra["images"]                # (unit, read, write) by name, from the compiler check
+    hazards = extra["hazards"] if "hazards" in extra else _hazards(program)
+    dirty = hazards._dirty
     for name, texture in ({**images, **more} if images else more).items():
         if name in declared:
             unit, read, write = declared[name]

@@ -6,7 +6,7 @@ from atmos.plugins.clouds.volume.light import DEFAULT_OCTAVES, light_uniforms
 from atmos.plugins.clouds.volume.sets import CloudSets
 from atmos.plugins.clouds.light.columns import COLUMNS
 from atmos.plugins.clouds.light.diffusion import DIFFUSION
-from atmos.gpu.uniforms import bind_textures, write_uniforms
+from atmos.gpu.uniforms import bind_textures, sampler_units, write_uniforms
 
 SAMPLERS = ("density_a", "density_b", "trans_a", "trans_b", "columns_a", "columns_b", "diffusion_a", "diffusion_b")
 
@@ -37,5 +37,6 @@ def bind_volume(program, sim, sampler, sun: Sun | None, octaves=DEFAULT_OCTAVES,
 def unbind_volume(program, sampler) -> None:
     """Unbind the sampler from the volume's units so later passes sample with their textures' own settings."""
     for name in SAMPLERS:
-        if name in program:
-            sampler.clear(program[name].value)
+        unit = sampler_units(program, name)
+        if unit is not None:
+            sampler.clear(unit)
