@@ -99,6 +99,56 @@ void main() { o[0] = a; o[1] = b.x + b.y + b.z; }
         write_uniforms(program, a=2.0, b=(1.0, 2.0, 3.0))
         assert meter.uniform_writes == 3
         write_uniforms(program, a=-0.0)
-        write_uniforms(program, a=0.0)                # -0.0 and 0.0 compare equal: zero is always written
+        write_uniforms(program, a=-0.0)
+        assert meter.uniform_writes == 4
+        write_uniforms(program, a=0.0)                # equal to -0.0, but not the same float
+        assert meter.uniform_writes == 5
+        write_uniforms(program, a=0.0)
         assert meter.uniform_writes == 5
     assert program["a"].value == 0.0 and program["b"].value == pytest.approx((1.0, 2.0, 3.0))
+
+
+COPY_LIGHT = """#version 430
+layout(local_size_x = 1) in;
+const int SUN_HEIGHTS = 5;
+layout(std140, binding = 2) uniform CloudLight {
+    vec3 sun_sources[SUN_HEIGHTS];
+    vec3 sky_source;
+    vec3 ground_source;
+    vec3 sun_dir;
+};
+layout(std430, binding = 0) buffer Out { float o[]; };
+void main() {
+    int k = 0;
+    for (int i = 0; i < SUN_HEIGHTS; i++) for (int c = 0; c < 3; c++) o[k++] = sun_sources[i][c];
+    for (int c = 0; c < 3; c++) o[k++] = sky_source[c];
+    for (int c = 0; c < 3; c++) o[k++] = ground_source[c];
+    for (int c = 0; c < 3; c++) o[k++] = sun_dir[c];
+}
+"""
+
+
+def test_cloud_light_block_is_std140(gpu):
+    """volume.glsl's CloudLight block as pack_light lays it out, read back member by member."""
+    from atmos.plugins.clouds.volume.light import LIGHT_BINDING, LIGHT_BLOCK, write_light
+    program = compile_program(gpu.ctx, {"compute_shader": _source(COPY_LIGHT)})
+    values = {"sun_sources": [(1.0 + i, 2.0 + i, 3.0 + i) for i in range(5)], "sky_source": (0.1, 0.2, 0.3),
+              "ground_source": (0.4, 0.5, 0.6), "sun_dir": (0.0, 0.6, -0.8)}
+    out = gpu.ctx.buffer(reserve=4 * 24)
+    try:
+        assert LIGHT_BINDING == 2 and program[LIGHT_BLOCK].binding == LIGHT_BINDING
+        assert program[LIGHT_BLOCK].size == 128
+        with GLMeter() as meter:
+            write_light(program, values)
+            write_light(program, values)              # unchanged: no second upload
+            assert meter.calls["Buffer.write"] == 1 and meter.uniform_writes == 0
+        bind_buffers(program, Out=out)
+        dispatch(program, 1)
+        got = np.frombuffer(out.read(), np.float32)
+        want = [c for row in [*values["sun_sources"], values["sky_source"], values["ground_source"],
+                              values["sun_dir"]] for c in row]
+        assert got == pytest.approx(want)
+    finally:
+        out.release()
+        for obj in program.extra.get("owned", ()):
+            obj.release()

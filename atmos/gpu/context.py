@@ -283,6 +283,9 @@ class GpuContext:
         for obj in list(self._tracked):
             obj.release()
         for program in self._programs.values():
+            extra = program.extra
+            for obj in extra.get("owned", ()) if isinstance(extra, dict) else ():
+                obj.release()               # what its users keep with it (a block's buffer: own_block)
             program.release()
         for obj in self._offscreen:
             release_gl(obj)

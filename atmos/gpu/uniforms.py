@@ -43,8 +43,9 @@ def write_uniforms(program, values: Mapping[str, object] | None = None, /, **mor
     compiler drops uniforms it proves unused, and shader variants use different ones) is skipped.
     ``bytes`` are written as they are (matrices, arrays); a ``list`` fills an array uniform, cut to the
     length the compiler kept (a tuple is one vector); anything else is the uniform's ``value``.
-    A program keeps its uniforms' values: a number, tuple or ``bytes`` equal to the one this wrote
-    last is not written again (a uniform written past this function is written here every time)."""
+    A program keeps its uniforms' values: a number, tuple, 1-D array or ``bytes`` equal to the one this
+    wrote last is not written again (a float zero only of the same sign; a uniform written past this
+    function must be forgotten: :func:`forget_uniform`)."""
     members, last = _tables(program)
     if members is None:
         members, last = {}, None
@@ -60,8 +61,8 @@ def write_uniforms(program, values: Mapping[str, object] | None = None, /, **mor
             value = tuple(value.tolist())
             kind = tuple
         if kind in _SCALARS and last is not None:
-            if name in last and last[name] == value and (value or kind is not float):   # -0.0 is written
-                continue
+            if name in last and last[name] == value and (value or kind is not float or str(value) == str(last[name])):
+                continue                      # (a float zero only of the same sign: -0.0 is not 0.0)
             last[name] = value
         elif last is not None and name in last:
             del last[name]
@@ -187,3 +188,25 @@ def bind_buffers(program, buffers: Mapping[str, object] | None = None, /, **more
             if written is None or name in written:
                 hazards.stage(buffer)
             buffer.bind_to_storage_buffer(binding)
+
+
+def write_block(program, name: str, binding: int, data: bytes) -> bool:
+    """Bind ``program``'s own buffer of uniform block ``name`` at ``binding`` with ``data`` (std140,
+    packed by the caller), written only when it changed (the buffer is kept in ``program.extra`` and
+    released with the program). Returns False, doing nothing, where the program has no such block."""
+    if not has_member(program, name):
+        return False
+    extra = program.extra
+    blocks = extra.setdefault("blocks", {})
+    entry = blocks.get(name)
+    if entry is None or len(entry[1]) != len(data):
+        if entry is not None:
+            entry[0].release()
+            extra["owned"].remove(entry[0])
+        entry = blocks[name] = [program.ctx.buffer(reserve=len(data)), b""]
+        extra.setdefault("owned", []).append(entry[0])
+    if entry[1] != data:
+        entry[0].write(data)
+        entry[1] = data
+    entry[0].bind_to_uniform_block(binding)
+    return True

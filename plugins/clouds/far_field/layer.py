@@ -162,8 +162,7 @@ class FarFieldLayer:
         use_columns(c, sim, density=profile)
         if profile:
             bind_images(c, column_profile=self._profile_texture(profile_heights(sim.shape[1])))
-        c["threshold"].value = float(sim.settings.cover_threshold)
-        c["max_sum"].value = float(sim.shape[1])
+        write_uniforms(c, threshold=float(sim.settings.cover_threshold), max_sum=float(sim.shape[1]))
         bind_buffers(c, Cover=self.cover)
         dispatch(c, 1)
 

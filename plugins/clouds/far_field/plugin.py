@@ -10,7 +10,7 @@ from atmos.plugin import Plugin
 from atmos.plugins.clouds.far_field.layer import FarFieldLayer
 from atmos.plugins.clouds.volume.sets import FAR_FIELD
 from atmos.plugins.clouds.far_field.settings import CloudFarFieldSettings
-from atmos.plugins.clouds.volume.light import CloudLightSettings, light_uniforms
+from atmos.plugins.clouds.volume.light import CloudLightSettings, light_uniforms, write_light
 from atmos.plugins.clouds.volume.field_demand import field_demand
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CloudSets
 from atmos.render_core import COLOR, DEPTH
@@ -58,7 +58,7 @@ class CloudFarFieldPass(FullscreenPass):
                                       / max(view.size[1], 1)),
                       **{name: float(getattr(params, name)) for name in
                          ("thickness", "horizon_fade")})
-        write_uniforms(p, values)
+        write_light(p, values)
         frame.fullscreen(p)
 
 

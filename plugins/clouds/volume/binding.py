@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from atmos.lighting import Sun
-from atmos.plugins.clouds.volume.light import DEFAULT_OCTAVES, light_uniforms
+from atmos.plugins.clouds.volume.light import DEFAULT_OCTAVES, light_uniforms, write_light
 from atmos.plugins.clouds.volume.sets import CloudSets
 from atmos.plugins.clouds.light.columns import COLUMNS
 from atmos.plugins.clouds.light.diffusion import DIFFUSION
@@ -28,7 +28,7 @@ def bind_volume(program, sim, sampler, sun: Sun | None, octaves=DEFAULT_OCTAVES,
     bind_textures(program, sampler=sampler, density_a=a["density"], density_b=b["density"], trans_a=a[light],
                   trans_b=b[light], columns_a=a[COLUMNS], columns_b=b[COLUMNS], diffusion_a=a[spread],
                   diffusion_b=b[spread])
-    write_uniforms(program, light_uniforms(sim.settings, sun, octaves, diffusion if field else 0.0, layer),
+    write_light(program, light_uniforms(sim.settings, sun, octaves, diffusion if field else 0.0, layer),
                    a_shift=(sim if isinstance(sim, CloudSets) else sim.sets()).a_shift, has_shading=int(shading),
                    edge_fade=float(sim.settings.edge_fade), t=float(t))
     return float(t)

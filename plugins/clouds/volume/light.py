@@ -3,11 +3,13 @@
 and the uniforms of J."""
 from __future__ import annotations
 
+import struct
 from dataclasses import dataclass
 
 import numpy as np
 
 from atmos.checks import CheckedSettings, num_field
+from atmos.gpu.uniforms import write_block, write_uniforms
 from atmos.lighting import Sun
 from atmos.plugins.clouds.light.medium import environment
 
@@ -140,3 +142,22 @@ def _light_uniforms(cloud_settings, sun: Sun, octaves, diffusion: float, layer) 
             "ms_octaves": tuple(float(v) for v in octaves),
             "column_tau": cell_tau(s),
             "ms_diffusion": float(diffusion)}
+
+
+LIGHT_BLOCK, LIGHT_BINDING = "CloudLight", 2      # volume.glsl's block of the light that changes with the sun
+LIGHT_MEMBERS = ("sun_sources", "sky_source", "ground_source", "sun_dir")
+
+
+def pack_light(values: dict) -> bytes:
+    """volume.glsl's CloudLight block (std140: vec3 sun_sources[SUN_HEIGHTS], sky_source, ground_source,
+    sun_dir, each in 16 bytes) from :func:`light_uniforms`' ``values``."""
+    rows = [*values["sun_sources"], values["sky_source"], values["ground_source"], values["sun_dir"]]
+    return struct.pack(f"<{4 * len(rows)}f", *(c for row in rows for c in (*row, 0.0)))
+
+
+def write_light(program, values: dict, **more) -> None:
+    """:func:`light_uniforms`' ``values`` (and ``more``) into ``program``: the sun's light into its
+    CloudLight block (one buffer write when it changed), the rest as uniforms."""
+    if write_block(program, LIGHT_BLOCK, LIGHT_BINDING, pack_light(values)):
+        values = {k: v for k, v in values.items() if k not in LIGHT_MEMBERS}
+    write_uniforms(program, values, **more)
