@@ -193,10 +193,12 @@ def bind_buffers(program, buffers: Mapping[str, object] | None = None, /, **more
 def write_block(program, name: str, binding: int, data: bytes) -> bool:
     """Bind ``program``'s own buffer of uniform block ``name`` at ``binding`` with ``data`` (std140,
     packed by the caller), written only when it changed (the buffer is kept in ``program.extra`` and
-    released with the program). Returns False, doing nothing, where the program has no such block."""
+    released with the program by the GpuContext that owns it). Returns False, doing nothing, where the program has no such block."""
     if not has_member(program, name):
         return False
     extra = program.extra
+    if type(extra) is not dict:                  # a program made past the compiler check
+        extra = program.extra = {}
     blocks = extra.setdefault("blocks", {})
     entry = blocks.get(name)
     if entry is None or len(entry[1]) != len(data):
