@@ -135,8 +135,8 @@ def bind_textures(program, textures: Mapping[str, object] | None = None, /, samp
         else:
             pairs = ((value, texture),)
         for unit, one in pairs:
-            if id(one) in dirty:
-                hazards.need(one, moderngl.TEXTURE_FETCH_BARRIER_BIT)
+            if dirty and (key := id(one)) in dirty and (entry := dirty[key])[0]() is one:   # Hazards.need, inlined
+                hazards._need |= entry[2] & moderngl.TEXTURE_FETCH_BARRIER_BIT
             one.use(unit)
             if sampler is not None:
                 sampler.use(unit)
@@ -155,8 +155,8 @@ def bind_images(program, images: Mapping[str, object] | None = None, /, **more) 
     for name, texture in ({**images, **more} if images else more).items():
         if name in declared:
             unit, read, write = declared[name]
-            if id(texture) in dirty:
-                hazards.need(texture, moderngl.SHADER_IMAGE_ACCESS_BARRIER_BIT)
+            if dirty and (key := id(texture)) in dirty and (entry := dirty[key])[0]() is texture:
+                hazards._need |= entry[2] & moderngl.SHADER_IMAGE_ACCESS_BARRIER_BIT
             if write:
                 hazards.stage(texture)
             texture.bind_to_image(unit, read=read, write=write)
@@ -168,7 +168,8 @@ def bind_buffers(program, buffers: Mapping[str, object] | None = None, /, **more
     block not declared ``readonly`` counts as written by the next dispatch."""
     extra = program.extra                        # storage blocks not declared readonly, from the compiler check
     if type(extra) is dict:
-        written, hazards = extra.get("written"), extra.get("hazards") or hazards_of(program.ctx)
+        written = extra["written"] if "written" in extra else None
+        hazards = extra["hazards"] if "hazards" in extra else hazards_of(program.ctx)
         try:
             bindings = extra["bindings"]
         except KeyError:
@@ -183,8 +184,8 @@ def bind_buffers(program, buffers: Mapping[str, object] | None = None, /, **more
             member = program.get(name, None)
             binding = bindings[name] = None if member is None else member.binding
         if binding is not None:
-            if id(buffer) in dirty:
-                hazards.need(buffer, moderngl.SHADER_STORAGE_BARRIER_BIT)
+            if dirty and (key := id(buffer)) in dirty and (entry := dirty[key])[0]() is buffer:
+                hazards._need |= entry[2] & moderngl.SHADER_STORAGE_BARRIER_BIT
             if written is None or name in written:
                 hazards.stage(buffer)
             buffer.bind_to_storage_buffer(binding)

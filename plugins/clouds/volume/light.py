@@ -133,7 +133,7 @@ def _light_uniforms(cloud_settings, sun: Sun, octaves, diffusion: float, layer) 
     e, sky, ground = environment(cloud_settings, middle, ambient, direction)
     s = cloud_settings
     sources = s.albedo * s.sun_intensity * colors
-    return {"sun_sources": [tuple(float(v) for v in row) for row in sources],
+    return {"sun_sources": [tuple(row) for row in np.asarray(sources, np.float64).tolist()],
             "sky_source": tuple(float(v) for v in 0.5 * s.albedo * sky),
             "ground_source": tuple(float(v) for v in 0.5 * s.albedo * ground),
             "sun_dir": tuple(float(v) for v in direction),
@@ -152,7 +152,7 @@ def pack_light(values: dict) -> bytes:
     """volume.glsl's CloudLight block (std140: vec3 sun_sources[SUN_HEIGHTS], sky_source, ground_source,
     sun_dir, each in 16 bytes) from :func:`light_uniforms`' ``values``."""
     rows = [*values["sun_sources"], values["sky_source"], values["ground_source"], values["sun_dir"]]
-    return struct.pack(f"<{4 * len(rows)}f", *(c for row in rows for c in (*row, 0.0)))
+    return struct.pack(f"<{4 * len(rows)}f", *[c for row in rows for c in (*row, 0.0)])
 
 
 def write_light(program, values: dict, **more) -> None:
