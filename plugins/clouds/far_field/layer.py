@@ -22,7 +22,7 @@ from atmos.plugins.clouds.far_field.columns import rank_texture, read_rank_textu
 from atmos.plugins.clouds.far_field.cover import LEVELS, QUANTILES, level_ranks, matched_tile_size, pattern_crossings
 from atmos.plugins.clouds.far_field.pattern import CHANNEL_STEPS, PERIODS, octave_frequencies, octave_offsets, rotations, turns_bytes
 from atmos.plugins.clouds.far_field.rank_light import RankLight
-from atmos.plugins.clouds.volume.light import cell_tau, light_uniforms
+from atmos.plugins.clouds.volume.light import cell_tau, unit_direction
 from atmos.plugins.clouds.volume.sets import CloudSets
 from atmos.tile_octaves import OctaveTextures
 from atmos.gpu.uniforms import bind_buffers, bind_images, bind_textures, write_uniforms
@@ -104,7 +104,7 @@ class FarFieldLayer:
             return
         self._prepared = view
         params = self.settings
-        sun_dir = light_uniforms(sim.settings, view.sun)["sun_dir"]
+        sun_dir = tuple(float(v) for v in unit_direction(view.sun))     # light_uniforms' sun_dir
         if self.octaves.needs_bake(params, sun_dir, REBAKE_TOLERANCE):
             self.octaves.bake(params, sun_dir, octave_frequencies(params.base_frequency), rotations(), CHANNEL_STEPS)
         self.measure_cover(sim)
