@@ -58,7 +58,7 @@ class OffscreenLayer:
         ctx = frame.gpu.ctx
         frame.framebuffer(depth=self.depth).use()
         bind_textures(self.far_depth, scene_depth=frame.resource(DEPTH))
-        self.far_depth["factor"].value = factor
+        write_uniforms(self.far_depth, factor=factor)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "1"                # always: the shader writes the block's farthest depth
         frame.fullscreen(self.far_depth)

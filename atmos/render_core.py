@@ -40,7 +40,7 @@ from atmos.hashing import lowbias32
 from atmos.graph import FullscreenPass, PassBuilder, PassContext, RenderPass, TextureDesc
 from atmos.plugin import Plugin
 from atmos.scene_uniforms import set_scene_uniforms
-from atmos.gpu.uniforms import bind_textures
+from atmos.gpu.uniforms import bind_textures, write_uniforms
 
 SCREEN = "screen"
 COLOR = "color"
@@ -139,8 +139,8 @@ class PresentPass(FullscreenPass):
     def execute(self, frame: PassContext) -> None:
         frame.resource(SCREEN).use()
         bind_textures(self.program, hdr=frame.resource(COLOR))
-        self.program["exposure"].value = self.plugin.settings.exposure
-        self.program["dither"].value = DITHER_STEP if self.plugin.settings.dither else 0.0
+        write_uniforms(self.program, exposure=self.plugin.settings.exposure,
+                       dither=DITHER_STEP if self.plugin.settings.dither else 0.0)
         frame.fullscreen(self.program)
 
 

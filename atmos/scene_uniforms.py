@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from atmos.camera import Camera, camera_matrices
 from atmos.frame_constants import FRAME_BLOCK
-from atmos.gpu.uniforms import write_uniforms
+from atmos.gpu.uniforms import has_member, write_uniforms
 from atmos.lighting import Sun
 
 MATRICES = ("view_proj", "inv_view_proj", "view_basis")   # computed on first use per frame (CameraMatrices.gl)
@@ -20,17 +20,17 @@ def set_camera_uniforms(program, camera: Camera, aspect: float) -> None:
     view rays and distances from depth at any far/near ratio; prefer them to ``inv_view_proj``.
     The matrices come from :func:`atmos.camera.camera_matrices`: computed once per frame, whatever the passes.
     Nothing for a program with the frame block (``lib/frame.glsl``)."""
-    if FRAME_BLOCK in program:
+    if has_member(program, FRAME_BLOCK):
         return
     matrices = camera_matrices(camera, aspect)
-    write_uniforms(program, {name: matrices.gl(name) for name in MATRICES if name in program},
+    write_uniforms(program, {name: matrices.gl(name) for name in MATRICES if has_member(program, name)},
                    camera_pos=matrices.camera_pos, near=float(camera.near), far=float(camera.far))
 
 
 def set_sun_uniforms(program, sun: Sun) -> None:
     """Write ``sun_dir``, ``sun_color`` and ``sky_ambient`` (the Sun's ambient) where the program has them
     (nothing for a program with the frame block)."""
-    if FRAME_BLOCK in program:
+    if has_member(program, FRAME_BLOCK):
         return
     write_uniforms(program, **{name: tuple(float(v) for v in value) for name, value in
                                (("sun_dir", sun.direction), ("sun_color", sun.color), ("sky_ambient", sun.ambient))})

@@ -7,7 +7,8 @@ at a tiny frame size (64×36 by default: almost no fragment work) after 10 warm-
 per frame, so the simulation chain runs its slices as in the demo.
 
 Method. *Calls*: ``sys.setprofile`` counts Python function calls (and C calls) over ``--frames``
-frames. *Python ms*: frames timed in the main thread's CPU time (``time.thread_time``: waits,
+frames. *Uniforms*: uniform values written per frame (``GLMeter.uniform_writes``; the rest of a
+frame's constants are in uniform blocks). *Python ms*: frames timed in the main thread's CPU time (``time.thread_time``: waits,
 llvmpipe's own threads and other processes do not count) with GL work stubbed out —
 :class:`atmos.gpu.gl_meter.GLMeter` with ``stub_work=True`` turns every moderngl call that hands
 the GPU work (draws, dispatches, clears, uploads) into a counted no-op, while state changes,
@@ -20,7 +21,8 @@ the work calls. ``GL ms`` is that CPU time, ``wall ms`` the frame's wall time wi
 git revision, extracted with ``git archive``, or a directory) in a subprocess, so before and after
 come from one run on one machine.
 
-Goal: <= 1 ms of Python per frame for sunset on the 2-core CI machine.
+Goals for sunset: <= 1 ms of Python per frame on the 2-core CI machine, <= 1,500 calls and <= 30
+uniform writes per frame (tests/test_frame_budget.py holds the counts to a budget).
 """
 from __future__ import annotations
 
@@ -95,7 +97,7 @@ def measure(name: str, frames: int = 30, size=(64, 36), warmup: int = 10) -> dic
             sys.setprofile(None)
         gpu.ctx.finish()
         overhead = meter_overhead_s()
-        subtracted, wall_ms, gl_ms, gl_calls = [], [], [], []
+        subtracted, wall_ms, gl_ms, gl_calls, uniform_writes = [], [], [], [], []
         readbacks = Counter()
         with GLMeter(clock=CLOCK) as meter:          # the GPU's work done, and taken out of the time
             for _ in range(frames):
@@ -111,6 +113,7 @@ def measure(name: str, frames: int = 30, size=(64, 36), warmup: int = 10) -> dic
                 wall_ms.append(wall * 1e3)
                 gl_ms.append(gl * 1e3)
                 gl_calls.append(wrapped)
+                uniform_writes.append(meter.uniform_writes)
                 subtracted.append((cpu - gl - wrapped * overhead) * 1e3)
             readbacks.update(f"{call} at {where}" for call, where in meter.readback_counts().elements()
                                  if not where.startswith("benchmarks/"))     # not the benchmark's own finish
@@ -129,7 +132,7 @@ def measure(name: str, frames: int = 30, size=(64, 36), warmup: int = 10) -> dic
                 "python_ms": float(np.mean(stubbed)), "python_ms_median": float(np.median(stubbed)),
                 "python_ms_max": float(np.max(stubbed)), "python_ms_subtracted": float(np.mean(subtracted)),
                 "wall_ms": float(np.mean(wall_ms)), "gl_ms": float(np.mean(gl_ms)),
-                "gl_calls": float(np.mean(gl_calls)),
+                "gl_calls": float(np.mean(gl_calls)), "uniform_writes": float(np.mean(uniform_writes)),
                 "readbacks_per_frame": {k: v / frames for k, v in sorted(readbacks.items())}}
     finally:
         app.close()
@@ -179,7 +182,7 @@ def measure_tree(tree: str, names, frames: int, size) -> list[dict]:
 
 
 def table(rows: list[dict], baseline: list[dict] | None = None) -> str:
-    head = (f"{'scene':>8} {'tree':>8} | {'py calls':>8} {'C calls':>8} | {'python ms':>9} {'median':>7} "
+    head = (f"{'scene':>8} {'tree':>8} | {'py calls':>8} {'C calls':>8} {'uniforms':>8} | {'python ms':>9} {'median':>7} "
             f"{'max':>7} {'subtracted':>10} | {'GL ms':>7} {'wall ms':>8} | goal")
     lines = [head, "-" * len(head)]
     old = {r["scene"]: r for r in baseline or []}
@@ -190,7 +193,8 @@ def table(rows: list[dict], baseline: list[dict] | None = None) -> str:
             goal = ""
             if r["scene"] == "sunset":
                 goal = f"<= {GOAL_MS} ms: {'met' if r['python_ms'] <= GOAL_MS else 'MISSED'}"
-            lines.append(f"{r['scene']:>8} {label:>8} | {r['python_calls']:8.0f} {r['c_calls']:8.0f} | "
+            lines.append(f"{r['scene']:>8} {label:>8} | {r['python_calls']:8.0f} {r['c_calls']:8.0f} "
+                         f"{r.get('uniform_writes', float('nan')):8.1f} | "
                          f"{r['python_ms']:9.3f} {r['python_ms_median']:7.3f} {r['python_ms_max']:7.3f} "
                          f"{r.get('python_ms_subtracted', float('nan')):10.3f} | "
                          f"{r['gl_ms']:7.2f} {r['wall_ms']:8.2f} | {goal}")

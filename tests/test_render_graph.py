@@ -479,8 +479,10 @@ def test_timings_cover_kept_passes_only(graph, screen):
     graph.add_pass(P("a", creates={"x": SMALL}))
     graph.add_pass(P("b", reads=["x"], writes=["screen"]))
     graph.add_pass(P("culled", creates={"y": SMALL}))
-    for _ in range(5):
+    for frame in range(200):          # results are read once in: a fast frame may run ahead of them
         graph.execute()
+        if frame >= 4 and len(graph.timings) >= 2:
+            break
     assert set(graph.timings) == {"a", "b"}
     for gpu_ms, cpu_ms in graph.timings.values():
         assert gpu_ms >= 0.0 and cpu_ms >= 0.0

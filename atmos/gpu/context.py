@@ -147,6 +147,7 @@ class GpuContext:
         self.headless = headless
         self.size = (0, 0)
         self._programs: dict[tuple, object] = {}
+        self._fast_programs: dict[tuple, object] = {}   # the same programs by their arguments' order as given
         self._tracked: "weakref.WeakSet" = weakref.WeakSet()
         self._offscreen: list = []
         self.released = False
@@ -239,7 +240,12 @@ class GpuContext:
         ``gpu.program(vertex_shader="sky.vert", fragment_shader="sky.frag")`` or
         ``gpu.program(compute_shader="volume.comp", defines={"N": 4})``.
         """
-        self._require_live()
+        if self.released:
+            self._require_live()
+        fast = (tuple(stages.items()), tuple(defines.items()) if defines else ())   # as the caller orders them
+        program = self._fast_programs.get(fast)
+        if program is not None:
+            return program
         key = (tuple(sorted(stages.items())), tuple(sorted((defines or {}).items())))
         program = self._programs.get(key)
         if program is None:
@@ -252,6 +258,7 @@ class GpuContext:
                     program.release()
                     raise
             self._programs[key] = program
+        self._fast_programs[fast] = program
         return program
 
     @property
@@ -283,10 +290,14 @@ class GpuContext:
         for obj in list(self._tracked):
             obj.release()
         for program in self._programs.values():
+            extra = program.extra
+            for obj in extra.get("owned", ()) if isinstance(extra, dict) else ():
+                obj.release()               # what its users keep with it (a block's buffer: own_block)
             program.release()
         for obj in self._offscreen:
             release_gl(obj)
         self._programs.clear()
+        self._fast_programs.clear()
         self._offscreen.clear()
         self.queries.clear()
         if self.headless:

@@ -11,6 +11,7 @@ block runs and records, per call kind:
   <atmos.gpu.queries.TimerQuery.result>` and ``ctx.finish()``; each is recorded with the atmos
   source line that made it (``meter.readbacks``), so a test can say exactly which ones a frame
   makes. A ``read_into`` a moderngl Buffer (a pixel-buffer copy, asynchronous) is work;
+* ``state`` — uniform writes (``Uniform.write``), counted: ``meter.uniform_writes``;
 * ``query`` — atmos's own timer queries begun (``TimerQuery.begin``) and polled
   (``TimerQuery.poll``: the result only once it is in, so no wait) are counted, not readbacks.
 
@@ -50,6 +51,7 @@ READBACK = {
     **{name: ("read", "read_into") for name in _TEXTURES},
 }
 READBACK_PROPERTIES = {"Query": ("elapsed",)}
+STATE = {"Uniform": ("write",)}      # counted (uniform writes: ``meter.uniform_writes``), never stubbed
 OWN = {TimerQuery: {"begin": "query", "poll": "query", "result": "readback"}}
 _PACKAGE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))   # atmos/
 _ROOT = os.path.dirname(_PACKAGE)
@@ -87,6 +89,11 @@ class GLMeter:
     def readback_s(self) -> float:
         return self.seconds["readback"]
 
+    @property
+    def uniform_writes(self) -> int:
+        """Uniform values written (``Uniform.write``: every ``.value =`` and ``write_uniforms`` write)."""
+        return self.calls["Uniform.write"]
+
     def reset(self) -> None:
         """Forget what was recorded so far (the meter stays installed)."""
         self.calls.clear()
@@ -101,7 +108,7 @@ class GLMeter:
     def __enter__(self) -> "GLMeter":
         if self._saved:
             raise RuntimeError("GLMeter is already installed; meters do not nest")
-        for table, kind in ((WORK, "work"), (READBACK, "readback")):
+        for table, kind in ((WORK, "work"), (READBACK, "readback"), (STATE, "state")):
             for cls_name, methods in table.items():
                 cls = getattr(moderngl, cls_name, None)
                 for method in methods:

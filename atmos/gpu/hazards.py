@@ -28,6 +28,7 @@ Access kinds (also what :class:`atmos.graph.PassBuilder` declares):
 from __future__ import annotations
 
 import weakref
+from collections import defaultdict
 
 import moderngl
 
@@ -50,6 +51,9 @@ _ALL = {kind: sum({bits for (k, _), bits in _BITS.items() if k == kind}) for kin
 
 BIT_NAMES = {bit: name.removesuffix("_BARRIER_BIT").lower() for name in dir(moderngl)
              if name.endswith("_BARRIER_BIT") and (bit := getattr(moderngl, name))}
+_BIT_ORDER = sorted(BIT_NAMES.items())
+_KINDS = {moderngl.Buffer: "buffer", **{cls: "texture" for cls in
+          (moderngl.Texture, moderngl.Texture3D, moderngl.TextureArray, moderngl.TextureCube)}}
 
 
 def kind_of(obj) -> str | None:
@@ -98,21 +102,25 @@ class Hazards:
     def __init__(self, ctx):
         self._ctx = weakref.ref(ctx)          # the registry is keyed by ctx: a strong ref would keep it alive
         self.barriers = 0
-        self.bits_issued: dict[str, int] = {}
+        self.bits_issued: dict[str, int] = defaultdict(int)
         self._dirty: dict[int, list] = {}     # id(obj) -> [weakref, kind, bits still to issue]
         self._staged: dict[int, tuple] = {}   # bound for a storage write by the coming dispatch: id -> (ref, kind)
         self._need = 0                        # bits the binds of the coming work asked for (issued by flush)
 
     def stage(self, obj) -> None:
         """``obj`` is bound for a storage write by the next :meth:`commit`-ed work (a bind does this)."""
-        kind = kind_of(obj)
-        if kind is not None:
-            self._staged[id(obj)] = (weakref.ref(obj), kind)
+        try:
+            kind = _KINDS[type(obj)]
+        except KeyError:
+            kind = kind_of(obj)
+            if kind is None:
+                return
+        self._staged[id(obj)] = (obj, kind)
 
     def commit(self) -> None:
         """The work just recorded ran: what was staged for writing is now dirty."""
-        for key, (ref, kind) in self._staged.items():
-            self._dirty[key] = [ref, kind, _ALL[kind]]
+        for key, (obj, kind) in self._staged.items():
+            self._dirty[key] = [weakref.ref(obj), kind, _ALL[kind]]
         self._staged.clear()
 
     def use(self, reads=(), writes=(), defer: bool = False) -> int:
@@ -170,8 +178,10 @@ class Hazards:
         self._ctx().memory_barrier(bits)
         self._need = 0
         self.barriers += 1
-        for name in bit_names(bits):
-            self.bits_issued[name] = self.bits_issued.get(name, 0) + 1
+        issued = self.bits_issued
+        for bit, name in _BIT_ORDER:
+            if bits & bit:
+                issued[name] += 1
         for key, entry in list(self._dirty.items()):
             entry[2] &= ~bits
             if not entry[2] or entry[0]() is None:
@@ -211,16 +221,20 @@ def hazards_of(ctx) -> Hazards:
 def dispatch(program, *groups: int) -> None:
     """Run compute ``program`` over ``groups`` work groups (x[, y[, z]]); what its binds staged for a
     storage write is dirty afterwards (:class:`Hazards`). The one way atmos runs a compute program."""
-    hazards = hazards_of(program.ctx)
-    hazards.flush()
+    extra = program.extra
+    hazards = extra["hazards"] if type(extra) is dict and "hazards" in extra else hazards_of(program.ctx)
+    if hazards._need:
+        hazards.flush()
     program.run(*groups)
-    hazards.commit()
+    if hazards._staged:
+        hazards.commit()
 
 
 def dispatch_indirect(program, args, offset: int = 0) -> None:
     """Run compute ``program`` with its group counts read on the GPU from buffer ``args`` (3 uints at
     ``offset``), after the barrier that makes a shader's write of ``args`` visible as indirect arguments."""
-    hazards = hazards_of(program.ctx)
+    extra = program.extra
+    hazards = extra["hazards"] if type(extra) is dict and "hazards" in extra else hazards_of(program.ctx)
     hazards.need(args, moderngl.COMMAND_BARRIER_BIT)     # with what the binds asked for: one barrier
     hazards.flush()
     program.run_indirect(args, offset)

@@ -8,6 +8,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 import moderngl
+import numpy as np
 
 from atmos.gpu.hazards import hazards_of
 
@@ -19,22 +20,90 @@ def _hazards(program):
     return hazards if hazards is not None else hazards_of(program.ctx)
 
 
+_SCALARS = frozenset((float, int, bool, tuple, bytes, np.float64, np.float32, np.int64, np.int32, np.bool_))
+# values compared with the last one written (a cheap ==); a 1-D numpy array is compared as a tuple
+
+
+def _tables(program):
+    """(members, written) of ``program``: its uniforms by name (None where the compiler dropped the
+    name) and the last value :func:`write_uniforms` wrote to each, kept in ``program.extra`` (None,
+    None for a program without it: nothing cached)."""
+    extra = program.extra
+    if type(extra) is not dict:
+        return None, None
+    try:
+        return extra["members"], extra["last"]
+    except KeyError:
+        extra["members"], extra["last"] = {}, {}
+        return extra["members"], extra["last"]
+
+
 def write_uniforms(program, values: Mapping[str, object] | None = None, /, **more) -> None:
     """Write each value to ``program``'s uniform of that name; a name the program does not have (the
     compiler drops uniforms it proves unused, and shader variants use different ones) is skipped.
     ``bytes`` are written as they are (matrices, arrays); a ``list`` fills an array uniform, cut to the
-    length the compiler kept (a tuple is one vector); anything else is the uniform's ``value``."""
-    get = program.get
+    length the compiler kept (a tuple is one vector); anything else is the uniform's ``value``.
+    A program keeps its uniforms' values: a number, tuple, 1-D array or ``bytes`` equal to the one this
+    wrote last is not written again (a float zero only of the same sign; a uniform written past this
+    function must be forgotten: :func:`forget_uniform`)."""
+    members, last = _tables(program)
+    if members is None:
+        members, last = {}, None
     for name, value in ({**values, **more} if values else more).items():
-        member = get(name, None)
+        try:
+            member = members[name]
+        except KeyError:
+            member = members[name] = program.get(name, None)
         if member is None:
             continue
-        if isinstance(value, (bytes, bytearray, memoryview)):
+        kind = type(value)
+        if kind is np.ndarray and value.ndim == 1:
+            value = tuple(value.tolist())
+            kind = tuple
+        if kind in _SCALARS and last is not None:
+            if name in last and last[name] == value and (value or kind is not float or str(value) == str(last[name])):
+                continue                      # (a float zero only of the same sign: -0.0 is not 0.0)
+            last[name] = value
+        elif last is not None and name in last:
+            del last[name]
+        if kind is bytes or kind is bytearray or kind is memoryview:
             member.write(value)
-        elif isinstance(value, list):
+        elif kind is list:
             member.value = value[:member.array_length] if member.array_length > 1 else value[0]
         else:
             member.value = value
+
+
+def has_member(program, name: str) -> bool:
+    """Whether ``program`` has a uniform, sampler or block ``name`` (``name in program`` walks every member)."""
+    members, _ = _tables(program)
+    if members is None:
+        return program.get(name, None) is not None
+    try:
+        return members[name] is not None
+    except KeyError:
+        member = members[name] = program.get(name, None)
+        return member is not None
+
+
+def sampler_units(program, name: str):
+    """The unit of ``program``'s sampler ``name`` (a list of units for a sampler array; None where it has
+    none), as :func:`bind_textures` binds it."""
+    extra = program.extra
+    units_of = extra.setdefault("units", {}) if type(extra) is dict else {}
+    try:
+        return units_of[name]
+    except KeyError:
+        member = program.get(name, None)
+        value = units_of[name] = None if member is None else member.value
+        return value
+
+
+def forget_uniform(program, name: str) -> None:
+    """``name`` was written past :func:`write_uniforms`: its next value there is written whatever it is."""
+    members, last = _tables(program)
+    if last is not None and name in last:
+        del last[name]
 
 
 def bind_textures(program, textures: Mapping[str, object] | None = None, /, sampler=None, **more) -> list[int]:
@@ -42,21 +111,32 @@ def bind_textures(program, textures: Mapping[str, object] | None = None, /, samp
     of its declaration; a sequence of textures to a sampler array, element by element); a name the
     program does not use is skipped. ``sampler`` (a moderngl Sampler) is bound at those units too.
     Returns the units bound (to clear ``sampler`` from afterwards)."""
-    get = program.get
+    extra = program.extra
+    if type(extra) is dict:
+        try:
+            units_of, hazards = extra["units"], extra["hazards"]
+        except KeyError:
+            units_of = extra["units"] = {}
+            hazards = _hazards(program)
+    else:
+        units_of, hazards = {}, _hazards(program)
     units = []
-    dirty = (hazards := _hazards(program))._dirty
+    dirty = hazards._dirty
     for name, texture in ({**textures, **more} if textures else more).items():
-        member = get(name, None)
-        if member is None:
+        try:
+            value = units_of[name]
+        except KeyError:
+            member = program.get(name, None)   # a sampler array: its units (one int where one element is used)
+            value = units_of[name] = None if member is None else member.value
+        if value is None:
             continue
-        value = member.value                 # a sampler array: its units (one int where one element is used)
-        if isinstance(texture, (list, tuple)):
-            pairs = zip(value if isinstance(value, list) else [value], texture)
+        if type(texture) is list or type(texture) is tuple:
+            pairs = zip(value if type(value) is list else [value], texture)
         else:
             pairs = ((value, texture),)
         for unit, one in pairs:
-            if id(one) in dirty:
-                hazards.need(one, moderngl.TEXTURE_FETCH_BARRIER_BIT)
+            if dirty and (key := id(one)) in dirty and (entry := dirty[key])[0]() is one:   # Hazards.need, inlined
+                hazards._need |= entry[2] & moderngl.TEXTURE_FETCH_BARRIER_BIT
             one.use(unit)
             if sampler is not None:
                 sampler.use(unit)
@@ -68,13 +148,15 @@ def bind_images(program, images: Mapping[str, object] | None = None, /, **more) 
     """Bind each texture as an image at the unit of ``program``'s image uniform of that name (its
     ``layout(binding = N, format)``), for the access its declaration gives (``readonly``,
     ``writeonly`` or both); a name the program does not use is skipped."""
-    declared = program.extra["images"]        # (unit, read, write) by name, from the compiler check
-    dirty = (hazards := _hazards(program))._dirty
+    extra = program.extra
+    declared = extra["images"]                # (unit, read, write) by name, from the compiler check
+    hazards = extra["hazards"] if "hazards" in extra else _hazards(program)
+    dirty = hazards._dirty
     for name, texture in ({**images, **more} if images else more).items():
         if name in declared:
             unit, read, write = declared[name]
-            if id(texture) in dirty:
-                hazards.need(texture, moderngl.SHADER_IMAGE_ACCESS_BARRIER_BIT)
+            if dirty and (key := id(texture)) in dirty and (entry := dirty[key])[0]() is texture:
+                hazards._need |= entry[2] & moderngl.SHADER_IMAGE_ACCESS_BARRIER_BIT
             if write:
                 hazards.stage(texture)
             texture.bind_to_image(unit, read=read, write=write)
@@ -84,15 +166,50 @@ def bind_buffers(program, buffers: Mapping[str, object] | None = None, /, **more
     """Bind each buffer at the binding of ``program``'s storage block of that name (its
     ``layout(std430, binding = N) buffer Name``); a name the program does not use is skipped. A
     block not declared ``readonly`` counts as written by the next dispatch."""
-    get = program.get
     extra = program.extra                        # storage blocks not declared readonly, from the compiler check
-    written = extra.get("written") if isinstance(extra, dict) else None   # unknown: every block may be
-    dirty = (hazards := _hazards(program))._dirty
+    if type(extra) is dict:
+        written = extra["written"] if "written" in extra else None
+        hazards = extra["hazards"] if "hazards" in extra else hazards_of(program.ctx)
+        try:
+            bindings = extra["bindings"]
+        except KeyError:
+            bindings = extra["bindings"] = {}
+    else:
+        written, hazards, bindings = None, hazards_of(program.ctx), {}   # unknown: every block may be written
+    dirty = hazards._dirty
     for name, buffer in ({**buffers, **more} if buffers else more).items():
-        member = get(name, None)
-        if member is not None:
-            if id(buffer) in dirty:
-                hazards.need(buffer, moderngl.SHADER_STORAGE_BARRIER_BIT)
+        try:
+            binding = bindings[name]
+        except KeyError:
+            member = program.get(name, None)
+            binding = bindings[name] = None if member is None else member.binding
+        if binding is not None:
+            if dirty and (key := id(buffer)) in dirty and (entry := dirty[key])[0]() is buffer:
+                hazards._need |= entry[2] & moderngl.SHADER_STORAGE_BARRIER_BIT
             if written is None or name in written:
                 hazards.stage(buffer)
-            buffer.bind_to_storage_buffer(member.binding)
+            buffer.bind_to_storage_buffer(binding)
+
+
+def write_block(program, name: str, binding: int, data: bytes) -> bool:
+    """Bind ``program``'s own buffer of uniform block ``name`` at ``binding`` with ``data`` (std140,
+    packed by the caller), written only when it changed (the buffer is kept in ``program.extra`` and
+    released with the program by the GpuContext that owns it). Returns False, doing nothing, where the program has no such block."""
+    if not has_member(program, name):
+        return False
+    extra = program.extra
+    if type(extra) is not dict:                  # a program made past the compiler check
+        extra = program.extra = {}
+    blocks = extra.setdefault("blocks", {})
+    entry = blocks.get(name)
+    if entry is None or len(entry[1]) != len(data):
+        if entry is not None:
+            entry[0].release()
+            extra["owned"].remove(entry[0])
+        entry = blocks[name] = [program.ctx.buffer(reserve=len(data)), b""]
+        extra.setdefault("owned", []).append(entry[0])
+    if entry[1] != data:
+        entry[0].write(data)
+        entry[1] = data
+    entry[0].bind_to_uniform_block(binding)
+    return True

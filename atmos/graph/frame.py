@@ -72,10 +72,23 @@ class PassContext:
         ``color`` is a name or a list of names. An imported framebuffer (such as the screen target)
         named alone as ``color`` is returned as it is.
         """
-        names = [color] if isinstance(color, str) else list(color)
-        attachments = [self.resource(n) for n in names]
-        depth_attachment = self.resource(depth) if depth is not None else None
-        if any(isinstance(a, moderngl.Framebuffer) for a in attachments + [depth_attachment]):
+        names = [color] if type(color) is str else list(color)
+        declared, resources = self._declared, self._resources
+        try:                                # the common case: declared textures, known this frame
+            attachments = [resources[n] for n in names if n in declared]
+            depth_attachment = None if depth is None else resources[depth] if depth in declared else False
+        except KeyError:
+            attachments = None
+        slow = attachments is None or len(attachments) != len(names) or depth_attachment is False
+        if not slow:
+            for a in attachments:
+                if type(a) is moderngl.Framebuffer:
+                    slow = True
+        if slow or type(depth_attachment) is moderngl.Framebuffer:
+            attachments = [self.resource(n) for n in names]          # the errors, and imported framebuffers
+            depth_attachment = self.resource(depth) if depth is not None else None
+            slow = any(isinstance(a, moderngl.Framebuffer) for a in attachments + [depth_attachment])
+        if slow:
             if len(attachments) == 1 and depth_attachment is None:
                 return attachments[0]
             raise GraphError(f"pass '{self.pass_name}': the imported framebuffer among {names + [depth]} "
@@ -84,13 +97,17 @@ class PassContext:
             raise GraphError(f"pass '{self.pass_name}': framebuffer() needs at least one color or a depth name")
         hazards = self.gpu.hazards
         dirty = hazards._dirty      # a texture a compute pass wrote, now drawn into: its writes first
-        if dirty and any(id(a) in dirty for a in attachments + [depth_attachment]):
+        if dirty and not dirty.keys().isdisjoint(map(id, attachments + [depth_attachment])):
             hazards.use(reads=[(a, "attachment") for a in attachments + [depth_attachment] if a is not None])
-        key = tuple(id(a) for a in attachments) + (id(depth_attachment),)
+        key = (*map(id, attachments), id(depth_attachment))
         entry = self._framebuffers.get(key)
-        if entry is not None and all(_alive(a) for a in entry[1]):
-            self._framebuffers.move_to_end(key)
-            return self._reset_framebuffer(entry[0])
+        if entry is not None:
+            for a in entry[1]:
+                if type(a.mglo) is moderngl.InvalidObject:     # _alive, inlined: released since
+                    break
+            else:
+                self._framebuffers.move_to_end(key)
+                return self._reset_framebuffer(entry[0])
         if entry is not None:
             self._drop(key)
         try:

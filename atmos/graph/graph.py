@@ -42,6 +42,7 @@ class RenderGraph:
         self._imports: dict[str, object] = {}
         self._compiled: CompiledGraph | None = None
         self._key: tuple | None = None
+        self._declared = None                # the last declarations (passes, their phases, builders, imports)
         self._prepared: dict[str, RenderPass] = {}
         self._timers = PassTimers(gpu.ctx)
         self._frame = PassContext(gpu)
@@ -116,14 +117,37 @@ class RenderGraph:
         """This frame's compiled graph: every pass's ``setup`` runs; the graph is compiled again only
         when a declaration, a phase, a pass or an import changed."""
         builders = self.declare()
-        key = (tuple((p.name, p.phase, p.before, p.after, builders[p.name].key()) for p in self._passes.values()),
-               tuple(self._imports))
+        passes = list(self._passes.values())
+        if not self._same_declarations(passes, builders):
+            key = (tuple((p.name, p.phase, p.before, p.after, builders[p.name].key()) for p in passes),
+                   tuple(self._imports))
+        else:
+            key = self._key
+        self._declared = (passes, [(p.name, p.phase, p.before, p.after) for p in passes], builders, tuple(self._imports))
         if key != self._key:
             compiled = compile_graph(list(self._passes.values()), builders, self._imports)
             self._compiled, self._key = compiled, key
             self.compiles += 1
             self._timers.keep_only(set(compiled.kept))
         return self._compiled
+
+    def _same_declarations(self, passes, builders) -> bool:
+        """Whether the passes, their phases and orderings, their declarations (in order) and the imports
+        are those of the last compile: the cheap check that spares building the graph's key."""
+        last = self._declared
+        if last is None or last[0] != passes or last[3] != tuple(self._imports):
+            return False
+        old = last[2]
+        for p, meta in zip(passes, last[1]):
+            if (p.name, p.phase, p.before, p.after) != meta:
+                return False
+            b, o = builders[p.name], old[p.name]
+            if (b.has_side_effect != o.has_side_effect or b.writes != o.writes      # values, then key order
+                    or b.reads != o.reads or b.access != o.access or b.creates != o.creates
+                    or list(b.reads) != list(o.reads) or list(b.access) != list(o.access)
+                    or list(b.creates) != list(o.creates)):
+                return False
+        return True
 
     def execute(self, view=None) -> None:
         """Run one frame: kept passes in order; ``view`` (an :class:`atmos.SceneView`: camera, sun,
@@ -154,7 +178,7 @@ class RenderGraph:
                     self._prepared[p.name] = p
                 reads, writes, stored = compiled.uses[i]
                 dirty = hazards._dirty      # the barrier this pass's declared uses need, before it
-                if dirty and any(id(resources[n]) in dirty for n, _ in reads + writes):
+                if dirty and not dirty.keys().isdisjoint([id(resources[n]) for n, _ in reads + writes]):
                     hazards.use(reads=[_use(resources, n, a, "sampled") for n, a in reads],
                                 writes=[_use(resources, n, a, "attachment") for n, a in writes])
                 frame._begin_pass(p.name, compiled.declared[i], compiled.declarations[p.name].access)

@@ -99,20 +99,26 @@ class PassBuilder:
     def read(self, name: str, at: str | None = None, access: str | None = None) -> None:
         """This pass samples (or blends onto) ``name``; ``at``: the phase whose final version it needs;
         ``access``: how it reads it (default ``sampled``; ``storage`` for image loads and storage blocks)."""
-        self._check(name)
+        if type(name) is not str or not name:
+            self._check(name)
         if at is not None and at not in PHASE_INDEX:
             raise GraphError(f"pass '{self.pass_name}' reads '{name}' at phase {at!r}; "
                              f"allowed: {', '.join(PHASES)}")
         self.reads[name] = at
-        self.access[name] = (self._access(name, access, None), self.access.get(name, (None, None))[1])
+        held = self.access
+        self.access[name] = (None if access is None else self._access(name, access, None),
+                             held[name][1] if name in held else None)
 
     def write(self, name: str, access: str | None = None) -> None:
         """This pass modifies an existing resource (read-modify-write passes also call ``read``);
         ``access``: how it writes it (default ``attachment``; ``storage`` for image stores)."""
-        self._check(name)
+        if type(name) is not str or not name:
+            self._check(name)
         if name not in self.writes:
             self.writes.append(name)
-        self.access[name] = (self.access.get(name, (None, None))[0], self._access(name, access, None))
+        held = self.access
+        held[name] = (held[name][0] if name in held else None,
+                      None if access is None else self._access(name, access, None))
 
     def _access(self, name: str, access: str | None, default: str | None) -> str | None:
         if access is None:

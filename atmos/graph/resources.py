@@ -28,13 +28,20 @@ class TextureDesc:
     storage: bool = False
 
     def __post_init__(self):
-        try:
-            size = tuple(int(s) for s in self.size)
-        except (TypeError, ValueError):
-            raise ValueError(f"TextureDesc.size must be (w, h) or (w, h, d) of positive ints, got {self.size!r}") from None
-        if len(size) not in (2, 3) or min(size) < 1 or any(s != o for s, o in zip(size, self.size)):
-            raise ValueError(f"TextureDesc.size must be (w, h) or (w, h, d) of positive ints, got {self.size!r}")
-        object.__setattr__(self, "size", size)
+        size = self.size
+        plain = type(size) is tuple and len(size) in (2, 3)      # a tuple of positive ints: kept as it is
+        if plain:
+            for s in size:
+                if type(s) is not int or s < 1:
+                    plain = False
+        if not plain:
+            try:
+                size = tuple(int(s) for s in self.size)
+            except (TypeError, ValueError):
+                raise ValueError(f"TextureDesc.size must be (w, h) or (w, h, d) of positive ints, got {self.size!r}") from None
+            if len(size) not in (2, 3) or min(size) < 1 or any(s != o for s, o in zip(size, self.size)):
+                raise ValueError(f"TextureDesc.size must be (w, h) or (w, h, d) of positive ints, got {self.size!r}")
+            object.__setattr__(self, "size", size)
         if self.components not in (1, 2, 3, 4):
             raise ValueError(f"TextureDesc.components must be 1, 2, 3 or 4, got {self.components!r}")
         if self.dtype not in DTYPES:

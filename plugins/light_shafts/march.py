@@ -130,7 +130,7 @@ class MarchedShafts:
         """The fog's factor and colour (as its own pass sets them) and its clouds' distance."""
         fog.set_uniforms(program, frame.view)
         bind_cloud_distance(frame, program)
-        program["fog_sun_share"].value = settings.fog_sun_share
+        write_uniforms(program, fog_sun_share=settings.fog_sun_share)
 
     @staticmethod
     def aerial_uniforms(frame: PassContext, program, sky) -> None:
@@ -144,4 +144,4 @@ def bind_cloud_distance(frame: PassContext, program) -> None:
     clouds = frame.declares(CLOUD_DISTANCE)
     if clouds:
         bind_textures(program, cloud_distance=frame.resource(CLOUD_DISTANCE))
-    program["has_cloud_distance"].value = int(clouds)
+    write_uniforms(program, has_cloud_distance=int(clouds))

@@ -8,6 +8,7 @@ from atmos.camera import Camera
 from atmos.composition import composition
 from atmos.graph import ComputePass, PassContext, RenderPass
 from atmos.lighting import Sun
+from atmos.gpu.uniforms import write_uniforms
 from atmos.plugin import Plugin
 import atmos.plugins.sky.sun_light as sun_light
 from atmos.plugins.sky.aerial import AERIAL, AerialPerspectivePass, active
@@ -75,7 +76,7 @@ class SkyPass(ComputePass):
         if self.physical:
             frame.resource(SKY_LUTS).bind(p)
             set_atmosphere_uniforms(p, settings.atmosphere)
-            p["view_r"].value = view_radius(settings.atmosphere, camera)
+            write_uniforms(p, view_r=view_radius(settings.atmosphere, camera))
         color = frame.image(COLOR)
         frame.dispatch(p, self.groups(color.size), textures={"scene_depth": DEPTH}, images={"color_image": color})
 

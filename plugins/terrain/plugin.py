@@ -9,6 +9,7 @@ import numpy as np
 from atmos.checks import CheckedSettings, int_field, num_field
 from atmos.collision import Hit, check_ray, height_normal, ray_grid
 from atmos.graph import PassContext
+from atmos.gpu.uniforms import write_uniforms
 from atmos.plugin import Plugin
 from atmos.plugins.terrain.heightfield import height, heightfield, triangle_count
 from atmos.render_core import OpaquePass
@@ -53,7 +54,7 @@ class TerrainPass(OpaquePass):
         self.begin(frame)
         if self.plugin.settings.mesh_key() != self.mesh_key:
             self.make_mesh(gpu)
-        self.program["relief"].value = self.plugin.settings.relief
+        write_uniforms(self.program, relief=self.plugin.settings.relief)
         self.vao.render(gpu.ctx.TRIANGLES)
 
     def _release_mesh(self) -> None:

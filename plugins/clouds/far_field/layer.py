@@ -20,9 +20,9 @@ import numpy as np
 
 from atmos.plugins.clouds.far_field.columns import rank_texture, read_rank_texture, use_columns
 from atmos.plugins.clouds.far_field.cover import LEVELS, QUANTILES, level_ranks, matched_tile_size, pattern_crossings
-from atmos.plugins.clouds.far_field.pattern import CHANNEL_STEPS, PERIODS, octave_frequencies, octave_offsets, rotations
+from atmos.plugins.clouds.far_field.pattern import CHANNEL_STEPS, PERIODS, octave_frequencies, octave_offsets, rotations, turns_bytes
 from atmos.plugins.clouds.far_field.rank_light import RankLight
-from atmos.plugins.clouds.volume.light import cell_tau, light_uniforms
+from atmos.plugins.clouds.volume.light import cell_tau, unit_direction
 from atmos.plugins.clouds.volume.sets import CloudSets
 from atmos.tile_octaves import OctaveTextures
 from atmos.gpu.uniforms import bind_buffers, bind_images, bind_textures, write_uniforms
@@ -88,6 +88,7 @@ class FarFieldLayer:
         self.profile = None                  # (INTERVALS, heights) rg32f: the volume's shape by rank (cover.comp)
         self.light = RankLight(gpu)          # the volume's light by rank (light_by_rank.comp)
         self._prepared = None                # the SceneView of the frame prepared last (held: never a reused id)
+        self._uniforms = None                # (view, sim, tile size, settings) and the field uniforms for them
         self.ranks = None                    # far_rank_table (rank_table_texture) of the texture setting _ranks_for
         self._ranks_for = None
 
@@ -103,7 +104,7 @@ class FarFieldLayer:
             return
         self._prepared = view
         params = self.settings
-        sun_dir = light_uniforms(sim.settings, view.sun)["sun_dir"]
+        sun_dir = tuple(float(v) for v in unit_direction(view.sun))     # light_uniforms' sun_dir
         if self.octaves.needs_bake(params, sun_dir, REBAKE_TOLERANCE):
             self.octaves.bake(params, sun_dir, octave_frequencies(params.base_frequency), rotations(), CHANNEL_STEPS)
         self.measure_cover(sim)
@@ -161,8 +162,7 @@ class FarFieldLayer:
         use_columns(c, sim, density=profile)
         if profile:
             bind_images(c, column_profile=self._profile_texture(profile_heights(sim.shape[1])))
-        c["threshold"].value = float(sim.settings.cover_threshold)
-        c["max_sum"].value = float(sim.shape[1])
+        write_uniforms(c, threshold=float(sim.settings.cover_threshold), max_sum=float(sim.shape[1]))
         bind_buffers(c, Cover=self.cover)
         dispatch(c, 1)
 
@@ -199,21 +199,30 @@ class FarFieldLayer:
         if self.profile is not None:
             bind_textures(program, far_profile=self.profile)
         self.light.use(program)
+        key = (view, sim, self.tile_size, params)
+        cached = self._uniforms
+        if cached is None or len(cached[0]) != len(key) or any(a is not b for a, b in zip(cached[0], key)):
+            cached = self._uniforms = (key, self._field_uniforms(view, sim))   # once per frame, whatever the users
+        bind_textures(program, far_rank_table=self.ranks)
+        write_uniforms(program, cached[1])
+
+    def _field_uniforms(self, view, sim: CloudSets) -> dict:
+        """field.glsl's uniforms for ``view`` (what :meth:`use` writes)."""
+        params = self.settings
         time = float(view.time) if params.animate else 0.0
         layout = sim.layout()
         camera = np.asarray(view.camera.position, np.float64)
         offsets = octave_offsets(camera[[0, 2]] + travel(params, sim, time), self.tile_size)
-        values = dict(field_origin=tuple(camera[[0, 2]]), field_tile_size=float(self.tile_size),
-                      field_lod_shift=tuple(np.log2(PERIODS)),
-                      field_mid_height=float(0.5 * (layout.lo[1] + layout.hi[1])),
-                      field_column_tau=column_tau(params, sim))
         span, first = self._rank_table()
-        bind_textures(program, far_rank_table=self.ranks)
         crossings = pattern_crossings(params.base_frequency, params.seed, params.size)   # far.comp's slant_rank
-        write_uniforms(program, values, field_offsets=offsets.astype("f4").tobytes(),
-                       field_turns=np.transpose(rotations(), (0, 2, 1)).astype("f4").tobytes(),   # column-major
-                       far_rank_span=tuple(span), field_first_level=first,
-                       field_crossings=np.asarray(crossings, "f4").tobytes())
+        return dict(field_origin=tuple(camera[[0, 2]]), field_tile_size=float(self.tile_size),
+                    field_lod_shift=tuple(np.log2(PERIODS)),
+                    field_mid_height=float(0.5 * (layout.lo[1] + layout.hi[1])),
+                    field_column_tau=column_tau(params, sim),
+                    field_offsets=offsets.astype("f4").tobytes(),
+                    field_turns=turns_bytes(),   # column-major
+                    far_rank_span=tuple(span), field_first_level=first,
+                    field_crossings=np.asarray(crossings, "f4").tobytes())
 
     def _rank_table(self) -> tuple:
         """(span, first level) of :attr:`ranks`, baked anew when the texture setting changed."""

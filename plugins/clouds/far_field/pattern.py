@@ -23,10 +23,25 @@ RELIEF_STEPS = 2.0                                          # light steps to the
 CHANNEL_STEPS = (0.0, RELIEF_STEPS, -RELIEF_STEPS, 0.0)     # the baked channels' light steps toward the sun
 
 
-def rotations() -> np.ndarray:
-    """(4, 2, 2) R(TURNS[k]) / PERIODS[k]: world xz in tiles → octave k's uv."""
+def _rotations() -> np.ndarray:
     c, s = np.cos(TURNS), np.sin(TURNS)
-    return np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2) / PERIODS[:, None, None]
+    turns = np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2) / PERIODS[:, None, None]
+    turns.setflags(write=False)
+    return turns
+
+
+_ROTATIONS = _rotations()
+_TURNS_F4 = np.transpose(_ROTATIONS, (0, 2, 1)).astype("f4").tobytes()     # column-major mat2[4]
+
+
+def rotations() -> np.ndarray:
+    """(4, 2, 2) R(TURNS[k]) / PERIODS[k]: world xz in tiles → octave k's uv (computed once, read-only)."""
+    return _ROTATIONS
+
+
+def turns_bytes() -> bytes:
+    """:func:`rotations` as a GLSL ``mat2[4]`` (column-major float32)."""
+    return _TURNS_F4
 
 
 def octave_uv(xz, offsets, tile_size: float) -> np.ndarray:

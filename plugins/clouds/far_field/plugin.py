@@ -10,11 +10,10 @@ from atmos.plugin import Plugin
 from atmos.plugins.clouds.far_field.layer import FarFieldLayer
 from atmos.plugins.clouds.volume.sets import FAR_FIELD
 from atmos.plugins.clouds.far_field.settings import CloudFarFieldSettings
-from atmos.plugins.clouds.volume.light import CloudLightSettings, light_uniforms
+from atmos.plugins.clouds.volume.light import CloudLightSettings, light_uniforms, write_light
 from atmos.plugins.clouds.volume.field_demand import field_demand
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CloudSets
 from atmos.render_core import COLOR, DEPTH
-from atmos.gpu.uniforms import write_uniforms
 
 
 class CloudFarFieldPass(ComputePass):
@@ -60,7 +59,7 @@ class CloudFarFieldPass(ComputePass):
                                       / max(view.size[1], 1)),
                       **{name: float(getattr(params, name)) for name in
                          ("thickness", "horizon_fade")})
-        write_uniforms(p, values)
+        write_light(p, values)
         images = {"color_image": COLOR, **({"distance_image": CLOUD_DISTANCE} if distance else {})}
         frame.dispatch(p, self.groups(frame.image(COLOR).size), textures={"scene_depth": DEPTH}, images=images)
 

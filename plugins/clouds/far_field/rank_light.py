@@ -16,7 +16,7 @@ from atmos.plugins.clouds.far_field.columns import INTERVALS, rank_texture, read
 from atmos.plugins.clouds.volume.light import cell_tau
 from atmos.plugins.clouds.light.diffusion import DIFFUSION
 from atmos.gpu.hazards import dispatch
-from atmos.gpu.uniforms import bind_buffers, bind_images, bind_textures
+from atmos.gpu.uniforms import bind_buffers, bind_images, bind_textures, write_uniforms
 
 READS = {"transmittance": "trans", DIFFUSION: "diffusion"}   # light_by_rank.comp's inputs beside columns.glsl's
 FIELD_BINS = 16                  # light_by_rank.comp's most height bins (sun_profile, field_profile)
@@ -53,9 +53,7 @@ class RankLight:
             use_columns(c, sim)
             bind_textures(c, inputs)
             bind_buffers(c, Cover=cover_buffer, Sums=self.sums)
-            for name, value in values.items():
-                if name in c:
-                    c[name].value = value
+            write_uniforms(c, values)
             if stage == 1:
                 bind_images(c, sun_by_rank=self.sun, thickness_by_rank=self.thickness, height_by_rank=self.height,
                             sun_profile=self.sun_profile)

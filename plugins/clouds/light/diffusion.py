@@ -24,6 +24,7 @@ float32 sum overflows.
 """
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -38,6 +39,9 @@ from atmos.plugins.clouds.light.reference import multilinear
 from atmos.plugins.clouds.light.shear_warp import check_volume_texture, groups, program
 from atmos.gpu.uniforms import bind_buffers, bind_images, bind_textures, write_uniforms
 from atmos.gpu.hazards import dispatch, dispatch_indirect
+from atmos.gpu.block_table import BlockTable, ints
+
+STEP_BINDING = 1        # diffusion.comp's Step block
 
 FLOOR = 1e-3               # 1/m: transport extinction floor (empty cells still conduct, finitely)
 TOLERANCE = 1e-4           # relative residual |b - A phi| / |b| the GPU solve stops at
@@ -231,14 +235,19 @@ class DiffusionSolver:
         self._parts = ctx.buffer(reserve=6 * 4 * self.groups)
         self._parts.clear()
         self._args = ctx.buffer(np.array([self.groups, 1, 1], np.uint32).tobytes())
+        self._steps = BlockTable(self.gpu, STEP_BINDING, [ints(stage, cur, first) for stage, cur, first
+                                                          in itertools.product(range(5), (0, 1), (0, 1))])
         self._cur = 0
         self._first = True
         self.iterations = 0          # run since the last begin (each does nothing once converged)
 
     def _dispatch(self, stage: int, **values) -> None:
-        """Stages 2 and 3 (the iteration) run indirect: no groups once converged."""
+        """Stages 2 and 3 (the iteration) run indirect: no groups once converged. The stage and the
+        iteration's state come from the Step block's record (stage, cur, first): no uniform writes."""
         prog = program(self.gpu, "diffusion")
-        write_uniforms(prog, values, stage=stage, cur=self._cur, first=int(self._first))
+        if values:
+            write_uniforms(prog, values)
+        self._steps.use(4 * stage + 2 * self._cur + int(self._first))
         bind_buffers(prog, Cells=self._cells, Parts=self._parts, Args=self._args)
         if stage in (2, 3):
             dispatch_indirect(prog, self._args)
@@ -296,6 +305,7 @@ class DiffusionSolver:
             if buf is not None:
                 buf.release()
         self._cells = self._parts = self._args = None
+        self._steps.release()
 
 
 class DiffusionTask(SliceTask):

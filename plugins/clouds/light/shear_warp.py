@@ -27,8 +27,11 @@ from atmos.gpu.context import GpuContext, require_gpu
 from atmos.gpu.uniforms import bind_images, bind_textures, write_uniforms
 import atmos.plugins.clouds.light.grid as grid
 from atmos.gpu.hazards import dispatch
+from atmos.gpu.block_table import BlockTable, ints
 
 _RESULT_FORMATS = {"f4": "r32f", "f2": "r16f"}
+_UNIT = ((1, 0, 0), (0, 1, 0), (0, 0, 1))      # axis_a/b/c by axis
+SLICE_BINDING = 1                               # shear_warp.comp's Slice block
 
 
 def program(gpu: GpuContext, name: str, **defines):
@@ -87,6 +90,8 @@ class ShearWarpShader:
         self._slices = [self._track(self.ctx.texture((side, side), 1, dtype="f4")) for _ in range(2)]
         self._coarse = (self._track(self.ctx.texture3d(self.shading_shape, 1, dtype="f4"))
                         if self.scale > 1 else None)
+        self._slice_table = BlockTable(gpu, SLICE_BINDING, [ints(j, first) for j in range(side) for first in (0, 1)])
+        self._objects.append(self._slice_table)
         self._plan = None
         self._next = 0
 
@@ -110,7 +115,7 @@ class ShearWarpShader:
         if self._coarse is not None:
             prog = program(self.gpu, "downsample", SCALE=self.scale)
             bind_textures(prog, fine=density_texture)
-            prog["fine_size"].value = self.shape
+            write_uniforms(prog, fine_size=self.shape)
             bind_images(prog, coarse=self._coarse)
             dispatch(prog, *(groups(n, 4) for n in self.shading_shape))
             density_texture = self._coarse
@@ -154,22 +159,17 @@ class ShearWarpShader:
         if self.model == "fixed-ratio":
             defines.update(FIXED_RATIO=1, LEVELS=self.levels)
         prog = program(self.gpu, "shear_warp", **defines)
-        basis = np.eye(3, dtype=int)
         a, (b, c) = plan.axis, plan.lateral
-        prog["size"].value = self.shading_shape
-        for name, axis in (("axis_a", a), ("axis_b", b), ("axis_c", c)):
-            prog[name].value = tuple(int(x) for x in basis[axis])
-        prog["step_dir"].value = tuple(float(x) for x in plan.step)
-        write_uniforms(prog, step_len=plan.length)
-        prog["sigma"].value = self._sigma
+        write_uniforms(prog, size=self.shading_shape, axis_a=_UNIT[a], axis_b=_UNIT[b], axis_c=_UNIT[c],
+                       step_dir=tuple(float(x) for x in plan.step), step_len=float(plan.length), sigma=self._sigma)
         bind_textures(prog, density=self._density)
         bind_images(prog, result=self._target)
         nb, nc = self.shading_shape[b], self.shading_shape[c]
+        order = plan.order
         for i in range(i0, i1):
             src, dst = self._slices[i % 2], self._slices[1 - i % 2]
             bind_images(prog, prev_slice=src, next_slice=dst)
-            prog["slice"].value = plan.order[i]
-            prog["first"].value = int(i == 0)
+            self._slice_table.use(2 * int(order[i]) + (i == 0))     # the Slice block: (slice, first)
             dispatch(prog, groups(nb, 8), groups(nc, 8))
         self._next = i1
 

@@ -13,7 +13,7 @@ from atmos.plugins.clouds.shadows.shadow_map import SHADOW_MAP, SHADOW_SPACE, sh
 from atmos.plugins.clouds.volume.column import column_uniforms
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS, FAR_FIELD, CloudSets
 from atmos.render_core import COLOR, DEPTH
-from atmos.gpu.uniforms import bind_textures
+from atmos.gpu.uniforms import bind_textures, write_uniforms
 
 
 def direct_weight(sun_direction, sun_color, settings) -> float:
@@ -81,7 +81,7 @@ class CloudShadowsPass(FullscreenPass):
         ctx.enable(ctx.BLEND)
         ctx.blend_func = ctx.ZERO, ctx.SRC_COLOR, ctx.ZERO, ctx.ONE    # alpha (sky occlusion) kept
         bind_textures(p, scene_depth=frame.resource(DEPTH))
-        p["weight"].value = weight
+        write_uniforms(p, weight=weight)
         if frame.declares(SHADOW_MAP):
             field_tau = column_tau(frame.resource(FAR_FIELD).settings, sim) if frame.declares(FAR_FIELD) else 0.0
             use_shadow_map(frame, p, sigma * params.strength, field_tau * params.strength)
@@ -92,7 +92,7 @@ class CloudShadowsPass(FullscreenPass):
             layer = frame.resource(FAR_FIELD)
             layer.prepare(view, sim)
             layer.use(p, view, sim)
-            p["field_column_tau"].value = column_tau(layer.settings, sim) * params.strength
+            write_uniforms(p, field_column_tau=column_tau(layer.settings, sim) * params.strength)
         frame.fullscreen(p)
 
 

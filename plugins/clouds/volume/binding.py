@@ -2,11 +2,11 @@
 from __future__ import annotations
 
 from atmos.lighting import Sun
-from atmos.plugins.clouds.volume.light import DEFAULT_OCTAVES, light_uniforms
+from atmos.plugins.clouds.volume.light import DEFAULT_OCTAVES, light_uniforms, write_light
 from atmos.plugins.clouds.volume.sets import CloudSets
 from atmos.plugins.clouds.light.columns import COLUMNS
 from atmos.plugins.clouds.light.diffusion import DIFFUSION
-from atmos.gpu.uniforms import bind_textures, write_uniforms
+from atmos.gpu.uniforms import bind_textures, sampler_units
 
 SAMPLERS = ("density_a", "density_b", "trans_a", "trans_b", "columns_a", "columns_b", "diffusion_a", "diffusion_b")
 
@@ -28,15 +28,15 @@ def bind_volume(program, sim, sampler, sun: Sun | None, octaves=DEFAULT_OCTAVES,
     bind_textures(program, sampler=sampler, density_a=a["density"], density_b=b["density"], trans_a=a[light],
                   trans_b=b[light], columns_a=a[COLUMNS], columns_b=b[COLUMNS], diffusion_a=a[spread],
                   diffusion_b=b[spread])
-    program["t"].value = float(t)
-    write_uniforms(program, light_uniforms(sim.settings, sun, octaves, diffusion if field else 0.0, layer),
+    write_light(program, light_uniforms(sim.settings, sun, octaves, diffusion if field else 0.0, layer),
                    a_shift=(sim if isinstance(sim, CloudSets) else sim.sets()).a_shift, has_shading=int(shading),
-                   edge_fade=float(sim.settings.edge_fade))
+                   edge_fade=float(sim.settings.edge_fade), t=float(t))
     return float(t)
 
 
 def unbind_volume(program, sampler) -> None:
     """Unbind the sampler from the volume's units so later passes sample with their textures' own settings."""
     for name in SAMPLERS:
-        if name in program:
-            sampler.clear(program[name].value)
+        unit = sampler_units(program, name)
+        if unit is not None:
+            sampler.clear(unit)

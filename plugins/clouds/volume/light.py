@@ -3,11 +3,13 @@
 and the uniforms of J."""
 from __future__ import annotations
 
+import struct
 from dataclasses import dataclass
 
 import numpy as np
 
 from atmos.checks import CheckedSettings, num_field
+from atmos.gpu.uniforms import write_block, write_uniforms
 from atmos.lighting import Sun
 from atmos.plugins.clouds.light.medium import environment
 
@@ -107,13 +109,31 @@ def light_uniforms(cloud_settings, sun: Sun | None, octaves=DEFAULT_OCTAVES, dif
     """The light uniforms of ``volume.glsl`` for a ``CloudSettings`` medium, the ``Sun``, the
     multiple-scattering octaves (a, b, c), the diffusion field's weight and the layer (base, top) world
     y (m) over which the clouds take the sun's colour (``sun_sources``: :func:`sun_colors`; the ground's
-    light takes the middle's; None: the camera's colour everywhere)."""
+    light takes the middle's; None: the camera's colour everywhere). The last few results are kept,
+    keyed by the identity of the settings, the Sun and its (immutable, assigned-anew) fields and by
+    the values of the rest: every renderer of a frame asks for the same."""
+    sun = sun or Sun()
+    key = (cloud_settings, sun, sun.direction, sun.color, sun.ambient, sun.color_by_altitude)
+    rest = (tuple(octaves), diffusion, None if layer is None else tuple(layer))
+    for held, held_rest, values in _LIGHT_MEMO:
+        if held_rest == rest and all(a is b for a, b in zip(held, key)):
+            return dict(values)
+    values = _light_uniforms(cloud_settings, sun, octaves, diffusion, layer)
+    _LIGHT_MEMO.insert(0, (key, rest, values))
+    del _LIGHT_MEMO[4:]
+    return dict(values)
+
+
+_LIGHT_MEMO: list = []      # (identities, values, uniforms), newest first
+
+
+def _light_uniforms(cloud_settings, sun: Sun, octaves, diffusion: float, layer) -> dict:
     colors, middle, ambient = layer_sun(sun, layer)
     direction = unit_direction(sun)
     e, sky, ground = environment(cloud_settings, middle, ambient, direction)
     s = cloud_settings
     sources = s.albedo * s.sun_intensity * colors
-    return {"sun_sources": [tuple(float(v) for v in row) for row in sources],
+    return {"sun_sources": [tuple(row) for row in np.asarray(sources, np.float64).tolist()],
             "sky_source": tuple(float(v) for v in 0.5 * s.albedo * sky),
             "ground_source": tuple(float(v) for v in 0.5 * s.albedo * ground),
             "sun_dir": tuple(float(v) for v in direction),
@@ -122,3 +142,22 @@ def light_uniforms(cloud_settings, sun: Sun | None, octaves=DEFAULT_OCTAVES, dif
             "ms_octaves": tuple(float(v) for v in octaves),
             "column_tau": cell_tau(s),
             "ms_diffusion": float(diffusion)}
+
+
+LIGHT_BLOCK, LIGHT_BINDING = "CloudLight", 2      # volume.glsl's block of the light that changes with the sun
+LIGHT_MEMBERS = ("sun_sources", "sky_source", "ground_source", "sun_dir")
+
+
+def pack_light(values: dict) -> bytes:
+    """volume.glsl's CloudLight block (std140: vec3 sun_sources[SUN_HEIGHTS], sky_source, ground_source,
+    sun_dir, each in 16 bytes) from :func:`light_uniforms`' ``values``."""
+    rows = [*values["sun_sources"], values["sky_source"], values["ground_source"], values["sun_dir"]]
+    return struct.pack(f"<{4 * len(rows)}f", *[c for row in rows for c in (*row, 0.0)])
+
+
+def write_light(program, values: dict, **more) -> None:
+    """:func:`light_uniforms`' ``values`` (and ``more``) into ``program``: the sun's light into its
+    CloudLight block (one buffer write when it changed), the rest as uniforms."""
+    if write_block(program, LIGHT_BLOCK, LIGHT_BINDING, pack_light(values)):
+        values = {k: v for k, v in values.items() if k not in LIGHT_MEMBERS}
+    write_uniforms(program, values, **more)

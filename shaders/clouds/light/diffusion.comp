@@ -9,9 +9,11 @@
 // |r| <= tolerance |b| (stage 3 then sets the indirect group count to 0: they cost nothing more).
 layout(local_size_x = 256) in;
 #include "clouds/light/sample.glsl"
-uniform int stage;
-uniform int cur;              // which of the two rz / rr partial arrays is the current one
-uniform int first;            // the first iteration after init: beta = 0
+layout(std140, binding = 1) uniform Step {   // one record per (stage, cur, first), bound per dispatch
+    int stage;
+    int cur;                  // which of the two rz / rr partial arrays is the current one
+    int first;                // the first iteration after init: beta = 0
+};
 uniform int cold;             // init from x = 0
 uniform ivec3 size;           // the shading grid
 layout(binding = 0) uniform sampler3D fine;       // the density (fine cells)

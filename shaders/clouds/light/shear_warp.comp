@@ -15,8 +15,10 @@ uniform ivec3 size;            // shading grid (x, y, z)
 uniform ivec3 axis_a;          // unit vectors: slicing axis and the two lateral axes
 uniform ivec3 axis_b;
 uniform ivec3 axis_c;
-uniform int slice;
-uniform int first;             // 1 on the light-side slice (no previous slice)
+layout(std140, binding = 1) uniform Slice {   // one record per (slice, first), bound per dispatch
+    int slice;
+    int first;                 // 1 on the light-side slice (no previous slice)
+};
 uniform vec3 step_dir;         // index-space step toward the sun, component along axis_a = +-1
 uniform float step_len;        // its true length in fine cells
 uniform float sigma;

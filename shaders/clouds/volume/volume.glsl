@@ -20,11 +20,13 @@ uniform float t;
 uniform ivec3 a_shift;         // cells from B's cell to A's at the same world point (CloudSets.a_shift)
 uniform int has_shading;       // 0: no transmittance textures, T = 1
 const int SUN_HEIGHTS = 5;     // light.py SUN_HEIGHTS
-uniform vec3 sun_sources[SUN_HEIGHTS];  // albedo * sun irradiance at the volume's heights k / 4 (uvw.y, base to
-                               // top): the sun's colour there (already 0 with the sun below the horizon)
-uniform vec3 sky_source;       // albedo * sky radiance / 2
-uniform vec3 ground_source;    // albedo * ground radiance / 2
-uniform vec3 sun_dir;          // toward the sun, unit
+layout(std140, binding = 2) uniform CloudLight {   // the light that moves with the sun (light.py write_light)
+    vec3 sun_sources[SUN_HEIGHTS];  // albedo * sun irradiance at the volume's heights k / 4 (uvw.y, base to
+                                    // top): the sun's colour there (already 0 with the sun below the horizon)
+    vec3 sky_source;                // albedo * sky radiance / 2
+    vec3 ground_source;             // albedo * ground radiance / 2
+    vec3 sun_dir;                   // toward the sun, unit
+};
 uniform vec3 phase_lobes;      // g, g2, w
 uniform float outward_share;   // the phase's share H of the hemisphere about a direction (medium.hemisphere_share)
 uniform vec3 ms_octaves;       // a (attenuation), b (contribution), c (eccentricity)
