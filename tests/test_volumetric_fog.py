@@ -346,7 +346,7 @@ def test_gpu_froxel_volume_matches_its_float64_twin(gpu, ctx, rng):
     got = gpu_froxels(gpu, cam, 16 / 9, params.froxels, params, sun, time=0.75)
     want = ref_froxels(cam, 16 / 9, params.froxels, params, sun, time=0.75)
     assert np.isfinite(got).all() and got.shape == want.shape == (24, 14, 41, 4)
-    assert (want[..., -1, 3] < 0.9).sum() > 20 and (want[..., -1, 3] > 0.999).sum() > 5, "columns in and past the fog"
+    assert (want[..., -1, 3] < 0.9).sum() >= 10 and (want[..., -1, 3] > 0.999).sum() >= 5, "columns in and past the fog"
     assert np.allclose(got[:, :, 0], [0, 0, 0, 1]), "layer 0 is the camera"
     # the march's float32 tolerance (early exits at 0.01 may flip) plus float16 storage (2^-11 relative)
     tol = 2e-3 + 1.5e-2 * np.abs(want).max(axis=(0, 1, 2)) + 2.0 ** -11 * np.abs(want)
