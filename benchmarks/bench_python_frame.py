@@ -77,7 +77,7 @@ def measure(name: str, frames: int = 30, size=(64, 36), warmup: int = 10) -> dic
     """Calls and milliseconds per frame of demo ``name`` (see the module docstring)."""
     from atmos.demo_registry import DemoSettings
     from atmos.gpu import create_headless
-    from atmos.gpu.gl_meter import GLMeter
+    from atmos.gpu.gl_meter import GLMeter, count_calls
     from atmos.runner import build_app
 
     gpu = create_headless(tuple(size))
@@ -85,16 +85,7 @@ def measure(name: str, frames: int = 30, size=(64, 36), warmup: int = 10) -> dic
     try:
         app.run_frames(warmup, 1 / 30)
         gpu.ctx.finish()
-        counts = {"call": 0, "c_call": 0}
-
-        def count(frame, event, arg):
-            if event in counts:
-                counts[event] += 1
-        sys.setprofile(count)
-        try:
-            app.run_frames(frames, 1 / 30)
-        finally:
-            sys.setprofile(None)
+        python_calls, c_calls = count_calls(lambda: app.run_frames(frames, 1 / 30))
         gpu.ctx.finish()
         overhead = meter_overhead_s()
         subtracted, wall_ms, gl_ms, gl_calls, uniform_writes = [], [], [], [], []
@@ -128,7 +119,7 @@ def measure(name: str, frames: int = 30, size=(64, 36), warmup: int = 10) -> dic
                 wrapped = sum(meter.calls.values())
                 stubbed.append((cpu - meter.readback_s - wrapped * overhead) * 1e3)
         return {"scene": name, "size": list(size), "frames": frames,
-                "python_calls": counts["call"] / frames, "c_calls": counts["c_call"] / frames,
+                "python_calls": python_calls / frames, "c_calls": c_calls / frames,
                 "python_ms": float(np.mean(stubbed)), "python_ms_median": float(np.median(stubbed)),
                 "python_ms_max": float(np.max(stubbed)), "python_ms_subtracted": float(np.mean(subtracted)),
                 "wall_ms": float(np.mean(wall_ms)), "gl_ms": float(np.mean(gl_ms)),

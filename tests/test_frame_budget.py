@@ -1,13 +1,12 @@
 """The sunset frame's Python work and uniform writes held to a budget (counts, not time: the same on
 any machine), and the per-dispatch uniform-block records (BlockTable) read back as the driver lays
 them out."""
-import sys
 
 import numpy as np
 import pytest
 
 from atmos.gpu.block_table import BlockTable, ints
-from atmos.gpu.gl_meter import GLMeter
+from atmos.gpu.gl_meter import GLMeter, count_calls
 from atmos.gpu.hazards import dispatch
 from atmos.gpu.shaders import GlslSource, compile_program
 from atmos.gpu.uniforms import bind_buffers, write_uniforms
@@ -37,19 +36,9 @@ def test_sunset_frame_budget():
     gpu, app = _sunset()
     try:
         app.run_frames(WARMUP, 1 / 30)
-        counts = {"call": 0, "c_call": 0}
-
-        def count(frame, event, arg):
-            if event in counts:
-                counts[event] += 1
-        sys.setprofile(count)
-        try:
-            app.run_frames(FRAMES, 1 / 30)
-        finally:
-            sys.setprofile(None)
+        calls = sum(count_calls(lambda: app.run_frames(FRAMES, 1 / 30))) / FRAMES
         with GLMeter() as meter:
             app.run_frames(FRAMES, 1 / 30)
-        calls = (counts["call"] + counts["c_call"]) / FRAMES
         writes = meter.uniform_writes / FRAMES
     finally:
         app.close()

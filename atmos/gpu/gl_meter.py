@@ -180,3 +180,19 @@ def _caller() -> tuple[str, int]:
 def _shown(path: str) -> str:
     path = os.path.abspath(path)
     return os.path.relpath(path, _ROOT) if path.startswith(_ROOT + os.sep) else path
+
+
+def count_calls(run: Callable[[], object]) -> tuple[int, int]:
+    """(Python, C) function calls made while ``run()`` runs (``sys.setprofile``; their sum is what
+    cProfile's total counts): tests/test_frame_budget.py and benchmarks/bench_python_frame.py."""
+    counts = {"call": 0, "c_call": 0}
+
+    def count(frame, event, arg):
+        if event in counts:
+            counts[event] += 1
+    sys.setprofile(count)
+    try:
+        run()
+    finally:
+        sys.setprofile(None)
+    return counts["call"], counts["c_call"]

@@ -94,8 +94,8 @@ def _uses(items, default_texture: str, default_buffer: str):
 class Hazards:
     """The storage writes of one context not yet made visible to every kind of use.
 
-    ``use(reads, writes)`` before work, ``wrote(writes)`` after it; or :meth:`dispatch`, which does
-    both around a compute dispatch. ``barriers`` counts the glMemoryBarrier calls issued and
+    ``use(reads, writes)`` before work, ``wrote(writes)`` after it (the graph around a pass); binds
+    call :meth:`need` and :meth:`stage`, and :func:`dispatch` flushes and commits. ``barriers`` counts the glMemoryBarrier calls issued and
     ``bits_issued`` how often each bit was in one (tests, benchmarks).
     """
 
@@ -123,11 +123,10 @@ class Hazards:
             self._dirty[key] = [weakref.ref(obj), kind, _ALL[kind]]
         self._staged.clear()
 
-    def use(self, reads=(), writes=(), defer: bool = False) -> int:
-        """Issue the barrier the coming work needs: ``reads`` and ``writes`` are GL objects (textures
-        default to ``sampled`` reads, buffers to ``storage``; writes default to ``storage``) or
-        (obj, access) pairs. ``defer``: only add the bits to the next :meth:`flush` (what binds do, so
-        the binds of one dispatch or draw share one barrier). Returns the bits needed (0: none)."""
+    def use(self, reads=(), writes=()) -> int:
+        """Issue the barrier the coming work needs (with what binds asked for): ``reads`` and ``writes``
+        are GL objects (textures default to ``sampled`` reads, buffers to ``storage``; writes default to
+        ``storage``) or (obj, access) pairs. Returns the bits needed (0: none)."""
         need = 0
         dirty = self._dirty
         for obj, kind, access in _uses(reads, "sampled", "storage"):
@@ -138,9 +137,7 @@ class Hazards:
             entry = dirty.get(id(obj))
             if entry is not None and entry[0]() is obj:   # write after a storage write: order the two
                 need |= entry[2] & _BITS.get((kind, access), 0)
-        if defer:
-            self._need |= need
-        elif need or self._need:
+        if need or self._need:
             self.issue(need | self._need)
         return need
 
@@ -161,17 +158,6 @@ class Hazards:
         for obj, kind, access in _uses(writes, "storage", "storage"):
             if access == "storage":
                 self._dirty[id(obj)] = [weakref.ref(obj), kind, _ALL[kind]]
-
-    def dispatch(self, program, groups=(1, 1, 1), reads=(), writes=()) -> None:
-        """Run compute ``program`` over ``groups`` (x, y, z work groups) after the barrier its
-        ``reads``/``writes`` (beyond what its binds declared) need; what it wrote is then dirty."""
-        self.use(reads, writes)
-        for obj, kind, access in _uses(writes, "storage", "storage"):
-            if access == "storage":
-                self.stage(obj)
-        self.flush()
-        program.run(*groups)
-        self.commit()
 
     def issue(self, bits: int) -> None:
         """One glMemoryBarrier with ``bits``; every pending write is then visible to those uses."""

@@ -3,7 +3,7 @@ per-froxel work: on GPUs that run graphics on a few units, compute is many times
 fullscreen fragment pass doing the same arithmetic)."""
 from __future__ import annotations
 
-from atmos.graph.passes import PassBuilder, RenderPass
+from atmos.graph.passes import PassBuilder, PluginPass
 
 
 def work_groups(size, local) -> tuple[int, ...]:
@@ -13,7 +13,7 @@ def work_groups(size, local) -> tuple[int, ...]:
     return tuple(-(-int(n) // int(k)) for n, k in zip(size, local))
 
 
-class ComputePass(RenderPass):
+class ComputePass(PluginPass):
     """Subclass with ``name``, ``phase``, ``compute`` (a ``.comp`` shader file), ``reads`` (names it samples)
     and ``writes`` (names it writes as images: read-modify-write ones are listed in both and are read
     as images too) and, if needed, :meth:`defines`; ``execute`` binds and dispatches with
@@ -28,22 +28,11 @@ class ComputePass(RenderPass):
     reads: tuple[str, ...] = ()
     writes: tuple[str, ...] = ()
 
-    def __init__(self, plugin=None):
-        self.plugin = plugin
-        self.gpu = None
-
-    def defines(self) -> dict:
-        """Compile-time constants of the compute shader (``#define`` name value)."""
-        return {}
-
     def setup(self, builder: PassBuilder) -> None:
         for name in self.reads:
             builder.read(name, access="storage" if name in self.writes else "sampled")
         for name in self.writes:
             builder.write(name, access="storage")
-
-    def prepare(self, gpu) -> None:
-        self.gpu = gpu
 
     @property
     def program(self):

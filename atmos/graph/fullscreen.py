@@ -1,10 +1,10 @@
 """FullscreenPass: a pass that draws one fullscreen-triangle program (the shape of most effects)."""
 from __future__ import annotations
 
-from atmos.graph.passes import PassBuilder, RenderPass
+from atmos.graph.passes import PassBuilder, PluginPass
 
 
-class FullscreenPass(RenderPass):
+class FullscreenPass(PluginPass):
     """Subclass with ``name``, ``phase``, ``fragment`` (a shader file; ``vertex``, the fullscreen
     triangle, is ``lib/fullscreen_far.vert`` for a pass drawn behind everything), ``reads`` and ``writes``
     (resource names) and, if needed, :meth:`defines`; ``execute`` binds a target and calls
@@ -19,22 +19,11 @@ class FullscreenPass(RenderPass):
     reads: tuple[str, ...] = ()
     writes: tuple[str, ...] = ("color",)
 
-    def __init__(self, plugin=None):
-        self.plugin = plugin
-        self.gpu = None
-
-    def defines(self) -> dict:
-        """Compile-time constants of the fragment shader (``#define`` name value)."""
-        return {}
-
     def setup(self, builder: PassBuilder) -> None:
         for name in self.reads:
             builder.read(name)
         for name in self.writes:
             builder.write(name)
-
-    def prepare(self, gpu) -> None:
-        self.gpu = gpu
 
     @property
     def program(self):

@@ -45,6 +45,22 @@ class RenderPass:
         return f"<{type(self).__name__} {self.name!r} [{self.phase}]>"
 
 
+class PluginPass(RenderPass):
+    """A pass made by a plugin (``plugin``: its settings) around one program from the GPU context's
+    program cache, compiled with :meth:`defines`: what FullscreenPass and ComputePass share."""
+
+    def __init__(self, plugin=None):
+        self.plugin = plugin
+        self.gpu = None
+
+    def defines(self) -> dict:
+        """Compile-time constants of the pass's shader (``#define`` name value)."""
+        return {}
+
+    def prepare(self, gpu) -> None:
+        self.gpu = gpu
+
+
 def check_pass(p) -> None:
     """A GraphError unless ``p`` is a RenderPass with a name and a known phase."""
     if not isinstance(p, RenderPass):
