@@ -299,11 +299,14 @@ def test_the_volumetric_fog_runs_as_one_compute_dispatch_per_frame(gpu):
     app.close()
 
 
-def test_the_light_shafts_march_is_a_compute_dispatch_into_a_storage_target(gpu):
+@pytest.mark.parametrize("froxels", [None, (40, 24, 32)])
+def test_the_light_shafts_march_is_a_compute_dispatch_into_a_storage_target(gpu, froxels):
+    """Per texel: the march and the upsampling composite (dispatches) and the low-res far depth (a draw);
+    from froxels: the volume's fill and the per-pixel apply, no draw."""
     from atmos.gpu.gl_meter import GLMeter
     from atmos.plugins.light_shafts import LightShaftsPlugin
     runs = []
-    for plugins in ((), (LightShaftsPlugin(mode="march"),)):
+    for plugins in ((), (LightShaftsPlugin(mode="march", froxels=froxels),)):
         app = atmos.App(gpu).add_plugins(atmos.DefaultPlugins(overlay=False), *plugins)
         app.update(1 / 60)
         with GLMeter() as meter:
@@ -311,6 +314,7 @@ def test_the_light_shafts_march_is_a_compute_dispatch_into_a_storage_target(gpu)
         runs.append((meter.calls["ComputeShader.run"], meter.calls["VertexArray.render"]))
         dump = app.graph.dump()
         app.close()
-    assert runs[1][0] == runs[0][0] + 2                 # the march and the upsampling composite: dispatches
-    assert runs[1][1] == runs[0][1] + 1                 # the low-res far depth: one draw
-    assert "light_shafts_march  transient" in dump and "storage" in dump
+    assert runs[1][0] == runs[0][0] + 2
+    assert runs[1][1] == runs[0][1] + (1 if froxels is None else 0)
+    target = "light_shafts_march  transient" if froxels is None else "light_shafts_volume  transient 40x24x33"
+    assert target in dump and "storage" in dump, dump

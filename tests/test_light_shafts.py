@@ -287,9 +287,13 @@ def test_screen_sun_fades():
     almost_behind = screen_sun(cam, 1.0, (1.0, 0.3, -0.01), p)
     assert all(np.isfinite(almost_behind.uv)) and almost_behind.strength == 0.0
     for bad in (dict(samples=0), dict(samples=1000), dict(decay=1.5), dict(downsample=0), dict(radius=0.0),
-                dict(exposure=-1.0), dict(density=math.inf)):
+                dict(exposure=-1.0), dict(density=math.inf), dict(froxels=(0, 4, 4)), dict(froxels=(8, 8)),
+                dict(froxels=(8, 8, 300)), dict(froxels="160x90x64")):
         with pytest.raises(ValueError, match=next(iter(bad))):
             LightShaftSettings(**bad)
+    with pytest.raises(ValueError, match=r"LightShaftSettings.froxels must be None or three ints in \[1, 256\]"):
+        LightShaftSettings(froxels=(1.5, 2, 2))
+    assert LightShaftSettings(froxels=[8, 4, 2]).froxels == (8, 4, 2) and LightShaftSettings(froxels=None).froxels is None
 
 
 @pytest.mark.parametrize("case", ["behind", "below", "edge", "centre", "far_outside", "tiny", "minimized"])

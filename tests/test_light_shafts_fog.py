@@ -26,9 +26,15 @@ def fog_gpu():
     gpu.release()
 
 
-def frame(gpu, density, shafts: bool, sky="fog", fog=True, color=(0.9, 0.9, 1.0)) -> np.ndarray:
+@pytest.fixture(params=[None, (40, 24, 64)], ids=["march", "froxels"])
+def froxels(request):
+    """The shafts marched per texel, or from a froxel volume (LightShaftSettings.froxels)."""
+    return request.param
+
+
+def frame(gpu, density, shafts: bool, sky="fog", fog=True, color=(0.9, 0.9, 1.0), froxels=None) -> np.ndarray:
     """Linear colour of the gap view (test_light_shafts_march) under an exponential fog, with or without shafts."""
-    extra = [LightShaftsPlugin(steps=48, max_distance=3000.0)] if shafts else []
+    extra = [LightShaftsPlugin(steps=48, max_distance=3000.0, froxels=froxels)] if shafts else []
     if fog:
         extra.append(FogPlugin(mode="exp", density=1.5e-3, sky=sky, fog_color=color))
     app = App(gpu).add_plugins(DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(),
@@ -47,17 +53,17 @@ def frame(gpu, density, shafts: bool, sky="fog", fog=True, color=(0.9, 0.9, 1.0)
         app.close()
 
 
-def test_shafts_add_nothing_to_the_fog_where_nothing_shadows_the_air(fog_gpu):
+def test_shafts_add_nothing_to_the_fog_where_nothing_shadows_the_air(fog_gpu, froxels):
     empty = np.zeros((32, 4, 32), np.float32)
-    alone, both = frame(fog_gpu, empty, False), frame(fog_gpu, empty, True)
+    alone, both = frame(fog_gpu, empty, False, froxels=froxels), frame(fog_gpu, empty, True, froxels=froxels)
     assert np.abs(both - alone).max() < 2e-3 * max(alone.max(), 1.0), "the fog's in-scatter is not counted twice"
-    kept = frame(fog_gpu, columns_volume(), True, sky="keep")
+    kept = frame(fog_gpu, columns_volume(), True, sky="keep", froxels=froxels)
     assert np.isfinite(kept).all()
 
 
-def test_cloud_shadows_show_as_darker_rays_in_the_fog(fog_gpu):
+def test_cloud_shadows_show_as_darker_rays_in_the_fog(fog_gpu, froxels):
     volume = columns_volume()
-    alone, both = frame(fog_gpu, volume, False), frame(fog_gpu, volume, True)
+    alone, both = frame(fog_gpu, volume, False, froxels=froxels), frame(fog_gpu, volume, True, froxels=froxels)
     attenuated = frame(fog_gpu, volume, False, color=(0.0, 0.0, 0.0))     # f · scene: the fog without its light
     dark = (alone - both).mean(-1)                     # what the shafts took away
     assert np.isfinite(both).all() and dark.min() > -2e-3, "the shafts only take light away"
@@ -70,12 +76,12 @@ def test_cloud_shadows_show_as_darker_rays_in_the_fog(fog_gpu):
     assert (dark <= inscatter + 4e-3).all()
 
 
-def aerial_frame(gpu, density, shafts: bool, aerial: bool = True, fog_color=None) -> np.ndarray:
+def aerial_frame(gpu, density, shafts: bool, aerial: bool = True, fog_color=None, froxels=None) -> np.ndarray:
     """The gap view under the physical sky, its aerial perspective on (or off), with or without shafts;
     ``fog_color``: under an exponential fog of that colour too (mixed with the air along the ray,
     atmos.composition)."""
     from atmos.plugins.sky import SkyPlugin
-    extra = [LightShaftsPlugin(steps=48, max_distance=3000.0)] if shafts else []
+    extra = [LightShaftsPlugin(steps=48, max_distance=3000.0, froxels=froxels)] if shafts else []
     if fog_color is not None:
         extra.append(FogPlugin(mode="exp", density=1.5e-3, sky="keep", fog_color=fog_color))
     app = App(gpu).add_plugins(DefaultPlugins(overlay=False), SkyPlugin(model="physical", stars=False,
@@ -97,16 +103,16 @@ def aerial_frame(gpu, density, shafts: bool, aerial: bool = True, fog_color=None
         app.close()
 
 
-def test_with_the_skys_aerial_perspective_shafts_only_take_its_light_away_in_cloud_shadow(fog_gpu):
+def test_with_the_skys_aerial_perspective_shafts_only_take_its_light_away_in_cloud_shadow(fog_gpu, froxels):
     """SHAFT_AERIAL: no fog, the physical sky's aerial perspective owns the air's light; the shafts add
     none of their own (nothing changes without clouds) and take away only what the clouds shadow,
     never more than the aerial perspective put in."""
     empty = np.zeros((32, 4, 32), np.float32)
-    alone, both = aerial_frame(fog_gpu, empty, False), aerial_frame(fog_gpu, empty, True)
+    alone, both = aerial_frame(fog_gpu, empty, False, froxels=froxels), aerial_frame(fog_gpu, empty, True, froxels=froxels)
     assert np.abs(both - alone).max() < 2e-3 * max(alone.max(), 1.0), "the air's in-scatter is not counted twice"
     volume = columns_volume()
-    alone, both = aerial_frame(fog_gpu, volume, False), aerial_frame(fog_gpu, volume, True)
-    plain = aerial_frame(fog_gpu, volume, False, aerial=False)
+    alone, both = aerial_frame(fog_gpu, volume, False, froxels=froxels), aerial_frame(fog_gpu, volume, True, froxels=froxels)
+    plain = aerial_frame(fog_gpu, volume, False, aerial=False, froxels=froxels)
     dark = (alone - both).mean(-1)
     lost = dark.mean(axis=0)
     w = lost.size
@@ -119,20 +125,21 @@ def test_with_the_skys_aerial_perspective_shafts_only_take_its_light_away_in_clo
     assert scene.mean() > 0.2 and (dark[scene] <= put_in[scene] + 2e-3).all(), "never more than it put in"
 
 
-def both_frame(gpu, density, shafts: bool, light: bool = True) -> np.ndarray:
+def both_frame(gpu, density, shafts: bool, light: bool = True, froxels=None) -> np.ndarray:
     """:func:`aerial_frame` under the fog too; ``light`` False: the fog's colour black."""
-    return aerial_frame(gpu, density, shafts, fog_color=(0.9, 0.9, 1.0) if light else (0.0, 0.0, 0.0))
+    return aerial_frame(gpu, density, shafts, fog_color=(0.9, 0.9, 1.0) if light else (0.0, 0.0, 0.0),
+                        froxels=froxels)
 
 
-def test_with_fog_and_air_both_the_shafts_take_away_both_in_cloud_shadow_only(fog_gpu):
+def test_with_fog_and_air_both_the_shafts_take_away_both_in_cloud_shadow_only(fog_gpu, froxels):
     """SHAFT_FOG and SHAFT_AERIAL together (the fog under the air, mixed): nothing changes without
     clouds; with them the shafts only take light away, more in the shadowed air than in the lit gap, and
     the air's in-scatter is shadowed too (seen alone with the fog's colour black)."""
     empty = np.zeros((32, 4, 32), np.float32)
-    alone, both = both_frame(fog_gpu, empty, False), both_frame(fog_gpu, empty, True)
+    alone, both = both_frame(fog_gpu, empty, False, froxels=froxels), both_frame(fog_gpu, empty, True, froxels=froxels)
     assert np.abs(both - alone).max() < 2e-3 * max(alone.max(), 1.0), "nothing shadows the air: nothing taken"
     volume = columns_volume()
-    alone, both = both_frame(fog_gpu, volume, False), both_frame(fog_gpu, volume, True)
+    alone, both = both_frame(fog_gpu, volume, False, froxels=froxels), both_frame(fog_gpu, volume, True, froxels=froxels)
     dark = (alone - both).mean(-1)
     assert np.isfinite(both).all() and dark.min() > -2e-3, "the shafts only take light away"
     lost = dark.mean(axis=0)
@@ -142,8 +149,38 @@ def test_with_fog_and_air_both_the_shafts_take_away_both_in_cloud_shadow_only(fo
     assert sides > 3.0 * centre and sides > 2e-3, (sides, centre)
     # the fog's light black: what is taken away then is the air's in-scatter in the clouds' shadow (seen:
     # 4.1e-3 beside the gap, 4e-4 in it; the fog's and the air's together 8.2e-2 and 4.6e-3)
-    air = (both_frame(fog_gpu, volume, False, light=False) - both_frame(fog_gpu, volume, True, light=False)).mean(-1)
+    air = (both_frame(fog_gpu, volume, False, light=False, froxels=froxels) - both_frame(fog_gpu, volume, True, light=False, froxels=froxels)).mean(-1)
     air_lost = air.mean(axis=0)
     air_sides = np.concatenate([air_lost[int(0.02 * w):int(0.2 * w)], air_lost[int(0.8 * w):int(0.98 * w)]]).mean()
     assert air.min() > -2e-3 and air_sides > 1e-3 and air_sides > 3.0 * air_lost[int(0.45 * w):int(0.55 * w)].mean(), \
         "the air's in-scatter is shadowed too"
+
+
+def test_a_heterogeneous_fog_keeps_the_per_texel_march_and_the_froxels_switch_live(fog_gpu):
+    """The froxel volume holds sums that a heterogeneous fog (its turbulence taken at each pixel's end) cannot
+    share between pixels: with one the shafts march per texel; a homogeneous fog, or froxels set or unset
+    live, switch on the next frame."""
+    shafts, fog = LightShaftsPlugin(max_distance=3000.0), FogPlugin(mode="hetero_exp", density=1.5e-3)
+    app = App(fog_gpu).add_plugins(DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(),
+                                   CloudsPlugin(CloudSettings(cell_size=CELL, base_altitude=BASE, shading=False,
+                                                              sigma_t=0.05), density=columns_volume()), shafts, fog)
+    app.insert_resource(Sun(np.array([0.0, 1.0, 0.25])))
+    app.startup()
+    cam = app.resource(Camera)
+    cam.position, cam.yaw, cam.pitch, cam.far = np.array([320.0, 60.0, 20.0]), math.pi, 0.25, 5000.0
+
+    def targets():
+        app.render()
+        assert fog_gpu.ctx.error == "GL_NO_ERROR" and np.isfinite(app.read_linear()).all()
+        dump = app.graph.dump()
+        return "light_shafts_march " in dump, "light_shafts_volume " in dump
+    try:
+        assert targets() == (True, False)
+        fog.configure(mode="exp")
+        assert targets() == (False, True)
+        shafts.configure(froxels=None)
+        assert targets() == (True, False)
+        shafts.configure(froxels=(16, 9, 8))
+        assert targets() == (False, True)
+    finally:
+        app.close()

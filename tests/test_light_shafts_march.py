@@ -17,6 +17,7 @@ from atmos.plugins.clouds import CloudSettings, CloudsPlugin
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS
 from atmos.plugins.ground import GroundPlugin
 from atmos.plugins.light_shafts import LightShaftsPlugin, reference
+from atmos.plugins.light_shafts.froxels import SHAFT_VOLUME
 from atmos.plugins.light_shafts.march import SHAFT_COLOR, SHAFT_DEPTH, march_irradiance
 from atmos.plugins.sky_gradient import SkyGradientPlugin
 from atmos.render_core import CapturePass
@@ -95,7 +96,8 @@ def march_gpu():
 def test_gpu_march_matches_the_float64_reference(march_gpu, rng, downsample, steps):
     density = (rng.random((16, 4, 16)) > 0.6).astype(np.float32) * rng.uniform(0.2, 1.5, (16, 4, 16)).astype(np.float32)
     probe = MarchProbe()
-    app, plugin, _ = march_app(march_gpu, density, probe, downsample=downsample, steps=steps, scattering=3e-4)
+    app, plugin, _ = march_app(march_gpu, density, probe, downsample=downsample, steps=steps, scattering=3e-4,
+                               froxels=None)
     app.insert_resource(Sun(np.array([0.3, 0.8, 0.4]), (1.0, 0.8, 0.6)))
     app.render()
     assert march_gpu.ctx.error == "GL_NO_ERROR"
@@ -110,6 +112,62 @@ def test_gpu_march_matches_the_float64_reference(march_gpu, rng, downsample, ste
     app.close()
 
 
+class VolumeProbe(RenderPass):
+    """Reads the froxel volume (W, H, D + 1, 4) and the cloud sets back after the light-shafts pass."""
+    name = "z_volume_probe"
+    phase = "post"
+    volume = sets = None
+
+    def setup(self, builder: PassBuilder) -> None:
+        builder.read(SHAFT_VOLUME)
+        builder.read(CLOUD_SETS)
+        builder.side_effect()
+
+    def execute(self, frame) -> None:
+        t = frame.resource(SHAFT_VOLUME)
+        w, h, d = t.size
+        self.volume = np.frombuffer(t.read(), np.float16).reshape(d, h, w, 4).transpose(2, 1, 0, 3).astype(np.float64)
+        self.sets = frame.resource(CLOUD_SETS)
+
+
+@pytest.mark.parametrize("froxels", [(32, 18, 48), (9, 5, 3)])
+def test_gpu_froxels_match_the_float64_twin(march_gpu, rng, froxels):
+    """LightShaftSettings.froxels: the volume against reference.froxel_shafts (the same cloud shadows as
+    the march's test), and the frame against the volume read back and composited by reference.froxel_apply
+    over the frame without shafts."""
+    density = (rng.random((16, 4, 16)) > 0.6).astype(np.float32) * rng.uniform(0.2, 1.5, (16, 4, 16)).astype(np.float32)
+    probe = VolumeProbe()
+    app, plugin, capture = march_app(march_gpu, density, probe, froxels=froxels, scattering=3e-4,
+                                     max_distance=rng.uniform(800.0, 4000.0))
+    app.insert_resource(Sun(np.array([0.3, 0.8, 0.4]), (1.0, 0.8, 0.6)))
+    app.render()
+    assert march_gpu.ctx.error == "GL_NO_ERROR"
+    settings, cam, sun = plugin.settings, app.resource(Camera), app.resource(Sun)
+    sun_dir = np.asarray(sun.direction) / np.linalg.norm(sun.direction)
+    sets = probe.sets
+    a, b, t = sets.view()
+    tau = lambda p: shadow_reference.sun_optical_depth(p, sets.maps_of(a).read_sums()[0], sets.maps_of(b).read_sums()[0],
+                                                       t, sun_dir, sets.settings.sigma, sets.layout(), sets.a_shift)
+    basis = view_basis(cam, SIZE[0] / SIZE[1])
+    want = reference.froxel_shafts(cam.position, basis, froxels, sun_dir, march_irradiance(sun, settings), settings, tau)
+    got = probe.volume
+    assert got.shape == want.shape and np.isfinite(got).all()
+    scale = want[..., :3].max()
+    assert scale > 0.05
+    # f2 volume, float32 sums and positions, the shadow map against exact column sums: as the march's
+    assert np.abs(got[..., :3] - want[..., :3]).max() < 4e-3 * scale + 1e-3
+    assert np.allclose(got[..., 3], want[..., 3], atol=2e-3)
+    shafts, depth = capture.color[..., :3].copy(), capture.depth.copy()
+    plugin.configure(scattering=0.0)                    # no light to scatter: the pass draws nothing
+    app.render()
+    composited = reference.froxel_apply(got, capture.color, depth, basis, cam.near, cam.far, settings)
+    # the f2 colour; the texture unit's trilinear weights (8 bits on common hardware): 1/256 of a neighbour's step
+    step = np.abs(np.diff(got, axis=2)).max()
+    assert np.abs(shafts - composited).max() < 2e-3 * max(composited.max(), 1.0) + step / 256, \
+        np.abs(shafts - composited).max()
+    app.close()
+
+
 def test_a_gap_between_cloud_columns_is_a_brighter_streak(march_gpu):
     """Looking along the gap between two cloud slabs with the sun high above: the air in the gap is
     lit, the air under the slabs is in their shadow, so the shafts add a bright vertical streak in
@@ -117,7 +175,7 @@ def test_a_gap_between_cloud_columns_is_a_brighter_streak(march_gpu):
     has no such streak."""
     probe = MarchProbe()
     app, plugin, capture = march_app(march_gpu, columns_volume(), probe, downsample=2, steps=48, scattering=4e-4,
-                                     max_distance=500.0)
+                                     max_distance=500.0, froxels=None)
     app.insert_resource(Sun(np.array([0.0, 1.0, 0.25]), (1.0, 0.95, 0.9)))
     app.render()
     light = probe.low[..., :3].mean(axis=-1)           # in-scattered light of the low-res texels
@@ -138,11 +196,12 @@ def test_a_gap_between_cloud_columns_is_a_brighter_streak(march_gpu):
     app.close()
 
 
+@pytest.mark.parametrize("froxels", [None, (160, 90, 64), (1, 1, 1)])
 @pytest.mark.parametrize("case", ["sun_below", "black_sun", "grazing", "no_clouds"])
-def test_march_extremes(case):
+def test_march_extremes(case, froxels):
     gpu = create_headless((48, 27))
     try:
-        plugin = LightShaftsPlugin(scattering=1e-3, max_distance=1e6)
+        plugin = LightShaftsPlugin(scattering=1e-3, max_distance=1e6, froxels=froxels)
         capture = CapturePass()
         plugins = [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(), plugin, pass_plugin(capture)]
         if case != "no_clouds":

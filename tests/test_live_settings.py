@@ -227,6 +227,12 @@ def march_under_clouds(app, plugin):
     app.insert_resource(Sun(np.array([0.0, 0.6, -1.0]) / math.hypot(0.6, 1.0), (1.0, 0.95, 0.85)))
 
 
+def march_per_texel(app, plugin):
+    """:func:`march_under_clouds` marched per texel (no froxel volume: ``steps`` counts)."""
+    march_under_clouds(app, plugin)
+    plugin.configure(froxels=None)
+
+
 @dataclass
 class Spec:
     """A plugin's scene and, per live field, the new value (``changes``); ``observe``: fields whose
@@ -328,10 +334,10 @@ SPECS = {
         dict(samples=8, density=0.4, decay=0.7, weight=0.3, exposure=2.0, threshold=0.2, ceiling=0.05, radius=0.1,
              downsample=4, horizon_fade=0.9, front_fade=1.0, edge_fade=2.0, mode="march", steps=3,
              scattering=1e-4, max_distance=400.0, sun_intensity=2.0, **{"phase.g": 0.0, "phase.g2": 0.6, "phase.w": 0.7},
-             fog_sun_share=0.3),
-        before={"__all__": sun_at((0.5, 0.55)), "edge_fade": sun_at((1.15, 0.55)),
-                **{f: march_under_clouds for f in ("steps", "scattering", "max_distance", "phase.g",
-                                                    "phase.g2", "phase.w", "sun_intensity")}},
+             fog_sun_share=0.3, froxels=(8, 6, 12)),
+        before={"__all__": sun_at((0.5, 0.55)), "edge_fade": sun_at((1.15, 0.55)), "steps": march_per_texel,
+                **{f: march_under_clouds for f in ("scattering", "max_distance", "phase.g", "phase.g2", "phase.w",
+                                                    "sun_intensity", "froxels")}},
         # fog_sun_share acts only with a FogPlugin (tests/test_light_shafts_fog.py renders it): the setting read
         observe={"downsample": resource_size(MASK), "fog_sun_share": lambda app, plugin: plugin.settings.fog_sun_share}),
     "template_volume": Spec(

@@ -303,7 +303,7 @@ def gpu_froxels(gpu, camera, aspect, froxels, params, sun, time=0.0):
     """(W, H, D + 1, 4): volumetric_fog/froxels.comp for ``camera`` (read back as float64)."""
     from atmos.gpu.hazards import dispatch
     from atmos.gpu.uniforms import bind_images, write_uniforms
-    from atmos.plugins.volumetric_fog.plugin import froxel_knee
+    from atmos.froxels import froxel_knee
     from atmos.scene_uniforms import set_camera_uniforms
     w, h, d = froxels
     prog = gpu.program(compute_shader="volumetric_fog/froxels.comp")
@@ -311,7 +311,7 @@ def gpu_froxels(gpu, camera, aspect, froxels, params, sun, time=0.0):
     try:
         set_camera_uniforms(prog, camera, aspect)
         set_medium_uniforms(prog, params, sun, time)
-        write_uniforms(prog, froxel_knee=froxel_knee(params))
+        write_uniforms(prog, froxel_knee=froxel_knee(params.max_distance))
         bind_images(prog, fog_volume=volume)
         dispatch(prog, -(-w // 8), -(-h // 8))
         data = np.frombuffer(volume.read(), np.float16).astype(np.float64)
@@ -322,10 +322,10 @@ def gpu_froxels(gpu, camera, aspect, froxels, params, sun, time=0.0):
 
 def ref_froxels(camera, aspect, froxels, params, sun, time=0.0):
     from atmos.camera import view_basis
-    from atmos.plugins.volumetric_fog.plugin import froxel_knee
+    from atmos.froxels import froxel_knee
     s, sun_light, ambient_light = sun_terms(sun, params)
     return reference.froxel_volume(camera.position, view_basis(camera, aspect), froxels, params, s, sun_light,
-                                   ambient_light, froxel_knee(params), time)
+                                   ambient_light, froxel_knee(params.max_distance), time)
 
 
 def froxel_camera(rng, params):
@@ -363,7 +363,7 @@ def test_froxels_converge_to_the_per_pixel_march_with_slices():
     cam.position = np.array([6.0, 2.0, 40.0])
     cam.look_at((0.0, 0.0, 0.0))
     from atmos.camera import view_basis
-    from atmos.plugins.volumetric_fog.plugin import froxel_knee
+    from atmos.froxels import froxel_knee, froxel_lookup
     w, h = 12, 8
     uv = np.stack(np.meshgrid((np.arange(w) + 0.5) / w, (np.arange(h) + 0.5) / h, indexing="ij"), -1).reshape(-1, 2)
     rays = np.c_[uv * 2 - 1, np.ones(len(uv))] @ view_basis(cam, 1.5).T
@@ -372,7 +372,7 @@ def test_froxels_converge_to_the_per_pixel_march_with_slices():
     errors = []
     for slices in (8, 32, 128):
         volume = ref_froxels(cam, 1.5, (w, h, slices), params, sun)
-        got = reference.froxel_lookup(volume, uv, dists, params, froxel_knee(params))
+        got = froxel_lookup(volume, uv, dists, params.max_distance, froxel_knee(params.max_distance))
         errors.append(np.abs(got - exact).max())
     assert errors[0] > errors[1] > errors[2] and errors[2] < 0.25 * errors[0], errors
     assert errors[2] < 0.02
@@ -380,7 +380,7 @@ def test_froxels_converge_to_the_per_pixel_march_with_slices():
 
 def test_a_scene_with_froxel_fog_is_the_twin_read_at_each_pixel(fresh_gpu):
     from atmos.camera import view_basis
-    from atmos.plugins.volumetric_fog.plugin import froxel_knee
+    from atmos.froxels import froxel_knee, froxel_lookup
     params = VolumetricFogSettings(octaves=4, light_steps=3, absorption=0.15, froxels=(32, 18, 48), animate=False)
     bg, cam = render(fresh_gpu)
     fog, _ = render(fresh_gpu, VolumetricFogPlugin(params))
@@ -393,7 +393,7 @@ def test_a_scene_with_froxel_fog_is_the_twin_read_at_each_pixel(fresh_gpu):
     view_z = cam.near / ((1 - z) + z * cam.near / cam.far)
     dists = np.where(z >= 1, 1e30, view_z * np.linalg.norm(rays, axis=1))
     volume = ref_froxels(cam, w / h, params.froxels, params, Sun.from_angles(30.0, 60.0))
-    medium = reference.froxel_lookup(volume, uv, dists, params, froxel_knee(params))
+    medium = froxel_lookup(volume, uv, dists, params.max_distance, froxel_knee(params.max_distance))
     want = medium[:, :3] + medium[:, 3:] * bg.color[ys, xs, :3]
     got = fog.color[ys, xs, :3]
     assert (medium[:, 3] < 0.8).sum() > 10, "the fog is visible"

@@ -49,10 +49,11 @@ class MarchedShafts:
             self.jitter.release()
             self.jitter = None
 
-    def program(self, far_field: bool, fog=None, aerial=None):
-        """The march, with the far field's shadows beyond the volume (column.glsl's CLOUD_FAR_FIELD) or
-        without; ``fog`` (the FogMedium): the variant that shadows the fog's in-scatter (SHAFT_FOG);
-        ``aerial`` (the SkyLight): the variant that shadows the sky's aerial perspective (SHAFT_AERIAL)."""
+    def program(self, far_field: bool, fog=None, aerial=None, shader: str = "light_shafts/march.comp"):
+        """``shader`` (the march, or the froxels' fill and apply) with the far field's shadows beyond the volume
+        (column.glsl's CLOUD_FAR_FIELD) or without; ``fog`` (the FogMedium): the variant that shadows the fog's
+        in-scatter (SHAFT_FOG); ``aerial`` (the SkyLight): the variant that shadows the sky's aerial
+        perspective (SHAFT_AERIAL)."""
         defines = {}
         if self.exact:
             defines.update(SHAFT_EXACT_SHADOWS=1, **({"CLOUD_FAR_FIELD": 1} if far_field else {}))
@@ -60,7 +61,7 @@ class MarchedShafts:
             defines.update(SHAFT_AERIAL=1, **aerial.aerial_defines())
         if fog is not None:
             defines.update(SHAFT_FOG=1, **fog.defines())
-        return self.gpu.program(defines or None, compute_shader="light_shafts/march.comp")
+        return self.gpu.program(defines or None, compute_shader=shader)
 
     @classmethod
     def declare(cls, builder: PassBuilder, size, factor: int, clouds: bool, far_field: bool = False, fog=None,
@@ -73,6 +74,11 @@ class MarchedShafts:
         builder.read(DEPTH)
         builder.read(COLOR)
         builder.write(COLOR)
+        cls.declare_medium(builder, clouds, far_field, fog, aerial)
+
+    @classmethod
+    def declare_medium(cls, builder: PassBuilder, clouds: bool, far_field: bool, fog, aerial) -> None:
+        """What light_shafts/medium.glsl reads: the clouds' shadows, the fog's and the air's inputs."""
         if clouds:
             builder.read(CLOUD_SETS)
             if not cls.exact:
@@ -88,18 +94,27 @@ class MarchedShafts:
                 builder.read(CLOUD_DISTANCE)          # (a second read of the same is the same read)
 
     def execute(self, frame: PassContext, settings, clouds: bool, fog=None, aerial=None) -> None:
-        view = frame.view
-        irradiance = march_irradiance(view.sun, settings)
+        irradiance = march_irradiance(frame.view.sun, settings)
         if irradiance is None:
             return
         factor = settings.downsample
         self.offscreen.begin(frame, factor, clear=False)      # the march writes every low-res texel
         frame.reset_state()
-        far_field = clouds and frame.declares(FAR_FIELD)
-        p = self.program(far_field, fog, aerial)
+        p = self.program(clouds and frame.declares(FAR_FIELD), fog, aerial)
         if self.jitter is None:
             self.jitter = blue_noise_texture(self.gpu.ctx)
         bind_textures(p, low_depth=frame.resource(SHAFT_DEPTH), blue_noise=self.jitter)
+        self.set_medium(frame, p, settings, clouds, irradiance, fog, aerial)
+        write_uniforms(p, steps=settings.steps, factor=factor, frame_size=tuple(float(v) for v in frame.view.size))
+        shafts = frame.image(SHAFT_COLOR)
+        frame.dispatch(p, work_groups(shafts.size, (8, 8)), images={"shafts": shafts})
+        self.offscreen.end(frame, factor, frame.view.camera.near, frame.view.camera.far, medium=True)
+
+    def set_medium(self, frame: PassContext, p, settings, clouds: bool, irradiance, fog=None, aerial=None) -> None:
+        """Every uniform and texture of light_shafts/medium.glsl: the clouds' shadows (the shadow map, or
+        the column sums and the far field), the haze, the fog's and the air's."""
+        view = frame.view
+        far_field = clouds and frame.declares(FAR_FIELD)
         if clouds and frame.declares(SHADOW_MAP):
             sim: CloudSets = frame.resource(CLOUD_SETS)
             field_tau = column_tau(frame.resource(FAR_FIELD).settings, sim) if far_field else 0.0
@@ -111,19 +126,12 @@ class MarchedShafts:
                 layer = frame.resource(FAR_FIELD)
                 layer.prepare(view, sim)
                 layer.use(p, view, sim)
-        values = dict(has_clouds=int(clouds),
-                      irradiance=tuple(float(v) for v in irradiance),
-                      lobes=settings.phase.lobes, scattering=settings.scattering,
-                      max_distance=settings.max_distance, steps=settings.steps, factor=factor,
-                      frame_size=tuple(float(v) for v in view.size))
+        write_uniforms(p, has_clouds=int(clouds), irradiance=tuple(float(v) for v in irradiance),
+                       lobes=settings.phase.lobes, scattering=settings.scattering, max_distance=settings.max_distance)
         if fog is not None:
             self.fog_uniforms(frame, p, fog, settings)
         if aerial is not None:
             self.aerial_uniforms(frame, p, aerial)
-        write_uniforms(p, values)
-        shafts = frame.image(SHAFT_COLOR)
-        frame.dispatch(p, work_groups(shafts.size, (8, 8)), images={"shafts": shafts})
-        self.offscreen.end(frame, factor, view.camera.near, view.camera.far, medium=True)
 
     @staticmethod
     def fog_uniforms(frame: PassContext, program, fog, settings) -> None:

@@ -9,6 +9,7 @@ from atmos.plugin import Plugin
 from atmos.plugins.clouds import CLOUD_SETS, FAR_FIELD
 from atmos.plugins.clouds.shadows.shadow_map import shadow_map_pass
 from atmos.plugins.fog import FogMedium
+from atmos.plugins.light_shafts.froxels import FroxelShafts, uses_froxels
 from atmos.plugins.light_shafts.march import MarchedShafts
 from atmos.plugins.light_shafts.settings import LightShaftSettings, blur_scale
 from atmos.plugins.light_shafts.screen_sun import screen_sun
@@ -44,7 +45,7 @@ class LightShaftsPass(RenderPass):
 
     def __init__(self, plugin: "LightShaftsPlugin"):
         self.plugin = plugin
-        self.mask = self.blur = self.composite = self.marched = None
+        self.mask = self.blur = self.composite = self.marched = self.froxels = None
 
     def clouds(self) -> bool:
         """Whether the march reads cloud shadows (a clouds plugin imported "cloud_sets")."""
@@ -53,9 +54,14 @@ class LightShaftsPass(RenderPass):
     def setup(self, builder: PassBuilder) -> None:
         w, h = self.plugin.gpu.size
         d = self.plugin.settings.downsample
-        if self.plugin.settings.mode == "march":
+        settings, fog = self.plugin.settings, self.plugin.fog
+        if settings.mode == "march" and uses_froxels(settings, fog):
+            FroxelShafts.declare(builder, settings.froxels, self.clouds(), self.plugin.graph.imports(FAR_FIELD),
+                                 fog, self.plugin.aerial())
+            return
+        if settings.mode == "march":
             MarchedShafts.declare(builder, (w, h), d, self.clouds(), self.plugin.graph.imports(FAR_FIELD),
-                                  self.plugin.fog, self.plugin.aerial())
+                                  fog, self.plugin.aerial())
             return
         desc = TextureDesc((math.ceil(w / d), math.ceil(h / d)), components=4, dtype="f2")
         builder.create(MASK, desc)
@@ -70,6 +76,7 @@ class LightShaftsPass(RenderPass):
         self.blur = gpu.program(vertex_shader=fullscreen, fragment_shader="light_shafts/blur.frag")
         self.composite = gpu.program(vertex_shader=fullscreen, fragment_shader="light_shafts/composite.frag")
         self.marched = MarchedShafts(gpu)
+        self.froxels = FroxelShafts(self.marched)
 
     def release(self) -> None:
         if self.marched is not None:
@@ -78,7 +85,8 @@ class LightShaftsPass(RenderPass):
     def execute(self, frame: PassContext) -> None:
         view, gpu, params = frame.view, frame.gpu, self.plugin.settings
         if params.mode == "march":
-            self.marched.execute(frame, params, frame.declares(CLOUD_SETS), self.plugin.fog, self.plugin.aerial())
+            shafts = self.froxels if uses_froxels(params, self.plugin.fog) else self.marched
+            shafts.execute(frame, params, frame.declares(CLOUD_SETS), self.plugin.fog, self.plugin.aerial())
             return
         w, h = view.size
         where = screen_sun(view.camera, view.aspect, view.sun.direction, params)

@@ -1,5 +1,6 @@
 """numpy float64 references of the light shafts: the screen mode's occlusion mask and radial blur
-toward the sun, and the march mode's in-scattering along the view rays (:func:`march_shafts`).
+toward the sun, and the march mode's in-scattering along the view rays (:func:`march_shafts`), or
+through a froxel volume (:func:`froxel_shafts`, :func:`froxel_apply`).
 
 Images are (h, w, c) in GL row order (row 0 at the bottom), pixel (x, y) at uv ((x+0.5)/w, (y+0.5)/h).
 """
@@ -8,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from atmos.blue_noise import blue_noise
+from atmos.froxels import column_rays, froxel_distance, froxel_knee, froxel_lookup
 from atmos.plugins.clouds.shadows import reference as shadows_reference
 from atmos.plugins.light_shafts.settings import blur_scale
 from atmos.render_core import HDR_MAX
@@ -92,3 +94,40 @@ def march_shafts(low_depth, basis, camera_pos, near: float, far: float, frame_si
     p = settings.phase(direction @ np.asarray(sun_dir, np.float64))
     light = np.minimum(np.asarray(irradiance, np.float64) * (sigma * p * total * ds)[..., None], HDR_MAX)
     return np.concatenate([light, np.exp(-sigma * d)[..., None]], -1)
+
+
+def froxel_shafts(camera_pos, basis, froxels, sun_dir, irradiance, settings, optical_depth=None) -> np.ndarray:
+    """(W, H, D + 1, 4) float64: shaders/light_shafts/froxels.comp without a fog or the aerial perspective —
+    each column's view ray (:func:`atmos.froxels.column_rays`) sampled once per slice at its middle s,
+    layer k holding (Σ σ p(cos) E exp(−τ_sun − σ s) ds, exp(−σ d_k)) from the camera to slice boundary
+    d_k; ``optical_depth`` as for :func:`march_shafts`."""
+    w, h, d = froxels
+    _, dirs = column_rays(basis, w, h)
+    bounds = froxel_distance(np.arange(d + 1) / d, settings.max_distance, froxel_knee(settings.max_distance))
+    sigma = settings.scattering
+    lit = np.asarray(irradiance, np.float64) * (sigma * settings.phase(dirs @ np.asarray(sun_dir, np.float64)))[:, None]
+    out = np.zeros((len(dirs), d + 1, 4))
+    out[:, 0, 3] = 1.0
+    light = np.zeros((len(dirs), 3))
+    for k in range(1, d + 1):
+        s, ds = 0.5 * (bounds[k - 1] + bounds[k]), bounds[k] - bounds[k - 1]
+        tau = 0.0 if optical_depth is None else optical_depth(np.asarray(camera_pos, np.float64) + dirs * s)
+        light = light + lit * (np.exp(-tau - sigma * s) * ds)[:, None]
+        out[:, k, :3], out[:, k, 3] = light, np.exp(-sigma * bounds[k])
+    return out.reshape(w, h, d + 1, 4)
+
+
+def froxel_apply(volume, color, depth, basis, near: float, far: float, settings) -> np.ndarray:
+    """(h, w, 3): shaders/light_shafts/froxel_apply.comp without a fog or the aerial perspective — each
+    pixel of ``color`` (h, w, 3) and window ``depth`` (h, w) (row 0 at the bottom) reads ``volume`` at its
+    distance (the sky: ``max_distance``): min(L, HDR_MAX) + T · color."""
+    depth = np.asarray(depth, np.float64)
+    h, w = depth.shape
+    uv = pixel_uv(w, h).reshape(-1, 2)
+    ray = np.concatenate([uv * 2.0 - 1.0, np.ones((len(uv), 1))], 1) @ np.asarray(basis, np.float64).T
+    z = depth.reshape(-1)
+    view_z = near / ((1.0 - z) + z * (near / far))
+    dist = np.where(z >= 1.0, settings.max_distance, view_z * np.linalg.norm(ray, axis=-1))
+    knee = froxel_knee(settings.max_distance)
+    sums = froxel_lookup(np.asarray(volume, np.float64), uv, dist, settings.max_distance, knee).reshape(h, w, 4)
+    return np.minimum(sums[..., :3], HDR_MAX) + sums[..., 3:] * np.asarray(color, np.float64)[..., :3]

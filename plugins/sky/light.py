@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 import atmos.plugins.sky.radiance as radiance
+from atmos.gpu.uniforms import write_uniforms
 from atmos.plugins.sky.aerial import active
 from atmos.plugins.sky.luts import SKY_LUTS, atmosphere_defines, set_atmosphere_uniforms, view_radius
 from atmos.plugins.sky.sun_light import horizon_radiance
@@ -79,4 +80,4 @@ class SkyLight:
         """The atmosphere's uniforms, its LUTs bound and the camera's radius (``view_r``)."""
         frame.resource(SKY_LUTS).bind(program)
         set_atmosphere_uniforms(program, self.settings.atmosphere)
-        program["view_r"].value = view_radius(self.settings.atmosphere, frame.view.camera)
+        write_uniforms(program, view_r=view_radius(self.settings.atmosphere, frame.view.camera))

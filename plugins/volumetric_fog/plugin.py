@@ -5,7 +5,9 @@ import numpy as np
 
 from atmos.scene_uniforms import set_camera_uniforms
 from atmos.composition import MEDIA_LIGHT, MEDIA_TRANSMITTANCE, composition
-from atmos.graph import ComputePass, PassContext, TextureDesc, work_groups
+from atmos.froxels import froxel_knee, volume_desc
+from atmos.gpu.uniforms import write_uniforms
+from atmos.graph import ComputePass, PassContext, work_groups
 from atmos.lighting import Sun, sun_and_day
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
@@ -14,13 +16,6 @@ from atmos.plugins.volumetric_fog.settings import VolumetricFogSettings
 
 HORIZON_SAMPLES = 16      # azimuths of the sky's horizon radiance averaged into the ambient
 FOG_VOLUME = "volumetric_fog_volume"     # the froxel volume (a transient of the pass; settings.froxels)
-KNEE_SHARE = 1.0 / 32.0   # froxel slices: even inside max_distance · KNEE_SHARE, logarithmic beyond
-
-
-def froxel_knee(settings: VolumetricFogSettings) -> float:
-    """m: the froxel slices' knee (lib/froxel_slices.glsl)."""
-    return settings.max_distance * KNEE_SHARE
-from atmos.gpu.uniforms import write_uniforms
 
 
 def sun_terms(sun: Sun, settings: VolumetricFogSettings, sky_ambient=None):
@@ -63,9 +58,7 @@ class VolumetricFogPass(ComputePass):
         super().setup(builder)
         froxels = self.plugin.settings.froxels
         if froxels is not None:                    # layer 0 is the camera: D slices, D + 1 layers
-            w, h, d = froxels
-            builder.create(FOG_VOLUME, TextureDesc((w, h, d + 1), components=4, dtype="f2", storage=True),
-                           access="storage")
+            builder.create(FOG_VOLUME, volume_desc(froxels), access="storage")
         if self.plugin.composition.media:          # the aerial perspective mixes the air with it
             for name in (MEDIA_LIGHT, MEDIA_TRANSMITTANCE):
                 builder.read(name, access="storage")
@@ -93,7 +86,7 @@ class VolumetricFogPass(ComputePass):
         volume.repeat_x = volume.repeat_y = volume.repeat_z = False     # read clamped to its edge texels
         for p in (fill, apply):
             set_camera_uniforms(p, view.camera, view.aspect)
-            write_uniforms(p, froxel_knee=froxel_knee(settings), max_distance=settings.max_distance)
+            write_uniforms(p, froxel_knee=froxel_knee(settings.max_distance), max_distance=settings.max_distance)
         set_medium_uniforms(fill, settings, view.sun, self.plugin.time(view), self.plugin.sky_ambient(view))
         frame.dispatch(fill, work_groups(volume.size[:2], (8, 8)), images={"fog_volume": volume})
         frame.dispatch(apply, self.groups(color.size), images=images,

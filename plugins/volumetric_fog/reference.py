@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from atmos.froxels import column_rays, froxel_distance
 from atmos.value_noise import fbm
 from atmos.plugins.volumetric_fog.settings import VolumetricFogSettings
 
@@ -73,25 +74,13 @@ def march(origins, dirs, limits, settings: VolumetricFogSettings, sun_dir, sun_l
     return np.concatenate([light, trans[:, None]], axis=1)
 
 
-def froxel_distance(w, max_distance: float, knee: float):
-    """Distance of slice coordinate w in [0, 1] (lib/froxel_slices.glsl)."""
-    return knee * np.expm1(np.asarray(w, np.float64) * np.log1p(max_distance / knee))
-
-
-def froxel_w(d, max_distance: float, knee: float):
-    """Slice coordinate in [0, 1] of distance d (lib/froxel_slices.glsl)."""
-    return np.log1p(np.maximum(d, 0.0) / knee) / np.log1p(max_distance / knee)
-
-
 def froxel_volume(camera_pos, basis, froxels, settings: VolumetricFogSettings, sun_dir, sun_light, ambient_light,
                   knee: float, time: float = 0.0) -> np.ndarray:
     """(W, H, D + 1, 4) float64: volumetric_fog/froxels.comp — each column's ray through uv = ((x, y) + 0.5)
     / (W, H) (``basis``: atmos.camera.view_basis) marched one sample per slice; layer k holds (light,
     transmittance) from the camera to slice boundary k."""
     w, h, d = froxels
-    uv = np.stack(np.meshgrid((np.arange(w) + 0.5) / w, (np.arange(h) + 0.5) / h, indexing="ij"), -1).reshape(-1, 2)
-    rays = np.concatenate([uv * 2.0 - 1.0, np.ones((len(uv), 1))], 1) @ np.asarray(basis, np.float64).T
-    dirs = rays / np.linalg.norm(rays, axis=-1, keepdims=True)
+    _, dirs = column_rays(basis, w, h)
     origins = np.broadcast_to(np.asarray(camera_pos, np.float64), dirs.shape)
     enter, leave = march_range(origins, dirs, np.full(len(dirs), settings.max_distance), settings)
     bounds = froxel_distance(np.arange(d + 1) / d, settings.max_distance, knee)
@@ -126,28 +115,3 @@ def sun_transmittance(p, settings: VolumetricFogSettings, sun_dir, time: float =
         tl = np.where(hit, tl * np.exp(-settings.absorption * np.maximum(dl, 0) * settings.light_step), tl)
         lit &= ~(hit & (tl <= 0.01))
     return tl
-
-
-def froxel_lookup(volume: np.ndarray, uv, dist, settings: VolumetricFogSettings, knee: float) -> np.ndarray:
-    """(N, 4): froxel_apply.comp's trilinear read of ``volume`` (W, H, L, 4) at uv (N, 2) and scene
-    distance (N,) (clamped to the edge texels, as the texture is)."""
-    w, h, layers = volume.shape[:3]
-    uv = np.asarray(uv, np.float64)
-    z = froxel_w(np.minimum(dist, settings.max_distance), settings.max_distance, knee) * (layers - 1)
-    coords = [uv[:, 0] * w - 0.5, uv[:, 1] * h - 0.5, np.asarray(z, np.float64)]
-    result = np.zeros((len(uv), 4))
-    lows, fracs = [], []
-    for c, n in zip(coords, (w, h, layers)):
-        c = np.clip(c, 0.0, n - 1)
-        lo = np.minimum(np.floor(c).astype(int), n - 2) if n > 1 else np.zeros(len(c), int)
-        lows.append(lo)
-        fracs.append(c - lo if n > 1 else np.zeros(len(c)))
-    for corner in range(8):
-        bits = [(corner >> i) & 1 for i in range(3)]
-        weight = np.ones(len(uv))
-        index = []
-        for bit, lo, frac, n in zip(bits, lows, fracs, (w, h, layers)):
-            weight = weight * (frac if bit else 1.0 - frac)
-            index.append(np.minimum(lo + bit, n - 1))
-        result += weight[:, None] * volume[index[0], index[1], index[2]]
-    return result

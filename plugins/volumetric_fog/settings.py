@@ -4,6 +4,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from atmos.checks import CheckedSettings, bool_field, check_shape, choice_field, int_field, num_field, vec_field
+from atmos.froxels import MAX_FROXELS
 
 MAX_OCTAVES = 16
 MAX_STEPS = 1024
@@ -50,4 +51,4 @@ class VolumetricFogSettings(CheckedSettings):
 
     def __post_init__(self):
         super().__post_init__()
-        self.store(dict(froxels=check_shape(self.froxels, "VolumetricFogSettings.froxels", hi=256, optional=True)))
+        self.store(dict(froxels=check_shape(self.froxels, "VolumetricFogSettings.froxels", hi=MAX_FROXELS, optional=True)))

@@ -24,44 +24,13 @@
 // Both (a fog under the aerial perspective, mixed along the ray: atmos/composition.py): both sums, each
 // medium's in-scatter at s dimmed by the other in front of s too (the fog's by the air's grey
 // transmittance exp(-ext s), the air's by the fog's f(s)).
-// view_basis, camera_pos, near, far, sun_dir: the frame block (lib/frame.glsl)
-#include "lib/frame.glsl"
-#include "lib/hdr_max.glsl"
-#include "lib/view_ray.glsl"
-#include "lib/phase.glsl"
-#if SHAFT_EXACT_SHADOWS
-#include "clouds/volume/column.glsl"
-#define SUN_TAU sun_optical_depth
-#else
-#include "clouds/shadows/shadow_map.glsl"
-#define SUN_TAU cloud_shadow_tau
-#endif
+#include "light_shafts/medium.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0, rgba16f) writeonly uniform image2D shafts;   // (L, T) per low-res texel
 layout(binding = 2) uniform sampler2D low_depth;   // the farthest scene depth of each block
-uniform vec3 irradiance;       // sun_intensity * Sun.color * horizon fade, at most float32's largest
-uniform vec3 lobes;            // phase_g, phase_g2, phase_w
-uniform float scattering;      // 1/m
-uniform float max_distance;
 uniform int steps;
-uniform int has_clouds;
 uniform int factor;
 uniform vec2 frame_size;
-#if SHAFT_FOG || SHAFT_AERIAL
-#include "lib/cloud_distance.glsl"
-uniform int has_cloud_distance;   // 1: cloud_distance is bound
-layout(binding = 3) uniform sampler2D cloud_distance;
-#endif
-#if SHAFT_FOG
-#include "fog/factor.glsl"
-#include "fog/color.glsl"
-uniform int fog_sky_keep;
-uniform float fog_sun_share;   // LightShaftSettings.fog_sun_share
-#endif
-#if SHAFT_AERIAL
-#include "sky/atmosphere.glsl"
-uniform float view_r;          // the camera's radius from the planet's centre
-#endif
 
 // Per-texel start offset in [0, 1): the tiled blue noise (atmos/blue_noise.py; white noise clumped).
 layout(binding = 23) uniform sampler2D blue_noise;
@@ -87,9 +56,7 @@ vec4 march(ivec2 q) {
 #if SHAFT_FOG
     // the fog's own distance: the scene's, the sky's far plane, or (keep) none above the horizon and
     // the ground plane's below it (fog.frag)
-    float z = texelFetch(low_depth, q, 0).r;
-    float behind = z < 1.0 ? d : (fog_sky_keep == 0 ? far * length(ray)
-                 : (dir.y < 0.0 && camera_pos.y > 0.0 ? camera_pos.y / max(-dir.y, 1e-6) : 0.0));
+    float behind = shaft_fog_behind(texelFetch(low_depth, q, 0).r, d, dir, length(ray));
     float reach = max(behind, a > 0.0 ? dc : 0.0);
     vec3 end = camera_pos + dir * reach;
     float dm = min(reach, max_distance);
@@ -101,11 +68,10 @@ vec4 march(ivec2 q) {
         float f1 = fog_factor(s0 + dsf, end, camera_pos);
         float s = s0 + j * dsf;
         float w = (s < dc ? a : 0.0) + (s < behind ? 1.0 - a : 0.0);
-        float tau = has_clouds != 0 ? SUN_TAU(camera_pos + dir * s, sun_dir) : 0.0;
+        float tau = shaft_sun_tau(camera_pos + dir * s);
         float air = 1.0;                        // the air in front of s (with the aerial perspective)
 #if SHAFT_AERIAL
-        vec3 s_ray0, s_mie0;
-        air = dot(exp(-atm_coefficients(atm_point(r, dir.y, sun_dir.y, nu, s).x, s_ray0, s_mie0) * s), vec3(1.0 / 3.0));
+        air = shaft_air(r, dir, nu, s);
 #endif
         lost += w * (f0 - f1) * (1.0 - exp(-tau)) * air;
         f0 = f1;
@@ -120,17 +86,13 @@ vec4 march(ivec2 q) {
     for (int i = 0; i < steps; ++i) {
         float s = (float(i) + j) * dsa;
         float w = (s < dc ? a : 0.0) + (s < d ? 1.0 - a : 0.0);
-        float tau = has_clouds != 0 ? SUN_TAU(camera_pos + dir * s, sun_dir) : 0.0;
+        float tau = shaft_sun_tau(camera_pos + dir * s);
         if (w <= 0.0 || tau <= 0.0) continue;
-        vec2 at = atm_point(r, dir.y, sun_dir.y, nu, s);
-        vec3 s_ray, s_mie;
-        vec3 ext = atm_coefficients(at.x, s_ray, s_mie);
         float fogged = 1.0;                     // the fog in front of s (with a FogPlugin)
 #if SHAFT_FOG
         fogged = fog_factor(s, end, camera_pos);
 #endif
-        shadowed += w * exp(-ext * s) * atm_transmittance_to_sun(at.x, at.y) * (s_ray * pr + s_mie * pm)
-                    * (1.0 - exp(-tau)) * fogged;
+        shadowed += w * shaft_air_light(r, dir, nu, s, pr, pm) * (1.0 - exp(-tau)) * fogged;
     }
     taken += shadowed * dsa * atm_sun;
 #endif
@@ -141,8 +103,7 @@ vec4 march(ivec2 q) {
     float sum = 0.0;
     for (int i = 0; i < steps; ++i) {
         float s = (float(i) + j) * ds;
-        float tau = has_clouds != 0 ? SUN_TAU(camera_pos + dir * s, sun_dir) : 0.0;
-        sum += exp(-tau - scattering * s);
+        sum += exp(-shaft_sun_tau(camera_pos + dir * s) - scattering * s);
     }
     vec3 light = irradiance * (scattering * phase2(dot(dir, sun_dir), lobes) * sum * ds);
     return vec4(min(light, vec3(HDR_MAX)), exp(-scattering * d));   // blended onto the float16 colour

@@ -20,7 +20,5 @@ void main() {
     if (any(greaterThanEqual(pixel, size))) return;
     vec2 uv = (vec2(pixel) + 0.5) / vec2(size);
     float dist = view_ray_distance(uv, texelFetch(scene_depth, pixel, 0).r, view_basis, near, far, 1e30);
-    float layers = float(textureSize(fog_volume, 0).z);
-    float w = froxel_w(min(dist, max_distance), max_distance, froxel_knee) * (layers - 1.0);
-    blend_medium(pixel, textureLod(fog_volume, vec3(uv, (w + 0.5) / layers), 0.0));
+    blend_medium(pixel, froxel_read(fog_volume, uv, dist, max_distance, froxel_knee));
 }

@@ -1,0 +1,53 @@
+"""The light shafts from a froxel volume (``LightShaftSettings.froxels``): each of W × H view-ray columns
+marched once in D slices through the cloud shadow map (shaders/light_shafts/froxels.comp), then every
+pixel reads its sums at its own distance (froxel_apply.comp) — W·H·D samples instead of texels × steps.
+A heterogeneous fog, whose factor along a ray depends on the ray's end, keeps the per-texel march.
+float64 twin: :func:`.reference.froxel_shafts`."""
+from __future__ import annotations
+
+from atmos.froxels import froxel_knee, volume_desc
+from atmos.graph import PassBuilder, PassContext, work_groups
+from atmos.plugins.clouds import FAR_FIELD
+from atmos.plugins.light_shafts.march import MarchedShafts, march_irradiance
+from atmos.render_core import COLOR, DEPTH
+from atmos.gpu.uniforms import write_uniforms
+
+SHAFT_VOLUME = "light_shafts_volume"      # (W, H, D + 1) sums from the camera to each slice boundary
+
+
+def uses_froxels(settings, fog=None) -> bool:
+    """Whether the shafts come from the froxel volume: ``froxels`` set and no heterogeneous fog."""
+    return settings.froxels is not None and not (fog is not None and fog.settings.heterogeneous)
+
+
+class FroxelShafts:
+    """The froxel volume's declarations and dispatches for a LightShaftsPass; the uniforms are the
+    march's (``medium``: its :class:`MarchedShafts`)."""
+
+    def __init__(self, medium: MarchedShafts):
+        self.medium = medium
+
+    @staticmethod
+    def declare(builder: PassBuilder, froxels, clouds: bool, far_field: bool = False, fog=None, aerial=None) -> None:
+        builder.create(SHAFT_VOLUME, volume_desc(froxels), access="storage")
+        builder.read(DEPTH)
+        builder.read(COLOR, access="storage")
+        builder.write(COLOR, access="storage")
+        MarchedShafts.declare_medium(builder, clouds, far_field, fog, aerial)
+
+    def execute(self, frame: PassContext, settings, clouds: bool, fog=None, aerial=None) -> None:
+        irradiance = march_irradiance(frame.view.sun, settings)
+        if irradiance is None:
+            return
+        far_field = clouds and frame.declares(FAR_FIELD)
+        fill, apply = (self.medium.program(far_field, fog, aerial, f"light_shafts/{name}.comp")
+                       for name in ("froxels", "froxel_apply"))
+        for p in (fill, apply):
+            self.medium.set_medium(frame, p, settings, clouds, irradiance, fog, aerial)
+            write_uniforms(p, froxel_knee=froxel_knee(settings.max_distance))
+        volume = frame.image(SHAFT_VOLUME)
+        volume.repeat_x = volume.repeat_y = volume.repeat_z = False     # read clamped to its edge texels
+        frame.dispatch(fill, work_groups(volume.size[:2], (8, 8)), images={"shaft_volume": volume})
+        color = frame.image(COLOR)
+        frame.dispatch(apply, work_groups(color.size, (8, 8)), images={"color_image": color},
+                       textures={"scene_depth": DEPTH, "shaft_volume": volume})

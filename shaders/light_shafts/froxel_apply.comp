@@ -1,0 +1,46 @@
+#version 430
+// The light shafts from their froxel volume (light_shafts/froxels.comp), one invocation per pixel,
+// composited onto the colour in place (lib/media_image.glsl). The haze alone: (L, T) read at the pixel's
+// distance (the sky: max_distance), rgb = min(L, HDR_MAX) + T rgb. With a fog or the aerial perspective
+// the light lost in cloud shadow is taken away, read where march.comp's weights put it: a cloud covering a
+// of the pixel at its own distance d_c, the rest at the scene's (the fog's own distance for the fog),
+//   rgb -= a S(d_c) + (1 - a) S(d)   (S: the volume's sums; the fog's times fog_sun_share C_fog(dir)).
+#include "light_shafts/medium.glsl"
+#include "lib/froxel_slices.glsl"
+#include "lib/media_image.glsl"
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(binding = 2) uniform sampler2D scene_depth;
+layout(binding = 4) uniform sampler3D shaft_volume;
+uniform float froxel_knee;
+
+vec4 sums_at(vec2 uv, float d) {
+    return froxel_read(shaft_volume, uv, d, max_distance, froxel_knee);
+}
+
+void main() {
+    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 size = imageSize(color_image);
+    if (any(greaterThanEqual(pixel, size))) return;
+    vec2 uv = (vec2(pixel) + 0.5) / vec2(size);
+    float z = texelFetch(scene_depth, pixel, 0).r;
+    float d = min(view_ray_distance(uv, z, view_basis, near, far, max_distance), max_distance);
+#if SHAFT_FOG || SHAFT_AERIAL
+    vec3 ray = view_ray(uv, view_basis);
+    vec3 dir = normalize(ray);
+    vec2 cloud = cloud_cover_distance(has_cloud_distance != 0 ? texelFetch(cloud_distance, pixel, 0).rg : vec2(0.0));
+    float a = cloud.x;
+    vec4 in_cloud = a > 0.0 ? a * sums_at(uv, cloud.y) : vec4(0.0);
+    vec3 taken = vec3(0.0);
+#if SHAFT_FOG
+    float behind = shaft_fog_behind(z, d, dir, length(ray));
+    taken += fog_sun_share * in_color(dir) * (in_cloud.a + (1.0 - a) * sums_at(uv, behind).a);
+#endif
+#if SHAFT_AERIAL
+    taken += in_cloud.rgb + (1.0 - a) * sums_at(uv, d).rgb;
+#endif
+    blend_medium(pixel, vec4(-taken, 1.0));
+#else
+    vec4 shafts = sums_at(uv, d);
+    blend_medium(pixel, vec4(min(shafts.rgb, vec3(HDR_MAX)), shafts.a));
+#endif
+}
