@@ -1,4 +1,5 @@
 """The window path under a virtual X server (Xvfb): frames render, ESC quits, resizing works."""
+import math
 import os
 import shutil
 import subprocess
@@ -46,14 +47,20 @@ def test_escape_quits_and_resize_is_safe(display):
 
 def test_a_resized_window_is_filled_and_atmos_leaves_no_gl_error(display, tmp_path):
     """tests/window_probe.py grows and shrinks a window while running, reads each size's frame with
-    read_pixels and then draws a pyglet Label with pyglet's GL error checking on."""
+    read_pixels and then draws a pyglet Label with pyglet's GL error checking on; the render graph's
+    timer queries run on GLX's functions."""
     import json
     env = dict(os.environ, DISPLAY=display)
     probe = os.path.join(os.path.dirname(__file__), "window_probe.py")
     proc = subprocess.run([sys.executable, probe, str(tmp_path)], env=env, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
-    seen = json.loads(proc.stdout.strip().splitlines()[-1])
+    report = json.loads(proc.stdout.strip().splitlines()[-1])
+    seen, timers = report["seen"], report["timers"]
     assert [s["size"] for s in seen] == [[200, 120], [320, 240], [160, 200]]
+    # the window's context is GLX's: the timer queries' functions resolve there, and their times come in
+    assert timers["apis"] == ["glx"], timers
+    ms = timers["ms"]
+    assert ms and all(math.isfinite(v) and v >= 0.0 for v in ms.values()) and max(ms.values()) > 0.0, ms
     for s in seen:
         assert s["pixels"] == s["size"] and s["error"] == "GL_NO_ERROR", s
         assert s["dark"] < 0.01, f"the frame at {s['size']} does not fill the window ({s['dark']:.0%} left dark)"

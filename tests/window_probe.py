@@ -1,5 +1,6 @@
 """Run under a (virtual) X display by tests/test_window.py: a real pyglet window through atmos.window,
-resized while running, with pyglet's GL error checking on. Prints one JSON line of what it saw.
+resized while running, with pyglet's GL error checking on, the render graph's timer queries on (read
+through GLX's functions here). Prints one JSON line of what it saw.
 
     python tests/window_probe.py OUT_DIR
 """
@@ -12,6 +13,7 @@ import pyglet
 pyglet.options["debug_gl"] = True          # every pyglet GL call raises on a pending GL error
 
 from atmos.demo_registry import DemoSettings  # noqa: E402
+from atmos.gpu import queries  # noqa: E402
 from atmos.runner import build_app  # noqa: E402
 from atmos.window import run_window  # noqa: E402
 
@@ -27,6 +29,7 @@ def main(out_dir: str) -> None:
     def on_frame(app, window, frame):
         if not label:                                  # made in the window's context
             label.append(pyglet.text.Label("atmos", x=4, y=4))
+            app.graph.timings_enabled = True
         step, at = divmod(frame, FRAMES_PER_SIZE)
         if at == FRAMES_PER_SIZE - 1:                  # the last frame at this size: look at it
             pixels = app.gpu.read_pixels()
@@ -38,11 +41,14 @@ def main(out_dir: str) -> None:
             if step + 1 < len(SIZES):
                 window.set_size(*SIZES[step + 1])
             else:
+                timers.update(apis=[api for api, gl in queries._LOADED.items() if gl is not None],
+                              ms={name: value[0] for name, value in app.graph.timings.items()})
                 app.running = False
 
+    timers = {}
     settings = DemoSettings(size=SIZES[0], frames=None, headless=False)
     run_window(lambda gpu: build_app("testbed", settings, gpu), SIZES[0], "atmos window probe", None, on_frame)
-    print(json.dumps(seen))
+    print(json.dumps({"seen": seen, "timers": timers}))
 
 
 if __name__ == "__main__":
