@@ -213,7 +213,7 @@ def test_automata_of_different_shapes_share_the_context_programs(gpu, make, rng,
     for ca, e in zip(autos, expected):
         assert all(np.array_equal(g, x) for g, x in zip(ca.download(), e))
     prefix = "clouds/automaton/packed_" if layout == "packed" else "clouds/automaton/cell_"
-    assert {prefix + "step.comp", prefix + "advect.comp"} <= gpu.compiled_files
+    assert prefix + "step.comp" in gpu.compiled_files
     programs = len(gpu._programs)
     autos[0].release()
     again = make(shapes[0], layout=layout)

@@ -7,7 +7,6 @@ through GLX's functions here). Prints one JSON line of what it saw.
 import json
 import sys
 
-import numpy as np
 import pyglet
 
 pyglet.options["debug_gl"] = True          # every pyglet GL call raises on a pending GL error

@@ -10,12 +10,19 @@ uint atmos_lowbias32(uint x) {
     return x;
 }
 
-// Keys (ka, kb) of the random stream (seed, step, rule, plane); stream id = rule * 256 + plane.
-uvec2 atmos_stream_key(uint seed, uint step, uint rule, uint plane) {
-    uint k = atmos_lowbias32(seed ^ 0x9e3779b9u);
-    k = atmos_lowbias32(k ^ step);
-    k = atmos_lowbias32(k ^ (rule * 256u + plane));
+// Keys (ka, kb) of the random stream (seed, step, rule, plane); stream id = rule * 256 + plane. In two
+// parts where many streams share a step: atmos_step_key(seed, step), then atmos_plane_key of it.
+uint atmos_step_key(uint seed, uint step) {
+    return atmos_lowbias32(atmos_lowbias32(seed ^ 0x9e3779b9u) ^ step);
+}
+
+uvec2 atmos_plane_key(uint step_key, uint rule, uint plane) {
+    uint k = atmos_lowbias32(step_key ^ (rule * 256u + plane));
     return uvec2(k, atmos_lowbias32(k ^ 0x68e31da4u));
+}
+
+uvec2 atmos_stream_key(uint seed, uint step, uint rule, uint plane) {
+    return atmos_plane_key(atmos_step_key(seed, step), rule, plane);
 }
 
 // The random uint of one counter value (cell or word index) in the stream with keys `key`.

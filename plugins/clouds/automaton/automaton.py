@@ -1,7 +1,9 @@
 """Dobashi's cloud cellular automaton (thesis sec. 2.3, eq. 2.1–2.10) on the GPU with compute shaders.
 
 One :meth:`CloudAutomaton.step` = growth (eq. 2.1–2.4) → stochastic rules (eq. 2.5–2.7) →
-advection (eq. 2.8–2.10), computed entirely on the GPU; steps chain without a CPU round trip.
+advection (eq. 2.8–2.10), one compute dispatch (each result word steps its advected source words;
+the random streams' keys are hashed on the GPU from the seed and the step); steps chain without a
+CPU round trip.
 
 Growth neighbourhood f_act (eq. 2.4, whose vertical axis k is our height axis y): the OR of act at
 ``(x±1, y, z)``, ``(x, y±1, z)``, ``(x, y, z±1)``, ``(x±2, y, z)``, ``(x, y, z±2)`` and
@@ -48,7 +50,6 @@ import numpy as np
 
 from atmos.checks import check_shape, is_int
 from atmos.gpu.context import GpuContext, require_gpu
-from atmos.hashing import stream_key
 from atmos.gpu.uniforms import bind_buffers, bind_textures, write_uniforms
 from atmos.gpu.hazards import dispatch
 
@@ -60,8 +61,7 @@ RULES = ("p_ext", "p_hum", "p_act")
 _GROUP = 64
 _ONE = 1 << PRECISION_BITS
 
-_RULE_IDS = np.repeat(np.arange(3, dtype=np.uint32), PRECISION_BITS)
-_PLANE_IDS = np.tile(np.arange(PRECISION_BITS, dtype=np.uint32), 3)
+_NO_SHIFTS = bytes(8 * MAX_LAYERS)     # u_shifts of a step that does not advect
 
 
 def _mb(n: int) -> str:
@@ -129,7 +129,6 @@ class CloudAutomaton:
 
         prefix = "clouds/automaton/packed_" if layout == "packed" else "clouds/automaton/cell_"
         self._prog_step = gpu.program(compute_shader=prefix + "step.comp")
-        self._prog_advect = gpu.program(compute_shader=prefix + "advect.comp")
         self._prog_pack = (gpu.program(compute_shader="clouds/automaton/pack_thresholds.comp")
                            if layout == "packed" else None)
         objects = []
@@ -212,32 +211,26 @@ class CloudAutomaton:
         self._run_step(modes, thresholds, shifts)
 
     def _run_step(self, modes, thresholds, shifts) -> None:
-        """Dispatch growth + stochastic rules (``modes``: 0 off, 1 scalar, 2 per-cell) + advection."""
-        ka, kb = stream_key(self.seed, self.step_count, _RULE_IDS, _PLANE_IDS)
-        keys = np.stack([ka, kb], axis=-1).astype("<u4").tobytes()
-
+        """Dispatch growth + stochastic rules (``modes``: 0 off, 1 scalar, 2 per-cell) + advection, one dispatch."""
+        if not shifts.any():
+            shift_bytes = _NO_SHIFTS
+        else:
+            if not np.array_equal(shifts, self._shifts):
+                self._shifts = shifts
+                padded = np.zeros((MAX_LAYERS, 2), "<i4")
+                padded[: len(shifts)] = shifts
+                self._shift_bytes = padded.tobytes()
+            shift_bytes = self._shift_bytes
         prog = self._prog_step
-        self._set_grid(prog)
-        write_uniforms(prog, u_mode=tuple(modes), u_threshold=tuple(thresholds), u_keys=keys)
+        self._set_grid(prog)        # the program is shared by every automaton on the context: set per run
+        write_uniforms(prog, u_mode=tuple(modes), u_threshold=tuple(thresholds), u_seed=self.seed,
+                       u_step=self.step_count & 0xFFFFFFFF, u_shifts=shift_bytes)
         src, dst = self._state[self._current], self._state[1 - self._current]
         per_cell = "Prob" if self.layout == "cell" else "Planes"     # the step's probability blocks, by rule
         bind_buffers(prog, {f"{per_cell}{name}": self._prob_buffers[rule] if modes[rule] == 2 else self._dummy
                             for rule, name in enumerate(("Ext", "Hum", "Act"))}, Src=src, Dst=dst)
         dispatch(prog, *self._grid)
         self._current = 1 - self._current
-
-        if shifts.any():
-            if not np.array_equal(shifts, self._shifts):
-                self._shifts = shifts
-                padded = np.zeros((MAX_LAYERS, 2), "<i4")
-                padded[: len(shifts)] = shifts
-                self._shift_bytes = padded.tobytes()
-            src, dst = self._state[self._current], self._state[1 - self._current]
-            bind_buffers(self._prog_advect, Src=src, Dst=dst)
-            self._set_grid(self._prog_advect)
-            write_uniforms(self._prog_advect, u_shifts=self._shift_bytes)   # per run: the program is shared
-            dispatch(self._prog_advect, *self._grid)
-            self._current = 1 - self._current
         self.step_count += 1
 
     def forget_probabilities(self) -> None:

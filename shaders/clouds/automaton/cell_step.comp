@@ -1,5 +1,7 @@
 #version 430
-// Cell layout (the thesis's, one element per cell), growth + stochastic rules. State buffers:
+// Cell layout (the thesis's, one element per cell), one whole step in one dispatch: growth + stochastic
+// rules of the source cell (x - sx, y, z - sz) with the shift of layer y (advection, empty from outside).
+// State buffers:
 // uint per cell c = x + nx * (y + ny * z), bit 0 hum, bit 1 act, bit 2 cld. Same random numbers
 // as the packed layout: cell x of row (y, z) takes bit x % 32 of the word hashes of word
 // x / 32 + nwx * (y + ny * z), so both layouts give identical results.
@@ -7,6 +9,7 @@ layout(local_size_x = 64) in;
 
 #include "lib/hash.glsl"
 #include "clouds/automaton/common.glsl"
+uint k_step;                 // atmos_step_key of the step, set first in main
 
 layout(std430, binding = 0) readonly buffer Src { uint src[]; };
 layout(std430, binding = 1) writeonly buffer Dst { uint dst[]; };
@@ -34,22 +37,17 @@ bool bernoulli_cell(uint rule, uint c, uint w, uint b) {
     if (T >= 65536u) return true;
     if (T == 0u) return false;
     for (int j = PRECISION_BITS - 1; j >= 0; --j) {
-        uint u = (atmos_hash_counter(w, u_keys[rule * uint(PRECISION_BITS) + uint(j)]) >> b) & 1u;
+        uint u = (atmos_hash_counter(w, atmos_plane_key(k_step, rule, uint(j))) >> b) & 1u;
         uint t = (T >> uint(j)) & 1u;
         if (u != t) return u < t;
     }
     return false;
 }
 
-void main() {
-    uint c = invocation_index();
-    if (c >= u_count) {
-        return;
-    }
-    int x = int(c % uint(u_size.x));
-    uint row = c / uint(u_size.x);
-    int y = int(row % uint(u_size.y));
-    int z = int(row / uint(u_size.y));
+// The state bits of cell (x, y, z) after growth and the stochastic rules.
+uint stepped(int x, int y, int z) {
+    uint row = uint(y) + uint(u_size.y) * uint(z);
+    uint c = uint(x) + uint(u_size.x) * row;
     uint s = src[c];
     bool hum = (s & 1u) != 0u;
     bool act = (s & 2u) != 0u;
@@ -67,5 +65,21 @@ void main() {
     if (cld2 && u_mode.x != 0u && bernoulli_cell(0u, c, w, b)) cld2 = false;
     if (!hum2 && u_mode.y != 0u && bernoulli_cell(1u, c, w, b)) hum2 = true;
     if (!act2 && u_mode.z != 0u && bernoulli_cell(2u, c, w, b)) act2 = true;
-    dst[c] = (hum2 ? 1u : 0u) | (act2 ? 2u : 0u) | (cld2 ? 4u : 0u);
+    return (hum2 ? 1u : 0u) | (act2 ? 2u : 0u) | (cld2 ? 4u : 0u);
+}
+
+void main() {
+    k_step = atmos_step_key(u_seed, u_step);
+    uint c = invocation_index();
+    if (c >= u_count) {
+        return;
+    }
+    int x = int(c % uint(u_size.x));
+    uint row = c / uint(u_size.x);
+    int y = int(row % uint(u_size.y));
+    int z = int(row / uint(u_size.y));
+    ivec2 s = u_shifts[y];
+    int xs = x - s.x;
+    int zs = z - s.y;
+    dst[c] = xs >= 0 && xs < u_size.x && zs >= 0 && zs < u_size.z ? stepped(xs, y, zs) : 0u;
 }

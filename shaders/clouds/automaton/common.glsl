@@ -12,9 +12,11 @@ uniform uint u_count;        // invocations that do work (words or cells)
 // u_mode: 0 = rule off (p == 0 everywhere), 1 = scalar threshold u_threshold, 2 = per-cell array.
 uniform uvec3 u_mode;
 uniform uvec3 u_threshold;   // T = floor(p * 65536 + 0.5) in [0, 65536] for mode 1
-uniform uvec2 u_keys[3 * PRECISION_BITS];   // stream keys (ka, kb) of (seed, step, rule, plane)
+// The random streams (seed, step, rule, plane) of the step (lib/hash.glsl atmos_step_key, hashed on the GPU).
+uniform uint u_seed;
+uniform uint u_step;
 // Advection's shift (sx, sz) per layer y, a uniform (captured when the step is dispatched: a buffer
-// updated per step raced the queued advections reading it on NVIDIA); automaton.py MAX_LAYERS.
+// updated per step raced the queued steps reading it on NVIDIA); automaton.py MAX_LAYERS.
 #define MAX_LAYERS 128
 uniform ivec2 u_shifts[MAX_LAYERS];
 
