@@ -175,3 +175,13 @@ def _text(name: str) -> str:
     """The text of an include-only file (no #version): read through the search path."""
     from atmos.gpu.shaders import _locate
     return _locate(name)[1].strip()
+
+
+def test_an_include_line_may_end_in_a_comment(tmp_path):
+    (tmp_path / "main.comp").write_text('#version 430\n#include "lib/hdr_max.glsl"   // HDR_MAX\nvoid main() {}\n')
+    add_shader_path(tmp_path, prefix="commented")
+    try:
+        source = load_source("commented/main.comp")
+    finally:
+        remove_shader_path(tmp_path, prefix="commented")
+    assert source.files == ["commented/main.comp", "lib/hdr_max.glsl"] and "#include" not in source.text

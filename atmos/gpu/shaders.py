@@ -34,7 +34,7 @@ import moderngl
 
 from atmos.gpu.hazards import hazards_of
 
-_INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*$')
+_INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*(//.*)?$')   # a trailing // comment allowed
 _VERSION = re.compile(r"^\s*#version\b")
 _LAYOUT = r"^[ \t]*(?:layout\s*\((?P<layout>[^)]*)\)\s*)?"
 _WORDS = r"(?:(?:coherent|volatile|restrict|readonly|writeonly|lowp|mediump|highp)\s+)*"

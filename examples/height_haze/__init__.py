@@ -1,16 +1,15 @@
 """A third-party effect written the way the README's "Writing a pass" shows: exponential height haze.
 
-``HeightHazePlugin(density=2e-4, scale_height=300)`` adds one pass in the ``media`` phase that reads
-the scene depth and blends the haze onto ``color``. Its GLSL lives beside this file and is found
-through the shader search path under the prefix ``height_haze``.
+``HeightHazePlugin(density=2e-4, scale_height=300)`` adds one compute pass in the ``media`` phase that
+reads the scene depth and composites the haze onto ``color`` in place. Its GLSL lives beside this file
+and is found through the shader search path under the prefix ``height_haze``.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
 
-from atmos import (COLOR, DEPTH, FullscreenPass, PassContext, Plugin, add_shader_path, bind_textures, set_camera_uniforms,
-                   write_uniforms)
+from atmos import COLOR, DEPTH, ComputePass, PassContext, Plugin, add_shader_path, write_uniforms
 from atmos.checks import CheckedSettings, num_field, vec_field
 
 
@@ -24,22 +23,18 @@ class HeightHazeSettings(CheckedSettings):
     haze_color: tuple = vec_field((0.7, 0.78, 0.9), 3, "non-negative", "linear RGB of the in-scattered light")
 
 
-class HeightHazePass(FullscreenPass):
+class HeightHazePass(ComputePass):
     name = "height_haze"
     phase = "media"                       # after the scene and the clouds, before post effects
-    fragment = "height_haze/haze.frag"    # on the search path (see HeightHazePlugin.build)
-    reads = (COLOR, DEPTH)                # it blends onto colour, so it reads it too
+    compute = "height_haze/haze.comp"     # on the search path (see HeightHazePlugin.build)
+    reads = (COLOR, DEPTH)                # colour is read and written in place (an image)
     writes = (COLOR,)
 
     def execute(self, frame: PassContext) -> None:
         s, p = self.plugin.settings, self.program
-        frame.framebuffer(color=[COLOR]).use()
-        frame.blend_transmittance()       # rgb = light + T * rgb; the graph resets state after
-        bind_textures(p, scene_depth=frame.resource(DEPTH))
-        set_camera_uniforms(p, frame.view.camera, frame.view.aspect)
         write_uniforms(p, density=s.density, base=s.base, scale_height=s.scale_height,
                        max_distance=s.max_distance, haze_color=s.haze_color)   # skips what the compiler dropped
-        frame.fullscreen(p)
+        frame.dispatch(p, self.groups(frame.view.size), textures={"scene_depth": DEPTH}, images={"color_image": COLOR})
 
 
 class HeightHazePlugin(Plugin):
