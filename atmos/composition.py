@@ -14,6 +14,9 @@ A pass cannot declare an optional read, so the plugins meet in the App resource
 :class:`ClearDistance` (phase clear, added with the Composition) creates ``"cloud_distance"`` and
 clears it to 0, every layer reads and writes it (the far field, then the sprites over it), and the
 readers read it: a scene without fog allocates no distance target, a fog without clouds reads none.
+A first writer that writes every pixel when it runs (the far field's compute pass) says so in
+``covers`` (name -> whether it runs this frame); while it runs, it creates the target instead, writing
+its distance without reading one, and the clear is culled.
 
 Local media and the air. A local medium (the fog) blends its (light L, transmittance T) over the colour;
 the aerial perspective, which spans the whole ray, would then add the air's light over the fog as if the
@@ -68,6 +71,7 @@ class Composition:
     media write ``"media_light"``/``"media_transmittance"`` and which passes read them."""
     writers: set = field(default_factory=set)
     readers: set = field(default_factory=set)
+    covers: dict = field(default_factory=dict)     # name -> () -> bool: the first writer writes every pixel
     media_writers: set = field(default_factory=set)
     media_readers: set = field(default_factory=set)
 
@@ -75,6 +79,11 @@ class Composition:
     def distance(self) -> bool:
         """True when the distance is both written and read: the writer creates it, the readers read it."""
         return bool(self.writers) and bool(self.readers)
+
+    @property
+    def distance_cleared(self) -> bool:
+        """True when the distance is wanted and no first writer that covers every pixel runs: the clear makes it."""
+        return self.distance and not any(runs() for runs in self.covers.values())
 
     @property
     def media(self) -> bool:
@@ -103,11 +112,12 @@ class CompositionClear(RenderPass):
 
 class ClearDistance(CompositionClear):
     """Pass "cloud_distance_clear": ``"cloud_distance"`` cleared to 0 (no layer) when the Composition
-    has a writer and a reader."""
+    has a writer and a reader, and no first writer covers every pixel (``distance_cleared``)."""
     name = "cloud_distance_clear"
 
     def __init__(self, comp: Composition, gpu):
-        super().__init__(gpu, lambda: comp.distance, lambda size: ((CLOUD_DISTANCE, distance_desc(size), 0.0),))
+        super().__init__(gpu, lambda: comp.distance_cleared,
+                         lambda size: ((CLOUD_DISTANCE, distance_desc(size), 0.0),))
 
 
 class ClearMedia(CompositionClear):

@@ -37,12 +37,13 @@ import numpy as np
 from atmos.checks import CheckedSettings, bool_field, num_field, vec_field
 from atmos.hashing import lowbias32
 
-from atmos.graph import FullscreenPass, PassBuilder, PassContext, RenderPass, TextureDesc
+from atmos.graph import ComputePass, PassBuilder, PassContext, RenderPass, TextureDesc
 from atmos.plugin import Plugin
 from atmos.scene_uniforms import set_scene_uniforms
 from atmos.gpu.uniforms import bind_textures, write_uniforms
 
 SCREEN = "screen"
+PRESENT_IMAGE = "present_image"      # the presented frame, 8-bit levels, before its copy to the screen
 COLOR = "color"
 DEPTH = "depth"
 
@@ -81,7 +82,7 @@ HDR_MAX = 16384.0             # the most light one effect adds to a colour pixel
 
 
 def tone_map(hdr, exposure: float = 1.0) -> np.ndarray:
-    """Display values in [0, 1] of linear HDR colours (``core/present.frag`` before dithering and
+    """Display values in [0, 1] of linear HDR colours (``core/present.comp`` before dithering and
     rounding): exposure, the ACES fit of Narkowicz, then gamma 1/2.2."""
     x = np.maximum(np.asarray(hdr, np.float64) * exposure, 0.0)
     return np.clip((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0) ** (1.0 / 2.2)
@@ -102,9 +103,9 @@ def dither_offsets(width: int, height: int) -> np.ndarray:
 
 
 def present_levels(hdr, exposure: float = 1.0, dither: bool = True) -> np.ndarray:
-    """The 8-bit levels (0..255, float64) ``core/present.frag`` writes for an (h, w, 3) HDR image, rows
+    """The 8-bit levels (0..255, float64) ``core/present.comp`` writes for an (h, w, 3) HDR image, rows
     bottom-up: :func:`tone_map`, plus :func:`dither_offsets` × ``DITHER_STEP`` when ``dither``, rounded
-    to the nearest level (the shader writes exactly level / 255, so the framebuffer's conversion to
+    to the nearest level (the shader writes exactly level / 255, so the conversion to
     8 bits keeps it whatever its rounding)."""
     x = tone_map(hdr, exposure)
     if dither:
@@ -125,23 +126,39 @@ def where_nothing_was_drawn(frame: PassContext):
     return fbo
 
 
-class PresentPass(FullscreenPass):
-    """Tone-maps the HDR ``color`` into the screen (window or offscreen target), with sRGB gamma
+class PresentPass(ComputePass):
+    """Tone-maps the HDR ``color`` for the screen (window or offscreen target), with sRGB gamma
     and (``RenderCoreSettings.dither``) a triangular dither of one 8-bit step against banding,
-    rounded to 8-bit levels in the shader (:func:`present_levels`); the screen's alpha is 1
+    rounded to 8-bit levels in the shader (:func:`present_levels`): one compute invocation per pixel
+    into ``"present_image"`` (rgba8), then one framebuffer blit to the screen (a multisampled screen,
+    which a blit writes only from its own format, gets it drawn 1:1). The screen's alpha is 1
     (``color.a``, the sky occlusion, is not shown)."""
     name = "present"
     phase = "present"
-    fragment = "core/present.frag"
-    reads = (COLOR,)
-    writes = (SCREEN,)
+    compute = "core/present.comp"
+    copy = "core/present_copy.frag"
+
+    def setup(self, builder: PassBuilder) -> None:
+        builder.read(COLOR)
+        builder.create(PRESENT_IMAGE, TextureDesc(tuple(self.plugin.gpu.size), components=4, dtype="f1",
+                                                  filter="nearest", storage=True), access="storage")
+        builder.write(SCREEN)
 
     def execute(self, frame: PassContext) -> None:
-        frame.resource(SCREEN).use()
-        bind_textures(self.program, hdr=frame.resource(COLOR))
-        write_uniforms(self.program, exposure=self.plugin.settings.exposure,
+        p = self.program
+        write_uniforms(p, exposure=self.plugin.settings.exposure,
                        dither=DITHER_STEP if self.plugin.settings.dither else 0.0)
-        frame.fullscreen(self.program)
+        image = frame.image(PRESENT_IMAGE)
+        frame.dispatch(p, self.groups(image.size), textures={"hdr": COLOR}, images={"screen_image": PRESENT_IMAGE})
+        screen = frame.resource(SCREEN)
+        screen.use()                                      # its scissor off: a blit obeys it
+        if screen.samples:
+            copy = self.gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader=self.copy)
+            bind_textures(copy, screen_image=image)
+            frame.fullscreen(copy)
+            return
+        frame.gpu.hazards.use(reads=[(image, "attachment"), (image, "copy")])   # the blit sees the stores
+        frame.gpu.ctx.copy_framebuffer(screen, frame.framebuffer(color=[PRESENT_IMAGE]))
 
 
 class OpaquePass(RenderPass):
@@ -212,6 +229,7 @@ class RenderCorePlugin(Plugin):
     def build(self, app) -> None:
         if app.graph is None:
             return
+        self.gpu = app.gpu
         app.graph.import_resource(SCREEN, lambda: app.gpu.target)
         app.graph.add_pass(ClearPass(app.gpu, self))
         app.graph.add_pass(PresentPass(self))

@@ -1,5 +1,6 @@
 """The cloud shadow map (plugins/clouds/shadows/shadow_map.py): its float64 lookup against the exact
-sun_optical_depth within the derived interpolation bound, and the GPU's bake and lookup against float64."""
+sun_optical_depth within the derived interpolation bound, the GPU's bake and lookup against float64, and
+the shadow pass on the map against lookup_reference."""
 import math
 
 import numpy as np
@@ -144,4 +145,55 @@ def test_gpu_bake_and_lookup_match_float64(gpu, ctx, rng):
     assert np.all(np.abs(got - exact) <= 2.0 ** -9 * 2 * step + 2 * FORMAT_ERROR * np.abs(exact)
                   + 1e-5 * scale * probe.weights[0])
     assert (exact > 0.1).mean() > 0.1, "the points are under clouds"
+    app.close()
+
+
+def test_the_shadow_pass_on_the_map_matches_lookup_reference(gpu, ctx, rng):
+    """cloud_shadows on the shadow map (shadows at the volume's own placement): each ground pixel's
+    colour times 1 − weight (1 − exp(−τ)), τ from lookup_reference on the GPU's own map at the point
+    behind the pixel; sky pixels and alpha (the sky occlusion) kept."""
+    from test_cloud_shadows import depth_of, ray_dirs, world_points
+    size = gpu.size
+    cell = tuple(rng.uniform([3.0, 1.0, 3.0], [8.0, 3.0, 8.0]))
+    params = CloudShadowSettings(sigma=rng.uniform(0.2, 1.0), strength=rng.uniform(0.5, 2.0),
+                                 direct_fraction=rng.uniform(0.5, 1.0))
+    app, sim, fill, probe = shadow_app(gpu, params, cell_size=cell)
+    capture = MapCapture()
+    app.graph.add_pass(capture)
+    for _ in range(2):
+        app.update(1 / 30)
+    a, b, _ = sim.view()
+    nx, ny, nz = sim.shape
+    layers = 1 + sim.maps_of(a).bands
+    for s in (a, b):
+        write_sums(sim, s, rng.uniform(0, ny, (layers, nx, nz)))
+    layout = sim.sets().layout()
+    sun = Sun.from_angles(rng.uniform(20, 85), rng.uniform(0, 360), color=tuple(rng.uniform(0.2, 2, 3)))
+    app.insert_resource(sun)
+    centre = layout.lo + 0.5 * (layout.hi - layout.lo)
+    shadow = centre - sun.direction * centre[1] / sun.direction[1]      # where the layer's shadow falls
+    shadow[1] = 0.0
+    cam = app.resource(Camera)
+    cam.near, cam.far = 1.0, 1000.0
+    cam.position = shadow + np.array([rng.uniform(-60, 60), rng.uniform(30, 250), rng.uniform(-60, 60)])
+    cam.look_at(shadow + np.array([rng.uniform(-20, 20), 0.0, rng.uniform(-20, 20)]))
+    h, w = size[1], size[0]
+    rays = ray_dirs(cam, size)
+    to_ground = np.where(rays[..., 1] < 0, cam.position[1] / np.maximum(-rays[..., 1], 1e-9), np.inf)
+    depth = depth_of(cam, size, cam.position + rays * np.minimum(to_ground, 300.0)[..., None])
+    depth[rng.random((h, w)) < 0.1] = 1.0       # sky pixels stay as they are
+    color = rng.uniform(0.5, 2.0, (h, w, 4))
+    fill.color, fill.depth = color, depth
+    app.render()                                # render only: the sets stay as written
+    assert capture.space is not None and np.isfinite(probe.color).all()
+    weight = reference.direct_weight(sun.direction, sun.color, params)
+    tau = lookup_reference(capture.space, capture.map, world_points(cam, size, probe.depth), unit_sun(sun.direction),
+                           (params.sigma * params.strength, 0.0))
+    expected = np.where(probe.depth >= 1.0, 1.0, 1.0 - weight * -np.expm1(-tau))
+    before = color.astype(np.float16).astype(np.float64)
+    error = np.abs(probe.color[..., :3] / before[..., :3] - expected[..., None]).max(-1)
+    # 2^-11: the f2 colour; float32 depth moves a few far points over the random map's texels
+    assert np.quantile(error, 0.995) < 2e-3 and error.max() < 1e-2, f"max error {error.max()}"
+    assert np.array_equal(probe.color[..., 3], before[..., 3])
+    assert (expected < 0.95).sum() > 500, "the random scene has shadows to compare"
     app.close()

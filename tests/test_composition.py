@@ -90,7 +90,8 @@ class DistanceReadback(RenderPass):
 
     def execute(self, frame):
         w, h = frame.gpu.size
-        self.value = np.frombuffer(frame.resource(CLOUD_DISTANCE).read(), np.float32).reshape(h, w, 2)[::-1]
+        self.texture = frame.resource(CLOUD_DISTANCE)
+        self.value = np.frombuffer(self.texture.read(), np.float32).reshape(h, w, 2)[::-1]
 
 
 def cloud_app(gpu, downsample, fog=None):
@@ -184,6 +185,11 @@ def test_fog_attenuates_the_far_field_by_its_own_distance(gpu, ctx):
     cam.look_at(np.array([320.0, 1400.0, 9000.0]))                # away from the volume: only the far field
     cam.near, cam.far = 1.0, 20000.0
     app.run_frames(2)
+    # the far field is the first writer: it creates the distance and writes every pixel, no clear before
+    assert app.graph.compile().resources[CLOUD_DISTANCE].creator == "cloud_far_field"
+    w, h = gpu.size
+    readback.texture.write(np.full((h, w, 2), np.nan, np.float32).tobytes())     # last frame's, pooled
+    app.render()
     clear = app.read_linear()[..., :3].astype(np.float64)
     cloud = readback.value.astype(np.float64)
     a = cloud[..., 1]
@@ -205,6 +211,10 @@ def test_fog_attenuates_the_far_field_by_its_own_distance(gpu, ctx):
     assert np.abs(fogged - clear)[a > 0.5].mean() > 0.05, "far-field clouds over the sky are fogged"
     sky = (a == 0) & (dirs[..., 1] >= 0.0)
     assert np.array_equal(fogged[sky], clear[sky]), "the open sky is kept"
+    next(p for p in app.plugins if isinstance(p, CloudFarFieldPlugin)).configure(enabled=False)
+    app.render()                                        # a far field that does not draw: the clear is back
+    assert app.graph.compile().resources[CLOUD_DISTANCE].creator == ClearDistance.name
+    assert np.array_equal(readback.value, np.zeros_like(readback.value))
     app.close()
 
 

@@ -92,7 +92,7 @@ def test_gpu_release_closes_its_apps_first_and_a_second_release_does_nothing():
 
 @pytest.mark.parametrize("use", [
     lambda gpu: gpu.read_pixels(), lambda gpu: gpu.resize((8, 8)), lambda gpu: gpu.make_current(),
-    lambda gpu: gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="core/present.frag"),
+    lambda gpu: gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="core/present_copy.frag"),
     lambda gpu: gpu.check(), lambda gpu: gpu.info(), lambda gpu: App(gpu),
 ], ids=["read_pixels", "resize", "make_current", "program", "check", "info", "App"])
 def test_use_after_gpu_release_is_a_clear_error(use):

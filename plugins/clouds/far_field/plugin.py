@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from atmos.scene_uniforms import set_camera_uniforms
-from atmos.composition import CLOUD_DISTANCE, composition
+from atmos.composition import CLOUD_DISTANCE, composition, distance_desc
 from atmos.graph import ComputePass, PassContext
 from atmos.plugin import Plugin
 from atmos.plugins.clouds.far_field.layer import FarFieldLayer
@@ -20,7 +20,7 @@ class CloudFarFieldPass(ComputePass):
     """Phase translucent, before the cloud renderers (its clouds are behind theirs): composites the far
     field onto ``color`` in place (premultiplied, one compute invocation per pixel) where the layer's
     middle plane is in front of ``depth``, and its distance onto ``"cloud_distance"`` when a media pass
-    reads it (:mod:`atmos.composition`)."""
+    reads it (:mod:`atmos.composition`): as its first writer it creates it and writes every pixel (no clear)."""
     name = "cloud_far_field"
     phase = "translucent"
     compute = "clouds/far_field/far.comp"
@@ -31,12 +31,16 @@ class CloudFarFieldPass(ComputePass):
         if self.plugin.drawn_by_march():
             return                          # a ray march draws the far field volumetrically: culled
         super().setup(builder)
-        if self.plugin.composition.distance:
+        comp = self.plugin.composition
+        if comp.distance and not comp.distance_cleared:        # the first writer: every pixel written
+            builder.create(CLOUD_DISTANCE, distance_desc(self.plugin.gpu.size), access="storage")
+        elif comp.distance:
             builder.read(CLOUD_DISTANCE, access="storage")
             builder.write(CLOUD_DISTANCE, access="storage")
 
     def defines(self) -> dict:
-        return {"FAR_DISTANCE": int(self.plugin.composition.distance)}
+        comp = self.plugin.composition
+        return {"FAR_DISTANCE": 0 if not comp.distance else 1 if comp.distance_cleared else 2}
 
     def execute(self, frame: PassContext) -> None:
         params = self.plugin.settings
@@ -77,6 +81,8 @@ class CloudFarFieldPlugin(Plugin):
             raise ValueError("CloudFarFieldPlugin needs an App with a GPU context (App(gpu))")
         self.composition = composition(app)
         self.composition.writers.add("cloud_far_field")   # the fog gets the layer's own distance
+        self.composition.covers["cloud_far_field"] = self.runs    # and it writes all of it (no clear)
+        self.gpu = app.gpu
         self.layer = FarFieldLayer(app.gpu, self)          # also read by the ground shadows
         self.demand = field_demand(app)                    # the cloud renderers (light_settings)
         self.marchers = set()       # renderers that may march the far field themselves (drawn_by_march)
@@ -91,11 +97,16 @@ class CloudFarFieldPlugin(Plugin):
         comp = getattr(self, "composition", None)
         if comp is not None:
             comp.writers.discard("cloud_far_field")
+            comp.covers.pop("cloud_far_field", None)
 
     def light_settings(self) -> CloudLightSettings:
         """The octaves and field weight the far field is lit with: the cloud renderer's (FieldDemand.light;
         the defaults without one), so the far clouds continue the volume's light."""
         return self.demand.light() or CloudLightSettings()
+
+    def runs(self) -> bool:
+        """Whether the 2D pass draws this frame (enabled, not marched by a cloud renderer)."""
+        return self.settings.enabled and not self.drawn_by_march()
 
     def drawn_by_march(self) -> bool:
         """Whether a cloud renderer marches the far field itself this frame (a registered renderer's

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.graph import FullscreenPass, PassContext
+from atmos.graph import ComputePass, PassContext
 from atmos.lighting import unit_sun
 from atmos.plugin import Plugin
 from atmos.plugins.clouds.volume.layout import CloudLayout
@@ -13,7 +13,7 @@ from atmos.plugins.clouds.shadows.shadow_map import SHADOW_MAP, SHADOW_SPACE, sh
 from atmos.plugins.clouds.volume.column import column_uniforms
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS, FAR_FIELD, CloudSets
 from atmos.render_core import COLOR, DEPTH
-from atmos.gpu.uniforms import bind_textures, write_uniforms
+from atmos.gpu.uniforms import write_uniforms
 
 
 def direct_weight(sun_direction, sun_color, settings) -> float:
@@ -32,14 +32,16 @@ def cloud_layout(sim, settings: CloudShadowSettings) -> CloudLayout:
     return sim.layout(settings.base_altitude, settings.cell_size)
 
 
-class CloudShadowsPass(FullscreenPass):
-    """Multiplies "color" by the shadow factor where "depth" has geometry (blend ZERO, SRC_COLOR): the
-    optical depth read from the cloud shadow map, or (``exact``, or settings placing the shadows apart
-    from the volume: ``base_altitude``/``cell_size``) summed from the density maps per pixel."""
+class CloudShadowsPass(ComputePass):
+    """Multiplies "color" in place by the shadow factor where "depth" has geometry (one compute
+    invocation per pixel, alpha kept): the optical depth read from the cloud shadow map, or (``exact``,
+    or settings placing the shadows apart from the volume: ``base_altitude``/``cell_size``) summed from
+    the density maps per pixel."""
     name = "cloud_shadows"
     phase = "shadows"
-    fragment = "clouds/shadows/shadow.frag"
+    compute = "clouds/shadows/shadow.comp"
     reads = (COLOR, DEPTH, CLOUD_SETS)
+    writes = (COLOR,)
     exact = False               # True: always the column sums (benchmarks, references)
 
     def far_field(self) -> bool:
@@ -67,33 +69,28 @@ class CloudShadowsPass(FullscreenPass):
             builder.read(FAR_FIELD)
 
     def execute(self, frame: PassContext) -> None:
-        view, gpu, p = frame.view, frame.gpu, self.program
+        view, p = frame.view, self.program
         params = self.plugin.settings
         sun = view.sun
         weight = direct_weight(sun.direction, sun.color, params)
         if weight <= 0.0 or params.strength == 0.0:
-            return                                  # no direct light to take away: nothing to draw
+            return                                  # no direct light to take away: nothing to do
         sim: CloudSets = frame.resource(CLOUD_SETS)
         layout = cloud_layout(sim, params)
         sigma = sim.settings.sigma if params.sigma is None else params.sigma
-        frame.framebuffer(color=[COLOR]).use()
-        ctx = gpu.ctx
-        ctx.enable(ctx.BLEND)
-        ctx.blend_func = ctx.ZERO, ctx.SRC_COLOR, ctx.ZERO, ctx.ONE    # alpha (sky occlusion) kept
-        bind_textures(p, scene_depth=frame.resource(DEPTH))
         write_uniforms(p, weight=weight)
         if frame.declares(SHADOW_MAP):
             field_tau = column_tau(frame.resource(FAR_FIELD).settings, sim) if frame.declares(FAR_FIELD) else 0.0
             use_shadow_map(frame, p, sigma * params.strength, field_tau * params.strength)
-            frame.fullscreen(p)
-            return
-        column_uniforms(p, sim, layout, sigma * params.strength)
-        if frame.declares(FAR_FIELD):
-            layer = frame.resource(FAR_FIELD)
-            layer.prepare(view, sim)
-            layer.use(p, view, sim)
-            write_uniforms(p, field_column_tau=column_tau(layer.settings, sim) * params.strength)
-        frame.fullscreen(p)
+        else:
+            column_uniforms(p, sim, layout, sigma * params.strength)
+            if frame.declares(FAR_FIELD):
+                layer = frame.resource(FAR_FIELD)
+                layer.prepare(view, sim)
+                layer.use(p, view, sim)
+                write_uniforms(p, field_column_tau=column_tau(layer.settings, sim) * params.strength)
+        frame.dispatch(p, self.groups(frame.image(COLOR).size), textures={"scene_depth": DEPTH},
+                       images={"color_image": COLOR})
 
 
 class CloudShadowsPlugin(Plugin):

@@ -18,7 +18,8 @@
 // carry a diffusion field, its light from their mean (phi, F); sky light with tau half above, half below.
 // One compute invocation per pixel composites the premultiplied result onto the colour in place (as
 // blend_over would: layer + (1 - alpha) colour, alpha too) and, FAR_DISTANCE 1, its distance (alpha *
-// distance to the hit, alpha) onto "cloud_distance" (atmos/composition.py) with the same weights.
+// distance to the hit, alpha) onto "cloud_distance" (atmos/composition.py) with the same weights;
+// FAR_DISTANCE 2 (its first writer, no clear before) stores it at every pixel, (0, 0) where no layer.
 #include "lib/view_ray.glsl"
 #include "clouds/far_field/field.glsl"
 #include "clouds/volume/volume.glsl"
@@ -123,9 +124,12 @@ void main() {
     if (any(greaterThanEqual(px, size))) return;
     vec4 layer, distance;
     far_pixel((vec2(px) + 0.5) / vec2(size), layer, distance);
+#if FAR_DISTANCE == 2
+    imageStore(distance_image, px, vec4(layer.a > 0.0 ? distance.rg : vec2(0.0), 0.0, 0.0));
+#endif
     if (!(layer.a > 0.0)) return;                        // nothing in front: the pixel stays as it is
     imageStore(color_image, px, layer + (1.0 - layer.a) * imageLoad(color_image, px));
-#if FAR_DISTANCE
+#if FAR_DISTANCE == 1
     vec2 d = imageLoad(distance_image, px).rg;
     imageStore(distance_image, px, vec4(distance.rg + (1.0 - distance.a) * d, 0.0, 0.0));
 #endif
