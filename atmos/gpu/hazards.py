@@ -159,6 +159,14 @@ class Hazards:
             if access == "storage":
                 self._dirty[id(obj)] = [weakref.ref(obj), kind, _ALL[kind]]
 
+    def wrote_storage(self, objects) -> None:
+        """The work just recorded made storage writes to ``objects`` (textures, buffers): now dirty."""
+        dirty = self._dirty
+        for obj in objects:
+            kind = _KINDS[type(obj)] if type(obj) in _KINDS else kind_of(obj)
+            if kind is not None:
+                dirty[id(obj)] = [weakref.ref(obj), kind, _ALL[kind]]
+
     def issue(self, bits: int) -> None:
         """One glMemoryBarrier with ``bits``; every pending write is then visible to those uses."""
         self._ctx().memory_barrier(bits)

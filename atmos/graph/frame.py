@@ -197,16 +197,6 @@ class PassContext:
         self._fresh.discard(id(fbo))
         release_gl(fbo)
 
-    def _begin_frame(self, view, resources: dict) -> None:
-        self.view = view
-        self._resources = resources
-
-    def _begin_pass(self, name: str, declared: frozenset[str], access: dict | None = None) -> None:
-        self.pass_name = name
-        self._declared = declared
-        self._access = access or {}
-        self.reset_state()
-
     def _end_frame(self) -> None:
         """The frame ends as every pass starts, with the host's framebuffer (``gpu.target``: a window's
         screen) bound at its full size, so a host that draws next draws where it expects."""
