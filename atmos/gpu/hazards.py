@@ -119,9 +119,11 @@ class Hazards:
 
     def commit(self) -> None:
         """The work just recorded ran: what was staged for writing is now dirty."""
-        for key, (obj, kind) in self._staged.items():
-            self._dirty[key] = [weakref.ref(obj), kind, _ALL[kind]]
-        self._staged.clear()
+        staged, dirty = self._staged, self._dirty
+        for key in staged:
+            obj, kind = staged[key]
+            dirty[key] = [weakref.ref(obj), kind, _ALL[kind]]
+        self._staged = {}
 
     def use(self, reads=(), writes=()) -> int:
         """Issue the barrier the coming work needs (with what binds asked for): ``reads`` and ``writes``
@@ -176,10 +178,12 @@ class Hazards:
         for bit, name in _BIT_ORDER:
             if bits & bit:
                 issued[name] += 1
-        for key, entry in list(self._dirty.items()):
+        dirty = self._dirty
+        for key in list(dirty):
+            entry = dirty[key]
             entry[2] &= ~bits
             if not entry[2] or entry[0]() is None:
-                del self._dirty[key]
+                del dirty[key]
 
     def settle(self) -> int:
         """Make every pending write visible to every use (for readers that declare nothing: a frame's
@@ -218,7 +222,7 @@ def dispatch(program, *groups: int) -> None:
     extra = program.extra
     hazards = extra["hazards"] if type(extra) is dict and "hazards" in extra else hazards_of(program.ctx)
     if hazards._need:
-        hazards.flush()
+        hazards.issue(hazards._need)
     program.run(*groups)
     if hazards._staged:
         hazards.commit()
@@ -229,10 +233,14 @@ def dispatch_indirect(program, args, offset: int = 0) -> None:
     ``offset``), after the barrier that makes a shader's write of ``args`` visible as indirect arguments."""
     extra = program.extra
     hazards = extra["hazards"] if type(extra) is dict and "hazards" in extra else hazards_of(program.ctx)
-    hazards.need(args, moderngl.COMMAND_BARRIER_BIT)     # with what the binds asked for: one barrier
-    hazards.flush()
+    dirty = hazards._dirty                               # Hazards.need, inlined
+    if dirty and id(args) in dirty and (entry := dirty[id(args)])[0]() is args:
+        hazards._need |= entry[2] & moderngl.COMMAND_BARRIER_BIT
+    if hazards._need:                                    # with what the binds asked for: one barrier
+        hazards.issue(hazards._need)
     program.run_indirect(args, offset)
-    hazards.commit()
+    if hazards._staged:
+        hazards.commit()
 
 
 _GUARDED = False
@@ -269,7 +277,7 @@ def _flushing(method):
     def draw(self, *args, **kwargs):
         tracker = _TRACKERS.get(self.ctx)
         if tracker is not None and tracker._need:
-            tracker.flush()
+            tracker.issue(tracker._need)
         return method(self, *args, **kwargs)
     draw._atmos_copy_use = True
     draw.__name__, draw.__qualname__, draw.__doc__ = method.__name__, method.__qualname__, method.__doc__

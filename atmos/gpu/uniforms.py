@@ -20,6 +20,7 @@ def _hazards(program):
     return hazards if hazards is not None else hazards_of(program.ctx)
 
 
+_TEXTURES = frozenset((moderngl.Texture, moderngl.Texture3D, moderngl.TextureArray, moderngl.TextureCube))
 _SCALARS = frozenset((float, int, bool, tuple, bytes, np.float64, np.float32, np.int64, np.int32, np.bool_))
 # values compared with the last one written (a cheap ==); a 1-D numpy array is compared as a tuple
 
@@ -49,7 +50,9 @@ def write_uniforms(program, values: Mapping[str, object] | None = None, /, **mor
     members, last = _tables(program)
     if members is None:
         members, last = {}, None
-    for name, value in ({**values, **more} if values else more).items():
+    values = {**values, **more} if values else more
+    for name in values:
+        value = values[name]
         try:
             member = members[name]
         except KeyError:
@@ -122,7 +125,9 @@ def bind_textures(program, textures: Mapping[str, object] | None = None, /, samp
         units_of, hazards = {}, _hazards(program)
     units = []
     dirty = hazards._dirty
-    for name, texture in ({**textures, **more} if textures else more).items():
+    textures = {**textures, **more} if textures else more
+    for name in textures:
+        texture = textures[name]
         try:
             value = units_of[name]
         except KeyError:
@@ -140,7 +145,7 @@ def bind_textures(program, textures: Mapping[str, object] | None = None, /, samp
             one.use(unit)
             if sampler is not None:
                 sampler.use(unit)
-            units.append(unit)
+            units += (unit,)
     return units
 
 
@@ -152,14 +157,20 @@ def bind_images(program, images: Mapping[str, object] | None = None, /, **more) 
     declared = extra["images"]                # (unit, read, write) by name, from the compiler check
     hazards = extra["hazards"] if "hazards" in extra else _hazards(program)
     dirty = hazards._dirty
-    for name, texture in ({**images, **more} if images else more).items():
+    images = {**images, **more} if images else more
+    for name in images:
         if name in declared:
+            texture = images[name]
             unit, read, write = declared[name]
-            if dirty and (key := id(texture)) in dirty and (entry := dirty[key])[0]() is texture:
+            key = id(texture)
+            if dirty and key in dirty and (entry := dirty[key])[0]() is texture:
                 hazards._need |= entry[2] & moderngl.SHADER_IMAGE_ACCESS_BARRIER_BIT
             if write:
-                hazards.stage(texture)
-            texture.bind_to_image(unit, read=read, write=write)
+                if type(texture) in _TEXTURES:       # Hazards.stage, inlined
+                    hazards._staged[key] = (texture, "texture")
+                else:
+                    hazards.stage(texture)
+            texture.bind_to_image(unit, read, write)
 
 
 def bind_buffers(program, buffers: Mapping[str, object] | None = None, /, **more) -> None:
@@ -177,17 +188,23 @@ def bind_buffers(program, buffers: Mapping[str, object] | None = None, /, **more
     else:
         written, hazards, bindings = None, hazards_of(program.ctx), {}   # unknown: every block may be written
     dirty = hazards._dirty
-    for name, buffer in ({**buffers, **more} if buffers else more).items():
+    buffers = {**buffers, **more} if buffers else more
+    for name in buffers:
+        buffer = buffers[name]
         try:
             binding = bindings[name]
         except KeyError:
             member = program.get(name, None)
             binding = bindings[name] = None if member is None else member.binding
         if binding is not None:
-            if dirty and (key := id(buffer)) in dirty and (entry := dirty[key])[0]() is buffer:
+            key = id(buffer)
+            if dirty and key in dirty and (entry := dirty[key])[0]() is buffer:
                 hazards._need |= entry[2] & moderngl.SHADER_STORAGE_BARRIER_BIT
             if written is None or name in written:
-                hazards.stage(buffer)
+                if type(buffer) is moderngl.Buffer:     # Hazards.stage, inlined
+                    hazards._staged[key] = (buffer, "buffer")
+                else:
+                    hazards.stage(buffer)
             buffer.bind_to_storage_buffer(binding)
 
 

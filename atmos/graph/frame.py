@@ -139,12 +139,28 @@ class PassContext:
         name, declared with storage access, or texture) and ``buffers`` (storage block name -> resource
         name or buffer); the binds get the barriers their uses need (:mod:`atmos.gpu.hazards`)."""
         if textures:
-            bind_textures(program, {k: self.resource(v) if isinstance(v, str) else v for k, v in textures.items()})
+            bind_textures(program, self._named(textures))
         if images:
-            bind_images(program, {k: self.image(v) if isinstance(v, str) else v for k, v in images.items()})
+            bind_images(program, self._named(images, True))
         if buffers:
-            bind_buffers(program, {k: self.resource(v) if isinstance(v, str) else v for k, v in buffers.items()})
+            bind_buffers(program, self._named(buffers))
         dispatch(program, *groups)
+
+    def _named(self, binds: dict, image: bool = False) -> dict:
+        """``binds`` with each resource name replaced by this frame's resource (checked as
+        :meth:`resource`, or :meth:`image` for ``image`` binds); objects kept as they are."""
+        declared, resources, access = self._declared, self._resources, self._access
+        out = {}
+        for k in binds:
+            v = binds[k]
+            if type(v) is str:
+                if (v in declared and v in resources and type(resources[v]) is not moderngl.Framebuffer
+                        and (not image or v in access and "storage" in access[v])):
+                    v = resources[v]
+                else:
+                    v = self.image(v) if image else self.resource(v)    # the errors (and framebuffers)
+            out[k] = v
+        return out
 
     def fullscreen(self, program) -> None:
         """Draw the fullscreen triangle (``lib/fullscreen.vert``) with ``program`` into the bound framebuffer."""
