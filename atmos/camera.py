@@ -45,8 +45,9 @@ class Camera:
     def check(self) -> "Camera":
         """Raise a ValueError unless the fields fit together (near < far, far / near, a finite
         position even after in-place edits); returns the camera."""
-        for name in ("position", "yaw", "pitch", "roll", "fov_y", "near", "far"):
-            _check_field(name, getattr(self, name))
+        p = self.position             # the angles, fov and distances are floats checked when set
+        if type(p) is not np.ndarray or p.shape != (3,) or not math.isfinite(p[0] + p[1] + p[2]):
+            _check_field("position", p)   # an in-place edit: the error (or a sum past the float range)
         if not self.far > self.near:
             raise ValueError(f"Camera.far must be greater than Camera.near, got near={self.near!r}, far={self.far!r}")
         if self.far / self.near > MAX_FAR_NEAR:
