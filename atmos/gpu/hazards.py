@@ -224,8 +224,13 @@ def dispatch(program, *groups: int) -> None:
     if hazards._need:
         hazards.issue(hazards._need)
     program.run(*groups)
-    if hazards._staged:
-        hazards.commit()
+    staged = hazards._staged
+    if staged:                                   # Hazards.commit, inlined
+        dirty = hazards._dirty
+        for key in staged:
+            obj, kind = staged[key]
+            dirty[key] = [weakref.ref(obj), kind, _ALL[kind]]
+        hazards._staged = {}
 
 
 def dispatch_indirect(program, args, offset: int = 0) -> None:
