@@ -208,6 +208,36 @@ def bind_buffers(program, buffers: Mapping[str, object] | None = None, /, **more
             buffer.bind_to_storage_buffer(binding)
 
 
+def buffer_uses(program, buffers: Mapping[str, object]) -> tuple:
+    """(buffer, binding, written) for each of ``buffers`` (block name -> buffer) that ``program`` has:
+    what :func:`bind_buffers` works out, once, for a loop of dispatches (:func:`use_buffers`)."""
+    extra = program.extra
+    written = extra.get("written") if type(extra) is dict else None
+    uses = []
+    for name, buffer in buffers.items():
+        member = program.get(name, None)
+        if member is not None:
+            uses.append((buffer, member.binding, written is None or name in written))
+    return tuple(uses)
+
+
+def use_buffers(program, uses: tuple, bind: bool = True) -> None:
+    """:func:`bind_buffers` from :func:`buffer_uses`: each buffer's barrier asked for and its storage
+    writes staged for the next dispatch; ``bind=False`` where they are still bound at their
+    bindings (a loop of dispatches of ``program`` with nothing else in between)."""
+    extra = program.extra
+    hazards = extra["hazards"] if type(extra) is dict and "hazards" in extra else hazards_of(program.ctx)
+    dirty, staged = hazards._dirty, hazards._staged
+    for buffer, binding, written in uses:
+        key = id(buffer)
+        if dirty and key in dirty and (entry := dirty[key])[0]() is buffer:
+            hazards._need |= entry[2] & moderngl.SHADER_STORAGE_BARRIER_BIT
+        if written:
+            staged[key] = (buffer, "buffer")
+        if bind:
+            buffer.bind_to_storage_buffer(binding)
+
+
 def write_block(program, name: str, binding: int, data: bytes) -> bool:
     """Bind ``program``'s own buffer of uniform block ``name`` at ``binding`` with ``data`` (std140,
     packed by the caller), written only when it changed (the buffer is kept in ``program.extra`` and

@@ -37,7 +37,7 @@ import atmos.plugins.clouds.light.grid as grid
 from atmos.phase import Phase
 from atmos.plugins.clouds.light.reference import multilinear
 from atmos.plugins.clouds.light.shear_warp import check_volume_texture, groups, program
-from atmos.gpu.uniforms import bind_buffers, bind_images, bind_textures, write_uniforms
+from atmos.gpu.uniforms import bind_images, bind_textures, buffer_uses, use_buffers, write_uniforms
 from atmos.gpu.hazards import dispatch, dispatch_indirect
 from atmos.gpu.block_table import BlockTable, ints
 
@@ -238,6 +238,7 @@ class DiffusionSolver:
         self._steps = BlockTable(self.gpu, STEP_BINDING, [ints(stage, cur, first) for stage, cur, first
                                                           in itertools.product(range(5), (0, 1), (0, 1))])
         self._program = program(self.gpu, "diffusion")    # the context's cached program, for its lifetime
+        self._buffers = buffer_uses(self._program, {"Cells": self._cells, "Parts": self._parts, "Args": self._args})
         self._cur = 0
         self._first = True
         self.iterations = 0          # run since the last begin (each does nothing once converged)
@@ -249,7 +250,7 @@ class DiffusionSolver:
         if values:
             write_uniforms(prog, values)
         self._steps.use(4 * stage + 2 * self._cur + int(self._first))
-        bind_buffers(prog, Cells=self._cells, Parts=self._parts, Args=self._args)
+        use_buffers(prog, self._buffers)
         if stage in (2, 3):
             dispatch_indirect(prog, self._args)
         else:
@@ -275,9 +276,16 @@ class DiffusionSolver:
         self._dispatch(1)
 
     def iterate(self, count: int) -> None:
+        """``count`` iterations (stages 2 and 3, as :meth:`_dispatch`): the buffers are bound by the
+        first dispatch and stay bound; each dispatch still declares their uses (its barrier)."""
+        prog, steps, args, uses = self._program, self._steps, self._args, self._buffers
+        bind = True
         for _ in range(int(count)):
-            self._dispatch(2)
-            self._dispatch(3)
+            for stage in (2, 3):
+                steps.use(4 * stage + 2 * self._cur + int(self._first))
+                use_buffers(prog, uses, bind)
+                bind = False
+                dispatch_indirect(prog, args)
             self._cur, self._first = 1 - self._cur, False
             self.iterations += 1
 
