@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+import operator
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -175,13 +176,13 @@ class CameraMatrices:
 
 
 _MATRICES: dict = {}          # camera state + aspect -> CameraMatrices, a few kept
-_STATE = tuple(f for f in Camera.__dataclass_fields__ if f != "position")
+_STATE = operator.attrgetter(*(f for f in Camera.__dataclass_fields__ if f != "position"))
 
 
 def camera_matrices(camera: Camera, aspect: float) -> CameraMatrices:
     """The :class:`CameraMatrices` of ``camera`` as it is now, at ``aspect``: computed on the first
     ask for this state (every field, the position by value) and shared by every pass of the frame."""
-    key = (float(aspect), camera.position.tobytes(), *[getattr(camera, name) for name in _STATE])
+    key = (float(aspect), camera.position.tobytes(), *_STATE(camera))
     matrices = _MATRICES.get(key)
     if matrices is None:
         if len(_MATRICES) >= 8:

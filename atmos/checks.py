@@ -88,11 +88,11 @@ def check_vec(owner: str, name: str, value, n: int, kind: str = "finite", option
     ok = (type(value) is tuple or type(value) is list) and len(value) == n
     if ok:                              # the common case: finite floats already (x - x is 0 only for those)
         for x in value:
-            if type(x) is not float or x - x != 0.0:
+            if (type(x) is not float and type(x) is not np.float64) or x - x != 0.0:
                 ok = False
                 break
     if ok:
-        v = tuple(value)
+        v = tuple(map(float, value))
     else:
         try:
             v = () if isinstance(value, (str, bytes)) else tuple(_real(x) for x in value)

@@ -205,6 +205,17 @@ class Hazards:
 
 
 _TRACKERS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()   # moderngl.Context -> Hazards
+_LAST: list = [None]          # the Hazards looked up last (one context is the common case)
+
+
+def _tracker(ctx) -> Hazards | None:
+    """The Hazards of ``ctx`` where it has one (the last one looked up first)."""
+    tracker = _LAST[0]
+    if tracker is None or tracker._ctx() is not ctx:
+        tracker = _TRACKERS.get(ctx)
+        if tracker is not None:
+            _LAST[0] = tracker
+    return tracker
 
 
 def hazards_of(ctx) -> Hazards:
@@ -280,7 +291,9 @@ def _guard_transfers() -> None:
 def _flushing(method):
     """A draw: the barrier its binds asked for, then the draw."""
     def draw(self, *args, **kwargs):
-        tracker = _TRACKERS.get(self.ctx)
+        tracker = _LAST[0]
+        if tracker is None or tracker._ctx() is not self.ctx:
+            tracker = _tracker(self.ctx)
         if tracker is not None and tracker._need:
             tracker.issue(tracker._need)
         return method(self, *args, **kwargs)
@@ -292,7 +305,9 @@ def _flushing(method):
 
 def _copy_use(method, uses):
     def transfer(self, *args, **kwargs):
-        tracker = _TRACKERS.get(self.ctx)
+        tracker = _LAST[0]
+        if tracker is None or tracker._ctx() is not self.ctx:
+            tracker = _tracker(self.ctx)
         if tracker is not None and id(self) in tracker._dirty:
             tracker.use(reads=[(self, access) for access in uses])
         return method(self, *args, **kwargs)

@@ -47,9 +47,13 @@ def write_uniforms(program, values: Mapping[str, object] | None = None, /, **mor
     A program keeps its uniforms' values: a number, tuple, 1-D array or ``bytes`` equal to the one this
     wrote last is not written again (a float zero only of the same sign; a uniform written past this
     function must be forgotten: :func:`forget_uniform`)."""
-    members, last = _tables(program)
-    if members is None:
-        members, last = {}, None
+    extra = program.extra                      # _tables, inlined
+    if type(extra) is dict and "last" in extra:
+        members, last = extra["members"], extra["last"]
+    else:
+        members, last = _tables(program)
+        if members is None:
+            members, last = {}, None
     values = {**values, **more} if values else more
     for name in values:
         value = values[name]
