@@ -250,7 +250,7 @@ def dispatch_indirect(program, args, offset: int = 0) -> None:
     extra = program.extra
     hazards = extra["hazards"] if type(extra) is dict and "hazards" in extra else hazards_of(program.ctx)
     dirty = hazards._dirty                               # Hazards.need, inlined
-    if dirty and id(args) in dirty and (entry := dirty[id(args)])[0]() is args:
+    if dirty and (key := id(args)) in dirty and (entry := dirty[key])[0]() is args:
         hazards._need |= entry[2] & moderngl.COMMAND_BARRIER_BIT
     if hazards._need:                                    # with what the binds asked for: one barrier
         hazards.issue(hazards._need)

@@ -213,15 +213,15 @@ def bind_buffers(program, buffers: Mapping[str, object] | None = None, /, **more
 
 
 def buffer_uses(program, buffers: Mapping[str, object]) -> tuple:
-    """(buffer, binding, written) for each of ``buffers`` (block name -> buffer) that ``program`` has:
-    what :func:`bind_buffers` works out, once, for a loop of dispatches (:func:`use_buffers`)."""
+    """(buffer, its id, binding, written) for each of ``buffers`` (block name -> buffer) that ``program``
+    has: what :func:`bind_buffers` works out, once, for a loop of dispatches (:func:`use_buffers`)."""
     extra = program.extra
     written = extra.get("written") if type(extra) is dict else None
     uses = []
     for name, buffer in buffers.items():
         member = program.get(name, None)
         if member is not None:
-            uses.append((buffer, member.binding, written is None or name in written))
+            uses.append((buffer, id(buffer), member.binding, written is None or name in written))
     return tuple(uses)
 
 
@@ -232,8 +232,7 @@ def use_buffers(program, uses: tuple, bind: bool = True) -> None:
     extra = program.extra
     hazards = extra["hazards"] if type(extra) is dict and "hazards" in extra else hazards_of(program.ctx)
     dirty, staged = hazards._dirty, hazards._staged
-    for buffer, binding, written in uses:
-        key = id(buffer)
+    for buffer, key, binding, written in uses:
         if dirty and key in dirty and (entry := dirty[key])[0]() is buffer:
             hazards._need |= entry[2] & moderngl.SHADER_STORAGE_BARRIER_BIT
         if written:

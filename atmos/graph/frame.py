@@ -11,6 +11,8 @@ from atmos.gpu.hazards import dispatch
 from atmos.gpu.uniforms import bind_buffers, bind_images, bind_textures
 from atmos.graph.errors import GraphError
 
+_PLAIN = frozenset((moderngl.Texture, moderngl.Texture3D, moderngl.TextureArray, moderngl.TextureCube,
+                    moderngl.Buffer))
 FRAMEBUFFER_CACHE = 64  # framebuffers kept per graph, least recently used dropped first
 STATE_FLAGS = moderngl.BLEND | moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.PROGRAM_POINT_SIZE
 
@@ -62,6 +64,8 @@ class PassContext:
             value = self._resources[name]
         except KeyError:
             raise GraphError(f"pass '{self.pass_name}': resource '{name}' is not available this frame") from None
+        if type(value) in _PLAIN:           # a texture or buffer: no framebuffer to reset
+            return value
         if isinstance(value, moderngl.Framebuffer):
             self._reset_framebuffer(value)
         return value
@@ -194,12 +198,13 @@ class PassContext:
         ctx.blend_func = moderngl.DEFAULT_BLENDING
         ctx.blend_equation = moderngl.FUNC_ADD
         ctx.depth_func = "<"
-        self._fresh.clear()
+        self._fresh = set()
 
     def _reset_framebuffer(self, fbo):
         """Depth and colour writes on, the full viewport, no scissor: the first time a pass takes ``fbo``."""
-        if id(fbo) not in self._fresh:
-            self._fresh.add(id(fbo))
+        key = id(fbo)
+        if key not in self._fresh:
+            self._fresh.add(key)
             fbo.depth_mask = True
             n = len(fbo.color_attachments or ())   # a window's default framebuffer has none listed
             if n:                            # moderngl takes one mask, or one per attachment

@@ -137,17 +137,17 @@ class TexturePool:
         self.evictions = 0    # textures released by end_frame
         self._free: dict[TextureDesc, list] = {}
         self._desc: dict[int, tuple[TextureDesc, object]] = {}  # id(texture) -> (desc, texture), all pooled
-        self._in_use: set[int] = set()
+        self._in_use: dict[int, object] = {}    # id(texture) -> texture, acquired and not released
         self._used: dict[int, int] = {}  # id(texture) -> frame it was last acquired or released
 
     def acquire(self, desc: TextureDesc | BufferDesc):
         """A texture (or buffer) matching ``desc``, free until :meth:`release` gives it back."""
         free = self._free.get(desc)
         texture = free.pop() if free else self._create(desc)
-        if isinstance(desc, BufferDesc) and desc.clear:
+        if type(desc) is BufferDesc and desc.clear:
             texture.clear()
         key = id(texture)
-        self._in_use.add(key)
+        self._in_use[key] = texture
         self._used[key] = self.frame
         return texture
 
@@ -158,9 +158,13 @@ class TexturePool:
             raise ValueError("TexturePool.release: this texture was not acquired from this pool")
         if key not in self._in_use:
             raise ValueError("TexturePool.release: this texture was already released")
-        self._in_use.discard(key)
+        del self._in_use[key]
         self._used[key] = self.frame
-        self._free.setdefault(self._desc[key][0], []).append(texture)
+        desc = self._desc[key][0]
+        if desc in self._free:
+            self._free[desc].append(texture)
+        else:
+            self._free[desc] = [texture]
 
     def end_frame(self) -> int:
         """End a frame: release every free texture not acquired (or released) during the last
@@ -169,8 +173,11 @@ class TexturePool:
         stale = self.frame - self.keep_frames  # last used at or before this frame: evict
         used = self._used
         for desc, free in list(self._free.items()):
-            if all(used[id(t)] > stale for t in free):
-                continue
+            for t in free:
+                if used[id(t)] <= stale:
+                    break
+            else:
+                continue                     # every free one used lately
             for texture in [t for t in free if used[id(t)] <= stale]:
                 del self._desc[id(texture)], used[id(texture)]
                 texture.release()
