@@ -57,6 +57,15 @@ class TextureDesc:
             raise ValueError(f"a storage TextureDesc (written as an image) must have 1, 2 or 4 components and "
                              f"not be depth, got components={self.components}, depth={self.depth}; a depth "
                              "made by compute is components=1, dtype='f4' (r32f)")
+        object.__setattr__(self, "_hash", hash((self.size, self.components, self.dtype, self.depth, self.filter,
+                                                self.storage)))
+
+    def __hash__(self) -> int:
+        """The fields' hash, worked out once (a desc is the pool's key, looked up every frame)."""
+        return self._hash
+
+    def __reduce__(self):                  # made anew from the fields: the hash of str differs between processes
+        return TextureDesc, (self.size, self.components, self.dtype, self.depth, self.filter, self.storage)
 
     @property
     def nbytes(self) -> int:
@@ -104,6 +113,14 @@ class BufferDesc:
             raise ValueError(f"BufferDesc.size must be a positive int (bytes), got {self.size!r}")
         if not isinstance(self.clear, bool):
             raise ValueError(f"BufferDesc.clear must be True or False, got {self.clear!r}")
+        object.__setattr__(self, "_hash", hash((self.size, self.clear)))
+
+    def __hash__(self) -> int:
+        """The fields' hash, worked out once (a desc is the pool's key)."""
+        return self._hash
+
+    def __reduce__(self):
+        return BufferDesc, (self.size, self.clear)
 
     @property
     def nbytes(self) -> int:
@@ -161,10 +178,11 @@ class TexturePool:
         del self._in_use[key]
         self._used[key] = self.frame
         desc = self._desc[key][0]
-        if desc in self._free:
-            self._free[desc].append(texture)
-        else:
+        free = self._free.get(desc)
+        if free is None:
             self._free[desc] = [texture]
+        else:
+            free.append(texture)
 
     def end_frame(self) -> int:
         """End a frame: release every free texture not acquired (or released) during the last
