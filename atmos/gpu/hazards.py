@@ -102,7 +102,7 @@ class Hazards:
     def __init__(self, ctx):
         self._ctx = weakref.ref(ctx)          # the registry is keyed by ctx: a strong ref would keep it alive
         self.barriers = 0
-        self.bits_issued: dict[str, int] = defaultdict(int)
+        self._issued: dict[int, int] = defaultdict(int)   # barrier bits -> how many barriers had exactly those
         self._dirty: dict[int, list] = {}     # id(obj) -> [weakref, kind, bits still to issue]
         self._staged: dict[int, tuple] = {}   # bound for a storage write by the coming dispatch: id -> (ref, kind)
         self._need = 0                        # bits the binds of the coming work asked for (issued by flush)
@@ -174,16 +174,25 @@ class Hazards:
         self._ctx().memory_barrier(bits)
         self._need = 0
         self.barriers += 1
-        issued = self.bits_issued
-        for bit, name in _BIT_ORDER:
-            if bits & bit:
-                issued[name] += 1
-        dirty = self._dirty
+        self._issued[bits] += 1
+        dirty, keep = self._dirty, ~bits
         for key in list(dirty):
             entry = dirty[key]
-            entry[2] &= ~bits
-            if not entry[2] or entry[0]() is None:
+            left = entry[2] & keep
+            if left and entry[0]() is not None:
+                entry[2] = left
+            else:
                 del dirty[key]
+
+    @property
+    def bits_issued(self) -> dict[str, int]:
+        """Bit name -> how many of the barriers issued had that bit (0 for a bit never issued)."""
+        counts: dict[str, int] = defaultdict(int)
+        for bits, n in self._issued.items():
+            for bit, name in _BIT_ORDER:
+                if bits & bit:
+                    counts[name] += n
+        return counts
 
     def settle(self) -> int:
         """Make every pending write visible to every use (for readers that declare nothing: a frame's
