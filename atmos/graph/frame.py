@@ -78,16 +78,21 @@ class PassContext:
         """
         names = [color] if type(color) is str else list(color)
         declared, resources = self._declared, self._resources
-        try:                                # the common case: declared textures, known this frame
-            attachments = [resources[n] for n in names if n in declared]
-            depth_attachment = None if depth is None else resources[depth] if depth in declared else False
-        except KeyError:
-            attachments = None
-        slow = attachments is None or len(attachments) != len(names) or depth_attachment is False
-        if not slow:
-            for a in attachments:
+        attachments, slow = [], False       # the common case: declared textures, known this frame
+        for n in names:
+            if n in declared and n in resources:
+                a = resources[n]
+                attachments += (a,)
                 if type(a) is moderngl.Framebuffer:
                     slow = True
+            else:
+                slow = True
+        depth_attachment = None
+        if depth is not None:
+            if depth in declared and depth in resources:
+                depth_attachment = resources[depth]
+            else:
+                slow = True
         if slow or type(depth_attachment) is moderngl.Framebuffer:
             attachments = [self.resource(n) for n in names]          # the errors, and imported framebuffers
             depth_attachment = self.resource(depth) if depth is not None else None

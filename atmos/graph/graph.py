@@ -158,8 +158,10 @@ class RenderGraph:
         if plan is None:
             plan = compiled.plan = _plan(compiled)
         resources: dict[str, object] = {}
+        ids: dict[str, int] = {}                 # id() of each resource this frame, for the hazard checks
         for name in compiled.imports_used:
-            resources[name] = self._resolve(name)
+            resources[name] = obj = self._resolve(name)
+            ids[name] = id(obj)
         transient: dict[str, object] = {}
         frame = self._frame
         timed = self.timings_enabled
@@ -175,13 +177,14 @@ class RenderGraph:
         try:
             for p, name, acquire, uses, stored, declared, access, release in plan:
                 for r, desc in acquire:
-                    resources[r] = transient[r] = pool.acquire(desc)
+                    resources[r] = transient[r] = texture = pool.acquire(desc)
+                    ids[r] = id(texture)
                 if name not in prepared or prepared[name] is not p:
                     p.prepare(self.gpu)
                     prepared[name] = p
                 dirty = hazards._dirty      # the barrier this pass's declared uses need, before it
                 if dirty:
-                    _barrier_before(hazards, dirty, resources, uses)
+                    _barrier_before(hazards, dirty, resources, ids, uses)
                 frame.pass_name, frame._declared, frame._access = name, declared, access
                 frame.reset_state()
                 if timed:
@@ -195,8 +198,9 @@ class RenderGraph:
                 if stored:
                     hazards.wrote_storage([resources[n] for n in stored])
                 for r in release:
-                    del resources[r]
-                    pool.release(transient.pop(r))
+                    texture = transient[r]
+                    del resources[r], transient[r]
+                    pool.release(texture)
         finally:
             for texture in transient.values():  # only after an exception
                 pool.release(texture)
@@ -283,17 +287,16 @@ def _plan(compiled: CompiledGraph) -> list[tuple]:
     return plan
 
 
-def _barrier_before(hazards, dirty: dict, resources: dict, uses: tuple) -> None:
+def _barrier_before(hazards, dirty: dict, resources: dict, ids: dict, uses: tuple) -> None:
     """The barrier a pass's declared ``uses`` (see :func:`_plan`) need before it, with what binds
     asked for: issued where any of its resources has a pending storage write."""
     need, hit = 0, False
     for name, texture_bit, buffer_bit in uses:
-        obj = resources[name]
-        key = id(obj)
+        key = ids[name]
         if key in dirty:
             hit = True
             entry = dirty[key]
-            if entry[0]() is obj:
+            if entry[0]() is resources[name]:
                 need |= entry[2] & (buffer_bit if entry[1] == "buffer" else texture_bit)
     if hit and (need or hazards._need):
         hazards.issue(need | hazards._need)
