@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+import operator
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -45,8 +46,9 @@ class Camera:
     def check(self) -> "Camera":
         """Raise a ValueError unless the fields fit together (near < far, far / near, a finite
         position even after in-place edits); returns the camera."""
-        for name in ("position", "yaw", "pitch", "roll", "fov_y", "near", "far"):
-            _check_field(name, getattr(self, name))
+        p = self.position             # the angles, fov and distances are floats checked when set
+        if type(p) is not np.ndarray or p.shape != (3,) or not math.isfinite(p[0] + p[1] + p[2]):
+            _check_field("position", p)   # an in-place edit: the error (or a sum past the float range)
         if not self.far > self.near:
             raise ValueError(f"Camera.far must be greater than Camera.near, got near={self.near!r}, far={self.far!r}")
         if self.far / self.near > MAX_FAR_NEAR:
@@ -174,13 +176,13 @@ class CameraMatrices:
 
 
 _MATRICES: dict = {}          # camera state + aspect -> CameraMatrices, a few kept
-_STATE = tuple(f for f in Camera.__dataclass_fields__ if f != "position")
+_STATE = operator.attrgetter(*(f for f in Camera.__dataclass_fields__ if f != "position"))
 
 
 def camera_matrices(camera: Camera, aspect: float) -> CameraMatrices:
     """The :class:`CameraMatrices` of ``camera`` as it is now, at ``aspect``: computed on the first
     ask for this state (every field, the position by value) and shared by every pass of the frame."""
-    key = (float(aspect), camera.position.tobytes(), *[getattr(camera, name) for name in _STATE])
+    key = (float(aspect), camera.position.tobytes(), *_STATE(camera))
     matrices = _MATRICES.get(key)
     if matrices is None:
         if len(_MATRICES) >= 8:

@@ -55,6 +55,8 @@ class FlyCameraPlugin(Plugin):
         inp, cam = app.get_resource(Input), app.get_resource(Camera)
         if inp is None or cam is None:
             return
+        if not inp.keys and not inp.buttons and -math.pi <= cam.yaw <= math.pi and -1.55 <= cam.pitch <= 1.55:
+            return                 # nothing held: no move or turn, and the angles are in range already
         s, dt = self.settings, app.clock.dt
         v = s.speed * (5.0 if {key.LSHIFT, key.RSHIFT} & inp.keys else 1.0) * dt
         move = (cam.forward() * inp.axis(key.S, key.W) + cam.right() * inp.axis(key.A, key.D)

@@ -81,14 +81,24 @@ def check_vec(owner: str, name: str, value, n: int, kind: str = "finite", option
               lo: float | None = None) -> tuple | None:
     """``n`` finite floats; ``kind`` 'positive' or 'non-negative' narrows them, ``lo`` (each >= lo)
     too; ``optional``: None passes."""
-    _declare(owner, name, "vec", n=n, vec_kind=kind, optional=optional, lo=lo)
+    if _recording is not None:
+        _declare(owner, name, "vec", n=n, vec_kind=kind, optional=optional, lo=lo)
     if optional and value is None:
         return None
-    try:
-        v = () if isinstance(value, (str, bytes)) else tuple(_real(x) for x in value)
-    except TypeError:
-        v = ()
-    ok = len(v) == n and all(math.isfinite(x) for x in v)
+    ok = (type(value) is tuple or type(value) is list) and len(value) == n
+    if ok:                              # the common case: finite floats already (x - x is 0 only for those)
+        for x in value:
+            if (type(x) is not float and type(x) is not np.float64) or x - x != 0.0:
+                ok = False
+                break
+    if ok:
+        v = tuple(map(float, value))
+    else:
+        try:
+            v = () if isinstance(value, (str, bytes)) else tuple(_real(x) for x in value)
+        except TypeError:
+            v = ()
+        ok = len(v) == n and all(math.isfinite(x) for x in v)
     if ok and kind == "positive":
         ok = min(v) > 0
     elif ok and kind == "non-negative":
@@ -115,11 +125,12 @@ def _real(value) -> float:
 def check_num(owner: str, name: str, value, lo: float | None = None, hi: float | None = None,
               lo_open: bool = False, optional: bool = False) -> float | None:
     """A finite float within [lo, hi] (``lo_open``: strictly above lo); ``optional``: None passes."""
-    _declare(owner, name, "num", lo=lo, hi=hi, lo_open=lo_open, optional=optional)
+    if _recording is not None:
+        _declare(owner, name, "num", lo=lo, hi=hi, lo_open=lo_open, optional=optional)
     if optional and value is None:
         return None
-    v = _real(value)
-    ok = math.isfinite(v) and (lo is None or (v > lo if lo_open else v >= lo)) and (hi is None or v <= hi)
+    v = value if type(value) is float else _real(value)
+    ok = v - v == 0.0 and (lo is None or (v > lo if lo_open else v >= lo)) and (hi is None or v <= hi)
     if not ok:
         bounds = [t for t in ("" if lo is None else f"{'>' if lo_open else '>='} {lo}",
                               "" if hi is None else f"<= {hi}") if t]
@@ -193,7 +204,7 @@ def check_sun_dir(sun_dir, name: str = "sun_dir") -> np.ndarray:
     if big == 0:
         raise ValueError(f"{name} must have a length > 0; got the zero vector")
     d = d / big
-    return d / np.linalg.norm(d)
+    return d / math.sqrt(d.dot(d))   # np.linalg.norm's own formula (1-D float64), without its overhead
 
 
 def check_known(owner: str, changes: dict, known) -> None:

@@ -11,6 +11,7 @@ edges (``lib/upsample.glsl``). References: :mod:`atmos.offscreen_reference`.
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import moderngl
 
@@ -31,6 +32,14 @@ def low_size(size, factor: int) -> tuple[int, int]:
     return math.ceil(size[0] / factor), math.ceil(size[1] / factor)
 
 
+@lru_cache(maxsize=16)
+def _low_descs(size, factor: int, storage: bool) -> tuple:
+    """The low-res targets' descs (colour, depth, distance) at 1/``factor`` of ``size`` (made once: setups run every frame)."""
+    low = low_size(size, factor)
+    return (TextureDesc(low, components=4, dtype="f2", filter="nearest", storage=storage),
+            TextureDesc(low, depth=True, filter="nearest"), distance_desc(low))
+
+
 class OffscreenLayer:
     """The low-res targets' declarations and the depth and composite draws of a pass that draws off
     screen (the cloud renderers, the light shafts' march; programs belong to the GpuContext)."""
@@ -45,12 +54,11 @@ class OffscreenLayer:
     def declare(builder: PassBuilder, size, factor: int, distance: bool = False, color: str = CLOUD_COLOR,
                 depth: str = CLOUD_DEPTH, storage: bool = False) -> None:
         """``storage``: a compute pass writes the low-res colour as an image (it then needs no clear)."""
-        low = low_size(size, factor)
-        builder.create(color, TextureDesc(low, components=4, dtype="f2", filter="nearest", storage=storage),
-                       access="storage" if storage else None)
-        builder.create(depth, TextureDesc(low, depth=True, filter="nearest"))
+        color_desc, depth_desc, low_distance = _low_descs(tuple(size), factor, storage)
+        builder.create(color, color_desc, access="storage" if storage else None)
+        builder.create(depth, depth_desc)
         if distance:
-            builder.create(CLOUD_LOW_DISTANCE, distance_desc(low))
+            builder.create(CLOUD_LOW_DISTANCE, low_distance)
 
     def begin(self, frame: PassContext, factor: int, distance: bool = False, clear: bool = True):
         """Write the low-res depth, clear the low-res colour (``clear``; a compute pass that writes every

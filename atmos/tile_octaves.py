@@ -32,7 +32,7 @@ def tile_noise(uv: np.ndarray, frequency: float, k) -> np.ndarray:
 def light_shift(sun_dir, light_step: float) -> np.ndarray:
     """uv step toward the sun: light_step along the sun's horizontal direction (0 with the sun overhead)."""
     xz = np.array([sun_dir[0], sun_dir[2]], np.float64)
-    n = np.linalg.norm(xz)
+    n = math.sqrt(xz.dot(xz))   # np.linalg.norm's own formula (1-D float64), without its overhead
     return xz / n * light_step if n > 1e-6 else np.zeros(2)
 
 
@@ -91,7 +91,8 @@ class OctaveTextures:
         more than ``tolerance`` of a light step (the sun turned)."""
         if self.baked_for is None or self.baked_for[0] != settings.texture_key():
             return True
-        moved = np.linalg.norm(light_shift(sun_dir, settings.light_step) - self.baked_for[1])
+        shift = light_shift(sun_dir, settings.light_step) - self.baked_for[1]
+        moved = math.sqrt(shift.dot(shift))   # np.linalg.norm's own formula (1-D float64), without its overhead
         return moved > tolerance * settings.light_step
 
     def download(self, k: int) -> np.ndarray:

@@ -243,9 +243,10 @@ class GpuContext:
         if self.released:
             self._require_live()
         fast = (tuple(stages.items()), tuple(defines.items()) if defines else ())   # as the caller orders them
-        program = self._fast_programs.get(fast)
-        if program is not None:
-            return program
+        try:
+            return self._fast_programs[fast]
+        except KeyError:
+            pass
         key = (tuple(sorted(stages.items())), tuple(sorted((defines or {}).items())))
         program = self._programs.get(key)
         if program is None:

@@ -102,7 +102,7 @@ class Hazards:
     def __init__(self, ctx):
         self._ctx = weakref.ref(ctx)          # the registry is keyed by ctx: a strong ref would keep it alive
         self.barriers = 0
-        self.bits_issued: dict[str, int] = defaultdict(int)
+        self._issued: dict[int, int] = defaultdict(int)   # barrier bits -> how many barriers had exactly those
         self._dirty: dict[int, list] = {}     # id(obj) -> [weakref, kind, bits still to issue]
         self._staged: dict[int, tuple] = {}   # bound for a storage write by the coming dispatch: id -> (ref, kind)
         self._need = 0                        # bits the binds of the coming work asked for (issued by flush)
@@ -119,9 +119,11 @@ class Hazards:
 
     def commit(self) -> None:
         """The work just recorded ran: what was staged for writing is now dirty."""
-        for key, (obj, kind) in self._staged.items():
-            self._dirty[key] = [weakref.ref(obj), kind, _ALL[kind]]
-        self._staged.clear()
+        staged, dirty = self._staged, self._dirty
+        for key in staged:
+            obj, kind = staged[key]
+            dirty[key] = [weakref.ref(obj), kind, _ALL[kind]]
+        self._staged = {}
 
     def use(self, reads=(), writes=()) -> int:
         """Issue the barrier the coming work needs (with what binds asked for): ``reads`` and ``writes``
@@ -159,19 +161,38 @@ class Hazards:
             if access == "storage":
                 self._dirty[id(obj)] = [weakref.ref(obj), kind, _ALL[kind]]
 
+    def wrote_storage(self, objects) -> None:
+        """The work just recorded made storage writes to ``objects`` (textures, buffers): now dirty."""
+        dirty = self._dirty
+        for obj in objects:
+            kind = _KINDS[type(obj)] if type(obj) in _KINDS else kind_of(obj)
+            if kind is not None:
+                dirty[id(obj)] = [weakref.ref(obj), kind, _ALL[kind]]
+
     def issue(self, bits: int) -> None:
         """One glMemoryBarrier with ``bits``; every pending write is then visible to those uses."""
         self._ctx().memory_barrier(bits)
         self._need = 0
         self.barriers += 1
-        issued = self.bits_issued
-        for bit, name in _BIT_ORDER:
-            if bits & bit:
-                issued[name] += 1
-        for key, entry in list(self._dirty.items()):
-            entry[2] &= ~bits
-            if not entry[2] or entry[0]() is None:
-                del self._dirty[key]
+        self._issued[bits] += 1
+        dirty, keep = self._dirty, ~bits
+        for key in list(dirty):
+            entry = dirty[key]
+            left = entry[2] & keep
+            if left and entry[0]() is not None:
+                entry[2] = left
+            else:
+                del dirty[key]
+
+    @property
+    def bits_issued(self) -> dict[str, int]:
+        """Bit name -> how many of the barriers issued had that bit (0 for a bit never issued)."""
+        counts: dict[str, int] = defaultdict(int)
+        for bits, n in self._issued.items():
+            for bit, name in _BIT_ORDER:
+                if bits & bit:
+                    counts[name] += n
+        return counts
 
     def settle(self) -> int:
         """Make every pending write visible to every use (for readers that declare nothing: a frame's
@@ -193,6 +214,17 @@ class Hazards:
 
 
 _TRACKERS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()   # moderngl.Context -> Hazards
+_LAST: list = [None]          # the Hazards looked up last (one context is the common case)
+
+
+def _tracker(ctx) -> Hazards | None:
+    """The Hazards of ``ctx`` where it has one (the last one looked up first)."""
+    tracker = _LAST[0]
+    if tracker is None or tracker._ctx() is not ctx:
+        tracker = _TRACKERS.get(ctx)
+        if tracker is not None:
+            _LAST[0] = tracker
+    return tracker
 
 
 def hazards_of(ctx) -> Hazards:
@@ -210,10 +242,15 @@ def dispatch(program, *groups: int) -> None:
     extra = program.extra
     hazards = extra["hazards"] if type(extra) is dict and "hazards" in extra else hazards_of(program.ctx)
     if hazards._need:
-        hazards.flush()
+        hazards.issue(hazards._need)
     program.run(*groups)
-    if hazards._staged:
-        hazards.commit()
+    staged = hazards._staged
+    if staged:                                   # Hazards.commit, inlined
+        dirty = hazards._dirty
+        for key in staged:
+            obj, kind = staged[key]
+            dirty[key] = [weakref.ref(obj), kind, _ALL[kind]]
+        hazards._staged = {}
 
 
 def dispatch_indirect(program, args, offset: int = 0) -> None:
@@ -221,10 +258,14 @@ def dispatch_indirect(program, args, offset: int = 0) -> None:
     ``offset``), after the barrier that makes a shader's write of ``args`` visible as indirect arguments."""
     extra = program.extra
     hazards = extra["hazards"] if type(extra) is dict and "hazards" in extra else hazards_of(program.ctx)
-    hazards.need(args, moderngl.COMMAND_BARRIER_BIT)     # with what the binds asked for: one barrier
-    hazards.flush()
+    dirty = hazards._dirty                               # Hazards.need, inlined
+    if dirty and (key := id(args)) in dirty and (entry := dirty[key])[0]() is args:
+        hazards._need |= entry[2] & moderngl.COMMAND_BARRIER_BIT
+    if hazards._need:                                    # with what the binds asked for: one barrier
+        hazards.issue(hazards._need)
     program.run_indirect(args, offset)
-    hazards.commit()
+    if hazards._staged:
+        hazards.commit()
 
 
 _GUARDED = False
@@ -259,9 +300,11 @@ def _guard_transfers() -> None:
 def _flushing(method):
     """A draw: the barrier its binds asked for, then the draw."""
     def draw(self, *args, **kwargs):
-        tracker = _TRACKERS.get(self.ctx)
+        tracker = _LAST[0]
+        if tracker is None or tracker._ctx() is not self.ctx:
+            tracker = _tracker(self.ctx)
         if tracker is not None and tracker._need:
-            tracker.flush()
+            tracker.issue(tracker._need)
         return method(self, *args, **kwargs)
     draw._atmos_copy_use = True
     draw.__name__, draw.__qualname__, draw.__doc__ = method.__name__, method.__qualname__, method.__doc__
@@ -271,7 +314,9 @@ def _flushing(method):
 
 def _copy_use(method, uses):
     def transfer(self, *args, **kwargs):
-        tracker = _TRACKERS.get(self.ctx)
+        tracker = _LAST[0]
+        if tracker is None or tracker._ctx() is not self.ctx:
+            tracker = _tracker(self.ctx)
         if tracker is not None and id(self) in tracker._dirty:
             tracker.use(reads=[(self, access) for access in uses])
         return method(self, *args, **kwargs)

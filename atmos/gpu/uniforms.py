@@ -20,6 +20,7 @@ def _hazards(program):
     return hazards if hazards is not None else hazards_of(program.ctx)
 
 
+_TEXTURES = frozenset((moderngl.Texture, moderngl.Texture3D, moderngl.TextureArray, moderngl.TextureCube))
 _SCALARS = frozenset((float, int, bool, tuple, bytes, np.float64, np.float32, np.int64, np.int32, np.bool_))
 # values compared with the last one written (a cheap ==); a 1-D numpy array is compared as a tuple
 
@@ -46,10 +47,16 @@ def write_uniforms(program, values: Mapping[str, object] | None = None, /, **mor
     A program keeps its uniforms' values: a number, tuple, 1-D array or ``bytes`` equal to the one this
     wrote last is not written again (a float zero only of the same sign; a uniform written past this
     function must be forgotten: :func:`forget_uniform`)."""
-    members, last = _tables(program)
-    if members is None:
-        members, last = {}, None
-    for name, value in ({**values, **more} if values else more).items():
+    extra = program.extra                      # _tables, inlined
+    if type(extra) is dict and "last" in extra:
+        members, last = extra["members"], extra["last"]
+    else:
+        members, last = _tables(program)
+        if members is None:
+            members, last = {}, None
+    values = {**values, **more} if values else more
+    for name in values:
+        value = values[name]
         try:
             member = members[name]
         except KeyError:
@@ -122,7 +129,9 @@ def bind_textures(program, textures: Mapping[str, object] | None = None, /, samp
         units_of, hazards = {}, _hazards(program)
     units = []
     dirty = hazards._dirty
-    for name, texture in ({**textures, **more} if textures else more).items():
+    textures = {**textures, **more} if textures else more
+    for name in textures:
+        texture = textures[name]
         try:
             value = units_of[name]
         except KeyError:
@@ -140,7 +149,7 @@ def bind_textures(program, textures: Mapping[str, object] | None = None, /, samp
             one.use(unit)
             if sampler is not None:
                 sampler.use(unit)
-            units.append(unit)
+            units += (unit,)
     return units
 
 
@@ -152,14 +161,20 @@ def bind_images(program, images: Mapping[str, object] | None = None, /, **more) 
     declared = extra["images"]                # (unit, read, write) by name, from the compiler check
     hazards = extra["hazards"] if "hazards" in extra else _hazards(program)
     dirty = hazards._dirty
-    for name, texture in ({**images, **more} if images else more).items():
+    images = {**images, **more} if images else more
+    for name in images:
         if name in declared:
+            texture = images[name]
             unit, read, write = declared[name]
-            if dirty and (key := id(texture)) in dirty and (entry := dirty[key])[0]() is texture:
+            key = id(texture)
+            if dirty and key in dirty and (entry := dirty[key])[0]() is texture:
                 hazards._need |= entry[2] & moderngl.SHADER_IMAGE_ACCESS_BARRIER_BIT
             if write:
-                hazards.stage(texture)
-            texture.bind_to_image(unit, read=read, write=write)
+                if type(texture) in _TEXTURES:       # Hazards.stage, inlined
+                    hazards._staged[key] = (texture, "texture")
+                else:
+                    hazards.stage(texture)
+            texture.bind_to_image(unit, read, write)
 
 
 def bind_buffers(program, buffers: Mapping[str, object] | None = None, /, **more) -> None:
@@ -177,17 +192,52 @@ def bind_buffers(program, buffers: Mapping[str, object] | None = None, /, **more
     else:
         written, hazards, bindings = None, hazards_of(program.ctx), {}   # unknown: every block may be written
     dirty = hazards._dirty
-    for name, buffer in ({**buffers, **more} if buffers else more).items():
+    buffers = {**buffers, **more} if buffers else more
+    for name in buffers:
+        buffer = buffers[name]
         try:
             binding = bindings[name]
         except KeyError:
             member = program.get(name, None)
             binding = bindings[name] = None if member is None else member.binding
         if binding is not None:
-            if dirty and (key := id(buffer)) in dirty and (entry := dirty[key])[0]() is buffer:
+            key = id(buffer)
+            if dirty and key in dirty and (entry := dirty[key])[0]() is buffer:
                 hazards._need |= entry[2] & moderngl.SHADER_STORAGE_BARRIER_BIT
             if written is None or name in written:
-                hazards.stage(buffer)
+                if type(buffer) is moderngl.Buffer:     # Hazards.stage, inlined
+                    hazards._staged[key] = (buffer, "buffer")
+                else:
+                    hazards.stage(buffer)
+            buffer.bind_to_storage_buffer(binding)
+
+
+def buffer_uses(program, buffers: Mapping[str, object]) -> tuple:
+    """(buffer, its id, binding, written) for each of ``buffers`` (block name -> buffer) that ``program``
+    has: what :func:`bind_buffers` works out, once, for a loop of dispatches (:func:`use_buffers`)."""
+    extra = program.extra
+    written = extra.get("written") if type(extra) is dict else None
+    uses = []
+    for name, buffer in buffers.items():
+        member = program.get(name, None)
+        if member is not None:
+            uses.append((buffer, id(buffer), member.binding, written is None or name in written))
+    return tuple(uses)
+
+
+def use_buffers(program, uses: tuple, bind: bool = True) -> None:
+    """:func:`bind_buffers` from :func:`buffer_uses`: each buffer's barrier asked for and its storage
+    writes staged for the next dispatch; ``bind=False`` where they are still bound at their
+    bindings (a loop of dispatches of ``program`` with nothing else in between)."""
+    extra = program.extra
+    hazards = extra["hazards"] if type(extra) is dict and "hazards" in extra else hazards_of(program.ctx)
+    dirty, staged = hazards._dirty, hazards._staged
+    for buffer, key, binding, written in uses:
+        if dirty and key in dirty and (entry := dirty[key])[0]() is buffer:
+            hazards._need |= entry[2] & moderngl.SHADER_STORAGE_BARRIER_BIT
+        if written:
+            staged[key] = (buffer, "buffer")
+        if bind:
             buffer.bind_to_storage_buffer(binding)
 
 

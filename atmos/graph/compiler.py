@@ -60,6 +60,7 @@ class CompiledGraph:
     sources: dict[str, str] = field(default_factory=dict)            # pass name -> "file:line" of its class
     uses: list[tuple[tuple, tuple, tuple]] = field(default_factory=list)
     # per kept pass: ((name, read access), ...), ((name, write access), ...), (names it writes as storage)
+    plan: list | None = None     # what execute does around each kept pass, made by its first run
 
     @property
     def kept(self) -> list[str]:

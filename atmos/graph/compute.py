@@ -10,7 +10,10 @@ def work_groups(size, local) -> tuple[int, ...]:
     """Work groups that cover ``size`` (w[, h[, d]]) with groups of ``local`` (the shader's local_size)."""
     if len(size) != len(local):
         raise ValueError(f"work_groups: size {tuple(size)} and local size {tuple(local)} differ in rank")
-    return tuple(-(-int(n) // int(k)) for n, k in zip(size, local))
+    groups = []
+    for n, k in zip(size, local):
+        groups += (-(-int(n) // int(k)),)
+    return tuple(groups)
 
 
 class ComputePass(PluginPass):

@@ -11,6 +11,8 @@ from atmos.gpu.hazards import dispatch
 from atmos.gpu.uniforms import bind_buffers, bind_images, bind_textures
 from atmos.graph.errors import GraphError
 
+_PLAIN = frozenset((moderngl.Texture, moderngl.Texture3D, moderngl.TextureArray, moderngl.TextureCube,
+                    moderngl.Buffer))
 FRAMEBUFFER_CACHE = 64  # framebuffers kept per graph, least recently used dropped first
 STATE_FLAGS = moderngl.BLEND | moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.PROGRAM_POINT_SIZE
 
@@ -62,6 +64,8 @@ class PassContext:
             value = self._resources[name]
         except KeyError:
             raise GraphError(f"pass '{self.pass_name}': resource '{name}' is not available this frame") from None
+        if type(value) in _PLAIN:           # a texture or buffer: no framebuffer to reset
+            return value
         if isinstance(value, moderngl.Framebuffer):
             self._reset_framebuffer(value)
         return value
@@ -74,16 +78,21 @@ class PassContext:
         """
         names = [color] if type(color) is str else list(color)
         declared, resources = self._declared, self._resources
-        try:                                # the common case: declared textures, known this frame
-            attachments = [resources[n] for n in names if n in declared]
-            depth_attachment = None if depth is None else resources[depth] if depth in declared else False
-        except KeyError:
-            attachments = None
-        slow = attachments is None or len(attachments) != len(names) or depth_attachment is False
-        if not slow:
-            for a in attachments:
+        attachments, slow = [], False       # the common case: declared textures, known this frame
+        for n in names:
+            if n in declared and n in resources:
+                a = resources[n]
+                attachments += (a,)
                 if type(a) is moderngl.Framebuffer:
                     slow = True
+            else:
+                slow = True
+        depth_attachment = None
+        if depth is not None:
+            if depth in declared and depth in resources:
+                depth_attachment = resources[depth]
+            else:
+                slow = True
         if slow or type(depth_attachment) is moderngl.Framebuffer:
             attachments = [self.resource(n) for n in names]          # the errors, and imported framebuffers
             depth_attachment = self.resource(depth) if depth is not None else None
@@ -139,12 +148,28 @@ class PassContext:
         name, declared with storage access, or texture) and ``buffers`` (storage block name -> resource
         name or buffer); the binds get the barriers their uses need (:mod:`atmos.gpu.hazards`)."""
         if textures:
-            bind_textures(program, {k: self.resource(v) if isinstance(v, str) else v for k, v in textures.items()})
+            bind_textures(program, self._named(textures))
         if images:
-            bind_images(program, {k: self.image(v) if isinstance(v, str) else v for k, v in images.items()})
+            bind_images(program, self._named(images, True))
         if buffers:
-            bind_buffers(program, {k: self.resource(v) if isinstance(v, str) else v for k, v in buffers.items()})
+            bind_buffers(program, self._named(buffers))
         dispatch(program, *groups)
+
+    def _named(self, binds: dict, image: bool = False) -> dict:
+        """``binds`` with each resource name replaced by this frame's resource (checked as
+        :meth:`resource`, or :meth:`image` for ``image`` binds); objects kept as they are."""
+        declared, resources, access = self._declared, self._resources, self._access
+        out = {}
+        for k in binds:
+            v = binds[k]
+            if type(v) is str:
+                if (v in declared and v in resources and type(resources[v]) is not moderngl.Framebuffer
+                        and (not image or v in access and "storage" in access[v])):
+                    v = resources[v]
+                else:
+                    v = self.image(v) if image else self.resource(v)    # the errors (and framebuffers)
+            out[k] = v
+        return out
 
     def fullscreen(self, program) -> None:
         """Draw the fullscreen triangle (``lib/fullscreen.vert``) with ``program`` into the bound framebuffer."""
@@ -178,12 +203,13 @@ class PassContext:
         ctx.blend_func = moderngl.DEFAULT_BLENDING
         ctx.blend_equation = moderngl.FUNC_ADD
         ctx.depth_func = "<"
-        self._fresh.clear()
+        self._fresh = set()
 
     def _reset_framebuffer(self, fbo):
         """Depth and colour writes on, the full viewport, no scissor: the first time a pass takes ``fbo``."""
-        if id(fbo) not in self._fresh:
-            self._fresh.add(id(fbo))
+        key = id(fbo)
+        if key not in self._fresh:
+            self._fresh.add(key)
             fbo.depth_mask = True
             n = len(fbo.color_attachments or ())   # a window's default framebuffer has none listed
             if n:                            # moderngl takes one mask, or one per attachment
@@ -196,16 +222,6 @@ class PassContext:
         fbo, _ = self._framebuffers.pop(key)
         self._fresh.discard(id(fbo))
         release_gl(fbo)
-
-    def _begin_frame(self, view, resources: dict) -> None:
-        self.view = view
-        self._resources = resources
-
-    def _begin_pass(self, name: str, declared: frozenset[str], access: dict | None = None) -> None:
-        self.pass_name = name
-        self._declared = declared
-        self._access = access or {}
-        self.reset_state()
 
     def _end_frame(self) -> None:
         """The frame ends as every pass starts, with the host's framebuffer (``gpu.target``: a window's

@@ -4,9 +4,8 @@ from __future__ import annotations
 
 from typing import Any, Callable
 
-import moderngl
-
 from atmos.frame_constants import frame_constants, view_frame
+from atmos.gpu.hazards import barrier_bit
 from atmos.gpu.host_memory import trim_heap
 from atmos.graph.compiler import CompiledGraph, compile_graph
 from atmos.graph.dump import dump_text, dump_dot
@@ -155,55 +154,62 @@ class RenderGraph:
         (``lib/frame.glsl``, :mod:`atmos.frame_constants`) holds while the frame runs: written and
         bound here, once."""
         compiled = self.compile()
+        plan = compiled.plan
+        if plan is None:
+            plan = compiled.plan = _plan(compiled)
         resources: dict[str, object] = {}
+        ids: dict[str, int] = {}                 # id() of each resource this frame, for the hazard checks
         for name in compiled.imports_used:
-            resources[name] = self._resolve(name)
+            resources[name] = obj = self._resolve(name)
+            ids[name] = id(obj)
         transient: dict[str, object] = {}
         frame = self._frame
         timed = self.timings_enabled
         if not timed and self._timers.held:
             self._timers.stop()                  # timing turned off: its queries go back to the pool
-        frame._begin_frame(view, resources)
+        frame.view, frame._resources = view, resources
         hazards = self.gpu.hazards
+        pool, prepared = self.pool, self._prepared
         data = view_frame(view) if view is not None else None
         block = frame_constants(self.gpu) if data is not None else None
         if block is not None:
             block.begin(data)
         try:
-            for i, p in enumerate(compiled.order):
-                for r in compiled.acquire[i]:
-                    resources[r] = transient[r] = self.pool.acquire(compiled.resources[r].desc)
-                if self._prepared.get(p.name) is not p:
+            for p, name, acquire, uses, stored, declared, access, release in plan:
+                for r, desc in acquire:
+                    resources[r] = transient[r] = texture = pool.acquire(desc)
+                    ids[r] = id(texture)
+                if name not in prepared or prepared[name] is not p:
                     p.prepare(self.gpu)
-                    self._prepared[p.name] = p
-                reads, writes, stored = compiled.uses[i]
+                    prepared[name] = p
                 dirty = hazards._dirty      # the barrier this pass's declared uses need, before it
-                if dirty and not dirty.keys().isdisjoint([id(resources[n]) for n, _ in reads + writes]):
-                    hazards.use(reads=[_use(resources, n, a, "sampled") for n, a in reads],
-                                writes=[_use(resources, n, a, "attachment") for n, a in writes])
-                frame._begin_pass(p.name, compiled.declared[i], compiled.declarations[p.name].access)
+                if dirty:
+                    _barrier_before(hazards, dirty, resources, ids, uses)
+                frame.pass_name, frame._declared, frame._access = name, declared, access
+                frame.reset_state()
                 if timed:
-                    self._timers.begin(p.name)
+                    self._timers.begin(name)
                     try:
                         p.execute(frame)
                     finally:
-                        self._timers.end(p.name)
+                        self._timers.end(name)
                 else:
                     p.execute(frame)
                 if stored:
-                    hazards.wrote([(resources[n], "storage") for n in stored])
-                for r in compiled.release[i]:
-                    del resources[r]
-                    self.pool.release(transient.pop(r))
+                    hazards.wrote_storage([resources[n] for n in stored])
+                for r in release:
+                    texture = transient[r]
+                    del resources[r], transient[r]
+                    pool.release(texture)
         finally:
             for texture in transient.values():  # only after an exception
-                self.pool.release(texture)
+                pool.release(texture)
             if timed:
                 self._timers.end_frame()
             frame._end_frame()
             if block is not None:
                 block.end()                # inside another graph's pass: that frame's block again
-            if self.pool.end_frame():  # evicted textures: drop the cached framebuffers over them
+            if pool.end_frame():  # evicted textures: drop the cached framebuffers over them
                 frame.drop_released()
                 if self.gpu.software:  # their storage was host memory: give the heap's free pages back
                     trim_heap()
@@ -265,7 +271,32 @@ class RenderGraph:
         self._timers.release()
 
 
-def _use(resources: dict, name: str, access: str | None, texture_default: str):
-    """(object, access) of a declared use; an undeclared access is the kind's default (buffers: storage)."""
-    obj = resources[name]
-    return obj, access or ("storage" if isinstance(obj, moderngl.Buffer) else texture_default)
+def _plan(compiled: CompiledGraph) -> list[tuple]:
+    """Per kept pass, what :meth:`RenderGraph.execute` does around it, worked out once per compile:
+    (pass, name, [(transient, desc) to acquire], uses, names it writes as storage, declared names,
+    access by name, transients to release). ``uses`` are (name, bit for a texture, bit for a buffer):
+    the barrier bit each declared use needs after a storage write (an undeclared access is the
+    kind's default: textures ``sampled`` when read, ``attachment`` when written; buffers ``storage``)."""
+    plan = []
+    for i, p in enumerate(compiled.order):
+        reads, writes, stored = compiled.uses[i]
+        uses = tuple((n, barrier_bit("texture", a or default), barrier_bit("buffer", a or "storage"))
+                     for group, default in ((reads, "sampled"), (writes, "attachment")) for n, a in group)
+        plan.append((p, p.name, [(r, compiled.resources[r].desc) for r in compiled.acquire[i]], uses, stored,
+                     compiled.declared[i], compiled.declarations[p.name].access or {}, compiled.release[i]))
+    return plan
+
+
+def _barrier_before(hazards, dirty: dict, resources: dict, ids: dict, uses: tuple) -> None:
+    """The barrier a pass's declared ``uses`` (see :func:`_plan`) need before it, with what binds
+    asked for: issued where any of its resources has a pending storage write."""
+    need, hit = 0, False
+    for name, texture_bit, buffer_bit in uses:
+        key = ids[name]
+        if key in dirty:
+            hit = True
+            entry = dirty[key]
+            if entry[0]() is resources[name]:
+                need |= entry[2] & (buffer_bit if entry[1] == "buffer" else texture_bit)
+    if hit and (need or hazards._need):
+        hazards.issue(need | hazards._need)

@@ -96,21 +96,29 @@ class PassBuilder:
 
     def create(self, name: str, desc: TextureDesc | BufferDesc, access: str | None = None) -> None:
         """A transient texture or buffer this pass creates (its first writer, with ``access``); the pool provides it."""
-        self._check(name)
-        if not isinstance(desc, (TextureDesc, BufferDesc)):
-            raise GraphError(f"pass '{self.pass_name}' creates '{name}' with {desc!r}; a TextureDesc or "
-                             "BufferDesc is required")
+        if type(name) is not str or not name:
+            self._check(name)
+        kind = type(desc)
+        if kind is not TextureDesc and kind is not BufferDesc:
+            if not isinstance(desc, (TextureDesc, BufferDesc)):
+                raise GraphError(f"pass '{self.pass_name}' creates '{name}' with {desc!r}; a TextureDesc or "
+                                 "BufferDesc is required")
+            kind = BufferDesc if isinstance(desc, BufferDesc) else TextureDesc
         if name in self.creates:
             raise GraphError(f"pass '{self.pass_name}' creates '{name}' twice")
-        access = self._access(name, access, "storage" if isinstance(desc, BufferDesc) else "attachment")
-        if access == "storage" and isinstance(desc, TextureDesc) and not desc.storage:
+        if access is None:
+            access = "storage" if kind is BufferDesc else "attachment"
+        elif access not in ACCESS:
+            self._access(name, access, None)         # the error
+        if access == "storage" and kind is TextureDesc and not desc.storage:
             raise GraphError(f"pass '{self.pass_name}' creates '{name}' for storage writes, but its TextureDesc "
                              f"({desc}) has storage=False; give TextureDesc(..., storage=True)")
-        if isinstance(desc, BufferDesc) and access not in ("storage", "copy"):
+        if kind is BufferDesc and access not in ("storage", "copy"):
             raise GraphError(f"pass '{self.pass_name}' creates buffer '{name}' with access {access!r}; "
                              "a pass writes a buffer with 'storage' or 'copy'")
         self.creates[name] = desc
-        self.access[name] = (self.access.get(name, (None, None))[0], access)
+        held = self.access
+        held[name] = (held[name][0] if name in held else None, access)
 
     def read(self, name: str, at: str | None = None, access: str | None = None) -> None:
         """This pass samples (or blends onto) ``name``; ``at``: the phase whose final version it needs;
@@ -122,8 +130,9 @@ class PassBuilder:
                              f"allowed: {', '.join(PHASES)}")
         self.reads[name] = at
         held = self.access
-        self.access[name] = (None if access is None else self._access(name, access, None),
-                             held[name][1] if name in held else None)
+        if access is not None and access not in ACCESS:
+            self._access(name, access, None)         # the error
+        held[name] = (access, held[name][1] if name in held else None)
 
     def write(self, name: str, access: str | None = None) -> None:
         """This pass modifies an existing resource (read-modify-write passes also call ``read``);
@@ -133,8 +142,9 @@ class PassBuilder:
         if name not in self.writes:
             self.writes.append(name)
         held = self.access
-        held[name] = (held[name][0] if name in held else None,
-                      None if access is None else self._access(name, access, None))
+        if access is not None and access not in ACCESS:
+            self._access(name, access, None)         # the error
+        held[name] = (held[name][0] if name in held else None, access)
 
     def _access(self, name: str, access: str | None, default: str | None) -> str | None:
         if access is None:

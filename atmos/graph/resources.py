@@ -57,6 +57,15 @@ class TextureDesc:
             raise ValueError(f"a storage TextureDesc (written as an image) must have 1, 2 or 4 components and "
                              f"not be depth, got components={self.components}, depth={self.depth}; a depth "
                              "made by compute is components=1, dtype='f4' (r32f)")
+        object.__setattr__(self, "_hash", hash((self.size, self.components, self.dtype, self.depth, self.filter,
+                                                self.storage)))
+
+    def __hash__(self) -> int:
+        """The fields' hash, worked out once (a desc is the pool's key, looked up every frame)."""
+        return self._hash
+
+    def __reduce__(self):                  # made anew from the fields: the hash of str differs between processes
+        return TextureDesc, (self.size, self.components, self.dtype, self.depth, self.filter, self.storage)
 
     @property
     def nbytes(self) -> int:
@@ -104,6 +113,14 @@ class BufferDesc:
             raise ValueError(f"BufferDesc.size must be a positive int (bytes), got {self.size!r}")
         if not isinstance(self.clear, bool):
             raise ValueError(f"BufferDesc.clear must be True or False, got {self.clear!r}")
+        object.__setattr__(self, "_hash", hash((self.size, self.clear)))
+
+    def __hash__(self) -> int:
+        """The fields' hash, worked out once (a desc is the pool's key)."""
+        return self._hash
+
+    def __reduce__(self):
+        return BufferDesc, (self.size, self.clear)
 
     @property
     def nbytes(self) -> int:
@@ -137,17 +154,17 @@ class TexturePool:
         self.evictions = 0    # textures released by end_frame
         self._free: dict[TextureDesc, list] = {}
         self._desc: dict[int, tuple[TextureDesc, object]] = {}  # id(texture) -> (desc, texture), all pooled
-        self._in_use: set[int] = set()
+        self._in_use: dict[int, object] = {}    # id(texture) -> texture, acquired and not released
         self._used: dict[int, int] = {}  # id(texture) -> frame it was last acquired or released
 
     def acquire(self, desc: TextureDesc | BufferDesc):
         """A texture (or buffer) matching ``desc``, free until :meth:`release` gives it back."""
         free = self._free.get(desc)
         texture = free.pop() if free else self._create(desc)
-        if isinstance(desc, BufferDesc) and desc.clear:
+        if type(desc) is BufferDesc and desc.clear:
             texture.clear()
         key = id(texture)
-        self._in_use.add(key)
+        self._in_use[key] = texture
         self._used[key] = self.frame
         return texture
 
@@ -158,9 +175,14 @@ class TexturePool:
             raise ValueError("TexturePool.release: this texture was not acquired from this pool")
         if key not in self._in_use:
             raise ValueError("TexturePool.release: this texture was already released")
-        self._in_use.discard(key)
+        del self._in_use[key]
         self._used[key] = self.frame
-        self._free.setdefault(self._desc[key][0], []).append(texture)
+        desc = self._desc[key][0]
+        free = self._free.get(desc)
+        if free is None:
+            self._free[desc] = [texture]
+        else:
+            free.append(texture)
 
     def end_frame(self) -> int:
         """End a frame: release every free texture not acquired (or released) during the last
@@ -169,8 +191,11 @@ class TexturePool:
         stale = self.frame - self.keep_frames  # last used at or before this frame: evict
         used = self._used
         for desc, free in list(self._free.items()):
-            if all(used[id(t)] > stale for t in free):
-                continue
+            for t in free:
+                if used[id(t)] <= stale:
+                    break
+            else:
+                continue                     # every free one used lately
             for texture in [t for t in free if used[id(t)] <= stale]:
                 del self._desc[id(texture)], used[id(texture)]
                 texture.release()

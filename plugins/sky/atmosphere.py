@@ -51,9 +51,15 @@ RADIUS_EPS = 1.0                    # points are kept this far (m) inside [Rg, R
 
 
 def medium(settings: AtmosphereSettings) -> dict:
-    """The coefficients as float64 arrays (3,), radii and heights as floats."""
+    """The coefficients as float64 arrays (3,), radii and heights as floats (a new dict; the arrays,
+    worked out once per settings, are read-only)."""
+    return dict(_medium(settings))
+
+
+@lru_cache(maxsize=8)
+def _medium(settings: AtmosphereSettings) -> dict:
     s = settings
-    return dict(rg=s.planet_radius, rt=s.top_radius, ray=np.array(s.rayleigh_scattering, np.float64),
+    m = dict(rg=s.planet_radius, rt=s.top_radius, ray=np.array(s.rayleigh_scattering, np.float64),
                 mie_s=np.array(s.mie_scattering, np.float64),
                 mie_t=np.array(s.mie_scattering, np.float64) + np.array(s.mie_absorption, np.float64),
                 ozone=np.array(s.ozone_absorption, np.float64), hr=s.rayleigh_scale_height,
@@ -61,6 +67,10 @@ def medium(settings: AtmosphereSettings) -> dict:
                 albedo=np.array(s.ground_albedo, np.float64), color=np.array(s.sun_color, np.float64),
                 sun=np.array(s.sun_color, np.float64) * s.sun_intensity,
                 ms=s.multiple_scattering)
+    for value in m.values():
+        if isinstance(value, np.ndarray):
+            value.flags.writeable = False
+    return m
 
 
 def coefficients(m: dict, r):
@@ -343,7 +353,7 @@ def sky_view_uv(m: dict, r: float, mu, cos_az):
 def unit(v) -> np.ndarray:
     """(3,) float64 ``v`` at unit length ((0, 1, 0) for a zero or non-finite vector)."""
     a = np.asarray(v, np.float64).reshape(3)
-    n = float(np.linalg.norm(a))
+    n = math.sqrt(a.dot(a))   # np.linalg.norm's own formula (1-D float64), without its overhead
     return a / n if math.isfinite(n) and n > 0 else np.array([0.0, 1.0, 0.0])
 
 

@@ -49,12 +49,18 @@ def atmosphere_defines() -> dict:
 
 def set_atmosphere_uniforms(program, settings: AtmosphereSettings) -> None:
     """Every uniform of ``sky/atmosphere.glsl`` that ``program`` uses (its LUTs: :meth:`AtmosphereLuts.bind`)."""
+    write_uniforms(program, _atmosphere_values(settings))
+
+
+@lru_cache(maxsize=8)
+def _atmosphere_values(settings: AtmosphereSettings) -> dict:
+    """The uniform values of :func:`set_atmosphere_uniforms` for ``settings`` (worked out once per settings)."""
     m = ref.medium(settings)
     values = {"atm_rg": m["rg"], "atm_rt": m["rt"], "atm_hr": m["hr"], "atm_hm": m["hm"], "atm_oz_c": m["oz_c"],
               "atm_oz_w": m["oz_w"], "atm_g": m["g"], "atm_ms": m["ms"], "atm_ray": m["ray"], "atm_mie_s": m["mie_s"],
               "atm_mie_t": m["mie_t"], "atm_ozone": m["ozone"], "atm_albedo": m["albedo"], "atm_sun": m["sun"]}
-    write_uniforms(program, {name: tuple(float(x) for x in value) if isinstance(value, np.ndarray) else value
-                             for name, value in values.items()})
+    return {name: tuple(float(x) for x in value) if isinstance(value, np.ndarray) else value
+            for name, value in values.items()}
 
 
 class AtmosphereLuts:

@@ -37,7 +37,7 @@ import atmos.plugins.clouds.light.grid as grid
 from atmos.phase import Phase
 from atmos.plugins.clouds.light.reference import multilinear
 from atmos.plugins.clouds.light.shear_warp import check_volume_texture, groups, program
-from atmos.gpu.uniforms import bind_buffers, bind_images, bind_textures, write_uniforms
+from atmos.gpu.uniforms import bind_images, bind_textures, buffer_uses, use_buffers, write_uniforms
 from atmos.gpu.hazards import dispatch, dispatch_indirect
 from atmos.gpu.block_table import BlockTable, ints
 
@@ -237,6 +237,8 @@ class DiffusionSolver:
         self._args = ctx.buffer(np.array([self.groups, 1, 1], np.uint32).tobytes())
         self._steps = BlockTable(self.gpu, STEP_BINDING, [ints(stage, cur, first) for stage, cur, first
                                                           in itertools.product(range(5), (0, 1), (0, 1))])
+        self._program = program(self.gpu, "diffusion")    # the context's cached program, for its lifetime
+        self._buffers = buffer_uses(self._program, {"Cells": self._cells, "Parts": self._parts, "Args": self._args})
         self._cur = 0
         self._first = True
         self.iterations = 0          # run since the last begin (each does nothing once converged)
@@ -244,11 +246,11 @@ class DiffusionSolver:
     def _dispatch(self, stage: int, **values) -> None:
         """Stages 2 and 3 (the iteration) run indirect: no groups once converged. The stage and the
         iteration's state come from the Step block's record (stage, cur, first): no uniform writes."""
-        prog = program(self.gpu, "diffusion")
+        prog = self._program
         if values:
             write_uniforms(prog, values)
         self._steps.use(4 * stage + 2 * self._cur + int(self._first))
-        bind_buffers(prog, Cells=self._cells, Parts=self._parts, Args=self._args)
+        use_buffers(prog, self._buffers)
         if stage in (2, 3):
             dispatch_indirect(prog, self._args)
         else:
@@ -263,7 +265,7 @@ class DiffusionSolver:
         if sun.shape != (3,) or not (np.isfinite(n) and n > 0):
             raise ValueError(f"sun_dir must be a finite nonzero 3-vector, got {sun_dir!r}")
         coarse = np.asarray(cell, np.float64) * np.array(self.shape) / np.array(self.field_shape)
-        bind_textures(program(self.gpu, "diffusion"), fine=density, trans=transmittance)
+        bind_textures(self._program, fine=density, trans=transmittance)
         self._cur, self._first, self.iterations = 0, True, 0
         self._args.write(np.array([self.groups, 1, 1], np.uint32).tobytes())
         common = {"fine_size": self.shape, "trans_size": self.shading_shape,
@@ -274,9 +276,16 @@ class DiffusionSolver:
         self._dispatch(1)
 
     def iterate(self, count: int) -> None:
+        """``count`` iterations (stages 2 and 3, as :meth:`_dispatch`): the buffers are bound by the
+        first dispatch and stay bound; each dispatch still declares their uses (its barrier)."""
+        prog, steps, args, uses = self._program, self._steps, self._args, self._buffers
+        bind = True
         for _ in range(int(count)):
-            self._dispatch(2)
-            self._dispatch(3)
+            for stage in (2, 3):
+                steps.use(4 * stage + 2 * self._cur + int(self._first))
+                use_buffers(prog, uses, bind)
+                bind = False
+                dispatch_indirect(prog, args)
             self._cur, self._first = 1 - self._cur, False
             self.iterations += 1
 
@@ -285,7 +294,7 @@ class DiffusionSolver:
         if size != self.field_shape or getattr(target, "components", 0) != 4 or getattr(target, "dtype", "") != "f2":
             raise ValueError(f"target must be a 4-component f2 3D texture of size {self.field_shape} "
                              f"(diffusion_desc); got {target!r}")
-        bind_images(program(self.gpu, "diffusion"), target=target)
+        bind_images(self._program, target=target)
         self._dispatch(4)
 
     def solve(self, density, transmittance, target, *medium, iterations: int = ITERATIONS, warm: bool = True) -> None:

@@ -164,13 +164,13 @@ class ShearWarpShader:
                        step_dir=tuple(float(x) for x in plan.step), step_len=float(plan.length), sigma=self._sigma)
         bind_textures(prog, density=self._density)
         bind_images(prog, result=self._target)
-        nb, nc = self.shading_shape[b], self.shading_shape[c]
+        gb, gc = groups(self.shading_shape[b], 8), groups(self.shading_shape[c], 8)
         order = plan.order
         for i in range(i0, i1):
             src, dst = self._slices[i % 2], self._slices[1 - i % 2]
             bind_images(prog, prev_slice=src, next_slice=dst)
             self._slice_table.use(2 * int(order[i]) + (i == 0))     # the Slice block: (slice, first)
-            dispatch(prog, groups(nb, 8), groups(nc, 8))
+            dispatch(prog, gb, gc)
         self._next = i1
 
     def run_all(self) -> None:

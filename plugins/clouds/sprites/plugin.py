@@ -141,6 +141,7 @@ def sprite_uniforms(plugin, sim, layout: CloudLayout, camera: Camera, aspect: fl
     tau_scale = plugin.extinction(sim) * cell.prod() / np.cbrt(cell.prod())     # sigma_t × V
     settings = plugin.settings
     limit = point_limit if settings.max_point_size is None else min(point_limit, settings.max_point_size)
+    basis = camera.basis()
     return {"volume_shape": tuple(int(n) for n in layout.shape), "group_size": tuple(layout.group),
             "layer_min": tuple(float(v) for v in layout.lo), "cell_size": tuple(float(c) for c in cell),
             "camera_cell": tuple(float(v) for v in (np.asarray(camera.position, np.float64) - layout.lo) / cell),
@@ -149,8 +150,8 @@ def sprite_uniforms(plugin, sim, layout: CloudLayout, camera: Camera, aspect: fl
             "max_point_size": float(limit), "tau_scale": float(tau_scale), "near": float(camera.near),
             "far": float(camera.far),
             "camera_pos": tuple(float(v) for v in camera.position),
-            "camera_right": tuple(float(v) for v in camera.right()),
-            "camera_up": tuple(float(v) for v in camera.up())}
+            "camera_right": tuple(float(v) for v in basis[:, 0]),
+            "camera_up": tuple(float(v) for v in basis[:, 1])}
 
 
 class CloudSpritePass(RenderPass):
@@ -164,7 +165,7 @@ class CloudSpritePass(RenderPass):
         self.plugin = plugin
         self.program = self.sampler = self.offscreen = None
         self.instances = self.commands = self.vao = None
-        self._group = self._uploaded = None
+        self._group = self._uploaded = self._drawn = None   # _drawn: (segments, group, commands) written
 
     def setup(self, builder: PassBuilder) -> None:
         if not self.plugin.settings.enabled:
@@ -199,12 +200,17 @@ class CloudSpritePass(RenderPass):
         self.commands = gpu.ctx.buffer(reserve=COMMAND_BYTES * 16)
         self.vao = gpu.ctx.vertex_array(self.program, [(self.instances, "4i/i", "in_segment")])
         self._group = (group, shape)
-        self._uploaded = None
+        self._uploaded = self._drawn = None
 
     def _draw(self, segments: np.ndarray, group) -> None:
         """Every run of segments with one level and span as one instanced draw of its blocks, all in one
         multi-draw: commands (blocks per unit, segments, first vertex 0, first instance). moderngl
-        strides array commands by 20 bytes (the indexed layout), hence the zero pad."""
+        strides array commands by 20 bytes (the indexed layout), hence the zero pad. The commands are
+        written again only for other segments (select_segments hands back the same read-only array
+        when nothing moved)."""
+        if self._drawn is not None and self._drawn[0] is segments and self._drawn[1] == tuple(group):
+            self.vao.render_indirect(self.commands, moderngl.POINTS, count=self._drawn[2])
+            return
         code = segments[:, 3]
         starts = np.flatnonzero(np.r_[True, code[1:] != code[:-1]])
         counts = np.diff(np.r_[starts, len(code)])
@@ -215,6 +221,7 @@ class CloudSpritePass(RenderPass):
         if commands.nbytes > self.commands.size:
             self.commands.orphan(commands.nbytes)
         self.commands.write(commands.tobytes())
+        self._drawn = (segments, tuple(group), len(commands))
         self.vao.render_indirect(self.commands, moderngl.POINTS, count=len(commands))
 
     def execute(self, frame: PassContext) -> None:
@@ -269,7 +276,7 @@ class CloudSpritePass(RenderPass):
             if obj is not None:
                 obj.release()
         self.vao = self.instances = self.commands = None
-        self._group = self._uploaded = None
+        self._group = self._uploaded = self._drawn = None   # _drawn: (segments, group, commands) written
 
     def release(self) -> None:
         self._release_buffers()

@@ -95,11 +95,15 @@ def draw_units(layout: CloudLayout, camera, keep, margin: float) -> np.ndarray:
     units = []
 
     def claim(i, k, sx, sz):
-        cells = [(a, c) for a in range(i, min(i + sx, gx)) for c in range(k, min(k + sz, gz))]
-        if not any(taken[a][c] for a, c in cells):
-            for a, c in cells:
+        a1, c1 = min(i + sx, gx), min(k + sz, gz)
+        for a in range(i, a1):
+            for c in range(k, c1):
+                if taken[a][c]:
+                    return
+        for a in range(i, a1):
+            for c in range(k, c1):
                 taken[a][c] = True
-            units.append((i, k, sx, sz))
+        units.append((i, k, sx, sz))
     if bx is not None and bz is not None:
         claim(bx - 1, bz - 1, 2, 2)
     for k in range(gz) if bx is not None else ():

@@ -3,6 +3,7 @@
 and the uniforms of J."""
 from __future__ import annotations
 
+import math
 import struct
 from dataclasses import dataclass
 
@@ -55,7 +56,7 @@ def sun_light(sun: Sun | None, altitude: float | None = None) -> tuple[tuple, tu
         ambient = tuple(float(c) for c in getattr(sun, "ambient", DEFAULT_AMBIENT))
         return tuple(float(c) for c in sun.color_at(altitude)), ambient
     direction = np.asarray(sun.direction, np.float64)
-    norm = np.linalg.norm(direction)
+    norm = math.sqrt(direction.dot(direction))   # np.linalg.norm's own formula (1-D float64), without its overhead
     y = direction[1] / norm if norm > 0 and np.isfinite(norm) else -1.0
     x = min(max((y + 0.01) / 0.02, 0.0), 1.0)
     fade = x * x * (3.0 - 2.0 * x)
@@ -94,7 +95,7 @@ def sun_source_at(sources, v) -> np.ndarray:
 
 def unit_direction(sun: Sun | None) -> np.ndarray:
     d = np.asarray((sun or Sun()).direction, np.float64)
-    n = np.linalg.norm(d)
+    n = math.sqrt(d.dot(d))   # np.linalg.norm's own formula (1-D float64), without its overhead
     return d / n if n > 0 and np.isfinite(n) else np.array([0.0, -1.0, 0.0])
 
 
