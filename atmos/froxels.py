@@ -24,6 +24,14 @@ def volume_desc(froxels, dtype: str = "f2") -> TextureDesc:
     return TextureDesc((w, h, d + 1), components=4, dtype=dtype, storage=True)
 
 
+def volume_image(frame, name: str):
+    """The pass's froxel volume ``name`` as an image, its reads clamped to the edge texels (as
+    :func:`froxel_lookup` reads)."""
+    volume = frame.image(name)
+    volume.repeat_x = volume.repeat_y = volume.repeat_z = False
+    return volume
+
+
 def froxel_distance(w, range_: float, knee: float):
     """Distance of slice coordinate w in [0, 1] (lib/froxel_slices.glsl)."""
     return knee * np.expm1(np.asarray(w, np.float64) * np.log1p(range_ / knee))

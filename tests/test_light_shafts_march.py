@@ -73,13 +73,17 @@ def march_app(gpu, density, probe, **shafts):
     return app, plugin, capture
 
 
+def sun_tau(sets, sun_dir):
+    """The sun's optical depth through the cloud sets at points (..., 3): the exact column sums."""
+    a, b, t = sets.view()
+    return lambda p: shadow_reference.sun_optical_depth(p, sets.maps_of(a).read_sums()[0], sets.maps_of(b).read_sums()[0],
+                                                        t, sun_dir, sets.settings.sigma, sets.layout(), sets.a_shift)
+
+
 def expected(app, probe, settings):
     """The reference march for what the probe read back (the GPU's own low-res depth)."""
-    cam, sun, sets = app.resource(Camera), app.resource(Sun), probe.sets
-    a, b, t = sets.view()
-    tau = lambda p: shadow_reference.sun_optical_depth(
-        p, sets.maps_of(a).read_sums()[0], sets.maps_of(b).read_sums()[0], t, np.asarray(sun.direction) /
-        np.linalg.norm(sun.direction), sets.settings.sigma, sets.layout(), sets.a_shift)
+    cam, sun = app.resource(Camera), app.resource(Sun)
+    tau = sun_tau(probe.sets, np.asarray(sun.direction) / np.linalg.norm(sun.direction))
     return reference.march_shafts(probe.depth, view_basis(cam, SIZE[0] / SIZE[1]), cam.position, cam.near, cam.far,
                                   SIZE, settings.downsample, np.asarray(sun.direction) / np.linalg.norm(sun.direction),
                                   march_irradiance(sun, settings), settings, tau)
@@ -144,10 +148,7 @@ def test_gpu_froxels_match_the_float64_twin(march_gpu, rng, froxels):
     assert march_gpu.ctx.error == "GL_NO_ERROR"
     settings, cam, sun = plugin.settings, app.resource(Camera), app.resource(Sun)
     sun_dir = np.asarray(sun.direction) / np.linalg.norm(sun.direction)
-    sets = probe.sets
-    a, b, t = sets.view()
-    tau = lambda p: shadow_reference.sun_optical_depth(p, sets.maps_of(a).read_sums()[0], sets.maps_of(b).read_sums()[0],
-                                                       t, sun_dir, sets.settings.sigma, sets.layout(), sets.a_shift)
+    tau = sun_tau(probe.sets, sun_dir)
     basis = view_basis(cam, SIZE[0] / SIZE[1])
     want = reference.froxel_shafts(cam.position, basis, froxels, sun_dir, march_irradiance(sun, settings), settings, tau)
     got = probe.volume

@@ -5,7 +5,7 @@ A heterogeneous fog, whose factor along a ray depends on the ray's end, keeps th
 float64 twin: :func:`.reference.froxel_shafts`."""
 from __future__ import annotations
 
-from atmos.froxels import froxel_knee, volume_desc
+from atmos.froxels import froxel_knee, volume_desc, volume_image
 from atmos.graph import PassBuilder, PassContext, work_groups
 from atmos.plugins.clouds import FAR_FIELD
 from atmos.plugins.light_shafts.march import MarchedShafts, march_irradiance
@@ -45,8 +45,7 @@ class FroxelShafts:
         for p in (fill, apply):
             self.medium.set_medium(frame, p, settings, clouds, irradiance, fog, aerial)
             write_uniforms(p, froxel_knee=froxel_knee(settings.max_distance))
-        volume = frame.image(SHAFT_VOLUME)
-        volume.repeat_x = volume.repeat_y = volume.repeat_z = False     # read clamped to its edge texels
+        volume = volume_image(frame, SHAFT_VOLUME)
         frame.dispatch(fill, work_groups(volume.size[:2], (8, 8)), images={"shaft_volume": volume})
         color = frame.image(COLOR)
         frame.dispatch(apply, work_groups(color.size, (8, 8)), images={"color_image": color},

@@ -5,7 +5,7 @@ import numpy as np
 
 from atmos.scene_uniforms import set_camera_uniforms
 from atmos.composition import MEDIA_LIGHT, MEDIA_TRANSMITTANCE, composition
-from atmos.froxels import froxel_knee, volume_desc
+from atmos.froxels import froxel_knee, volume_desc, volume_image
 from atmos.gpu.uniforms import write_uniforms
 from atmos.graph import ComputePass, PassContext, work_groups
 from atmos.lighting import Sun, sun_and_day
@@ -82,8 +82,7 @@ class VolumetricFogPass(ComputePass):
         defines = self.defines()
         fill = self.gpu.program(compute_shader="volumetric_fog/froxels.comp")
         apply = self.gpu.program(compute_shader="volumetric_fog/froxel_apply.comp", defines=defines)
-        volume = frame.image(FOG_VOLUME)
-        volume.repeat_x = volume.repeat_y = volume.repeat_z = False     # read clamped to its edge texels
+        volume = volume_image(frame, FOG_VOLUME)
         for p in (fill, apply):
             set_camera_uniforms(p, view.camera, view.aspect)
             write_uniforms(p, froxel_knee=froxel_knee(settings.max_distance), max_distance=settings.max_distance)
