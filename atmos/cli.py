@@ -5,7 +5,7 @@ import argparse
 import os
 import sys
 
-from atmos.demo_registry import (CLOUD_RENDERERS, DEFAULT_DEMO, HAZES, SKY_MODELS, DemoSettings, haze_conflict,
+from atmos.demo_registry import (CLOUD_RENDERERS, DEFAULT_DEMO, EXPOSURES, HAZES, SKY_MODELS, DemoSettings, haze_conflict,
                                  list_demos, load_demo)
 
 
@@ -110,6 +110,9 @@ def _clouds_option(command) -> None:
                          help="distance haze of the hazy demos (sunset, flight): an exponential fog toward the "
                               "sky's colour, the physical sky's aerial perspective, Earth's own air, or both mixed "
                               "along each ray (air and both need --sky physical; default fog)")
+    command.add_argument("--exposure", choices=EXPOSURES, default="auto",
+                         help="camera of the outdoor demos (sunset, flight, weather, sky_day): metered, adapting "
+                              "EV100 with bloom, or the fixed exposure 1 (default auto)")
 
 
 def cmd_info(args) -> int:
@@ -156,7 +159,7 @@ def _play(args, game, stem: str) -> int:
     if problem is not None:
         print(f"atmos: {problem}; rendering headless", file=sys.stderr)
     settings = DemoSettings(size=args.size, seed=args.seed, frames=args.frames, clouds=args.clouds, sky=args.sky,
-                            haze=args.haze, headless=args.headless or args.out is not None or problem is not None)   # as atmos.run
+                            haze=args.haze, exposure=args.exposure, headless=args.headless or args.out is not None or problem is not None)   # as atmos.run
     if settings.headless:
         out = args.out if args.out is not None else (f"out/{stem}/" if args.shots else f"out/{stem}.mp4")
         result = run_headless(game, settings, out, progress=not args.quiet, script=args.script, shots=args.shots)
@@ -177,7 +180,7 @@ def cmd_graph(args, top) -> int:
         top.error(str(error))
     gpu = create_headless((320, 180))
     app = build_app(args.name, DemoSettings(size=gpu.size, headless=True, clouds=args.clouds, sky=args.sky,
-                                                 haze=args.haze), gpu, start=False)
+                                                 haze=args.haze, exposure=args.exposure), gpu, start=False)
     try:
         print(app.graph.to_dot() if args.dot else app.graph.dump())
         if args.png:

@@ -12,6 +12,8 @@ CLOUD_RENDERERS = ("sprites", "march")
 SKY_MODELS = ("preetham", "physical")      # atmos.plugins.sky.MODELS (kept here so the CLI imports no plugin)
 HAZES = ("fog", "air", "both")   # the hazy demos' distance haze: a FogPlugin toward the sky, the physical sky's
                                  # aerial perspective, or both mixed along each ray (atmos.composition)
+EXPOSURES = ("auto", "fixed")    # the outdoor demos' camera: metered and adapted EV100 with bloom
+                                 # (atmos.plugins.physical_camera), or RenderCoreSettings.exposure alone
 
 
 def haze_conflict(haze: str, sky: str) -> str | None:
@@ -31,14 +33,24 @@ class DemoSettings:
     clouds: str = "sprites"       # the cloud scenes' renderer: point sprites or the ray march (key C flips it)
     sky: str = "physical"         # the sky's model in the demos with a sky (SkySettings.model)
     haze: str = "fog"             # sunset's and flight's haze: "fog" (FogPlugin toward the sky), "air" (aerial perspective) or "both"
+    exposure: str = "auto"        # the outdoor demos' camera: "auto" (metered EV100 and bloom) or "fixed" (exposure 1)
 
     def __post_init__(self):
         check_choice("DemoSettings", "clouds", self.clouds, CLOUD_RENDERERS)
         check_choice("DemoSettings", "sky", self.sky, SKY_MODELS)
         check_choice("DemoSettings", "haze", self.haze, HAZES)
+        check_choice("DemoSettings", "exposure", self.exposure, EXPOSURES)
         conflict = haze_conflict(self.haze, self.sky)
         if conflict:
             raise ValueError(f"DemoSettings.haze {self.haze!r} is {conflict} (or take haze='fog')")
+
+
+def add_demo_camera(app, settings: DemoSettings) -> None:
+    """The outdoor demos' camera: with ``settings.exposure`` "auto" a PhysicalCameraPlugin (metered,
+    adapted EV100 and bloom); "fixed" adds nothing (RenderCoreSettings.exposure)."""
+    if settings.exposure == "auto":
+        from atmos.plugins.physical_camera import PhysicalCameraPlugin
+        app.add_plugins(PhysicalCameraPlugin())
 
 
 def list_demos() -> dict[str, str]:

@@ -30,6 +30,7 @@ shafts instead of casting them.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import moderngl
 import numpy as np
@@ -46,6 +47,27 @@ SCREEN = "screen"
 PRESENT_IMAGE = "present_image"      # the presented frame, 8-bit levels, before its copy to the screen
 COLOR = "color"
 DEPTH = "depth"
+CAMERA_EXPOSURE = "camera_exposure"  # buffer: the exposure (and bloom weight) written on the GPU (shaders/lib/camera.glsl)
+BLOOM = "bloom"                      # half-size blurred colour the present mixes in (plugins/physical_camera)
+
+
+@dataclass
+class PresentInputs:
+    """App resource: what the present takes besides ``color``. A pass cannot declare an optional read,
+    so a plugin that writes :data:`CAMERA_EXPOSURE` (and :data:`BLOOM`) sets ``camera`` (and ``bloom``) to
+    a zero-argument callable that says whether it does this frame; None or False: the present uses
+    ``RenderCoreSettings.exposure`` and no bloom."""
+    camera: Callable[[], bool] | None = None
+    bloom: Callable[[], bool] | None = None
+
+
+def present_inputs(app) -> PresentInputs:
+    """The App's :class:`PresentInputs` (made on first use)."""
+    inputs = app.get_resource(PresentInputs)
+    if inputs is None:
+        inputs = PresentInputs()
+        app.insert_resource(inputs)
+    return inputs
 
 
 def color_desc(gpu) -> TextureDesc:
@@ -132,24 +154,41 @@ class PresentPass(ComputePass):
     rounded to 8-bit levels in the shader (:func:`present_levels`): one compute invocation per pixel
     into ``"present_image"`` (rgba8), then one framebuffer blit to the screen (a multisampled screen,
     which a blit writes only from its own format, gets it drawn 1:1). The screen's alpha is 1
-    (``color.a``, the sky occlusion, is not shown)."""
+    (``color.a``, the sky occlusion, is not shown). With a physical camera (:class:`PresentInputs`) the
+    exposure and the bloom's weight come from its buffer and the bloom is mixed in first."""
     name = "present"
     phase = "present"
     compute = "core/present.comp"
     copy = "core/present_copy.frag"
+    camera = bloom = False               # this frame's inputs (setup)
 
     def setup(self, builder: PassBuilder) -> None:
+        inputs = self.plugin.inputs
+        self.camera = bool(inputs.camera is not None and inputs.camera())
+        self.bloom = bool(self.camera and inputs.bloom is not None and inputs.bloom())
+        if self.camera:
+            builder.read(CAMERA_EXPOSURE, access="storage")
+        if self.bloom:
+            builder.read(BLOOM)
         builder.read(COLOR)
         builder.create(PRESENT_IMAGE, TextureDesc(tuple(self.plugin.gpu.size), components=4, dtype="f1",
                                                   filter="nearest", storage=True), access="storage")
         builder.write(SCREEN)
 
+    def defines(self) -> dict:
+        return {"CAMERA": int(self.camera), "BLOOM": int(self.bloom)}
+
     def execute(self, frame: PassContext) -> None:
         p = self.program
-        write_uniforms(p, exposure=self.plugin.settings.exposure,
-                       dither=DITHER_STEP if self.plugin.settings.dither else 0.0)
+        if self.camera:
+            write_uniforms(p, dither=DITHER_STEP if self.plugin.settings.dither else 0.0)
+        else:
+            write_uniforms(p, exposure=self.plugin.settings.exposure,
+                           dither=DITHER_STEP if self.plugin.settings.dither else 0.0)
         image = frame.image(PRESENT_IMAGE)
-        frame.dispatch(p, self.groups(image.size), textures={"hdr": COLOR}, images={"screen_image": PRESENT_IMAGE})
+        frame.dispatch(p, self.groups(image.size), textures={"hdr": COLOR, "bloom_image": BLOOM} if self.bloom
+                       else {"hdr": COLOR}, images={"screen_image": PRESENT_IMAGE},
+                       buffers={"Camera": CAMERA_EXPOSURE} if self.camera else None)
         screen = frame.resource(SCREEN)
         screen.use()                                      # its scissor off: a blit obeys it
         if screen.samples:
@@ -214,7 +253,8 @@ class RenderCoreSettings(CheckedSettings):
     """How each frame starts and how it reaches the screen (all live)."""
     clear_color: tuple = vec_field((0.0, 0.0, 0.0), 3, "non-negative", "linear HDR colour ``color`` starts "
                                    "each frame with")
-    exposure: float = num_field(1.0, 0.0, 1e6, "HDR scale before tone mapping", lo_open=True)
+    exposure: float = num_field(1.0, 0.0, 1e6, "HDR scale before tone mapping (a PhysicalCameraPlugin's exposure, "
+                                "metered or in EV100, replaces it)", lo_open=True)
     dither: bool = bool_field(True, "add a triangular dither of ±1 step before 8-bit output (mean unchanged, "
                               "no banding)")
 
@@ -230,6 +270,7 @@ class RenderCorePlugin(Plugin):
         if app.graph is None:
             return
         self.gpu = app.gpu
+        self.inputs = present_inputs(app)
         app.graph.import_resource(SCREEN, lambda: app.gpu.target)
         app.graph.add_pass(ClearPass(app.gpu, self))
         app.graph.add_pass(PresentPass(self))

@@ -6,7 +6,7 @@ import os
 import sys
 
 from atmos.app import App
-from atmos.demo_registry import CLOUD_RENDERERS, HAZES, SKY_MODELS, DemoSettings, haze_conflict, load_demo
+from atmos.demo_registry import CLOUD_RENDERERS, EXPOSURES, HAZES, SKY_MODELS, DemoSettings, haze_conflict, load_demo
 from atmos.gpu import create_headless
 
 _FILES: dict = {}      # game files loaded so far, by resolved path: each runs once per process
@@ -211,7 +211,7 @@ def run_window(name, settings: DemoSettings, title: str | None = None, script=No
 
 def run(game, *, size: tuple[int, int] = (960, 540), title: str | None = None, headless: bool | None = None,
         frames: int | None = None, out: str | None = None, seed: int = 0, clouds: str = "sprites",
-        sky: str = "physical", haze: str = "fog", progress: bool = False, script=None, shots=None) -> dict | None:
+        sky: str = "physical", haze: str = "fog", exposure: str = "auto", progress: bool = False, script=None, shots=None) -> dict | None:
     """Run a game: ``game`` is ``build(app, settings)`` (a function, a module that defines it, a path
     to a ``.py`` file, or a demo name). The App is made for you on a window's context (the window must
     exist before the GL context, so atmos makes both), or on a headless one when ``headless`` is True,
@@ -222,6 +222,7 @@ def run(game, *, size: tuple[int, int] = (960, 540), title: str | None = None, h
     march), like ``atmos demo --clouds`` (the demos ``sunset``, ``flight`` and ``weather`` read it);
     ``sky``: "preetham" or "physical", like ``atmos demo --sky`` (the demos with a sky read it);
     ``haze``: "fog", "air" (the physical sky's aerial perspective) or "both", like ``atmos demo --haze``.
+    ``exposure``: "auto" (a metered, adapting physical camera with bloom) or "fixed", like ``atmos demo --exposure``.
     Headless: ``frames`` frames (default the game's ``DEFAULT_FRAMES`` or 90) at 1/30 s, written to
     ``out`` (``.mp4``, ``.gif``, ``.png`` or a folder) if given, only the frame numbers ``shots`` (into
     a folder) when given; returns what was written. Windowed: until the window closes (or ``frames``
@@ -237,6 +238,7 @@ def run(game, *, size: tuple[int, int] = (960, 540), title: str | None = None, h
     clouds = check_choice("atmos.run", "clouds", clouds, CLOUD_RENDERERS)
     sky = check_choice("atmos.run", "sky", sky, SKY_MODELS)
     haze = check_choice("atmos.run", "haze", haze, HAZES)
+    exposure = check_choice("atmos.run", "exposure", exposure, EXPOSURES)
     conflict = haze_conflict(haze, sky)
     if conflict:
         raise ValueError(f"atmos.run haze={haze!r} is {conflict}")
@@ -245,7 +247,7 @@ def run(game, *, size: tuple[int, int] = (960, 540), title: str | None = None, h
         headless = problem is not None
         if problem is not None:
             print(f"atmos: {problem}; rendering headless" + (f" into {out}" if out else ""), file=sys.stderr)
-    settings = DemoSettings(size=size, seed=seed, frames=frames, clouds=clouds, sky=sky, haze=haze,
+    settings = DemoSettings(size=size, seed=seed, frames=frames, clouds=clouds, sky=sky, haze=haze, exposure=exposure,
                             headless=bool(headless) or out is not None)
     if settings.headless:
         return run_headless(game, settings, out, progress=progress, script=script, shots=shots)

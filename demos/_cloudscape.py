@@ -13,6 +13,7 @@ import numpy as np
 
 from atmos.camera import Camera
 from atmos.defaults import DefaultPlugins
+from atmos.demo_registry import add_demo_camera
 from atmos.input import Input
 from atmos.keys import key
 from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
@@ -59,6 +60,7 @@ def build_cloudscape(app, settings, *, hours: float, speed: float = 0.0, cloud_d
                     RaymarchCloudsPlugin(enabled=settings.clouds == "march"),
                     LightShaftsPlugin())
     app.add_system(switch_key, "update", label="cloud_renderer_switch")
+    add_demo_camera(app, settings)
     if horizon:
         app.add_plugins(CloudFarFieldPlugin())
     if haze and settings.haze in ("fog", "both"):

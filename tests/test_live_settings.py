@@ -39,6 +39,7 @@ from atmos.plugins.clouds.far_field import CloudFarFieldPlugin
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
 from atmos.plugins.clouds.presets import CloudSky, CloudWeatherPlugin
 from atmos.plugins.antialias import AntialiasPlugin
+from atmos.plugins.physical_camera import PhysicalCameraPlugin
 from atmos.plugins.clouds.simulation.top_view import CloudTopViewPlugin
 from atmos.plugins.daylight import DaylightPlugin, TimeOfDay
 from atmos.plugins.fog import FogPlugin
@@ -431,6 +432,25 @@ SPECS["antialias"] = Spec(
     lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(), AntialiasPlugin()],
     AntialiasPlugin, look((0.0, 3.0, 10.0), yaw=0.3, pitch=0.02),
     dict(span_max=1.0, reduce_mul=1.0, reduce_min=1.0))
+def adapting_from(offset):
+    """One frame's adaptation from ``offset`` EV off the metered target (the camera's speeds show there)."""
+    def observe(app, plugin):
+        plugin.reset(plugin.read_state()["target"] + offset)
+        render(app, 1 / 30)
+        return plugin.read_state()["ev100"]
+    return observe
+
+
+SPECS["physical_camera"] = Spec(
+    lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(), PhysicalCameraPlugin()],
+    PhysicalCameraPlugin, look((0.0, 3.0, 10.0), yaw=0.3, pitch=0.02),
+    dict(auto_exposure=False, ev100=3.0, compensation=-1.0, ev_range=(8.0, 14.0), metering_filter=(0.0, 0.1),
+         speed_up=6.0, speed_down=3.0, transition=0.2, bloom=0.5, bloom_levels=2, enabled=False),
+    observe={"speed_up": adapting_from(-3.0), "speed_down": adapting_from(3.0), "transition": adapting_from(-0.5),
+             # the metered target moves at once; the exposure follows it at the camera's speeds (frozen here)
+             **{name: lambda app, plugin: plugin.read_state()["target"]
+                for name in ("compensation", "ev_range", "metering_filter")}},
+    before={"ev100": configure_first(auto_exposure=False), "bloom_levels": configure_first(bloom=0.5)})
 SPECS["cloud_weather"] = Spec(
     lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), CloudSky("fair_weather", warmup_steps=1)],
     CloudWeatherPlugin, look((0.0, 300.0, 0.0), pitch=0.9, far=20000.0),
