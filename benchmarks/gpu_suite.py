@@ -24,7 +24,7 @@ Sections (each reuses its benchmark module's functions, so the numbers are the s
 Writes ``gpu_suite.md`` (one Markdown report, the thesis's and the anchors' figures beside ours)
 and ``gpu_suite.json`` to ``--out`` (default ``out/``). ``--quick`` runs the same code at small
 sizes (it is what tests/test_gpu_suite.py runs on llvmpipe); the sizes used are in the report.
-Goals on an H100/H200: automaton step ≤ 20 µs at 256×32×256, the sunset frame ≤ 2 ms GPU at
+Goals on an H100/H200: automaton step ≤ 10 µs GPU and ≤ 30 µs wall at 256×32×256, the sunset frame ≤ 2 ms GPU at
 1920×1080. On llvmpipe only the ratios inside one run mean anything, and timer queries are not
 GPU times.
 """
@@ -43,7 +43,7 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 sys.path.insert(0, str(HERE))
 
-GOALS = {"automaton_step_us": 20.0, "sunset_frame_gpu_ms": 2.0}
+GOALS = {"automaton_step_us": 10.0, "automaton_wall_us": 30.0, "sunset_frame_gpu_ms": 2.0}
 ANCHORS = {"Nubis (Horizon Zero Dawn clouds), PS4": "≈ 2 ms per frame",
            "thesis GPU": "GeForce 8700M GT (32 shader units), 1024×768, 256×32×256 volume"}
 SIZES = {   # full: what the thesis and the goals name; quick: the same code small enough for llvmpipe
@@ -67,12 +67,18 @@ def automaton(cfg) -> dict:
     finally:
         gpu.release()
     for r in rows:
-        r["packed_us"] = r["packed_ms"] * 1e3
-    return {"title": f"Automaton step, {_shape(cfg['volume'])} cells ({cfg['automaton_steps']} chained steps, glFinish)",
-            "columns": [("case", "case"), ("packed µs", "packed_us"), ("cell ms", "cell_ms"),
-                        ("cell / packed", "speedup"), ("thesis ms (Table 8.1)", "thesis_ms")],
+        for layout in ("packed", "cell"):
+            for part in ("gpu", "python", "wall"):
+                r[f"{layout}_{part}_us"] = r[f"{layout}_{part}_ms"] * 1e3
+    return {"title": f"Automaton step, {_shape(cfg['volume'])} cells ({cfg['automaton_steps']} queued steps: GPU by "
+                     "timer query, Python issuing them, wall glFinish to glFinish)",
+            "columns": [("case", "case"), ("packed GPU µs", "packed_gpu_us"), ("packed Python µs", "packed_python_us"),
+                        ("packed wall µs", "packed_wall_us"), ("cell GPU µs", "cell_gpu_us"),
+                        ("cell Python µs", "cell_python_us"), ("cell / packed (GPU)", "speedup"),
+                        ("thesis ms (Table 8.1)", "thesis_ms")],
             "rows": rows,
-            "notes": [f"goal on an H100/H200: packed full step ≤ {GOALS['automaton_step_us']:g} µs at 256×32×256",
+            "notes": [f"goal on an H100/H200: packed full step ≤ {GOALS['automaton_step_us']:g} µs GPU and ≤ {GOALS['automaton_wall_us']:g} µs wall at 256×32×256",
+                      "a GPU time of 0: the driver ran the steps while they were issued (Mesa's llvmpipe), the Python column holds them",
                       "thesis: 12.5 ms per simulation step update, GeForce 8700M GT, pixel shader, one RGBA8 texel per cell"]}
 
 
@@ -292,7 +298,7 @@ def markdown(report: dict) -> str:
              f"- CPU: {m['cpu']} ({m['cpus']} logical), Python {m['python']}, {m['platform']}",
              f"- sizes: volume {_shape(report['sizes']['volume'])}, frame {_shape(report['sizes']['frame'])}; "
              f"total {report['seconds']:.0f} s",
-             f"- goals (H100/H200): automaton step ≤ {GOALS['automaton_step_us']:g} µs at 256×32×256; "
+             f"- goals (H100/H200): automaton step ≤ {GOALS['automaton_step_us']:g} µs GPU, ≤ {GOALS['automaton_wall_us']:g} µs wall at 256×32×256; "
              f"sunset frame ≤ {GOALS['sunset_frame_gpu_ms']:g} ms GPU at 1920×1080",
              *[f"- anchor: {k}: {v}" for k, v in ANCHORS.items()], ""]
     for name, section in report["sections"].items():
