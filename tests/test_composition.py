@@ -12,7 +12,7 @@ from atmos.plugins.clouds.sprites import CloudRenderPlugin
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
 from atmos.plugins.fog import FogPlugin, FogSettings, apply_fog
 from atmos.plugins.fog.factors import apply_fog_ref
-from atmos.plugins.fog.sky_color import SAMPLES, horizon_table, sky_fog_color
+from atmos.plugins.fog.sky_color import SAMPLES, horizon_at, horizon_table, sky_fog_color
 from atmos.plugins.sky.light import horizon_colors
 from atmos.plugins.sky import SkySettings
 from atmos.plugins.clouds.weather import VolumeOrigin
@@ -64,16 +64,28 @@ def test_apply_fog_fogs_a_cloud_layer_by_its_own_distance_like_the_float64_refer
     assert np.array_equal(plain[~(cloud[..., 1] > 0)], want[~(cloud[..., 1] > 0)])
 
 
-def test_the_sky_fog_colour_is_the_horizon_sky_in_the_rays_azimuth():
+def test_the_sky_fog_colour_is_the_horizon_sky_at_the_rays_angle_from_the_sun(rng):
     sun = Sun.from_angles(4.6, 80.0)
+    s = sun.direction
     table = horizon_colors(sun, SkySettings(), SAMPLES)
     assert table.shape == (SAMPLES, 3) and np.isfinite(table).all()
-    toward = sky_fog_color(unit([np.sin(np.radians(80)), 0.0, -np.cos(np.radians(80))]), table, (1, 1, 1))
-    away = sky_fog_color(unit([-np.sin(np.radians(80)), 0.0, np.cos(np.radians(80))]), table, (1, 1, 1))
+    toward = sky_fog_color(unit([np.sin(np.radians(80)), 0.0, -np.cos(np.radians(80))]), table, (1, 1, 1), s)
+    away = sky_fog_color(unit([-np.sin(np.radians(80)), 0.0, np.cos(np.radians(80))]), table, (1, 1, 1), s)
     assert toward.sum() > 2.0 * away.sum(), "the horizon glows toward the low sun"
     assert toward[0] > toward[2], "and is warm there"
+    # on the horizon, a ray takes the sky in its own azimuth (the sky is symmetric about the sun's): a smooth
+    # symmetric sky 1 + 0.5 cos(azimuth - the sun's), within the two tables' linear interpolation (< 0.01)
+    sun_azimuth = np.arctan2(s[0], -s[2])
+    smooth = np.repeat(1.0 + 0.5 * np.cos(2 * np.pi * np.arange(SAMPLES) / SAMPLES - sun_azimuth)[:, None], 3, 1)
+    azimuths = rng.uniform(0.0, 2.0 * np.pi, 50)
+    flat_rays = np.stack([np.sin(azimuths), np.zeros(50), -np.cos(azimuths)], -1)
+    own = horizon_at(smooth, azimuths)
+    assert np.abs(sky_fog_color(flat_rays, smooth, (1, 1, 1), s) - own).max() < 0.01
+    # a ray down onto the ground under the low sun is far from it: no bright pillar under the sun
+    down = sky_fog_color(unit([np.sin(np.radians(80)), -2.0, -np.cos(np.radians(80))]), table, (1, 1, 1), s)
+    assert down.sum() < 0.8 * toward.sum(), "the ground under the sun is not fogged with the sun's glow"
     flat = horizon_table(Sun(ambient=(0.2, 0.3, 0.4)))          # no sky plugin: the Sun's ambient
-    assert np.allclose(sky_fog_color(unit([1.0, 0.3, 2.0]), flat, (0.5, 1, 1)), [0.1, 0.3, 0.4])
+    assert np.allclose(sky_fog_color(unit([1.0, 0.3, 2.0]), flat, (0.5, 1, 1), s), [0.1, 0.3, 0.4])
     with pytest.raises(ValueError, match="FogSettings.color_from"):
         FogSettings(color_from="sun")
 

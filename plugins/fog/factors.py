@@ -66,7 +66,7 @@ def apply_fog_ref(color, distance, settings, positions=None, time: float = 0.0, 
     seen from above y = 0 is fogged as that plane at ``camera.y / −direction.y``.
     """
     from atmos.plugins.fog.noise import turbulence_ref
-    from atmos.plugins.fog.sky_color import sky_fog_color
+    from atmos.plugins.fog.sky_color import ZENITH, sky_fog_color
 
     eye = np.asarray(camera, np.float64)
 
@@ -96,7 +96,9 @@ def apply_fog_ref(color, distance, settings, positions=None, time: float = 0.0, 
         dc = np.maximum(cloud[..., 0] / np.where(a > 0, cloud[..., 1], 1.0), 0.0)
         where = np.asarray(camera, np.float64) + np.asarray(directions, np.float64) * dc[..., None]
         f = np.where(a > 0, a * factor(dc, where) + (1.0 - a) * f, f)
-    fog = settings.fog_color if settings.color_from == "fixed" else sky_fog_color(directions, horizon, settings.fog_color)
+    sky_sun = ZENITH if sun is None else sun.direction
+    fog = (settings.fog_color if settings.color_from == "fixed"
+           else sky_fog_color(directions, horizon, settings.fog_color, sky_sun))
     if sun is not None and settings.sun_scattering > 0:
         fog = fog + fog_light(directions, sun, settings)
     return blend(color, fog, f)
