@@ -36,9 +36,10 @@ per full-res pixel (``shaders/clouds/raymarch/temporal.comp``, one compute invoc
   the upsample, whose own error read as a change the next frame (7× the clouds' own change).
 
 The output (premultiplied colour RGBA16F, (a·distance, a) RG32F as in :mod:`atmos.composition`) is
-the next frame's history, stored as images; the pass blends it onto "color" (and "cloud_distance").
-The history is no graph resource: its binds ask for the barriers its reads need
-(:mod:`atmos.gpu.hazards`). The numpy float64 reference is :mod:`.temporal_reference`.
+the next frame's history, stored as images; the same dispatch composites it onto "color" (and
+"cloud_distance") in place for the pass, as a blend ONE, ONE_MINUS_SRC_ALPHA did. The history is no
+graph resource: its binds ask for the barriers its reads need (:mod:`atmos.gpu.hazards`). The numpy
+float64 reference is :mod:`.temporal_reference`.
 
 Knobs and their cost (the resolve itself is one full-res dispatch: 1 fresh + 4 bilinear + 9
 neighbourhood fetches of the low-res targets, 2 × 4 bilinear history fetches, 2 depth fetches, 1
@@ -172,13 +173,17 @@ class TemporalClouds:
         self._valid = False
 
     def resolve(self, low_color, low_distance, size, r: int, offset, camera, aspect: float, depth=None,
-                history_clamp: float = HISTORY_CLAMP, motion_limit: float = MOTION_LIMIT, low_depth=None):
+                history_clamp: float = HISTORY_CLAMP, motion_limit: float = MOTION_LIMIT, low_depth=None,
+                onto=None, onto_distance=None):
         """Resolve this frame at full-res ``size`` (w, h) from the low-res ``low_color`` (RGBA
         premultiplied) and ``low_distance`` ((a·d, a)) textures marched at ``offset`` with divisor
         ``r``, seen by ``camera`` at ``aspect``; ``depth``: the scene's depth texture at ``size``
         (None: nothing but sky); ``low_depth``: the depth each sample's ray saw (low-res; with ``depth``
         the upsample is depth-aware, :data:`~atmos.offscreen.EDGE`). Returns (color, distance) full-res textures, valid until the next
-        resolve (they are the history it reads); one compute dispatch."""
+        resolve (they are the history it reads). ``onto``: a full-res RGBA16F texture (the frame's
+        colour) the same dispatch composites the result onto in place, premultiplied as
+        :meth:`~atmos.graph.PassContext.blend_over` would; ``onto_distance`` (with ``onto``): an RG32F
+        texture ("cloud_distance") the distance goes onto the same way."""
         r = check_resolution(r)
         size = (int(size[0]), int(size[1]))
         ox, oy = offset
@@ -196,12 +201,18 @@ class TemporalClouds:
         if not 0.0 <= history_clamp <= 1.0 or not motion_limit > 0.0:
             raise ValueError(f"TemporalClouds.resolve: history_clamp must be in [0, 1] and motion_limit > 0, "
                              f"got {history_clamp!r}, {motion_limit!r}")
+        for name, tex in (("onto", onto), ("onto_distance", onto_distance)):
+            if tex is not None and tuple(tex.size) != size:
+                raise ValueError(f"TemporalClouds.resolve: {name} must be {size[0]}x{size[1]}, got {tex.size}")
+        if onto_distance is not None and onto is None:
+            raise ValueError("TemporalClouds.resolve: onto_distance needs onto (the colour it composites with)")
         if self._key != (size, r):
             self._make(size, r)
         state = camera_state(camera, aspect)
         matrices = camera_matrices(camera, aspect)
         prev, write = self._sets[self._current], self._sets[1 - self._current]
-        p = self.gpu.program(compute_shader="clouds/raymarch/temporal.comp")
+        p = self.gpu.program(compute_shader="clouds/raymarch/temporal.comp",
+                             defines={"COMPOSITE": int(onto is not None), "COMPOSITE_DISTANCE": int(onto_distance is not None)})
         p["view_basis"].write(matrices.gl("view_basis"))
         write_uniforms(p, near=float(camera.near), far=float(camera.far), r=r, offset=(int(ox), int(oy)),
                        has_depth=depth is not None,
@@ -224,6 +235,8 @@ class TemporalClouds:
         if depth is not None:
             bind_textures(p, scene_depth=depth)
         bind_images(p, next_color=write[0], next_distance=write[1], next_scene=write[2], next_sample=write[3])
+        if onto is not None:
+            bind_images(p, color_image=onto, **({"distance_image": onto_distance} if onto_distance is not None else {}))
         dispatch(p, *work_groups(size, (8, 8)))   # the binds asked for the barriers; the stores are tracked
         self._current = 1 - self._current
         self.still_frames = self.still_frames + 1 if valid and state == self._prev[0] else 0

@@ -2,7 +2,10 @@
 // The temporal resolve of the ray-marched clouds (plugins/clouds/raymarch/temporal.py says what and
 // why; float64 reference: plugins/clouds/raymarch/temporal_reference.py). One compute invocation per
 // full-res pixel stores the next history: colour (premultiplied), distance (a·d, a), the scene distance
-// behind the pixel and its last marched sample.
+// behind the pixel and its last marched sample. COMPOSITE 1: it also composites the colour, as stored
+// (float16, read back), onto the frame's colour in place, premultiplied as blend_over did (rgb and alpha =
+// history + (1 - a) · colour), and, COMPOSITE_DISTANCE 1, the distance onto "cloud_distance" with the same
+// weights.
 #include "lib/view_ray.glsl"
 #include "lib/upsample.glsl"
 
@@ -37,10 +40,20 @@ const float ALPHA_EPS = 1e-4;
 const float CHANGE_TOLERANCE = 0.02;
 
 layout(local_size_x = 8, local_size_y = 8) in;
+#if COMPOSITE
+layout(binding = 0, rgba16f) uniform image2D next_color;       // the history written (the other set), read back
+#else
 layout(binding = 0, rgba16f) uniform writeonly image2D next_color;     // the history written: the other set
+#endif
 layout(binding = 1, rg32f) uniform writeonly image2D next_distance;
 layout(binding = 2, r32f) uniform writeonly image2D next_scene;
 layout(binding = 3, rgba16f) uniform writeonly image2D next_sample;
+#if COMPOSITE
+layout(binding = 4, rgba16f) uniform image2D color_image;             // the frame's colour
+#endif
+#if COMPOSITE_DISTANCE
+layout(binding = 5, rg32f) uniform image2D distance_image;            // the frame's "cloud_distance"
+#endif
 
 // Bilinear sample of a colour and a distance texture at texel-centre coordinates p, clamped to the edge
 // (done by hand: the same weights as the reference, whatever the texture's filter).
@@ -188,4 +201,11 @@ void main() {
     imageStore(next_distance, pix, vec4(distance, 0.0, 0.0));
     imageStore(next_scene, pix, vec4(scene, 0.0, 0.0, 0.0));
     imageStore(next_sample, pix, last);
+#if COMPOSITE
+    vec4 held = imageLoad(next_color, pix);     // as stored (float16, rounded as the GL rounds): this invocation's own write
+    imageStore(color_image, pix, held + (1.0 - held.a) * imageLoad(color_image, pix));
+#endif
+#if COMPOSITE_DISTANCE
+    imageStore(distance_image, pix, vec4(distance + (1.0 - distance.y) * imageLoad(distance_image, pix).rg, 0.0, 0.0));
+#endif
 }
