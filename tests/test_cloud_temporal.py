@@ -227,6 +227,54 @@ def test_gpu_resolve_matches_the_float64_reference(frames, rng):
         prev = (cam, ASPECT)
 
 
+
+def test_the_resolve_composites_its_output_onto_the_frame_in_place(gpu, ctx, rng):
+    """``onto``/``onto_distance``: the dispatch that stores the history also composites it, as stored
+    (float16), onto a colour and a distance target in place as blend_over did (rgb and alpha = out +
+    (1 - a) · target; the pair (a·d, a) likewise), and leaves the history as a resolve without them."""
+    r, size = 2, SIZE
+    plain, onto = Frames(gpu), Frames(gpu)
+    try:
+        cam = camera()
+        for k in range(8):                      # moving, then still
+            if 0 < k < 4:
+                cam = camera(yaw=cam.yaw + 0.01, position=cam.position + rng.uniform(-3, 3, 3))
+            color, distance = random_inputs(rng, size, r)
+            depth = ground_depth(cam, size)
+            a = rng.uniform(0, 1, (size[1], size[0], 1))
+            target_c = np.concatenate([rng.uniform(0, 4, (size[1], size[0], 3)), a], -1).astype(np.float16)
+            target_d = np.concatenate([a * rng.uniform(100, 5000, a.shape), a], -1).astype(np.float32)
+            tc = ctx.texture(size, 4, target_c.tobytes(), dtype="f2")
+            td = ctx.texture(size, 2, target_d.tobytes(), dtype="f4")
+            onto.textures += [tc, td]
+            outs = []
+            for f, kw in ((plain, {}), (onto, {"onto": tc, "onto_distance": td})):
+                offset = f.temporal.offset(r)
+                lc, ld = f.low(color, distance, r)
+                out = f.temporal.resolve(lc, ld, size, r, offset, cam, ASPECT, depth=f.depth(depth), **kw)
+                outs.append((read(out[0], 4, np.float16), read(out[1], 2, np.float32), f.temporal.read_history()))
+            (c0, d0, h0), (c1, d1, h1) = outs
+            np.testing.assert_array_equal(c0, c1)
+            np.testing.assert_array_equal(d0, d1)
+            for x, y in zip(h0, h1):
+                np.testing.assert_array_equal(x, y)
+            want_c = c1 + (1.0 - c1[..., 3:]) * target_c.astype(np.float64)
+            got_c = read(tc, 4, np.float16)
+            ulp = np.spacing(np.abs(want_c).astype(np.float16)).astype(np.float64)   # the GL's float16 rounding
+            assert (np.abs(got_c - want_c) <= ulp).all(), (k, np.abs(got_c - want_c).max())
+            want_d = d1 + (1.0 - d1[..., 1:]) * target_d.astype(np.float64)
+            np.testing.assert_allclose(read(td, 2, np.float32), want_d, rtol=1e-6, atol=1e-6)
+        lc, ld = plain.low(color, distance, r)
+        small = ctx.texture((8, 8), 4, dtype="f2")
+        plain.textures.append(small)
+        with pytest.raises(ValueError, match="onto must be 64x48"):
+            plain.temporal.resolve(lc, ld, size, r, (0, 0), cam, ASPECT, onto=small)
+        with pytest.raises(ValueError, match="onto_distance needs onto"):
+            plain.temporal.resolve(lc, ld, size, r, (0, 0), cam, ASPECT, onto_distance=td)
+    finally:
+        plain.release()
+        onto.release()
+
 # -- disocclusion ---------------------------------------------------------------------------------
 def test_an_occluder_appearing_rejects_the_history(frames):
     r = 2

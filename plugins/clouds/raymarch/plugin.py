@@ -9,10 +9,10 @@ distance. At ``resolution`` r > 1 it marches one pixel per r × r block into the
 "cloud_raymarch_color" (RGBA16F), "cloud_raymarch_distance" (RG32F (a·distance, a)) and
 "cloud_raymarch_depth" (the scene depth the ray saw): texel (i, j) is the ray through the full-res
 pixel (i·r + o.x, j·r + o.y), o the frame's jitter offset; then :meth:`RaymarchPass._resolve`
-(the temporal resolve's hook, wired to :class:`.temporal.TemporalClouds`: with ``reprojection`` it
-returns full-res (colour, distance) textures that :meth:`RaymarchPass._blend` blends; without, it
-blends a depth-aware upsample of this frame's samples itself —
-:class:`~atmos.offscreen.OffscreenLayer`' composite — and returns None).
+(the temporal resolve's hook, wired to :class:`.temporal.TemporalClouds`: with ``reprojection`` its
+compute resolve composites the full-res result onto "color" (and "cloud_distance") in place; without,
+a depth-aware upsample of this frame's samples is composited instead —
+:class:`~atmos.offscreen.OffscreenLayer`' composite).
 """
 from __future__ import annotations
 
@@ -244,9 +244,7 @@ class RaymarchPass(RenderPass):
         finally:
             unbind_volume(p, self.sampler)
         if r > 1:
-            textures = self._resolve(frame, LOW_COLOR, LOW_DISTANCE, offset)
-            if textures is not None:
-                self._blend(frame, *textures, distance)
+            self._resolve(frame, LOW_COLOR, LOW_DISTANCE, offset)
         else:
             self.temporal.release()         # no history at full resolution
         self.frame_index += 1
@@ -266,31 +264,24 @@ class RaymarchPass(RenderPass):
             self.noise = DetailNoise(self.gpu)
         return self.noise
 
-    def _resolve(self, frame: PassContext, low_color: str, low_distance: str, offset):
-        """The temporal resolve's hook. ``reprojection`` on: :class:`.temporal.TemporalClouds`
-        resolves the low-res samples with its history and returns the full-res (colour, distance)
-        textures, which :meth:`_blend` blends. Off: the history is dropped and a depth-aware upsample
-        of this frame's samples is blended straight onto "color" (and "cloud_distance"); None."""
+    def _resolve(self, frame: PassContext, low_color: str, low_distance: str, offset) -> None:
+        """The temporal resolve's hook: composite this frame's low-res samples onto "color" (and
+        "cloud_distance") in place, premultiplied. ``reprojection`` on: :class:`.temporal.TemporalClouds`
+        resolves them with its history in one compute dispatch that also composites the result. Off: the
+        history is dropped and a depth-aware upsample of this frame's samples is composited instead."""
         view, s = frame.view, self.plugin.settings
         camera = view.camera
+        distance = frame.declares(CLOUD_DISTANCE)
         if s.reprojection:
-            return self.temporal.resolve(frame.resource(low_color), frame.resource(low_distance), view.size,
-                                         self.plugin.settings.resolution, offset, camera, view.aspect,
-                                         depth=frame.resource(DEPTH), history_clamp=s.history_clamp,
-                                         motion_limit=s.motion_limit, low_depth=frame.resource(LOW_DEPTH))
+            self.temporal.resolve(frame.resource(low_color), frame.resource(low_distance), view.size,
+                                  s.resolution, offset, camera, view.aspect,
+                                  depth=frame.resource(DEPTH), history_clamp=s.history_clamp,
+                                  motion_limit=s.motion_limit, low_depth=frame.resource(LOW_DEPTH),
+                                  onto=frame.resource(COLOR),
+                                  onto_distance=frame.resource(CLOUD_DISTANCE) if distance else None)
+            return
         self.temporal.release()
-        self.offscreen.end(frame, self.plugin.settings.resolution, camera.near, camera.far,
-                           frame.declares(CLOUD_DISTANCE), offset=offset)
-        return None
-
-    def _blend(self, frame: PassContext, color, distance_texture, distance: bool) -> None:
-        """Blend full-res premultiplied (colour, (a·distance, a)) textures onto the frame."""
-        frame.reset_state()
-        frame.framebuffer(color=[COLOR, CLOUD_DISTANCE] if distance else [COLOR]).use()
-        program = self.gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="clouds/raymarch/blend.frag")
-        bind_textures(program, clouds=color, cloud_distance=distance_texture)
-        frame.blend_over()
-        frame.fullscreen(program)
+        self.offscreen.end(frame, s.resolution, camera.near, camera.far, distance, offset=offset)
 
     def _release_skip(self) -> None:
         if self.skip is not None:

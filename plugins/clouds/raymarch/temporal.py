@@ -3,7 +3,7 @@ resolve the full-resolution image from this frame's samples and the reprojected 
 
 Each frame the march writes a low-res target whose texel (i, j) is the full-res pixel
 (i·r + ox, j·r + oy), (ox, oy) = :func:`jitter` (frame, r). :meth:`TemporalClouds.resolve` then,
-per full-res pixel (``shaders/clouds/raymarch/temporal.frag``):
+per full-res pixel (``shaders/clouds/raymarch/temporal.comp``, one compute invocation each):
 
 * marched this frame → the fresh sample, exactly;
 * else the history, reprojected with the previous frame's camera: the ray's direction is projected
@@ -22,7 +22,7 @@ per full-res pixel (``shaders/clouds/raymarch/temporal.frag``):
   real, and marched with this camera) the history stays where the clouds evolve in place and is
   tested where they drift. The history also keeps each pixel's last marched sample (a fourth target;
   the upsample where the scene behind it changed), and drift is told from evolution by matching
-  (``shaders/clouds/raymarch/drift.frag``, a low-res pass; twin :func:`.temporal_reference.drift_flags`):
+  (``shaders/clouds/raymarch/drift.comp``, a low-res dispatch; twin :func:`.temporal_reference.drift_flags`):
   each low-res texel compares this frame's 3×3 samples with the samples marched at the same pixels r²
   frames ago, unshifted and shifted by one texel (r px) each way. Where a shift explains the change
   better than none (by ``DRIFT_GAIN`` of it, the change above ``DRIFT_FLOOR``), or the samples changed
@@ -36,14 +36,17 @@ per full-res pixel (``shaders/clouds/raymarch/temporal.frag``):
   the upsample, whose own error read as a change the next frame (7× the clouds' own change).
 
 The output (premultiplied colour RGBA16F, (a·distance, a) RG32F as in :mod:`atmos.composition`) is
-the next frame's history; the pass blends it onto "color" (and "cloud_distance"). The numpy float64
-reference is :mod:`.temporal_reference`.
+the next frame's history, stored as images; the same dispatch composites it onto "color" (and
+"cloud_distance") in place for the pass, as a blend ONE, ONE_MINUS_SRC_ALPHA did. The history is no
+graph resource: its binds ask for the barriers its reads need (:mod:`atmos.gpu.hazards`). The numpy
+float64 reference is :mod:`.temporal_reference`.
 
-Knobs and their cost (the resolve itself is one fullscreen pass: 1 fresh + 4 bilinear + 9
+Knobs and their cost (the resolve itself is one full-res dispatch: 1 fresh + 4 bilinear + 9
 neighbourhood fetches of the low-res targets, 2 × 4 bilinear history fetches, 2 depth fetches, 1
 last-sample fetch each pixel, plus 4 × 2 × 4 for the correction while moving: 1.43× the resolve
-without it, 640×360 r 2 on llvmpipe; under a still camera also 9 drift-flag fetches, after the
-low-res drift pass: 25 + 9 × 9 fetches per low-res texel; 36 bytes of history per pixel, twice):
+without it, 640×360 r 2 on llvmpipe, measured as a fragment pass; under a still camera also 9
+drift-flag fetches, after the low-res drift dispatch: 25 + 9 × 9 fetches per low-res texel; 28 bytes
+of history per pixel, twice):
 
 * ``reprojection`` (the plugin's): off → no history (the upsample alone, which blurs at r > 1);
   on → r² frames to converge when still, a ghost after fast motion bounded by the clamp.
@@ -61,8 +64,10 @@ import moderngl
 import numpy as np
 
 from atmos.camera import camera_matrices, gl_matrix
+from atmos.graph import work_groups
 from atmos.offscreen import EDGE
-from atmos.gpu.uniforms import bind_textures, write_uniforms
+from atmos.gpu.hazards import dispatch
+from atmos.gpu.uniforms import bind_images, bind_textures, write_uniforms
 
 RESOLUTIONS = (1, 2, 4)
 HISTORY_CLAMP = 1.0        # default clamp weight of moving history (0..1)
@@ -129,8 +134,9 @@ def forward_of(camera) -> np.ndarray:
 
 class TemporalClouds:
     """Full-resolution cloud history of one pass on ``gpu``: ping-pong colour (RGBA16F), distance
-    (RG32F, (a·d, a)) and the scene distance behind each pixel (R32F), made at the first resolve,
-    remade (and so reset) when the size or r changes, kept across frames, freed by :meth:`release`.
+    (RG32F, (a·d, a)), the scene distance behind each pixel (R32F) and its last sample (RGBA16F), the
+    images the resolve stores, made (zeros) at the first resolve, remade (and so reset) when the size or
+    r changes, kept across frames, freed by :meth:`release`.
 
     Per frame: ``offset = temporal.offset(r)`` (march with it), then :meth:`resolve`. The previous
     frame's camera is the one the last resolve was given (kept as a snapshot). The history resets by
@@ -141,14 +147,13 @@ class TemporalClouds:
     def __init__(self, gpu):
         self.gpu = gpu
         self.frame_index = 0
-        self._sets: list | None = None     # [(fbo, color, distance, scene, last sample)] × 2
-        self._drift = None                 # (fbo, texture): the low-res drift flags
+        self._sets: list | None = None     # [(color, distance, scene, last sample)] × 2
+        self._drift = None                 # the low-res drift flags (r8)
         self._key = None                   # (size, r) the history was made for
         self._current = 0                  # which set holds the last output
         self._valid = False
         self._prev = None                  # (camera_state, CameraMatrices, position) of the last resolve
         self.still_frames = 0              # resolves in a row with the camera of the one before
-        self._vaos: dict = {}              # program -> its empty vertex array
 
     # -- per frame -----------------------------------------------------------------------------
     def offset(self, r: int) -> tuple[int, int]:
@@ -168,13 +173,17 @@ class TemporalClouds:
         self._valid = False
 
     def resolve(self, low_color, low_distance, size, r: int, offset, camera, aspect: float, depth=None,
-                history_clamp: float = HISTORY_CLAMP, motion_limit: float = MOTION_LIMIT, low_depth=None):
+                history_clamp: float = HISTORY_CLAMP, motion_limit: float = MOTION_LIMIT, low_depth=None,
+                onto=None, onto_distance=None):
         """Resolve this frame at full-res ``size`` (w, h) from the low-res ``low_color`` (RGBA
         premultiplied) and ``low_distance`` ((a·d, a)) textures marched at ``offset`` with divisor
         ``r``, seen by ``camera`` at ``aspect``; ``depth``: the scene's depth texture at ``size``
         (None: nothing but sky); ``low_depth``: the depth each sample's ray saw (low-res; with ``depth``
         the upsample is depth-aware, :data:`~atmos.offscreen.EDGE`). Returns (color, distance) full-res textures, valid until the next
-        resolve (they are the history it reads)."""
+        resolve (they are the history it reads). ``onto``: a full-res RGBA16F texture (the frame's
+        colour) the same dispatch composites the result onto in place, premultiplied as
+        :meth:`~atmos.graph.PassContext.blend_over` would; ``onto_distance`` (with ``onto``): an RG32F
+        texture ("cloud_distance") the distance goes onto the same way."""
         r = check_resolution(r)
         size = (int(size[0]), int(size[1]))
         ox, oy = offset
@@ -192,12 +201,18 @@ class TemporalClouds:
         if not 0.0 <= history_clamp <= 1.0 or not motion_limit > 0.0:
             raise ValueError(f"TemporalClouds.resolve: history_clamp must be in [0, 1] and motion_limit > 0, "
                              f"got {history_clamp!r}, {motion_limit!r}")
+        for name, tex in (("onto", onto), ("onto_distance", onto_distance)):
+            if tex is not None and tuple(tex.size) != size:
+                raise ValueError(f"TemporalClouds.resolve: {name} must be {size[0]}x{size[1]}, got {tex.size}")
+        if onto_distance is not None and onto is None:
+            raise ValueError("TemporalClouds.resolve: onto_distance needs onto (the colour it composites with)")
         if self._key != (size, r):
             self._make(size, r)
         state = camera_state(camera, aspect)
         matrices = camera_matrices(camera, aspect)
         prev, write = self._sets[self._current], self._sets[1 - self._current]
-        p = self.gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="clouds/raymarch/temporal.frag")
+        p = self.gpu.program(compute_shader="clouds/raymarch/temporal.comp",
+                             defines={"COMPOSITE": int(onto is not None), "COMPOSITE_DISTANCE": int(onto_distance is not None)})
         p["view_basis"].write(matrices.gl("view_basis"))
         write_uniforms(p, near=float(camera.near), far=float(camera.far), r=r, offset=(int(ox), int(oy)),
                        has_depth=depth is not None,
@@ -214,80 +229,56 @@ class TemporalClouds:
             p["prev_proj"].write(gl_matrix(proj[[0, 1, 3], :3] @ view[:3, :3]))
             write_uniforms(p, cam_delta=tuple(float(c) for c in np.asarray(camera.position) - prev_position),
                            history_clamp=float(history_clamp), motion_limit=float(motion_limit))
-        bind_textures(p, low_color=low_color, low_distance=low_distance, hist_color=prev[1], hist_distance=prev[2],
-                      hist_scene=prev[3], hist_sample=prev[4], drift=self._drift[1],            # drift: read when detect_change
+        bind_textures(p, low_color=low_color, low_distance=low_distance, hist_color=prev[0], hist_distance=prev[1],
+                      hist_scene=prev[2], hist_sample=prev[3], drift=self._drift,               # drift: read when detect_change
                       low_depth=low_depth if low_depth is not None else low_color)     # low_depth: read at edge < 1e30
         if depth is not None:
             bind_textures(p, scene_depth=depth)
-        write[0].use()
-        self._draw(p)
+        bind_images(p, next_color=write[0], next_distance=write[1], next_scene=write[2], next_sample=write[3])
+        if onto is not None:
+            bind_images(p, color_image=onto, **({"distance_image": onto_distance} if onto_distance is not None else {}))
+        dispatch(p, *work_groups(size, (8, 8)))   # the binds asked for the barriers; the stores are tracked
         self._current = 1 - self._current
         self.still_frames = self.still_frames + 1 if valid and state == self._prev[0] else 0
         self._valid = True
         self._prev = (state, matrices, np.array(camera.position, np.float64), forward_of(camera))
         self.frame_index += 1
-        return write[1], write[2]
+        return write[0], write[1]
 
     def _flag_drift(self, low_color, prev, r: int, offset, depth, matrices, camera) -> None:
         """The low-res drift flags of this frame's samples against the last ones in the history set
-        ``prev`` (``drift.frag``); ``depth`` (or None: sky) tells where the scene changed."""
-        p = self.gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="clouds/raymarch/drift.frag")
+        ``prev`` (``drift.comp``, one invocation per low-res texel); ``depth`` (or None: sky) tells
+        where the scene changed."""
+        p = self.gpu.program(compute_shader="clouds/raymarch/drift.comp")
         write_uniforms(p, r=r, offset=offset, has_depth=depth is not None, near=float(camera.near),
                        far=float(camera.far))
         if "view_basis" in p:
             p["view_basis"].write(matrices.gl("view_basis"))
-        bind_textures(p, low_color=low_color, hist_sample=prev[4], hist_scene=prev[3])
+        bind_textures(p, low_color=low_color, hist_sample=prev[3], hist_scene=prev[2])
         if depth is not None:
             bind_textures(p, scene_depth=depth)
-        self._drift[0].use()
-        self._draw(p)
-
-    def _draw(self, p) -> None:
-        ctx = self.gpu.ctx
-        ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST | moderngl.CULL_FACE)
-        if p not in self._vaos:
-            self._vaos[p] = self.gpu.track(ctx.vertex_array(p, []))
-        self._vaos[p].render(moderngl.TRIANGLES, vertices=3)
-
+        bind_images(p, flags=self._drift)
+        dispatch(p, *work_groups(self._drift.size, (8, 8)))
 
     # -- lifetime ------------------------------------------------------------------------------
     def _make(self, size, r) -> None:
         self._free()
         ctx = self.gpu.ctx
         self._sets = []
-        for _ in range(2):
-            textures = [ctx.texture(size, 4, dtype="f2"), ctx.texture(size, 2, dtype="f4"),
-                        ctx.texture(size, 1, dtype="f4"), ctx.texture(size, 4, dtype="f2")]
-            for tex in textures:
-                tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
-                tex.repeat_x = tex.repeat_y = False
-            fbo = ctx.framebuffer(textures)
-            fbo.use()                      # clear() re-binds the framebuffer bound before it: this one
-            fbo.clear(0.0, 0.0, 0.0, 0.0)
-            self._sets.append(tuple(self.gpu.track(o) for o in (fbo, *textures)))
-        flags = ctx.texture(low_size(size, r), 1, dtype="f1")
-        flags.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        fbo = ctx.framebuffer([flags])
-        fbo.use()
-        fbo.clear(0.0, 0.0, 0.0, 0.0)
-        self._drift = tuple(self.gpu.track(o) for o in (fbo, flags))
+        for _ in range(2):       # colour, distance, scene distance, last sample: images the resolve stores
+            self._sets.append(tuple(_zeros(ctx, self.gpu, size, n, dtype) for n, dtype in
+                                    ((4, "f2"), (2, "f4"), (1, "f4"), (4, "f2"))))
+        self._drift = _zeros(ctx, self.gpu, low_size(size, r), 1, "f1")
         self._key, self._current, self._valid = (size, r), 0, False
 
     def _free(self) -> None:
-        held = [*(self._sets or ()), *((self._drift,) if self._drift else ())]
-        if any(self.gpu.ctx.fbo is objects[0] for objects in held):
-            self.gpu.target.use()          # never leave a released framebuffer bound
-        for objects in held:
-            for obj in objects:
-                obj.release()
+        for tex in [*(t for textures in self._sets or () for t in textures), *((self._drift,) if self._drift else ())]:
+            tex.release()
         self._sets, self._drift, self._key, self._valid = None, None, None, False
 
     def release(self) -> None:
-        """Free the history (the next resolve makes it again); the program is the context's."""
+        """Free the history (the next resolve makes it again); the programs are the context's."""
         self._free()
-        for vao in self._vaos.values():
-            vao.release()
-        self._vaos = {}
 
     def read_history(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """The last output as float64 arrays, GL row order (row 0 at the bottom): colour (h, w, 4),
@@ -296,7 +287,7 @@ class TemporalClouds:
         if self._sets is None:
             raise ValueError("TemporalClouds.read_history: nothing resolved yet (or released)")
         (w, h), _ = self._key
-        _, color, distance, scene, last = self._sets[self._current]
+        color, distance, scene, last = self._sets[self._current]
         out = [np.frombuffer(t.read(), dt).reshape(h, w, n).astype(np.float64)
                for t, dt, n in ((color, np.float16, 4), (distance, np.float32, 2), (scene, np.float32, 1),
                                 (last, np.float16, 4))]
@@ -306,3 +297,12 @@ class TemporalClouds:
     def allocated(self) -> bool:
         """Whether history textures exist (tests: a culled pass allocates none)."""
         return self._sets is not None
+
+
+def _zeros(ctx, gpu, size, components: int, dtype: str):
+    """A new 2D texture of zeros (nearest, clamped; tracked by ``gpu``) for the resolve's images."""
+    tex = ctx.texture(size, components, dtype=dtype)
+    tex.write(bytes(size[0] * size[1] * components * int(dtype[1])))
+    tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+    tex.repeat_x = tex.repeat_y = False
+    return gpu.track(tex)

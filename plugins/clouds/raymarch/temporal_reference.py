@@ -1,4 +1,4 @@
-"""float64 numpy reference of the temporal resolve (:mod:`.temporal`, ``shaders/clouds/raymarch/temporal.frag``).
+"""float64 numpy reference of the temporal resolve (:mod:`.temporal`, ``shaders/clouds/raymarch/temporal.comp``).
 
 Arrays are in GL order: ``a[y, x]`` with row 0 at the bottom of the frame (texture order). It
 projects with the previous camera's full 4×4 view-projection (the shader uses a translation-free
@@ -64,7 +64,7 @@ def _around(a: np.ndarray, i: int, j: int) -> np.ndarray:
 
 
 def drift_flags(low_color: np.ndarray, last_sample: np.ndarray, r: int, offset, same=None) -> np.ndarray:
-    """``shaders/clouds/raymarch/drift.frag``: per low-res texel (lh, lw), whether this frame's 3×3
+    """``shaders/clouds/raymarch/drift.comp``: per low-res texel (lh, lw), whether this frame's 3×3
     samples around it moved since they were last marched (``last_sample``, full-res (h, w, 4): each
     pixel's last sample, r² frames old at this frame's pixels): a one-texel shift explains
     ``DRIFT_GAIN`` of their change (above ``DRIFT_FLOOR`` each on average), or they changed by more

@@ -1,6 +1,6 @@
 #version 430
 // Drifting clouds under a still camera (plugins/clouds/raymarch/temporal.py says why; float64 twin:
-// temporal_reference.drift_flags). Drawn over the low-res grid: texel n is 1 where this frame's 3x3
+// temporal_reference.drift_flags). One compute invocation per low-res texel: flag n is 1 where this frame's 3x3
 // samples around it moved since they were last marched (r² frames ago, same pixels), i.e. a shift of
 // one texel either way matches them better than none does, or where they changed by more than
 // DRIFT_MEAN on average or one by more than DRIFT_CHANGE (a drift too fast for the shifts); 0 where they changed in place (clouds evolving) or not at all. A sample whose scene
@@ -24,7 +24,8 @@ const float DRIFT_FLOOR = 0.1;
 const float DRIFT_MEAN = 0.15;
 const float DEPTH_TOLERANCE = 0.1;
 
-layout(location = 0) out vec4 out_flag;
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(binding = 0, r8) uniform writeonly image2D flags;   // low-res, the size of low_color
 
 // the change measure: alpha, and rgb relative to the neighbourhood's brightest channel
 float change(vec4 a, vec4 b, float scale) {
@@ -42,8 +43,9 @@ bool same_scene(ivec2 p, vec2 size) {
 }
 
 void main() {
-    ivec2 n = ivec2(gl_FragCoord.xy);
+    ivec2 n = ivec2(gl_GlobalInvocationID.xy);
     ivec2 last = textureSize(low_color, 0) - 1;
+    if (any(greaterThan(n, last))) return;
     ivec2 size = textureSize(hist_sample, 0);
     float scale = 1e-3;
     for (int j = -2; j <= 2; ++j)
@@ -75,5 +77,5 @@ void main() {
     float gain = (still_cost - min(best, still_cost)) / max(still_cost, 1e-6);
     bool drift = (gain > DRIFT_GAIN && still_cost > 9.0 * DRIFT_FLOOR) || still_cost > 9.0 * DRIFT_MEAN
               || largest > DRIFT_CHANGE;
-    out_flag = vec4(drift ? 1.0 : 0.0, 0.0, 0.0, 1.0);
+    imageStore(flags, n, vec4(drift ? 1.0 : 0.0, 0.0, 0.0, 0.0));
 }

@@ -1,7 +1,11 @@
 #version 430
 // The temporal resolve of the ray-marched clouds (plugins/clouds/raymarch/temporal.py says what and
-// why; float64 reference: plugins/clouds/raymarch/temporal_reference.py). Drawn over the full-res
-// history target: colour (premultiplied), distance (a·d, a), and the scene distance behind the pixel.
+// why; float64 reference: plugins/clouds/raymarch/temporal_reference.py). One compute invocation per
+// full-res pixel stores the next history: colour (premultiplied), distance (a·d, a), the scene distance
+// behind the pixel and its last marched sample. COMPOSITE 1: it also composites the colour, as stored
+// (float16, read back), onto the frame's colour in place, premultiplied as blend_over did (rgb and alpha =
+// history + (1 - a) · colour), and, COMPOSITE_DISTANCE 1, the distance onto "cloud_distance" with the same
+// weights.
 #include "lib/view_ray.glsl"
 #include "lib/upsample.glsl"
 
@@ -12,8 +16,8 @@ layout(binding = 3) uniform sampler2D hist_distance;
 layout(binding = 4) uniform sampler2D hist_scene;     // its scene distance (m), -1 = sky
 layout(binding = 5) uniform sampler2D scene_depth;    // this frame's depth (when has_depth)
 layout(binding = 6) uniform sampler2D low_depth;      // the scene depth each sample's ray saw (edge < 1e30)
-layout(binding = 7) uniform sampler2D hist_sample;    // each pixel's last marched sample (carried for drift.frag)
-layout(binding = 8) uniform sampler2D drift;          // low-res: 1 where this frame's samples moved (drift.frag; detect_change)
+layout(binding = 7) uniform sampler2D hist_sample;    // each pixel's last marched sample (carried for drift.comp)
+layout(binding = 8) uniform sampler2D drift;          // low-res: 1 where this frame's samples moved (drift.comp; detect_change)
 
 uniform mat3 view_basis;      // this frame's rays (lib/view_ray.glsl)
 uniform float near, far;
@@ -35,10 +39,21 @@ const float DEPTH_TOLERANCE = 0.1;
 const float ALPHA_EPS = 1e-4;
 const float CHANGE_TOLERANCE = 0.02;
 
-layout(location = 0) out vec4 out_color;
-layout(location = 1) out vec4 out_distance;
-layout(location = 2) out vec4 out_scene;
-layout(location = 3) out vec4 out_sample;
+layout(local_size_x = 8, local_size_y = 8) in;
+#if COMPOSITE
+layout(binding = 0, rgba16f) uniform image2D next_color;       // the history written (the other set), read back
+#else
+layout(binding = 0, rgba16f) uniform writeonly image2D next_color;     // the history written: the other set
+#endif
+layout(binding = 1, rg32f) uniform writeonly image2D next_distance;
+layout(binding = 2, r32f) uniform writeonly image2D next_scene;
+layout(binding = 3, rgba16f) uniform writeonly image2D next_sample;
+#if COMPOSITE
+layout(binding = 4, rgba16f) uniform image2D color_image;             // the frame's colour
+#endif
+#if COMPOSITE_DISTANCE
+layout(binding = 5, rg32f) uniform image2D distance_image;            // the frame's "cloud_distance"
+#endif
 
 // Bilinear sample of a colour and a distance texture at texel-centre coordinates p, clamped to the edge
 // (done by hand: the same weights as the reference, whatever the texture's filter).
@@ -65,21 +80,20 @@ bool project(vec3 v, vec2 size, out vec2 q) {
     return true;
 }
 
-void main() {
-    vec2 size = vec2(textureSize(hist_color, 0));
-    ivec2 pix = ivec2(gl_FragCoord.xy);
-    vec2 uv = gl_FragCoord.xy / size;
+// The history at full-res pixel pix: colour, distance (a·d, a), scene distance, last sample.
+void resolve(ivec2 pix, vec2 size, out vec4 out_color, out vec2 out_distance, out float out_scene, out vec4 out_sample) {
+    vec2 uv = (vec2(pix) + 0.5) / size;
     vec3 dir = view_ray_dir(uv, view_basis);
     float scene = -1.0;
     if (has_depth) scene = view_ray_distance(uv, texelFetch(scene_depth, pix, 0).r, view_basis, near, far, -1.0);
-    out_scene = vec4(scene, 0.0, 0.0, 1.0);
+    out_scene = scene;
 
     // a pixel marched this frame: its sample, exactly
     ivec2 rel = pix - offset;
     if (rel.x >= 0 && rel.y >= 0 && rel.x % r == 0 && rel.y % r == 0) {
         ivec2 q = min(rel / r, textureSize(low_color, 0) - 1);
         out_color = texelFetch(low_color, q, 0);
-        out_distance = vec4(texelFetch(low_distance, q, 0).rg, 0.0, 1.0);
+        out_distance = texelFetch(low_distance, q, 0).rg;
         out_sample = out_color;
         return;
     }
@@ -98,7 +112,7 @@ void main() {
     if (!history_valid) {
         out_sample = c;
         out_color = c;
-        out_distance = vec4(d, 0.0, 1.0);
+        out_distance = d;
         return;
     }
     ivec2 centre = clamp(ivec2(floor(lp + 0.5)), ivec2(0), last);
@@ -174,5 +188,24 @@ void main() {
     float trust = 1.0 - clamp(2.0 * change / CHANGE_TOLERANCE - 1.0, 0.0, 1.0);
     float keep = (inside && same) ? trust * clamp(1.0 - motion / motion_limit, 0.0, 1.0) : 0.0;
     out_color = (1.0 - keep) * c + keep * hc;                 // not mix(): exact at keep = 1
-    out_distance = vec4((1.0 - keep) * d + keep * hd, 0.0, 1.0);
+    out_distance = (1.0 - keep) * d + keep * hd;
+}
+
+void main() {
+    ivec2 pix = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 extent = imageSize(next_color);
+    if (any(greaterThanEqual(pix, extent))) return;
+    vec4 color, last; vec2 distance; float scene;
+    resolve(pix, vec2(extent), color, distance, scene, last);
+    imageStore(next_color, pix, color);
+    imageStore(next_distance, pix, vec4(distance, 0.0, 0.0));
+    imageStore(next_scene, pix, vec4(scene, 0.0, 0.0, 0.0));
+    imageStore(next_sample, pix, last);
+#if COMPOSITE
+    vec4 held = imageLoad(next_color, pix);     // as stored (float16, rounded as the GL rounds): this invocation's own write
+    imageStore(color_image, pix, held + (1.0 - held.a) * imageLoad(color_image, pix));
+#endif
+#if COMPOSITE_DISTANCE
+    imageStore(distance_image, pix, vec4(distance + (1.0 - distance.y) * imageLoad(distance_image, pix).rg, 0.0, 0.0));
+#endif
 }
