@@ -9,6 +9,7 @@ from atmos.demo_registry import DemoSettings
 from atmos.lighting import Sun
 from atmos.plugins.daylight import DaylightPlugin
 from atmos.plugins.ground import GroundPlugin
+from atmos.plugins.physical_camera import PhysicalCameraPlugin
 from atmos.plugins.sky import SkyPlugin
 
 TITLE = "the sky through a day–night cycle: sunset, Earth's shadow, twinkling stars, sunrise, noon"
@@ -35,7 +36,8 @@ def face_the_sun(app) -> None:
     cam.yaw, cam.pitch = math.atan2(s[0], -s[2]), 0.18
 
 
-EXPOSURE = (0.05, 1.0, 6.0)     # the physical sky: (sky-light luminance exposed at 1 and above, adaptation power, widest)
+EXPOSURE = (0.05, 1.0, 6.0)     # --exposure fixed, the physical sky: (sky-light luminance exposed at 1 and above, adaptation power, widest)
+NIGHT_EV_RANGE = (-2.0, 14.0)   # --exposure auto: the camera's EV100 range (the night stays night: at most ~7x the day's exposure)
 
 
 def expose_for_the_sky(app) -> None:
@@ -58,5 +60,7 @@ def build(app, settings) -> None:
     cam.fov_y = math.radians(70.0)
     app.add_system(pacer(daylight), "update", label="pace_time", before="daylight")
     app.add_system(face_the_sun, "update", label="face_the_sun", after="daylight")
-    if settings.sky == "physical":
+    if settings.exposure == "auto":      # a camera metering the sky, quick (time runs fast); at night up to EV100 -2
+        app.add_plugins(PhysicalCameraPlugin(ev_range=NIGHT_EV_RANGE, speed_up=4.0, speed_down=3.0))   # hours per second
+    elif settings.sky == "physical":
         app.add_system(expose_for_the_sky, "update", label="expose_for_the_sky", after="sky_light")
