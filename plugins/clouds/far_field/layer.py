@@ -18,7 +18,7 @@ from __future__ import annotations
 import moderngl
 import numpy as np
 
-from atmos.plugins.clouds.far_field.columns import rank_texture, read_rank_texture, use_columns
+from atmos.plugins.clouds.far_field.columns import INTERVALS, rank_texture, read_rank_texture, use_columns
 from atmos.plugins.clouds.far_field.cover import LEVELS, QUANTILES, level_ranks, matched_tile_size, pattern_crossings
 from atmos.plugins.clouds.far_field.pattern import CHANNEL_STEPS, PERIODS, octave_frequencies, octave_offsets, rotations, turns_bytes
 from atmos.plugins.clouds.far_field.rank_light import RankLight
@@ -30,6 +30,9 @@ from atmos.gpu.hazards import dispatch
 
 REBAKE_TOLERANCE = 0.05          # re-bake the octaves when the sun moved the light step by this fraction
 MAX_HEIGHTS = 64                 # cover.comp's most height samples
+HISTOGRAM_BINS = 256             # cover.comp's BINS (plus one for the empty columns)
+COLUMNS_PER_GROUP = 1024         # the cover's measure: columns per group of 256 (four each) ...
+MAX_GROUPS = 256                 # ... in at most this many groups (their partials summed by one)
 TILE_TIME = 5.0                  # s: the matched tile follows a change of the volume's with this time constant
 
 
@@ -81,6 +84,7 @@ class FarFieldLayer:
         self.cover = gpu.track(gpu.ctx.buffer(reserve=4 * (2 + QUANTILES)))   # cover, column_quantiles, transitions
         self._staged = gpu.track(gpu.ctx.buffer(reserve=self.cover.size))      # a copy of one step's measure
         self._staged_for = None              # the set B whose measure is staged (held: never a reused id)
+        self._measure = None                 # [partials, histogram, profile sums]: the measure's own buffers
         self._target = None                  # the matched tile the drawn one follows (m)
         self.tile_size = float(self.plugin.settings.tile_size or 8000.0)    # metres per tile as drawn (update_tile)
         self._tile_time = None               # App time of the last update_tile
@@ -156,14 +160,35 @@ class FarFieldLayer:
         read (float32: cover, then QUANTILES column sums in cells; :meth:`read_cover`), and with
         ``profile`` (None: when the ray march draws the far field, ``drawn_by_march()``; it reads the
         sets' density) the covered columns' vertical profile per rank interval into :attr:`profile`
-        (:meth:`read_profile`)."""
+        (:meth:`read_profile`). Many groups measure the columns, one sums them (cover.comp's passes)."""
         profile = self.plugin.drawn_by_march() if profile is None else bool(profile)
-        c = self.gpu.program(compute_shader="clouds/far_field/cover.comp", defines={"PROFILE": int(profile)})
-        use_columns(c, sim, density=profile)
-        if profile:
-            bind_images(c, column_profile=self._profile_texture(profile_heights(sim.shape[1])))
+        columns = int(sim.shape[0]) * int(sim.shape[2])
+        groups = max(1, min(MAX_GROUPS, -(-columns // COLUMNS_PER_GROUP)))
+        if self._measure is None:       # zero-filled; the passes that read the sums zero them again
+            self._measure = [self.gpu.track(self.gpu.ctx.buffer(bytes(size)))
+                             for size in (16 * MAX_GROUPS, 4 * (HISTOGRAM_BINS + 1), 4 * INTERVALS * MAX_HEIGHTS)]
+        partials, histogram, acc = self._measure
+        c = self.gpu.program(compute_shader="clouds/far_field/cover_columns.comp")
+        use_columns(c, sim, density=False)
         write_uniforms(c, threshold=float(sim.settings.cover_threshold), max_sum=float(sim.shape[1]))
-        bind_buffers(c, Cover=self.cover)
+        bind_buffers(c, CoverPartials=partials, CoverHistogram=histogram)
+        dispatch(c, groups)
+        c = self.gpu.program(compute_shader="clouds/far_field/cover.comp")
+        write_uniforms(c, groups=groups, max_sum=float(sim.shape[1]))
+        bind_buffers(c, Cover=self.cover, CoverPartials=partials, CoverHistogram=histogram)
+        dispatch(c, 1)
+        if not profile:
+            return
+        heights = profile_heights(sim.shape[1])
+        c = self.gpu.program(compute_shader="clouds/far_field/cover_profile.comp")
+        use_columns(c, sim, density=True)
+        write_uniforms(c, heights=heights)
+        bind_buffers(c, Cover=self.cover, CoverProfile=acc)
+        dispatch(c, groups)
+        c = self.gpu.program(compute_shader="clouds/far_field/cover_profile_finish.comp")
+        write_uniforms(c, heights=heights, layer_rows=int(sim.shape[1]))
+        bind_buffers(c, CoverProfile=acc)
+        bind_images(c, column_profile=self._profile_texture(heights))
         dispatch(c, 1)
 
     def _profile_texture(self, heights: int):
@@ -239,10 +264,10 @@ class FarFieldLayer:
         if self.octaves is not None:
             self.octaves.release()
             self.octaves = None
-        for buffer in (self.cover, self._staged):
+        for buffer in (self.cover, self._staged, *(self._measure or ())):
             if buffer is not None:
                 buffer.release()
-        self.cover = self._staged = self._staged_for = None
+        self.cover = self._staged = self._staged_for = self._measure = None
         if self.profile is not None:
             self.profile.release()
             self.profile = None
