@@ -165,6 +165,14 @@ class App:
     def get_resource(self, kind: type, default=None):
         return self.resources.get(kind, default)
 
+    def init_resource(self, kind: type):
+        """The ``kind`` resource, made with ``kind()`` and inserted first if the App has none."""
+        resource = self.resources.get(kind)
+        if resource is None:
+            resource = kind()
+            self.insert_resource(resource)
+        return resource
+
     # -- timers and states ----------------------------------------------------------------
     def after(self, seconds: float, fn, *, in_state: str | None = None) -> Timer:
         """Call ``fn(app)`` once, ``seconds`` (finite, > 0) of game time from now, at the start of a

@@ -63,11 +63,7 @@ class PresentInputs:
 
 def present_inputs(app) -> PresentInputs:
     """The App's :class:`PresentInputs` (made on first use)."""
-    inputs = app.get_resource(PresentInputs)
-    if inputs is None:
-        inputs = PresentInputs()
-        app.insert_resource(inputs)
-    return inputs
+    return app.init_resource(PresentInputs)
 
 
 def color_desc(gpu) -> TextureDesc:

@@ -97,6 +97,15 @@ def test_missing_resource_is_a_clear_error():
     app.close()
 
 
+def test_init_resource_makes_one_and_then_keeps_it():
+    app = App()
+    made = app.init_resource(Position)
+    assert isinstance(made, Position) and app.resource(Position) is made
+    made.x = 5.0
+    assert app.init_resource(Position) is made and made.x == 5.0, "an existing resource is kept as it is"
+    app.close()
+
+
 def test_entry_point_discovery_finds_the_shipped_plugins():
     found = discover_plugins()
     assert {"ground", "sky_gradient", "overlay", "clouds", "cloud_render", "weather"} <= set(found)

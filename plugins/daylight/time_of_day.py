@@ -66,10 +66,7 @@ class DaylightPlugin(Plugin):
         """System: advance the clock by ``speed × dt`` and write the Sun's direction, colour and ambient."""
         tod = self.time_of_day
         tod.hours = (tod.hours + self.settings.speed * app.clock.dt) % 24.0
-        sun = app.get_resource(Sun)
-        if sun is None:
-            sun = Sun()
-            app.insert_resource(sun)
+        sun = app.init_resource(Sun)
         sun.direction = self.sun_direction()
         color, ambient = sky_light(sun.direction)
         sun.color, sun.ambient = tuple(color), tuple(ambient)

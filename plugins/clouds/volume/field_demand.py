@@ -33,8 +33,4 @@ class FieldDemand:
 
 def field_demand(app) -> FieldDemand:
     """The App's :class:`FieldDemand` (made on first use)."""
-    demand = app.get_resource(FieldDemand)
-    if demand is None:
-        demand = FieldDemand()
-        app.insert_resource(demand)
-    return demand
+    return app.init_resource(FieldDemand)
