@@ -8,7 +8,7 @@ from __future__ import annotations
 from atmos.froxels import froxel_knee, volume_desc, volume_image
 from atmos.graph import PassBuilder, PassContext, work_groups
 from atmos.plugins.clouds import FAR_FIELD
-from atmos.plugins.light_shafts.march import MarchedShafts, march_irradiance
+from atmos.plugins.light_shafts.march import MarchedShafts, bind_cloud_distance, march_irradiance
 from atmos.render_core import COLOR, DEPTH
 from atmos.gpu.uniforms import write_uniforms
 
@@ -42,9 +42,14 @@ class FroxelShafts:
         far_field = clouds and frame.declares(FAR_FIELD)
         fill, apply = (self.medium.program(far_field, fog, aerial, f"light_shafts/{name}.comp")
                        for name in ("froxels", "froxel_apply"))
-        for p in (fill, apply):
-            self.medium.set_medium(frame, p, settings, clouds, irradiance, fog, aerial)
-            write_uniforms(p, froxel_knee=froxel_knee(settings.max_distance))
+        knee = froxel_knee(settings.max_distance)
+        self.medium.set_medium(frame, fill, settings, clouds, irradiance, fog, aerial)
+        write_uniforms(fill, froxel_knee=knee)
+        write_uniforms(apply, froxel_knee=knee, max_distance=settings.max_distance)   # the apply reads the sums:
+        if fog is not None:                                 # no shadows, sun or phase; the fog's colour and
+            self.medium.fog_uniforms(frame, apply, fog, settings)      # the clouds' distance where it takes
+        elif aerial is not None:                            # light away
+            bind_cloud_distance(frame, apply)
         volume = volume_image(frame, SHAFT_VOLUME)
         frame.dispatch(fill, work_groups(volume.size[:2], (8, 8)), images={"shaft_volume": volume})
         color = frame.image(COLOR)
