@@ -7,13 +7,13 @@ from atmos import App, DefaultPlugins
 from atmos.camera import Camera
 from atmos.lighting import Sun
 from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
-from atmos.plugins.clouds.raymarch.plugin import LOW_COLOR, skip_map
+from atmos.graph import RenderPass, TextureDesc, work_groups
+from atmos.plugins.clouds.raymarch.plugin import LOW_COLOR, LOW_DEPTH, LOW_DISTANCE, sample_offset, skip_map
+from atmos.render_core import DEPTH
 from atmos.plugins.clouds.raymarch.reference import march_reference
 from atmos.plugins.clouds.light.diffusion import DIFFUSION, read_field
 from atmos.plugins.clouds.sprites import CloudRenderPlugin
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
-from atmos.plugins.clouds.simulation.density_maps import DensityMaps
-from atmos.plugins.clouds.weather import VolumeOrigin
 from atmos.plugins.clouds.raymarch.reference import integrate, rays
 from atmos.plugins.clouds.light.medium import source_reference
 from atmos.plugins.clouds.light.reference import multilinear
@@ -87,6 +87,76 @@ def test_the_march_matches_its_float64_reference(gpu, ctx, sun):
     assert np.percentile(off, 99.5) < 0.002, "coverage off the reference"
     assert (off > 0.02).mean() < 0.002, "only rays grazing the box's faces may differ (float32 entry/exit)"
     assert np.abs(image[..., 3] - ref["alpha"]).max() < 0.2
+    app.close()
+
+
+class LowProbe(RenderPass):
+    """After the march: its low-res targets, the scene depth as a sampler reads it and the frame's sample
+    offset, read back."""
+    name = "raymarch_probe"
+    phase = "translucent"
+
+    def __init__(self, march):
+        self.march, self.values = march, {}
+
+    def setup(self, builder) -> None:
+        for name in (LOW_COLOR, LOW_DISTANCE, LOW_DEPTH, DEPTH):
+            builder.read(name)
+        builder.create("probe_depth", TextureDesc(self.march.plugin.gpu.size, components=1, dtype="f4",
+                                                  filter="nearest", storage=True), access="storage")
+        builder.side_effect()
+
+    def execute(self, frame) -> None:
+        fetched = frame.image("probe_depth")
+        frame.dispatch(frame.gpu.program(compute_shader="test/depth_fetch.comp"), work_groups(fetched.size, (8, 8)),
+                       textures={"depth": DEPTH}, images={"fetched": "probe_depth"})
+        for name, dtype, n in ((LOW_COLOR, np.float16, 4), (LOW_DISTANCE, np.float32, 2), (LOW_DEPTH, np.float32, 1),
+                               ("probe_depth", np.float32, 1)):
+            tex = frame.resource(name)
+            self.values[name] = np.frombuffer(tex.read(), dtype).reshape(tex.size[1], tex.size[0], n).astype(np.float64)
+        self.values["offset"] = sample_offset(self.march.frame_index - 1, 2)
+
+
+def test_at_resolution_2_each_texel_holds_its_pixels_ray_and_the_exact_scene_depth(gpu, ctx):
+    """The low-res targets (storage images) against the float64 reference at the pixels the frame's offset
+    picks: colour and (a·distance, a) as at resolution 1, and the scene depth the ray saw, exactly."""
+    from atmos.plugins.ground import GroundPlugin
+    app = scene(gpu, volume(), plugins=(GroundPlugin(),), resolution=2, empty_space_skipping=False,
+                min_transmittance=0.0, steps=96, step_growth=0.002, reprojection=False)
+    march = next(p for p in app.graph.passes if p.name == "cloud_raymarch")
+    probe = app.graph.add_pass(LowProbe(march))
+    cam = aim(app, (80.0, 470.0, -150.0))
+    for _ in range(2):                      # two frames: two offsets
+        app.render()
+        v = probe.values
+        w, h = gpu.size
+        depth = v["probe_depth"][..., 0]
+        assert (depth < 1.0).mean() > 0.2, "the view must see the ground"
+        ox, oy = v["offset"]
+        lh, lw = v[LOW_DEPTH].shape[:2]
+        py, px = np.minimum(np.arange(lh) * 2 + oy, h - 1), np.minimum(np.arange(lw) * 2 + ox, w - 1)
+        np.testing.assert_array_equal(v[LOW_DEPTH][..., 0], depth[np.ix_(py, px)])
+        plugin = next(p for p in app.plugins if isinstance(p, CloudsPlugin))
+        sim = plugin.simulation.sets()
+        trans = np.frombuffer(sim.a["transmittance"].read(), np.float16).astype(np.float64)
+        tshape = sim.a["transmittance"].size
+        trans = trans.reshape(tshape[2], tshape[1], tshape[0]).transpose(2, 1, 0)
+        settings = next(p for p in app.plugins if isinstance(p, RaymarchCloudsPlugin)).settings
+        _, start = rays(cam, gpu.size)
+        scene_distance = np.where(depth < 1.0, cam.near / ((1.0 - depth) + depth * (cam.near / cam.far))
+                                  * start / cam.near, np.inf)
+        ref = march_reference(volume(), trans, sim.settings, settings, sim.layout(), cam, DAY, gpu.size,
+                              scene=scene_distance, field=read_field(sim.a[DIFFUSION]))
+        ref = {k: ref[k][np.ix_(py, px)] for k in ("light", "alpha", "distance")}
+        assert ref["alpha"].max() > 0.9 and (ref["alpha"] > 0.01).mean() > 0.05, "the view must see the clouds"
+        color, distance = v[LOW_COLOR], v[LOW_DISTANCE]
+        rmse = np.sqrt(np.mean((color[..., :3] - ref["light"]) ** 2)) / np.sqrt(np.mean(ref["light"] ** 2))
+        assert rmse < 0.005, f"colour off the reference: relative RMSE {rmse:.4f}"
+        off = np.abs(color[..., 3] - ref["alpha"])
+        assert np.percentile(off, 99.5) < 0.002 and off.max() < 0.2, "coverage off the reference"
+        assert np.abs(distance[..., 1] - color[..., 3]).max() < 1e-3, "the distance's alpha is the colour's"
+        d_rmse = np.sqrt(np.mean((distance[..., 0] - ref["distance"]) ** 2)) / np.sqrt(np.mean(ref["distance"] ** 2))
+        assert d_rmse < 0.005, f"distance off the reference: relative RMSE {d_rmse:.4f}"
     app.close()
 
 

@@ -1,5 +1,5 @@
 """float64 numpy reference of the march's volumetric far field (``shaders/clouds/raymarch/far.glsl`` in
-``march.frag`` with FAR_FIELD): the profile, its light, and the march of rays that stay outside the
+``march.glsl`` with FAR_FIELD): the profile, its light, and the march of rays that stay outside the
 volume's footprint (far weight 1; mip 0 of the far field's textures, detail noise off, midpoints)."""
 from __future__ import annotations
 

@@ -1,14 +1,16 @@
 """RaymarchCloudsPlugin: the CloudsPlugin's clouds ray-marched (issue 15), beside the sprites.
 
-Pass "cloud_raymarch" (phase translucent) reads "depth" and "cloud_sets" and blends premultiplied
+Pass "cloud_raymarch" (phase translucent) reads "depth" and "cloud_sets" and composites premultiplied
 onto "color" (and onto "cloud_distance" when a media pass wants it, :mod:`atmos.composition`). The
-march (``shaders/clouds/raymarch/march.frag``; float64 reference :mod:`.reference`) goes through the
-layer's box with the light of ``clouds/volume/volume.glsl`` (the sprites' model), skips empty sprite
-groups × height bands (:func:`skip_map`), stops at ``min_transmittance`` and grows its step with the
-distance. At ``resolution`` r > 1 it marches one pixel per r × r block into the low-res targets
-"cloud_raymarch_color" (RGBA16F), "cloud_raymarch_distance" (RG32F (a·distance, a)) and
-"cloud_raymarch_depth" (the scene depth the ray saw): texel (i, j) is the ray through the full-res
-pixel (i·r + o.x, j·r + o.y), o the frame's jitter offset; then :meth:`RaymarchPass._resolve`
+march (``shaders/clouds/raymarch/march.glsl``, one compute invocation per ray in ``march.comp``;
+float64 reference :mod:`.reference`) goes through the layer's box with the light of
+``clouds/volume/volume.glsl`` (the sprites' model), skips empty sprite groups × height bands
+(:func:`skip_map`), stops at ``min_transmittance`` and grows its step with the distance. At
+``resolution`` 1 each invocation composites its pixel onto "color" (and "cloud_distance") in place, as
+blend_over would. At r > 1 it marches one pixel per r × r block into the low-res storage images
+"cloud_raymarch_color" (rgba16f), "cloud_raymarch_distance" (rg32f (a·distance, a)) and
+"cloud_raymarch_depth" (r32f: the scene's window depth the ray saw): texel (i, j) is the ray through
+the full-res pixel (i·r + o.x, j·r + o.y), o the frame's jitter offset; then :meth:`RaymarchPass._resolve`
 (the temporal resolve's hook, wired to :class:`.temporal.TemporalClouds`: with ``reprojection`` its
 compute resolve composites the full-res result onto "color" (and "cloud_distance") in place; without,
 a depth-aware upsample of this frame's samples is composited instead —
@@ -16,13 +18,15 @@ a depth-aware upsample of this frame's samples is composited instead —
 """
 from __future__ import annotations
 
+from functools import lru_cache
+
 import moderngl
 import numpy as np
 
 from atmos.blue_noise import blue_noise_texture
 from atmos.scene_uniforms import set_camera_uniforms
 from atmos.composition import CLOUD_DISTANCE, composition, distance_desc
-from atmos.graph import PassBuilder, PassContext, RenderPass, TextureDesc
+from atmos.graph import PassBuilder, PassContext, RenderPass, TextureDesc, work_groups
 from atmos.plugin import Plugin
 from atmos.plugins.clouds.volume.sets import FAR_FIELD
 from atmos.plugins.clouds.far_field.plugin import CloudFarFieldPlugin
@@ -58,6 +62,15 @@ def skip_map(max_maps: np.ndarray) -> np.ndarray:
             for dx in range(3):
                 np.maximum(out, padded[dz:dz + n[0], dy:dy + n[1], dx:dx + n[2]], out=out)
     return out
+
+
+@lru_cache(maxsize=16)
+def low_descs(size, r: int) -> tuple:
+    """The low-res targets' descs (colour, distance, depth the ray saw) at 1/``r`` of ``size``, storage
+    images (rgba16f, rg32f, r32f), made once per size (setups run every frame)."""
+    low = low_size(size, r)
+    return (TextureDesc(low, components=4, dtype="f2", filter="nearest", storage=True), distance_desc(low),
+            TextureDesc(low, components=1, dtype="f4", filter="nearest", storage=True))
 
 
 def sample_offset(frame_index: int, r: int) -> tuple[int, int]:
@@ -147,16 +160,16 @@ class RaymarchPass(RenderPass):
         builder.read(CLOUD_SETS)
         if self.plugin.marches_far_field():
             builder.read(FAR_FIELD)
-        builder.read(COLOR)                 # blends onto it
-        builder.write(COLOR)
+        # composited onto in place: by the march (resolution 1), the temporal resolve or the upsample
+        builder.read(COLOR, access="storage")
+        builder.write(COLOR, access="storage")
         if self.plugin.composition.distance:
-            builder.read(CLOUD_DISTANCE)
-            builder.write(CLOUD_DISTANCE)
+            builder.read(CLOUD_DISTANCE, access="storage")
+            builder.write(CLOUD_DISTANCE, access="storage")
         if s.resolution > 1:
-            low = low_size(self.plugin.gpu.size, s.resolution)
-            builder.create(LOW_COLOR, TextureDesc(low, components=4, dtype="f2", filter="nearest"))
-            builder.create(LOW_DISTANCE, distance_desc(low))
-            builder.create(LOW_DEPTH, TextureDesc(low, depth=True, filter="nearest"))
+            descs = low_descs(tuple(self.plugin.gpu.size), s.resolution)
+            for name, desc in zip((LOW_COLOR, LOW_DISTANCE, LOW_DEPTH), descs):
+                builder.create(name, desc, access="storage")
 
     def prepare(self, gpu) -> None:
         self.gpu = gpu
@@ -165,12 +178,18 @@ class RaymarchPass(RenderPass):
         self.temporal = TemporalClouds(gpu)
 
     def program(self, far: bool = False):
-        """The variant for the detail octaves, sun steps and far field (the program cache: a dict lookup)."""
+        """The variant for the detail octaves, sun steps and far field, into the low-res targets or, at
+        resolution 1, onto "color" (and "cloud_distance" when declared) in place (the program cache: a
+        dict lookup)."""
         s = self.plugin.settings
-        return self.gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="clouds/raymarch/march.frag",
+        onto = s.resolution == 1
+        distance = onto and self.plugin.composition.distance
+        return self.gpu.program(compute_shader="clouds/raymarch/march.comp",
                                 defines={"DETAIL_OCTAVES": s.detail_octaves,
                                          "SUN_STEPS": s.sun_steps,
-                                         "FAR_FIELD": int(far)})
+                                         "FAR_FIELD": int(far),
+                                         "MARCH_ONTO": int(onto),
+                                         "MARCH_DISTANCE": int(distance)})
 
     def _skip_texture(self, sim: CloudSets):
         """The dilated skip map as a small r32f 3D texture, re-uploaded when the max maps change."""
@@ -213,13 +232,6 @@ class RaymarchPass(RenderPass):
         distance = frame.declares(CLOUD_DISTANCE)
         far = frame.declares(FAR_FIELD)
         p = self.program(far)
-        if r == 1:                          # straight onto the frame
-            frame.framebuffer(color=[COLOR, CLOUD_DISTANCE] if distance else [COLOR]).use()
-            frame.blend_over()
-        else:                               # every texel is overwritten: no clear
-            frame.framebuffer(color=[LOW_COLOR, LOW_DISTANCE], depth=LOW_DEPTH).use()
-            frame.gpu.ctx.enable(moderngl.DEPTH_TEST)
-            frame.gpu.ctx.depth_func = "1"  # always: the shader writes the scene depth it saw
         set_camera_uniforms(p, view.camera, view.aspect)
         layout = sim.layout(s.base_altitude)
         write_uniforms(p, self._uniforms(frame, sim, layout, offset))
@@ -239,8 +251,12 @@ class RaymarchPass(RenderPass):
             layout = sim.layout(s.base_altitude)
             self._detail().bind(p, view.time, self.plugin.wind(sim), s.detail_scale * float(np.min(layout.cell)),
                                 s.detail_strength, layer=(float(layout.lo[1]), float(layout.hi[1] - layout.lo[1])))
+        if r == 1:                          # straight onto the frame
+            images = {"color_image": COLOR, **({"distance_image": CLOUD_DISTANCE} if distance else {})}
+        else:                               # every texel is written: no clear
+            images = {"color_image": LOW_COLOR, "distance_image": LOW_DISTANCE, "depth_image": LOW_DEPTH}
         try:
-            frame.fullscreen(p)
+            frame.dispatch(p, work_groups(frame.image(images["color_image"]).size, (8, 8)), images=images)
         finally:
             unbind_volume(p, self.sampler)
         if r > 1:

@@ -1,5 +1,5 @@
-"""float64 numpy reference of ``shaders/clouds/raymarch/march.frag`` at resolution 1, midpoint samples
-(``jitter`` off), no detail noise and no empty-space skipping (which changes only where the steps
+"""float64 numpy reference of ``shaders/clouds/raymarch/march.glsl`` (run by ``march.comp``) at resolution 1,
+midpoint samples (``jitter`` off), no detail noise and no empty-space skipping (which changes only where the steps
 fall): the same segments (``step_base + step_growth · s``, s from the near plane or the layer's box
 to its far side or the scene), the density trilinear between cell centres (clamp to edge), the
 light J of :func:`atmos.plugins.clouds.light.medium.source_reference` with the column depths of
@@ -95,7 +95,7 @@ def integrate(pos, dirs, enter, leave, steps, step_base, growth, min_transmittan
 
 
 def sun_transmittance(density, transmittance, sigma_t, lo, extent, step, steps, sun_dir, p) -> np.ndarray:
-    """march.frag's sun_transmittance at world points ``p`` (n, 3): ``steps`` steps toward ``sun_dir``
+    """march.glsl's sun_transmittance at world points ``p`` (n, 3): ``steps`` steps toward ``sun_dir``
     (unit), the first ``step`` m long and each next SUN_GROWTH times the last, the trilinear ``density``
     at each step's midpoint (0 from the first midpoint outside the box on) times the step, then the
     shading volume ``transmittance`` (trilinear) where they end (1 outside the box); ``steps`` 0: the

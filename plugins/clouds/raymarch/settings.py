@@ -10,7 +10,7 @@ from atmos.plugins.clouds.volume.light import CloudLightSettings
 RESOLUTIONS = (1, 2, 4)
 MAX_STEPS = 4096
 MAX_SUN_STEPS = 16
-SUN_SPACING = 0.5        # cells (of the smallest side): the sun march's first step (march.frag sun_transmittance)
+SUN_SPACING = 0.5        # cells (of the smallest side): the sun march's first step (march.glsl sun_transmittance)
 SUN_GROWTH = 2.0         # each next sun-march step this many times the last (4 steps reach 7.5 cells)
 REFERENCE = dict(resolution=1, jitter=False, reprojection=False, detail_octaves=0, step=0.25, step_growth=0.0,
                  steps=MAX_STEPS, min_transmittance=0.0)

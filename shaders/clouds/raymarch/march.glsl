@@ -1,18 +1,17 @@
-#version 430
-// The ray-marched cloud layer (plugins/clouds/raymarch): one ray per low-res texel (i, j), through the
-// full-res pixel centre (i, j) * factor + sample_offset + 0.5, from the near plane (or the layer's
-// box) to the box's far side or the scene depth. Segments of length step_base + step_growth * s
-// (s: distance from the camera), one density sample per segment at `jitter` of its length (0.5:
-// the midpoint), extinction sigma_t * density, light J = volume.glsl's cloud_source. Sprite groups
-// x height bands whose dilated max map is 0 are jumped over; a ray stops once its transmittance
-// falls below min_transmittance or after `steps` samples. float64 reference:
+// The ray-marched cloud layer (plugins/clouds/raymarch), the body of clouds/raymarch/march.comp:
+// cloud_march(pixel) marches the ray through the full-res pixel centre pixel + 0.5, from the near plane
+// (or the layer's box) to the box's far side or the scene depth. Segments of length step_base +
+// step_growth * s (s: distance from the camera), one density sample per segment at `jitter` of its
+// length (0.5: the midpoint), extinction sigma_t * density, light J = volume.glsl's cloud_source.
+// Sprite groups x height bands whose dilated max map is 0 are jumped over; a ray stops once its
+// transmittance falls below min_transmittance or after `steps` samples. float64 reference:
 // plugins/clouds/raymarch/reference.py.
 // FAR_FIELD 1: the ray goes on through the layer's altitude band beyond the volume, to far_distance,
 // through the volumetric far field (clouds/raymarch/far.glsl) weighted by 1 - the volume's edge weight
 // (so the two cross-fade over the edge fade); from where the ray first reaches the fade ring the step
 // grows by mix(step_growth, far_growth, that weight) of the distance and nothing is skipped.
 // Out: premultiplied (light, 1 - T); (a * distance, a) with distance the transmittance-weighted
-// distance from the camera (m, atmos/composition.py); depth: the scene depth the ray stopped at.
+// distance from the camera (m, atmos/composition.py); the scene's window depth the ray stopped at.
 #include "clouds/volume/volume.glsl"
 #include "clouds/raymarch/detail.glsl"
 #ifndef FAR_FIELD
@@ -22,8 +21,6 @@
 #include "clouds/raymarch/far.glsl"
 #endif
 #include "lib/view_ray.glsl"
-out vec4 frag;
-layout(location = 1) out vec4 frag_distance;
 layout(binding = 4) uniform sampler3D skip_map;   // (groups x, bands, groups z): 0 = no density within
 layout(binding = 9) uniform sampler2D scene_depth;
 uniform mat3 view_basis;       // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
@@ -41,8 +38,6 @@ uniform float min_transmittance;
 uniform int skipping;          // 1: use skip_map
 uniform vec3 skip_cells;       // cells per skip-map texel (group x, band height, group z)
 uniform int max_skips;         // skip-map texels a ray can cross
-uniform int factor;            // resolution divisor r
-uniform ivec2 sample_offset;   // the frame's jitter offset o in [0, r)^2
 uniform ivec2 frame_size;      // full-res pixels
 uniform int jitter;            // 1: per-pixel first-sample offset, fixed in time; 0: midpoints
 uniform vec3 sun_march;        // toward the sun, times the sun march's first step (m)
@@ -119,11 +114,11 @@ float skip_exit(ivec3 g, vec3 pos, vec3 inv_dir, vec3 dir) {
     return max(min(min(tt.x, tt.y), tt.z), 0.0);
 }
 
-void main() {
-    ivec2 pixel = min(ivec2(gl_FragCoord.xy) * factor + sample_offset, frame_size - 1);
+// The march through full-res pixel `pixel`: premultiplied (light, alpha = 1 - T) in `color`,
+// (alpha * distance, alpha) in `distance`, the scene's window depth there in `depth`.
+void cloud_march(ivec2 pixel, out vec4 color, out vec2 distance, out float depth) {
     vec2 uv = (vec2(pixel) + 0.5) / vec2(frame_size);
-    float depth = texelFetch(scene_depth, pixel, 0).r;
-    gl_FragDepth = depth;
+    depth = texelFetch(scene_depth, pixel, 0).r;
     vec3 dir = view_ray_dir(uv, view_basis);
     float scene = view_ray_distance(uv, depth, view_basis, near, far, 1e30);
     vec3 safe = mix(dir, vec3(1e-12), lessThan(abs(dir), vec3(1e-12)));
@@ -210,6 +205,6 @@ void main() {
         }
     }
     float alpha = 1.0 - trans;
-    frag = vec4(light, alpha);
-    frag_distance = vec4(weighted, alpha, 0.0, alpha);   // blends by its own alpha (atmos/composition.py)
+    color = vec4(light, alpha);
+    distance = vec2(weighted, alpha);   // composited by its own alpha (atmos/composition.py)
 }
