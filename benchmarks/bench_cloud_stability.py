@@ -34,11 +34,13 @@ MODES = {"sprites": ("sprites", {}),
 LEGIT = "march r1 no jitter (legit)"
 
 
-def sunset_frames(gpu, clouds: str, fields: dict, frames: int) -> tuple[np.ndarray, np.ndarray]:
-    """(frames + 1 images (h, w, 3) float64, shown step + t per image) of the sunset scene, still camera."""
+def sunset_frames(gpu, clouds: str, fields: dict, frames: int, frozen: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """(frames + 1 images (h, w, 3) float64, shown step + t per image) of the sunset scene, still camera;
+    ``frozen``: the clouds, their wind and the sun stopped (all the change is the renderer's)."""
     app = App(gpu)
-    build_cloudscape(app, DemoSettings(size=gpu.size, headless=True, clouds=clouds), hours=19.2, speed=0.01,
-                     cloud_density=150, warmup_steps=12, haze=True)
+    build_cloudscape(app, DemoSettings(size=gpu.size, headless=True, clouds=clouds), hours=19.2,
+                     speed=0.0 if frozen else 0.01, cloud_density=150, warmup_steps=12, haze=True,
+                     **(dict(wind=(0.0, 0.0, 0.0)) if frozen else {}))
     if fields:
         _renderers(app)[1].configure(**fields)
     app.startup()
@@ -47,6 +49,8 @@ def sunset_frames(gpu, clouds: str, fields: dict, frames: int) -> tuple[np.ndarr
     sun = app.resource(Sun).direction
     cam.yaw, cam.pitch = math.atan2(sun[0], -sun[2]) + 0.35, math.radians(7.0)
     sim = app.resource(CloudSimulation)
+    if frozen:
+        app.frames.remove(sim.job)          # the simulation paused: the shown step and t stay
     images, shown = [], []
     for _ in range(frames + 1):
         app.update(1 / 60)
