@@ -8,7 +8,10 @@ the mean absolute change of the 8-bit picture and the shown interpolation positi
 legit part of the change is the one of the march at resolution 1 without jitter (the clouds evolving,
 nothing from the renderer); a mode's own noise is the frame-to-frame change of its difference from
 those frames. Prints mean, median, max/median (a periodic spike: max/median far above 1) and plots
-everything to ``out/st_stability.png``.
+everything to ``out/st_stability.png``. ``--frozen``: the clouds, their wind and the sun stopped, so
+all the change is the renderer's (temporal noise at 1:1): per mode the mean change over the last half
+of the frames and the speckle of the last frame (mean |picture − its 3×3 box blur|, 8-bit levels; the
+jitter's pattern, frozen or not, is most of it), no plot.
 """
 from __future__ import annotations
 
@@ -60,6 +63,13 @@ def sunset_frames(gpu, clouds: str, fields: dict, frames: int, frozen: bool = Fa
     return np.stack(images), np.array(shown)
 
 
+def speckle(image: np.ndarray) -> float:
+    """Mean |image − its 3×3 box blur| (8-bit levels) over the interior pixels: fine spatial noise."""
+    h, w = image.shape[:2]
+    blur = sum(image[1 + j:h - 1 + j, 1 + i:w - 1 + i] for j in (-1, 0, 1) for i in (-1, 0, 1)) / 9.0
+    return float(np.abs(image[1:h - 1, 1:w - 1] - blur).mean())
+
+
 def change(images: np.ndarray) -> np.ndarray:
     """Mean |frame − previous| per frame (8-bit levels)."""
     return np.abs(np.diff(images, axis=0)).mean(axis=(1, 2, 3))
@@ -70,15 +80,23 @@ def main() -> None:
     parser.add_argument("--frames", type=int, default=60)
     parser.add_argument("--size", default="320x180")
     parser.add_argument("--modes", default=",".join(MODES), help="comma-separated subset of: " + ", ".join(MODES))
+    parser.add_argument("--frozen", action="store_true", help="clouds, wind and sun stopped: the renderer's own noise")
     args = parser.parse_args()
     size = tuple(int(v) for v in args.size.split("x"))
     modes = [m.strip() for m in args.modes.split(",")]
     if LEGIT not in modes:
         modes.append(LEGIT)
     gpu = create_headless(size)
-    print(f"renderer: {gpu.ctx.info['GL_RENDERER']}, sunset {size[0]}x{size[1]}, still camera, {args.frames} frames")
-    runs = {m: sunset_frames(gpu, MODES[m][0], MODES[m][1], args.frames) for m in modes}
+    print(f"renderer: {gpu.ctx.info['GL_RENDERER']}, sunset {size[0]}x{size[1]}, still camera, {args.frames} frames"
+          + (", frozen clouds" if args.frozen else ""))
+    runs = {m: sunset_frames(gpu, MODES[m][0], MODES[m][1], args.frames, frozen=args.frozen) for m in modes}
     gpu.release()
+    if args.frozen:
+        for m in modes:
+            c = change(runs[m][0])
+            print(f"{m:28s} change over the last {len(c) // 2} frames {c[len(c) // 2:].mean():.3f} (max "
+                  f"{c[len(c) // 2:].max():.3f}), speckle of the last frame {speckle(runs[m][0][-1]):.3f}")
+        return
     legit = runs[LEGIT][0]
     rows = {}
     for m in modes:

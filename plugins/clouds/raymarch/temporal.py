@@ -5,7 +5,12 @@ Each frame the march writes a low-res target whose texel (i, j) is the full-res 
 (i·r + ox, j·r + oy), (ox, oy) = :func:`jitter` (frame, r). :meth:`TemporalClouds.resolve` then,
 per full-res pixel (``shaders/clouds/raymarch/temporal.comp``, one compute invocation each):
 
-* marched this frame → the fresh sample, exactly;
+* marched this frame → the fresh sample blended into the pixel's history (the same history as
+  below, clamped to the box of this frame's 3×3 samples) with weight max(1/(n + 1), ``HISTORY_BLEND``),
+  n the samples the history averages (a running mean, then an exponential one; the history stores n,
+  carried times keep · (1 − moved) · (1 − drifting), so every rejection below restarts it and a
+  moving camera takes the corrected fresh sample). With the march's jitter turning (:func:`jitter_shift`)
+  a still picture converges to the mean over the offsets instead of freezing one offset's speckle;
 * else the history, reprojected with the previous frame's camera: the ray's direction is projected
   first (sky at infinity), then the point at the distance the history holds there (camera + ray ·
   distance; where it holds no cloud, the scene's distance behind the pixel, so cloudless terrain
@@ -13,8 +18,9 @@ per full-res pixel (``shaders/clouds/raymarch/temporal.comp``, one compute invoc
   history first corrected by this frame's samples (the upsample's weights times fresh − history at
   each sample, reprojected with this pixel's motion: history and fresh samples agree, no 2-pixel
   pattern while moving), the clamp and the correction loosened to 0 below ``CLAMP_MOTION`` pixels of
-  motion, so that a still camera over still clouds keeps every fresh sample and converges to the
-  full-res march in r² frames, while clouds that move are clamped; rejected, falling back to the depth-aware upsample
+  motion, so that a still camera over still clouds keeps every pixel's mean and converges to the
+  full-res march in r² frames (without jitter; with it, toward the mean over the offsets), while
+  clouds that move are clamped; rejected, falling back to the depth-aware upsample
   of this frame's samples (``lib/upsample.glsl``, shared with OffscreenLayer' composite), when its point was off screen or the scene behind the pixel changed
   (``DEPTH_TOLERANCE``: an object moved in front, or away); and mixed toward the upsample the faster
   the pixel moves (weight 1 − motion / ``motion_limit``, motion in full-res pixels per frame).
@@ -24,7 +30,8 @@ per full-res pixel (``shaders/clouds/raymarch/temporal.comp``, one compute invoc
   the upsample where the scene behind it changed), and drift is told from evolution by matching
   (``shaders/clouds/raymarch/drift.comp``, a low-res dispatch; twin :func:`.temporal_reference.drift_flags`):
   each low-res texel compares this frame's 3×3 samples with the samples marched at the same pixels r²
-  frames ago, unshifted and shifted by one texel (r px) each way. Where a shift explains the change
+  frames ago, unshifted and shifted by one texel (r px) each way, on the frames whose jitter is the
+  one of r² frames ago (:func:`jitter_repeats`; a new offset changes every sample by its noise). Where a shift explains the change
   better than none (by ``DRIFT_GAIN`` of it, the change above ``DRIFT_FLOOR``), or the samples changed
   by more than ``DRIFT_MEAN`` on average or one by more than ``DRIFT_CHANGE`` (a drift too fast for
   the shifts), the clouds moved: within one texel the block's fresh sample is compared with the

@@ -53,9 +53,9 @@ uniform float far_growth;      // FAR_FIELD: the step's growth per metre of dist
 uniform float pixel_angle;     // a full-res pixel's angle (rad): its width per metre of distance
 
 // The blue noise (atmos/blue_noise.py) of the full-res pixel, tiled, rotated by jitter_shift (mod 1):
-// the plugin turns it by the golden ratio each time the resolve has visited every pixel of a block
-// (r² frames), so each pixel's successive samples spread over the step and the temporal resolve
-// averages them; 0 where nothing averages (resolution 1, no reprojection): there an offset that moved
+// the plugin turns it by the golden ratio every two r²-frame cycles of the resolve (each pixel marched
+// twice with each offset: the resolve's drift test compares like with like), so each pixel's samples
+// spread over the step and the temporal resolve averages them; 0 where nothing averages (resolution 1, no reprojection): there an offset that moved
 // only flickered. Interleaved gradient noise, a set of diagonal lines, showed as a woven hatching
 // under the history a moving camera reprojects.
 layout(binding = 23) uniform sampler2D blue_noise;
