@@ -50,10 +50,10 @@ float64 reference is :mod:`.temporal_reference`.
 
 Knobs and their cost (the resolve itself is one full-res dispatch: 1 fresh + 4 bilinear + 9
 neighbourhood fetches of the low-res targets, 2 × 4 bilinear history fetches, 2 depth fetches, 1
-last-sample fetch each pixel, plus 4 × 2 × 4 for the correction while moving: 1.43× the resolve
-without it, 640×360 r 2 on llvmpipe, measured as a fragment pass; under a still camera also 9
-drift-flag fetches, after the low-res drift dispatch: 25 + 9 × 9 fetches per low-res texel; 28 bytes
-of history per pixel, twice):
+last-sample fetch each pixel (the marched ones too: they blend into their history), plus 4 × 2 × 4
+for the correction while moving: 1.43× the resolve without it, 640×360 r 2 on llvmpipe, measured as a
+fragment pass; under a still camera also 9 drift-flag fetches, after the low-res drift dispatch: 25 +
+9 × 9 fetches per low-res texel; 32 bytes of history per pixel, twice):
 
 * ``reprojection`` (the plugin's): off → no history (the upsample alone, which blurs at r > 1);
   on → r² frames to converge when still, a ghost after fast motion bounded by the clamp.

@@ -15,7 +15,7 @@ from atmos.offscreen import EDGE
 from atmos.offscreen_reference import inv_depth, upsample_weights
 
 from .temporal import (ALPHA_EPS, CHANGE_TOLERANCE, CLAMP_MOTION, DEPTH_TOLERANCE, DRIFT_CHANGE, DRIFT_FLOOR, DRIFT_GAIN, DRIFT_MEAN,
-                                              HISTORY_BLEND, HISTORY_CLAMP, MOTION_LIMIT, TemporalClouds, camera_state, detects_change, forward_of)
+                       HISTORY_BLEND, HISTORY_CLAMP, MOTION_LIMIT, TemporalClouds, camera_state, detects_change, forward_of)
 
 
 def bilinear(image: np.ndarray, px: np.ndarray, py: np.ndarray) -> np.ndarray:

@@ -2,10 +2,10 @@
 // The temporal resolve of the ray-marched clouds (plugins/clouds/raymarch/temporal.py says what and
 // why; float64 reference: plugins/clouds/raymarch/temporal_reference.py). One compute invocation per
 // full-res pixel stores the next history: colour (premultiplied), distance (a·d, a), the scene distance
-// behind the pixel with the samples its colour averages, and its last marched sample. COMPOSITE 1: it also composites the colour, as stored
-// (float16, read back), onto the frame's colour in place, premultiplied as blend_over did (rgb and alpha =
-// history + (1 - a) · colour), and, COMPOSITE_DISTANCE 1, the distance onto "cloud_distance" with the same
-// weights.
+// behind the pixel with the samples its colour averages, and its last marched sample. COMPOSITE 1: it
+// also composites the colour, as stored (float16, read back), onto the frame's colour in place,
+// premultiplied as blend_over did (rgb and alpha = history + (1 - a) · colour), and, COMPOSITE_DISTANCE
+// 1, the distance onto "cloud_distance" with the same weights.
 #include "lib/view_ray.glsl"
 #include "lib/upsample.glsl"
 
