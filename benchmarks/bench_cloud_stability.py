@@ -8,7 +8,10 @@ the mean absolute change of the 8-bit picture and the shown interpolation positi
 legit part of the change is the one of the march at resolution 1 without jitter (the clouds evolving,
 nothing from the renderer); a mode's own noise is the frame-to-frame change of its difference from
 those frames. Prints mean, median, max/median (a periodic spike: max/median far above 1) and plots
-everything to ``out/st_stability.png``.
+everything to ``out/st_stability.png``. ``--frozen``: the clouds, their wind and the sun stopped, so
+all the change is the renderer's (temporal noise at 1:1): per mode the mean change over the last half
+of the frames and the speckle of the last frame (mean |picture − its 3×3 box blur|, 8-bit levels; the
+jitter's pattern, frozen or not, is most of it), no plot.
 """
 from __future__ import annotations
 
@@ -34,11 +37,13 @@ MODES = {"sprites": ("sprites", {}),
 LEGIT = "march r1 no jitter (legit)"
 
 
-def sunset_frames(gpu, clouds: str, fields: dict, frames: int) -> tuple[np.ndarray, np.ndarray]:
-    """(frames + 1 images (h, w, 3) float64, shown step + t per image) of the sunset scene, still camera."""
+def sunset_frames(gpu, clouds: str, fields: dict, frames: int, frozen: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """(frames + 1 images (h, w, 3) float64, shown step + t per image) of the sunset scene, still camera;
+    ``frozen``: the clouds, their wind and the sun stopped (all the change is the renderer's)."""
     app = App(gpu)
-    build_cloudscape(app, DemoSettings(size=gpu.size, headless=True, clouds=clouds), hours=19.2, speed=0.01,
-                     cloud_density=150, warmup_steps=12, haze=True)
+    build_cloudscape(app, DemoSettings(size=gpu.size, headless=True, clouds=clouds), hours=19.2,
+                     speed=0.0 if frozen else 0.01, cloud_density=150, warmup_steps=12, haze=True,
+                     **(dict(wind=(0.0, 0.0, 0.0)) if frozen else {}))
     if fields:
         _renderers(app)[1].configure(**fields)
     app.startup()
@@ -47,6 +52,8 @@ def sunset_frames(gpu, clouds: str, fields: dict, frames: int) -> tuple[np.ndarr
     sun = app.resource(Sun).direction
     cam.yaw, cam.pitch = math.atan2(sun[0], -sun[2]) + 0.35, math.radians(7.0)
     sim = app.resource(CloudSimulation)
+    if frozen:
+        app.frames.remove(sim.job)          # the simulation paused: the shown step and t stay
     images, shown = [], []
     for _ in range(frames + 1):
         app.update(1 / 60)
@@ -54,6 +61,13 @@ def sunset_frames(gpu, clouds: str, fields: dict, frames: int) -> tuple[np.ndarr
         shown.append(sim.job.step + sim.job.progress)
     app.close()
     return np.stack(images), np.array(shown)
+
+
+def speckle(image: np.ndarray) -> float:
+    """Mean |image − its 3×3 box blur| (8-bit levels) over the interior pixels: fine spatial noise."""
+    h, w = image.shape[:2]
+    blur = sum(image[1 + j:h - 1 + j, 1 + i:w - 1 + i] for j in (-1, 0, 1) for i in (-1, 0, 1)) / 9.0
+    return float(np.abs(image[1:h - 1, 1:w - 1] - blur).mean())
 
 
 def change(images: np.ndarray) -> np.ndarray:
@@ -66,15 +80,23 @@ def main() -> None:
     parser.add_argument("--frames", type=int, default=60)
     parser.add_argument("--size", default="320x180")
     parser.add_argument("--modes", default=",".join(MODES), help="comma-separated subset of: " + ", ".join(MODES))
+    parser.add_argument("--frozen", action="store_true", help="clouds, wind and sun stopped: the renderer's own noise")
     args = parser.parse_args()
     size = tuple(int(v) for v in args.size.split("x"))
     modes = [m.strip() for m in args.modes.split(",")]
     if LEGIT not in modes:
         modes.append(LEGIT)
     gpu = create_headless(size)
-    print(f"renderer: {gpu.ctx.info['GL_RENDERER']}, sunset {size[0]}x{size[1]}, still camera, {args.frames} frames")
-    runs = {m: sunset_frames(gpu, MODES[m][0], MODES[m][1], args.frames) for m in modes}
+    print(f"renderer: {gpu.ctx.info['GL_RENDERER']}, sunset {size[0]}x{size[1]}, still camera, {args.frames} frames"
+          + (", frozen clouds" if args.frozen else ""))
+    runs = {m: sunset_frames(gpu, MODES[m][0], MODES[m][1], args.frames, frozen=args.frozen) for m in modes}
     gpu.release()
+    if args.frozen:
+        for m in modes:
+            c = change(runs[m][0])
+            print(f"{m:28s} change over the last {len(c) // 2} frames {c[len(c) // 2:].mean():.3f} (max "
+                  f"{c[len(c) // 2:].max():.3f}), speckle of the last frame {speckle(runs[m][0][-1]):.3f}")
+        return
     legit = runs[LEGIT][0]
     rows = {}
     for m in modes:

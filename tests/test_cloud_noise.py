@@ -190,3 +190,17 @@ def test_one_build_per_context_and_the_context_frees_it(rng):
 def test_bad_arguments_name_what_is_allowed(gpu, field, value):
     with pytest.raises(ValueError, match=f"DetailNoise.{field} must be"):
         DetailNoise(gpu, **{field: value})
+
+
+def test_the_fine_band_thins_an_edge_but_never_holes_it(gpu, ctx, rng):
+    """Band 3's threshold scales with the coverage: wherever bands 1-2 leave density, band 3 keeps some
+    (a threshold of its own cut thin edges to 0: isolated pinholes at 1:1), never more than it had."""
+    noise = DetailNoise(gpu, BASE, FINE, seed=random_seed(rng))
+    h, w = 32, 64
+    points = rng.uniform(-3000.0, 3000.0, (h, w, 3))
+    d = np.repeat(np.linspace(0.0, 0.7, w)[None, :], h, axis=0)
+    shaped = probe(gpu, noise, points, d, 2, strength=1.0)
+    eroded = probe(gpu, noise, points, d, 3, strength=1.0)
+    assert np.all(eroded[shaped > 1e-3] > 0.0)
+    assert np.all(eroded <= shaped + 1e-6)
+    assert np.mean(eroded < shaped - 1e-3) > 0.2          # the band still erodes

@@ -140,5 +140,5 @@ def detail_density(d, p, base, detail, octaves: int, scale: float, strength: flo
         v = p * (DETAIL_RATIO / scale) - off_fine
         fine = sum(w * sample_repeat_trilinear(detail[..., c], v) for c, w in enumerate(WORLEY_WEIGHTS))
         keep_fine = detail_fade(footprint, scale / DETAIL_RATIO)
-        out = erode(out, keep_fine * BAND_STRENGTH * strength * (fine + (1.0 - 2.0 * fine) * np.clip(3.0 * h, 0.0, 1.0)))
+        out = erode(out, out * keep_fine * BAND_STRENGTH * strength * (fine + (1.0 - 2.0 * fine) * np.clip(3.0 * h, 0.0, 1.0)))
     return np.where(x >= COVERAGE, x, COVERAGE * out)

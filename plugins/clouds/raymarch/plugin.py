@@ -33,7 +33,7 @@ from atmos.plugins.clouds.far_field.plugin import CloudFarFieldPlugin
 from atmos.plugins.clouds.raymarch.far import far_uniforms
 from atmos.plugins.clouds.raymarch.noise import pixel_angle
 from atmos.plugins.clouds.raymarch.settings import REFERENCE, SUN_GROWTH, SUN_SPACING, RaymarchCloudSettings
-from atmos.plugins.clouds.raymarch.temporal import TemporalClouds, jitter
+from atmos.plugins.clouds.raymarch.temporal import TemporalClouds, jitter, jitter_repeats, jitter_shift
 from atmos.gpu import clamp_sampler
 from atmos.plugins.clouds.volume.binding import bind_volume, unbind_volume
 from atmos.plugins.clouds.volume.light import unit_direction
@@ -220,7 +220,8 @@ class RaymarchPass(RenderPass):
                 "min_transmittance": s.min_transmittance, "skipping": int(s.empty_space_skipping),
                 "skip_cells": skip_cells, "max_skips": int(sum(grid)) + 3, "factor": s.resolution,
                 "sample_offset": tuple(offset), "frame_size": tuple(int(v) for v in view.size),
-                "jitter": int(s.jitter),
+                "jitter": int(s.jitter),    # turned per frame only where the resolve averages (r > 1, reprojection)
+                "jitter_shift": jitter_shift(self.frame_index, s.resolution) if s.resolution > 1 and s.reprojection else 0.0,
                 "sun_march": tuple(float(v) for v in sun * SUN_SPACING * cell.min()), "sun_growth": SUN_GROWTH,
                 "pixel_angle": pixel_angle(view)}
 
@@ -294,7 +295,8 @@ class RaymarchPass(RenderPass):
                                   depth=frame.resource(DEPTH), history_clamp=s.history_clamp,
                                   motion_limit=s.motion_limit, low_depth=frame.resource(LOW_DEPTH),
                                   onto=frame.resource(COLOR),
-                                  onto_distance=frame.resource(CLOUD_DISTANCE) if distance else None)
+                                  onto_distance=frame.resource(CLOUD_DISTANCE) if distance else None,
+                                  repeats=not s.jitter or jitter_repeats(self.frame_index, s.resolution))
             return
         self.temporal.release()
         self.offscreen.end(frame, s.resolution, camera.near, camera.far, distance, offset=offset)

@@ -47,8 +47,10 @@ class RaymarchCloudSettings(CloudLightSettings):
                                          "through (0 marches to the layer's end; the pixel's alpha is short by at "
                                          "most that much)")
     jitter: bool = bool_field(True, "offset each pixel's first sample by a tiled blue noise of the pixel "
-                              "(:mod:`atmos.blue_noise`), fixed in time (turns step banding into fine spatial "
-                              "noise that does not flicker); False: midpoint samples, reproducible (tests)")
+                              "(:mod:`atmos.blue_noise`; turns step banding into fine noise); with the temporal "
+                              "resolve (resolution > 1, reprojection) turned by the golden ratio every 2 r² "
+                              "frames and averaged (a still picture converges to the mean over offsets), "
+                              "else fixed in time; False: midpoint samples, reproducible (tests)")
     resolution: int = int_field(2, 1, max(RESOLUTIONS), "march one pixel of every r × r block (1, 2 or 4; 2 "
                                 "costs a quarter of the samples, the frame's jitter moves the marched pixel "
                                 "inside the block)")

@@ -5,7 +5,12 @@ Each frame the march writes a low-res target whose texel (i, j) is the full-res 
 (i·r + ox, j·r + oy), (ox, oy) = :func:`jitter` (frame, r). :meth:`TemporalClouds.resolve` then,
 per full-res pixel (``shaders/clouds/raymarch/temporal.comp``, one compute invocation each):
 
-* marched this frame → the fresh sample, exactly;
+* marched this frame → the fresh sample blended into the pixel's history (the same history as
+  below, clamped to the box of this frame's 3×3 samples) with weight max(1/(n + 1), ``HISTORY_BLEND``),
+  n the samples the history averages (a running mean, then an exponential one; the history stores n,
+  carried times keep · (1 − moved) · (1 − drifting), so every rejection below restarts it and a
+  moving camera takes the corrected fresh sample). With the march's jitter turning (:func:`jitter_shift`)
+  a still picture converges to the mean over the offsets instead of freezing one offset's speckle;
 * else the history, reprojected with the previous frame's camera: the ray's direction is projected
   first (sky at infinity), then the point at the distance the history holds there (camera + ray ·
   distance; where it holds no cloud, the scene's distance behind the pixel, so cloudless terrain
@@ -13,8 +18,9 @@ per full-res pixel (``shaders/clouds/raymarch/temporal.comp``, one compute invoc
   history first corrected by this frame's samples (the upsample's weights times fresh − history at
   each sample, reprojected with this pixel's motion: history and fresh samples agree, no 2-pixel
   pattern while moving), the clamp and the correction loosened to 0 below ``CLAMP_MOTION`` pixels of
-  motion, so that a still camera over still clouds keeps every fresh sample and converges to the
-  full-res march in r² frames, while clouds that move are clamped; rejected, falling back to the depth-aware upsample
+  motion, so that a still camera over still clouds keeps every pixel's mean and converges to the
+  full-res march in r² frames (without jitter; with it, toward the mean over the offsets), while
+  clouds that move are clamped; rejected, falling back to the depth-aware upsample
   of this frame's samples (``lib/upsample.glsl``, shared with OffscreenLayer' composite), when its point was off screen or the scene behind the pixel changed
   (``DEPTH_TOLERANCE``: an object moved in front, or away); and mixed toward the upsample the faster
   the pixel moves (weight 1 − motion / ``motion_limit``, motion in full-res pixels per frame).
@@ -24,7 +30,8 @@ per full-res pixel (``shaders/clouds/raymarch/temporal.comp``, one compute invoc
   the upsample where the scene behind it changed), and drift is told from evolution by matching
   (``shaders/clouds/raymarch/drift.comp``, a low-res dispatch; twin :func:`.temporal_reference.drift_flags`):
   each low-res texel compares this frame's 3×3 samples with the samples marched at the same pixels r²
-  frames ago, unshifted and shifted by one texel (r px) each way. Where a shift explains the change
+  frames ago, unshifted and shifted by one texel (r px) each way, on the frames whose jitter is the
+  one of r² frames ago (:func:`jitter_repeats`; a new offset changes every sample by its noise). Where a shift explains the change
   better than none (by ``DRIFT_GAIN`` of it, the change above ``DRIFT_FLOOR``), or the samples changed
   by more than ``DRIFT_MEAN`` on average or one by more than ``DRIFT_CHANGE`` (a drift too fast for
   the shifts), the clouds moved: within one texel the block's fresh sample is compared with the
@@ -43,10 +50,10 @@ float64 reference is :mod:`.temporal_reference`.
 
 Knobs and their cost (the resolve itself is one full-res dispatch: 1 fresh + 4 bilinear + 9
 neighbourhood fetches of the low-res targets, 2 × 4 bilinear history fetches, 2 depth fetches, 1
-last-sample fetch each pixel, plus 4 × 2 × 4 for the correction while moving: 1.43× the resolve
-without it, 640×360 r 2 on llvmpipe, measured as a fragment pass; under a still camera also 9
-drift-flag fetches, after the low-res drift dispatch: 25 + 9 × 9 fetches per low-res texel; 28 bytes
-of history per pixel, twice):
+last-sample fetch each pixel (the marched ones too: they blend into their history), plus 4 × 2 × 4
+for the correction while moving: 1.43× the resolve without it, 640×360 r 2 on llvmpipe, measured as a
+fragment pass; under a still camera also 9 drift-flag fetches, after the low-res drift dispatch: 25 +
+9 × 9 fetches per low-res texel; 32 bytes of history per pixel, twice):
 
 * ``reprojection`` (the plugin's): off → no history (the upsample alone, which blurs at r > 1);
   on → r² frames to converge when still, a ghost after fast motion bounded by the clamp.
@@ -73,6 +80,8 @@ RESOLUTIONS = (1, 2, 4)
 HISTORY_CLAMP = 1.0        # default clamp weight of moving history (0..1)
 MOTION_LIMIT = 16.0        # default pixels of motion per frame at which history is dropped
 CLAMP_MOTION = 1.0         # pixels of motion per frame below which the clamp is loosened linearly to 0 ...
+HISTORY_BLEND = 0.15       # least weight of a fresh sample in a marched pixel's running mean (at most 1/0.15 samples)
+GOLDEN = 0.6180339887498949   # the jitter's rotation per 2 r² frames (jitter_shift)
 CHANGE_TOLERANCE = 0.02    # ... unless, where clouds drift, this frame's sample differs from the history by more
 DRIFT_GAIN = 0.3           # still camera: the share of the r²-frame change a one-texel shift must explain to be drift ...
 DRIFT_FLOOR = 0.1          # ... of a mean change (alpha, relative rgb) over the 3×3 samples above this ...
@@ -109,15 +118,30 @@ def jitter(frame_index: int, r: int) -> tuple[int, int]:
     return int(x), int(y)
 
 
+def jitter_shift(frame_index: int, r: int) -> float:
+    """The march's rotation of its blue-noise first-sample offsets at ``frame_index`` (mod 1): the golden
+    ratio times the pairs of r²-frame cycles done, so each pixel's samples (one a cycle) spread evenly
+    over the step for the resolve to average, each offset twice in a row (:func:`jitter_repeats`)."""
+    return math.fmod((int(frame_index) // (2 * r * r)) * GOLDEN, 1.0)
+
+
+def jitter_repeats(frame_index: int, r: int) -> bool:
+    """Whether ``frame_index`` marches with the offsets of r² frames before (the second cycle of a
+    pair): only then does a still camera's change of a sample tell that the clouds drifted."""
+    return (int(frame_index) // (r * r)) % 2 == 1
+
+
 def low_size(size, r: int) -> tuple[int, int]:
     """The low-res target's (w, h) at resolution divisor r: every full-res pixel falls in one block."""
     return math.ceil(size[0] / r), math.ceil(size[1] / r)
 
 
-def detects_change(still_frames: int, r: int) -> bool:
+def detects_change(still_frames: int, r: int, repeats: bool = True) -> bool:
     """Whether the resolve tells drifting clouds from evolving ones (the drift pass): once the camera
-    has been still for r² frames, every pixel holds a sample marched with it, so a change is the clouds'."""
-    return still_frames >= r * r
+    has been still for r² frames, every pixel holds a sample marched with it, so a change is the
+    clouds' where this frame's samples were marched with the same jitter as those (``repeats``,
+    :func:`jitter_repeats`; a jitter that moved changes them by its noise)."""
+    return still_frames >= r * r and repeats
 
 
 def camera_state(camera, aspect: float) -> tuple:
@@ -174,7 +198,7 @@ class TemporalClouds:
 
     def resolve(self, low_color, low_distance, size, r: int, offset, camera, aspect: float, depth=None,
                 history_clamp: float = HISTORY_CLAMP, motion_limit: float = MOTION_LIMIT, low_depth=None,
-                onto=None, onto_distance=None):
+                onto=None, onto_distance=None, repeats: bool = True):
         """Resolve this frame at full-res ``size`` (w, h) from the low-res ``low_color`` (RGBA
         premultiplied) and ``low_distance`` ((a·d, a)) textures marched at ``offset`` with divisor
         ``r``, seen by ``camera`` at ``aspect``; ``depth``: the scene's depth texture at ``size``
@@ -183,7 +207,8 @@ class TemporalClouds:
         resolve (they are the history it reads). ``onto``: a full-res RGBA16F texture (the frame's
         colour) the same dispatch composites the result onto in place, premultiplied as
         :meth:`~atmos.graph.PassContext.blend_over` would; ``onto_distance`` (with ``onto``): an RG32F
-        texture ("cloud_distance") the distance goes onto the same way."""
+        texture ("cloud_distance") the distance goes onto the same way. ``repeats``: whether the samples
+        were marched with the jitter of r² frames before (:func:`jitter_repeats`; False: no drift test)."""
         r = check_resolution(r)
         size = (int(size[0]), int(size[1]))
         ox, oy = offset
@@ -219,7 +244,7 @@ class TemporalClouds:
                        edge=EDGE if depth is not None and low_depth is not None else 1e30)
         valid = self._valid and self._prev is not None and not self.is_cut(camera, self._prev[2], self._prev[3])
         write_uniforms(p, history_valid=valid)
-        detect = valid and state == self._prev[0] and detects_change(self.still_frames + 1, r)
+        detect = valid and state == self._prev[0] and detects_change(self.still_frames + 1, r, repeats)
         if detect:
             self._flag_drift(low_color, prev, r, (int(ox), int(oy)), depth, matrices, camera)
         if valid:
@@ -265,9 +290,9 @@ class TemporalClouds:
         self._free()
         ctx = self.gpu.ctx
         self._sets = []
-        for _ in range(2):       # colour, distance, scene distance, last sample: images the resolve stores
+        for _ in range(2):       # colour, distance, (scene distance, samples averaged), last sample: stored images
             self._sets.append(tuple(_zeros(ctx, self.gpu, size, n, dtype) for n, dtype in
-                                    ((4, "f2"), (2, "f4"), (1, "f4"), (4, "f2"))))
+                                    ((4, "f2"), (2, "f4"), (2, "f4"), (4, "f2"))))
         self._drift = _zeros(ctx, self.gpu, low_size(size, r), 1, "f1")
         self._key, self._current, self._valid = (size, r), 0, False
 
@@ -280,18 +305,18 @@ class TemporalClouds:
         """Free the history (the next resolve makes it again); the programs are the context's."""
         self._free()
 
-    def read_history(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def read_history(self) -> tuple[np.ndarray, ...]:
         """The last output as float64 arrays, GL row order (row 0 at the bottom): colour (h, w, 4),
-        distance (h, w, 2), scene distance (h, w) (−1: sky), each pixel's last sample (h, w, 4). For
-        tests and debugging (a GPU read)."""
+        distance (h, w, 2), scene distance (h, w) (−1: sky), each pixel's last marched sample (h, w, 4),
+        the samples its colour averages (h, w). For tests and debugging (a GPU read)."""
         if self._sets is None:
             raise ValueError("TemporalClouds.read_history: nothing resolved yet (or released)")
         (w, h), _ = self._key
         color, distance, scene, last = self._sets[self._current]
         out = [np.frombuffer(t.read(), dt).reshape(h, w, n).astype(np.float64)
-               for t, dt, n in ((color, np.float16, 4), (distance, np.float32, 2), (scene, np.float32, 1),
+               for t, dt, n in ((color, np.float16, 4), (distance, np.float32, 2), (scene, np.float32, 2),
                                 (last, np.float16, 4))]
-        return out[0], out[1], out[2][..., 0], out[3]
+        return out[0], out[1], out[2][..., 0], out[3], out[2][..., 1]
 
     @property
     def allocated(self) -> bool:

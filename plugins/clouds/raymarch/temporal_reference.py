@@ -14,8 +14,8 @@ from atmos.camera import Camera, view_basis
 from atmos.offscreen import EDGE
 from atmos.offscreen_reference import inv_depth, upsample_weights
 
-from .temporal import (ALPHA_EPS, CHANGE_TOLERANCE, CLAMP_MOTION, DEPTH_TOLERANCE, DRIFT_CHANGE, DRIFT_FLOOR, DRIFT_GAIN, DRIFT_MEAN, HISTORY_CLAMP,
-                       MOTION_LIMIT, TemporalClouds, camera_state, detects_change, forward_of)
+from .temporal import (ALPHA_EPS, CHANGE_TOLERANCE, CLAMP_MOTION, DEPTH_TOLERANCE, DRIFT_CHANGE, DRIFT_FLOOR, DRIFT_GAIN, DRIFT_MEAN,
+                       HISTORY_BLEND, HISTORY_CLAMP, MOTION_LIMIT, TemporalClouds, camera_state, detects_change, forward_of)
 
 
 def bilinear(image: np.ndarray, px: np.ndarray, py: np.ndarray) -> np.ndarray:
@@ -97,13 +97,14 @@ def resolve_reference(history, low_color, low_distance, depth, size, r: int, off
                       history_clamp: float = HISTORY_CLAMP, motion_limit: float = MOTION_LIMIT,
                       detect_change: bool = False, low_depth=None):
     """One resolve at full-res ``size`` (w, h). ``history``: None (no valid history) or (color (h, w, 4),
-    distance (h, w, 2), scene distance (h, w), each pixel's last sample (h, w, 4)) of the previous frame; ``low_color`` (lh, lw, 4),
+    distance (h, w, 2), scene distance (h, w), each pixel's last marched sample (h, w, 4), the samples its
+    colour averages (h, w)) of the previous frame; ``low_color`` (lh, lw, 4),
     ``low_distance`` (lh, lw, 2): this frame's samples at full-res pixels (i·r + ox, j·r + oy);
     ``depth``: the window-space scene depth (h, w) or None; ``prev``: (camera, aspect) of the
     history's frame; ``detect_change``: :func:`.temporal.detects_change` of the frames the camera
     has been still; ``low_depth``: the window depth each sample's ray saw (lh, lw), with ``depth``
-    making the upsample depth-aware. Returns (color, distance, scene distance, last sample): the frame
-    and the next history."""
+    making the upsample depth-aware. Returns (color, distance, scene distance, last marched sample,
+    samples averaged): the frame and the next history."""
     lh, lw = low_color.shape[:2]
     w, h = size
     ox, oy = offset
@@ -124,7 +125,10 @@ def resolve_reference(history, low_color, low_distance, depth, size, r: int, off
                       for j in (-1, 0, 1) for i in (-1, 0, 1)])
     lo, hi = neigh.min(axis=0), neigh.max(axis=0)
 
-    out, last = up, up[..., :4]
+    fresh = ((x - ox) % r == 0) & ((y - oy) % r == 0)
+    fi, fj = ((x - ox) // r).astype(np.int64), ((y - oy) // r).astype(np.int64)
+    fresh_value = both[np.clip(fj, 0, lh - 1), np.clip(fi, 0, lw - 1)]
+    out, last, held = up, up[..., :4], np.zeros((h, w))
     if history is not None:
         hist = np.concatenate([history[0], history[1]], axis=-1)
         prev_camera, prev_aspect = prev
@@ -161,18 +165,20 @@ def resolve_reference(history, low_color, low_distance, depth, size, r: int, off
         correction = sum(weight[..., None] * (both[ty, tx] - bilinear(hist, tx * r + ox + (qx - x), ty * r + oy + (qy - y)))
                          for tx, ty, weight in taps)
         sampled = sampled + moved * correction
-        clamp_w = history_clamp * moved
+        clamp_w = np.where(fresh[..., None], history_clamp, history_clamp * moved)   # a marched pixel's mean: the box
         sampled = sampled + clamp_w * (np.clip(sampled, lo, hi) - sampled)
         trust = 1.0 - np.clip(2.0 * change / CHANGE_TOLERANCE - 1.0, 0.0, 1.0)     # drifting clouds: the upsample
         keep = np.where(inside & same, trust * np.clip(1.0 - motion / motion_limit, 0.0, 1.0), 0.0)[..., None]
         out = out + keep * (sampled - out)
+        held = history[4][ny, nx] * keep[..., 0] * (1.0 - moved[..., 0]) * (1.0 - drifting)   # the samples the history averages
+        a = np.maximum(1.0 / (held + 1.0), HISTORY_BLEND)[..., None]
+        # a marched pixel: the running mean of its samples, then an exponential one
+        fresh_value = fresh_value + (1.0 - a) * (sampled - fresh_value)
 
-    fresh = ((x - ox) % r == 0) & ((y - oy) % r == 0)
-    fi, fj = ((x - ox) // r).astype(np.int64), ((y - oy) // r).astype(np.int64)
-    fresh_value = np.concatenate([low_color, low_distance], axis=-1)[np.clip(fj, 0, lh - 1), np.clip(fi, 0, lw - 1)]
     out = np.where(fresh[..., None], fresh_value, out)
-    last = np.where(fresh[..., None], fresh_value[..., :4], last)
-    return out[..., :4], out[..., 4:], scene, last
+    last = np.where(fresh[..., None], both[np.clip(fj, 0, lh - 1), np.clip(fi, 0, lw - 1), :4], last)
+    held = np.where(fresh, np.minimum(held + 1.0, 1.0 / HISTORY_BLEND), held)
+    return out[..., :4], out[..., 4:], scene, last, held
 
 
 def _reproject(hist_distance, camera, prev_camera, prev_aspect, aspect, size, scene):
@@ -215,16 +221,16 @@ class ReferenceHistory:
         self.history = self.prev = self.r = None
         self.still_frames = 0
 
-    def resolve(self, low_color, low_distance, depth, r, offset, camera, aspect, **knobs):
+    def resolve(self, low_color, low_distance, depth, r, offset, camera, aspect, repeats=True, **knobs):
         if r != self.r or (self.prev is not None and TemporalClouds.is_cut(camera, np.asarray(self.prev[0].position, np.float64),
                                                                            forward_of(self.prev[0]))):
             self.history, self.r = None, r
         still = self.history is not None and camera_state(camera, aspect) == camera_state(*self.prev)
         self.still_frames = self.still_frames + 1 if still else 0
-        color, distance, scene, last = resolve_reference(self.history, low_color, low_distance, depth, self.size, r,
+        color, distance, scene, last, held = resolve_reference(self.history, low_color, low_distance, depth, self.size, r,
                                                    offset, camera, self.prev, aspect, **knobs,
-                                                   detect_change=detects_change(self.still_frames, r))
-        self.history = (color, distance, scene, last)
+                                                   detect_change=detects_change(self.still_frames, r, repeats))
+        self.history = (color, distance, scene, last, held)
         self.prev = (_copy(camera), aspect)
         return color, distance
 

@@ -14,10 +14,12 @@
 //         where it is low the edge is carved in. Less carving at the base (flatter bases), most at
 //         the top (cauliflower tops). shape = base.r (Perlin–Worley) with 1 octave, from 2 on Nubis'
 //         remap(base.r, fbm - 1, 1, 0, 1) with fbm = base.gba · (.625, .25, .125) (same fetch).
-//   band 3 (detail)  c = erode(c, B strength mix(fine, 1 - fine, clamp(3 h, 0, 1))), erode(c, e) =
+//   band 3 (detail)  c = erode(c, c B strength mix(fine, 1 - fine, clamp(3 h, 0, 1))), erode(c, e) =
 //         remap(c, min(e, 0.98), 1, 0, 1), fine = the detail texture's Worley FBM (tile
 //         detail_scale / 8, a second 3D read), B = detail_band_strength / strength: wispy strands at
-//         the base (the FBM's cells), cauliflower billows above (its inverse).
+//         the base (the FBM's cells), cauliflower billows above (its inverse). The threshold scales
+//         with c, so the fine band thins a thin edge (to c (1 - e) / (1 - e c)) but never cuts it to 0:
+//         a threshold of its own punched isolated pinholes through every edge, seen at 1:1.
 // c = 1 stays 1 (e <= 1 - w; a core is never holed) and the result grows with d.
 // footprint: the pixel's width at p (m). A band's noise finer than the pixel aliases (stripes and
 // crawling jaggies on far clouds), so each band's strength is scaled by keep = detail_fade(footprint in
@@ -75,7 +77,7 @@ float detail_density(float d, vec3 p, float footprint) {
     vec3 f = textureLod(detail_fine_noise, fract(p * detail_inv_scale_fine - detail_offset_fine), 0.0).rgb;
     float fine = dot(f, vec3(0.625, 0.25, 0.125));
     float keep_fine = detail_fade(footprint * detail_inv_scale_fine);
-    c = detail_erode(c, keep_fine * detail_band_strength * mix(fine, 1.0 - fine, clamp(3.0 * h, 0.0, 1.0)));
+    c = detail_erode(c, c * keep_fine * detail_band_strength * mix(fine, 1.0 - fine, clamp(3.0 * h, 0.0, 1.0)));
 #endif
     return detail_coverage * c;
 #endif

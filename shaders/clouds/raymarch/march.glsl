@@ -39,22 +39,24 @@ uniform int skipping;          // 1: use skip_map
 uniform vec3 skip_cells;       // cells per skip-map texel (group x, band height, group z)
 uniform int max_skips;         // skip-map texels a ray can cross
 uniform ivec2 frame_size;      // full-res pixels
-uniform int jitter;            // 1: per-pixel first-sample offset, fixed in time; 0: midpoints
+uniform int jitter;            // 1: per-pixel first-sample offset (blue noise + jitter_shift); 0: midpoints
+uniform float jitter_shift;    // the frame's rotation of the offsets (0: fixed in time)
 uniform vec3 sun_march;        // toward the sun, times the sun march's first step (m)
 uniform float sun_growth;      // each sun-march step is this many times the last
 uniform float far_distance;    // FAR_FIELD: the march ends this far from the camera (m)
 uniform float far_growth;      // FAR_FIELD: the step's growth per metre of distance in the far field
 uniform float pixel_angle;     // a full-res pixel's angle (rad): its width per metre of distance
 
-// The blue noise (atmos/blue_noise.py) of the full-res pixel, tiled, the same every frame: the temporal
-// resolve keeps each pixel's latest sample (it does not average), so an offset that moved per frame
-// only flickered (1.1 levels per frame at resolution 1, 5x the clouds' own change in sunset); and
-// interleaved gradient noise, a set of diagonal lines, showed as a woven hatching under the history
-// a moving camera reprojects.
+// The blue noise (atmos/blue_noise.py) of the full-res pixel, tiled, rotated by jitter_shift (mod 1):
+// the plugin turns it by the golden ratio every two r²-frame cycles of the resolve (each pixel marched
+// twice with each offset: the resolve's drift test compares like with like), so each pixel's samples
+// spread over the step and the temporal resolve averages them; 0 where nothing averages (resolution 1, no reprojection): there an offset that moved
+// only flickered. Interleaved gradient noise, a set of diagonal lines, showed as a woven hatching
+// under the history a moving camera reprojects.
 layout(binding = 23) uniform sampler2D blue_noise;
 float sample_jitter(vec2 pixel) {
     if (jitter == 0) return 0.5;
-    return texelFetch(blue_noise, ivec2(pixel) % textureSize(blue_noise, 0), 0).r;
+    return fract(texelFetch(blue_noise, ivec2(pixel) % textureSize(blue_noise, 0), 0).r + jitter_shift);
 }
 
 // Transmittance toward the sun from p (uvw: its texture coordinates): SUN_STEPS steps toward the

@@ -2,10 +2,10 @@
 // The temporal resolve of the ray-marched clouds (plugins/clouds/raymarch/temporal.py says what and
 // why; float64 reference: plugins/clouds/raymarch/temporal_reference.py). One compute invocation per
 // full-res pixel stores the next history: colour (premultiplied), distance (a·d, a), the scene distance
-// behind the pixel and its last marched sample. COMPOSITE 1: it also composites the colour, as stored
-// (float16, read back), onto the frame's colour in place, premultiplied as blend_over did (rgb and alpha =
-// history + (1 - a) · colour), and, COMPOSITE_DISTANCE 1, the distance onto "cloud_distance" with the same
-// weights.
+// behind the pixel with the samples its colour averages, and its last marched sample. COMPOSITE 1: it
+// also composites the colour, as stored (float16, read back), onto the frame's colour in place,
+// premultiplied as blend_over did (rgb and alpha = history + (1 - a) · colour), and, COMPOSITE_DISTANCE
+// 1, the distance onto "cloud_distance" with the same weights.
 #include "lib/view_ray.glsl"
 #include "lib/upsample.glsl"
 
@@ -13,7 +13,7 @@ layout(binding = 0) uniform sampler2D low_color;      // this frame's samples: t
 layout(binding = 1) uniform sampler2D low_distance;
 layout(binding = 2) uniform sampler2D hist_color;     // the previous frame's output, full res
 layout(binding = 3) uniform sampler2D hist_distance;
-layout(binding = 4) uniform sampler2D hist_scene;     // its scene distance (m), -1 = sky
+layout(binding = 4) uniform sampler2D hist_scene;     // its scene distance (m), -1 = sky; the samples its colour averages
 layout(binding = 5) uniform sampler2D scene_depth;    // this frame's depth (when has_depth)
 layout(binding = 6) uniform sampler2D low_depth;      // the scene depth each sample's ray saw (edge < 1e30)
 layout(binding = 7) uniform sampler2D hist_sample;    // each pixel's last marched sample (carried for drift.comp)
@@ -38,6 +38,7 @@ const float CLAMP_MOTION = 1.0;      // temporal.py's constants
 const float DEPTH_TOLERANCE = 0.1;
 const float ALPHA_EPS = 1e-4;
 const float CHANGE_TOLERANCE = 0.02;
+const float HISTORY_BLEND = 0.15;
 
 layout(local_size_x = 8, local_size_y = 8) in;
 #if COMPOSITE
@@ -46,7 +47,7 @@ layout(binding = 0, rgba16f) uniform image2D next_color;       // the history wr
 layout(binding = 0, rgba16f) uniform writeonly image2D next_color;     // the history written: the other set
 #endif
 layout(binding = 1, rg32f) uniform writeonly image2D next_distance;
-layout(binding = 2, r32f) uniform writeonly image2D next_scene;
+layout(binding = 2, rg32f) uniform writeonly image2D next_scene;
 layout(binding = 3, rgba16f) uniform writeonly image2D next_sample;
 #if COMPOSITE
 layout(binding = 4, rgba16f) uniform image2D color_image;             // the frame's colour
@@ -80,22 +81,22 @@ bool project(vec3 v, vec2 size, out vec2 q) {
     return true;
 }
 
-// The history at full-res pixel pix: colour, distance (a·d, a), scene distance, last sample.
-void resolve(ivec2 pix, vec2 size, out vec4 out_color, out vec2 out_distance, out float out_scene, out vec4 out_sample) {
+// The history at full-res pixel pix: colour, distance (a·d, a), (scene distance, samples averaged), last
+// marched sample.
+void resolve(ivec2 pix, vec2 size, out vec4 out_color, out vec2 out_distance, out vec2 out_scene, out vec4 out_sample) {
     vec2 uv = (vec2(pix) + 0.5) / size;
     vec3 dir = view_ray_dir(uv, view_basis);
     float scene = -1.0;
     if (has_depth) scene = view_ray_distance(uv, texelFetch(scene_depth, pix, 0).r, view_basis, near, far, -1.0);
-    out_scene = scene;
 
-    // a pixel marched this frame: its sample, exactly
+    // a pixel marched this frame: its sample, averaged into its history below
     ivec2 rel = pix - offset;
-    if (rel.x >= 0 && rel.y >= 0 && rel.x % r == 0 && rel.y % r == 0) {
+    bool fresh = rel.x >= 0 && rel.y >= 0 && rel.x % r == 0 && rel.y % r == 0;
+    vec4 fc = vec4(0.0); vec2 fd = vec2(0.0);
+    if (fresh) {
         ivec2 q = min(rel / r, textureSize(low_color, 0) - 1);
-        out_color = texelFetch(low_color, q, 0);
-        out_distance = texelFetch(low_distance, q, 0).rg;
-        out_sample = out_color;
-        return;
+        fc = texelFetch(low_color, q, 0);
+        fd = texelFetch(low_distance, q, 0).rg;
     }
     // this frame's samples upsampled, and the box of the 3x3 low-res texels around the pixel
     vec2 lp = (vec2(pix) - vec2(offset)) / float(r);
@@ -110,9 +111,10 @@ void resolve(ivec2 pix, vec2 size, out vec4 out_color, out vec2 out_distance, ou
         d += weights[k] * texelFetch(low_distance, taps[k], 0).rg;
     }
     if (!history_valid) {
-        out_sample = c;
-        out_color = c;
-        out_distance = d;
+        out_color = fresh ? fc : c;
+        out_distance = fresh ? fd : d;
+        out_sample = out_color;
+        out_scene = vec2(scene, fresh ? 1.0 : 0.0);
         return;
     }
     ivec2 centre = clamp(ivec2(floor(lp + 0.5)), ivec2(0), last);
@@ -180,26 +182,37 @@ void resolve(ivec2 pix, vec2 size, out vec4 out_color, out vec2 out_distance, ou
     }
     hc += moved * dc;
     hd += moved * dd;
-    float clamp_w = history_clamp * moved;
+    float clamp_w = history_clamp * (fresh ? 1.0 : moved);     // a marched pixel's mean: to this frame's box
     hc = mix(hc, clamp(hc, lo_c, hi_c), clamp_w);
     hd = mix(hd, clamp(hd, lo_d, hi_d), clamp_w);
     // drifting clouds: the history is stale where its sample changed, the upsample of this frame's
     // samples is nearer (all of it from CHANGE_TOLERANCE, none below half)
     float trust = 1.0 - clamp(2.0 * change / CHANGE_TOLERANCE - 1.0, 0.0, 1.0);
     float keep = (inside && same) ? trust * clamp(1.0 - motion / motion_limit, 0.0, 1.0) : 0.0;
+    // the samples the kept history averages (none where it moved, was dropped or the clouds drift)
+    float held = texelFetch(hist_scene, nearest, 0).g * keep * (1.0 - moved) * (1.0 - drifting);
+    if (fresh) {        // the running mean of its samples, then an exponential one (HISTORY_BLEND)
+        float a = max(1.0 / (held + 1.0), HISTORY_BLEND);
+        out_color = fc + (1.0 - a) * (hc - fc);                 // exact at a = 1
+        out_distance = fd + (1.0 - a) * (hd - fd);
+        out_sample = fc;
+        out_scene = vec2(scene, min(held + 1.0, 1.0 / HISTORY_BLEND));
+        return;
+    }
     out_color = (1.0 - keep) * c + keep * hc;                 // not mix(): exact at keep = 1
     out_distance = (1.0 - keep) * d + keep * hd;
+    out_scene = vec2(scene, held);
 }
 
 void main() {
     ivec2 pix = ivec2(gl_GlobalInvocationID.xy);
     ivec2 extent = imageSize(next_color);
     if (any(greaterThanEqual(pix, extent))) return;
-    vec4 color, last; vec2 distance; float scene;
+    vec4 color, last; vec2 distance, scene;
     resolve(pix, vec2(extent), color, distance, scene, last);
     imageStore(next_color, pix, color);
     imageStore(next_distance, pix, vec4(distance, 0.0, 0.0));
-    imageStore(next_scene, pix, vec4(scene, 0.0, 0.0, 0.0));
+    imageStore(next_scene, pix, vec4(scene, 0.0, 0.0));
     imageStore(next_sample, pix, last);
 #if COMPOSITE
     vec4 held = imageLoad(next_color, pix);     // as stored (float16, rounded as the GL rounds): this invocation's own write
