@@ -65,6 +65,13 @@ BY_ALTITUDE = Sun(DAY.direction, DAY.color, color_by_altitude=lambda d, h: np.st
     [h / 500.0, np.full_like(h, 0.6), np.full_like(h, 0.3)], -1))
 
 
+def shading_volume(sim) -> np.ndarray:
+    """Set A's shading volume (transmittance toward the sun) as float64 [x, y, z], read back."""
+    texture = sim.a["transmittance"]
+    nx, ny, nz = texture.size
+    return np.frombuffer(texture.read(), np.float16).astype(np.float64).reshape(nz, ny, nx).transpose(2, 1, 0)
+
+
 @pytest.mark.parametrize("sun", [DAY, BY_ALTITUDE], ids=["day", "by_altitude"])
 def test_the_march_matches_its_float64_reference(gpu, ctx, sun):
     app = scene(gpu, volume(), sun, empty_space_skipping=False, min_transmittance=0.0, steps=96, step_growth=0.002)
@@ -72,9 +79,7 @@ def test_the_march_matches_its_float64_reference(gpu, ctx, sun):
     image = linear(app)
     plugin = next(p for p in app.plugins if isinstance(p, CloudsPlugin))
     sim = plugin.simulation.sets()
-    trans = np.frombuffer(sim.a["transmittance"].read(), np.float16).astype(np.float64)
-    tshape = sim.a["transmittance"].size
-    trans = trans.reshape(tshape[2], tshape[1], tshape[0]).transpose(2, 1, 0)
+    trans = shading_volume(sim)
     settings = next(p for p in app.plugins if isinstance(p, RaymarchCloudsPlugin)).settings
     ref = march_reference(volume(), trans, sim.settings, settings, sim.layout(), cam, sun, gpu.size,
                           field=read_field(sim.a[DIFFUSION]))
@@ -138,9 +143,7 @@ def test_at_resolution_2_each_texel_holds_its_pixels_ray_and_the_exact_scene_dep
         np.testing.assert_array_equal(v[LOW_DEPTH][..., 0], depth[np.ix_(py, px)])
         plugin = next(p for p in app.plugins if isinstance(p, CloudsPlugin))
         sim = plugin.simulation.sets()
-        trans = np.frombuffer(sim.a["transmittance"].read(), np.float16).astype(np.float64)
-        tshape = sim.a["transmittance"].size
-        trans = trans.reshape(tshape[2], tshape[1], tshape[0]).transpose(2, 1, 0)
+        trans = shading_volume(sim)
         settings = next(p for p in app.plugins if isinstance(p, RaymarchCloudsPlugin)).settings
         _, start = rays(cam, gpu.size)
         scene_distance = np.where(depth < 1.0, cam.near / ((1.0 - depth) + depth * (cam.near / cam.far))
