@@ -17,7 +17,7 @@ from atmos.plugins.fog.medium import FogMedium
 from atmos.plugins.fog.noise import NoiseVolumes
 from atmos.plugins.fog.post import FogPass, draw_state, fog_program, restore_state, set_fog_uniforms
 from atmos.plugins.fog.settings import MODES, PAPER_RESOLUTIONS, FogSettings
-from atmos.plugins.fog.sky_color import SAMPLES, horizon_table
+from atmos.plugins.fog.sky_color import SAMPLES, horizon_table, shader_table
 from atmos.plugins.sky import SkyLight
 from atmos.gpu.uniforms import bind_textures, write_uniforms
 
@@ -36,6 +36,7 @@ class FogPlugin(Plugin):
         self.fog_pass: FogPass | None = None
         self.composition = None
         self._sky = None
+        self._table = None                  # (SceneView, its sky table): held, never a reused id
 
     def build(self, app) -> None:
         self.composition = composition(app)
@@ -54,6 +55,15 @@ class FogPlugin(Plugin):
         if self.settings.color_from != "sky":
             return None
         return horizon_table(view.sun, self._sky, altitude=max(float(view.camera.position[1]), 0.0))
+
+    def sky_table(self, view):
+        """:meth:`horizon` by angle from the sun as the shader reads it (:func:`.sky_color.shader_table`),
+        None with a fixed colour; made once per frame, whatever the users (the fog pass, the shafts' fog)."""
+        if self.settings.color_from != "sky":
+            return None
+        if self._table is None or self._table[0] is not view:
+            self._table = (view, shader_table(self.horizon(view), view.sun))
+        return self._table[1]
 
     def cleanup(self, app) -> None:
         if self.composition is not None:
@@ -122,7 +132,7 @@ def apply_fog(gpu, color, distance, mode: str = "exp2", density: float = 0.044, 
             volumes = NoiseVolumes(gpu, settings)
             volumes.bind(prog)
         bind_textures(prog, fog_distance=dist_tex, fog_position=pos_tex, cloud_distance=cloud_tex, fog_direction=dir_tex)
-        set_fog_uniforms(prog, settings, time, horizon, sun)
+        set_fog_uniforms(prog, settings, time, None if horizon is None else shader_table(horizon, sun), sun)
         write_uniforms(prog, fog_far=far, fog_camera=tuple(float(v) for v in camera))
         fbo.use()
         gl.viewport = (0, 0, w, h)

@@ -35,4 +35,4 @@ class FogMedium:
     def set_uniforms(self, program, view) -> None:
         """The factor's and the colour's uniforms at this SceneView's time, sun and camera."""
         s = self.settings
-        set_fog_uniforms(program, s, view.time + s.time_offset, self._plugin.horizon(view), view.sun)
+        set_fog_uniforms(program, s, view.time + s.time_offset, self._plugin.sky_table(view), view.sun)

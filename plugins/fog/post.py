@@ -11,7 +11,7 @@ from atmos.graph import PassBuilder, PassContext, RenderPass, work_groups
 from atmos.graph.frame import BLEND_TRANSMITTANCE, blend
 from atmos.plugins.fog.noise import NoiseVolumes, octave_key
 from atmos.plugins.fog.settings import MODES
-from atmos.plugins.fog.sky_color import SAMPLES, ZENITH, sun_angle_table
+from atmos.plugins.fog.sky_color import SAMPLES, sky_sun
 from atmos.render_core import COLOR, DEPTH
 from atmos.gpu.uniforms import write_uniforms
 
@@ -43,15 +43,12 @@ def sun_light(sun, settings) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(direction, np.float64), np.asarray(sun.color, np.float64) * settings.sun_scattering * day
 
 
-def set_fog_uniforms(prog, settings, time: float, horizon=None, sun=None) -> None:
+def set_fog_uniforms(prog, settings, time: float, table=None, sun=None) -> None:
     """The factor's uniforms (fog/factor.glsl) and the fog colour and sky handling (fog/fog.frag);
-    ``horizon``: the (SAMPLES, 3) horizon sky colours of ``color_from="sky"`` (:mod:`.sky_color`, read
-    round ``sun``'s direction; the zenith without one); ``sun`` (a Sun; None: none): the sunlight it
-    scatters (``sun_scattering``)."""
-    if horizon is not None:             # the azimuth table, read at each ray's angle from the sun
-        sky_sun = np.asarray(sun.direction, np.float64) if sun is not None else np.array(ZENITH)
-        write_uniforms(prog, fog_horizon=np.asarray(sun_angle_table(horizon, sky_sun), np.float32).tobytes(),
-                       fog_sky_sun=tuple(sky_sun))
+    ``table``: ``color_from="sky"``'s horizon by angle from ``sun`` (:func:`.sky_color.shader_table`);
+    ``sun`` (a Sun; None: none): the sunlight it scatters (``sun_scattering``)."""
+    if table is not None:
+        write_uniforms(prog, fog_horizon=table.tobytes(), fog_sky_sun=sky_sun(sun))
     direction, light = sun_light(sun, settings)
     write_uniforms(prog, fog_sun_light=tuple(light), fog_sun_dir=tuple(direction), fog_lobes=settings.phase.lobes)
     write_uniforms(prog, fog_density=settings.density, fog_start=settings.start, fog_end=settings.end,
@@ -128,7 +125,7 @@ class FogPass(RenderPass):
             textures["cloud_distance"] = CLOUD_DISTANCE
         if self.volumes is not None:
             self.volumes.bind(prog)
-        set_fog_uniforms(prog, settings, view.time + settings.time_offset, self.plugin.horizon(view), view.sun)
+        set_fog_uniforms(prog, settings, view.time + settings.time_offset, self.plugin.sky_table(view), view.sun)
         images = {"color_image": COLOR}
         if media:
             images.update(media_light_image=MEDIA_LIGHT, media_transmittance_image=MEDIA_TRANSMITTANCE)

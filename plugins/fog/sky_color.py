@@ -52,6 +52,17 @@ def sun_angle_table(table, sun_dir=ZENITH) -> np.ndarray:
     return 0.5 * (horizon_at(table, sun_azimuth + delta) + horizon_at(table, sun_azimuth - delta))
 
 
+def sky_sun(sun) -> tuple:
+    """The direction the sky's colour is read round: ``sun``'s (an :class:`atmos.Sun`), the zenith without one."""
+    return ZENITH if sun is None else tuple(float(v) for v in sun.direction)
+
+
+def shader_table(table, sun) -> np.ndarray:
+    """float32 (n, 3): what ``fog/color.glsl`` reads (its ``fog_horizon``): the horizon ``table`` by
+    angle from ``sun`` (:func:`sun_angle_table` round :func:`sky_sun`)."""
+    return sun_angle_table(table, sky_sun(sun)).astype(np.float32)
+
+
 def sun_angle(directions, sun_dir=ZENITH) -> np.ndarray:
     """(...) sin(Δ/2) of the horizontal angle Δ from the sun a view ray takes its light at: with
     c = clamp(d·s / |s.xz|, −1, 1), sqrt((1 − c) / 2) (the sun at the zenith: 0 or 1)."""
