@@ -20,6 +20,7 @@ uniform float edge;          // relative view-depth difference that makes an edg
 uniform vec2 sample_offset;  // texel (i, j) holds the frame's pixel (i, j) * factor + sample_offset
 
 #include "lib/upsample.glsl"
+#include "lib/over.glsl"
 
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
@@ -35,12 +36,11 @@ void main() {
 #if COMPOSITE_MEDIUM
     imageStore(color_image, px, vec4(sum.rgb + sum.a * c.rgb, c.a));
 #else
-    imageStore(color_image, px, sum + (1.0 - sum.a) * c);
+    imageStore(color_image, px, over(sum, c));
 #endif
 #if COMPOSITE_DISTANCE
     vec2 dist = vec2(0.0);
     for (int k = 0; k < 4; ++k) dist += weights[k] * texelFetch(cloud_distance, taps[k], 0).rg;
-    vec2 d = imageLoad(distance_image, px).rg;
-    imageStore(distance_image, px, vec4(dist + (1.0 - dist.y) * d, 0.0, 0.0));
+    imageStore(distance_image, px, vec4(over(dist, imageLoad(distance_image, px).rg), 0.0, 0.0));
 #endif
 }

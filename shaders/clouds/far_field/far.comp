@@ -23,6 +23,7 @@
 #include "lib/view_ray.glsl"
 #include "clouds/far_field/field.glsl"
 #include "clouds/volume/volume.glsl"
+#include "lib/over.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0, rgba16f) uniform image2D color_image;
 #if FAR_DISTANCE
@@ -128,9 +129,8 @@ void main() {
     imageStore(distance_image, px, vec4(layer.a > 0.0 ? distance.rg : vec2(0.0), 0.0, 0.0));
 #endif
     if (!(layer.a > 0.0)) return;                        // nothing in front: the pixel stays as it is
-    imageStore(color_image, px, layer + (1.0 - layer.a) * imageLoad(color_image, px));
+    imageStore(color_image, px, over(layer, imageLoad(color_image, px)));
 #if FAR_DISTANCE == 1
-    vec2 d = imageLoad(distance_image, px).rg;
-    imageStore(distance_image, px, vec4(distance.rg + (1.0 - distance.a) * d, 0.0, 0.0));
+    imageStore(distance_image, px, vec4(over(distance.rg, imageLoad(distance_image, px).rg), 0.0, 0.0));
 #endif
 }

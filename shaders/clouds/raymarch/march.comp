@@ -7,6 +7,7 @@
 // would (layer + (1 - a) colour, alpha too) and, MARCH_DISTANCE 1, its distance onto "cloud_distance"
 // with its own alpha (atmos/composition.py).
 #include "clouds/raymarch/march.glsl"
+#include "lib/over.glsl"
 #ifndef MARCH_ONTO
 #define MARCH_ONTO 0
 #endif
@@ -35,9 +36,9 @@ void main() {
     float depth;
     cloud_march(min(texel * factor + sample_offset, frame_size - 1), color, distance, depth);
 #if MARCH_ONTO
-    imageStore(color_image, texel, color + (1.0 - color.a) * imageLoad(color_image, texel));
+    imageStore(color_image, texel, over(color, imageLoad(color_image, texel)));
 #if MARCH_DISTANCE
-    imageStore(distance_image, texel, vec4(distance + (1.0 - distance.y) * imageLoad(distance_image, texel).rg, 0.0, 0.0));
+    imageStore(distance_image, texel, vec4(over(distance, imageLoad(distance_image, texel).rg), 0.0, 0.0));
 #endif
 #else
     imageStore(color_image, texel, color);

@@ -8,6 +8,7 @@
 // 1, the distance onto "cloud_distance" with the same weights.
 #include "lib/view_ray.glsl"
 #include "lib/upsample.glsl"
+#include "lib/over.glsl"
 
 layout(binding = 0) uniform sampler2D low_color;      // this frame's samples: texel (i, j) = pixel (i·r + ox, j·r + oy)
 layout(binding = 1) uniform sampler2D low_distance;
@@ -216,9 +217,9 @@ void main() {
     imageStore(next_sample, pix, last);
 #if COMPOSITE
     vec4 held = imageLoad(next_color, pix);     // as stored (float16, rounded as the GL rounds): this invocation's own write
-    imageStore(color_image, pix, held + (1.0 - held.a) * imageLoad(color_image, pix));
+    imageStore(color_image, pix, over(held, imageLoad(color_image, pix)));
 #endif
 #if COMPOSITE_DISTANCE
-    imageStore(distance_image, pix, vec4(distance + (1.0 - distance.y) * imageLoad(distance_image, pix).rg, 0.0, 0.0));
+    imageStore(distance_image, pix, vec4(over(distance, imageLoad(distance_image, pix).rg), 0.0, 0.0));
 #endif
 }
