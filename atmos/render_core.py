@@ -176,11 +176,9 @@ class PresentPass(ComputePass):
 
     def execute(self, frame: PassContext) -> None:
         p = self.program
-        if self.camera:
-            write_uniforms(p, dither=DITHER_STEP if self.plugin.settings.dither else 0.0)
-        else:
-            write_uniforms(p, exposure=self.plugin.settings.exposure,
-                           dither=DITHER_STEP if self.plugin.settings.dither else 0.0)
+        write_uniforms(p, dither=DITHER_STEP if self.plugin.settings.dither else 0.0)
+        if not self.camera:                               # else the camera's buffer holds it
+            write_uniforms(p, exposure=self.plugin.settings.exposure)
         image = frame.image(PRESENT_IMAGE)
         frame.dispatch(p, self.groups(image.size), textures={"hdr": COLOR, "bloom_image": BLOOM} if self.bloom
                        else {"hdr": COLOR}, images={"screen_image": PRESENT_IMAGE},

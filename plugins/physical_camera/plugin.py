@@ -19,6 +19,7 @@ import numpy as np
 from atmos.checks import check_num
 
 from atmos.graph import BufferDesc, ComputePass, PassBuilder, PassContext, TextureDesc
+from atmos.offscreen import low_size
 from atmos.plugin import Plugin
 from atmos.render_core import BLOOM, CAMERA_EXPOSURE, COLOR, present_inputs
 from atmos.gpu.hazards import dispatch
@@ -36,12 +37,8 @@ def level_name(k: int) -> str:
 
 
 def level_sizes(size, levels: int) -> list[tuple[int, int]]:
-    """(w, h) of levels 1 .. ``levels``: each half the last, rounded up."""
-    out, (w, h) = [], size
-    for _ in range(levels):
-        w, h = -(-w // 2), -(-h // 2)
-        out.append((w, h))
-    return out
+    """(w, h) of levels 1 .. ``levels``: each half the last, rounded up (``size`` / 2^k, rounded up)."""
+    return [low_size(size, 2 ** k) for k in range(1, levels + 1)]
 
 
 class ExposurePass(ComputePass):
