@@ -30,7 +30,8 @@ _EXPORTS = {
     "CapturePass": "atmos.render_core", "OpaquePass": "atmos.render_core", "RenderCorePlugin": "atmos.render_core",
     # what passes see and write
     "SceneView": "atmos.scene_view", "Camera": "atmos.camera", "CameraPlugin": "atmos.camera_control",
-    "set_camera_uniforms": "atmos.scene_uniforms", "Sun": "atmos.lighting", "set_sun_uniforms": "atmos.scene_uniforms",
+    "set_camera_uniforms": "atmos.scene_uniforms", "Sun": "atmos.lighting", "GroundSurface": "atmos.lighting",
+    "set_sun_uniforms": "atmos.scene_uniforms",
     "set_scene_uniforms": "atmos.scene_uniforms", "write_uniforms": "atmos.gpu.uniforms",
     "bind_textures": "atmos.gpu.uniforms", "bind_images": "atmos.gpu.uniforms", "bind_buffers": "atmos.gpu.uniforms",
     "FixedClock": "atmos.clock",

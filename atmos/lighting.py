@@ -39,6 +39,27 @@ _SUN_CHECKS = {
 }
 
 
+class GroundSurface:
+    """The scene's ground as light sees it: ``albedo``, the linear RGB reflectance of what the terrain or
+    ground plane draws (each in [0, 1]), given as a tuple or as a callable read each frame (a live change
+    of the drawing plugin's settings is seen on the next one). TerrainPlugin and GroundPlugin insert one;
+    the clouds' light from below takes it (:mod:`atmos.plugins.clouds.light.medium`)."""
+
+    __slots__ = ("_albedo",)
+
+    def __init__(self, albedo=(0.3, 0.3, 0.3)):
+        if not callable(albedo):
+            albedo = check_vec("GroundSurface", "albedo", albedo, 3, "non-negative")
+            if max(albedo) > 1.0:
+                raise ValueError(f"GroundSurface.albedo must be 3 numbers in [0, 1], got {albedo!r}")
+        self._albedo = albedo
+
+    @property
+    def albedo(self) -> tuple:
+        a = self._albedo
+        return tuple(float(min(max(c, 0.0), 1.0)) for c in (a() if callable(a) else a))
+
+
 @dataclass(slots=True)
 class Sun:
     """``direction`` points from the scene toward the sun (kept at unit length, read-only: assign a

@@ -5,12 +5,13 @@ from dataclasses import dataclass
 
 from atmos.camera import Camera
 from atmos.clock import FixedClock
-from atmos.lighting import Sun
+from atmos.lighting import GroundSurface, Sun
 
 
 @dataclass(frozen=True, slots=True)
 class SceneView:
-    """This frame's camera, sun, clock and frame size, built by the App before the graph runs.
+    """This frame's camera, sun, clock and frame size, and the ground's surface (None where no plugin
+    draws one), built by the App before the graph runs.
 
     A scene without a ``Camera`` or ``Sun`` resource gets the defaults (``Camera()``,
     ``Sun()``). Passes read the scene through it, never through the App; what a pass needs of the
@@ -20,6 +21,7 @@ class SceneView:
     sun: Sun
     clock: FixedClock
     size: tuple[int, int]
+    ground: GroundSurface | None = None
 
     @property
     def aspect(self) -> float:
@@ -36,7 +38,7 @@ class SceneView:
         """The view of ``app`` now; the camera is checked (:meth:`Camera.check`) so a bad one fails here,
         before the frame renders, naming the field."""
         return cls((app.get_resource(Camera) or _DEFAULT_CAMERA).check(), app.get_resource(Sun) or _DEFAULT_SUN, app.clock,
-                   app.gpu.size)
+                   app.gpu.size, app.get_resource(GroundSurface))
 
 
 _DEFAULT_CAMERA = Camera()

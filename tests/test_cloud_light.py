@@ -158,9 +158,11 @@ def test_sprite_image_does_not_grow_with_the_size_factor(gpu, ctx):
             assert 0.3 < image[..., 3].max() and image[..., 3].max() <= 1.0
         app.close()
     ref = sums["march"]
-    # +7 % / +11 % here: the footprint is the quadratic B-spline's, a little wider than the march's hat
-    # (no grid ripple), on tall cells (30 m) that size 3 cuts at 2.5 sigma
-    assert abs(sums[3] / ref - 1) < 0.1 and abs(sums[6] / ref - 1) < 0.13, sums
+    # +10 % / +13.5 % here (+7 / +11 % under a fully sunlit ground): the footprint is the quadratic
+    # B-spline's, a little wider than the march's hat (no grid ripple), on tall cells (30 m) that size 3
+    # cuts at 2.5 sigma; the blob's shadow on the ground (G 0.37) widens the sky-ground difference,
+    # which the sprites take once per sprite and the march per sample
+    assert abs(sums[3] / ref - 1) < 0.11 and abs(sums[6] / ref - 1) < 0.15, sums
     assert abs(sums[6] / sums[3] - 1) < 0.05, sums
     assert abs(sums["lod"] / ref - 1) < 0.36, sums
 

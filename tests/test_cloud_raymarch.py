@@ -12,6 +12,7 @@ from atmos.plugins.clouds.raymarch.plugin import LOW_COLOR, LOW_DEPTH, LOW_DISTA
 from atmos.render_core import DEPTH
 from atmos.plugins.clouds.raymarch.reference import march_reference
 from atmos.plugins.clouds.light.diffusion import DIFFUSION, read_field
+from atmos.plugins.clouds.light.ground import ground_sun_of
 from atmos.plugins.clouds.sprites import CloudRenderPlugin
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
 from atmos.plugins.clouds.raymarch.reference import integrate, rays
@@ -82,7 +83,7 @@ def test_the_march_matches_its_float64_reference(gpu, ctx, sun):
     trans = shading_volume(sim)
     settings = next(p for p in app.plugins if isinstance(p, RaymarchCloudsPlugin)).settings
     ref = march_reference(volume(), trans, sim.settings, settings, sim.layout(), cam, sun, gpu.size,
-                          field=read_field(sim.a[DIFFUSION]))
+                          field=read_field(sim.a[DIFFUSION]), ground_sun=ground_sun_of(sim))
     assert settings.ms_diffusion > 0 and read_field(sim.a[DIFFUSION])[..., 0].max() > 0.1, "the field must be in it"
     assert ref["alpha"].max() > 0.9 and (ref["alpha"] > 0.01).mean() > 0.05, "the view must see the clouds"
     light = ref["light"]
@@ -126,7 +127,8 @@ def test_at_resolution_2_each_texel_holds_its_pixels_ray_and_the_exact_scene_dep
     """The low-res targets (storage images) against the float64 reference at the pixels the frame's offset
     picks: colour and (a·distance, a) as at resolution 1, and the scene depth the ray saw, exactly."""
     from atmos.plugins.ground import GroundPlugin
-    app = scene(gpu, volume(), plugins=(GroundPlugin(),), resolution=2, empty_space_skipping=False,
+    of_ground = GroundPlugin()
+    app = scene(gpu, volume(), plugins=(of_ground,), resolution=2, empty_space_skipping=False,
                 min_transmittance=0.0, steps=96, step_growth=0.002, reprojection=False)
     march = next(p for p in app.graph.passes if p.name == "cloud_raymarch")
     probe = app.graph.add_pass(LowProbe(march))
@@ -149,7 +151,8 @@ def test_at_resolution_2_each_texel_holds_its_pixels_ray_and_the_exact_scene_dep
         scene_distance = np.where(depth < 1.0, cam.near / ((1.0 - depth) + depth * (cam.near / cam.far))
                                   * start / cam.near, np.inf)
         ref = march_reference(volume(), trans, sim.settings, settings, sim.layout(), cam, DAY, gpu.size,
-                              scene=scene_distance, field=read_field(sim.a[DIFFUSION]))
+                              scene=scene_distance, field=read_field(sim.a[DIFFUSION]),
+                              albedo=of_ground.settings.albedo, ground_sun=ground_sun_of(sim))
         ref = {k: ref[k][np.ix_(py, px)] for k in ("light", "alpha", "distance")}
         assert ref["alpha"].max() > 0.9 and (ref["alpha"] > 0.01).mean() > 0.05, "the view must see the clouds"
         color, distance = v[LOW_COLOR], v[LOW_DISTANCE]

@@ -11,6 +11,7 @@ from atmos.plugins.clouds.far_field.cover import level_table
 from atmos.plugins.clouds.far_field.layer import drift
 from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
 from atmos.plugins.clouds.raymarch.far_reference import FarField, far_march_reference
+from atmos.plugins.clouds.light.ground import ground_sun_of
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
 
 SHAPE = (16, 8, 16)
@@ -88,8 +89,9 @@ def test_the_far_field_march_matches_its_float64_reference(gpu, ctx, yaw, fields
     sim = of(app, CloudsPlugin).simulation.sets()
     layout = sim.layout()
     band = (float(layout.lo[1]), float(layout.hi[1] - layout.lo[1]))
+    ground_sun = ground_sun_of(sim)
     ref = far_march_reference(field_reference(app), sim.settings, of(app, RaymarchCloudsPlugin).settings, band,
-                              cam, sun, gpu.size)
+                              cam, sun, gpu.size, ground_sun=ground_sun)
     alpha = ref["alpha"]
     assert 0.05 < (alpha > 0.05).mean() < 0.95 and alpha.max() > 0.5, "the view must see far clouds and gaps"
     light = ref["light"]
@@ -102,7 +104,7 @@ def test_the_far_field_march_matches_its_float64_reference(gpu, ctx, yaw, fields
         assert far.field_profile is not None, "the sets carry a diffusion field"
         far.field_profile = None
         without = far_march_reference(far, sim.settings, of(app, RaymarchCloudsPlugin).settings, band, cam, DAY,
-                                      gpu.size)["light"]
+                                      gpu.size, ground_sun=ground_sun)["light"]
         assert np.sqrt(np.mean((image[..., :3] - without) ** 2)) / np.sqrt(np.mean(without ** 2)) > 0.3
     app.close()
 

@@ -396,8 +396,8 @@ def _clouds_spec():
     observe = {"step_seconds": next_step_reads("dt"), "cover_threshold": lambda app, plugin: plugin.simulation.cover(),
                "scattering": shading_extinction}
     observe.update({f"weather.{name}": next_step_reads(name) for name in live_fields(WeatherPlugin)})
-    return Spec(lambda: [DefaultPlugins(overlay=False), clouds(cover=20), SkyGradientPlugin(), GroundPlugin(),
-                         CloudRenderPlugin()],
+    # no ground plane: its GroundSurface would stand for ground_albedo
+    return Spec(lambda: [DefaultPlugins(overlay=False), clouds(cover=20), SkyGradientPlugin(), CloudRenderPlugin()],
                 CloudsPlugin, look((320.0, 60.0, 1100.0), target=CLOUD_CENTER, far=6000.0), changes, observe=observe)
 
 

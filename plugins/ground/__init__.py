@@ -6,6 +6,7 @@ import numpy as np
 from atmos.checks import CheckedSettings, num_field, vec_field
 
 from atmos.graph import PassContext
+from atmos.lighting import GroundSurface
 from atmos.plugin import Plugin
 from atmos.render_core import OpaquePass
 
@@ -63,3 +64,4 @@ class GroundPlugin(Plugin):
 
     def build(self, app) -> None:
         app.graph.add_pass(GroundPass(self))
+        app.insert_resource(GroundSurface(lambda: self.settings.albedo))   # what the clouds' light from below sees

@@ -8,6 +8,7 @@ from atmos.composition import CLOUD_DISTANCE, composition, distance_desc
 from atmos.graph import ComputePass, PassContext
 from atmos.plugin import Plugin
 from atmos.plugins.clouds.far_field.layer import FarFieldLayer
+from atmos.plugins.clouds.light.ground import GROUND, bind_ground, ground_sun_pass
 from atmos.plugins.clouds.volume.sets import FAR_FIELD
 from atmos.plugins.clouds.far_field.settings import CloudFarFieldSettings
 from atmos.plugins.clouds.volume.light import CloudLightSettings, light_uniforms, write_light
@@ -31,6 +32,7 @@ class CloudFarFieldPass(ComputePass):
         if self.plugin.drawn_by_march():
             return                          # a ray march draws the far field volumetrically: culled
         super().setup(builder)
+        builder.read(GROUND, access="uniform")
         comp = self.plugin.composition
         if comp.distance and not comp.distance_cleared:        # the first writer: every pixel written
             builder.create(CLOUD_DISTANCE, distance_desc(self.plugin.gpu.size), access="storage")
@@ -56,7 +58,8 @@ class CloudFarFieldPass(ComputePass):
         set_camera_uniforms(p, view.camera, view.aspect)
         light = self.plugin.light_settings()       # the renderer's octaves; its field's weight where measured
         diffusion = light.ms_diffusion if layer.light.has_field else 0.0
-        values = dict(light_uniforms(sim.settings, view.sun, light.octaves, diffusion, layout.heights),
+        ground = None if view.ground is None else view.ground.albedo
+        values = dict(light_uniforms(sim.settings, view.sun, light.octaves, diffusion, layout.heights, ground),
                       footprint_min=tuple(layout.lo[[0, 2]]), footprint_size=tuple(layout.hi[[0, 2]] - layout.lo[[0, 2]]),
                       edge_fade=float(sim.settings.edge_fade), layer_height=float(layout.hi[1] - layout.lo[1]),
                       lod_scale=float(params.size / layer.tile_size * 2.0 * np.tan(view.camera.fov_y / 2)
@@ -64,6 +67,7 @@ class CloudFarFieldPass(ComputePass):
                       **{name: float(getattr(params, name)) for name in
                          ("thickness", "horizon_fade")})
         write_light(p, values)
+        bind_ground(p, frame.resource(GROUND))
         images = {"color_image": COLOR, **({"distance_image": CLOUD_DISTANCE} if distance else {})}
         frame.dispatch(p, self.groups(frame.image(COLOR).size), textures={"scene_depth": DEPTH}, images=images)
 
@@ -89,6 +93,7 @@ class CloudFarFieldPlugin(Plugin):
         app.graph.import_resource(FAR_FIELD, self.layer)
         self.pass_ = CloudFarFieldPass(self)
         app.graph.add_pass(self.pass_)
+        ground_sun_pass(app.graph)
 
     def cleanup(self, app) -> None:
         layer = getattr(self, "layer", None)

@@ -11,8 +11,10 @@ The light: sun irradiance ``E = sun_intensity * Sun.color`` (on a plane facing t
 already carries its path through the atmosphere and is 0 below the horizon; the default 4 pi makes
 isotropic single scattering of a unit colour equal to the colour, the old ``sun x T`` model); sky
 radiance ``L_sky = sky_intensity * Sun.ambient`` from every direction above the horizon; the ground
-below a Lambertian ``ground_albedo`` lit by both, radiance ``ground_albedo * (E * max(sun_y, 0) / pi
-+ L_sky)``. :func:`environment` gives the three; :mod:`atmos.plugins.clouds.light.path_tracer` renders exactly
+below a Lambertian of albedo ``rho_g`` (the scene's ground, :class:`atmos.lighting.GroundSurface`, else
+``ground_albedo``) lit by both, radiance ``rho_g * (E * max(sun_y, 0) * G / pi + L_sky)``, ``G`` the
+ground's mean sun transmittance through the clouds (their shadow on it: :mod:`.ground`; 1 without).
+:func:`environment` gives the three; :mod:`atmos.plugins.clouds.light.path_tracer` renders exactly
 this scene (all orders), the real-time renderers approximate it (``clouds/volume/volume.glsl``):
 
     source per unit extinction J = albedo * (E * (sum_i b^i p(cos; c^i g) P_i(T) + beta L_field)
@@ -61,13 +63,23 @@ def cell_sigma(sigma_t: float, cell, direction) -> float:
     return float(sigma_t * np.linalg.norm(u / n * cell))
 
 
-def environment(settings, sun_color, sky, sun_dir) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(sun irradiance E, sky radiance, ground radiance) as float64 RGB for a ``CloudSettings``."""
-    e = settings.sun_intensity * np.asarray(sun_color, np.float64)
-    l_sky = settings.sky_intensity * np.asarray(sky, np.float64)
+def ground_parts(settings, sun_color, sky, sun_dir, albedo=None) -> tuple[np.ndarray, np.ndarray]:
+    """(sunlit, sky-lit) parts of the ground's radiance as float64 RGB: ``rho_g E max(sun_y, 0) / pi`` and
+    ``rho_g L_sky`` (``albedo``: the scene ground's RGB; None: the medium's ``ground_albedo``); the radiance
+    is ``sky-lit + G sunlit`` at the ground's mean sun transmittance ``G``."""
+    rho = settings.ground_albedo if albedo is None else np.asarray(albedo, np.float64)
     s = np.asarray(sun_dir, np.float64)
     up = max(float(s[1] / math.sqrt(s.dot(s))), 0.0)   # np.linalg.norm's own formula (1-D float64), without its overhead
-    return e, l_sky, settings.ground_albedo * (e * up / math.pi + l_sky)
+    e = settings.sun_intensity * np.asarray(sun_color, np.float64)
+    return rho * e * up / math.pi, rho * settings.sky_intensity * np.asarray(sky, np.float64)
+
+
+def environment(settings, sun_color, sky, sun_dir, albedo=None, ground_sun: float = 1.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(sun irradiance E, sky radiance, ground radiance) as float64 RGB for a ``CloudSettings``, the
+    ground of ``albedo`` (None: ``settings.ground_albedo``) at mean sun transmittance ``ground_sun``."""
+    e = settings.sun_intensity * np.asarray(sun_color, np.float64)
+    lit, sky_lit = ground_parts(settings, sun_color, sky, sun_dir, albedo)
+    return e, settings.sky_intensity * np.asarray(sky, np.float64), sky_lit + ground_sun * lit
 
 
 def octave_transmittances(T, a: float) -> np.ndarray:
@@ -96,15 +108,16 @@ def ambient_profile(tau_up, tau_down, g_mean: float, ray_y) -> np.ndarray:
 
 
 def source_reference(settings, render, T, tau_up, tau_down, cos, ray_y, sun_color, sky, sun_dir,
-                     diffusion=None, *, octaves=None, sun_colors=None) -> np.ndarray:
+                     diffusion=None, *, octaves=None, sun_colors=None, albedo=None, ground_sun: float = 1.0) -> np.ndarray:
     """float64 (n, 3): J of the module docstring at points with transmittance ``T`` (or, given
     ``octaves`` (n, 4), those as the octaves' sun transmittances: the far fields' by rank), column optical
     depths ``tau_up``/``tau_down``, view/sun cosine ``cos`` and view ray y ``ray_y`` (``render``:
     the CloudRenderSettings or RaymarchCloudSettings); ``diffusion``: the diffusion field's radiance
     there (:func:`atmos.plugins.clouds.light.diffusion.diffusion_radiance`, unit irradiance), added with the weight
     ``render.ms_diffusion`` (None: no field); ``sun_colors`` (n, 3): the sun's colour at each point
-    (None: ``sun_color``, which the ground's light takes in any case)."""
-    e, l_sky, l_ground = environment(settings, sun_color, sky, sun_dir)
+    (None: ``sun_color``, which the ground's light takes in any case); ``albedo``, ``ground_sun``: the
+    ground's (:func:`environment`)."""
+    e, l_sky, l_ground = environment(settings, sun_color, sky, sun_dir, albedo, ground_sun)
     if sun_colors is not None:
         e = settings.sun_intensity * np.asarray(sun_colors, np.float64)
     tau_up, tau_down = np.asarray(tau_up, np.float64), np.asarray(tau_down, np.float64)

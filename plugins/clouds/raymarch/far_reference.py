@@ -63,8 +63,9 @@ class FarField:
         return np.stack([self.rank(xz, k) for k in range(4)], -1)
 
 
-def far_source(field: FarField, medium, settings, p, dirs, band, sun) -> np.ndarray:
-    """J (n, 3) at points ``p`` (n, 3) for view directions ``dirs``; ``band`` (base y, height)."""
+def far_source(field: FarField, medium, settings, p, dirs, band, sun, albedo=None, ground_sun: float = 1.0) -> np.ndarray:
+    """J (n, 3) at points ``p`` (n, 3) for view directions ``dirs``; ``band`` (base y, height); ``albedo``,
+    ``ground_sun``: the ground below (:func:`atmos.plugins.clouds.light.medium.environment`)."""
     sun_dir = unit_direction(sun)
     c = field.channels(p[:, [0, 2]])
     h01 = np.clip((p[:, 1] - band[0]) / band[1], 0.0, 1.0)
@@ -81,14 +82,17 @@ def far_source(field: FarField, medium, settings, p, dirs, band, sun) -> np.ndar
         values = sample_profile(field.field_profile, c[:, 0], h01)
         diffusion = field_radiance(values, dirs, medium.phase.lobes, sun_dir)
     return source_reference(medium, settings, None, up, down, dirs @ sun_dir, dirs[:, 1], sun_color, ambient, sun_dir,
-                            diffusion, octaves=octaves, sun_colors=sun_source_at(by_height, h01))
+                            diffusion, octaves=octaves, sun_colors=sun_source_at(by_height, h01), albedo=albedo,
+                            ground_sun=ground_sun)
 
 
-def far_march_reference(field: FarField, medium, settings, band, camera, sun, size) -> dict:
+def far_march_reference(field: FarField, medium, settings, band, camera, sun, size, albedo=None,
+                        ground_sun: float = 1.0) -> dict:
     """The march of the far field alone for rays that never meet the volume's footprint: from the
     near plane or the band's entry to its exit or ``settings.far_distance``, steps ``step_base +
     far_step_growth · s`` (``step_base`` = ``settings.step`` × ``medium``'s smallest cell), midpoint
-    samples. Returns ``light`` (h, w, 3), ``alpha`` (h, w), ``distance`` (h, w): a·distance."""
+    samples (``albedo``, ``ground_sun``: :func:`far_source`'s). Returns ``light`` (h, w, 3), ``alpha`` (h, w),
+    ``distance`` (h, w): a·distance."""
     dirs, start = rays(camera, size)
     h, w = start.shape
     dirs, start = dirs.reshape(-1, 3), start.reshape(-1)
@@ -101,7 +105,7 @@ def far_march_reference(field: FarField, medium, settings, band, camera, sun, si
 
     def sample(i, p):
         rho = field.density(field.rank(p[:, [0, 2]]), (p[:, 1] - band[0]) / band[1])
-        return rho, far_source(field, medium, settings, p, dirs[i], band, sun)
+        return rho, far_source(field, medium, settings, p, dirs[i], band, sun, albedo, ground_sun)
 
     return integrate(pos, dirs, enter, leave, settings.steps, step_base, settings.far_step_growth,
                      settings.min_transmittance, medium.sigma_t, sample, (h, w))

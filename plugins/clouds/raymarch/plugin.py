@@ -35,6 +35,7 @@ from atmos.plugins.clouds.raymarch.noise import pixel_angle
 from atmos.plugins.clouds.raymarch.settings import REFERENCE, SUN_GROWTH, SUN_SPACING, RaymarchCloudSettings
 from atmos.plugins.clouds.raymarch.temporal import TemporalClouds, jitter, jitter_repeats, jitter_shift
 from atmos.gpu import clamp_sampler
+from atmos.plugins.clouds.light.ground import GROUND, ground_sun_pass
 from atmos.plugins.clouds.volume.binding import bind_volume, unbind_volume
 from atmos.plugins.clouds.volume.light import unit_direction
 from atmos.offscreen import OffscreenLayer, low_size
@@ -104,6 +105,7 @@ class RaymarchCloudsPlugin(Plugin):
         self.composition = composition(app)
         self.composition.writers.add(RaymarchPass.name)     # the fog gets the clouds' own distance
         app.graph.add_pass(RaymarchPass(self))
+        ground_sun_pass(app.graph)
         self.demand = field_demand(app)
         self.demand.readers.add(self)
 
@@ -158,6 +160,7 @@ class RaymarchPass(RenderPass):
             return
         builder.read(DEPTH)
         builder.read(CLOUD_SETS)
+        builder.read(GROUND, access="uniform")
         if self.plugin.marches_far_field():
             builder.read(FAR_FIELD)
         # composited onto in place: by the march (resolution 1), the temporal resolve or the upsample
@@ -236,7 +239,8 @@ class RaymarchPass(RenderPass):
         set_camera_uniforms(p, view.camera, view.aspect)
         layout = sim.layout(s.base_altitude)
         write_uniforms(p, self._uniforms(frame, sim, layout, offset))
-        bind_volume(p, sim, self.sampler, view.sun, s.octaves, s.ms_diffusion, layout.heights)
+        bind_volume(p, sim, self.sampler, view.sun, s.octaves, s.ms_diffusion, layout.heights, view.ground,
+                    frame.resource(GROUND))
         if s.empty_space_skipping:
             bind_textures(p, skip_map=self._skip_texture(sim))
         else:                               # nothing uploaded; the shader reads no skip map

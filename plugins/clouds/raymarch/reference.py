@@ -27,11 +27,13 @@ def rays(camera, size) -> tuple[np.ndarray, np.ndarray]:
     return ray / length[..., None], float(camera.near) * length
 
 
-def march_reference(density, transmittance, medium, settings, layout, camera, sun, size, scene=None, field=None) -> dict:
+def march_reference(density, transmittance, medium, settings, layout, camera, sun, size, scene=None, field=None,
+                    albedo=None, ground_sun: float = 1.0) -> dict:
     """``density`` (nx, ny, nz) and ``transmittance`` (the shading volume, its own shape) of one set;
     ``medium``: the CloudSettings; ``settings``: the RaymarchCloudSettings (steps, step, step_growth,
     min_transmittance, ms_*); ``layout``: the CloudLayout; ``scene``: distance to the scene (h, w), None
-    for sky; ``field``: the set's diffusion field (its own shape, 4), None: none. Returns ``light`` (h, w, 3), ``alpha`` (h, w) and ``distance`` (h, w): a·distance."""
+    for sky; ``field``: the set's diffusion field (its own shape, 4), None: none; ``albedo``, ``ground_sun``:
+    the ground below (:func:`atmos.plugins.clouds.light.medium.environment`). Returns ``light`` (h, w, 3), ``alpha`` (h, w) and ``distance`` (h, w): a·distance."""
     d = np.asarray(density, np.float64)
     trans_volume = np.asarray(transmittance, np.float64)
     shape = np.array(d.shape, np.float64)
@@ -61,7 +63,7 @@ def march_reference(density, transmittance, medium, settings, layout, camera, su
         L = None if field is None else diffusion_radiance(field, uvw, dirs[i], lobes, sun_dir)
         return multilinear(d, uvw * shape - 0.5), source_reference(
             medium, settings, T, up, down, dirs[i] @ sun_dir, dirs[i][:, 1], sun_color, ambient, sun_dir, L,
-            sun_colors=sun_source_at(by_height, uvw[:, 1]))
+            sun_colors=sun_source_at(by_height, uvw[:, 1]), albedo=albedo, ground_sun=ground_sun)
 
     return integrate(pos, dirs, enter, leave, settings.steps, step_base, settings.step_growth,
                      settings.min_transmittance, medium.sigma_t, sample, (h, w))

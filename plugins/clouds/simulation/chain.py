@@ -82,7 +82,8 @@ class CloudSettings(CheckedSettings):
     phase: Phase = nested_field(Phase(0.85, -0.3, 0.1), "the cloud droplets' two-lobe phase function")
     sun_intensity: float = num_field(4.0 * math.pi, 0.0, doc="sun irradiance = this × ``Sun.color``")
     sky_intensity: float = num_field(1.0, 0.0, doc="sky radiance = this × ``Sun.ambient``")
-    ground_albedo: float = num_field(0.3, 0.0, 1.0, "the ground's albedo (light from below)")
+    ground_albedo: float = num_field(0.3, 0.0, 1.0, "the ground's albedo (light from below) where the scene "
+                                     "publishes no GroundSurface (terrain and ground plane do)")
     scattering: Scattering | None = None
     shading_scale: int = 1
     shading_slices_per_run: int = int_field(8, 1, 4096, "light-space slices per job slice of the shading")

@@ -43,6 +43,7 @@ from atmos.composition import CLOUD_DISTANCE, composition
 from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.plugin import Plugin
 from atmos.gpu import clamp_sampler
+from atmos.plugins.clouds.light.ground import GROUND, ground_sun_pass
 from atmos.plugins.clouds.volume.binding import bind_volume, unbind_volume
 from atmos.plugins.clouds.volume.light import CloudLightSettings
 from atmos.offscreen import MAX_DOWNSAMPLE, OffscreenLayer, low_size
@@ -104,6 +105,7 @@ class CloudRenderPlugin(Plugin):
         self.composition = composition(app)
         self.composition.writers.add("cloud_render")     # the sprites give the fog their own distance
         app.graph.add_pass(CloudSpritePass(self))
+        ground_sun_pass(app.graph)
         self.demand = field_demand(app)
         self.demand.readers.add(self)
 
@@ -172,6 +174,7 @@ class CloudSpritePass(RenderPass):
             return                          # declares nothing: culled, allocates nothing
         builder.read(DEPTH)
         builder.read(CLOUD_SETS)
+        builder.read(GROUND, access="uniform")
         builder.read(COLOR)                 # blends onto it
         builder.write(COLOR)
         downsample = self.plugin.settings.downsample
@@ -263,7 +266,8 @@ class CloudSpritePass(RenderPass):
         frame.blend_over()
         ctx.enable(moderngl.DEPTH_TEST | moderngl.PROGRAM_POINT_SIZE)
         ctx.depth_func = "<="          # a tiny near plane rounds far depths to 1.0: still in front of the sky
-        bind_volume(p, sim, self.sampler, view.sun, settings.octaves, settings.ms_diffusion, layout.heights)
+        bind_volume(p, sim, self.sampler, view.sun, settings.octaves, settings.ms_diffusion, layout.heights,
+                    view.ground, frame.resource(GROUND))
         try:
             self._draw(segments, layout.group)
         finally:

@@ -93,14 +93,15 @@ def shifted(volume: np.ndarray, shift) -> np.ndarray:
 
 
 def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, uniforms: dict, view_proj,
-                    light: dict, a_shift=(0, 0, 0), weight_bits: int | None = None) -> dict:
+                    light: dict, a_shift=(0, 0, 0), weight_bits: int | None = None, ground_sun: float = 1.0) -> dict:
     """Arrays over the vertices of every segment (gi, j, gk, packed level and span), in order: ``position`` (n, 4),
     ``size``, ``octaves`` (n, 4), ``ambient`` (n, 3), ``sun`` (n, 3: the sun's source at its height), ``center`` (n, 3), ``radius``, ``tau``, ``stretch``, ``coverage``,
     ``visible``. ``trans_a``/``trans_b`` None: no shading (T = 1). ``light``: the light uniforms
     (:func:`atmos.plugins.clouds.volume.light.light_uniforms`). ``a_shift``: A's cell for B's cell c is
     c + a_shift (zero past A's edge for the cell sums; clamp-to-edge for the sampled light, as the GPU).
     ``weight_bits``: the sun's transmittance filtered as a texture unit with that many bits of sub-texel
-    weight would (:func:`texel_filter`; None: exactly, as sprite.vert)."""
+    weight would (:func:`texel_filter`; None: exactly, as sprite.vert). ``ground_sun``: the ground's
+    mean sun transmittance G (:mod:`atmos.plugins.clouds.light.ground`)."""
     u = uniforms
     shape = np.array(u["volume_shape"])
     gx, gz = u["group_size"]
@@ -155,7 +156,8 @@ def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, 
     world = np.asarray(u["layer_min"]) + center * np.asarray(u["cell_size"])
     ray = world - np.asarray(u["camera_pos"], np.float64)
     h = ambient_profile(up, down, g_mean, ray[:, 1] / np.linalg.norm(ray, axis=1))[:, None]
-    sky, ground = np.asarray(light["sky_source"]), np.asarray(light["ground_source"])
+    sky = np.asarray(light["sky_source"])
+    ground = np.asarray(light["ground_sky_source"]) + ground_sun * np.asarray(light["ground_sun_source"])
     ambient = (sky + ground) + h * (sky - ground)
     clip = np.concatenate([world, np.ones((len(c), 1))], 1) @ np.asarray(view_proj, np.float64).T
     diameter = s * u["base_diameter"]

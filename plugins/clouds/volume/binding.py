@@ -6,19 +6,22 @@ from atmos.plugins.clouds.volume.light import DEFAULT_OCTAVES, light_uniforms, w
 from atmos.plugins.clouds.volume.sets import CloudSets
 from atmos.plugins.clouds.light.columns import COLUMNS
 from atmos.plugins.clouds.light.diffusion import DIFFUSION
+from atmos.plugins.clouds.light.ground import bind_ground
 from atmos.gpu.uniforms import bind_textures, sampler_units
 
 SAMPLERS = ("density_a", "density_b", "trans_a", "trans_b", "columns_a", "columns_b", "diffusion_a", "diffusion_b")
 
 
 def bind_volume(program, sim, sampler, sun: Sun | None, octaves=DEFAULT_OCTAVES, diffusion: float = 0.0,
-                layer=None) -> float:
+                layer=None, ground=None, ground_light=None) -> float:
     """Bind mix(A, B, t)'s textures (``sim``: the frame's CloudSets, or the CloudSimulation) to
     ``volume.glsl``'s samplers (density, transmittance, the light volume's columns, the diffusion field)
     with ``sampler`` and set ``t``, ``a_shift`` (A drawn where it was computed), ``has_shading`` and the
     light (:func:`light_uniforms` of the simulation's medium, the sun and the multiple-scattering
     ``octaves``; the diffusion field's weight ``diffusion``, 0 where the sets have no field; the sun's
-    colour taken over ``layer``, (base, top) world y); returns t. Call :func:`unbind_volume` when the
+    colour taken over ``layer``, (base, top) world y; the ground below of the scene's ``ground``, a
+    GroundSurface (None: the medium's albedo), in the clouds' shadow ``ground_light``, the frame's
+    "cloud_ground" buffer (None: fully sunlit)); returns t. Call :func:`unbind_volume` when the
     draw is done."""
     a, b, t = sim.view()
     shading = "transmittance" in a
@@ -28,7 +31,9 @@ def bind_volume(program, sim, sampler, sun: Sun | None, octaves=DEFAULT_OCTAVES,
     bind_textures(program, sampler=sampler, density_a=a["density"], density_b=b["density"], trans_a=a[light],
                   trans_b=b[light], columns_a=a[COLUMNS], columns_b=b[COLUMNS], diffusion_a=a[spread],
                   diffusion_b=b[spread])
-    write_light(program, light_uniforms(sim.settings, sun, octaves, diffusion if field else 0.0, layer),
+    bind_ground(program, ground_light)
+    write_light(program, light_uniforms(sim.settings, sun, octaves, diffusion if field else 0.0, layer,
+                                        None if ground is None else ground.albedo),
                    a_shift=(sim if isinstance(sim, CloudSets) else sim.sets()).a_shift, has_shading=int(shading),
                    edge_fade=float(sim.settings.edge_fade), t=float(t))
     return float(t)

@@ -12,7 +12,7 @@ import numpy as np
 from atmos.checks import CheckedSettings, num_field
 from atmos.gpu.uniforms import write_block, write_uniforms
 from atmos.lighting import Sun
-from atmos.plugins.clouds.light.medium import environment
+from atmos.plugins.clouds.light.medium import ground_parts
 
 DEFAULT_AMBIENT = (0.35, 0.47, 0.65)
 DEFAULT_OCTAVES = (0.25, 0.9525, 0.875)   # a, b, c of the octaves, fitted to the path tracer (bench_cloud_light --fit)
@@ -106,20 +106,21 @@ def cell_tau(cloud_settings) -> float:
 
 
 def light_uniforms(cloud_settings, sun: Sun | None, octaves=DEFAULT_OCTAVES, diffusion: float = 0.0,
-                   layer=None) -> dict:
+                   layer=None, ground=None) -> dict:
     """The light uniforms of ``volume.glsl`` for a ``CloudSettings`` medium, the ``Sun``, the
     multiple-scattering octaves (a, b, c), the diffusion field's weight and the layer (base, top) world
     y (m) over which the clouds take the sun's colour (``sun_sources``: :func:`sun_colors`; the ground's
-    light takes the middle's; None: the camera's colour everywhere). The last few results are kept,
+    light takes the middle's; None: the camera's colour everywhere) and the ``ground``'s albedo (RGB;
+    None: the medium's ``ground_albedo``). The last few results are kept,
     keyed by the identity of the settings, the Sun and its (immutable, assigned-anew) fields and by
     the values of the rest: every renderer of a frame asks for the same."""
     sun = sun or Sun()
     key = (cloud_settings, sun, sun.direction, sun.color, sun.ambient, sun.color_by_altitude)
-    rest = (tuple(octaves), diffusion, None if layer is None else tuple(layer))
+    rest = (tuple(octaves), diffusion, None if layer is None else tuple(layer), None if ground is None else tuple(ground))
     for held, held_rest, values in _LIGHT_MEMO:
         if held_rest == rest and all(a is b for a, b in zip(held, key)):
             return dict(values)
-    values = _light_uniforms(cloud_settings, sun, octaves, diffusion, layer)
+    values = _light_uniforms(cloud_settings, sun, octaves, diffusion, layer, ground)
     _LIGHT_MEMO.insert(0, (key, rest, values))
     del _LIGHT_MEMO[4:]
     return dict(values)
@@ -128,15 +129,17 @@ def light_uniforms(cloud_settings, sun: Sun | None, octaves=DEFAULT_OCTAVES, dif
 _LIGHT_MEMO: list = []      # (identities, values, uniforms), newest first
 
 
-def _light_uniforms(cloud_settings, sun: Sun, octaves, diffusion: float, layer) -> dict:
+def _light_uniforms(cloud_settings, sun: Sun, octaves, diffusion: float, layer, ground) -> dict:
     colors, middle, ambient = layer_sun(sun, layer)
     direction = unit_direction(sun)
-    e, sky, ground = environment(cloud_settings, middle, ambient, direction)
+    lit, sky_lit = ground_parts(cloud_settings, middle, ambient, direction, ground)
     s = cloud_settings
     sources = s.albedo * s.sun_intensity * colors
+    sky = s.sky_intensity * np.asarray(ambient, np.float64)
     return {"sun_sources": [tuple(row) for row in np.asarray(sources, np.float64).tolist()],
             "sky_source": tuple(float(v) for v in 0.5 * s.albedo * sky),
-            "ground_source": tuple(float(v) for v in 0.5 * s.albedo * ground),
+            "ground_sky_source": tuple(float(v) for v in 0.5 * s.albedo * sky_lit),
+            "ground_sun_source": tuple(float(v) for v in 0.5 * s.albedo * lit),
             "sun_dir": tuple(float(v) for v in direction),
             "phase_lobes": s.phase.lobes,
             "outward_share": float(s.phase.hemisphere_share),
@@ -146,13 +149,13 @@ def _light_uniforms(cloud_settings, sun: Sun, octaves, diffusion: float, layer) 
 
 
 LIGHT_BLOCK, LIGHT_BINDING = "CloudLight", 2      # volume.glsl's block of the light that changes with the sun
-LIGHT_MEMBERS = ("sun_sources", "sky_source", "ground_source", "sun_dir")
+LIGHT_MEMBERS = ("sun_sources", "sky_source", "ground_sky_source", "ground_sun_source", "sun_dir")
 
 
 def pack_light(values: dict) -> bytes:
-    """volume.glsl's CloudLight block (std140: vec3 sun_sources[SUN_HEIGHTS], sky_source, ground_source,
-    sun_dir, each in 16 bytes) from :func:`light_uniforms`' ``values``."""
-    rows = [*values["sun_sources"], values["sky_source"], values["ground_source"], values["sun_dir"]]
+    """volume.glsl's CloudLight block (std140: vec3 sun_sources[SUN_HEIGHTS], sky_source, ground_sky_source,
+    ground_sun_source, sun_dir, each in 16 bytes) from :func:`light_uniforms`' ``values``."""
+    rows = [*values["sun_sources"], *(values[k] for k in LIGHT_MEMBERS[1:])]
     return struct.pack(f"<{4 * len(rows)}f", *[c for row in rows for c in (*row, 0.0)])
 
 

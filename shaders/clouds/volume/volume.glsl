@@ -2,6 +2,7 @@
 // mix(A, B, t) of the two latest completed steps, and the light model of plugins/clouds/light/medium.py:
 // source per unit extinction J = sun_source(y) * sum_i b^i p(cos; c^i g) P_i(T)
 //                              + (sky_source + ground_source) + (sky_source - ground_source) h,
+// ground_source = ground_sky_source + G ground_sun_source (G: the clouds' shadow on the ground),
 // P_i: the octaves' transmittances (lib/octaves.glsl: light forward-scattered i times on its way, the
 // last all higher counts), h = clamp(u + g_mean ray_y exp(-(tau_up + tau_down) / 2z), -1, 1),
 // u = (tau_down - tau_up) / (tau_up + tau_down + 2z), z = 2 / (3 (1 - g_mean)): the diffusion profile
@@ -24,8 +25,12 @@ layout(std140, binding = 2) uniform CloudLight {   // the light that moves with 
     vec3 sun_sources[SUN_HEIGHTS];  // albedo * sun irradiance at the volume's heights k / 4 (uvw.y, base to
                                     // top): the sun's colour there (already 0 with the sun below the horizon)
     vec3 sky_source;                // albedo * sky radiance / 2
-    vec3 ground_source;             // albedo * ground radiance / 2
+    vec3 ground_sky_source;         // albedo * the ground's sky-lit radiance / 2
+    vec3 ground_sun_source;         // albedo * the ground's sunlit radiance / 2, were no cloud in the way
     vec3 sun_dir;                   // toward the sun, unit
+};
+layout(std140, binding = 3) uniform CloudGround {  // written on the GPU (plugins/clouds/light/ground.py)
+    vec4 cloud_ground;              // x: G, the ground's mean sun transmittance through the clouds
 };
 uniform vec3 phase_lobes;      // g, g2, w
 uniform float outward_share;   // the phase's share H of the hemisphere about a direction (medium.hemisphere_share)
@@ -124,6 +129,7 @@ vec3 ambient_source(float tau_up, float tau_down, float ray_y) {
     float z = 2.0 / (3.0 * (1.0 - min(g, 0.99)));
     float u = (tau_down - tau_up) / (tau_up + tau_down + 2.0 * z);
     float h = clamp(u + g * ray_y * exp(-(tau_up + tau_down) / (2.0 * z)), -1.0, 1.0);
+    vec3 ground_source = ground_sky_source + cloud_ground.x * ground_sun_source;
     return (sky_source + ground_source) + (sky_source - ground_source) * h;
 }
 

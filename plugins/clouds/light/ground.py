@@ -1,0 +1,103 @@
+"""The clouds' shadow on the ground as the clouds' light from below sees it: ``G`` of
+:mod:`atmos.plugins.clouds.light.medium`, the ground's mean sun transmittance, so the ground under an
+overcast sends back sky light only and cloud bases darken as they should.
+
+Once per frame (phase shadows) one work group (``shaders/clouds/light/ground.comp``) averages
+``exp(−τ)`` over ``GRID × GRID`` ground points whose rays toward the sun cross the layer's middle plane
+at an even grid over the volume's footprint (τ = sigma × the column sum there, as the ground shadows
+take it), weighted by the volume's edge weight (the far field beyond the fade continues the volume's
+own statistics, so its core stands for the sky around); sets A and B each over their own footprint,
+mixed by t, so ``G`` runs on smoothly when a step arrives at a moved placement; and writes ``G`` into the
+16-byte buffer ``"cloud_ground"``; the cloud renderers read it as the uniform block ``CloudGround``
+(``clouds/volume/volume.glsl``): nothing is read back.
+"""
+from __future__ import annotations
+
+import weakref
+
+import numpy as np
+
+from atmos.graph import BufferDesc, ComputePass
+from atmos.plugins.clouds.volume.column import column_uniforms
+from atmos.plugins.clouds.volume.sets import CLOUD_SETS
+
+GROUND = "cloud_ground"                # buffer: vec4 (G, 0, 0, 0)
+GROUND_BLOCK = "CloudGround"           # volume.glsl's uniform block that reads it
+GRID = 64                              # ground.comp's GRID: sample points per side of the footprint
+
+
+class GroundSunPass(ComputePass):
+    """Writes "cloud_ground" from "cloud_sets"; culled unread."""
+    name = "cloud_ground"
+    phase = "shadows"
+    compute = "clouds/light/ground.comp"
+    local_size = (256,)
+
+    def __init__(self, graph):
+        super().__init__()
+        self.graph = graph
+
+    def setup(self, builder) -> None:
+        if not self.graph.imports(CLOUD_SETS):
+            return
+        builder.create(GROUND, BufferDesc(16), access="storage")
+        builder.read(CLOUD_SETS)
+
+    def execute(self, frame) -> None:
+        p, sim = self.program, frame.resource(CLOUD_SETS)
+        column_uniforms(p, sim, sim.layout(), float(sim.settings.sigma))
+        frame.dispatch(p, (1,), buffers={GROUND_BLOCK: GROUND})
+
+
+def ground_sun_pass(graph) -> GroundSunPass:
+    """The graph's GroundSunPass, added by the first cloud renderer that reads it."""
+    for p in graph.passes:
+        if isinstance(p, GroundSunPass):
+            return p
+    p = GroundSunPass(graph)
+    graph.add_pass(p)
+    return p
+
+
+_SUNLIT: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()    # ctx -> a buffer holding G = 1
+
+
+def bind_ground(program, buffer=None) -> None:
+    """Bind ``buffer`` (the frame's "cloud_ground"; None: a fully sunlit ground, G = 1) at ``program``'s
+    CloudGround block, where it has one."""
+    block = program.get(GROUND_BLOCK, None)
+    if block is None:
+        return
+    if buffer is None:
+        buffer = _SUNLIT.get(program.ctx)
+        if buffer is None:
+            buffer = _SUNLIT[program.ctx] = program.ctx.buffer(np.array([1.0, 0.0, 0.0, 0.0], np.float32).tobytes())
+    buffer.bind_to_uniform_block(block.binding)
+
+
+def ground_sun_reference(sums_a, sums_b, t: float, layout, extinction: float, edge_fade: float = 0.0) -> float:
+    """float64 G: ground.comp's mix over t of each set's edge-weighted mean of exp(−extinction × column
+    sum) over its points (``sums_a``/``sums_b``: the (nx, nz) top-view sums of sets A and B, each at its
+    own placement; ``layout``: the volume's shape and cells)."""
+    from atmos.plugins.clouds.shadows.reference import zero_border_bilinear
+    from atmos.plugins.clouds.volume.edge import edge_weight
+    shape = np.array([layout.shape[0], layout.shape[2]], np.float64)
+    k = np.arange(GRID, dtype=np.float64) + 0.5
+    v = np.stack(np.meshgrid(k * shape[0] / GRID - 0.5, k * shape[1] / GRID - 0.5, indexing="xy"), -1)
+    w = edge_weight((v + 0.5) / shape, edge_fade)
+    g = [(w * np.exp(-extinction * zero_border_bilinear(np.asarray(s, np.float64), v))).sum() / w.sum()
+         for s in (sums_a, sums_b)]
+    return float((1.0 - t) * g[0] + t * g[1])
+
+
+def ground_sun_of(sets) -> float:
+    """float64 G for a frame's CloudSets from the column sums its maps hold on the GPU (a read back:
+    tests and benchmarks, not per frame)."""
+    a, b, t = sets.view()
+    sums = []
+    for texture_set in (a, b):
+        tex = sets.maps_of(texture_set).sums
+        nx, nz = tex.size[:2]
+        sums.append(np.frombuffer(tex.read(), np.float32).reshape(-1, nz, nx)[0].T.astype(np.float64))
+    return ground_sun_reference(sums[0], sums[1], t, sets.layout(), float(sets.settings.sigma),
+                                float(sets.settings.edge_fade))
