@@ -19,7 +19,8 @@ from atmos.plugins.ground import GroundPlugin
 from atmos.lighting import sky_light
 from atmos.plugins.sky import SkySettings, SkyPlugin, evaluate_sky, sky_color, sky_radiance
 from atmos.plugins.sky.preetham import preetham_rgb
-from atmos.plugins.sky.shader import LIMB_FLOOR, set_sky_uniforms, sky_defines
+from atmos.plugins.sky.shader import set_sky_uniforms, sky_defines
+from atmos.sun_disc import LIMB_FLOOR
 from fullscreen_probe import run_fullscreen
 
 OUT = os.path.join(os.path.dirname(__file__), "..", "out", "sky")

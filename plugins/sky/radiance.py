@@ -23,8 +23,9 @@ from atmos.plugins.sky.settings import SkySettings
 from atmos.plugins.sky.preetham import check_turbidity, preetham_rgb, unit_vectors
 from atmos.plugins.sky.stars import smoothstep, star_field
 # the model's constants are the GLSL's (handed over as defines by .shader); kept here by name
-from atmos.plugins.sky.shader import (BELOW_FADE, DAY_FADE, EDGE_MIN, GLARE_REACH, GROUND_DIM, LIMB_FLOOR,  # noqa: F401
-                                      OZONE_BELOW, OZONE_DEPTH, OZONE_SHELL, SUN_LIMB, disc_chord)
+from atmos.plugins.sky.shader import (BELOW_FADE, DAY_FADE, GROUND_DIM, OZONE_BELOW, OZONE_DEPTH,  # noqa: F401
+                                      OZONE_SHELL)
+from atmos.sun_disc import sun_disc
 
 
 def ozone_transmittance(sun_y) -> np.ndarray:
@@ -58,21 +59,6 @@ def sky_radiance(view_dir, sun_dir, turbidity: float = SkySettings.turbidity, sc
     ozone = ozone_transmittance(s[1]) ** (np.maximum(v[..., 1:2], 0.0) ** 2)
     rgb = np.asarray(night, np.float64) * (1.0 - day) + scale * preetham_rgb(v, s, turbidity) * ozone * day
     return rgb * below_horizon(v[..., 1])[..., None]
-
-
-def sun_disc(view_dir, sun_dir, sun_color, size_deg: float, gain: float, glare: float = 0.0,
-             pixel_angle: float = 0.0) -> np.ndarray:
-    """(..., 3) radiance of the sun disc and its glare (unit directions): ``gain · sun_color`` at the
-    centre, limb-darkened as ``μ^SUN_LIMB`` (μ = cos of the angle on the solar surface, at least
-    ``LIMB_FLOOR``), antialiased over one pixel (``pixel_angle``, at least ``EDGE_MIN`` of the
-    radius); the glare ``glare · gain · sun_color · (r / max(c, r))²`` fades out by ``GLARE_REACH``."""
-    c = np.linalg.norm(view_dir - sun_dir, axis=-1)[..., None]
-    r = disc_chord(size_deg)
-    half = 0.5 * max(pixel_angle, EDGE_MIN * r)
-    cover = 1.0 - smoothstep(r - half, r + half, c)
-    mu = np.sqrt(np.maximum(1.0 - (c / r) ** 2, LIMB_FLOOR ** 2))
-    halo = glare * (r / np.maximum(c, r)) ** 2 * (1.0 - smoothstep(0.0, GLARE_REACH, c))
-    return gain * (cover * mu ** np.array(SUN_LIMB) + halo) * np.asarray(sun_color, np.float64)
 
 
 def sky_color(view_dir, sun_dir, sun_color, settings: SkySettings | None = None, time: float = 0.0,

@@ -3,8 +3,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from atmos.checks import CheckedSettings, bool_field, check_shape, choice_field, int_field, nested_field, num_field, vec_field
+from atmos.checks import bool_field, check_shape, choice_field, int_field, nested_field, num_field, vec_field
 from atmos.lighting import NIGHT_SKY
+from atmos.sun_disc import SunDiscSettings
 from atmos.plugins.sky.atmosphere_settings import AtmosphereSettings
 from atmos.plugins.sky.preetham import TURBIDITY_RANGE, check_turbidity
 
@@ -13,9 +14,9 @@ MODELS = ("preetham", "physical")
 
 
 @dataclass(frozen=True)
-class SkySettings(CheckedSettings):
-    """Look of the sky: the model, haze, brightness in the HDR pipeline, sun disc, night and stars
-    (all live). The sun disc, night and stars are the same for both models. Two fields are checked
+class SkySettings(SunDiscSettings):
+    """Look of the sky: the sun disc (:class:`atmos.sun_disc.SunDiscSettings`' fields first), the model,
+    haze, brightness in the HDR pipeline, night and stars (all live). The sun disc, night and stars are the same for both models. Two fields are checked
     by hand (not in the list below):
 
     ``turbidity`` = 2.5: the Preetham sky's haze, a number in [2, 10] (2 clear .. 10 hazy).
@@ -34,12 +35,6 @@ class SkySettings(CheckedSettings):
     turbidity: float = 2.5
     scale: float = num_field(0.03, 0.0, 1e3, "HDR units per kcd/m² of Preetham luminance (0.03 puts a clear noon "
                              "zenith near 0.25, beside the sun colour ≈ 1 of sky_light)", lo_open=True)
-    sun_size_deg: float = num_field(0.2665, 0.0, 5.0, "angular radius of the sun disc in degrees (the real sun's: "
-                                    "0.2665°, 0.53° across)", lo_open=True)
-    sun_gain: float = num_field(20.0, 0.0, 1e4, "radiance at the disc's centre per unit of the Sun resource's "
-                                "colour (limb-darkened toward the edge)")
-    sun_glare: float = num_field(0.05, 0.0, 1.0, "the glare round the disc, as a fraction of the centre's "
-                                 "radiance at the disc's edge (falling as 1/angle² beyond it)")
     night: tuple = vec_field(tuple(map(float, NIGHT_SKY)), 3, "non-negative", "the sky colour once the sun is "
                              "well below the horizon")
     stars: bool = bool_field(True, "draw the stars")

@@ -11,6 +11,7 @@ from atmos.plugins.sky.settings import SkySettings
 from atmos.plugins.sky.preetham import COS_FLOOR, unit_vectors
 from atmos.gpu.uniforms import bind_buffers, write_uniforms
 from atmos.gpu.hazards import dispatch
+from atmos.sun_disc import SUN_DISC_DEFINES, disc_chord
 
 DAY_FADE = (-0.2, 0.02)      # sun height (sin elevation): night below the first, full Preetham day above the second
 GROUND_DIM = 0.3
@@ -18,15 +19,6 @@ BELOW_FADE = 0.1
 OZONE_DEPTH = (0.0097, 0.0282, 0.0013)    # vertical optical depth of the ozone layer (Chappuis band; red, green, blue)
 OZONE_SHELL = 0.0069                      # 2 h / R: the layer's height h ≈ 22 km over the earth's radius
 OZONE_BELOW = 10.0                        # growth of the path per unit of the sun's depth below the horizon
-SUN_LIMB = (0.397, 0.503, 0.652)   # limb darkening I(μ) = μ^a per channel (red, green, blue)
-LIMB_FLOOR = 0.25                  # the μ the disc's very edge is given (its last pixel stays lit)
-GLARE_REACH = 0.2                  # chord |v − s| (≈ 11.5°) by which the glare has faded to 0
-EDGE_MIN = 0.05                    # narrowest antialiased edge, as a fraction of the disc's radius
-
-
-def disc_chord(size_deg: float) -> float:
-    """Chord length |v − s| of the disc's angular radius ``size_deg``."""
-    return 2.0 * math.sin(0.5 * math.radians(size_deg))
 
 
 @lru_cache(maxsize=1)
@@ -36,8 +28,7 @@ def sky_defines() -> dict:
     return {"SKY_COS_FLOOR": repr(COS_FLOOR), "DAY_LO": repr(DAY_FADE[0]), "DAY_HI": repr(DAY_FADE[1]),
             "GROUND_DIM": repr(GROUND_DIM), "BELOW_FADE": repr(BELOW_FADE),
             "OZONE_DEPTH": "vec3({}, {}, {})".format(*OZONE_DEPTH), "OZONE_SHELL": repr(OZONE_SHELL),
-            "OZONE_BELOW": repr(OZONE_BELOW), "SUN_LIMB": "vec3({}, {}, {})".format(*SUN_LIMB), "LIMB_FLOOR": repr(LIMB_FLOOR),
-            "GLARE_REACH": repr(GLARE_REACH), "EDGE_MIN": repr(EDGE_MIN),
+            "OZONE_BELOW": repr(OZONE_BELOW), **SUN_DISC_DEFINES,
             "STAR_GRID": stars.STAR_GRID, "STAR_KEY_A": f"{stars.STAR_KEY[0]}u", "STAR_KEY_B": f"{stars.STAR_KEY[1]}u",
             "STAR_SIGMA": repr(stars.STAR_SIGMA), "STAR_SIGMA_MAX": repr(stars.STAR_SIGMA_MAX),
             "STAR_FOOTPRINT": repr(stars.FOOTPRINT),

@@ -1,18 +1,40 @@
-"""A cheap analytic sky: horizon-to-zenith gradient, a sun disc and glow. Draws the whole background."""
+"""A cheap analytic sky: horizon-to-zenith gradient, a glow round the sun and its disc (the real sun's
+size, limb-darkened, with glare: :mod:`atmos.sun_disc`). Draws the whole background."""
 from dataclasses import dataclass
 
-from atmos.checks import CheckedSettings, vec_field
+import numpy as np
+
+from atmos.checks import vec_field
 from atmos.graph import FullscreenPass, PassContext
+from atmos.gpu.uniforms import write_uniforms
 from atmos.plugin import Plugin
 from atmos.render_core import DEPTH, where_nothing_was_drawn
+from atmos.sun_disc import SUN_DISC_DEFINES, SunDiscSettings, smoothstep, disc_chord, sun_disc
 
 
 @dataclass(frozen=True)
-class SkyGradientSettings(CheckedSettings):
-    """The gradient's sky colours, linear HDR (all live)."""
+class SkyGradientSettings(SunDiscSettings):
+    """The gradient's sky colours, linear HDR, after the sun disc's fields (all live)."""
     zenith: tuple = vec_field((0.15, 0.35, 0.8), 3, "non-negative", "overhead")
     horizon: tuple = vec_field((0.75, 0.85, 1.0), 3, "non-negative", "at eye level")
     ground: tuple = vec_field((0.35, 0.33, 0.3), 3, "non-negative", "below the horizon")
+
+
+def gradient_sky(view_dir, sun_dir, sun_color, settings: SkyGradientSettings | None = None,
+                 pixel_angle: float = 0.0) -> np.ndarray:
+    """(..., 3) float64: what the gradient pass writes for unit view directions ``view_dir`` (..., 3), the
+    unit ``sun_dir`` and ``sun_color`` (``pixel_angle``: radians per pixel)."""
+    p = settings or SkyGradientSettings()
+    v = np.asarray(view_dir, np.float64)
+    s = np.asarray(sun_dir, np.float64)
+    up = v[..., 1:2]
+    sky = np.asarray(p.horizon) + (np.asarray(p.zenith) - np.asarray(p.horizon)) * np.clip(up, 0.0, 1.0) ** 0.6
+    sky = sky + (np.asarray(p.ground) - sky) * smoothstep(0.0, -0.08, up)
+    day = float(smoothstep(-0.15, 0.1, s[1]))
+    sky = sky * (0.05 + 0.95 * day)
+    disc = sun_disc(v, s, (1.0, 1.0, 1.0), p.sun_size_deg, p.sun_gain, p.sun_glare, pixel_angle)
+    glow = 0.25 * np.maximum(v @ s, 0.0)[..., None] ** 32
+    return sky + np.asarray(sun_color, np.float64) * day * (glow + disc * (1.0 - smoothstep(0.0, -0.01, up)))
 
 
 class SkyGradientPass(FullscreenPass):
@@ -23,12 +45,15 @@ class SkyGradientPass(FullscreenPass):
     vertex = "lib/fullscreen_far.vert"
     reads = (DEPTH,)
 
+    def defines(self) -> dict:
+        return SUN_DISC_DEFINES
+
     def execute(self, frame: PassContext) -> None:
         where_nothing_was_drawn(frame)
-        settings = self.plugin.settings
-        self.program["zenith"].value = settings.zenith
-        self.program["horizon"].value = settings.horizon
-        self.program["ground"].value = settings.ground
+        settings, view = self.plugin.settings, frame.view
+        write_uniforms(self.program, zenith=settings.zenith, horizon=settings.horizon, ground=settings.ground,
+                       sun_look=(disc_chord(settings.sun_size_deg), settings.sun_gain, settings.sun_glare,
+                                 view.camera.fov_y / max(1, view.size[1])))
         frame.fullscreen(self.program)
 
 

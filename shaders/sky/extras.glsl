@@ -1,6 +1,6 @@
 // What both skies (Preetham, sky.glsl; physical, physical.frag) draw over their radiance: the sun disc
 // (limb-darkened, antialiased over a pixel) and its glare, the stars. float64 reference:
-// plugins/sky/radiance.py (sun_disc, star_field); uniforms set by plugins/sky/shader.py:set_sky_uniforms.
+// plugins/sky/radiance.py (atmos/sun_disc.py sun_disc, star_field); uniforms set by plugins/sky/shader.py:set_sky_uniforms.
 #include "sky/stars.glsl"
 
 uniform vec3 sky_sun_dir;       // unit, toward the sun
@@ -18,15 +18,11 @@ uniform float pixel_angle;      // radians per pixel
 // 1 above the horizon, down to GROUND_DIM under it; reference: below_horizon.
 float sky_below_horizon(float view_y) { return mix(1.0, GROUND_DIM, smoothstep(0.0, -BELOW_FADE, view_y)); }
 
-// The sun disc and its glare; reference: sun_disc.
+#include "lib/sun_disc.glsl"
+
+// The sun disc and its glare; reference: atmos/sun_disc.py sun_disc.
 vec3 sky_sun_disc(vec3 v, vec3 s) {
-    float c = length(v - s);
-    float r = sun_chord;
-    float half_edge = 0.5 * max(pixel_angle, EDGE_MIN * r);
-    float cover = 1.0 - smoothstep(r - half_edge, r + half_edge, c);
-    float mu = sqrt(max(1.0 - (c / r) * (c / r), LIMB_FLOOR * LIMB_FLOOR));
-    float halo = sun_glare * (r / max(c, r)) * (r / max(c, r)) * (1.0 - smoothstep(0.0, GLARE_REACH, c));
-    return sun_gain * (cover * pow(vec3(mu), SUN_LIMB) + halo) * sky_sun_color;
+    return sun_disc(v, s, sun_chord, sun_gain, sun_glare, pixel_angle) * sky_sun_color;
 }
 
 // Sun disc, glare and stars for view v, dimmed below the horizon like the Preetham sky.
