@@ -61,6 +61,14 @@ class RenderGraph:
         self._passes[p.name] = p
         return p
 
+    def shared_pass(self, kind: type, make: Callable[[], RenderPass]) -> tuple[RenderPass, bool]:
+        """(the graph's pass of type ``kind``, whether it was made now): a pass several plugins need (a bake
+        they all read) is added by the first of them with ``make()``, then found by the rest."""
+        for p in self._passes.values():
+            if isinstance(p, kind):
+                return p, False
+        return self.add_pass(make()), True
+
     def remove_pass(self, name: str) -> None:
         """Unregister pass ``name`` and release what its ``prepare`` made."""
         p = self._passes.pop(name, None)

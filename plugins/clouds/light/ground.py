@@ -51,12 +51,7 @@ class GroundSunPass(ComputePass):
 
 def ground_sun_pass(graph) -> GroundSunPass:
     """The graph's GroundSunPass, added by the first cloud renderer that reads it."""
-    for p in graph.passes:
-        if isinstance(p, GroundSunPass):
-            return p
-    p = GroundSunPass(graph)
-    graph.add_pass(p)
-    return p
+    return graph.shared_pass(GroundSunPass, lambda: GroundSunPass(graph))[0]
 
 
 _SUNLIT: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()    # ctx -> a buffer holding G = 1

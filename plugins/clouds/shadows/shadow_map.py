@@ -147,12 +147,9 @@ class CloudShadowMapPass(ComputePass):
 
 def shadow_map_pass(graph) -> CloudShadowMapPass:
     """The graph's CloudShadowMapPass, added (with its SHADOW_SPACE import) by the first reader."""
-    for p in graph.passes:
-        if isinstance(p, CloudShadowMapPass):
-            return p
-    p = CloudShadowMapPass(graph)
-    graph.add_pass(p)
-    graph.import_resource(SHADOW_SPACE, p.space)
+    p, made = graph.shared_pass(CloudShadowMapPass, lambda: CloudShadowMapPass(graph))
+    if made:
+        graph.import_resource(SHADOW_SPACE, p.space)
     return p
 
 
