@@ -201,7 +201,7 @@ def test_material_has_grass_rock_and_snow_and_fades_its_detail_with_distance(rng
     near, far = material.albedo(line, up, 0.05, 500.0, 1.0, 0.3), material.albedo(line, up, 50.0, 500.0, 1.0, 0.3)
     assert np.abs(np.diff(near[:, 1])).sum() > 20 * np.abs(np.diff(far[:, 1])).sum()
     for i in range(material.OCTAVES):                                                     # each octave fades out
-        cell = material.CELL0 / 4.0 ** i
+        cell = material.CELL0 / 2.0 ** i
         assert np.all(material.octave(xz, i, 0.5 * cell) == 0.0)
         assert np.any(material.octave(xz, i, 0.2 * cell) != 0.0)
 

@@ -8,8 +8,9 @@ from atmos import value_noise
 from atmos.collision import height_normal
 from atmos.plugins.terrain.heightfield import height
 
-OCTAVES = 6
-CELL0 = 2048.0                        # m: the broadest octave's lattice cell; each next is 4x finer
+OCTAVES = 12
+BROAD = 3                             # the first three (2048, 1024, 512 m) make the broad patches
+CELL0 = 2048.0                        # m: the broadest octave's lattice cell; each next is 2x finer
 GRASS = np.array([[0.09, 0.20, 0.05], [0.25, 0.27, 0.11]])     # lush, dry
 ROCK = np.array([[0.20, 0.18, 0.16], [0.42, 0.38, 0.33]])      # dark, light
 SNOW = np.array([0.80, 0.82, 0.86])
@@ -24,7 +25,7 @@ def smoothstep(e0, e1, x):
 def octave(xz, i: int, footprint) -> np.ndarray:
     """Octave ``i`` of the detail at ground points ``xz`` (..., 2), centred on 0 and faded out as
     ``footprint`` (m) grows from 1/4 to 1/2 of its lattice cell (``terrain_octave``)."""
-    cell = CELL0 / 4.0 ** i
+    cell = CELL0 / 2.0 ** i
     fade = 1.0 - smoothstep(0.25, 0.5, np.asarray(footprint, np.float64) / cell)
     noise = value_noise.value_noise(np.asarray(xz, np.float64) / cell + np.array([0.37, 0.71]) * i,
                                     value_noise.key(i))
@@ -39,8 +40,8 @@ def albedo(p, n, footprint, relief: float, snowline: float, rock_slope: float) -
     p, n = np.asarray(p, np.float64), np.asarray(n, np.float64)
     footprint = np.broadcast_to(np.asarray(footprint, np.float64), p.shape[:-1])
     o = [octave(p[..., [0, 2]], i, footprint) for i in range(OCTAVES)]
-    broad = 0.6 * o[0] + 0.4 * o[1]
-    fine = 0.35 * o[2] + 0.3 * o[3] + 0.2 * o[4] + 0.15 * o[5]
+    broad = 0.5 * o[0] + 0.3 * o[1] + 0.2 * o[2]
+    fine = sum(0.15 * o[i] for i in range(BROAD, OCTAVES))
     slope = np.sqrt(np.maximum(1.0 - n[..., 1] * n[..., 1], 0.0))
 
     def mix(a, b, t):
@@ -53,7 +54,7 @@ def albedo(p, n, footprint, relief: float, snowline: float, rock_slope: float) -
     snowy = (smoothstep(snowline - 0.05, snowline + 0.05, h + 0.25 * broad + 0.1 * fine)
              * (1.0 - smoothstep(rock_slope, rock_slope + 0.2, slope + 0.1 * fine)))
     a = mix(mix(grass, rock, rocky), SNOW, snowy)
-    return np.clip(a * (1.0 + 0.6 * fine * (1.0 - 0.7 * snowy))[..., None], 0.0, 1.0)
+    return np.clip(a * (1.0 + 0.8 * fine * (1.0 - 0.7 * snowy))[..., None], 0.0, 1.0)
 
 
 def mean_albedo(size: float, cells: int, relief: float, snowline: float, rock_slope: float) -> np.ndarray:
