@@ -116,6 +116,11 @@ def test_ground_under_every_ray_below_the_horizon(gpu, ctx):
     below = elevation < -math.atan((cam.position[1] - lowest) / (horizon - np.abs(cam.position).max()))
     assert below.mean() > 0.3
     assert np.all(depth[below] < 1.0), f"{np.sum(depth[below] >= 1.0)} sky pixels under the horizon"
+    # from above a heightfield, looking nearly level, a ray below one that meets ground meets it too:
+    # no sky under ground in any column (rows from the bottom, GL order)
+    ground = depth < 1.0
+    top = ground.shape[0] - 1 - np.argmax(ground[::-1], 0)
+    assert all(ground[:top[c], c].all() for c in range(ground.shape[1]) if ground[:, c].any())
     assert 0.02 < (depth >= 1.0).mean() < 0.7                     # the sky above it
     assert distance[depth < 1.0].max() > 2 * 4000.0             # ground well beyond the square
     assert np.all(color[depth < 1.0, 3] == 1.0)
