@@ -1,4 +1,4 @@
-"""fog_valley: a ~10,000-triangle terrain under Zdrojewska's heterogeneous fog (figures 6-10 presets).
+"""fog_valley: a ~10,000-triangle terrain and its far ring under Zdrojewska's heterogeneous fog (figures 6-10 presets).
 
 Pick the paper's settings with ATMOS_FOG_PRESET=fig6 ... fig10 (default fig6), or keys 1-5 in a window.
 """
