@@ -24,9 +24,9 @@ class TerrainSettings(CheckedSettings):
     cells: int = int_field(71, 1, 1024, "quads along each side, cells² in all (2 triangles each; 71 → 10,082)")
     relief: float = num_field(30.0, doc="metres: the hills' height scale")
     horizon: float = num_field(150000.0, 0.0, 1e7, "metres from the origin to the edge of the far ring (the "
-                               "hills continued around the square, cells growing 1.2x per step outward); at "
-                               "most size/2: the square alone. The camera's far plane must reach it: "
-                               "TerrainPlugin.far_plane")
+                               "hills continued around the square, each step outward heightfield.FAR_GROWTH "
+                               "times wider); at most size/2: the square alone. The camera's far plane must "
+                               "reach it: TerrainPlugin.far_plane")
     snowline: float = num_field(1.0, doc="the height, in reliefs, above which flat ground is snow")
     rock_slope: float = num_field(0.3, 0.0, 1.0, "the slope (sine of its angle) where the ground is half grass, "
                                   "half rock (all rock 0.08 above)")
