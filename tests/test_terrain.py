@@ -85,6 +85,8 @@ def test_the_far_plane_of_the_horizon_costs_the_near_view_no_precision():
 
 # -- a rendered view -----------------------------------------------------------------------------
 def render(gpu, horizon: float):
+    """A near-level view over a 4 km square (with a far ring to ``horizon``): colour, depth, each
+    pixel's ray elevation (radians) and distance from depth (GL row order), and the camera."""
     capture = CapturePass()
     terrain = TerrainPlugin(size=4000.0, cells=40, relief=60.0, horizon=horizon)
     app = App(gpu).add_plugins(DefaultPlugins(overlay=False, fly_camera=False), terrain, pass_plugin(capture))
@@ -95,7 +97,6 @@ def render(gpu, horizon: float):
     app.insert_resource(Sun(np.array([0.3, 0.5, -1.0])))
     app.render()
     color, depth = capture.color.copy(), capture.depth.copy()
-    elevation = np.empty(depth.shape)
     w, h = gpu.size
     x, y = np.meshgrid((np.arange(w) + 0.5) / w * 2 - 1, (np.arange(h) + 0.5) / h * 2 - 1)
     t = math.tan(cam.fov_y / 2)
