@@ -102,7 +102,7 @@ def build(app, settings) -> None:
                     FogPlugin(mode="height", density=0.006, height_base=0.0, scale_height=30.0, sky="keep",
                               sun_scattering=0.12, color_from="sky", fog_color=(1.0, 1.0, 1.0)), AntialiasPlugin())
     cam = app.resource(Camera)
-    cam.near, cam.far = 1.0, terrain.far_plane
+    cam.near, cam.far = 1.0, terrain.far_plane()
     balloon = app.world.create_entity(Transform(START.copy()), MeshInstance(sphere(9.0), (0.8, 0.2, 0.15)))
     app.world.create_entity(Transform((0.0, -13.0, 0.0)), MeshInstance(cylinder(1.6, 1.8), (0.45, 0.3, 0.15)),
                             Parent(balloon))

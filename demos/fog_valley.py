@@ -61,7 +61,7 @@ def build(app, settings, fog_preset: str | None = None) -> FogPlugin:
     app.add_plugins(DefaultPlugins(overlay=not settings.headless), SkyGradientPlugin(), terrain, fog)
     cam = app.resource(Camera)
     cam.position = CAMERA_POS.copy()
-    cam.far = terrain.far_plane
+    cam.far = terrain.far_plane()
     cam.look_at(CAMERA_TARGET)
 
     def switch_preset(app) -> None:

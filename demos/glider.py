@@ -105,7 +105,7 @@ def build(app, settings) -> None:
                     FogPlugin(mode="exp", density=0.0001, sky="keep", color_from="sky", fog_color=(1.0, 1.0, 1.0)),
                     MeshPlugin(), TextPlugin(), chase)
     cam = app.resource(Camera)
-    cam.near, cam.far = 1.0, terrain.far_plane
+    cam.near, cam.far = 1.0, terrain.far_plane()
     glider_entity = app.world.create_entity(Transform(START.copy()), MeshInstance(glider(6.0), (0.85, 0.25, 0.15)))
     game = Game(terrain, chase, np.random.default_rng(settings.seed), glider=glider_entity)
     game.hud = {"score": app.world.create_entity(Label("", x=12, y=10, size=22)),

@@ -72,9 +72,12 @@ def depth_step(camera: Camera, d: float) -> float:
 
 
 def test_the_far_plane_of_the_horizon_costs_the_near_view_no_precision():
-    terrain = TerrainPlugin(size=40000.0, cells=71, relief=500.0)          # the cloud demos' terrain
-    far = terrain.far_plane
+    terrain = TerrainPlugin(size=40000.0, cells=71, relief=500.0)          # the cloud demos' terrain, its default ring
+    far = terrain.far_plane()
     assert far >= math.hypot(150000.0 + 20000.0, 150000.0 + 20000.0) + 1000.0
+    assert terrain.far_plane(within=0.0) == pytest.approx(math.sqrt(2.0) * 150000.0 + 1000.0)
+    with pytest.raises(ValueError, match=r"TerrainPlugin\.far_plane\.within"):
+        terrain.far_plane(within=-1.0)
     before, after = Camera(near=1.0, far=20000.0), Camera(near=1.0, far=far)
     for d in (2.0, 10.0, 100.0, 1000.0, 10000.0):
         assert depth_step(after, d) / depth_step(before, d) == pytest.approx(1.0, abs=1e-4)
@@ -93,7 +96,7 @@ def render(gpu, horizon: float):
     app.startup()
     cam = app.resource(Camera)
     cam.position, cam.yaw, cam.pitch, cam.roll = np.array([300.0, 120.0, -200.0]), 0.7, -0.02, 0.0
-    cam.near, cam.far = 1.0, terrain.far_plane
+    cam.near, cam.far = 1.0, terrain.far_plane()
     app.insert_resource(Sun(np.array([0.3, 0.5, -1.0])))
     app.render()
     color, depth = capture.color.copy(), capture.depth.copy()

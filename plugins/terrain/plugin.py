@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from atmos.checks import CheckedSettings, int_field, num_field
+from atmos.checks import CheckedSettings, check_num, int_field, num_field
 from atmos.collision import Hit, check_ray, height_normal, ray_grid
 from atmos.graph import PassContext
 from atmos.gpu.uniforms import write_uniforms
@@ -26,7 +26,7 @@ class TerrainSettings(CheckedSettings):
     horizon: float = num_field(150000.0, 0.0, 1e7, "metres from the origin to the edge of the far ring (the "
                                "hills continued around the square, each step outward heightfield.FAR_GROWTH "
                                "times wider); at most size/2: the square alone. The camera's far plane must "
-                               "reach it: TerrainPlugin.far_plane")
+                               "reach it: TerrainPlugin.far_plane()")
     snowline: float = num_field(1.0, doc="the height, in reliefs, above which flat ground is snow")
     rock_slope: float = num_field(0.3, 0.0, 1.0, "the slope (sine of its angle) where the ground is half grass, "
                                   "half rock (all rock 0.08 above)")
@@ -93,15 +93,17 @@ class TerrainPlugin(Plugin):
         """Triangles of the near square (the far ring adds its own: :func:`terrain_mesh`)."""
         return triangle_count(self.settings.cells)
 
-    @property
-    def far_plane(self) -> float:
-        """m: a camera far plane that shows all the drawn terrain from anywhere over the square, up to
-        2·relief high: from a corner of the square to the far corner of the ring, √2 (horizon + size/2),
-        and the hills' height. With 24-bit depth and near n, the depth step at distance d ≫ n is about
-        d² / (n 2^24) whatever the far plane (it only scales it by 1 − n / far), so the far ring costs
-        the near view no precision (tests/test_terrain.py); at the horizon the step is about 1%."""
+    def far_plane(self, within: float | None = None) -> float:
+        """m: a camera far plane that shows all the drawn terrain from anywhere within ``within`` metres
+        (horizontally) of the origin, up to 2·relief above the hills (None: anywhere over the square,
+        size/√2): the distance to the ring's farthest corner, √2·horizon + within, plus 2·relief.
+        With 24-bit depth and near n, the depth step at distance d ≫ n is about d² / (n 2^24) whatever
+        the far plane (it only scales it by 1 − n / far), so the far ring costs the near view no
+        precision (tests/test_terrain.py); at the horizon the step is about 1 % of the distance."""
         s = self.settings
-        return math.sqrt(2.0) * (max(s.horizon, s.size / 2) + s.size / 2) + 2.0 * abs(s.relief)
+        within = s.size / math.sqrt(2.0) if within is None else check_num("TerrainPlugin.far_plane", "within",
+                                                                            within, 0.0)
+        return math.sqrt(2.0) * max(s.horizon, s.size / 2) + within + 2.0 * abs(s.relief)
 
     @property
     def mean_albedo(self) -> np.ndarray:
