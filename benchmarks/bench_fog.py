@@ -1,8 +1,8 @@
 """Heterogeneous fog: image error against run time, texture vs procedural noise, 1-4 octaves.
 
-The fog_valley scene (10,082-triangle terrain, sky, eq. 7 fog with g = 0.044 and the paper's 16³-128³
-octaves) is rendered with each noise variant; RMSE is taken over the final sRGB image (0-1 scale,
-uint8 quantisation floor ≈ 0.001) against the 4-octave *procedural* render, which evaluates the exact
+The fog_valley scene (10,082-triangle terrain square and its far ring, sky, eq. 7 fog with g = 0.044
+and the paper's 16³-128³ octaves) is rendered with each noise variant; RMSE is taken over the final
+sRGB image (0-1 scale, uint8 quantisation floor ≈ 0.001) against the 4-octave *procedural* render, which evaluates the exact
 periodic noise per pixel (float32 on the GPU; the float64 references agree with it to ~1e-6, see
 tests/test_fog.py), so it is the highest-quality image this renderer makes. The 1-3 octave rows
 show the truncation error of eq. (5); the texture rows add the trilinear-resampling error of storing

@@ -32,6 +32,10 @@ SHAPE = (128, 16, 128)
 CELL = (40.0, 40.0, 40.0)
 BASE_ALTITUDE = 900.0
 EDGE_FADE = 0.35        # outer fraction of the volume's half width over which it gives way to the far field
+# m: the terrain's far ring. Nearer than TerrainSettings' default: the haze hides what lies beyond, and
+# the cloud shadow map's far cascade spans 1.25 x the camera's far plane (its texels grow with it).
+HORIZON = 40000.0
+REACH = 5000.0          # m: the cameras stay this near the origin (the far plane covers the ring from there)
 
 
 def build_cloudscape(app, settings, *, hours: float, speed: float = 0.0, cloud_density: int = 140,
@@ -46,6 +50,8 @@ def build_cloudscape(app, settings, *, hours: float, speed: float = 0.0, cloud_d
     clouds to the horizon, the volume fading out over its outer EDGE_FADE into the far field
     (:mod:`atmos.plugins.clouds.far_field`)."""
     weather = example_weather(SHAPE, cloud_density=cloud_density, wind=wind)
+    terrain = TerrainPlugin(size=40000.0, cells=71, relief=500.0, horizon=HORIZON,
+                            rock_slope=0.08)                     # gentle hills: rock on the steepest
     clouds = CloudSettings(cell_size=CELL, base_altitude=BASE_ALTITUDE, smoothing_slices=8, group_size=(32, 32),
                            sigma_t=0.02, edge_fade=EDGE_FADE if horizon else 0.0)
     cloud_plugin = CloudsPlugin(clouds, weather=weather, seed=settings.seed, warmup_steps=warmup_steps)
@@ -53,7 +59,7 @@ def build_cloudscape(app, settings, *, hours: float, speed: float = 0.0, cloud_d
     app.add_plugins(DefaultPlugins(overlay=not settings.headless),
                     DaylightPlugin(hours=hours, speed=speed),
                     SkyPlugin(model=settings.sky, aerial_perspective=haze and settings.haze in ("air", "both")),
-                    TerrainPlugin(size=40000.0, cells=71, relief=500.0),
+                    terrain,
                     cloud_plugin,
                     CloudShadowsPlugin(),
                     CloudRenderPlugin(size_factor=4.0, enabled=settings.clouds == "sprites"),
@@ -67,7 +73,7 @@ def build_cloudscape(app, settings, *, hours: float, speed: float = 0.0, cloud_d
         app.add_plugins(FogPlugin(mode="exp", density=4e-5, sky="keep", color_from="sky", fog_color=(1.0, 1.0, 1.0)))
     app.frames.slices_per_frame = slices_per_frame
     cam = app.resource(Camera)
-    cam.near, cam.far = 1.0, 20000.0
+    cam.near, cam.far = 1.0, terrain.far_plane(within=REACH)
     cam.position = np.array([0.0, 250.0, 0.0])
     return cloud_plugin
 

@@ -94,7 +94,7 @@ def hud(app) -> None:
 
 
 def build(app, settings) -> None:
-    terrain = TerrainPlugin(size=9000.0, cells=96, relief=240.0)
+    terrain = TerrainPlugin(size=9000.0, cells=96, relief=240.0, rock_slope=0.16)
     chase = ChaseCameraPlugin(distance=60.0, height=12.0)
     sky = CloudSky("fair_weather", seed=settings.seed, altitude=900.0, transition=30.0)
     app.add_plugins(DefaultPlugins(fly_camera=False), DaylightPlugin(hours=6.2, speed=0.05),
@@ -102,7 +102,7 @@ def build(app, settings) -> None:
                     FogPlugin(mode="height", density=0.006, height_base=0.0, scale_height=30.0, sky="keep",
                               sun_scattering=0.12, color_from="sky", fog_color=(1.0, 1.0, 1.0)), AntialiasPlugin())
     cam = app.resource(Camera)
-    cam.near, cam.far = 1.0, 20000.0
+    cam.near, cam.far = 1.0, terrain.far_plane()
     balloon = app.world.create_entity(Transform(START.copy()), MeshInstance(sphere(9.0), (0.8, 0.2, 0.15)))
     app.world.create_entity(Transform((0.0, -13.0, 0.0)), MeshInstance(cylinder(1.6, 1.8), (0.45, 0.3, 0.15)),
                             Parent(balloon))

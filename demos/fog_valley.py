@@ -1,4 +1,4 @@
-"""fog_valley: a ~10,000-triangle terrain under Zdrojewska's heterogeneous fog (figures 6-10 presets).
+"""fog_valley: a ~10,000-triangle terrain and its far ring under Zdrojewska's heterogeneous fog (figures 6-10 presets).
 
 Pick the paper's settings with ATMOS_FOG_PRESET=fig6 ... fig10 (default fig6), or keys 1-5 in a window.
 """
@@ -57,10 +57,11 @@ def build(app, settings, fog_preset: str | None = None) -> FogPlugin:
     name = fog_preset or os.environ.get("ATMOS_FOG_PRESET", "fig6")
     fog = FogPlugin(sky="fog", tile_size=NOISE_TILE, seed=settings.seed, **preset(name))   # --seed: the noise lattice
     app.insert_resource(Sun.from_angles(elevation_deg=30.0, azimuth_deg=-30.0))
-    app.add_plugins(DefaultPlugins(overlay=not settings.headless), SkyGradientPlugin(), TerrainPlugin(size=TERRAIN_SIZE, relief=10.0), fog)
+    terrain = TerrainPlugin(size=TERRAIN_SIZE, relief=10.0, rock_slope=0.6)   # steep grassy hills, as in the paper
+    app.add_plugins(DefaultPlugins(overlay=not settings.headless), SkyGradientPlugin(), terrain, fog)
     cam = app.resource(Camera)
     cam.position = CAMERA_POS.copy()
-    cam.far = 400.0
+    cam.far = terrain.far_plane()
     cam.look_at(CAMERA_TARGET)
 
     def switch_preset(app) -> None:

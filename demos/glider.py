@@ -99,13 +99,13 @@ def hud(app) -> None:
 
 
 def build(app, settings) -> None:
-    terrain, chase = TerrainPlugin(size=12000.0, cells=96, relief=260.0), ChaseCameraPlugin(distance=16.0, height=4.0, bank=0.6)
+    terrain, chase = TerrainPlugin(size=12000.0, cells=96, relief=260.0, rock_slope=0.14), ChaseCameraPlugin(distance=16.0, height=4.0, bank=0.6)
     app.add_plugins(DefaultPlugins(overlay=False, fly_camera=False), DaylightPlugin(hours=16.5, speed=0.02),
                     SkyPlugin(model=settings.sky), terrain, CloudSky("fair_weather", seed=settings.seed, altitude=700.0),
                     FogPlugin(mode="exp", density=0.0001, sky="keep", color_from="sky", fog_color=(1.0, 1.0, 1.0)),
                     MeshPlugin(), TextPlugin(), chase)
     cam = app.resource(Camera)
-    cam.near, cam.far = 1.0, 20000.0
+    cam.near, cam.far = 1.0, terrain.far_plane()
     glider_entity = app.world.create_entity(Transform(START.copy()), MeshInstance(glider(6.0), (0.85, 0.25, 0.15)))
     game = Game(terrain, chase, np.random.default_rng(settings.seed), glider=glider_entity)
     game.hud = {"score": app.world.create_entity(Label("", x=12, y=10, size=22)),

@@ -281,7 +281,7 @@ SPECS = {
     "terrain": Spec(
         lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), TerrainPlugin(cells=24)], TerrainPlugin,
         look((0.0, 50.0, 130.0), target=(0.0, 0.0, 0.0)),
-        dict(size=128.0, cells=12, relief=60.0)),
+        dict(size=128.0, cells=12, relief=60.0, horizon=0.0, snowline=0.2, rock_slope=0.05)),
     "sky": Spec(
         lambda: [DefaultPlugins(overlay=False), SkyPlugin(star_density=0.5), GroundPlugin()], SkyPlugin,
         look((0.0, 2.0, 0.0), yaw=math.radians(200.0), pitch=0.45),

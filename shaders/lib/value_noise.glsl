@@ -8,6 +8,12 @@ const float VN_SCALE = 1.0 / 16777216.0;
 
 uint vn_key(uint seed) { return atmos_lowbias32(seed ^ 0x9e3779b9u); }
 
+float vn_lattice2(ivec2 c, uint key) {
+    uint h = atmos_lowbias32(uint(c.x) ^ key);
+    h = atmos_lowbias32(h ^ uint(c.y));
+    return float(h >> 8) * VN_SCALE;
+}
+
 float vn_lattice3(ivec3 c, uint key) {
     uint h = atmos_lowbias32(uint(c.x) ^ key);
     h = atmos_lowbias32(h ^ uint(c.y));
@@ -21,6 +27,16 @@ float vn_lattice4(ivec4 c, uint key) {
     h = atmos_lowbias32(h ^ uint(c.z));
     h = atmos_lowbias32(h ^ uint(c.w));
     return float(h >> 8) * VN_SCALE;
+}
+
+// 2D value noise in [0, 1): bilinear blend of the 4 corner values with weights f*f*(3-2f).
+float value_noise2(vec2 x, uint key) {
+    vec2 p = floor(x);
+    vec2 f = x - p;
+    f = f * f * (3.0 - 2.0 * f);
+    ivec2 c = ivec2(p);
+    return mix(mix(vn_lattice2(c, key), vn_lattice2(c + ivec2(1, 0), key), f.x),
+               mix(vn_lattice2(c + ivec2(0, 1), key), vn_lattice2(c + ivec2(1, 1), key), f.x), f.y);
 }
 
 // 3D value noise in [0, 1): trilinear blend of the 8 corner values with weights f*f*(3-2f).
