@@ -83,3 +83,26 @@ def test_ground_surface_checks_its_albedo():
     with pytest.raises(ValueError, match="GroundSurface"):
         GroundSurface((0.5, float("nan"), 0.2))
     assert GroundSurface(lambda: (2.0, 0.5, -1.0)).albedo == (1.0, 0.5, 0.0)     # a drawing plugin's value, clamped
+
+
+def test_terrain_and_ground_publish_their_albedo(gpu, ctx):
+    """TerrainPlugin and GroundPlugin insert the GroundSurface the clouds' light reads, following live changes."""
+    from atmos import App, DefaultPlugins
+    from atmos.plugins.ground import GroundPlugin
+    from atmos.plugins.terrain import TerrainPlugin
+    terrain = TerrainPlugin(size=4000.0, cells=16, relief=300.0, horizon=2000.0)
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), terrain)
+    app.startup()
+    surface = app.resource(GroundSurface)
+    assert surface.albedo == pytest.approx(tuple(terrain.mean_albedo))
+    before = surface.albedo
+    terrain.configure(snowline=0.1)                 # snow on most of it: brighter
+    assert sum(surface.albedo) > sum(before) + 0.1
+    app.close()
+    ground = GroundPlugin(albedo=(0.1, 0.2, 0.3))
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), ground)
+    app.startup()
+    assert app.resource(GroundSurface).albedo == (0.1, 0.2, 0.3)
+    ground.configure(albedo=(0.5, 0.5, 0.5))
+    assert app.resource(GroundSurface).albedo == (0.5, 0.5, 0.5)
+    app.close()

@@ -10,6 +10,7 @@ from atmos.checks import CheckedSettings, check_num, int_field, num_field
 from atmos.collision import Hit, check_ray, height_normal, ray_grid
 from atmos.graph import PassContext
 from atmos.gpu.uniforms import write_uniforms
+from atmos.lighting import GroundSurface
 from atmos.plugin import Plugin
 from atmos.plugins.terrain import material
 from atmos.plugins.terrain.heightfield import height, terrain_mesh, triangle_count
@@ -151,3 +152,4 @@ class TerrainPlugin(Plugin):
 
     def build(self, app) -> None:
         app.graph.add_pass(TerrainPass(self))
+        app.insert_resource(GroundSurface(lambda: self.mean_albedo))   # what the clouds' light from below sees
