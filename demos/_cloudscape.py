@@ -64,7 +64,7 @@ def build_cloudscape(app, settings, *, hours: float, speed: float = 0.0, cloud_d
                     CloudShadowsPlugin(),
                     CloudRenderPlugin(size_factor=4.0, enabled=settings.clouds == "sprites"),
                     RaymarchCloudsPlugin(enabled=settings.clouds == "march"),
-                    LightShaftsPlugin())
+                    LightShaftsPlugin(horizon_fade=0.03))   # the sun's own colour already fades at the horizon
     app.add_system(switch_key, "update", label="cloud_renderer_switch")
     add_demo_camera(app, settings)
     if horizon:
