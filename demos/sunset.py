@@ -23,7 +23,7 @@ def pan_toward_the_sun(app) -> None:
 
 
 def build(app, settings) -> None:
-    # the sun 2.2° up, setting in about 15 s of play (0.02 game hours a second)
-    build_cloudscape(app, settings, hours=19.5, speed=0.02, cloud_density=150, warmup_steps=12, haze=True)
+    # the sun 2.2° up, setting in about half a minute of play (0.01 game hours a second)
+    build_cloudscape(app, settings, hours=19.5, speed=0.01, cloud_density=150, warmup_steps=12, haze=True)
     app.resource(Camera).position = np.array([0.0, 320.0, 0.0])
     app.add_system(pan_toward_the_sun, "update", label="pan_toward_the_sun", after="daylight")

@@ -274,10 +274,11 @@ SPECS = {
         lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin()], GroundPlugin,
         look((0.0, 3.0, 10.0), yaw=0.0, pitch=-0.2),
         dict(half_size=5.0, tile=1.0, albedo=(0.9, 0.1, 0.1))),
-    "sky_gradient": Spec(
+    "sky_gradient": Spec(                                   # the default sun in view, as the sky's
         lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin()], SkyGradientPlugin,
-        look((0.0, 3.0, 10.0), yaw=0.0, pitch=0.3),
-        dict(zenith=(0.9, 0.1, 0.1), horizon=(0.1, 0.9, 0.1), ground=(0.1, 0.1, 0.9))),
+        look((0.0, 2.0, 0.0), yaw=math.radians(200.0), pitch=0.45),
+        dict(zenith=(0.9, 0.1, 0.1), horizon=(0.1, 0.9, 0.1), ground=(0.1, 0.1, 0.9), sun_size_deg=4.0, sun_gain=200.0,
+             sun_glare=0.5)),
     "terrain": Spec(
         lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), TerrainPlugin(cells=24)], TerrainPlugin,
         look((0.0, 50.0, 130.0), target=(0.0, 0.0, 0.0)),
