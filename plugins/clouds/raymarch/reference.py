@@ -13,7 +13,7 @@ import numpy as np
 
 from atmos.camera import view_basis
 from atmos.plugins.clouds.raymarch.settings import SUN_GROWTH, SUN_SPACING
-from atmos.plugins.clouds.raymarch.shape import type_density
+from atmos.plugins.clouds.raymarch.shape import TYPE_SUN_STEPS, type_density
 from atmos.plugins.clouds.volume.light import layer_sun, sun_source_at, unit_direction
 from atmos.plugins.clouds.sprites.reference import column_depth
 from atmos.plugins.clouds.light.diffusion import diffusion_radiance
@@ -59,8 +59,10 @@ def march_reference(density, transmittance, medium, settings, layout, camera, su
 
     def sample(i, p):
         uvw = (p - lo) / extent
+        typed = settings.cloud_type is not None and settings.sun_steps > 0
         T = sun_transmittance(d, trans_volume, medium.sigma_t, lo, extent, SUN_SPACING * cell.min(),
-                              settings.sun_steps, sun_dir, p, density_at)
+                              settings.sun_steps + TYPE_SUN_STEPS * typed, sun_dir, p, density_at,
+                              shading=not typed)
         up, down = column_depth(d, uvw, column_tau, trans_volume.shape)
         L = None if field is None else diffusion_radiance(field, uvw, dirs[i], lobes, sun_dir)
         return density_at(uvw), source_reference(
@@ -112,11 +114,12 @@ def integrate(pos, dirs, enter, leave, steps, step_base, growth, min_transmittan
             "distance": weighted.reshape(h, w)}
 
 
-def sun_transmittance(density, transmittance, sigma_t, lo, extent, step, steps, sun_dir, p, density_at=None) -> np.ndarray:
+def sun_transmittance(density, transmittance, sigma_t, lo, extent, step, steps, sun_dir, p, density_at=None,
+                      shading: bool = True) -> np.ndarray:
     """march.glsl's sun_transmittance at world points ``p`` (n, 3): ``steps`` steps toward ``sun_dir``
     (unit), the first ``step`` m long and each next SUN_GROWTH times the last, the trilinear ``density``
     (or ``density_at(uvw)``: :func:`shaped_density`) at each step's midpoint (0 from the first midpoint
-    outside the box on) times the step, then the
+    outside the box on) times the step, then (``shading``; else 1: a cloud type) the
     shading volume ``transmittance`` (trilinear) where they end (1 outside the box); ``steps`` 0: the
     shading volume's T at p."""
     d, tv = np.asarray(density, np.float64), np.asarray(transmittance, np.float64)
@@ -134,7 +137,7 @@ def sun_transmittance(density, transmittance, sigma_t, lo, extent, step, steps, 
         tau += np.where(live, h * rho, 0.0)
         at, h = at + h, h * SUN_GROWTH
     end = (p + sun_dir * at - lo) / extent
-    far = multilinear(tv, end * tshape - 0.5)
+    far = multilinear(tv, end * tshape - 0.5) if shading else np.ones(len(p))
     if steps > 0:
         far = np.where(live & inside(end), far, 1.0)
     return np.exp(-sigma_t * tau) * far

@@ -73,8 +73,10 @@ class RaymarchCloudSettings(CloudLightSettings):
                                          "mean density sets how much of the type's height profile it fills, and the "
                                          "detail noise erodes wherever the density is below the body's, through the "
                                          "volume. The same type everywhere (the far field too). None: the "
-                                         "simulation's own vertical shape (what the sprites draw). Cost: one more "
-                                         "texture read per density sample; skipping then skips whole empty columns",
+                                         "simulation's own vertical shape (what the sprites draw). Cost: the column's "
+                                         "texture read in place of the density's per sample; skipping then skips only "
+                                         "whole empty columns; the sun march takes 2 more (long) steps in place of "
+                                         "the shading volume, which holds the simulation's own shape",
                                          optional=True)
     detail_octaves: int = int_field(3, 0, 3, "noise channels the density is eroded by (0 = off; each one two "
                                     "more texture fetches per sample; ``shaders/clouds/raymarch/detail.glsl``)")

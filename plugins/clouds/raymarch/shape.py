@@ -30,6 +30,8 @@ PROFILES = ((0.05, 0.10, 0.28),   # stratus: (rise end, fall start, fall end) in
 COLUMN_FULL = 0.35    # a column whose mean density over the layer is this or more is fully covered
 ANVIL = 0.5           # the top's coverage exponent falls by up to this much at t = 1 (c^0.5: wider)
 ANVIL_FROM = (0.7, 0.95)   # over these height fractions
+TYPE_SUN_STEPS = 2    # with a type the sun march takes this many more steps and ends with 1, not the shading
+                      # volume's T (which holds the simulation's own shape: march.glsl sun_transmittance)
 
 
 def _ramp(x, a, b):

@@ -76,19 +76,25 @@ float sample_jitter(vec2 pixel) {
 // cell centres; trilinear between centres an e-fold apart it is 12 % too bright midway (0.68 for
 // 0.61), at any depth, and it blurs the lit surface over a cell (a low sun crosses a dense cloud's
 // cells lengthwise: dark bodies came out grey, rims weak); the march resolves the surface and the
-// first cells behind it. SUN_STEPS 0: the shading volume's T at p.
+// first cells behind it. SUN_STEPS 0: the shading volume's T at p. With a cloud type (shape.glsl) the
+// shading volume holds the simulation's own shape (a stratus sheet under it would lie in the shadow of
+// the simulated blob above), so the march goes on TYPE_SUN_STEPS more steps (4 + 2 reach 31.5 cells)
+// and ends with 1; those long steps see the detail at their own length as the footprint (the noise
+// finer than a step is not read).
 float sun_transmittance(vec3 p, vec3 uvw, vec3 extent, float footprint) {
 #if SUN_STEPS > 0
     float tau = 0.0, at = 0.0, h = length(sun_march);
     vec3 toward = sun_march / h;
-    for (int k = 0; k < SUN_STEPS; ++k, at += h, h *= sun_growth) {
+    bool typed = cloud_type >= 0.0;
+    int n = SUN_STEPS + (typed ? TYPE_SUN_STEPS : 0);
+    for (int k = 0; k < n; ++k, at += h, h *= sun_growth) {
         vec3 q = p + toward * (at + 0.5 * h);
         vec3 s = (q - layer_min) / extent;
         if (any(lessThan(s, vec3(0.0))) || any(greaterThan(s, vec3(1.0)))) return exp(-sigma_t * tau);
-        tau += h * detail_density(shaped_density(s, extent.y / cell_size.y), q, footprint);
+        tau += h * detail_density(shaped_density(s, extent.y / cell_size.y), q, k < SUN_STEPS ? footprint : max(footprint, h));
     }
     vec3 e = (p + toward * at - layer_min) / extent;
-    bool inside = all(greaterThanEqual(e, vec3(0.0))) && all(lessThanEqual(e, vec3(1.0)));
+    bool inside = !typed && all(greaterThanEqual(e, vec3(0.0))) && all(lessThanEqual(e, vec3(1.0)));
     return exp(-sigma_t * tau) * (inside ? cloud_transmittance(e) : 1.0);
 #else
     return cloud_transmittance(uvw);

@@ -10,6 +10,7 @@ const vec3 TYPE_PROFILES[3] = vec3[3](vec3(0.05, 0.10, 0.28), vec3(0.08, 0.25, 0
 const float COLUMN_FULL = 0.35;
 const float ANVIL = 0.5;
 const vec2 ANVIL_FROM = vec2(0.7, 0.95);
+const int TYPE_SUN_STEPS = 2;   // march.glsl sun_transmittance: more sun steps in place of the shading volume
 
 float type_ramp(float x, float a, float b) {
     return clamp((x - a) / (b - a), 0.0, 1.0);
