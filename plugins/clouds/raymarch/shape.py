@@ -24,8 +24,8 @@ import numpy as np
 CLOUD_TYPES = {"stratus": 0.0, "cumulus": 0.5, "congestus": 1.0}
 """The key types: t of each."""
 PROFILES = ((0.05, 0.10, 0.28),   # stratus: (rise end, fall start, fall end) in height fraction: thin, flat
-            (0.08, 0.25, 0.70),   # cumulus: flat base, rounded top at about two thirds of the layer
-            (0.06, 0.40, 1.00))   # congestus: towers to the top of the layer
+            (0.08, 0.20, 0.70),   # cumulus: flat base, rounded top at about two thirds of the layer
+            (0.06, 0.20, 1.00))   # congestus: towers to the top of the layer, tapering
 """(rise end, fall start, fall end) of each key type, in the order of CLOUD_TYPES."""
 COLUMN_FULL = 0.35    # a column whose mean density over the layer is this or more is fully covered
 ANVIL = 0.5           # the top's coverage exponent falls by up to this much at t = 1 (c^0.5: wider)

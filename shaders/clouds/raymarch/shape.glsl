@@ -6,7 +6,7 @@
 
 uniform float cloud_type;      // RaymarchCloudSettings.cloud_type; -1: None
 
-const vec3 TYPE_PROFILES[3] = vec3[3](vec3(0.05, 0.10, 0.28), vec3(0.08, 0.25, 0.70), vec3(0.06, 0.40, 1.00));
+const vec3 TYPE_PROFILES[3] = vec3[3](vec3(0.05, 0.10, 0.28), vec3(0.08, 0.20, 0.70), vec3(0.06, 0.20, 1.00));
 const float COLUMN_FULL = 0.35;
 const float ANVIL = 0.5;
 const vec2 ANVIL_FROM = vec2(0.7, 0.95);
