@@ -76,12 +76,13 @@ def test_the_march_with_each_type_matches_its_float64_reference(gpu, ctx, rng, n
                           field=read_field(sim.a[DIFFUSION]))
     assert (ref["alpha"] > 0.05).mean() > 0.02, "the view must see the clouds"
     # the columns are half floats (relative 2^-11) and the shaped density moves by at most as much as the
-    # coverage m / COLUMN_FULL (clamp(P - 1 + c, 0, c)): ~1e-3 of density, so alpha and colour ~1e-3
+    # coverage m / COLUMN_FULL (clamp(P - 1 + c, 0, c)): up to 2^-11 / COLUMN_FULL = 1.4e-3 of density, so
+    # alpha and colour ~1e-3 (measured: colour 5e-4..6e-4, alpha p99.5 4e-4..6e-4)
     light = ref["light"]
     rmse = np.sqrt(np.mean((image[..., :3] - light) ** 2)) / np.sqrt(np.mean(light ** 2))
-    assert rmse < 0.01, f"colour off the reference: relative RMSE {rmse:.4f}"
+    assert rmse < 0.003, f"colour off the reference: relative RMSE {rmse:.4f}"
     off = np.abs(image[..., 3] - ref["alpha"])
-    assert np.percentile(off, 99.5) < 0.005, "coverage off the reference"
+    assert np.percentile(off, 99.5) < 0.002, "coverage off the reference"
     assert (off > 0.02).mean() < 0.002, "only rays grazing the box's faces may differ (float32 entry/exit)"
     app.close()
 
