@@ -111,3 +111,11 @@ def test_a_bad_cloud_type_is_refused_naming_the_field(value):
 def test_the_default_is_cumulus_and_none_is_the_simulations_own_shape():
     assert RaymarchCloudSettings().cloud_type == CLOUD_TYPES["cumulus"]
     assert RaymarchCloudSettings(cloud_type=None).cloud_type is None
+
+
+def test_the_weather_demos_type_follows_the_weather():
+    from atmos.demos.weather import cloud_type_at
+    assert [cloud_type_at(p) for p in (0.0, 0.5, 1.0)] == [CLOUD_TYPES[k] for k in ("cumulus", "congestus", "stratus")]
+    phases = np.linspace(0.0, 1.0, 101)
+    kinds = np.array([cloud_type_at(p) for p in phases])
+    assert np.all((kinds >= 0.0) & (kinds <= 1.0)) and np.all(np.abs(np.diff(kinds)) <= 0.021), "smooth in phase"
