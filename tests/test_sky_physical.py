@@ -675,7 +675,8 @@ def test_at_dusk_the_tops_keep_the_sun_after_the_bases_lose_it(gpu, ctx, rendere
     all but set for the base (the planet's shadow: 0.6 % of the top's red) and not for the top. Both
     renderers take the sun's colour at each height (volume.glsl sun_source_at): the top glows red over a
     base lit by the sky alone. Drawn again with the middle's colour at every height (the model before),
-    the base is brighter and the top darker."""
+    the base is brighter and the top darker. The march draws it as congestus (cloud_type 1: a tower to the
+    layer's top)."""
     from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
     from atmos.plugins.clouds.sprites import CloudRenderPlugin
     from atmos.plugins.clouds.volume import light
@@ -685,7 +686,7 @@ def test_at_dusk_the_tops_keep_the_sun_after_the_bases_lose_it(gpu, ctx, rendere
         density = np.zeros((8, 24, 8), np.float32)
         density[1:7, 1:23, 1:7] = 1.0
         settings = CloudSettings(cell_size=(50.0, 50.0, 50.0), base_altitude=900.0, group_size=(4, 4), sigma_t=0.01)
-        drawing = CloudRenderPlugin() if renderer == "sprites" else RaymarchCloudsPlugin(jitter=False)
+        drawing = CloudRenderPlugin() if renderer == "sprites" else RaymarchCloudsPlugin(jitter=False, cloud_type=1.0)
         app = App(gpu).add_plugins(DefaultPlugins(overlay=False), SkyPlugin(model="physical"),
                                    CloudsPlugin(settings, density=density), drawing)
         app.insert_resource(Sun(direction=sun_at(-1.2, 60.0)))

@@ -7,6 +7,7 @@ import numpy as np
 
 from atmos.plugins.clouds.far_field.reference import column_at_rank, far_relief, field_fbm, field_rank, relief_light
 from atmos.plugins.clouds.raymarch.reference import integrate, rays
+from atmos.plugins.clouds.raymarch.shape import type_density
 from atmos.plugins.clouds.volume.light import cell_tau, layer_sun, sun_source_at, unit_direction
 from atmos.plugins.clouds.light.diffusion import field_radiance
 from atmos.plugins.clouds.light.medium import OCTAVES, source_reference
@@ -52,9 +53,13 @@ class FarField:
     def rank(self, xz, channel: int = 0) -> np.ndarray:
         return field_rank(field_fbm(xz, **self.field, channel=channel), self.quantiles)
 
-    def density(self, rank, h) -> np.ndarray:
-        """far.glsl's far_density: the column sum at ``rank`` × the profile's R at height fraction ``h``."""
+    def density(self, rank, h, cloud_type=None, ny: float = 1.0) -> np.ndarray:
+        """far.glsl's far_density: the column sum at ``rank`` × the profile's R at height fraction ``h``;
+        with a ``cloud_type``, :func:`~atmos.plugins.clouds.raymarch.shape.type_density` of the column
+        sum / ``ny`` (the layer's height in cells)."""
         h = np.asarray(h, np.float64)
+        if cloud_type is not None:
+            return type_density(column_at_rank(rank, self.columns) / ny, h, cloud_type)
         d = column_at_rank(rank, self.columns) * sample_profile(self.profile, rank, h)[..., 0]
         return np.where((h >= 0.0) & (h <= 1.0), d, 0.0)
 
@@ -104,7 +109,8 @@ def far_march_reference(field: FarField, medium, settings, band, camera, sun, si
     step_base = settings.step * float(np.min(medium.cell_size))
 
     def sample(i, p):
-        rho = field.density(field.rank(p[:, [0, 2]]), (p[:, 1] - band[0]) / band[1])
+        rho = field.density(field.rank(p[:, [0, 2]]), (p[:, 1] - band[0]) / band[1], settings.cloud_type,
+                            band[1] / float(medium.cell_size[1]))
         return rho, far_source(field, medium, settings, p, dirs[i], band, sun, albedo, ground_sun)
 
     return integrate(pos, dirs, enter, leave, settings.steps, step_base, settings.far_step_growth,

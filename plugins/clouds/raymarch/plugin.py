@@ -226,7 +226,7 @@ class RaymarchPass(RenderPass):
                 "jitter": int(s.jitter),    # turned per frame only where the resolve averages (r > 1, reprojection)
                 "jitter_shift": jitter_shift(self.frame_index, s.resolution) if s.resolution > 1 and s.reprojection else 0.0,
                 "sun_march": tuple(float(v) for v in sun * SUN_SPACING * cell.min()), "sun_growth": SUN_GROWTH,
-                "pixel_angle": pixel_angle(view)}
+                "pixel_angle": pixel_angle(view), "cloud_type": -1.0 if s.cloud_type is None else float(s.cloud_type)}
 
     def execute(self, frame: PassContext) -> None:
         s, view = self.plugin.settings, frame.view

@@ -4,13 +4,16 @@ fall): the same segments (``step_base + step_growth · s``, s from the near plan
 to its far side or the scene), the density trilinear between cell centres (clamp to edge), the
 light J of :func:`atmos.plugins.clouds.light.medium.source_reference` with the column depths of
 :func:`atmos.plugins.clouds.sprites.reference.column_depth` and the set's diffusion field
-(``edge_fade`` 0: neither fades)."""
+(``edge_fade`` 0: neither fades). With ``settings.cloud_type`` the density is
+:func:`~atmos.plugins.clouds.raymarch.shape.type_density` of the column's mean density (the light volume's
+columns, as ``shape.glsl`` reads them), in the view march and the sun march alike."""
 from __future__ import annotations
 
 import numpy as np
 
 from atmos.camera import view_basis
 from atmos.plugins.clouds.raymarch.settings import SUN_GROWTH, SUN_SPACING
+from atmos.plugins.clouds.raymarch.shape import TYPE_SUN_STEPS, type_density
 from atmos.plugins.clouds.volume.light import layer_sun, sun_source_at, unit_direction
 from atmos.plugins.clouds.sprites.reference import column_depth
 from atmos.plugins.clouds.light.diffusion import diffusion_radiance
@@ -54,19 +57,36 @@ def march_reference(density, transmittance, medium, settings, layout, camera, su
     sun_dir = unit_direction(sun)
     column_tau = medium.sigma_t * cell[1]
     lobes = medium.phase.lobes
+    density_at = shaped_density(d, settings.cloud_type, trans_volume.shape, extent[1] / cell[1])
 
     def sample(i, p):
         uvw = (p - lo) / extent
+        typed = settings.cloud_type is not None and settings.sun_steps > 0
         T = sun_transmittance(d, trans_volume, medium.sigma_t, lo, extent, SUN_SPACING * cell.min(),
-                              settings.sun_steps, sun_dir, p)
+                              settings.sun_steps + TYPE_SUN_STEPS * typed, sun_dir, p, density_at,
+                              shading=not typed)
         up, down = column_depth(d, uvw, column_tau, trans_volume.shape)
         L = None if field is None else diffusion_radiance(field, uvw, dirs[i], lobes, sun_dir)
-        return multilinear(d, uvw * shape - 0.5), source_reference(
+        return density_at(uvw), source_reference(
             medium, settings, T, up, down, dirs[i] @ sun_dir, dirs[i][:, 1], sun_color, ambient, sun_dir, L,
             sun_colors=sun_source_at(by_height, uvw[:, 1]), albedo=albedo, ground_sun=ground_sun)
 
     return integrate(pos, dirs, enter, leave, settings.steps, step_base, settings.step_growth,
                      settings.min_transmittance, medium.sigma_t, sample, (h, w))
+
+
+def shaped_density(density, cloud_type, shading_shape, ny: float):
+    """``shape.glsl``'s shaped_density as a function of uvw (n, 3): the trilinear ``density`` (cloud_type
+    None), else type_density of the columns' (up + down) / ``ny`` (the layer's height in cells) of the
+    shading grid ``shading_shape``."""
+    d = np.asarray(density, np.float64)
+    if cloud_type is None:
+        return lambda uvw: multilinear(d, uvw * np.array(d.shape, np.float64) - 0.5)
+
+    def at(uvw):
+        up, down = column_depth(d, uvw, 1.0, shading_shape)
+        return type_density((up + down) / ny, uvw[:, 1], cloud_type)
+    return at
 
 
 def integrate(pos, dirs, enter, leave, steps, step_base, growth, min_transmittance, sigma_t, sample, shape) -> dict:
@@ -96,10 +116,12 @@ def integrate(pos, dirs, enter, leave, steps, step_base, growth, min_transmittan
             "distance": weighted.reshape(h, w)}
 
 
-def sun_transmittance(density, transmittance, sigma_t, lo, extent, step, steps, sun_dir, p) -> np.ndarray:
+def sun_transmittance(density, transmittance, sigma_t, lo, extent, step, steps, sun_dir, p, density_at=None,
+                      shading: bool = True) -> np.ndarray:
     """march.glsl's sun_transmittance at world points ``p`` (n, 3): ``steps`` steps toward ``sun_dir``
     (unit), the first ``step`` m long and each next SUN_GROWTH times the last, the trilinear ``density``
-    at each step's midpoint (0 from the first midpoint outside the box on) times the step, then the
+    (or ``density_at(uvw)``: :func:`shaped_density`) at each step's midpoint (0 from the first midpoint
+    outside the box on) times the step, then (``shading``; else 1: a cloud type) the
     shading volume ``transmittance`` (trilinear) where they end (1 outside the box); ``steps`` 0: the
     shading volume's T at p."""
     d, tv = np.asarray(density, np.float64), np.asarray(transmittance, np.float64)
@@ -113,10 +135,11 @@ def sun_transmittance(density, transmittance, sigma_t, lo, extent, step, steps, 
     for _ in range(steps):
         uvw = (p + sun_dir * (at + 0.5 * h) - lo) / extent
         live &= inside(uvw)
-        tau += np.where(live, h * multilinear(d, uvw * shape - 0.5), 0.0)
+        rho = multilinear(d, uvw * shape - 0.5) if density_at is None else density_at(uvw)
+        tau += np.where(live, h * rho, 0.0)
         at, h = at + h, h * SUN_GROWTH
     end = (p + sun_dir * at - lo) / extent
-    far = multilinear(tv, end * tshape - 0.5)
+    far = multilinear(tv, end * tshape - 0.5) if shading else np.ones(len(p))
     if steps > 0:
         far = np.where(live & inside(end), far, 1.0)
     return np.exp(-sigma_t * tau) * far

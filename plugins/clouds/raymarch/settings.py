@@ -4,6 +4,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from atmos.checks import bool_field, int_field, num_field, vec_field
+from atmos.plugins.clouds.raymarch.shape import CLOUD_TYPES
 from atmos.plugins.clouds.raymarch.temporal import HISTORY_CLAMP, MOTION_LIMIT
 from atmos.plugins.clouds.volume.light import CloudLightSettings
 
@@ -13,10 +14,10 @@ MAX_SUN_STEPS = 16
 SUN_SPACING = 0.5        # cells (of the smallest side): the sun march's first step (march.glsl sun_transmittance)
 SUN_GROWTH = 2.0         # each next sun-march step this many times the last (4 steps reach 7.5 cells)
 REFERENCE = dict(resolution=1, jitter=False, reprojection=False, detail_octaves=0, step=0.25, step_growth=0.0,
-                 steps=MAX_STEPS, min_transmittance=0.0)
+                 steps=MAX_STEPS, min_transmittance=0.0, cloud_type=None)
 """The reference configuration (:meth:`RaymarchCloudsPlugin.reference`): every pixel marched, one sample
 at the midpoint of every quarter-cell step to the layer's end or the scene depth (at most 4096 samples
-in occupied space), no detail noise, jitter, history or early exit; empty-space skipping stays on (it
+in occupied space), no detail noise, jitter, history, early exit or cloud type (the simulation's own shape, as the sprites draw it); empty-space skipping stays on (it
 moves where the steps fall, nothing else). The image the sprites and the real-time settings are
 measured against."""
 
@@ -64,6 +65,19 @@ class RaymarchCloudSettings(CloudLightSettings):
     motion_limit: float = num_field(MOTION_LIMIT, 0.0, 1e4, "pixels per frame: history is mixed toward this "
                                     "frame's upsampled samples linearly, gone at this motion (smaller: less smear "
                                     "on fast turns, blurrier while moving; free; :mod:`.temporal`)", lo_open=True)
+    cloud_type: float | None = num_field(CLOUD_TYPES["cumulus"], 0.0, 1.0, "the clouds' vertical shape "
+                                         "(Nubis' cloud type, :mod:`.shape`): 0 stratus (a thin flat sheet low in "
+                                         "the layer), 0.5 cumulus (flat bases, round tops at about two thirds of the "
+                                         "layer), 1 congestus (towers to the layer's top, widening under it), "
+                                         "between them a blend (``CLOUD_TYPES`` names them); each simulated column's "
+                                         "mean density sets how much of the type's height profile it fills, and the "
+                                         "detail noise erodes wherever the density is below the body's, through the "
+                                         "volume. The same type everywhere (the far field too). None: the "
+                                         "simulation's own vertical shape (what the sprites draw). Cost: the column's "
+                                         "texture read in place of the density's per sample; skipping then skips only "
+                                         "whole empty columns; the sun march takes 2 more (long) steps in place of "
+                                         "the shading volume, which holds the simulation's own shape",
+                                         optional=True)
     detail_octaves: int = int_field(3, 0, 3, "noise channels the density is eroded by (0 = off; each one two "
                                     "more texture fetches per sample; ``shaders/clouds/raymarch/detail.glsl``)")
     detail_scale: float = num_field(8.0, 0.5, 1e4, "cells of the smallest side per base-noise tile (8: billows "

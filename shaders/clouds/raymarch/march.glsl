@@ -5,7 +5,8 @@
 // length (0.5: the midpoint), extinction sigma_t * density, light J = volume.glsl's cloud_source.
 // Sprite groups x height bands whose dilated max map is 0 are jumped over; a ray stops once its
 // transmittance falls below min_transmittance or after `steps` samples. float64 reference:
-// plugins/clouds/raymarch/reference.py.
+// plugins/clouds/raymarch/reference.py. The density: shape.glsl's shaped_density (the cloud type's
+// vertical shape of the simulated columns, or the simulation's own), eroded by detail.glsl.
 // FAR_FIELD 1: the ray goes on through the layer's altitude band beyond the volume, to far_distance,
 // through the volumetric far field (clouds/raymarch/far.glsl) weighted by 1 - the volume's edge weight
 // (so the two cross-fade over the edge fade); from where the ray first reaches the fade ring the step
@@ -14,6 +15,7 @@
 // distance from the camera (m, atmos/composition.py); the scene's window depth the ray stopped at.
 #include "clouds/volume/volume.glsl"
 #include "clouds/raymarch/detail.glsl"
+#include "clouds/raymarch/shape.glsl"
 #ifndef FAR_FIELD
 #define FAR_FIELD 0
 #endif
@@ -47,6 +49,14 @@ uniform float far_distance;    // FAR_FIELD: the march ends this far from the ca
 uniform float far_growth;      // FAR_FIELD: the step's growth per metre of distance in the far field
 uniform float pixel_angle;     // a full-res pixel's angle (rad): its width per metre of distance
 
+// The marched density at uvw (volume.glsl's cloud_density, cloud_columns, column_tau): with a cloud type
+// shape.glsl's type_density of the column's mean density (its up and down integrals over ny cells).
+float shaped_density(vec3 uvw, float ny) {
+    if (cloud_type < 0.0) return cloud_density(uvw);
+    vec2 c = cloud_columns(uvw);
+    return type_density((c.x + c.y) / (column_tau * ny), uvw.y, cloud_type);
+}
+
 // The blue noise (atmos/blue_noise.py) of the full-res pixel, tiled, rotated by jitter_shift (mod 1):
 // the plugin turns it by the golden ratio every two r²-frame cycles of the resolve (each pixel marched
 // twice with each offset: the resolve's drift test compares like with like), so each pixel's samples
@@ -66,19 +76,25 @@ float sample_jitter(vec2 pixel) {
 // cell centres; trilinear between centres an e-fold apart it is 12 % too bright midway (0.68 for
 // 0.61), at any depth, and it blurs the lit surface over a cell (a low sun crosses a dense cloud's
 // cells lengthwise: dark bodies came out grey, rims weak); the march resolves the surface and the
-// first cells behind it. SUN_STEPS 0: the shading volume's T at p.
+// first cells behind it. SUN_STEPS 0: the shading volume's T at p. With a cloud type (shape.glsl) the
+// shading volume holds the simulation's own shape (a stratus sheet under it would lie in the shadow of
+// the simulated blob above), so the march goes on TYPE_SUN_STEPS more steps (4 + 2 reach 31.5 cells)
+// and ends with 1; those long steps see the detail at their own length as the footprint (the noise
+// finer than a step is not read).
 float sun_transmittance(vec3 p, vec3 uvw, vec3 extent, float footprint) {
 #if SUN_STEPS > 0
     float tau = 0.0, at = 0.0, h = length(sun_march);
     vec3 toward = sun_march / h;
-    for (int k = 0; k < SUN_STEPS; ++k, at += h, h *= sun_growth) {
+    bool typed = cloud_type >= 0.0;
+    int n = SUN_STEPS + (typed ? TYPE_SUN_STEPS : 0);
+    for (int k = 0; k < n; ++k, at += h, h *= sun_growth) {
         vec3 q = p + toward * (at + 0.5 * h);
         vec3 s = (q - layer_min) / extent;
         if (any(lessThan(s, vec3(0.0))) || any(greaterThan(s, vec3(1.0)))) return exp(-sigma_t * tau);
-        tau += h * detail_density(cloud_density(s), q, footprint);
+        tau += h * detail_density(shaped_density(s, extent.y / cell_size.y), q, k < SUN_STEPS ? footprint : max(footprint, h));
     }
     vec3 e = (p + toward * at - layer_min) / extent;
-    bool inside = all(greaterThanEqual(e, vec3(0.0))) && all(lessThanEqual(e, vec3(1.0)));
+    bool inside = !typed && all(greaterThanEqual(e, vec3(0.0))) && all(lessThanEqual(e, vec3(1.0)));
     return exp(-sigma_t * tau) * (inside ? cloud_transmittance(e) : 1.0);
 #else
     return cloud_transmittance(uvw);
@@ -108,10 +124,24 @@ float far_entry(vec3 dir) {
     return (-ab + sqrt(max(ab * ab - bb * aa, 0.0))) / bb;
 }
 
-// Distance along the ray to where it leaves skip-map texel g (a box in world space).
+// Whether skip-map texel g holds no density: with a cloud type (shape.glsl) the whole column of texels
+// above and below it, since the type spreads a column's density over the layer's height.
+bool skip_empty(ivec3 g, ivec3 grid) {
+    if (cloud_type < 0.0) return texelFetch(skip_map, g, 0).r <= 0.0;
+    for (int y = 0; y < grid.y; ++y)
+        if (texelFetch(skip_map, ivec3(g.x, y, g.z), 0).r > 0.0) return false;
+    return true;
+}
+
+// Distance along the ray to where it leaves skip-map texel g (a box in world space; with a cloud type
+// its whole column).
 float skip_exit(ivec3 g, vec3 pos, vec3 inv_dir, vec3 dir) {
     vec3 lo = layer_min + vec3(g) * skip_cells * cell_size;
     vec3 hi = min(lo + skip_cells * cell_size, layer_max);
+    if (cloud_type >= 0.0) {
+        lo.y = layer_min.y;
+        hi.y = layer_max.y;
+    }
     vec3 tt = (mix(lo, hi, step(0.0, dir)) - pos) * inv_dir;
     return max(min(min(tt.x, tt.y), tt.z), 0.0);
 }
@@ -158,7 +188,7 @@ void cloud_march(ivec2 pixel, out vec4 color, out vec2 distance, out float depth
             bool far_zone = s >= far_from;
             if (skipping != 0 && !far_zone) {
                 ivec3 g = clamp(ivec3(floor((pos - layer_min) / cell_size / skip_cells)), ivec3(0), grid - 1);
-                if (texelFetch(skip_map, g, 0).r <= 0.0) {
+                if (skip_empty(g, grid)) {
                     s = min(s + skip_exit(g, pos, inv_dir, dir) + eps, max(far_from, s + eps));
                     continue;
                 }
@@ -175,7 +205,7 @@ void cloud_march(ivec2 pixel, out vec4 color, out vec2 distance, out float depth
             vec3 p = camera_pos + dir * sp;
             vec3 uvw = (p - layer_min) / extent;
             bool in_box = all(greaterThanEqual(uvw, vec3(0.0))) && all(lessThanEqual(uvw, vec3(1.0)));
-            float dv = in_box ? cloud_density(uvw) : 0.0, df = 0.0;
+            float dv = in_box ? shaped_density(uvw, ny) : 0.0, df = 0.0;
 #if FAR_FIELD
             vec4 fc = vec4(0.0);
             float fh = far_height(p.y);
@@ -183,7 +213,7 @@ void cloud_march(ivec2 pixel, out vec4 color, out vec2 distance, out float depth
                 fw = far_weight((p.xz - layer_min.xz) / extent.xz);
                 if (fw > 0.0) {
                     fc = far_ranks(p.xz, sp);
-                    df = fw * far_density(fc.x, fh);
+                    df = fw * far_density(fc.x, fh, ny);
                 }
             }
 #endif

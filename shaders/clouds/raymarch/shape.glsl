@@ -1,0 +1,33 @@
+// The cloud type's vertical shape of the marched density (Nubis), what and why:
+// plugins/clouds/raymarch/shape.py (the float64 twins type_profile and type_density, the constants).
+// type_density(m, h, t): a column of mean density m over the layer, at height fraction h, of type t
+// (0 stratus, 0.5 cumulus, 1 congestus). cloud_type < 0: the simulation's own vertical shape (march.glsl
+// shaped_density applies it).
+
+uniform float cloud_type;      // RaymarchCloudSettings.cloud_type; -1: None
+
+const vec3 TYPE_PROFILES[3] = vec3[3](vec3(0.05, 0.10, 0.28), vec3(0.08, 0.20, 0.70), vec3(0.06, 0.20, 1.00));
+const float COLUMN_FULL = 0.35;
+const float ANVIL = 0.5;
+const vec2 ANVIL_FROM = vec2(0.7, 0.95);
+const int TYPE_SUN_STEPS = 2;   // march.glsl sun_transmittance: more sun steps in place of the shading volume
+
+float type_ramp(float x, float a, float b) {
+    return clamp((x - a) / (b - a), 0.0, 1.0);
+}
+
+float type_profile(float h, float t) {
+    if (h < 0.0 || h > 1.0) return 0.0;
+    t = clamp(t, 0.0, 1.0);
+    vec3 b = TYPE_PROFILES[0] + (TYPE_PROFILES[1] - TYPE_PROFILES[0]) * clamp(2.0 * t, 0.0, 1.0)
+           + (TYPE_PROFILES[2] - TYPE_PROFILES[1]) * clamp(2.0 * t - 1.0, 0.0, 1.0);
+    float x = type_ramp(h, b.y, b.z);
+    return type_ramp(h, 0.0, b.x) * (1.0 - x * x);
+}
+
+float type_density(float m, float h, float t) {
+    float c = clamp(m / COLUMN_FULL, 0.0, 1.0);
+    if (c <= 0.0) return 0.0;
+    c = pow(c, 1.0 - ANVIL * clamp(2.0 * t - 1.0, 0.0, 1.0) * type_ramp(h, ANVIL_FROM.x, ANVIL_FROM.y));
+    return clamp(type_profile(h, t) - (1.0 - c), 0.0, c);    // c remap(P, 1 - c, 1, 0, 1)
+}

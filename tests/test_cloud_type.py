@@ -1,0 +1,121 @@
+"""The ray march's cloud type (plugins/clouds/raymarch/shape.py): the shader's profile and shaped density
+against their float64 twins on fresh random inputs, the march with each type against its reference, the
+profiles' shapes, skipping with a type, and the setting's checks."""
+import numpy as np
+import pytest
+
+from atmos.plugins.clouds import CloudsPlugin
+from atmos.plugins.clouds.light.diffusion import DIFFUSION, read_field
+from atmos.plugins.clouds.raymarch import RaymarchCloudSettings, RaymarchCloudsPlugin
+from atmos.plugins.clouds.raymarch.reference import march_reference
+from atmos.plugins.clouds.raymarch.shape import CLOUD_TYPES, COLUMN_FULL, type_density, type_profile
+from fullscreen_probe import run_fullscreen
+from test_cloud_raymarch import DAY, aim, linear, scene, shading_volume
+
+F32 = 2.0 ** -23      # float32's unit roundoff (the probe computes in float32 from float32 inputs)
+
+
+def test_the_shaders_profile_and_density_match_their_float64_twins(gpu, ctx, rng):
+    w, h = 64, 32
+    m = rng.uniform(-0.1, 1.2, (h, w))
+    m[:, :8] = rng.uniform(0.0, 0.02, (h, 8))                       # thin columns: the smallest coverages
+    points = np.stack([m, rng.uniform(-0.1, 1.1, (h, w)), rng.uniform(0.0, 1.0, (h, w))], -1)
+    points[0, :3, 2] = list(CLOUD_TYPES.values())                   # the key types exactly
+    points = points.astype(np.float32)
+    out = run_fullscreen(gpu, "test/type_probe.frag", (w, h), inputs={"probe_points": points}, nearest=True)
+    mm, hh, tt = (points[..., k].astype(np.float64) for k in range(3))
+    # the remaps divide by breakpoint spans >= 0.02 and square once: a few float32 roundings each scaled by
+    # at most 1 / 0.02; the anvil's pow (c^e, e in [0.5, 1]) adds its own few ulps relative
+    assert np.abs(out[..., 0] - type_profile(hh, tt)).max() < 64 * F32 / 0.02
+    assert np.abs(out[..., 1] - type_density(mm, hh, tt)).max() < 64 * F32 / 0.02 + 1e-5
+    assert (type_density(mm, hh, tt) > 0.1).mean() > 0.2, "the inputs must reach the shaped density"
+
+
+def test_the_profiles_have_the_types_shapes():
+    h = np.linspace(0.0, 1.0, 1001)
+    stratus, cumulus, congestus = (type_profile(h, t) for t in CLOUD_TYPES.values())
+    top = {name: h[type_profile(h, t) > 0].max() for name, t in CLOUD_TYPES.items()}
+    assert top["stratus"] < 0.3 < top["cumulus"] < 0.75 < 0.95 < top["congestus"], top
+    for p in (stratus, cumulus, congestus):                 # flat bases: full density within 8 % of the base
+        assert p[0] == 0.0 and p[h <= 0.08].max() == 1.0 and np.all(p <= 1.0) and np.all(p >= 0.0)
+    # a thin column is a smaller cloud of the same type: it holds cloud over less height, never more
+    for name, t in CLOUD_TYPES.items():
+        thin, full = type_density(0.3 * COLUMN_FULL, h, t), type_density(COLUMN_FULL, h, t)
+        assert np.all(thin <= full) and 0 < (thin > 0).sum() < (full > 0).sum(), name
+        assert np.all(thin <= 0.3 + 1e-12), "a column's density is at most its coverage"
+    # congestus widens near the top (the anvil): there more of the columns hold cloud than its profile gives
+    c = np.linspace(0.0, 1.0, 1001)
+    for y in (0.85, 0.9):
+        no_anvil = np.clip(type_profile(y, 1.0) - (1.0 - c), 0.0, c)
+        anvil = type_density(c * COLUMN_FULL, y, 1.0)
+        assert np.all(anvil >= no_anvil) and (anvil > 0).mean() > (no_anvil > 0).mean() + 0.05, y
+    assert np.allclose(type_density(c * COLUMN_FULL, 0.6, 1.0), np.clip(type_profile(0.6, 1.0) - 1.0 + c, 0.0, c),
+                       rtol=0.0, atol=1e-12), "below the anvil: the profile alone"
+
+
+def random_volume(rng, shape=(16, 6, 16)):
+    """A few boxes of random density and height: columns from thin to full."""
+    d = np.zeros(shape, np.float32)
+    for _ in range(6):
+        x, z = rng.integers(0, shape[0] - 4), rng.integers(0, shape[2] - 4)
+        y0 = rng.integers(0, shape[1] - 1)
+        d[x:x + rng.integers(2, 6), y0:y0 + rng.integers(1, shape[1] - y0 + 1), z:z + rng.integers(2, 6)] = rng.uniform(0.3, 1.0)
+    return d
+
+
+@pytest.mark.parametrize("name", list(CLOUD_TYPES))
+def test_the_march_with_each_type_matches_its_float64_reference(gpu, ctx, rng, name):
+    d = random_volume(rng)
+    app = scene(gpu, d, DAY, empty_space_skipping=False, min_transmittance=0.0, steps=128, step_growth=0.002,
+                cloud_type=CLOUD_TYPES[name])
+    cam = aim(app, (80.0, 520.0, -220.0), target=(160.0, 470.0, 200.0))
+    image = linear(app)
+    sim = next(p for p in app.plugins if isinstance(p, CloudsPlugin)).simulation.sets()
+    settings = next(p for p in app.plugins if isinstance(p, RaymarchCloudsPlugin)).settings
+    ref = march_reference(d, shading_volume(sim), sim.settings, settings, sim.layout(), cam, DAY, gpu.size,
+                          field=read_field(sim.a[DIFFUSION]))
+    assert (ref["alpha"] > 0.05).mean() > 0.02, "the view must see the clouds"
+    # the columns are half floats (relative 2^-11) and the shaped density moves by at most as much as the
+    # coverage m / COLUMN_FULL (clamp(P - 1 + c, 0, c)): up to 2^-11 / COLUMN_FULL = 1.4e-3 of density, so
+    # alpha and colour ~1e-3 (measured: colour 5e-4..6e-4, alpha p99.5 4e-4..6e-4)
+    light = ref["light"]
+    rmse = np.sqrt(np.mean((image[..., :3] - light) ** 2)) / np.sqrt(np.mean(light ** 2))
+    assert rmse < 0.003, f"colour off the reference: relative RMSE {rmse:.4f}"
+    off = np.abs(image[..., 3] - ref["alpha"])
+    assert np.percentile(off, 99.5) < 0.002, "coverage off the reference"
+    assert (off > 0.02).mean() < 0.002, "only rays grazing the box's faces may differ (float32 entry/exit)"
+    app.close()
+
+
+def test_with_a_type_skipping_keeps_the_columns_whole(gpu, ctx, rng):
+    d = np.zeros((16, 8, 16), np.float32)
+    d[4:12, 0:2, 4:12] = 1.0                 # density in the lowest band only: congestus lifts it to the top
+    app = scene(gpu, d, DAY, empty_space_skipping=False, min_transmittance=0.0, cloud_type=1.0)
+    plugin = next(p for p in app.plugins if isinstance(p, RaymarchCloudsPlugin))
+    aim(app, (160.0, 900.0, -400.0), target=(160.0, 600.0, 200.0))
+    full = linear(app)
+    plugin.configure(empty_space_skipping=True)
+    skipped = linear(app)
+    scale = full[..., :3].max()
+    assert scale > 0.1 and (full[..., 3] > 0.5).mean() > 0.02
+    assert np.abs(skipped - full).max() < 0.02 * scale, "skipping cut the type's columns"
+    app.close()
+
+
+@pytest.mark.parametrize("value", [-0.1, 1.5, float("nan"), "cumulus", True])
+def test_a_bad_cloud_type_is_refused_naming_the_field(value):
+    with pytest.raises(ValueError, match="cloud_type"):
+        RaymarchCloudSettings(cloud_type=value)
+
+
+def test_the_default_is_cumulus_and_none_is_the_simulations_own_shape():
+    assert RaymarchCloudSettings().cloud_type == CLOUD_TYPES["cumulus"]
+    assert RaymarchCloudSettings(cloud_type=None).cloud_type is None
+
+
+def test_the_weather_demos_type_follows_the_weather():
+    from atmos.demos.weather import cloud_type_at
+    assert [cloud_type_at(p) for p in (0.0, 0.5, 1.0)] == [CLOUD_TYPES[k] for k in ("cumulus", "congestus", "stratus")]
+    phases = np.linspace(0.0, 1.0, 101)
+    kinds = np.array([cloud_type_at(p) for p in phases])
+    assert np.all((kinds >= 0.0) & (kinds <= 1.0)) and np.all(np.abs(np.diff(kinds)) <= 0.021), "smooth in phase"
