@@ -6,6 +6,7 @@ import pytest
 
 from atmos.plugins.clouds import CloudsPlugin
 from atmos.plugins.clouds.light.diffusion import DIFFUSION, read_field
+from atmos.plugins.clouds.light.ground import ground_sun_of
 from atmos.plugins.clouds.raymarch import RaymarchCloudSettings, RaymarchCloudsPlugin
 from atmos.plugins.clouds.raymarch.reference import march_reference
 from atmos.plugins.clouds.raymarch.shape import CLOUD_TYPES, COLUMN_FULL, type_density, type_profile
@@ -73,7 +74,7 @@ def test_the_march_with_each_type_matches_its_float64_reference(gpu, ctx, rng, n
     sim = next(p for p in app.plugins if isinstance(p, CloudsPlugin)).simulation.sets()
     settings = next(p for p in app.plugins if isinstance(p, RaymarchCloudsPlugin)).settings
     ref = march_reference(d, shading_volume(sim), sim.settings, settings, sim.layout(), cam, DAY, gpu.size,
-                          field=read_field(sim.a[DIFFUSION]))
+                          field=read_field(sim.a[DIFFUSION]), ground_sun=ground_sun_of(sim))
     assert (ref["alpha"] > 0.05).mean() > 0.02, "the view must see the clouds"
     # the columns are half floats (relative 2^-11) and the shaped density moves by at most as much as the
     # coverage m / COLUMN_FULL (clamp(P - 1 + c, 0, c)): up to 2^-11 / COLUMN_FULL = 1.4e-3 of density, so
