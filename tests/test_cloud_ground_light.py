@@ -106,3 +106,26 @@ def test_terrain_and_ground_publish_their_albedo(gpu, ctx):
     ground.configure(albedo=(0.5, 0.5, 0.5))
     assert app.resource(GroundSurface).albedo == (0.5, 0.5, 0.5)
     app.close()
+
+
+def test_the_ground_plane_fades_into_the_skys_own_light(gpu, ctx):
+    """Far ground takes HAZE_GAIN × the Sun's ambient (a twilight sky's is dim: no bright line at the
+    horizon); haze_distance 0 keeps the plane's own shading to its edge."""
+    from atmos import App, Camera, DefaultPlugins
+    from atmos.plugins.ground import GroundPlugin
+    ambient = (0.03, 0.02, 0.025)
+    for distance in (667.0, 0.0):
+        app = App(gpu).insert_resource(Sun(direction=np.array([0.0, -0.05, -1.0]), color=(0.0, 0.0, 0.0),
+                                           ambient=ambient))
+        app.add_plugins(DefaultPlugins(overlay=False), GroundPlugin(half_size=4e4, haze_distance=distance))
+        app.startup()
+        cam = app.resource(Camera)
+        cam.position, cam.far = np.array([0.0, 50.0, 0.0]), 1e5
+        cam.yaw, cam.pitch = 0.0, 0.0
+        image = app.read_linear()
+        app.close()
+        far = image[image.shape[0] // 2, :, :3].mean(axis=0)     # half a pixel under the horizon: kilometres away
+        if distance:
+            assert far == pytest.approx(2.0 * np.asarray(ambient), rel=0.05)
+        else:
+            assert np.all(far < 0.3 * 2.0 * np.asarray(ambient)), "its own shade: the albedo times the ambient"

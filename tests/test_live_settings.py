@@ -273,7 +273,7 @@ SPECS = {
     "ground": Spec(
         lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin()], GroundPlugin,
         look((0.0, 3.0, 10.0), yaw=0.0, pitch=-0.2),
-        dict(half_size=5.0, tile=1.0, albedo=(0.9, 0.1, 0.1))),
+        dict(half_size=5.0, tile=1.0, albedo=(0.9, 0.1, 0.1), haze_distance=2.0)),
     "sky_gradient": Spec(                                   # the default sun in view, as the sky's
         lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin()], SkyGradientPlugin,
         look((0.0, 2.0, 0.0), yaw=math.radians(200.0), pitch=0.45),

@@ -6,6 +6,7 @@ import numpy as np
 from atmos.checks import CheckedSettings, num_field, vec_field
 
 from atmos.graph import PassContext
+from atmos.gpu.uniforms import write_uniforms
 from atmos.lighting import GroundSurface
 from atmos.plugin import Plugin
 from atmos.render_core import OpaquePass
@@ -18,6 +19,9 @@ class GroundSettings(CheckedSettings):
                                  lo_open=True)
     tile: float = num_field(4.0, 0.0, doc="checker tiles of this many metres", lo_open=True)
     albedo: tuple = vec_field((0.28, 0.36, 0.2), 3, "non-negative", "linear RGB reflectance (physical: at most 1)")
+    haze_distance: float = num_field(667.0, 0.0, doc="metres over which the plane fades (e-folding) into the sky's "
+                                     "ambient light, hiding its edge; 0: no fade (a fog or the sky's aerial "
+                                     "perspective hazes it instead)")
 
 
 def ground_quad(half_size: float) -> bytes:
@@ -46,8 +50,8 @@ class GroundPass(OpaquePass):
         if settings.half_size != self.half_size:           # a live change: the same 4 corners, moved
             self.half_size = settings.half_size
             self.vbo.write(ground_quad(self.half_size))
-        self.program["albedo"].value = settings.albedo
-        self.program["tile"].value = settings.tile
+        write_uniforms(self.program, albedo=settings.albedo, tile=settings.tile,
+                       haze_rate=1.0 / settings.haze_distance if settings.haze_distance > 0.0 else 0.0)
         self.vao.render(gpu.ctx.TRIANGLE_STRIP)
 
     def release(self) -> None:

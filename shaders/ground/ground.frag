@@ -1,5 +1,7 @@
 #version 430
-// Ground: anti-aliased checker in albedo, Lambert sun light plus the Sun's sky ambient, distance haze.
+// Ground: anti-aliased checker in albedo, Lambert sun light plus the Sun's sky ambient, fading with
+// distance into HAZE_GAIN × the sky's ambient light (dark at night, dim at twilight: no bright line at
+// the horizon then), which hides the plane's edge.
 // Alpha 1: opaque, hides the sky (color.a is the sky occlusion, atmos/render_core.py).
 // camera_pos, sun_dir, sun_color, sky_ambient: the frame block (lib/frame.glsl)
 #include "lib/frame.glsl"
@@ -7,6 +9,8 @@ in vec3 v_world;
 out vec4 frag;
 uniform vec3 albedo;
 uniform float tile;
+uniform float haze_rate;        // 1 / GroundSettings.haze_distance (0: no fade)
+const float HAZE_GAIN = 2.0;    // the horizon's light over the ambient's (the default day: (0.7, 0.94, 1.3))
 
 void main() {
     vec2 p = v_world.xz / tile;
@@ -17,6 +21,5 @@ void main() {
     vec3 s = normalize(sun_dir);
     vec3 light = sun_color * max(s.y, 0.0) + sky_ambient;
     float dist = length(v_world - camera_pos);
-    vec3 haze = vec3(0.7, 0.8, 0.95) * smoothstep(-0.2, 0.2, s.y);
-    frag = vec4(mix(base * light, haze, 1.0 - exp(-dist * 0.0015)), 1.0);
+    frag = vec4(mix(base * light, HAZE_GAIN * sky_ambient, 1.0 - exp(-dist * haze_rate)), 1.0);
 }
