@@ -197,11 +197,15 @@ def freeze_frame_times(app, plugin):
     plugin.times.record = lambda: None
 
 
-def physical_ground(**changes):
-    """The physical sky (and ``changes``), the camera turned down onto the ground: the aerial perspective's view."""
+def physical_ground(height: float | None = None, **changes):
+    """The physical sky (and ``changes``), the camera turned down onto the ground: the aerial perspective's view
+    (``height``: the camera raised to it, m, so a ray crosses the air's fall with height)."""
     def hook(app, plugin):
         plugin.configure(model="physical", **changes)
-        app.resource(Camera).pitch = -0.12
+        cam = app.resource(Camera)
+        cam.pitch = -0.12
+        if height is not None:
+            cam.position = np.array([cam.position[0], height, cam.position[2]])
     return hook
 
 
@@ -293,7 +297,7 @@ SPECS = {
                 "star_brightness": set_sun(NIGHT), "twinkle": set_sun(NIGHT),
                 **{name: configure_first(model="physical") for name in PHYSICAL_CHANGES},
                 "aerial_perspective": physical_ground(),
-                "aerial_steps": physical_ground(aerial_perspective=True, aerial_froxels=None),   # the per-pixel march's
+                "aerial_steps": physical_ground(400.0, aerial_perspective=True, aerial_froxels=None),   # the per-pixel march's
                 "aerial_froxels": physical_ground(aerial_perspective=True)}),
     "sky_layer": Spec(
         lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), SkyLayerPlugin(size=32)], SkyLayerPlugin,
