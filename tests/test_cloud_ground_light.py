@@ -129,3 +129,18 @@ def test_the_ground_plane_fades_into_the_skys_own_light(gpu, ctx):
             assert far == pytest.approx(2.0 * np.asarray(ambient), rel=0.05)
         else:
             assert np.all(far < 0.3 * 2.0 * np.asarray(ambient)), "its own shade: the albedo times the ambient"
+    from atmos.plugins.sky import SkyPlugin, SkyLight
+    from atmos.plugins.ground import haze_color
+    for elevation in (30.0, -3.0):                   # with a sky: its mean horizon light, day and twilight
+        app = App(gpu).insert_resource(Sun.from_angles(elevation, 40.0))
+        app.add_plugins(DefaultPlugins(overlay=False), SkyPlugin(model="physical", stars=False), GroundPlugin(half_size=4e4))
+        app.startup()
+        cam = app.resource(Camera)
+        cam.position, cam.far = np.array([0.0, 50.0, 0.0]), 1e5
+        cam.yaw, cam.pitch = 0.0, 0.0
+        image = app.read_linear()
+        want = app.resource(SkyLight).mean_horizon(app.resource(Sun), 50.0)
+        view = type("View", (), {"sun": app.resource(Sun), "camera": cam})
+        assert haze_color(view, app.resource(SkyLight)) == pytest.approx(want)
+        app.close()
+        assert image[image.shape[0] // 2, :, :3].mean(axis=0) == pytest.approx(want, rel=0.03)

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-SAMPLES = 32
+from atmos.plugins.sky.light import HORIZON_SAMPLES as SAMPLES   # one cache with the sky's other readers
 
 
 def horizon_table(sun, sky_light=None, n: int = SAMPLES, altitude: float = 0.0) -> np.ndarray:

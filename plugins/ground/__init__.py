@@ -8,6 +8,7 @@ from atmos.checks import CheckedSettings, num_field, vec_field
 from atmos.graph import PassContext
 from atmos.gpu.uniforms import write_uniforms
 from atmos.lighting import GroundSurface
+from atmos.plugins.sky.light import SkyLight
 from atmos.plugin import Plugin
 from atmos.render_core import OpaquePass
 
@@ -20,14 +21,26 @@ class GroundSettings(CheckedSettings):
     tile: float = num_field(4.0, 0.0, doc="checker tiles of this many metres", lo_open=True)
     albedo: tuple = vec_field((0.28, 0.36, 0.2), 3, "non-negative", "linear RGB reflectance (physical: at most 1)")
     haze_distance: float = num_field(667.0, 0.0, doc="metres over which the plane fades (e-folding) into the sky's "
-                                     "ambient light, hiding its edge; 0: no fade (a fog or the sky's aerial "
-                                     "perspective hazes it instead)")
+                                     "horizon light (:func:`haze_color`), hiding its edge; 0: no fade (a fog or "
+                                     "the sky's aerial perspective hazes it instead)")
 
 
 def ground_quad(half_size: float) -> bytes:
     """The plane's four (x, z) corners as a triangle strip."""
     h = half_size
     return np.array([[-h, -h], [h, -h], [-h, h], [h, h]], np.float32).tobytes()
+
+
+HAZE_GAIN = 2.0     # without a sky's light: the horizon's light over the Sun's ambient (the default day: (0.7, 0.94, 1.3))
+
+
+def haze_color(view, sky=None) -> np.ndarray:
+    """(3,) float64 the plane fades into: the sky's mean horizon light seen from the camera (``sky``, the
+    SkyLight a SkyPlugin publishes) or, without one, HAZE_GAIN × the Sun's ambient (dark at night, dim at
+    twilight: no bright line at the horizon then)."""
+    if sky is not None:
+        return sky.mean_horizon(view.sun, max(float(view.camera.position[1]), 0.0))
+    return HAZE_GAIN * np.asarray(view.sun.ambient, np.float64)
 
 
 class GroundPass(OpaquePass):
@@ -51,7 +64,8 @@ class GroundPass(OpaquePass):
             self.half_size = settings.half_size
             self.vbo.write(ground_quad(self.half_size))
         write_uniforms(self.program, albedo=settings.albedo, tile=settings.tile,
-                       haze_rate=1.0 / settings.haze_distance if settings.haze_distance > 0.0 else 0.0)
+                       haze_rate=1.0 / settings.haze_distance if settings.haze_distance > 0.0 else 0.0,
+                       haze_color=tuple(float(c) for c in haze_color(frame.view, self.plugin.sky)))
         self.vao.render(gpu.ctx.TRIANGLE_STRIP)
 
     def release(self) -> None:
@@ -66,6 +80,11 @@ class GroundPlugin(Plugin):
 
     settings_class = GroundSettings
 
+    sky = None          # the scene's SkyLight, where a SkyPlugin publishes one (finish)
+
     def build(self, app) -> None:
         app.graph.add_pass(GroundPass(self))
         app.insert_resource(GroundSurface(lambda: self.settings.albedo))   # what the clouds' light from below sees
+
+    def finish(self, app) -> None:
+        self.sky = app.get_resource(SkyLight)

@@ -20,6 +20,7 @@ from atmos.plugins.sky.luts import SKY_LUTS, atmosphere_defines, set_atmosphere_
 from atmos.plugins.sky.sun_light import horizon_radiance
 
 ELEVATION = math.radians(2.0)
+HORIZON_SAMPLES = 32         # the azimuths its readers ask for (the fog's table; the ground's mean), one cache
 
 
 def horizon_directions(n: int) -> np.ndarray:
@@ -58,6 +59,10 @@ class SkyLight:
         if key != self._key:
             self._key, self._table = key, horizon_colors(sun, settings, n, altitude)
         return self._table
+
+    def mean_horizon(self, sun, altitude: float) -> np.ndarray:
+        """(3,) float64: :meth:`horizon` at HORIZON_SAMPLES azimuths, averaged round the horizon."""
+        return self.horizon(sun, altitude, HORIZON_SAMPLES).mean(axis=0)
 
     @property
     def aerial(self) -> bool:

@@ -1,7 +1,7 @@
 #version 430
 // Ground: anti-aliased checker in albedo, Lambert sun light plus the Sun's sky ambient, fading with
-// distance into HAZE_GAIN × the sky's ambient light (dark at night, dim at twilight: no bright line at
-// the horizon then), which hides the plane's edge.
+// distance into the sky's horizon light (plugins/ground haze_color: dark at night, dim at twilight, no
+// bright line at the horizon then), which hides the plane's edge.
 // Alpha 1: opaque, hides the sky (color.a is the sky occlusion, atmos/render_core.py).
 // camera_pos, sun_dir, sun_color, sky_ambient: the frame block (lib/frame.glsl)
 #include "lib/frame.glsl"
@@ -10,7 +10,7 @@ out vec4 frag;
 uniform vec3 albedo;
 uniform float tile;
 uniform float haze_rate;        // 1 / GroundSettings.haze_distance (0: no fade)
-const float HAZE_GAIN = 2.0;    // the horizon's light over the ambient's (the default day: (0.7, 0.94, 1.3))
+uniform vec3 haze_color;
 
 void main() {
     vec2 p = v_world.xz / tile;
@@ -21,5 +21,5 @@ void main() {
     vec3 s = normalize(sun_dir);
     vec3 light = sun_color * max(s.y, 0.0) + sky_ambient;
     float dist = length(v_world - camera_pos);
-    frag = vec4(mix(base * light, HAZE_GAIN * sky_ambient, 1.0 - exp(-dist * haze_rate)), 1.0);
+    frag = vec4(mix(base * light, haze_color, 1.0 - exp(-dist * haze_rate)), 1.0);
 }
