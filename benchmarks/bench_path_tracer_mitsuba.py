@@ -34,10 +34,13 @@ scene. On Mitsuba's side (``llvm_ad_rgb``, the ``volpath`` integrator driven ray
 
 Per case: the image-sum bias of the project against Mitsuba (%) with its standard error, the
 relative RMSE over pixels (RMSE / mean Mitsuba radiance) beside the RMSE the two estimates' noise
-alone would give, and each side's seconds (CPU). ``--check`` runs the trivial cases first (a
-homogeneous slab, single scattering, transmittance alone).
+alone would give, the same for 1 − T over the pixels that see the volume, and each side's seconds
+(CPU). The trivial cases run first (a thin homogeneous slab: single scattering, orders ≤ 2, sky and
+ground alone, all orders; transmittance in each); ``--check``: only them, ``--no-check``: without.
 
-    python benchmarks/bench_path_tracer_mitsuba.py [--size 32 32] [--spp 256] [--mi-spp 1024] [--quick]
+    python benchmarks/bench_path_tracer_mitsuba.py [--size 32 32] [--spp 256] [--mi-spp 1024] [--check | --no-check]
+
+The table in benchmarks/README.md: --spp 2048 --mi-spp 8192.
 """
 from __future__ import annotations
 
@@ -51,10 +54,9 @@ import numpy as np
 from atmos.plugins.clouds.light.path_tracer import camera_rays, trace
 
 try:
-    import drjit as dr
     import mitsuba as mi
 except ImportError:                                  # pragma: no cover - optional dependency
-    mi = dr = None
+    mi = None
 
 SUN_EL = 30.0
 SUN_DIR = np.array([math.cos(math.radians(SUN_EL)), math.sin(math.radians(SUN_EL)), 0.0])  # toward the sun (+x)
