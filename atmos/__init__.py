@@ -34,6 +34,7 @@ _EXPORTS = {
     "set_sun_uniforms": "atmos.scene_uniforms",
     "set_scene_uniforms": "atmos.scene_uniforms", "write_uniforms": "atmos.gpu.uniforms",
     "bind_textures": "atmos.gpu.uniforms", "bind_images": "atmos.gpu.uniforms", "bind_buffers": "atmos.gpu.uniforms",
+    "bind_blocks": "atmos.gpu.uniforms",
     "FixedClock": "atmos.clock",
     # games: running, input, moving things and the camera
     "run": "atmos.runner", "DemoSettings": "atmos.demo_registry", "Input": "atmos.input",

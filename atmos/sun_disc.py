@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from atmos.checks import CheckedSettings, num_field
+from atmos.glsl_math import smoothstep
 
 SUN_LIMB = (0.397, 0.503, 0.652)   # limb darkening I(μ) = μ^a per channel (red, green, blue)
 LIMB_FLOOR = 0.25                  # the μ the disc's very edge is given (its last pixel stays lit)
@@ -40,10 +41,6 @@ def disc_chord(size_deg: float) -> float:
     """Chord length |v − s| of the disc's angular radius ``size_deg``."""
     return 2.0 * math.sin(0.5 * math.radians(size_deg))
 
-
-def smoothstep(e0: float, e1: float, x) -> np.ndarray:
-    t = np.clip((np.asarray(x, np.float64) - e0) / (e1 - e0), 0.0, 1.0)
-    return t * t * (3.0 - 2.0 * t)
 
 
 def sun_disc(view_dir, sun_dir, sun_color, size_deg: float, gain: float, glare: float = 0.0,

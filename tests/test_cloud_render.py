@@ -141,6 +141,7 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale,
              "v_conic", "v_falloff", "v_stretch", "v_slope", "v_sun"]
     prog = ctx.program(vertex_shader=src, varyings=names)
     sampler = clamp_sampler(ctx)
+    sunlit = ctx.buffer(np.array([1.0, 0.0, 0.0, 0.0], np.float32).tobytes())   # G = 1: a ground in full sun
     sun = app.resource(Sun)
     # a sun whose colour changes over the layer's height (as the physical sky's does at sunset): each
     # sprite takes it at its own height (volume.glsl sun_source_at)
@@ -151,7 +152,7 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale,
         for name, value in uniforms.items():
             if name in prog:                      # the camera's basis is the fragment shader's
                 prog[name].value = value
-        bind_volume(prog, sim, sampler, sun, renderer.settings.octaves, layer=layout.heights)
+        bind_volume(prog, sim, sampler, sun, renderer.settings.octaves, layer=layout.heights, ground_light=sunlit)
         for code in np.unique(segments[:, 3]):
             mine = segments[segments[:, 3] == code]
             _, sx, sz = unpack(code)
@@ -165,7 +166,7 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale,
                 obj.release()
         unbind_volume(prog, sampler)
     finally:
-        for obj in (sampler, prog):
+        for obj in (sampler, prog, sunlit):
             obj.release()
     got = np.concatenate(parts)
     n = len(got)

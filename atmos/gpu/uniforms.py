@@ -212,6 +212,18 @@ def bind_buffers(program, buffers: Mapping[str, object] | None = None, /, **more
             buffer.bind_to_storage_buffer(binding)
 
 
+def bind_blocks(program, blocks: Mapping[str, object] | None = None, /, **more) -> None:
+    """Bind each buffer at the binding of ``program``'s uniform block of that name (its ``layout(std140,
+    binding = N) uniform Name``), a buffer another pass wrote (declared ``uniform`` in the graph, which
+    issues its barrier); a name the program does not use is skipped. A block the CPU writes goes
+    through :func:`write_block` instead."""
+    blocks = {**blocks, **more} if blocks else more
+    for name in blocks:
+        member = program.get(name, None)
+        if member is not None:
+            blocks[name].bind_to_uniform_block(member.binding)
+
+
 def buffer_uses(program, buffers: Mapping[str, object]) -> tuple:
     """(buffer, its id, binding, written) for each of ``buffers`` (block name -> buffer) that ``program``
     has: what :func:`bind_buffers` works out, once, for a loop of dispatches (:func:`use_buffers`)."""

@@ -18,6 +18,7 @@ import math
 
 import numpy as np
 
+from atmos.glsl_math import smoothstep
 from atmos.hashing import hash_counter, lowbias32
 
 STAR_GRID = 200                     # cells per cube-face side (about 0.45° each)
@@ -33,10 +34,6 @@ TWINKLE_PERIOD = 64.0               # seconds after which the twinkling repeats 
 TWINKLE_CYCLES = (32, 96)           # each star twinkles a whole number of times in that period
 TINTS = (np.array([1.0, 0.82, 0.65]), np.array([0.75, 0.85, 1.0]))
 
-
-def smoothstep(e0, e1, x):
-    t = np.clip((np.asarray(x, np.float64) - e0) / (e1 - e0), 0.0, 1.0)
-    return t * t * (3.0 - 2.0 * t)
 
 
 def star_threshold(density: float) -> int:

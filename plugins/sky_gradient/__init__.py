@@ -9,7 +9,8 @@ from atmos.graph import FullscreenPass, PassContext
 from atmos.gpu.uniforms import write_uniforms
 from atmos.plugin import Plugin
 from atmos.render_core import DEPTH, where_nothing_was_drawn
-from atmos.sun_disc import SUN_DISC_DEFINES, SunDiscSettings, smoothstep, disc_chord, sun_disc
+from atmos.glsl_math import smoothstep
+from atmos.sun_disc import SUN_DISC_DEFINES, SunDiscSettings, disc_chord, sun_disc
 
 
 @dataclass(frozen=True)

@@ -6,6 +6,7 @@ import numpy as np
 
 from atmos import value_noise
 from atmos.collision import height_normal
+from atmos.glsl_math import smoothstep
 from atmos.plugins.terrain.heightfield import height
 
 OCTAVES = 12
@@ -16,10 +17,6 @@ ROCK = np.array([[0.20, 0.18, 0.16], [0.42, 0.38, 0.33]])      # dark, light
 SNOW = np.array([0.80, 0.82, 0.86])
 MEAN_SAMPLES = 512                    # mean_albedo's samples along each side of the square (at most)
 
-
-def smoothstep(e0, e1, x):
-    t = np.clip((np.asarray(x, np.float64) - e0) / (e1 - e0), 0.0, 1.0)
-    return t * t * (3.0 - 2.0 * t)
 
 
 def octave(xz, i: int, footprint) -> np.ndarray:

@@ -13,11 +13,10 @@ mixed by t, so ``G`` runs on smoothly when a step arrives at a moved placement; 
 """
 from __future__ import annotations
 
-import weakref
-
 import numpy as np
 
 from atmos.graph import BufferDesc, ComputePass
+from atmos.gpu.uniforms import bind_blocks
 from atmos.plugins.clouds.volume.column import column_uniforms
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS
 
@@ -54,20 +53,9 @@ def ground_sun_pass(graph) -> GroundSunPass:
     return graph.shared_pass(GroundSunPass, lambda: GroundSunPass(graph))[0]
 
 
-_SUNLIT: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()    # ctx -> a buffer holding G = 1
-
-
-def bind_ground(program, buffer=None) -> None:
-    """Bind ``buffer`` (the frame's "cloud_ground"; None: a fully sunlit ground, G = 1) at ``program``'s
-    CloudGround block, where it has one."""
-    block = program.get(GROUND_BLOCK, None)
-    if block is None:
-        return
-    if buffer is None:
-        buffer = _SUNLIT.get(program.ctx)
-        if buffer is None:
-            buffer = _SUNLIT[program.ctx] = program.ctx.buffer(np.array([1.0, 0.0, 0.0, 0.0], np.float32).tobytes())
-    buffer.bind_to_uniform_block(block.binding)
+def bind_ground(program, buffer) -> None:
+    """Bind ``buffer`` (the frame's "cloud_ground") at ``program``'s CloudGround block, where it has one."""
+    bind_blocks(program, {GROUND_BLOCK: buffer})
 
 
 def ground_sun_reference(sums_a, sums_b, t: float, layout, extinction: float, edge_fade: float = 0.0) -> float:

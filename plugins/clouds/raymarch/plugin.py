@@ -240,7 +240,7 @@ class RaymarchPass(RenderPass):
         layout = sim.layout(s.base_altitude)
         write_uniforms(p, self._uniforms(frame, sim, layout, offset))
         bind_volume(p, sim, self.sampler, view.sun, s.octaves, s.ms_diffusion, layout.heights, view.ground,
-                    frame.resource(GROUND))
+                    ground_light=frame.resource(GROUND))
         if s.empty_space_skipping:
             bind_textures(p, skip_map=self._skip_texture(sim))
         else:                               # nothing uploaded; the shader reads no skip map

@@ -267,7 +267,7 @@ class CloudSpritePass(RenderPass):
         ctx.enable(moderngl.DEPTH_TEST | moderngl.PROGRAM_POINT_SIZE)
         ctx.depth_func = "<="          # a tiny near plane rounds far depths to 1.0: still in front of the sky
         bind_volume(p, sim, self.sampler, view.sun, settings.octaves, settings.ms_diffusion, layout.heights,
-                    view.ground, frame.resource(GROUND))
+                    view.ground, ground_light=frame.resource(GROUND))
         try:
             self._draw(segments, layout.group)
         finally:

@@ -13,7 +13,7 @@ SAMPLERS = ("density_a", "density_b", "trans_a", "trans_b", "columns_a", "column
 
 
 def bind_volume(program, sim, sampler, sun: Sun | None, octaves=DEFAULT_OCTAVES, diffusion: float = 0.0,
-                layer=None, ground=None, ground_light=None) -> float:
+                layer=None, ground=None, *, ground_light) -> float:
     """Bind mix(A, B, t)'s textures (``sim``: the frame's CloudSets, or the CloudSimulation) to
     ``volume.glsl``'s samplers (density, transmittance, the light volume's columns, the diffusion field)
     with ``sampler`` and set ``t``, ``a_shift`` (A drawn where it was computed), ``has_shading`` and the
@@ -21,7 +21,7 @@ def bind_volume(program, sim, sampler, sun: Sun | None, octaves=DEFAULT_OCTAVES,
     ``octaves``; the diffusion field's weight ``diffusion``, 0 where the sets have no field; the sun's
     colour taken over ``layer``, (base, top) world y; the ground below of the scene's ``ground``, a
     GroundSurface (None: the medium's albedo), in the clouds' shadow ``ground_light``, the frame's
-    "cloud_ground" buffer (None: fully sunlit)); returns t. Call :func:`unbind_volume` when the
+    "cloud_ground" buffer (:mod:`atmos.plugins.clouds.light.ground`)); returns t. Call :func:`unbind_volume` when the
     draw is done."""
     a, b, t = sim.view()
     shading = "transmittance" in a

@@ -11,12 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from atmos.glsl_math import smoothstep
 from atmos.plugins.clouds.volume.layout import CloudLayout
-
-
-def smoothstep(e0: float, e1: float, x) -> np.ndarray:
-    t = np.clip((np.asarray(x, np.float64) - e0) / (e1 - e0), 0.0, 1.0)
-    return t * t * (3.0 - 2.0 * t)
 
 
 def edge_weight(uv, fade: float) -> np.ndarray:
