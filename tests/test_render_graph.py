@@ -1,4 +1,6 @@
 """Render graph: ordering, validation, culling, transient texture pooling, a real GPU frame, timings, dumps."""
+import time
+
 import numpy as np
 import pytest
 
@@ -479,9 +481,12 @@ def test_timings_cover_kept_passes_only(graph, screen):
     graph.add_pass(P("a", creates={"x": SMALL}))
     graph.add_pass(P("b", reads=["x"], writes=["screen"]))
     graph.add_pass(P("culled", creates={"y": SMALL}))
-    for frame in range(200):          # results are read once in: a fast frame may run ahead of them
+    deadline = time.monotonic() + 10.0
+    frame = 0
+    while time.monotonic() < deadline:   # results are read once in: fast frames on a loaded machine run ahead of them
         graph.execute()
-        if frame >= 4 and len(graph.timings) >= 2:
+        frame += 1
+        if frame > 4 and len(graph.timings) >= 2:
             break
     assert set(graph.timings) == {"a", "b"}
     for gpu_ms, cpu_ms in graph.timings.values():
