@@ -150,11 +150,12 @@ def light_reference(far, sets) -> dict:
     """light_by_rank (float64) of the sets' textures as the GPU holds them, ranked by its quantiles."""
     from atmos.plugins.clouds.volume.light import cell_tau
     from atmos.plugins.clouds.light.diffusion import DIFFUSION, read_field
+    from atmos.plugins.clouds.light.medium import octave_parameters
     _, quantiles = far.layer.read_cover()
     a, b = sets.a, sets.b
     return light_by_rank(*(sets.maps_of(s).read_sums()[0] for s in (a, b)), *(read_volume(s["density"]) for s in (a, b)),
                          sets.t, sets.a_shift, sets.settings.edge_fade, quantiles, heights=profile_heights(sets.shape[1]),
-                         attenuation=far.light_settings().ms_attenuation, column_tau=cell_tau(sets.settings),
+                         attenuation=octave_parameters(far.light_settings().octaves, sets.settings)[0], column_tau=cell_tau(sets.settings),
                          trans_a=read_volume(a["transmittance"]), trans_b=read_volume(b["transmittance"]),
                          field_a=read_field(a[DIFFUSION]), field_b=read_field(b[DIFFUSION]))
 

@@ -1,5 +1,7 @@
 """Issue 12's outside-comparison API: static clouds from a given density volume, the linear HDR
 readback, and no sky light without a sky (``Sun.ambient = 0``)."""
+import math
+
 import numpy as np
 import pytest
 
@@ -139,9 +141,9 @@ def test_sprite_image_does_not_grow_with_the_size_factor(gpu, ctx):
     """The sprites spread each block's optical depth like its mass (the hat's spread), cut off at the
     size factor's radius: the image sum stays with the ray march's of the same volume whatever the
     size, and levels of detail stay nearer (the old fixed (1 - r²)² disc of the whole diameter spread
-    it wider: here +4 % at size 3, +27 % at size 6, +218 % with every column at level 2; now +6, +10
-    and +32 %, of which the ungated diffusion field's share at the coarse sprites' centres is 11
-    points: +21 % with ms_diffusion 0)."""
+    it wider: here +4 % at size 3, +27 % at size 6, +218 % with every column at level 2; now +10, +14
+    and +36 % (+32 % while the octaves' a and c were fixed numbers, not the phase's), of which the ungated
+    diffusion field's share at the coarse sprites' centres is 11 points: +21 % with ms_diffusion 0)."""
     x, y, z = np.meshgrid(*[(np.arange(k) + 0.5) / k for k in SHAPE], indexing="ij")
     density = np.clip(1.5 - 6.0 * ((x - 0.5) ** 2 + (y - 0.5) ** 2 * 0.3 + (z - 0.5) ** 2), 0, 1).astype(np.float32)
     sums = {}
@@ -164,7 +166,7 @@ def test_sprite_image_does_not_grow_with_the_size_factor(gpu, ctx):
     # which the sprites take once per sprite and the march per sample
     assert abs(sums[3] / ref - 1) < 0.11 and abs(sums[6] / ref - 1) < 0.15, sums
     assert abs(sums[6] / sums[3] - 1) < 0.05, sums
-    assert abs(sums["lod"] / ref - 1) < 0.36, sums
+    assert abs(sums["lod"] / ref - 1) < 0.40, sums
 
 
 def test_sprites_light_varies_across_each_sprite_as_the_sun_transmittance_does(gpu, ctx):
@@ -224,6 +226,33 @@ def test_sky_light_is_exact_in_a_white_furnace_and_follows_the_columns():
     np.testing.assert_allclose(middle, 0.5 * sky)                      # deep inside: the faces' mean
     assert (sky_part(0.01, 0.0, 1.0) > 1.6 * sky_part(0.01, 0.0, 0.0)).all(), "thin base from below: forward share"
     assert np.isfinite(sky_part(1e30, 1e30)).all() and np.isfinite(sky_part(0.0, 0.0, 1.0)).all()
+
+
+def test_sky_light_dies_with_depth_below_albedo_one(rng):
+    """ambient_weights below albedo 1: each face's share solves the slab's diffusion equation w'' = kappa² w
+    along the column (second differences on random columns), is 1 at its own extrapolated face and 0 at
+    the other's, runs on continuously into the albedo-1 line, dies deep in a thick absorbing cloud, and
+    stays finite at the extremes."""
+    from atmos.plugins.clouds.light.medium import ambient_weights
+    g, albedo = rng.uniform(0.5, 0.9), rng.uniform(0.8, 0.99)
+    kappa = math.sqrt(3.0 * (1.0 - albedo) * (1.0 - albedo * g))
+    z = 2.0 / (3.0 * (1.0 - albedo * g))
+    total = rng.uniform(1.0, 60.0, 16)
+    up = rng.uniform(0.1, 0.9, 16) * total
+    h = 1e-3
+    w = [ambient_weights(up + k * h, total - up - k * h, g, albedo, 0.0) for k in (-1, 0, 1)]
+    second = (w[0] - 2.0 * w[1] + w[2]) / h ** 2
+    np.testing.assert_allclose(second, kappa ** 2 * w[1], rtol=1e-4, atol=1e-9)
+    face = ambient_weights(np.array([-z, total[0] + z]), np.array([total[0] + z, -z]), g, albedo, 0.0)
+    np.testing.assert_allclose(face, [[1.0, 0.0], [0.0, 1.0]], atol=1e-12)
+    near_one = ambient_weights(up, total - up, g, 1.0 - 1e-9, 0.0)
+    np.testing.assert_allclose(near_one, ambient_weights(up, total - up, g, 1.0, 0.0), rtol=1e-6, atol=1e-9)
+    deep = ambient_weights(25.0, 25.0, g, 0.9, 0.0)
+    assert deep.sum() < 1e-3 * ambient_weights(25.0, 25.0, g, 1.0, 0.0).sum(), deep
+    for up_, down_ in ((0.0, 0.0), (1e30, 1e30), (0.0, 1e30), (1e-30, 0.0)):
+        for a in (0.0, 0.5, 1.0):
+            v = ambient_weights(up_, down_, g, a, 1.0)
+            assert np.isfinite(v).all() and (v >= 0).all() and v.sum() <= 1.0 + 1e-12, (up_, down_, a, v)
 
 
 def test_the_octaves_count_forward_scatterings_on_the_way_in(rng):

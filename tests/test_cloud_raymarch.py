@@ -6,6 +6,7 @@ import pytest
 from atmos import App, DefaultPlugins
 from atmos.camera import Camera
 from atmos.lighting import Sun
+from atmos.phase import Phase
 from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
 from atmos.graph import RenderPass, TextureDesc, work_groups
 from atmos.plugins.clouds.raymarch.plugin import LOW_COLOR, LOW_DEPTH, LOW_DISTANCE, sample_offset, skip_map
@@ -39,9 +40,10 @@ def medium(**changes):
                          sigma_t=changes.pop("sigma_t", 0.02), edge_fade=0.0, **changes)
 
 
-def scene(gpu, density, sun=DAY, plugins=(), **fields):
+def scene(gpu, density, sun=DAY, plugins=(), medium_fields=None, **fields):
+    """``medium_fields``: CloudSettings changes (:func:`medium`)."""
     fields = dict(dict(resolution=1, jitter=False, detail_octaves=0), **fields)   # no noise unless asked
-    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(medium(), density=density),
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(medium(**(medium_fields or {})), density=density),
                                RaymarchCloudsPlugin(**fields), *plugins)
     app.insert_resource(sun)
     app.startup()
@@ -73,9 +75,14 @@ def shading_volume(sim) -> np.ndarray:
     return np.frombuffer(texture.read(), np.float16).astype(np.float64).reshape(nz, ny, nx).transpose(2, 1, 0)
 
 
-@pytest.mark.parametrize("sun", [DAY, BY_ALTITUDE], ids=["day", "by_altitude"])
-def test_the_march_matches_its_float64_reference(gpu, ctx, sun):
-    app = scene(gpu, volume(), sun, empty_space_skipping=False, min_transmittance=0.0, steps=96, step_growth=0.002)
+ABSORBING = dict(albedo=0.85, sigma_t=0.08, phase=Phase(0.7, -0.2, 0.15))    # sky light dies inside, kappa ~ 0.5
+
+
+@pytest.mark.parametrize("sun, medium_fields", [(DAY, None), (BY_ALTITUDE, None), (DAY, ABSORBING)],
+                         ids=["day", "by_altitude", "absorbing"])
+def test_the_march_matches_its_float64_reference(gpu, ctx, sun, medium_fields):
+    app = scene(gpu, volume(), sun, medium_fields=medium_fields, empty_space_skipping=False, min_transmittance=0.0,
+                steps=96, step_growth=0.002)
     cam = aim(app, (80.0, 470.0, -150.0))
     image = linear(app)
     plugin = next(p for p in app.plugins if isinstance(p, CloudsPlugin))

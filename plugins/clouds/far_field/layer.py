@@ -22,6 +22,7 @@ from atmos.plugins.clouds.far_field.columns import INTERVALS, rank_texture, read
 from atmos.plugins.clouds.far_field.cover import LEVELS, QUANTILES, level_ranks, matched_tile_size, pattern_crossings
 from atmos.plugins.clouds.far_field.pattern import CHANNEL_STEPS, PERIODS, octave_frequencies, octave_offsets, rotations, turns_bytes
 from atmos.plugins.clouds.far_field.rank_light import RankLight
+from atmos.plugins.clouds.light.medium import octave_parameters
 from atmos.plugins.clouds.volume.light import cell_tau, unit_direction
 from atmos.plugins.clouds.volume.sets import CloudSets
 from atmos.tile_octaves import OctaveTextures
@@ -113,7 +114,7 @@ class FarFieldLayer:
             self.octaves.bake(params, sun_dir, octave_frequencies(params.base_frequency), rotations(), CHANNEL_STEPS)
         self.measure_cover(sim)
         if self.plugin.drawn_by_march() or params.enabled:      # a far field is drawn (not just shadows)
-            self.light.measure(sim, self.cover, self.plugin.light_settings().ms_attenuation,
+            self.light.measure(sim, self.cover, octave_parameters(self.plugin.light_settings().octaves, sim.settings)[0],
                                profile_heights(sim.shape[1]))
         self.update_tile(sim, float(view.time))
 

@@ -18,7 +18,7 @@ ground's mean sun transmittance through the clouds (their shadow on it: :mod:`.g
 this scene (all orders), the real-time renderers approximate it (``clouds/volume/volume.glsl``):
 
     source per unit extinction J = albedo * (E * (sum_i b^i p(cos; c^i g) P_i(T) + beta L_field)
-                                             + (L_sky + L_ground) / 2 + h (L_sky - L_ground) / 2)
+                                             + w_sky L_sky + w_ground L_ground)
 
 with ``T`` the transmittance toward the sun and ``p`` the phase at the angle between the view ray and
 the sun (per pixel). The sun's light splits in two. What stays forward: octaves ``i < 4`` after
@@ -32,14 +32,16 @@ diffusion field (:mod:`atmos.plugins.clouds.light.diffusion`, weight beta: ``ms_
 scattered fluence whose radiance ``L_field`` is diffuse and runs with the flux.
 ``tau_up``/``tau_down`` (straight up and down to the volume's faces) come from the light volume's
 columns, computed once per texture set (:mod:`atmos.plugins.clouds.light.columns`).
-Sky and ground light: the diffusion solution between a slab's two lit faces, ``u = (tau_down −
-tau_up) / (tau_up + tau_down + 2 z)`` with the extrapolation length ``z = 2 / (3 (1 − g_mean))``
-(deep in a cloud the light is the faces' mean, near a face that face's; a white furnace, equal sky
-and ground at albedo 1, gives exactly ``J = L`` at any depth), plus where the column is thin the
-phase's forward share ``g_mean ray_y`` (looking up at a thin base sees sky light scattered forward):
-``h = clamp(u + g_mean ray_y exp(−(tau_up + tau_down) / 2 z), −1, 1)``. No fitted constant dims it;
-a, b, c and beta are fitted to the path tracer (``benchmarks/bench_cloud_light.py --fit``) over both
-volumes, both renderers and five views.
+Sky and ground light: the diffusion solution between a slab's two lit faces (:func:`ambient_weights`):
+each face's share ``sinh(kappa (tau_other + z)) / sinh(kappa D)`` with the extrapolation length
+``z = 2 / (3 (1 − albedo g_mean))`` and ``kappa = sqrt(3 (1 − albedo)(1 − albedo g_mean))``, the linear
+``(tau_other + z) / D`` at albedo 1 (deep in a cloud the light is the faces' mean, near a face that
+face's; a white furnace, equal sky and ground at albedo 1, gives exactly ``J = L`` at any depth; below
+albedo 1 diffuse light dies with depth), plus where the column is thin the phase's forward share
+``g_mean ray_y`` (looking up at a thin base sees sky light scattered forward). No fitted constant dims
+it. The octaves follow the medium (:func:`octave_parameters`: a and c from the phase unless set, the
+albedo per forward scattering); b and beta are fitted to the path tracer
+(``benchmarks/bench_cloud_light.py --fit-grid``).
 """
 from __future__ import annotations
 
@@ -93,18 +95,61 @@ def octave_transmittances(T, a: float) -> np.ndarray:
     return np.stack([*low, np.maximum(T ** a - sum(low), 0.0)], -1)
 
 
+FORWARD_SCALE = 1.0      # k_f: the forward share 1 - a = k_f g_mean where ms_attenuation is None (bench_cloud_light --fit-grid)
+ECCENTRICITY_SCALE = 1.0  # k_c: the octaves' eccentricity c = k_c g where ms_eccentricity is None
+
+
+def phase_octaves(phase, scales=None) -> tuple[float, float]:
+    """(a, c) that follow the phase (:class:`atmos.phase.Phase`): the forward share 1 - a = k_f g_mean (the
+    similarity relation's share that stays forward), c = k_c g (octave i's lobe c^i g near g^(i+1): i forward
+    scatterings, then one toward the eye); ``scales``: (k_f, k_c), None: FORWARD_SCALE, ECCENTRICITY_SCALE."""
+    k_f, k_c = (FORWARD_SCALE, ECCENTRICITY_SCALE) if scales is None else scales
+    return 1.0 - min(k_f * max(phase.mean_cosine, 0.0), 1.0), min(k_c * max(phase.g, 0.0), 1.0)
+
+
+def octave_parameters(octaves, settings) -> tuple[float, float, float]:
+    """(a, b, c) the renderers' octaves take (``volume.glsl`` ``ms_octaves``) for the medium ``settings``
+    (a CloudSettings) from a CloudLightSettings' ``octaves`` (a, b, c), a or c None: :func:`phase_octaves`'.
+    Light that stays forward keeps ``albedo`` of itself per scattering: the Poisson count of k forward
+    scatterings then weighs albedo^k, which is the same Poisson law with the forward share albedo (1 - a),
+    so a becomes 1 - albedo (1 - a)."""
+    a, b, c = octaves
+    if a is None or c is None:
+        derived = phase_octaves(settings.phase)
+        a, c = derived[0] if a is None else a, derived[1] if c is None else c
+    return 1.0 - float(settings.albedo) * (1.0 - float(a)), float(b), float(c)
+
+
 def octave_weights(T, a: float, b: float) -> np.ndarray:
     """(..., 4): ``b^i P_i(T)`` of the module docstring."""
     return octave_transmittances(T, a) * b ** np.arange(OCTAVES)
 
 
-def ambient_profile(tau_up, tau_down, g_mean: float, ray_y) -> np.ndarray:
-    """``h`` of the module docstring: J's sky and ground part is ``(L_sky + L_ground) / 2 + h
-    (L_sky - L_ground) / 2`` (times the albedo) at column optical depths ``tau_up``/``tau_down``."""
+def ambient_weights(tau_up, tau_down, g_mean: float, albedo: float, ray_y) -> np.ndarray:
+    """(..., 2): the shares (w_sky, w_ground) of J's sky and ground part, ``albedo (w_sky L_sky + w_ground
+    L_ground)``, at column optical depths ``tau_up``/``tau_down`` (``volume.glsl`` ambient_source): each
+    face's share of the diffusion solution between a slab's two lit faces, ``sinh(kappa (tau_other + z)) /
+    sinh(kappa D)``, ``D = tau_up + tau_down + 2 z``, extrapolation length ``z = 2 / (3 (1 - albedo g_mean))``,
+    ``kappa = sqrt(3 (1 - albedo) (1 - albedo g_mean))`` how fast diffuse light dies per optical depth
+    (at albedo 1 the limit ``(tau_other + z) / D``: equal sky and ground give exactly ``J = L``); where the
+    column is thin, ``g_mean ray_y exp(-(tau_up + tau_down) / 2z)`` / 2 of their sum moves from the
+    ground's share to the sky's (looking up at a thin base sees sky light scattered forward), each share
+    kept within [0, sum]."""
     up, down = np.asarray(tau_up, np.float64), np.asarray(tau_down, np.float64)
-    z = 2.0 / (3.0 * (1.0 - min(g_mean, 0.99)))
-    u = (down - up) / (up + down + 2.0 * z)
-    return np.clip(u + g_mean * np.asarray(ray_y, np.float64) * np.exp(-(up + down) / (2.0 * z)), -1.0, 1.0)
+    z = 2.0 / (3.0 * (1.0 - min(albedo * g_mean, 0.99)))
+    d = up + down + 2.0 * z
+    kappa = math.sqrt(max(3.0 * (1.0 - albedo) * (1.0 - albedo * g_mean), 0.0))
+
+    def share(x):
+        y = kappa * d
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            ratio = np.exp(kappa * x - y) * -np.expm1(-2.0 * kappa * x) / -np.expm1(-2.0 * y)
+        return np.where(y < 1e-3, x / d, ratio)
+
+    w = np.stack(np.broadcast_arrays(share(down + z), share(up + z)), -1)
+    s = w.sum(-1)
+    f = 0.5 * s * g_mean * np.asarray(ray_y, np.float64) * np.exp(-(up + down) / (2.0 * z))
+    return np.clip(w + np.stack([f, -f], -1), 0.0, s[..., None])
 
 
 def source_reference(settings, render, T, tau_up, tau_down, cos, ray_y, sun_color, sky, sun_dir,
@@ -121,13 +166,13 @@ def source_reference(settings, render, T, tau_up, tau_down, cos, ray_y, sun_colo
     if sun_colors is not None:
         e = settings.sun_intensity * np.asarray(sun_colors, np.float64)
     tau_up, tau_down = np.asarray(tau_up, np.float64), np.asarray(tau_down, np.float64)
-    a, b, c = render.ms_attenuation, render.ms_contribution, render.ms_eccentricity
+    a, b, c = octave_parameters(render.octaves, settings)
     g_mean = settings.phase.mean_cosine
     w = octave_weights(T, a, b) if octaves is None else np.asarray(octaves, np.float64) * b ** np.arange(OCTAVES)
     sun = sum(w[..., i] * phase(cos, settings.phase.g * c ** i, settings.phase.g2 * c ** i, settings.phase.w)
               for i in range(OCTAVES))
     if diffusion is not None:
         sun = sun + render.ms_diffusion * np.asarray(diffusion, np.float64)
-    h = ambient_profile(tau_up, tau_down, g_mean, ray_y)[..., None]
-    amb = 0.5 * (l_sky + l_ground) + 0.5 * h * (l_sky - l_ground)
+    w = ambient_weights(tau_up, tau_down, g_mean, settings.albedo, ray_y)
+    amb = w[..., :1] * l_sky + w[..., 1:] * l_ground
     return settings.albedo * (sun[..., None] * e + amb)

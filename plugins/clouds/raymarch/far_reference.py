@@ -10,7 +10,7 @@ from atmos.plugins.clouds.raymarch.reference import integrate, rays
 from atmos.plugins.clouds.raymarch.shape import type_density
 from atmos.plugins.clouds.volume.light import cell_tau, layer_sun, sun_source_at, unit_direction
 from atmos.plugins.clouds.light.diffusion import field_radiance
-from atmos.plugins.clouds.light.medium import OCTAVES, source_reference
+from atmos.plugins.clouds.light.medium import OCTAVES, octave_parameters, source_reference
 
 
 def sample_profile(profile, rank, h) -> np.ndarray:
@@ -75,7 +75,7 @@ def far_source(field: FarField, medium, settings, p, dirs, band, sun, albedo=Non
     c = field.channels(p[:, [0, 2]])
     h01 = np.clip((p[:, 1] - band[0]) / band[1], 0.0, 1.0)
     exponents = np.ones(OCTAVES)
-    exponents[-1] = settings.ms_attenuation                         # volume.glsl's octave_exponents
+    exponents[-1] = octave_parameters(settings.octaves, medium)[0]  # volume.glsl's octave_exponents
     relief = far_relief(c, field.columns, cell_tau(medium), float(sun_dir[1]))
     octaves = relief_light(sample_profile(field.sun_profile, c[:, 0], h01), relief[:, None] * exponents)
     column = cell_tau(medium) * column_at_rank(c[:, 0], field.columns)

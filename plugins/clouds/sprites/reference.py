@@ -16,7 +16,7 @@ from atmos.plugins.clouds.volume.light import sun_source_at
 from atmos.plugins.clouds.sprites.particle import centre_tau, footprint, screen_axes
 from atmos.plugins.clouds.sprites.segments import unpack
 from atmos.phase import Phase
-from atmos.plugins.clouds.light.medium import ambient_profile, octave_weights
+from atmos.plugins.clouds.light.medium import ambient_weights, octave_weights
 from atmos.plugins.clouds.light.columns import column_reference, columns_at
 from atmos.plugins.clouds.light.grid import SCALES
 from atmos.plugins.clouds.light.grid import shading_shape as grid_shape
@@ -155,10 +155,10 @@ def sprite_vertices(density_a, density_b, trans_a, trans_b, t: float, segments, 
         slope += side * np.log(np.maximum(T, MIN_T))[:, None]
     world = np.asarray(u["layer_min"]) + center * np.asarray(u["cell_size"])
     ray = world - np.asarray(u["camera_pos"], np.float64)
-    h = ambient_profile(up, down, g_mean, ray[:, 1] / np.linalg.norm(ray, axis=1))[:, None]
+    w = ambient_weights(up, down, g_mean, light["albedo"], ray[:, 1] / np.linalg.norm(ray, axis=1))
     sky = np.asarray(light["sky_source"])
     ground = np.asarray(light["ground_sky_source"]) + ground_sun * np.asarray(light["ground_sun_source"])
-    ambient = (sky + ground) + h * (sky - ground)
+    ambient = 2.0 * (w[:, :1] * sky + w[:, 1:] * ground)
     clip = np.concatenate([world, np.ones((len(c), 1))], 1) @ np.asarray(view_proj, np.float64).T
     diameter = s * u["base_diameter"]
     axis_x, axis_y, stretch = screen_axes(ray, u["camera_right"], u["camera_up"], u["near"])

@@ -12,11 +12,11 @@ import numpy as np
 from atmos.checks import CheckedSettings, num_field
 from atmos.gpu.uniforms import write_block, write_uniforms
 from atmos.lighting import Sun
-from atmos.plugins.clouds.light.medium import ground_parts
+from atmos.plugins.clouds.light.medium import ground_parts, octave_parameters
 
 DEFAULT_AMBIENT = (0.35, 0.47, 0.65)
-DEFAULT_OCTAVES = (0.25, 0.9525, 0.875)   # a, b, c of the octaves, fitted to the path tracer (bench_cloud_light --fit)
-DEFAULT_DIFFUSION = 0.575                 # the diffusion field's weight beta, fitted with them (README "Cloud light")
+DEFAULT_OCTAVES = (None, 0.9525, None)    # a, b, c of the octaves: a and c follow the medium (medium.octave_parameters), b fitted
+DEFAULT_DIFFUSION = 0.575                 # the diffusion field's weight beta, fitted with b (bench_cloud_light --fit-grid)
 SUN_HEIGHTS = 5                           # volume.glsl's samples of the sun's colour over the layer, base to top (2: the middle)
 
 
@@ -24,16 +24,19 @@ SUN_HEIGHTS = 5                           # volume.glsl's samples of the sun's c
 class CloudLightSettings(CheckedSettings):
     """The multiple-scattering octaves both cloud renderers share (the sprites' CloudRenderSettings
     and the march's RaymarchCloudSettings inherit them; :mod:`atmos.plugins.clouds.light.medium`), and
-    the weight of the diffusion field beside them. The defaults are the search
-    ``benchmarks/bench_cloud_light.py --fit`` found against the path tracer on the bench's two volumes,
-    scoring both renderers in the goal's four views and a low sun (README "Cloud light"). The 2D far
+    the weight of the diffusion field beside them. By default a and c follow the medium's phase (and every
+    octave its albedo: :func:`atmos.plugins.clouds.light.medium.octave_parameters`); b and beta are the
+    search ``benchmarks/bench_cloud_light.py --fit-grid`` found against the path tracer (README "Cloud
+    light"). The 2D far
     field is lit with the drawing renderer's settings (``CloudFarFieldPlugin.light_settings``). A
     subclass declares its own fields after these four; ``CheckedSettings.__post_init__`` checks all of
     them, naming the subclass."""
-    ms_attenuation: float = num_field(DEFAULT_OCTAVES[0], 0.0, 1.0, "a: the share of scatterings that turn "
-                                      "light aside (the octaves' Poisson mean (1 - a) tau)")
+    ms_attenuation: float | None = num_field(DEFAULT_OCTAVES[0], 0.0, 1.0, "a: the share of scatterings that turn "
+                                             "light aside (the octaves' Poisson mean (1 - a) tau); None: from the "
+                                             "phase, 1 - g_mean (medium.phase_octaves)", optional=True)
     ms_contribution: float = num_field(DEFAULT_OCTAVES[1], 0.0, 1.0, "b: octave i's weight b^i")
-    ms_eccentricity: float = num_field(DEFAULT_OCTAVES[2], 0.0, 1.0, "c: octave i's lobes c^i g")
+    ms_eccentricity: float | None = num_field(DEFAULT_OCTAVES[2], 0.0, 1.0, "c: octave i's lobes c^i g; None: "
+                                              "the phase's g (octave i's lobe g^(i+1))", optional=True)
     ms_diffusion: float = num_field(DEFAULT_DIFFUSION, 0.0, 2.0, "the weight beta of the diffusion field, the "
                                     "light turned aside (:mod:`atmos.plugins.clouds.light.diffusion`: J += "
                                     "sun_source beta max(phi - 3 g F.ray, -cos 2 H phi, 0) / 4pi, cos = ray . sun); "
@@ -143,8 +146,9 @@ def _light_uniforms(cloud_settings, sun: Sun, octaves, diffusion: float, layer, 
             "sun_dir": tuple(float(v) for v in direction),
             "phase_lobes": s.phase.lobes,
             "outward_share": float(s.phase.hemisphere_share),
-            "ms_octaves": tuple(float(v) for v in octaves),
+            "ms_octaves": octave_parameters(octaves, s),
             "column_tau": cell_tau(s),
+            "albedo": float(s.albedo),
             "ms_diffusion": float(diffusion)}
 
 

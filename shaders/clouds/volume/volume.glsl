@@ -1,12 +1,11 @@
 // The cloud volume as the renderers see it: density and transmittance toward the sun, each
 // mix(A, B, t) of the two latest completed steps, and the light model of plugins/clouds/light/medium.py:
 // source per unit extinction J = sun_source(y) * sum_i b^i p(cos; c^i g) P_i(T)
-//                              + (sky_source + ground_source) + (sky_source - ground_source) h,
+//                              + 2 (sky_source w_sky + ground_source w_ground),
 // ground_source = ground_sky_source + G ground_sun_source (G: the clouds' shadow on the ground),
 // P_i: the octaves' transmittances (lib/octaves.glsl: light forward-scattered i times on its way, the
-// last all higher counts), h = clamp(u + g_mean ray_y exp(-(tau_up + tau_down) / 2z), -1, 1),
-// u = (tau_down - tau_up) / (tau_up + tau_down + 2z), z = 2 / (3 (1 - g_mean)): the diffusion profile
-// between a slab's lit faces (see medium.py); plus the diffusion field's term (diffusion_part) where the
+// last all higher counts), w: each face's share of the diffusion solution between a slab's lit faces
+// (ambient_source; medium.py ambient_weights); plus the diffusion field's term (diffusion_part) where the
 // set has one: the light turned aside (diffuse), where the octaves carry what stays forward.
 layout(binding = 0) uniform sampler3D density_a;
 layout(binding = 1) uniform sampler3D density_b;
@@ -36,6 +35,7 @@ uniform vec3 phase_lobes;      // g, g2, w
 uniform float outward_share;   // the phase's share H of the hemisphere about a direction (medium.hemisphere_share)
 uniform vec3 ms_octaves;       // a (attenuation), b (contribution), c (eccentricity)
 uniform float column_tau;      // sigma_t * cell height: optical depth of one cell of density 1, vertically
+uniform float albedo;          // CloudSettings.albedo: how sky and ground light fade into the cloud (ambient_source)
 uniform float edge_fade;       // CloudSettings.edge_fade: density fades to 0 toward the inscribed circle
 #include "clouds/volume/edge.glsl"
 const float PI = 3.14159265358979;
@@ -121,16 +121,28 @@ vec4 octave_weights(float T) {
     return octave_weights_of(octave_transmittances(T, ms_octaves.x));
 }
 
-// Sky and ground light toward the eye along ray_y (the view ray's y): their mean plus half their
-// difference times h, the diffusion profile u between the columns above and below (a furnace of equal
-// sky and ground stays exact) and, where the column is thin, the phase's forward share g_mean ray_y.
+// sinh(x) / sinh(y) for 0 <= x <= y, y > 0, without overflow.
+float sinh_ratio(float x, float y) {
+    return exp(x - y) * (1.0 - exp(-2.0 * x)) / (1.0 - exp(-2.0 * y));
+}
+
+// Sky and ground light toward the eye along ray_y (the view ray's y) (medium.py ambient_weights): each
+// face's share of the diffusion solution between the columns above and below, sinh(kappa (tau_other + z)) /
+// sinh(kappa D) with D = tau_up + tau_down + 2z, kappa = sqrt(3 (1 - albedo) (1 - albedo g_mean)) (linear
+// at albedo 1: a furnace of equal sky and ground stays exact); where the column is thin, the phase's
+// forward share g_mean ray_y moves light from the ground's share to the sky's.
 vec3 ambient_source(float tau_up, float tau_down, float ray_y) {
     float g = mean_cosine();
-    float z = 2.0 / (3.0 * (1.0 - min(g, 0.99)));
-    float u = (tau_down - tau_up) / (tau_up + tau_down + 2.0 * z);
-    float h = clamp(u + g * ray_y * exp(-(tau_up + tau_down) / (2.0 * z)), -1.0, 1.0);
+    float z = 2.0 / (3.0 * (1.0 - min(albedo * g, 0.99)));
+    float D = tau_up + tau_down + 2.0 * z;
+    float kappa = sqrt(max(3.0 * (1.0 - albedo) * (1.0 - albedo * g), 0.0));
+    vec2 w = kappa * D < 1e-3 ? vec2(tau_down + z, tau_up + z) / D
+           : vec2(sinh_ratio(kappa * (tau_down + z), kappa * D), sinh_ratio(kappa * (tau_up + z), kappa * D));
+    float s = w.x + w.y;
+    float f = 0.5 * s * g * ray_y * exp(-(tau_up + tau_down) / (2.0 * z));
+    w = clamp(w + vec2(f, -f), 0.0, s);
     vec3 ground_source = ground_sky_source + cloud_ground.x * ground_sun_source;
-    return (sky_source + ground_source) + (sky_source - ground_source) * h;
+    return 2.0 * (sky_source * w.x + ground_source * w.y);
 }
 
 #include "lib/phase.glsl"
