@@ -15,6 +15,8 @@ _PLAIN = frozenset((moderngl.Texture, moderngl.Texture3D, moderngl.TextureArray,
                     moderngl.Buffer))
 FRAMEBUFFER_CACHE = 64  # framebuffers kept per graph, least recently used dropped first
 STATE_FLAGS = moderngl.BLEND | moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.PROGRAM_POINT_SIZE
+_DEFAULT_BLEND_FUNC = tuple(moderngl.DEFAULT_BLENDING)   # reset_state's values, as moderngl's setters pass them
+_DEFAULT_BLEND_EQUATION = (moderngl.FUNC_ADD,)
 
 # The blend modes passes use (colour factors, then alpha factors); see the PassContext methods.
 BLEND_OVER = (moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA, moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA)
@@ -197,12 +199,13 @@ class PassContext:
         blend(self.gpu.ctx, BLEND_ALPHA)
 
     def reset_state(self) -> None:
-        """The GL state every pass starts from (and a frame ends with)."""
-        ctx = self.gpu.ctx
-        ctx.disable(STATE_FLAGS)
-        ctx.blend_func = moderngl.DEFAULT_BLENDING
-        ctx.blend_equation = moderngl.FUNC_ADD
-        ctx.depth_func = "<"
+        """The GL state every pass starts from (and a frame ends with): set on the context's C object
+        (``mglo``) as moderngl's own setters do, without their Python wrappers (once per pass)."""
+        gl = self.gpu.ctx.mglo
+        gl.disable(STATE_FLAGS)
+        gl.blend_func = _DEFAULT_BLEND_FUNC
+        gl.blend_equation = _DEFAULT_BLEND_EQUATION
+        gl.depth_func = "<"
         self._fresh = set()
 
     def _reset_framebuffer(self, fbo):
