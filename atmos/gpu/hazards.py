@@ -264,8 +264,13 @@ def dispatch_indirect(program, args, offset: int = 0) -> None:
     if hazards._need:                                    # with what the binds asked for: one barrier
         hazards.issue(hazards._need)
     program.run_indirect(args, offset)
-    if hazards._staged:
-        hazards.commit()
+    staged = hazards._staged
+    if staged:                                   # Hazards.commit, inlined
+        dirty = hazards._dirty
+        for key in staged:
+            obj, kind = staged[key]
+            dirty[key] = [weakref.ref(obj), kind, _ALL[kind]]
+        hazards._staged = {}
 
 
 _GUARDED = False

@@ -13,6 +13,7 @@ from atmos.graph.errors import GraphError
 
 _PLAIN = frozenset((moderngl.Texture, moderngl.Texture3D, moderngl.TextureArray, moderngl.TextureCube,
                     moderngl.Buffer))
+_FRAMEBUFFER_TYPES: dict[type, bool] = {}   # type of an imported resource -> whether it is a Framebuffer
 FRAMEBUFFER_CACHE = 64  # framebuffers kept per graph, least recently used dropped first
 STATE_FLAGS = moderngl.BLEND | moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.PROGRAM_POINT_SIZE
 _DEFAULT_BLEND_FUNC = tuple(moderngl.DEFAULT_BLENDING)   # reset_state's values, as moderngl's setters pass them
@@ -66,9 +67,14 @@ class PassContext:
             value = self._resources[name]
         except KeyError:
             raise GraphError(f"pass '{self.pass_name}': resource '{name}' is not available this frame") from None
-        if type(value) in _PLAIN:           # a texture or buffer: no framebuffer to reset
+        kind = type(value)
+        if kind in _PLAIN:                  # a texture or buffer: no framebuffer to reset
             return value
-        if isinstance(value, moderngl.Framebuffer):
+        try:
+            framebuffer = _FRAMEBUFFER_TYPES[kind]
+        except KeyError:
+            framebuffer = _FRAMEBUFFER_TYPES[kind] = issubclass(kind, moderngl.Framebuffer)
+        if framebuffer:
             self._reset_framebuffer(value)
         return value
 
@@ -138,7 +144,8 @@ class PassContext:
     def image(self, name: str):
         """The texture ``name`` for image load/store: the pass must have declared it with ``storage`` access."""
         value = self.resource(name)
-        if "storage" not in self._access.get(name, ()):
+        access = self._access
+        if name not in access or "storage" not in access[name]:
             raise GraphError(f"pass '{self.pass_name}' uses '{name}' as an image but declared it without "
                              "access='storage' (builder.read/write(name, access='storage'))")
         return value
