@@ -204,7 +204,7 @@ class RenderGraph:
                 else:
                     p.execute(frame)
                 if stored:
-                    hazards.wrote_storage([resources[n] for n in stored])
+                    hazards.wrote_storage(map(resources.__getitem__, stored))
                 for r in release:
                     texture = transient[r]
                     del resources[r], transient[r]

@@ -70,7 +70,7 @@ def sun_color(sun_dir, altitude, settings: AtmosphereSettings) -> np.ndarray:
     (n, 3) in one vectorised pass (``Sun.color_by_altitude``: a cloud layer's heights). Remembered for
     the last few directions and altitudes: the camera's and the cloud layers' are asked every frame."""
     heights = np.asarray(altitude, np.float64)
-    direction = tuple(float(v) for v in np.asarray(sun_dir, np.float64).reshape(3))
+    direction = tuple(map(float, np.asarray(sun_dir, np.float64).reshape(3)))
     return _sun_color(direction, tuple(heights.reshape(-1).tolist()), settings).reshape(heights.shape + (3,)).copy()
 
 
