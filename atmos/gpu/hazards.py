@@ -170,8 +170,9 @@ class Hazards:
                 dirty[id(obj)] = [weakref.ref(obj), kind, _ALL[kind]]
 
     def issue(self, bits: int) -> None:
-        """One glMemoryBarrier with ``bits``; every pending write is then visible to those uses."""
-        self._ctx().memory_barrier(bits)
+        """One glMemoryBarrier with ``bits``; every pending write is then visible to those uses. The one
+        place atmos issues a barrier: moderngl's ``Context.memory_barrier`` made on its C object directly."""
+        self._ctx().mglo.memory_barrier(bits, False)
         self._need = 0
         self.barriers += 1
         self._issued[bits] += 1

@@ -154,7 +154,10 @@ def bind_textures(program, textures: Mapping[str, object] | None = None, /, samp
             else:
                 one.use(unit)
             if sampler is not None:
-                sampler.use(unit)
+                if type(sampler) is moderngl.Sampler and sampler.texture is None:
+                    sampler.mglo.use(unit)        # Sampler.use, unwrapped (no texture of its own to bind)
+                else:
+                    sampler.use(unit)
             units += (unit,)
     return units
 

@@ -216,16 +216,19 @@ class PassContext:
         self._fresh = set()
 
     def _reset_framebuffer(self, fbo):
-        """Depth and colour writes on, the full viewport, no scissor: the first time a pass takes ``fbo``."""
+        """Depth and colour writes on, the full viewport, no scissor: the first time a pass takes ``fbo``
+        (set on its C object, ``mglo``, as moderngl's setters do)."""
         key = id(fbo)
         if key not in self._fresh:
             self._fresh.add(key)
-            fbo.depth_mask = True
+            gl = fbo.mglo
+            gl.depth_mask = True
             n = len(fbo.color_attachments or ())   # a window's default framebuffer has none listed
             if n:                            # moderngl takes one mask, or one per attachment
-                fbo.color_mask = (True, True, True, True) if n == 1 else ((True, True, True, True),) * n
-            fbo.viewport = (0, 0, *fbo.size)
-            fbo.scissor = None
+                gl.color_mask = (True, True, True, True) if n == 1 else ((True, True, True, True),) * n
+            w, h = fbo.size
+            gl.viewport = (0, 0, int(w), int(h))
+            gl.scissor = None
         return fbo
 
     def _drop(self, key) -> None:
