@@ -58,6 +58,9 @@ class CloudShadowsPass(ComputePass):
             return {}
         return {"CLOUD_SHADOW_EXACT": 1, **({"CLOUD_FAR_FIELD": 1} if self.far_field() else {})}
 
+    def setup_key(self) -> tuple:
+        return (self.plugin.settings, self.exact, self.plugin.graph.imports(FAR_FIELD), self.reads, self.writes)
+
     def setup(self, builder) -> None:
         super().setup(builder)
         if self.uses_map():

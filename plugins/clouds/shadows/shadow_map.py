@@ -117,6 +117,9 @@ class CloudShadowMapPass(ComputePass):
     def defines(self) -> dict:
         return {"CLOUD_FAR_FIELD": 1} if self.far_field() else {}
 
+    def setup_key(self) -> tuple:
+        return (self.graph.imports(CLOUD_SETS), self.far_field(), self.size)
+
     def setup(self, builder) -> None:
         if not self.graph.imports(CLOUD_SETS):
             return

@@ -169,6 +169,9 @@ class CloudSpritePass(RenderPass):
         self.instances = self.commands = self.vao = None
         self._group = self._uploaded = self._drawn = None   # _drawn: (segments, group, commands) written
 
+    def setup_key(self) -> tuple:
+        return (self.plugin.settings, self.plugin.composition.distance, self.plugin.gpu.size)
+
     def setup(self, builder: PassBuilder) -> None:
         if not self.plugin.settings.enabled:
             return                          # declares nothing: culled, allocates nothing
