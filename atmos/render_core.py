@@ -210,6 +210,9 @@ class OpaquePass(RenderPass):
     phase = "opaque"
     program = None
 
+    def setup_key(self) -> tuple:
+        return ()                           # the same declarations every frame
+
     def setup(self, builder: PassBuilder) -> None:
         builder.write(COLOR)
         builder.read(DEPTH)                 # depth-tested

@@ -266,6 +266,22 @@ def test_passes_with_setup_keys_follow_live_changes():
         gpu.release()
 
 
+def test_a_subclass_overriding_setup_does_not_inherit_the_key(graph):
+    class Keyed(P):
+        def setup_key(self):
+            return ()
+
+    class Overrides(Keyed):
+        def setup(self, builder):
+            self.setups += 1
+            builder.side_effect()
+
+    keyed, overrides = graph.add_pass(Keyed("keyed", side=True)), graph.add_pass(Overrides("overrides"))
+    for _ in range(3):
+        graph.compile()
+    assert keyed.setups == 1 and overrides.setups == 3
+
+
 def test_setup_key_follows_an_import_that_appears_or_goes(graph):
     from atmos.plugins.clouds.light.ground import GroundSunPass
     from atmos.plugins.clouds.volume.sets import CLOUD_SETS

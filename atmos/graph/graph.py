@@ -44,6 +44,7 @@ class RenderGraph:
         self._key: tuple | None = None
         self._declared = None                # the last declarations (passes, their phases, builders, imports)
         self._setups: dict[str, tuple] = {}  # pass name -> (pass, its setup_key, its builder): setups kept
+        self._keys: dict[str, Callable | None] = {}   # pass name -> its setup_key where that covers its setup
         self._prepared: dict[str, RenderPass] = {}
         self._timers = PassTimers(gpu.ctx)
         self._frame = PassContext(gpu)
@@ -61,6 +62,7 @@ class RenderGraph:
             raise GraphError(f"the graph already has a pass named '{p.name}' "
                              f"({type(self._passes[p.name]).__name__}); pass names must be unique")
         self._passes[p.name] = p
+        self._keys[p.name] = setup_key_of(p)
         return p
 
     def shared_pass(self, kind: type, make: Callable[[], RenderPass]) -> tuple[RenderPass, bool]:
@@ -80,6 +82,7 @@ class RenderGraph:
             del self._prepared[name]
             p.release()
         self._setups.pop(name, None)
+        del self._keys[name]
         self._timers.forget(name)
 
     def import_resource(self, name: str, source: Any | Callable[[], Any]) -> None:
@@ -118,9 +121,10 @@ class RenderGraph:
     def declare(self) -> dict[str, PassBuilder]:
         """This frame's declarations: every pass's ``setup`` runs, but for a pass whose ``setup_key()``
         equals the one of its last setup, whose builder is kept (:class:`RenderPass`)."""
-        builders, kept = {}, self._setups
+        builders, kept, keys = {}, self._setups, self._keys
         for p in self._passes.values():
-            name, key_of = p.name, p.setup_key
+            name = p.name
+            key_of = keys[name]
             if key_of is not None:
                 key = key_of()
                 if name in kept:
@@ -293,6 +297,15 @@ class RenderGraph:
         self._frame.release()
         self.pool.release_all()
         self._timers.release()
+
+
+def setup_key_of(p: RenderPass) -> Callable | None:
+    """``p.setup_key`` where it covers ``p.setup``: None when there is none, or when a subclass overrides
+    ``setup`` below the class that gave the key (whose key would leave out what that setup reads)."""
+    mro = type(p).__mro__
+    key_owner = next(c for c in mro if "setup_key" in c.__dict__)
+    setup_owner = next(c for c in mro if "setup" in c.__dict__)
+    return p.setup_key if issubclass(key_owner, setup_owner) else None
 
 
 def _plan(compiled: CompiledGraph) -> list[tuple]:

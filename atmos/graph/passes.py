@@ -25,7 +25,8 @@ class RenderPass:
     ``setup_key``: None (``setup`` runs every frame), or a method returning a tuple of what ``setup``
     reads (settings objects, which are replaced on a change, the frame size, whether an import exists,
     ...): while it equals (``==``) the key of the pass's last setup, the graph keeps those declarations
-    and skips ``setup``. A setup that reads anything its key leaves out must not have one.
+    and skips ``setup``. A setup that reads anything its key leaves out must not have one; a subclass
+    that overrides ``setup`` gives its own key, else its setup runs every frame.
     """
 
     name: str = ""
