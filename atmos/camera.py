@@ -156,7 +156,7 @@ class CameraMatrices:
         self.view_basis = view_basis(camera, aspect)
         for m in (self.view, self.projection, self.view_proj, self.view_basis):
             m.flags.writeable = False
-        self.camera_pos = tuple(float(c) for c in camera.position)
+        self.camera_pos = tuple(map(float, camera.position))
         self._gl: dict[str, bytes] = {}
 
     def gl(self, name: str) -> bytes:

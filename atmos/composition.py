@@ -100,6 +100,9 @@ class CompositionClear(RenderPass):
     def __init__(self, gpu, wanted, targets):
         self.gpu, self.wanted, self.targets = gpu, wanted, targets
 
+    def setup_key(self) -> tuple:
+        return (self.wanted(), self.gpu.size)
+
     def setup(self, builder) -> None:
         if self.wanted():
             for name, desc, _ in self.targets(tuple(self.gpu.size)):

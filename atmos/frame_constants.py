@@ -87,7 +87,7 @@ def frame_constants(gpu) -> FrameConstants:
 def view_frame(view) -> bytes | None:
     """:func:`pack_frame` of an :class:`atmos.SceneView`: its camera, sun, size, time and clock frame
     (None for a view without a camera, sun and size: nothing to write)."""
-    if not all(hasattr(view, name) for name in ("camera", "sun", "size")):
+    if not (hasattr(view, "camera") and hasattr(view, "sun") and hasattr(view, "size")):
         return None
     clock = getattr(view, "clock", None)
     return pack_frame(view.camera, view.sun, view.size, getattr(view, "time", 0.0),

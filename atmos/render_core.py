@@ -85,6 +85,9 @@ class ClearPass(RenderPass):
         self.gpu = gpu
         self.plugin = plugin
 
+    def setup_key(self) -> tuple:
+        return (self.gpu.size,)
+
     def setup(self, builder: PassBuilder) -> None:
         builder.create(COLOR, color_desc(self.gpu))
         builder.create(DEPTH, depth_desc(self.gpu))
@@ -158,10 +161,17 @@ class PresentPass(ComputePass):
     copy = "core/present_copy.frag"
     camera = bloom = False               # this frame's inputs (setup)
 
-    def setup(self, builder: PassBuilder) -> None:
+    def _inputs(self) -> tuple[bool, bool]:
+        """(a physical camera's exposure, its bloom) this frame (:class:`PresentInputs`)."""
         inputs = self.plugin.inputs
-        self.camera = bool(inputs.camera is not None and inputs.camera())
-        self.bloom = bool(self.camera and inputs.bloom is not None and inputs.bloom())
+        camera = bool(inputs.camera is not None and inputs.camera())
+        return camera, bool(camera and inputs.bloom is not None and inputs.bloom())
+
+    def setup_key(self) -> tuple:
+        return (*self._inputs(), self.plugin.gpu.size)
+
+    def setup(self, builder: PassBuilder) -> None:
+        self.camera, self.bloom = self._inputs()
         if self.camera:
             builder.read(CAMERA_EXPOSURE, access="storage")
         if self.bloom:
@@ -199,6 +209,9 @@ class OpaquePass(RenderPass):
     ``self.program`` in ``prepare`` and starts its ``execute`` with :meth:`begin`."""
     phase = "opaque"
     program = None
+
+    def setup_key(self) -> tuple:
+        return ()                           # the same declarations every frame
 
     def setup(self, builder: PassBuilder) -> None:
         builder.write(COLOR)

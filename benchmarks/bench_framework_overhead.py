@@ -5,8 +5,8 @@ render graph runs eight passes that declare transient textures but draw nothing.
 frame on the 2-core CI machine.
 
 Second: the render graph's per-frame setup on a full scene (the sunset demo: sky, terrain, clouds,
-cloud shadows, cloud sprites, light shafts, overlay): ``RenderGraph.compile()`` runs every pass's
-``setup`` each frame and compiles again only when a declaration changed; its steady cost is printed
+cloud shadows, cloud sprites, light shafts, overlay): ``RenderGraph.compile()`` runs each pass's
+``setup`` (but those whose ``setup_key`` is unchanged) and compiles again only when a declaration changed; its steady cost is printed
 beside one full compile (what recompiling every frame would cost).
 
 Run: .venv/bin/python -m pytest -s benchmarks/bench_framework_overhead.py

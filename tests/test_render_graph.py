@@ -194,6 +194,105 @@ def test_setup_runs_every_frame_and_recompiles_only_on_change(gpu, graph):
     assert graph.compiles == 2 and graph.compile() and graph.compiles == 3
 
 
+def test_setup_key_keeps_declarations_while_unchanged(gpu, graph):
+    """A pass with a setup_key declares again only when its key changes; a new pass of the same name
+    declares on its own."""
+    sizes, key = [], [(8, 8)]
+
+    class Keyed(P):
+        def setup_key(self):
+            return (key[0],)
+
+        def setup(self, builder):
+            self.setups += 1
+            builder.create("c", TextureDesc(key[0]))
+            builder.side_effect()
+
+    keyed = graph.add_pass(Keyed("keyed", run=lambda p, f: sizes.append(f.resource("c").size)))
+    for _ in range(3):
+        graph.execute()
+    assert keyed.setups == 1 and graph.compiles == 1 and sizes == [(8, 8)] * 3
+    key[0] = (4, 4)                          # what setup reads changed: declared and compiled anew next frame
+    graph.execute()
+    assert keyed.setups == 2 and graph.compiles == 2 and sizes[-1] == (4, 4)
+    graph.execute()
+    assert keyed.setups == 2
+    graph.remove_pass("keyed")
+    again = graph.add_pass(Keyed("keyed", run=lambda p, f: sizes.append(f.resource("c").size)))
+    graph.execute()
+    assert again.setups == 1 and sizes[-1] == (4, 4)
+
+
+def test_passes_with_setup_keys_follow_live_changes():
+    """The App's keyed passes (clear, present, sprites, fog, shadows, camera): a setting changed live and
+    a resize take effect in the next frame's declarations."""
+    from atmos.demo_registry import DemoSettings
+    from atmos.gpu import create_headless
+    from atmos.plugins.physical_camera import PhysicalCameraPlugin
+    from atmos.runner import build_app
+    gpu = create_headless((64, 36))
+    app = build_app("sunset", DemoSettings(size=(64, 36), headless=True), gpu)
+    try:
+        app.run_frames(2, 1 / 30)
+        graph = app.graph
+        keyed = [p.name for p in graph.passes if p.setup_key is not None]
+        assert {"clear", "present", "cloud_render", "fog", "cloud_shadows", "cloud_shadow_map"} <= set(keyed)
+
+        def declared(name):
+            return graph.compile().declarations[name]
+
+        assert "bloom" in declared("present").reads
+        camera = next(p for p in app.plugins if isinstance(p, PhysicalCameraPlugin))
+        camera.configure(bloom=0.0)              # live: the present no longer reads the bloom
+        app.run_frames(1, 1 / 30)
+        assert "bloom" not in declared("present").reads and "bloom" not in graph.compile().kept
+        camera.configure(enabled=False)
+        app.run_frames(1, 1 / 30)
+        assert "camera_exposure" not in declared("present").reads
+        sprites = next(p for p in graph.passes if p.name == "cloud_render")
+        sprites.plugin.configure(enabled=False)  # switched off: declares nothing, culled
+        app.run_frames(1, 1 / 30)
+        assert not declared("cloud_render").names and "cloud_render" not in graph.compile().kept
+        sprites.plugin.configure(enabled=True, downsample=2)      # on again, through a low-res layer
+        app.run_frames(1, 1 / 30)
+        assert "cloud_color" in declared("cloud_render").creates
+        gpu.resize((32, 18))                     # the frame size: the clear makes its targets at it
+        app.run_frames(1, 1 / 30)
+        assert declared("clear").creates["color"].size == (32, 18)
+        assert declared("present").creates["present_image"].size == (32, 18)
+        app.run_frames(1, 1 / 30)
+    finally:
+        app.close()
+        gpu.release()
+
+
+def test_a_subclass_overriding_setup_does_not_inherit_the_key(graph):
+    class Keyed(P):
+        def setup_key(self):
+            return ()
+
+    class Overrides(Keyed):
+        def setup(self, builder):
+            self.setups += 1
+            builder.side_effect()
+
+    keyed, overrides = graph.add_pass(Keyed("keyed", side=True)), graph.add_pass(Overrides("overrides"))
+    for _ in range(3):
+        graph.compile()
+    assert keyed.setups == 1 and overrides.setups == 3
+
+
+def test_setup_key_follows_an_import_that_appears_or_goes(graph):
+    from atmos.plugins.clouds.light.ground import GroundSunPass
+    from atmos.plugins.clouds.volume.sets import CLOUD_SETS
+    ground = graph.add_pass(GroundSunPass(graph))
+    assert not graph.compile().declarations[ground.name].names
+    graph.import_resource(CLOUD_SETS, object())
+    assert CLOUD_SETS in graph.compile().declarations[ground.name].reads
+    graph.remove_import(CLOUD_SETS)
+    assert not graph.compile().declarations[ground.name].names
+
+
 def test_cycle_names_the_passes(graph):
     graph.add_pass(P("a", creates={"x": SMALL}, side=True, after=["c"]))
     graph.add_pass(P("b", reads=["x"], creates={"y": SMALL}))

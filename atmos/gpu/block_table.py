@@ -23,8 +23,8 @@ class BlockTable:
         self.buffer = ctx.buffer((b"".join(r.ljust(self.stride, b"\0") for r in records)))
 
     def use(self, index: int) -> None:
-        """Bind record ``index`` at the block's binding."""
-        self.buffer.bind_to_uniform_block(self.binding, offset=index * self.stride, size=self.size)
+        """Bind record ``index`` at the block's binding (moderngl's Buffer.bind_to_uniform_block, unwrapped)."""
+        self.buffer.mglo.bind_to_uniform_block(self.binding, index * self.stride, self.size)
 
     def release(self) -> None:
         if self.buffer is not None:

@@ -170,8 +170,9 @@ class Hazards:
                 dirty[id(obj)] = [weakref.ref(obj), kind, _ALL[kind]]
 
     def issue(self, bits: int) -> None:
-        """One glMemoryBarrier with ``bits``; every pending write is then visible to those uses."""
-        self._ctx().memory_barrier(bits)
+        """One glMemoryBarrier with ``bits``; every pending write is then visible to those uses. The one
+        place atmos issues a barrier: moderngl's ``Context.memory_barrier`` made on its C object directly."""
+        self._ctx().mglo.memory_barrier(bits, False)
         self._need = 0
         self.barriers += 1
         self._issued[bits] += 1
@@ -264,8 +265,13 @@ def dispatch_indirect(program, args, offset: int = 0) -> None:
     if hazards._need:                                    # with what the binds asked for: one barrier
         hazards.issue(hazards._need)
     program.run_indirect(args, offset)
-    if hazards._staged:
-        hazards.commit()
+    staged = hazards._staged
+    if staged:                                   # Hazards.commit, inlined
+        dirty = hazards._dirty
+        for key in staged:
+            obj, kind = staged[key]
+            dirty[key] = [weakref.ref(obj), kind, _ALL[kind]]
+        hazards._staged = {}
 
 
 _GUARDED = False

@@ -2,7 +2,10 @@
 program, skipping what its compiler dropped. A unit is written once, in the GLSL that declares the
 sampler, image or buffer (``layout(binding = N)``); Python binds by name and never names a unit.
 A bind is also the declaration of a use (:mod:`atmos.gpu.hazards`): it gets the memory barrier the
-use needs after earlier storage writes, and stages its own storage writes for the next dispatch."""
+use needs after earlier storage writes, and stages its own storage writes for the next dispatch.
+A moderngl texture's or buffer's bind method is one call of its C object (``mglo``); the binders make
+that call directly (state changes only: GL work, transfers and uniform writes still go through
+moderngl, where :class:`atmos.gpu.gl_meter.GLMeter` and the hazard guard see them)."""
 from __future__ import annotations
 
 from collections.abc import Mapping
@@ -146,9 +149,15 @@ def bind_textures(program, textures: Mapping[str, object] | None = None, /, samp
         for unit, one in pairs:
             if dirty and (key := id(one)) in dirty and (entry := dirty[key])[0]() is one:   # Hazards.need, inlined
                 hazards._need |= entry[2] & moderngl.TEXTURE_FETCH_BARRIER_BIT
-            one.use(unit)
+            if type(one) in _TEXTURES:
+                one.mglo.use(unit)            # Texture.use, without its Python wrapper
+            else:
+                one.use(unit)
             if sampler is not None:
-                sampler.use(unit)
+                if type(sampler) is moderngl.Sampler and sampler.texture is None:
+                    sampler.mglo.use(unit)        # Sampler.use, unwrapped (no texture of its own to bind)
+                else:
+                    sampler.use(unit)
             units += (unit,)
     return units
 
@@ -174,7 +183,10 @@ def bind_images(program, images: Mapping[str, object] | None = None, /, **more) 
                     hazards._staged[key] = (texture, "texture")
                 else:
                     hazards.stage(texture)
-            texture.bind_to_image(unit, read, write)
+            if type(texture) in _TEXTURES:
+                texture.mglo.bind(unit, read, write, 0, 0)     # Texture.bind_to_image, unwrapped
+            else:
+                texture.bind_to_image(unit, read, write)
 
 
 def bind_buffers(program, buffers: Mapping[str, object] | None = None, /, **more) -> None:
@@ -209,7 +221,10 @@ def bind_buffers(program, buffers: Mapping[str, object] | None = None, /, **more
                     hazards._staged[key] = (buffer, "buffer")
                 else:
                     hazards.stage(buffer)
-            buffer.bind_to_storage_buffer(binding)
+            if type(buffer) is moderngl.Buffer:
+                buffer.mglo.bind_to_storage_buffer(binding, 0, -1)   # Buffer.bind_to_storage_buffer, unwrapped
+            else:
+                buffer.bind_to_storage_buffer(binding)
 
 
 def bind_blocks(program, blocks: Mapping[str, object] | None = None, /, **more) -> None:
@@ -250,7 +265,10 @@ def use_buffers(program, uses: tuple, bind: bool = True) -> None:
         if written:
             staged[key] = (buffer, "buffer")
         if bind:
-            buffer.bind_to_storage_buffer(binding)
+            if type(buffer) is moderngl.Buffer:
+                buffer.mglo.bind_to_storage_buffer(binding, 0, -1)
+            else:
+                buffer.bind_to_storage_buffer(binding)
 
 
 def write_block(program, name: str, binding: int, data: bytes) -> bool:

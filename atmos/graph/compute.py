@@ -8,11 +8,14 @@ from atmos.graph.passes import PassBuilder, PluginPass
 
 def work_groups(size, local) -> tuple[int, ...]:
     """Work groups that cover ``size`` (w[, h[, d]]) with groups of ``local`` (the shader's local_size)."""
-    if len(size) != len(local):
-        raise ValueError(f"work_groups: size {tuple(size)} and local size {tuple(local)} differ in rank")
     groups = []
-    for n, k in zip(size, local):
-        groups += (-(-int(n) // int(k)),)
+    try:
+        for n, k in zip(size, local, strict=True):
+            groups += (-(-int(n) // int(k)),)
+    except ValueError:
+        if len(groups) == min(len(size), len(local)):     # zip's: the ranks differ
+            raise ValueError(f"work_groups: size {tuple(size)} and local size {tuple(local)} differ in rank") from None
+        raise
     return tuple(groups)
 
 

@@ -13,8 +13,11 @@ from atmos.graph.errors import GraphError
 
 _PLAIN = frozenset((moderngl.Texture, moderngl.Texture3D, moderngl.TextureArray, moderngl.TextureCube,
                     moderngl.Buffer))
+_FRAMEBUFFER_TYPES: dict[type, bool] = {}   # type of an imported resource -> whether it is a Framebuffer
 FRAMEBUFFER_CACHE = 64  # framebuffers kept per graph, least recently used dropped first
 STATE_FLAGS = moderngl.BLEND | moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.PROGRAM_POINT_SIZE
+_DEFAULT_BLEND_FUNC = tuple(moderngl.DEFAULT_BLENDING)   # reset_state's values, as moderngl's setters pass them
+_DEFAULT_BLEND_EQUATION = (moderngl.FUNC_ADD,)
 
 # The blend modes passes use (colour factors, then alpha factors); see the PassContext methods.
 BLEND_OVER = (moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA, moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA)
@@ -64,9 +67,14 @@ class PassContext:
             value = self._resources[name]
         except KeyError:
             raise GraphError(f"pass '{self.pass_name}': resource '{name}' is not available this frame") from None
-        if type(value) in _PLAIN:           # a texture or buffer: no framebuffer to reset
+        kind = type(value)
+        if kind in _PLAIN:                  # a texture or buffer: no framebuffer to reset
             return value
-        if isinstance(value, moderngl.Framebuffer):
+        try:
+            framebuffer = _FRAMEBUFFER_TYPES[kind]
+        except KeyError:
+            framebuffer = _FRAMEBUFFER_TYPES[kind] = issubclass(kind, moderngl.Framebuffer)
+        if framebuffer:
             self._reset_framebuffer(value)
         return value
 
@@ -136,7 +144,8 @@ class PassContext:
     def image(self, name: str):
         """The texture ``name`` for image load/store: the pass must have declared it with ``storage`` access."""
         value = self.resource(name)
-        if "storage" not in self._access.get(name, ()):
+        access = self._access
+        if name not in access or "storage" not in access[name]:
             raise GraphError(f"pass '{self.pass_name}' uses '{name}' as an image but declared it without "
                              "access='storage' (builder.read/write(name, access='storage'))")
         return value
@@ -197,25 +206,29 @@ class PassContext:
         blend(self.gpu.ctx, BLEND_ALPHA)
 
     def reset_state(self) -> None:
-        """The GL state every pass starts from (and a frame ends with)."""
-        ctx = self.gpu.ctx
-        ctx.disable(STATE_FLAGS)
-        ctx.blend_func = moderngl.DEFAULT_BLENDING
-        ctx.blend_equation = moderngl.FUNC_ADD
-        ctx.depth_func = "<"
+        """The GL state every pass starts from (and a frame ends with): set on the context's C object
+        (``mglo``) as moderngl's own setters do, without their Python wrappers (once per pass)."""
+        gl = self.gpu.ctx.mglo
+        gl.disable(STATE_FLAGS)
+        gl.blend_func = _DEFAULT_BLEND_FUNC
+        gl.blend_equation = _DEFAULT_BLEND_EQUATION
+        gl.depth_func = "<"
         self._fresh = set()
 
     def _reset_framebuffer(self, fbo):
-        """Depth and colour writes on, the full viewport, no scissor: the first time a pass takes ``fbo``."""
+        """Depth and colour writes on, the full viewport, no scissor: the first time a pass takes ``fbo``
+        (set on its C object, ``mglo``, as moderngl's setters do)."""
         key = id(fbo)
         if key not in self._fresh:
             self._fresh.add(key)
-            fbo.depth_mask = True
+            gl = fbo.mglo
+            gl.depth_mask = True
             n = len(fbo.color_attachments or ())   # a window's default framebuffer has none listed
             if n:                            # moderngl takes one mask, or one per attachment
-                fbo.color_mask = (True, True, True, True) if n == 1 else ((True, True, True, True),) * n
-            fbo.viewport = (0, 0, *fbo.size)
-            fbo.scissor = None
+                gl.color_mask = (True, True, True, True) if n == 1 else ((True, True, True, True),) * n
+            w, h = fbo.size
+            gl.viewport = (0, 0, int(w), int(h))
+            gl.scissor = None
         return fbo
 
     def _drop(self, key) -> None:

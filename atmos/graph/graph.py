@@ -19,7 +19,8 @@ from atmos.graph.timing import PassTimers
 class RenderGraph:
     """A Frostbite-style frame graph.
 
-    Passes declare resources and a phase in ``setup``, which runs every frame; :meth:`compile`
+    Passes declare resources and a phase in ``setup``, which runs every frame unless the pass's
+    ``setup_key`` says nothing it reads changed (:class:`RenderPass`); :meth:`compile`
     recompiles only when the declarations (or the set of passes and imports) changed: it orders the
     passes by phase and data, versions every write, culls those whose outputs nothing needs
     (writing an imported resource is a side effect) and plans when each transient texture is taken
@@ -42,6 +43,8 @@ class RenderGraph:
         self._compiled: CompiledGraph | None = None
         self._key: tuple | None = None
         self._declared = None                # the last declarations (passes, their phases, builders, imports)
+        self._setups: dict[str, tuple] = {}  # pass name -> (pass, its setup_key, its builder): setups kept
+        self._keys: dict[str, Callable | None] = {}   # pass name -> its setup_key where that covers its setup
         self._prepared: dict[str, RenderPass] = {}
         self._timers = PassTimers(gpu.ctx)
         self._frame = PassContext(gpu)
@@ -59,6 +62,7 @@ class RenderGraph:
             raise GraphError(f"the graph already has a pass named '{p.name}' "
                              f"({type(self._passes[p.name]).__name__}); pass names must be unique")
         self._passes[p.name] = p
+        self._keys[p.name] = setup_key_of(p)
         return p
 
     def shared_pass(self, kind: type, make: Callable[[], RenderPass]) -> tuple[RenderPass, bool]:
@@ -77,6 +81,8 @@ class RenderGraph:
         if self._prepared.get(name) is p:
             del self._prepared[name]
             p.release()
+        self._setups.pop(name, None)
+        del self._keys[name]
         self._timers.forget(name)
 
     def import_resource(self, name: str, source: Any | Callable[[], Any]) -> None:
@@ -113,16 +119,28 @@ class RenderGraph:
 
     # -- compiling and running ---------------------------------------------------------------
     def declare(self) -> dict[str, PassBuilder]:
-        """Run every pass's ``setup``: this frame's declarations."""
-        builders = {}
+        """This frame's declarations: every pass's ``setup`` runs, but for a pass whose ``setup_key()``
+        equals the one of its last setup, whose builder is kept (:class:`RenderPass`)."""
+        builders, kept, keys = {}, self._setups, self._keys
         for p in self._passes.values():
-            builder = builders[p.name] = PassBuilder(p.name)
+            name = p.name
+            key_of = keys[name]
+            if key_of is not None:
+                key = key_of()
+                if name in kept:
+                    held = kept[name]
+                    if held[0] is p and held[1] == key:
+                        builders[name] = held[2]
+                        continue
+            builder = builders[name] = PassBuilder(name)
             p.setup(builder)
+            if key_of is not None:
+                kept[name] = (p, key, builder)
         return builders
 
     def compile(self) -> CompiledGraph:
-        """This frame's compiled graph: every pass's ``setup`` runs; the graph is compiled again only
-        when a declaration, a phase, a pass or an import changed."""
+        """This frame's compiled graph: the passes declare (:meth:`declare`); the graph is compiled
+        again only when a declaration, a phase, a pass or an import changed."""
         builders = self.declare()
         passes = list(self._passes.values())
         if not self._same_declarations(passes, builders):
@@ -149,6 +167,8 @@ class RenderGraph:
             if (p.name, p.phase, p.before, p.after) != meta:
                 return False
             b, o = builders[p.name], old[p.name]
+            if b is o:                           # a kept setup's builder
+                continue
             if (b.has_side_effect != o.has_side_effect or b.writes != o.writes      # values, then key order
                     or b.reads != o.reads or b.access != o.access or b.creates != o.creates
                     or list(b.reads) != list(o.reads) or list(b.access) != list(o.access)
@@ -204,7 +224,7 @@ class RenderGraph:
                 else:
                     p.execute(frame)
                 if stored:
-                    hazards.wrote_storage([resources[n] for n in stored])
+                    hazards.wrote_storage(map(resources.__getitem__, stored))
                 for r in release:
                     texture = transient[r]
                     del resources[r], transient[r]
@@ -277,6 +297,15 @@ class RenderGraph:
         self._frame.release()
         self.pool.release_all()
         self._timers.release()
+
+
+def setup_key_of(p: RenderPass) -> Callable | None:
+    """``p.setup_key`` where it covers ``p.setup``: None when there is none, or when a subclass overrides
+    ``setup`` below the class that gave the key (whose key would leave out what that setup reads)."""
+    mro = type(p).__mro__
+    key_owner = next(c for c in mro if "setup_key" in c.__dict__)
+    setup_owner = next(c for c in mro if "setup" in c.__dict__)
+    return p.setup_key if issubclass(key_owner, setup_owner) else None
 
 
 def _plan(compiled: CompiledGraph) -> list[tuple]:

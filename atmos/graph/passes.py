@@ -21,6 +21,12 @@ class RenderPass:
     ``exclusive``: a group name for passes that are alternatives to each other (the two cloud
     renderers: "cloud volume"): at most one pass of a group may declare anything in a frame, else
     the compile raises a GraphError naming them (a pass that is switched off declares nothing).
+
+    ``setup_key``: None (``setup`` runs every frame), or a method returning a tuple of what ``setup``
+    reads (settings objects, which are replaced on a change, the frame size, whether an import exists,
+    ...): while it equals (``==``) the key of the pass's last setup, the graph keeps those declarations
+    and skips ``setup``. A setup that reads anything its key leaves out must not have one; a subclass
+    that overrides ``setup`` gives its own key, else its setup runs every frame.
     """
 
     name: str = ""
@@ -28,6 +34,7 @@ class RenderPass:
     before: tuple[str, ...] = ()
     after: tuple[str, ...] = ()
     exclusive: str = ""
+    setup_key = None
 
     def setup(self, builder: PassBuilder) -> None:
         """Declare the resources this pass creates, reads and writes (every frame)."""

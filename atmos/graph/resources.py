@@ -159,8 +159,10 @@ class TexturePool:
 
     def acquire(self, desc: TextureDesc | BufferDesc):
         """A texture (or buffer) matching ``desc``, free until :meth:`release` gives it back."""
-        free = self._free.get(desc)
-        texture = free.pop() if free else self._create(desc)
+        try:                                 # one lookup: a desc's hash is a Python call
+            texture = self._free[desc].pop()
+        except (KeyError, IndexError):
+            texture = self._create(desc)
         if type(desc) is BufferDesc and desc.clear:
             texture.clear()
         key = id(texture)
@@ -178,11 +180,10 @@ class TexturePool:
         del self._in_use[key]
         self._used[key] = self.frame
         desc = self._desc[key][0]
-        free = self._free.get(desc)
-        if free is None:
+        try:
+            self._free[desc].append(texture)
+        except KeyError:
             self._free[desc] = [texture]
-        else:
-            free.append(texture)
 
     def end_frame(self) -> int:
         """End a frame: release every free texture not acquired (or released) during the last

@@ -86,5 +86,5 @@ def solar_direction(hours: float, latitude: float = 45.0, day_of_year: float = 1
                     longitude: float | None = None, utc_offset: float | None = None) -> np.ndarray:
     """Unit vector toward the sun (x east, y up, −z north) from :func:`solar_position`; below the
     horizon it points below it (y < 0): night."""
-    e, a = (math.radians(x) for x in solar_position(hours, latitude, day_of_year, year, longitude, utc_offset))
+    e, a = map(math.radians, solar_position(hours, latitude, day_of_year, year, longitude, utc_offset))
     return np.array([math.sin(a) * math.cos(e), math.sin(e), -math.cos(a) * math.cos(e)])

@@ -89,6 +89,9 @@ class FogPass(RenderPass):
         self.gpu = None
         self.volumes: NoiseVolumes | None = None
 
+    def setup_key(self) -> tuple:
+        return (self.plugin.composition.distance, self.plugin.composition.media)
+
     def setup(self, builder: PassBuilder) -> None:
         builder.read(DEPTH)
         builder.read(COLOR, access="storage")          # composites onto it in place

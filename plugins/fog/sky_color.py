@@ -54,7 +54,7 @@ def sun_angle_table(table, sun_dir=ZENITH) -> np.ndarray:
 
 def sky_sun(sun) -> tuple:
     """The direction the sky's colour is read round: ``sun``'s (an :class:`atmos.Sun`), the zenith without one."""
-    return ZENITH if sun is None else tuple(float(v) for v in sun.direction)
+    return ZENITH if sun is None else tuple(map(float, sun.direction))
 
 
 def shader_table(table, sun) -> np.ndarray:

@@ -126,7 +126,7 @@ class MarchedShafts:
                 layer = frame.resource(FAR_FIELD)
                 layer.prepare(view, sim)
                 layer.use(p, view, sim)
-        write_uniforms(p, has_clouds=int(clouds), irradiance=tuple(float(v) for v in irradiance),
+        write_uniforms(p, has_clouds=int(clouds), irradiance=tuple(map(float, irradiance)),
                        lobes=settings.phase.lobes, scattering=settings.scattering, max_distance=settings.max_distance)
         if fog is not None:
             self.fog_uniforms(frame, p, fog, settings)

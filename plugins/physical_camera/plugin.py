@@ -47,6 +47,9 @@ class ExposurePass(ComputePass):
     phase = "present"
     local_size = (16, 16)
 
+    def setup_key(self) -> tuple:
+        return (self.plugin.settings,)
+
     def setup(self, builder: PassBuilder) -> None:
         s = self.plugin.settings
         if not s.enabled:
@@ -86,6 +89,9 @@ class BloomPass(ComputePass):
     name = "bloom"
     phase = "present"
     _plan = None                        # (size, levels) -> [(name, desc, groups)] per level, made once per change
+
+    def setup_key(self) -> tuple:
+        return (self.plugin.settings, self.plugin.gpu.size)
 
     def setup(self, builder: PassBuilder) -> None:
         s = self.plugin.settings

@@ -62,6 +62,9 @@ class SkyPass(ComputePass):
             return {**sky_defines(), **atmosphere_defines(), "SKY_PHYSICAL": 1}
         return sky_defines()
 
+    def setup_key(self) -> tuple:
+        return (self.plugin.settings, self.reads, self.writes)
+
     def setup(self, builder) -> None:
         super().setup(builder)
         if self.physical:

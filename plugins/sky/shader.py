@@ -43,7 +43,7 @@ def set_sky_uniforms(program, settings: SkySettings, sun_dir, sun_color, time: f
                      pixel_angle: float = 0.0) -> None:
     """Write every uniform of ``sky/sky.glsl`` (``sun_dir`` is normalised here)."""
     s = unit_vectors(sun_dir, "sun_dir").reshape(3)
-    values = {"sky_sun_dir": tuple(s), "sky_sun_color": tuple(float(c) for c in sun_color),
+    values = {"sky_sun_dir": tuple(s), "sky_sun_color": tuple(map(float, sun_color)),
               "turbidity": settings.turbidity, "sky_scale": settings.scale,
               "sun_chord": disc_chord(settings.sun_size_deg), "sun_gain": settings.sun_gain,
               "sun_glare": settings.sun_glare,

@@ -70,7 +70,7 @@ def sun_color(sun_dir, altitude, settings: AtmosphereSettings) -> np.ndarray:
     (n, 3) in one vectorised pass (``Sun.color_by_altitude``: a cloud layer's heights). Remembered for
     the last few directions and altitudes: the camera's and the cloud layers' are asked every frame."""
     heights = np.asarray(altitude, np.float64)
-    direction = tuple(float(v) for v in np.asarray(sun_dir, np.float64).reshape(3))
+    direction = tuple(map(float, np.asarray(sun_dir, np.float64).reshape(3)))
     return _sun_color(direction, tuple(heights.reshape(-1).tolist()), settings).reshape(heights.shape + (3,)).copy()
 
 
@@ -94,9 +94,9 @@ def horizon_radiance(directions, sun_dir, altitude: float, settings: AtmosphereS
     azimuth from the sun; plus the night term as the pass draws it."""
     d = np.asarray(directions, np.float64)
     s = ref.unit(sun_dir)
-    elevation = float(np.arcsin(np.clip(d[0, 1], -1.0, 1.0)))
+    elevation = float(np.arcsin(d[0, 1].clip(-1.0, 1.0)))
     _, cos_az, _, _ = ref.view_angles(d, s)
-    x = np.arccos(np.clip(cos_az, -1.0, 1.0)) / math.pi * (HORIZON_AZIMUTHS - 1)
+    x = np.arccos(cos_az.clip(-1.0, 1.0)) / math.pi * (HORIZON_AZIMUTHS - 1)
     i0 = np.minimum(np.floor(x).astype(int), HORIZON_AZIMUTHS - 2)
     f = (x - i0)[:, None]
     total = 0.0

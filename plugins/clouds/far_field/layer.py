@@ -15,6 +15,8 @@ far field takes its density from; a second dispatch its light by rank (:attr:`Fa
 """
 from __future__ import annotations
 
+from operator import is_
+
 import moderngl
 import numpy as np
 
@@ -109,7 +111,7 @@ class FarFieldLayer:
             return
         self._prepared = view
         params = self.settings
-        sun_dir = tuple(float(v) for v in unit_direction(view.sun))     # light_uniforms' sun_dir
+        sun_dir = tuple(map(float, unit_direction(view.sun)))     # light_uniforms' sun_dir
         if self.octaves.needs_bake(params, sun_dir, REBAKE_TOLERANCE):
             self.octaves.bake(params, sun_dir, octave_frequencies(params.base_frequency), rotations(), CHANNEL_STEPS)
         self.measure_cover(sim)
@@ -227,7 +229,7 @@ class FarFieldLayer:
         self.light.use(program)
         key = (view, sim, self.tile_size, params)
         cached = self._uniforms
-        if cached is None or len(cached[0]) != len(key) or any(a is not b for a, b in zip(cached[0], key)):
+        if cached is None or len(cached[0]) != len(key) or not all(map(is_, cached[0], key)):
             cached = self._uniforms = (key, self._field_uniforms(view, sim))   # once per frame, whatever the users
         bind_textures(program, far_rank_table=self.ranks)
         write_uniforms(program, cached[1])

@@ -36,6 +36,9 @@ class GroundSunPass(ComputePass):
         super().__init__()
         self.graph = graph
 
+    def setup_key(self) -> tuple:
+        return (self.graph.imports(CLOUD_SETS),)
+
     def setup(self, builder) -> None:
         if not self.graph.imports(CLOUD_SETS):
             return

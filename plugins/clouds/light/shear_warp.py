@@ -161,7 +161,7 @@ class ShearWarpShader:
         prog = program(self.gpu, "shear_warp", **defines)
         a, (b, c) = plan.axis, plan.lateral
         write_uniforms(prog, size=self.shading_shape, axis_a=_UNIT[a], axis_b=_UNIT[b], axis_c=_UNIT[c],
-                       step_dir=tuple(float(x) for x in plan.step), step_len=float(plan.length), sigma=self._sigma)
+                       step_dir=tuple(map(float, plan.step)), step_len=float(plan.length), sigma=self._sigma)
         bind_textures(prog, density=self._density)
         bind_images(prog, result=self._target)
         gb, gc = groups(self.shading_shape[b], 8), groups(self.shading_shape[c], 8)

@@ -20,7 +20,7 @@ def direct_weight(sun_direction, sun_color, settings) -> float:
     """How much of the light shadows can take away: ``direct_fraction`` × smoothstep(0,
     ``horizon_fade``, sun height), and 0 when the sun has no colour (night) or no direction."""
     s = unit_sun(sun_direction)
-    if s is None or not max(float(c) for c in sun_color) > 0.0:
+    if s is None or not max(map(float, sun_color)) > 0.0:
         return 0.0
     x = float(np.clip(s[1] / settings.horizon_fade, 0.0, 1.0))
     return settings.direct_fraction * x * x * (3.0 - 2.0 * x)
@@ -57,6 +57,9 @@ class CloudShadowsPass(ComputePass):
         if self.uses_map():
             return {}
         return {"CLOUD_SHADOW_EXACT": 1, **({"CLOUD_FAR_FIELD": 1} if self.far_field() else {})}
+
+    def setup_key(self) -> tuple:
+        return (self.plugin.settings, self.exact, self.plugin.graph.imports(FAR_FIELD), self.reads, self.writes)
 
     def setup(self, builder) -> None:
         super().setup(builder)

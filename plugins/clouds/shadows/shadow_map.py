@@ -82,7 +82,7 @@ def shadow_space(layout, camera_position, sun_dir, camera_far: float, size: int 
     sun toward ``sun_dir`` (unit): near on the volume's columns, far around the camera's projection."""
     space = space or ShadowMapSpace()
     lo, cell = np.asarray(layout.lo, np.float64), np.asarray(layout.cell, np.float64)
-    shape = tuple(int(s) for s in layout.shape)
+    shape = tuple(map(int, layout.shape))
     space.size, space.lo, space.cell, space.shape = int(size), lo, cell, shape
     mid = lo[1] + 0.5 * shape[1] * cell[1]
     cam, s = np.asarray(camera_position, np.float64), np.asarray(sun_dir, np.float64)
@@ -116,6 +116,9 @@ class CloudShadowMapPass(ComputePass):
 
     def defines(self) -> dict:
         return {"CLOUD_FAR_FIELD": 1} if self.far_field() else {}
+
+    def setup_key(self) -> tuple:
+        return (self.graph.imports(CLOUD_SETS), self.far_field(), self.size)
 
     def setup(self, builder) -> None:
         if not self.graph.imports(CLOUD_SETS):

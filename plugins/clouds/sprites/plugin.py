@@ -144,16 +144,16 @@ def sprite_uniforms(plugin, sim, layout: CloudLayout, camera: Camera, aspect: fl
     settings = plugin.settings
     limit = point_limit if settings.max_point_size is None else min(point_limit, settings.max_point_size)
     basis = camera.basis()
-    return {"volume_shape": tuple(int(n) for n in layout.shape), "group_size": tuple(layout.group),
-            "layer_min": tuple(float(v) for v in layout.lo), "cell_size": tuple(float(c) for c in cell),
-            "camera_cell": tuple(float(v) for v in (np.asarray(camera.position, np.float64) - layout.lo) / cell),
+    return {"volume_shape": tuple(map(int, layout.shape)), "group_size": tuple(layout.group),
+            "layer_min": tuple(map(float, layout.lo)), "cell_size": tuple(map(float, cell)),
+            "camera_cell": tuple(map(float, (np.asarray(camera.position, np.float64) - layout.lo) / cell)),
             "base_diameter": float(settings.size_factor * max(cell[0], cell[2])),
             "pixel_scale": float(height) / 2.0 * float(camera_matrices(camera, aspect).projection[1, 1]),
             "max_point_size": float(limit), "tau_scale": float(tau_scale), "near": float(camera.near),
             "far": float(camera.far),
-            "camera_pos": tuple(float(v) for v in camera.position),
-            "camera_right": tuple(float(v) for v in basis[:, 0]),
-            "camera_up": tuple(float(v) for v in basis[:, 1])}
+            "camera_pos": tuple(map(float, camera.position)),
+            "camera_right": tuple(map(float, basis[:, 0])),
+            "camera_up": tuple(map(float, basis[:, 1]))}
 
 
 class CloudSpritePass(RenderPass):
@@ -168,6 +168,9 @@ class CloudSpritePass(RenderPass):
         self.program = self.sampler = self.offscreen = None
         self.instances = self.commands = self.vao = None
         self._group = self._uploaded = self._drawn = None   # _drawn: (segments, group, commands) written
+
+    def setup_key(self) -> tuple:
+        return (self.plugin.settings, self.plugin.composition.distance, self.plugin.gpu.size)
 
     def setup(self, builder: PassBuilder) -> None:
         if not self.plugin.settings.enabled:

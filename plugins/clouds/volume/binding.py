@@ -1,6 +1,8 @@
 """Binding the simulation's A/B textures and the light model to a program (``clouds/volume/volume.glsl``)."""
 from __future__ import annotations
 
+import moderngl
+
 from atmos.lighting import Sun
 from atmos.plugins.clouds.volume.light import DEFAULT_OCTAVES, light_uniforms, write_light
 from atmos.plugins.clouds.volume.sets import CloudSets
@@ -40,8 +42,14 @@ def bind_volume(program, sim, sampler, sun: Sun | None, octaves=DEFAULT_OCTAVES,
 
 
 def unbind_volume(program, sampler) -> None:
-    """Unbind the sampler from the volume's units so later passes sample with their textures' own settings."""
-    for name in SAMPLERS:
-        unit = sampler_units(program, name)
-        if unit is not None:
-            sampler.clear(unit)
+    """Unbind the sampler from the volume's units so later passes sample with their textures' own settings
+    (the units looked up once per program; moderngl's Sampler.clear made on its C object)."""
+    extra = program.extra
+    units = extra.get("volume_units") if type(extra) is dict else None
+    if units is None:
+        units = [unit for unit in (sampler_units(program, name) for name in SAMPLERS) if unit is not None]
+        if type(extra) is dict:
+            extra["volume_units"] = units
+    clear = sampler.mglo.clear if type(sampler) is moderngl.Sampler else sampler.clear
+    for unit in units:
+        clear(unit)

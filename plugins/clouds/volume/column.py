@@ -12,5 +12,5 @@ def column_uniforms(program, sim: CloudSets, layout: CloudLayout, extinction: fl
     """Bind mix(A, B, t)'s column sums and set the uniforms of ``clouds/volume/column.glsl``."""
     bind_textures(program, sums_a=sim.maps_of(sim.a).sums, sums_b=sim.maps_of(sim.b).sums)
     write_uniforms(program, extinction=extinction, t=sim.t, a_shift=(sim.a_shift[0], sim.a_shift[2]),
-                   layer_min=tuple(float(v) for v in layout.lo), cell_size=layout.cell, shape=layout.shape,
+                   layer_min=tuple(map(float, layout.lo)), cell_size=layout.cell, shape=layout.shape,
                    edge_fade=float(sim.settings.edge_fade))

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import struct
+from operator import is_
 from dataclasses import dataclass
 
 import numpy as np
@@ -64,7 +65,7 @@ def sun_light(sun: Sun | None, altitude: float | None = None) -> tuple[tuple, tu
     x = min(max((y + 0.01) / 0.02, 0.0), 1.0)
     fade = x * x * (3.0 - 2.0 * x)
     color = tuple(float(c) * fade for c in sun.color)
-    ambient = tuple(float(c) for c in getattr(sun, "ambient", DEFAULT_AMBIENT))
+    ambient = tuple(map(float, getattr(sun, "ambient", DEFAULT_AMBIENT)))
     return color, ambient
 
 
@@ -75,7 +76,7 @@ def sun_colors(sun: Sun | None, layer=None) -> np.ndarray:
     sun = sun or Sun()
     if layer is None or sun.color_by_altitude is None:
         return np.tile(np.asarray(sun_light(sun)[0], np.float64), (SUN_HEIGHTS, 1))
-    base, top = (float(v) for v in layer)
+    base, top = map(float, layer)
     return sun.color_at(base + np.arange(SUN_HEIGHTS) / (SUN_HEIGHTS - 1) * (top - base))
 
 
@@ -121,7 +122,7 @@ def light_uniforms(cloud_settings, sun: Sun | None, octaves=DEFAULT_OCTAVES, dif
     key = (cloud_settings, sun, sun.direction, sun.color, sun.ambient, sun.color_by_altitude)
     rest = (tuple(octaves), diffusion, None if layer is None else tuple(layer), None if ground is None else tuple(ground))
     for held, held_rest, values in _LIGHT_MEMO:
-        if held_rest == rest and all(a is b for a, b in zip(held, key)):
+        if held_rest == rest and all(map(is_, held, key)):
             return dict(values)
     values = _light_uniforms(cloud_settings, sun, octaves, diffusion, layer, ground)
     _LIGHT_MEMO.insert(0, (key, rest, values))
@@ -140,10 +141,10 @@ def _light_uniforms(cloud_settings, sun: Sun, octaves, diffusion: float, layer, 
     sources = s.albedo * s.sun_intensity * colors
     sky = s.sky_intensity * np.asarray(ambient, np.float64)
     return {"sun_sources": [tuple(row) for row in np.asarray(sources, np.float64).tolist()],
-            "sky_source": tuple(float(v) for v in 0.5 * s.albedo * sky),
-            "ground_sky_source": tuple(float(v) for v in 0.5 * s.albedo * sky_lit),
-            "ground_sun_source": tuple(float(v) for v in 0.5 * s.albedo * lit),
-            "sun_dir": tuple(float(v) for v in direction),
+            "sky_source": tuple(map(float, 0.5 * s.albedo * sky)),
+            "ground_sky_source": tuple(map(float, 0.5 * s.albedo * sky_lit)),
+            "ground_sun_source": tuple(map(float, 0.5 * s.albedo * lit)),
+            "sun_dir": tuple(map(float, direction)),
             "phase_lobes": s.phase.lobes,
             "outward_share": float(s.phase.hemisphere_share),
             "ms_octaves": octave_parameters(octaves, s),
@@ -159,7 +160,7 @@ LIGHT_MEMBERS = ("sun_sources", "sky_source", "ground_sky_source", "ground_sun_s
 def pack_light(values: dict) -> bytes:
     """volume.glsl's CloudLight block (std140: vec3 sun_sources[SUN_HEIGHTS], sky_source, ground_sky_source,
     ground_sun_source, sun_dir, each in 16 bytes) from :func:`light_uniforms`' ``values``."""
-    rows = [*values["sun_sources"], *(values[k] for k in LIGHT_MEMBERS[1:])]
+    rows = [*values["sun_sources"], *map(values.__getitem__, LIGHT_MEMBERS[1:])]
     return struct.pack(f"<{4 * len(rows)}f", *[c for row in rows for c in (*row, 0.0)])
 
 

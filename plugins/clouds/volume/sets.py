@@ -64,7 +64,7 @@ class CloudSets:
     def layout(self, base_altitude: float | None = None, cell_size=None, pad: float = 0.0) -> CloudLayout:
         """Where the sets are drawn: B's placement (see :meth:`CloudSimulation.layout`)."""
         s = self.settings
-        cell = tuple(float(c) for c in (s.cell_size if cell_size is None else cell_size))
+        cell = tuple(map(float, s.cell_size if cell_size is None else cell_size))
         base = float(s.base_altitude if base_altitude is None else base_altitude)
         return CloudLayout(tuple(self.shape), cell, (float(self.placement_b[0]), float(self.placement_b[2])), base,
                            tuple(s.group_size), pad)
