@@ -441,11 +441,15 @@ def inside(bias: float, rmse: float) -> bool:
     return abs(bias) <= 0.10 and rmse <= 0.15
 
 
+def grid_index(rows):
+    """(the media in order, {(medium, view): {mode: (bias, RMSE)}}) of :func:`run_grid`'s rows."""
+    return list(dict.fromkeys(r[0] for r in rows)), {(r[0], r[2]): r[3] for r in rows}
+
+
 def grid_report(rows, ms, modes) -> str:
     """The grid as a Markdown table (one row per medium: bias / RMSE per view and mode, ms beside) and a
     summary per mode, the fitted media and the held-out ones apart."""
-    media = list(dict.fromkeys(r[0] for r in rows))
-    by = {(r[0], r[2]): r[3] for r in rows}
+    media, by = grid_index(rows)
     lines = ["| medium | τ | renderer | " + " | ".join(GRID_VIEWS) + " | frame ms |", "|---|---|---|" + "---|" * (len(GRID_VIEWS) + 1)]
     for label in media:
         tau = next(r[1] for r in rows if r[0] == label)
@@ -477,8 +481,7 @@ def grid_plot(rows, modes, path):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    media = list(dict.fromkeys(r[0] for r in rows))
-    by = {(r[0], r[2]): r[3] for r in rows}
+    media, by = grid_index(rows)
     fig, axes = plt.subplots(1, len(modes), figsize=(5.2 * len(modes), 0.28 * len(media) + 1.6), squeeze=False)
     for ax, m in zip(axes[0], modes):
         score = np.array([[max(abs(by[(lab, v)][m][0]) / 0.10, by[(lab, v)][m][1] / 0.15) for v in GRID_VIEWS]

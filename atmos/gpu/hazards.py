@@ -245,13 +245,8 @@ def dispatch(program, *groups: int) -> None:
     if hazards._need:
         hazards.issue(hazards._need)
     program.run(*groups)
-    staged = hazards._staged
-    if staged:                                   # Hazards.commit, inlined
-        dirty = hazards._dirty
-        for key in staged:
-            obj, kind = staged[key]
-            dirty[key] = [weakref.ref(obj), kind, _ALL[kind]]
-        hazards._staged = {}
+    if hazards._staged:                          # a dispatch without storage writes skips the call
+        hazards.commit()
 
 
 def dispatch_indirect(program, args, offset: int = 0) -> None:
@@ -265,13 +260,8 @@ def dispatch_indirect(program, args, offset: int = 0) -> None:
     if hazards._need:                                    # with what the binds asked for: one barrier
         hazards.issue(hazards._need)
     program.run_indirect(args, offset)
-    staged = hazards._staged
-    if staged:                                   # Hazards.commit, inlined
-        dirty = hazards._dirty
-        for key in staged:
-            obj, kind = staged[key]
-            dirty[key] = [weakref.ref(obj), kind, _ALL[kind]]
-        hazards._staged = {}
+    if hazards._staged:                          # a dispatch without storage writes skips the call
+        hazards.commit()
 
 
 _GUARDED = False
