@@ -247,8 +247,8 @@ def test_sky_light_dies_with_depth_below_albedo_one(rng):
     np.testing.assert_allclose(face, [[1.0, 0.0], [0.0, 1.0]], atol=1e-12)
     near_one = ambient_weights(up, total - up, g, 1.0 - 1e-9, 0.0)
     np.testing.assert_allclose(near_one, ambient_weights(up, total - up, g, 1.0, 0.0), rtol=1e-6, atol=1e-9)
-    deep = ambient_weights(25.0, 25.0, g, 0.9, 0.0)
-    assert deep.sum() < 1e-3 * ambient_weights(25.0, 25.0, g, 1.0, 0.0).sum(), deep
+    deep = ambient_weights(60.0, 60.0, g, 0.9, 0.0)       # kappa >= 0.24 (g 0.9): e^(-kappa 60) < 1e-6
+    assert deep.sum() < 1e-3 * ambient_weights(60.0, 60.0, g, 1.0, 0.0).sum(), deep
     for up_, down_ in ((0.0, 0.0), (1e30, 1e30), (0.0, 1e30), (1e-30, 0.0)):
         for a in (0.0, 0.5, 1.0):
             v = ambient_weights(up_, down_, g, a, 1.0)
@@ -281,3 +281,33 @@ def test_the_octaves_count_forward_scatterings_on_the_way_in(rng):
     rim = octave_transmittances(np.array([1.0, 1.0 - 1e-9]), a)
     assert rim[:, 1:].max() < 1e-8 and rim[0, 0] == 1.0
     assert np.isfinite(octave_transmittances(np.array([0.0, 1e-300]), a)).all()
+
+
+@pytest.mark.parametrize("g, g2, w, albedo", [(0.85, -0.3, 0.1, 1.0), (0.9, 0.0, 0.0, 0.95), (0.6, -0.3, 0.2, 0.9),
+                                              (0.0, 0.0, 0.0, 1.0), (0.99, 0.0, 0.0, 1.0)])
+def test_the_octaves_and_the_diffusion_field_follow_the_medium(g, g2, w, albedo):
+    """medium.octave_parameters and field_weight, as light_uniforms hands them to both renderers: a and c
+    from the phase (1 - a = g_mean, c = g) with albedo per forward scattering (a' = 1 - albedo (1 - a));
+    the field's weight beta sqrt(a / a_0), exactly beta for the default phase (where it was fitted), less
+    for a more forward phase, never below 0; set octaves win over the derived ones, and beta 0 stays 0."""
+    from atmos.phase import Phase
+    from atmos.plugins.clouds.light.medium import FIELD_REFERENCE_A, field_weight, octave_parameters
+    from atmos.plugins.clouds.volume.light import DEFAULT_DIFFUSION, DEFAULT_OCTAVES, light_uniforms
+
+    phase = Phase(g=g, g2=g2, w=w)
+    settings = CloudSettings(phase=phase, albedo=albedo)
+    g_mean = (1 - w) * g + w * g2
+    a, b, c = octave_parameters(DEFAULT_OCTAVES, settings)
+    assert a == pytest.approx(1.0 - albedo * g_mean, abs=1e-12) and b == DEFAULT_OCTAVES[1] and c == pytest.approx(g)
+    values = light_uniforms(settings, Sun.from_angles(30.0, 0.0), DEFAULT_OCTAVES, DEFAULT_DIFFUSION)
+    assert values["ms_octaves"] == (a, b, c)
+    expected = DEFAULT_DIFFUSION * math.sqrt((1.0 - g_mean) / FIELD_REFERENCE_A)
+    assert values["ms_diffusion"] == pytest.approx(expected, rel=1e-12) and math.isfinite(values["ms_diffusion"])
+    if phase == Phase():
+        assert values["ms_diffusion"] == DEFAULT_DIFFUSION
+    assert FIELD_REFERENCE_A == pytest.approx(0.265)
+    assert field_weight(0.0, DEFAULT_OCTAVES, settings) == 0.0
+    assert field_weight(0.5, (0.4, 0.9, 0.5), settings) == pytest.approx(0.5 * math.sqrt(0.4 / FIELD_REFERENCE_A))
+    assert octave_parameters((0.4, 0.9, 0.5), settings) == pytest.approx((1.0 - albedo * 0.6, 0.9, 0.5))
+    forward = field_weight(DEFAULT_DIFFUSION, DEFAULT_OCTAVES, CloudSettings(phase=Phase(g=0.95, g2=0.0, w=0.0)))
+    assert 0.0 <= forward < DEFAULT_DIFFUSION

@@ -13,7 +13,7 @@ import numpy as np
 from atmos.checks import CheckedSettings, num_field
 from atmos.gpu.uniforms import write_block, write_uniforms
 from atmos.lighting import Sun
-from atmos.plugins.clouds.light.medium import ground_parts, octave_parameters
+from atmos.plugins.clouds.light.medium import field_weight, ground_parts, octave_parameters
 
 DEFAULT_AMBIENT = (0.35, 0.47, 0.65)
 DEFAULT_OCTAVES = (None, 0.9525, None)    # a, b, c of the octaves: a and c follow the medium (medium.octave_parameters), b fitted
@@ -112,7 +112,8 @@ def cell_tau(cloud_settings) -> float:
 def light_uniforms(cloud_settings, sun: Sun | None, octaves=DEFAULT_OCTAVES, diffusion: float = 0.0,
                    layer=None, ground=None) -> dict:
     """The light uniforms of ``volume.glsl`` for a ``CloudSettings`` medium, the ``Sun``, the
-    multiple-scattering octaves (a, b, c), the diffusion field's weight and the layer (base, top) world
+    multiple-scattering octaves (a, b, c), the diffusion field's weight beta (scaled by the medium:
+    ``medium.field_weight``) and the layer (base, top) world
     y (m) over which the clouds take the sun's colour (``sun_sources``: :func:`sun_colors`; the ground's
     light takes the middle's; None: the camera's colour everywhere) and the ``ground``'s albedo (RGB;
     None: the medium's ``ground_albedo``). The last few results are kept,
@@ -150,7 +151,7 @@ def _light_uniforms(cloud_settings, sun: Sun, octaves, diffusion: float, layer, 
             "ms_octaves": octave_parameters(octaves, s),
             "column_tau": cell_tau(s),
             "albedo": float(s.albedo),
-            "ms_diffusion": float(diffusion)}
+            "ms_diffusion": field_weight(diffusion, octaves, s)}
 
 
 LIGHT_BLOCK, LIGHT_BINDING = "CloudLight", 2      # volume.glsl's block of the light that changes with the sun
