@@ -1,7 +1,7 @@
 """Light shafts: frame cost of the marched shafts, the froxel volume's and the screen-space ones in the
 sunset demo (one run, this machine), and the error of the march vs its step count and of the froxel
-volume vs its size against a 256-step march (float64 references, two cloud slabs with a gap, looking
-along it). Prints numbers; `.venv/bin/python benchmarks/bench_light_shafts.py`."""
+volume vs its size, per frame and with its temporal history, against a 256-step march (float64
+references, two cloud slabs with a gap, looking along it). Prints numbers; `.venv/bin/python benchmarks/bench_light_shafts.py`."""
 from __future__ import annotations
 
 import math
@@ -11,13 +11,16 @@ import numpy as np
 from atmos import create_headless
 from atmos.camera import Camera, view_basis
 from atmos.demo_registry import DemoSettings
+from atmos.froxels import HISTORY_BLEND, froxel_jitter
 from atmos.plugins.clouds.volume.layout import CloudLayout
 from atmos.plugins.clouds.shadows.reference import sun_optical_depth
 from atmos.plugins.light_shafts import LightShaftSettings, LightShaftsPass, reference
 from atmos.runner import build_app
 
 SIZE = (640, 360)
-FROXEL_SIZES = ((8, 5, 16), (16, 9, 32), (16, 9, 64), (32, 18, 64), (64, 36, 64), (64, 36, 128))
+FROXEL_SIZES = ((8, 5, 16), (16, 9, 32), (16, 9, 64), (32, 18, 64), (64, 36, 4), (64, 36, 8), (64, 36, 16), (64, 36, 64),
+                (64, 36, 128), (128, 72, 8))
+HISTORY_FRAMES = 16       # still frames the froxel volume's history averages in the error table
 
 
 def pass_ms(mode: str, frames: int = 30, froxels=None) -> float:
@@ -86,9 +89,20 @@ def step_errors(steps=(4, 8, 16, 24, 48, 128)) -> list[tuple[int, float, float, 
     return rows
 
 
-def froxel_errors(sizes=FROXEL_SIZES) -> list[tuple[tuple, float, float]]:
+def accumulated(volume_of, frames: int = HISTORY_FRAMES, blend: float = HISTORY_BLEND) -> np.ndarray:
+    """What FroxelHistory holds after ``frames`` frames of a still view: the volumes ``volume_of(jitter)`` at
+    the middle, then at frames 1.., each blended in with weight max(1 / (n + 1), blend)."""
+    out = None
+    for n in range(frames):
+        volume = volume_of(0.5 if n == 0 else froxel_jitter(n))
+        out = volume if out is None else out + max(1.0 / (n + 1), blend) * (volume - out)
+    return out
+
+
+def froxel_errors(sizes=FROXEL_SIZES) -> list[tuple[tuple, float, float, float]]:
     """Per froxel volume (W, H, D) over a 128 × 72 image: (size, relative RMSE of each pixel's in-scattered
-    light, and after a 3x3 blur) against a 256-step march per pixel (no jitter: the pixel's own ray)."""
+    light, and after a 3x3 blur, and with the temporal history after HISTORY_FRAMES still frames) against a
+    256-step march per pixel (no jitter: the pixel's own ray)."""
     tau, sun, cam = gap_scene()
     settings = LightShaftSettings(scattering=4e-4, max_distance=500.0)
     basis = view_basis(cam, 16 / 9)
@@ -102,11 +116,63 @@ def froxel_errors(sizes=FROXEL_SIZES) -> list[tuple[tuple, float, float]]:
         reference.march_jitter = saved
     rows = []
     for size in sizes:
-        volume = reference.froxel_shafts(cam.position, basis, size, sun, np.ones(3), settings, tau)
-        image = reference.froxel_apply(volume, np.zeros((72, 128, 3)), np.ones((72, 128)), basis, cam.near, cam.far,
-                                       settings)[..., 0]
+        def volume_of(jitter, size=size):
+            return reference.froxel_shafts(cam.position, basis, size, sun, np.ones(3), settings, tau, jitter)
+        def image_of(volume):
+            return reference.froxel_apply(volume, np.zeros((72, 128, 3)), np.ones((72, 128)), basis, cam.near,
+                                          cam.far, settings)[..., 0]
+        image = image_of(volume_of(0.5))
         rmse = lambda a, b: float(np.sqrt(np.mean((a - b) ** 2)) / b.mean())
-        rows.append((size, rmse(image, truth), rmse(box3(image), box3(truth))))
+        rows.append((size, rmse(image, truth), rmse(box3(image), box3(truth)),
+                     rmse(image_of(accumulated(volume_of)), truth)))
+    return rows
+
+
+MOTIONS = {"turning 0.5 deg a frame": (math.radians(0.5), 0.0), "walking 2 m a frame": (0.0, 2.0)}
+
+
+def motion_errors(sizes=((64, 36, 16), (128, 72, 8)), frames: int = 12) -> list[tuple[str, tuple, float, float]]:
+    """Per camera motion (MOTIONS: yaw and forward step per frame) and froxel volume over a 128 × 72 image:
+    (motion, size, relative RMSE of one frame's slice middles, of the history's output; both the mean over
+    the last half of ``frames``) against a 256-step march per pixel of each frame's view: what the history
+    (:func:`atmos.froxels.history_reference`, jittered slices reprojected) costs or gains while the view moves."""
+    from atmos.froxels import froxel_knee, history_reference
+    tau, sun, start = gap_scene()
+    settings = LightShaftSettings(scattering=4e-4, max_distance=500.0)
+    march = LightShaftSettings(steps=256, scattering=4e-4, max_distance=500.0)
+    knee = froxel_knee(settings.max_distance)
+    rmse = lambda a, b: float(np.sqrt(np.mean((a - b) ** 2)) / b.mean())
+    rows = []
+    for name, (turn, step) in MOTIONS.items():
+        views = []
+        for n in range(frames):
+            ahead = start.forward() * np.array([1.0, 0.0, 1.0])
+            cam = Camera(position=start.position + step * n * ahead / np.linalg.norm(ahead))
+            cam.yaw, cam.pitch = start.yaw + turn * n, start.pitch
+            views.append(cam)
+        saved = reference.march_jitter
+        reference.march_jitter = lambda w, h: np.full((h, w), 0.5)
+        try:
+            truths = [reference.march_shafts(np.ones((72, 128)), view_basis(c, 16 / 9), c.position, c.near, c.far,
+                                             (128, 72), 1, sun, np.ones(3), march, tau)[..., 0] for c in views]
+        finally:
+            reference.march_jitter = saved
+        for size in sizes:
+            history, prev, single, kept = None, None, [], []
+            for n, cam in enumerate(views):
+                basis = view_basis(cam, 16 / 9)
+                image_of = lambda v: reference.froxel_apply(v, np.zeros((72, 128, 3)), np.ones((72, 128)), basis,
+                                                            cam.near, cam.far, settings)[..., 0]
+                middle = reference.froxel_shafts(cam.position, basis, size, sun, np.ones(3), settings, tau)
+                fresh = middle if n == 0 else reference.froxel_shafts(cam.position, basis, size, sun, np.ones(3),
+                                                                      settings, tau, froxel_jitter(n))
+                history = history_reference(fresh, history, basis, cam.position, *(prev or (basis, cam.position)),
+                                            settings.max_distance, knee, max(1.0 / (n + 1), HISTORY_BLEND))
+                prev = (basis, cam.position)
+                if n >= frames // 2:
+                    single.append(rmse(image_of(middle), truths[n]))
+                    kept.append(rmse(image_of(history), truths[n]))
+            rows.append((name, size, float(np.mean(single)), float(np.mean(kept))))
     return rows
 
 
@@ -117,9 +183,15 @@ def main() -> None:
     for froxels in ((40, 23, 32), (80, 45, 64), (160, 90, 64)):
         print(f"  froxels {'x'.join(map(str, froxels)):>10s} {pass_ms('march', froxels=froxels):8.2f}")
     print("froxel volume error vs size, 128x72 pixels (relative RMSE of the in-scattered light vs a 256-step")
-    print("march per pixel; per pixel and after a 3x3 blur):")
-    for size, e, blurred in froxel_errors():
-        print(f"  {'x'.join(map(str, size)):>10s}  {100 * e:6.2f} %   blurred {100 * blurred:6.2f} %")
+    print("march per pixel; per pixel, after a 3x3 blur, and one frame's slice middles against the history of")
+    print(f"{HISTORY_FRAMES} still frames of jittered slices, froxel_history {HISTORY_BLEND}):")
+    for size, e, blurred, history in froxel_errors():
+        print(f"  {'x'.join(map(str, size)):>10s}  {100 * e:6.2f} %   blurred {100 * blurred:6.2f} %   "
+              f"history {100 * history:6.2f} %")
+    print("froxel volume error while the view moves (relative RMSE vs a 256-step march of each frame's view,")
+    print("mean over the last 6 of 12 frames; one frame's slice middles against the reprojected history):")
+    for name, size, single, kept in motion_errors():
+        print(f"  {name:24s} {'x'.join(map(str, size)):>10s}  {100 * single:6.2f} %   history {100 * kept:6.2f} %")
     print("march error vs steps (relative RMSE of the in-scattered light vs 256 steps; blue-noise offsets,")
     print("per texel and after a 3x3 blur; white-noise offsets after the blur):")
     for n, e, blurred, white in step_errors():

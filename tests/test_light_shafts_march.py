@@ -9,6 +9,7 @@ import pytest
 from atmos.app import App
 from atmos.camera import Camera, view_basis
 from atmos.defaults import DefaultPlugins
+from atmos.froxels import froxel_jitter
 from atmos.gpu import create_headless
 from atmos.graph import PassBuilder, RenderPass
 from atmos.lighting import Sun
@@ -225,3 +226,44 @@ def test_march_extremes(case, froxels):
         app.close()
     finally:
         gpu.release()
+
+
+def test_froxel_history_averages_the_jittered_slices_of_a_still_view(march_gpu, rng):
+    """LightShaftSettings.froxel_history: each frame samples its slices at froxel_jitter of that frame and
+    a still camera over still clouds averages the frames (a running mean while 1/(n + 1) > the blend): after
+    six frames the volume is the mean of reference.froxel_shafts at the six jitters (the first at the middle) — not the middle's
+    volume, which a shadow edge inside a slice changes; a frame drawn again without advancing restarts
+    from its own fresh volume."""
+    density = (rng.random((16, 4, 16)) > 0.6).astype(np.float32) * rng.uniform(0.2, 1.5, (16, 4, 16)).astype(np.float32)
+    probe = VolumeProbe()
+    froxels = (24, 14, 12)
+    app, plugin, _ = march_app(march_gpu, density, probe, froxels=froxels, scattering=3e-4, max_distance=3000.0,
+                               froxel_history=0.1)
+    app.insert_resource(Sun(np.array([0.3, 0.8, 0.4]), (1.0, 0.8, 0.6)))
+    frames = []
+    for _ in range(6):
+        app.update(0.0)                     # no simulation step: the clouds stay; the frame index advances
+        frames.append(app.clock.frame)
+    history = next(p for p in app.graph.passes if p.name == "light_shafts").froxels.history
+    got = history.read()
+    assert history.frames == 6 and march_gpu.ctx.error == "GL_NO_ERROR"
+    settings, cam, sun = plugin.settings, app.resource(Camera), app.resource(Sun)
+    sun_dir = np.asarray(sun.direction) / np.linalg.norm(sun.direction)
+    tau = sun_tau(probe.sets, sun_dir)
+    basis = view_basis(cam, SIZE[0] / SIZE[1])
+    def volume(jitter):
+        return reference.froxel_shafts(cam.position, basis, froxels, sun_dir, march_irradiance(sun, settings),
+                                       settings, tau, jitter)
+    jitters = [0.5] + [froxel_jitter(n) for n in frames[1:]]      # the first frame: the middle
+    assert len(set(jitters)) == 6
+    want = np.mean([volume(j) for j in jitters], axis=0)
+    middle = volume(0.5)
+    scale = want[..., :3].max()
+    bound = 4e-3 * scale + 1e-3 + 6 * 2.0 ** -11 * scale          # as the volume's test, and six f2 blends
+    assert np.abs(got[..., :3] - want[..., :3]).max() < bound
+    assert np.allclose(got[..., 3], want[..., 3], atol=2e-3)
+    off_mean, off_middle = (np.abs(got[..., :3] - v[..., :3]).max() for v in (want, middle))
+    assert off_middle > 3 * off_mean, ("the jitter must move the samples", off_mean, off_middle)
+    app.render()                                   # the same frame again: no history to blend
+    assert history.frames == 1 and np.array_equal(history.read(), probe.volume)
+    app.close()

@@ -51,7 +51,7 @@ from atmos.plugins.sky import SkyPlugin
 from atmos.plugins.sky_gradient import SkyGradientPlugin
 from atmos.plugins.sky_layer import SkyLayerPlugin
 from atmos.plugins.terrain import TerrainPlugin
-from atmos.plugins.template_volume import TemplateVolumePlugin, VolumeBox
+from atmos.plugins.template_volume import TemplateVolumePlugin
 from atmos.plugins.volumetric_fog import VolumetricFogPlugin
 from atmos.plugins.clouds.weather import WeatherPlugin
 from atmos.plugins.clouds.light.scattering import Scattering
@@ -226,8 +226,9 @@ CLOUD_CENTER = (320.0, 360.0, 320.0)
 
 
 def march_under_clouds(app, plugin):
-    """Marched shafts seen from under the clouds of :func:`clouds`, toward a sun behind them."""
-    plugin.configure(mode="march")
+    """Marched shafts seen from under the clouds of :func:`clouds`, toward a sun behind them; each frame
+    alone (froxel_history 1: the history's jitter moves a still frame; it has its own case)."""
+    plugin.configure(mode="march", froxel_history=1.0)
     look((320.0, 40.0, 900.0), target=(320.0, 250.0, 300.0), far=6000.0)(app)
     app.insert_resource(Sun(np.array([0.0, 0.6, -1.0]) / math.hypot(0.6, 1.0), (1.0, 0.95, 0.85)))
 
@@ -318,7 +319,9 @@ SPECS = {
         dict(center=(3.0, 0.0, -12.0), scale=(4.0, 3.0, 4.0), bias=0.6, falloff=0.2, frequency=0.5, octaves=5,
              seed=9, wind=(-4.0, 1.0, 3.0), absorption=0.05, steps=40, light_steps=6, light_step=0.5,
              max_distance=12.0, ambient=(0.9, 0.1, 0.1), scattering=(0.1, 0.1, 0.9), animate=False,
-             ambient_from="sky", froxels=(8, 6, 12))),
+             ambient_from="sky", froxels=(8, 6, 12), froxel_history=0.5),
+        # from froxels whose frames stand alone (froxel_history 1) to a history, which jitters the next frame
+        before={"froxel_history": configure_first(froxels=(8, 6, 12), froxel_history=1.0)}),
     "fog": Spec(
         lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(),
                  FogPlugin(mode="hetero_exp2", density=0.06, resolutions=(4, 8, 8, 16), tile_size=32.0)],
@@ -340,10 +343,10 @@ SPECS = {
         dict(samples=8, density=0.4, decay=0.7, weight=0.3, exposure=2.0, threshold=0.2, ceiling=0.05, radius=0.1,
              downsample=4, horizon_fade=0.9, front_fade=1.0, edge_fade=2.0, mode="march", steps=3,
              scattering=1e-4, max_distance=400.0, sun_intensity=2.0, **{"phase.g": 0.0, "phase.g2": 0.6, "phase.w": 0.7},
-             fog_sun_share=0.3, froxels=(8, 6, 12)),
+             fog_sun_share=0.3, froxels=(8, 6, 12), froxel_history=0.5),
         before={"__all__": sun_at((0.5, 0.55)), "edge_fade": sun_at((1.15, 0.55)), "steps": march_per_texel,
                 **{f: march_under_clouds for f in ("scattering", "max_distance", "phase.g", "phase.g2", "phase.w",
-                                                    "sun_intensity", "froxels")}},
+                                                    "sun_intensity", "froxels", "froxel_history")}},
         # fog_sun_share acts only with a FogPlugin (tests/test_light_shafts_fog.py renders it): the setting read
         observe={"downsample": resource_size(MASK), "fog_sun_share": lambda app, plugin: plugin.settings.fog_sun_share}),
     "template_volume": Spec(

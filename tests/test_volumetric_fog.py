@@ -6,6 +6,7 @@ import pytest
 
 from atmos.app import App
 from atmos.camera import Camera
+from atmos.froxels import froxel_jitter
 from atmos.defaults import DefaultPlugins
 from atmos.lighting import Sun
 from atmos.plugins.ground import GroundPlugin
@@ -299,8 +300,9 @@ def test_the_fog_can_take_its_ambient_light_from_the_sky():
 
 
 # -- the froxel volume (VolumetricFogSettings.froxels) ------------------------------------------------
-def gpu_froxels(gpu, camera, aspect, froxels, params, sun, time=0.0):
-    """(W, H, D + 1, 4): volumetric_fog/froxels.comp for ``camera`` (read back as float64)."""
+def gpu_froxels(gpu, camera, aspect, froxels, params, sun, time=0.0, frame=None):
+    """(W, H, D + 1, 4): volumetric_fog/froxels.comp for ``camera``, its slices sampled at the middles or at
+    froxel_jitter of ``frame`` (read back as float64)."""
     from atmos.gpu.hazards import dispatch
     from atmos.gpu.uniforms import bind_images, write_uniforms
     from atmos.froxels import froxel_knee
@@ -311,7 +313,8 @@ def gpu_froxels(gpu, camera, aspect, froxels, params, sun, time=0.0):
     try:
         set_camera_uniforms(prog, camera, aspect)
         set_medium_uniforms(prog, params, sun, time)
-        write_uniforms(prog, froxel_knee=froxel_knee(params.max_distance))
+        write_uniforms(prog, froxel_knee=froxel_knee(params.max_distance), froxel_frame=frame or 0,
+                       froxel_jittered=int(frame is not None))
         bind_images(prog, fog_volume=volume)
         dispatch(prog, -(-w // 8), -(-h // 8))
         data = np.frombuffer(volume.read(), np.float16).astype(np.float64)
@@ -320,12 +323,12 @@ def gpu_froxels(gpu, camera, aspect, froxels, params, sun, time=0.0):
         volume.release()
 
 
-def ref_froxels(camera, aspect, froxels, params, sun, time=0.0):
+def ref_froxels(camera, aspect, froxels, params, sun, time=0.0, jitter=0.5):
     from atmos.camera import view_basis
     from atmos.froxels import froxel_knee
     s, sun_light, ambient_light = sun_terms(sun, params)
     return reference.froxel_volume(camera.position, view_basis(camera, aspect), froxels, params, s, sun_light,
-                                   ambient_light, froxel_knee(params.max_distance), time)
+                                   ambient_light, froxel_knee(params.max_distance), time, jitter)
 
 
 def froxel_camera(rng, params):
@@ -343,8 +346,9 @@ def test_gpu_froxel_volume_matches_its_float64_twin(gpu, ctx, rng):
                                    max_distance=150.0, froxels=(24, 14, 40))
     sun = Sun.from_angles(float(rng.uniform(10, 70)), float(rng.uniform(0, 360)))
     cam = froxel_camera(rng, params)
-    got = gpu_froxels(gpu, cam, 16 / 9, params.froxels, params, sun, time=0.75)
-    want = ref_froxels(cam, 16 / 9, params.froxels, params, sun, time=0.75)
+    index = int(rng.integers(0, 2**32))           # the frame: where in each slice the sample lies (froxel_jitter)
+    got = gpu_froxels(gpu, cam, 16 / 9, params.froxels, params, sun, time=0.75, frame=index)
+    want = ref_froxels(cam, 16 / 9, params.froxels, params, sun, time=0.75, jitter=froxel_jitter(index))
     assert np.isfinite(got).all() and got.shape == want.shape == (24, 14, 41, 4)
     assert (want[..., -1, 3] < 0.9).sum() >= 10 and (want[..., -1, 3] > 0.999).sum() >= 5, "columns in and past the fog"
     assert np.allclose(got[:, :, 0], [0, 0, 0, 1]), "layer 0 is the camera"

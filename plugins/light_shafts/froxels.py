@@ -1,11 +1,13 @@
 """The light shafts from a froxel volume (``LightShaftSettings.froxels``): each of W × H view-ray columns
 marched once in D slices through the cloud shadow map (shaders/light_shafts/froxels.comp), then every
 pixel reads its sums at its own distance (froxel_apply.comp) — W·H·D samples instead of texels × steps.
+Each slice's sample moves every frame and the frames are averaged (:class:`atmos.froxels.FroxelHistory`,
+``LightShaftSettings.froxel_history``).
 A heterogeneous fog, whose factor along a ray depends on the ray's end, keeps the per-texel march.
 float64 twin: :func:`.reference.froxel_shafts`."""
 from __future__ import annotations
 
-from atmos.froxels import froxel_knee, volume_desc, volume_image
+from atmos.froxels import FroxelHistory, froxel_knee, volume_desc, volume_image
 from atmos.graph import PassBuilder, PassContext, work_groups
 from atmos.plugins.clouds import FAR_FIELD
 from atmos.plugins.light_shafts.march import MarchedShafts, bind_cloud_distance, march_irradiance
@@ -24,8 +26,9 @@ class FroxelShafts:
     """The froxel volume's declarations and dispatches for a LightShaftsPass; the uniforms are the
     march's (``medium``: its :class:`MarchedShafts`)."""
 
-    def __init__(self, medium: MarchedShafts):
+    def __init__(self, medium: MarchedShafts, gpu):
         self.medium = medium
+        self.history = FroxelHistory(gpu)
 
     @staticmethod
     def declare(builder: PassBuilder, froxels, clouds: bool, far_field: bool = False, fog=None, aerial=None) -> None:
@@ -44,7 +47,8 @@ class FroxelShafts:
                        for name in ("froxels", "froxel_apply"))
         knee = froxel_knee(settings.max_distance)
         self.medium.set_medium(frame, fill, settings, clouds, irradiance, fog, aerial)
-        write_uniforms(fill, froxel_knee=knee)
+        write_uniforms(fill, froxel_knee=knee, froxel_jittered=int(self.history.jittered(frame.view.clock.frame,
+                                                                                         settings.froxel_history)))
         write_uniforms(apply, froxel_knee=knee, max_distance=settings.max_distance)   # the apply reads the sums:
         if fog is not None:                                 # no shadows, sun or phase; the fog's colour and
             self.medium.fog_uniforms(frame, apply, fog, settings)      # the clouds' distance where it takes
@@ -52,6 +56,8 @@ class FroxelShafts:
             bind_cloud_distance(frame, apply)
         volume = volume_image(frame, SHAFT_VOLUME)
         frame.dispatch(fill, work_groups(volume.size[:2], (8, 8)), images={"shaft_volume": volume})
+        volume = self.history.resolve(frame, volume, settings.max_distance, knee, settings.froxel_history,
+                                      key=(far_field, fog is not None, aerial is not None, clouds))
         color = frame.image(COLOR)
         frame.dispatch(apply, work_groups(color.size, (8, 8)), images={"color_image": color},
                        textures={"scene_depth": DEPTH, "shaft_volume": volume})

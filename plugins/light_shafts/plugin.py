@@ -76,14 +76,18 @@ class LightShaftsPass(RenderPass):
         self.blur = gpu.program(vertex_shader=fullscreen, fragment_shader="light_shafts/blur.frag")
         self.composite = gpu.program(vertex_shader=fullscreen, fragment_shader="light_shafts/composite.frag")
         self.marched = MarchedShafts(gpu)
-        self.froxels = FroxelShafts(self.marched)
+        self.froxels = FroxelShafts(self.marched, gpu)
 
     def release(self) -> None:
         if self.marched is not None:
             self.marched.release()
+        if self.froxels is not None:
+            self.froxels.history.release()
 
     def execute(self, frame: PassContext) -> None:
         view, gpu, params = frame.view, frame.gpu, self.plugin.settings
+        if params.mode != "march" or not uses_froxels(params, self.plugin.fog):
+            self.froxels.history.release()              # no volume to accumulate: no history kept
         if params.mode == "march":
             shafts = self.froxels if uses_froxels(params, self.plugin.fog) else self.marched
             shafts.execute(frame, params, frame.declares(CLOUD_SETS), self.plugin.fog, self.plugin.aerial())

@@ -96,9 +96,11 @@ def march_shafts(low_depth, basis, camera_pos, near: float, far: float, frame_si
     return np.concatenate([light, np.exp(-sigma * d)[..., None]], -1)
 
 
-def froxel_shafts(camera_pos, basis, froxels, sun_dir, irradiance, settings, optical_depth=None) -> np.ndarray:
+def froxel_shafts(camera_pos, basis, froxels, sun_dir, irradiance, settings, optical_depth=None,
+                  jitter: float = 0.5) -> np.ndarray:
     """(W, H, D + 1, 4) float64: shaders/light_shafts/froxels.comp without a fog or the aerial perspective —
-    each column's view ray (:func:`atmos.froxels.column_rays`) sampled once per slice at its middle s,
+    each column's view ray (:func:`atmos.froxels.column_rays`) sampled once per slice at s, the share
+    ``jitter`` of its depth (0.5: the middle),
     layer k holding (Σ σ p(cos) E exp(−τ_sun − σ s) ds, exp(−σ d_k)) from the camera to slice boundary
     d_k; ``optical_depth`` as for :func:`march_shafts`."""
     w, h, d = froxels
@@ -110,7 +112,7 @@ def froxel_shafts(camera_pos, basis, froxels, sun_dir, irradiance, settings, opt
     out[:, 0, 3] = 1.0
     light = np.zeros((len(dirs), 3))
     for k in range(1, d + 1):
-        s, ds = 0.5 * (bounds[k - 1] + bounds[k]), bounds[k] - bounds[k - 1]
+        s, ds = bounds[k - 1] + jitter * (bounds[k] - bounds[k - 1]), bounds[k] - bounds[k - 1]
         tau = 0.0 if optical_depth is None else optical_depth(np.asarray(camera_pos, np.float64) + dirs * s)
         light = light + lit * (np.exp(-tau - sigma * s) * ds)[:, None]
         out[:, k, :3], out[:, k, 3] = light, np.exp(-sigma * bounds[k])

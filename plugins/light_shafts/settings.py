@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from atmos.checks import CheckedSettings, check_shape, choice_field, int_field, nested_field, num_field
-from atmos.froxels import MAX_FROXELS
+from atmos.froxels import MAX_FROXELS, history_field
 from atmos.phase import Phase
 
 MODES = ("march", "screen")
@@ -34,9 +34,10 @@ class LightShaftSettings(CheckedSettings):
     ``froxels`` = (W, H, D), each 1..256 (default 160 × 90 × 64): the march runs through a froxel volume
     (:mod:`atmos.plugins.light_shafts.froxels`) — each of W × H view-ray columns marched once in D slices
     (even near the camera, logarithmic beyond max_distance / 32), every pixel reading it at its own
-    distance (``steps`` and ``downsample`` then unused): W·H·D samples whatever the frame's size, no
-    noise, edges as soft as a column. None (or a heterogeneous fog): per texel at 1/``downsample``
-    resolution, ``steps`` jittered samples each (``benchmarks/bench_light_shafts.py`` compares both).
+    distance (``steps`` and ``downsample`` then unused): W·H·D samples whatever the frame's size, edges
+    as soft as a column; each slice's sample moves every frame and the frames are averaged through
+    reprojection (``froxel_history``), so a still view converges to the slices' mean, without bands.
+    None (or a heterogeneous fog): per texel at 1/``downsample`` resolution, ``steps`` jittered samples each (``benchmarks/bench_light_shafts.py`` compares both).
 
     Screen: sky pixels brighter than ``threshold`` near the sun (open to the sky: ``1 − color.a``)
     form a mask, blurred toward the sun's screen position and added to the colour (at most
@@ -71,6 +72,7 @@ class LightShaftSettings(CheckedSettings):
     fog_sun_share: float = num_field(0.8, 0.0, 1.0, "with a fog: the part of the fog's colour that is sunlight "
                                      "(what cloud shadow takes away)")
     froxels: tuple | None = (160, 90, 64)
+    froxel_history: float = history_field()
 
     def __post_init__(self):
         super().__post_init__()

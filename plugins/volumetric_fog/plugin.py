@@ -5,7 +5,7 @@ import numpy as np
 
 from atmos.scene_uniforms import set_camera_uniforms
 from atmos.composition import MEDIA_LIGHT, MEDIA_TRANSMITTANCE, composition
-from atmos.froxels import froxel_knee, volume_desc, volume_image
+from atmos.froxels import FroxelHistory, froxel_knee, volume_desc, volume_image
 from atmos.gpu.uniforms import write_uniforms
 from atmos.graph import ComputePass, PassContext, work_groups
 from atmos.lighting import Sun, sun_and_day
@@ -64,8 +64,14 @@ class VolumetricFogPass(ComputePass):
                 builder.read(name, access="storage")
                 builder.write(name, access="storage")
 
+    history: FroxelHistory | None = None       # the froxel volume's temporal accumulation (settings.froxels)
+
     def defines(self) -> dict:
         return {"LOCAL_MEDIA": int(self.plugin.composition.media)}
+
+    def release(self) -> None:
+        if self.history is not None:
+            self.history.release()
 
     def execute(self, frame: PassContext) -> None:
         view, settings = frame.view, self.plugin.settings
@@ -74,6 +80,8 @@ class VolumetricFogPass(ComputePass):
             images.update(media_light_image=MEDIA_LIGHT, media_transmittance_image=MEDIA_TRANSMITTANCE)
         color = frame.image(COLOR)
         if settings.froxels is None:
+            if self.history is not None:
+                self.history.release()                 # no volume to accumulate: no history kept
             p = self.program
             set_camera_uniforms(p, view.camera, view.aspect)
             set_medium_uniforms(p, settings, view.sun, self.plugin.time(view), self.plugin.sky_ambient(view))
@@ -87,7 +95,14 @@ class VolumetricFogPass(ComputePass):
             set_camera_uniforms(p, view.camera, view.aspect)
             write_uniforms(p, froxel_knee=froxel_knee(settings.max_distance), max_distance=settings.max_distance)
         set_medium_uniforms(fill, settings, view.sun, self.plugin.time(view), self.plugin.sky_ambient(view))
+        if self.history is None:
+            self.history = FroxelHistory(self.gpu)
+        index = view.clock.frame
+        write_uniforms(fill, froxel_frame=index & 0xFFFFFFFF,
+                       froxel_jittered=int(self.history.jittered(index, settings.froxel_history)))
         frame.dispatch(fill, work_groups(volume.size[:2], (8, 8)), images={"fog_volume": volume})
+        volume = self.history.resolve(frame, volume, settings.max_distance, froxel_knee(settings.max_distance),
+                                      settings.froxel_history)
         frame.dispatch(apply, self.groups(color.size), images=images,
                        textures={"scene_depth": DEPTH, "fog_volume": volume})
 

@@ -75,9 +75,10 @@ def march(origins, dirs, limits, settings: VolumetricFogSettings, sun_dir, sun_l
 
 
 def froxel_volume(camera_pos, basis, froxels, settings: VolumetricFogSettings, sun_dir, sun_light, ambient_light,
-                  knee: float, time: float = 0.0) -> np.ndarray:
+                  knee: float, time: float = 0.0, jitter: float = 0.5) -> np.ndarray:
     """(W, H, D + 1, 4) float64: volumetric_fog/froxels.comp — each column's ray through uv = ((x, y) + 0.5)
-    / (W, H) (``basis``: atmos.camera.view_basis) marched one sample per slice; layer k holds (light,
+    / (W, H) (``basis``: atmos.camera.view_basis) marched one sample per slice, at the share ``jitter`` of
+    the slice's part inside the envelope; layer k holds (light,
     transmittance) from the camera to slice boundary k."""
     w, h, d = froxels
     _, dirs = column_rays(basis, w, h)
@@ -93,7 +94,7 @@ def froxel_volume(camera_pos, basis, froxels, settings: VolumetricFogSettings, s
     for k in range(1, d + 1):
         a, b = np.maximum(bounds[k - 1], enter), np.minimum(bounds[k], leave)
         idx = np.flatnonzero((b > a) & (trans > 0.01))
-        p = origins[idx] + dirs[idx] * (0.5 * (a[idx] + b[idx]))[:, None]
+        p = origins[idx] + dirs[idx] * (a[idx] + jitter * (b[idx] - a[idx]))[:, None]
         dens = density(p, settings, time)
         inside = dens > 0
         idx, p, dens = idx[inside], p[inside], dens[inside]

@@ -4,7 +4,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from atmos.checks import CheckedSettings, bool_field, check_shape, choice_field, int_field, num_field, vec_field
-from atmos.froxels import MAX_FROXELS
+from atmos.froxels import MAX_FROXELS, history_field
 
 MAX_OCTAVES = 16
 MAX_STEPS = 1024
@@ -22,7 +22,8 @@ class VolumetricFogSettings(CheckedSettings):
     (W, H, D), each 1..256: a froxel volume instead — each of W × H columns marched once in D slices
     (even near the camera, logarithmic beyond max_distance / 32), every pixel reading it trilinearly:
     W·H·D samples instead of pixels × steps, softer detail (``benchmarks/bench_volumetric_fog.py``
-    measures the error against a 256-step float64 march by size).
+    measures the error against a 256-step float64 march by size); each slice's sample moves every frame
+    and the frames are averaged through reprojection (``froxel_history``).
     """
 
     center: tuple = vec_field((0.0, 0.0, 0.0), 3, doc="m, the centre of the medium's envelope")
@@ -48,6 +49,7 @@ class VolumetricFogSettings(CheckedSettings):
                                      "light at the camera's altitude: dawn-coloured at dawn, dark at night; "
                                      "ambient=(1, 1, 1) for the sky's own colour)")
     froxels: tuple | None = None
+    froxel_history: float = history_field()
 
     def __post_init__(self):
         super().__post_init__()

@@ -2,6 +2,13 @@
 // and nearly linear inside it, w = ln(1 + d / knee) / ln(1 + range / knee): even steps of the distance's
 // ratio far out, no slice wasted near the camera (atmos/froxels.py is the float64 twin). The sky's aerial
 // perspective (sky/aerial_slices.glsl), the volumetric fog's and the light shafts' froxels use it.
+// Where in its slice a froxel fill samples in frame `frame` (the frame block's frame_index): 0 the near
+// boundary, 1 the far one; frac(1/2 + frame / phi) in 32-bit fixed point (Roberts' R1 sequence, exact for any
+// frame; the middle in frame 0), or the middle (0.5) where not `jittered` (atmos/froxels.py froxel_jitter).
+float froxel_jitter(uint frame, bool jittered) {
+    return jittered ? float((2147483648u + frame * 2654435769u) >> 8u) / 16777216.0 : 0.5;
+}
+
 float froxel_w(float d, float range, float knee) {
     return log(1.0 + max(d, 0.0) / knee) / log(1.0 + range / knee);
 }

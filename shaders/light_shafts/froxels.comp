@@ -1,7 +1,8 @@
 #version 430
 // The light shafts' froxel volume (LightShaftSettings.froxels = (W, H, D)): one invocation per column
-// marches the view ray through its centre, uv = ((x, y) + 0.5) / (W, H), one sample at the middle of each
-// slice (lib/froxel_slices.glsl, out to max_distance), with march.comp's terms (light_shafts/medium.glsl);
+// marches the view ray through its centre, uv = ((x, y) + 0.5) / (W, H), one sample in each slice at the
+// share froxel_jitter of its depth (0.5: the middle; it moves every frame and core/froxel_history.comp
+// averages the frames) (lib/froxel_slices.glsl, out to max_distance), with march.comp's terms (light_shafts/medium.glsl);
 // layer k holds the sums from the camera to slice boundary k, which froxel_apply.comp reads per pixel:
 //   the haze alone: (L, T) = (sum sigma p(cos) E exp(-tau_sun - sigma s) ds, exp(-sigma d_k));
 //   SHAFT_AERIAL: rgb = the air's sunlight lost in cloud shadow, sum T_air E_sun (s_ray p_R + s_mie p_M)
@@ -15,6 +16,7 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0, rgba16f) writeonly uniform image3D shaft_volume;
 uniform float froxel_knee;     // m: slices are nearly even inside it, logarithmic beyond
+uniform int froxel_jittered;   // 1: the samples move with the frame (lib/froxel_slices.glsl froxel_jitter); 0: the middles
 
 void main() {
     ivec3 size = imageSize(shaft_volume);
@@ -38,10 +40,10 @@ void main() {
     float pr = atm_rayleigh_phase(nu), pm = atm_hg_phase(atm_g, nu);
 #endif
     imageStore(shaft_volume, ivec3(c, 0), sums);
-    float d0 = 0.0;
+    float d0 = 0.0, jitter = froxel_jitter(frame_index, froxel_jittered != 0);
     for (int z = 1; z <= slices; ++z) {
         float d1 = froxel_distance(float(z) / float(slices), max_distance, froxel_knee);
-        float s = 0.5 * (d0 + d1), ds = d1 - d0;
+        float s = mix(d0, d1, jitter), ds = d1 - d0;
         float tau = shaft_sun_tau(camera_pos + dir * s);
         float shade = 1.0 - exp(-tau);          // the share of the sunlight the clouds take
 #if SHAFT_FOG

@@ -1,9 +1,9 @@
 #version 430
 // The volumetric fog's froxel volume (VolumetricFogSettings.froxels = (W, H, D)): one invocation per
 // froxel column marches the view ray through its centre, uv = ((x, y) + 0.5) / (W, H), slice by slice
-// (lib/froxel_slices.glsl, out to max_distance), one sample per slice at the middle of the part of the
-// slice inside the medium's bounding ellipsoid — the per-pixel march (volumetric_fog/medium.glsl
-// fog_march) with the slices as its steps. Layer k holds (in-scattered light, transmittance) from the
+// (lib/froxel_slices.glsl, out to max_distance), one sample per slice in the part of the slice inside the
+// medium's bounding ellipsoid, at the share froxel_jitter of it (0.5: the middle; it moves every frame and
+// core/froxel_history.comp averages the frames) — the per-pixel march (volumetric_fog/medium.glsl fog_march) with the slices as its steps. Layer k holds (in-scattered light, transmittance) from the
 // camera to slice boundary k (layer 0: the camera, (0, 0, 0, 1)); froxel_apply.comp reads it
 // trilinearly. float64 twin: plugins/volumetric_fog/reference.py froxel_volume.
 #include "lib/hash.glsl"
@@ -16,6 +16,8 @@ layout(binding = 0, rgba16f) writeonly uniform image3D fog_volume;
 uniform mat3 view_basis;       // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
 uniform vec3 camera_pos;
 uniform float froxel_knee;     // m: slices are nearly even inside it, logarithmic beyond
+uniform uint froxel_frame;     // the frame's index (the clock's frame) and whether the slices' samples move with
+uniform int froxel_jittered;   // it (lib/froxel_slices.glsl froxel_jitter; 0: the middles)
 
 void main() {
     ivec3 size = imageSize(fog_volume);
@@ -28,12 +30,12 @@ void main() {
     vec3 light = vec3(0.0);
     float trans = 1.0;
     imageStore(fog_volume, ivec3(c, 0), vec4(light, trans));
-    float d0 = 0.0;
+    float d0 = 0.0, jitter = froxel_jitter(froxel_frame, froxel_jittered != 0);
     for (int z = 1; z <= slices; ++z) {
         float d1 = froxel_distance(float(z) / float(slices), max_distance, froxel_knee);
         float a = max(d0, range.x), b = min(d1, range.y);
         if (b > a && trans > 0.01) {
-            vec3 p = camera_pos + dir * (0.5 * (a + b));
+            vec3 p = camera_pos + dir * mix(a, b, jitter);
             float d = fog_density(p, key);
             if (d > 0.0) {
                 float step_t = exp(-absorption * d * (b - a));
