@@ -1,5 +1,6 @@
 """Volumetric fog: image error against a 1024-step march versus time per frame, 8..128 view steps per
-pixel and froxel volumes of several sizes (VolumetricFogSettings.froxels).
+pixel and froxel volumes of several sizes (VolumetricFogSettings.froxels), each frame alone
+(froxel_history 1) and with the temporal history after the frames measured (the default).
 
 Plain script: prints a table and writes out/bench_volumetric_fog.png. On llvmpipe only the ratios
 between rows mean anything; absolute numbers need a real GPU.
@@ -17,6 +18,7 @@ import numpy as np
 from atmos.app import App
 from atmos.camera import Camera
 from atmos.defaults import DefaultPlugins
+from atmos.froxels import HISTORY_BLEND
 from atmos.demos.volumetric_fog import FOG
 from atmos.gpu import create_headless
 from atmos.graph import RenderPass
@@ -27,7 +29,7 @@ from atmos.plugins.volumetric_fog import VolumetricFogPlugin
 from atmos.render_core import COLOR
 
 STEPS = (8, 16, 32, 64, 128)
-FROXELS = ((40, 23, 32), (80, 45, 32), (80, 45, 64), (160, 90, 64), (160, 90, 128))
+FROXELS = ((40, 23, 32), (80, 45, 32), (80, 45, 64), (160, 90, 64), (160, 90, 128), (256, 144, 64))
 REFERENCE_STEPS = 1024
 
 
@@ -45,10 +47,11 @@ class ReadColor(RenderPass):
         self.image = np.frombuffer(frame.resource(COLOR).read(), np.float16).reshape(h, w, 4)[..., :3].astype(float)
 
 
-def measure(app, plugin, reader, steps: int, frames: int, froxels=None):
+def measure(app, plugin, reader, steps: int, frames: int, froxels=None, history: float = HISTORY_BLEND):
     """(image, median wall ms per frame, fog pass GPU ms) with ``steps`` view samples per pixel, or
-    with a froxel volume of ``froxels`` (W, H, D)."""
-    plugin.configure(steps=steps, froxels=froxels)
+    with a froxel volume of ``froxels`` (W, H, D) and ``froxel_history`` ``history`` (the image: the last
+    frame's, a still view's history of frames + 2)."""
+    plugin.configure(steps=steps, froxels=froxels, froxel_history=history)
     app.run_frames(2)                                       # warm up (and read the first timer queries)
     wall = []
     for _ in range(frames):
@@ -92,9 +95,11 @@ def main() -> None:
     rows.append((REFERENCE_STEPS, 0.0, 0.0, ref_wall, ref_gpu))
     froxel_rows = []
     for froxels in FROXELS:
-        image, wall, gpu_ms = measure(app, plugin, reader, 1, args.frames, froxels)
-        rmse = float(np.sqrt(np.mean((image - reference) ** 2)))
-        froxel_rows.append(("x".join(map(str, froxels)), rmse, rmse / signal, wall, gpu_ms))
+        for history in (1.0, HISTORY_BLEND):
+            image, wall, gpu_ms = measure(app, plugin, reader, 1, args.frames, froxels, history)
+            rmse = float(np.sqrt(np.mean((image - reference) ** 2)))
+            name = "x".join(map(str, froxels)) + (" history" if history < 1.0 else "")
+            froxel_rows.append((name, rmse, rmse / signal, wall, gpu_ms))
     info = gpu.info()
     app.close()
     gpu.release()
@@ -104,9 +109,9 @@ def main() -> None:
     print(f"{'steps':>6} {'RMSE':>10} {'rel. RMSE':>10} {'ms/frame':>10} {'fog GPU ms':>11}")
     for steps, rmse, rel, wall, gpu_ms in rows:
         print(f"{steps:>6} {rmse:>10.5f} {rel:>10.5f} {wall:>10.2f} {gpu_ms:>11.2f}")
-    print(f"{'froxels':>11} {'RMSE':>10} {'rel. RMSE':>10} {'ms/frame':>10} {'fog GPU ms':>11}")
+    print(f"{'froxels':>19} {'RMSE':>10} {'rel. RMSE':>10} {'ms/frame':>10} {'fog GPU ms':>11}")
     for name, rmse, rel, wall, gpu_ms in froxel_rows:
-        print(f"{name:>11} {rmse:>10.5f} {rel:>10.5f} {wall:>10.2f} {gpu_ms:>11.2f}")
+        print(f"{name:>19} {rmse:>10.5f} {rel:>10.5f} {wall:>10.2f} {gpu_ms:>11.2f}")
 
     import matplotlib
     matplotlib.use("Agg")
@@ -116,9 +121,11 @@ def main() -> None:
     ax.loglog(xs, [r[1] for r in rows[:-1]], "o-", label="per pixel (steps)")
     for steps, rmse, _, wall, _ in rows[:-1]:
         ax.annotate(f"{steps}", (wall, rmse), textcoords="offset points", xytext=(5, 5))
-    ax.loglog([r[3] for r in froxel_rows], [r[1] for r in froxel_rows], "s-", label="froxels (W×H×D)")
+    for kind, mark in (("", "s-"), (" history", "^-")):
+        rows_of = [r for r in froxel_rows if r[0].endswith(" history") == bool(kind)]
+        ax.loglog([r[3] for r in rows_of], [r[1] for r in rows_of], mark, label=f"froxels (W×H×D){kind}")
     for name, rmse, _, wall, _ in froxel_rows:
-        ax.annotate(name, (wall, rmse), textcoords="offset points", xytext=(5, -10), fontsize=7)
+        ax.annotate(name.split()[0], (wall, rmse), textcoords="offset points", xytext=(5, -10), fontsize=7)
     ax.legend(fontsize=8)
     ax.set_xlabel("ms per frame (whole frame, wall clock)")
     ax.set_ylabel(f"image RMSE vs {REFERENCE_STEPS} steps (linear HDR)")
