@@ -91,7 +91,7 @@ def view_frame(view) -> bytes | None:
         return None
     clock = getattr(view, "clock", None)
     return pack_frame(view.camera, view.sun, view.size, getattr(view, "time", 0.0),
-                      clock.frame if clock is not None else 0)
+                      clock.frame if clock is not None else 0, getattr(view, "jitter", (0.0, 0.0)))
 
 
 def bind_frame(gpu, camera: Camera | None = None, sun: Sun | None = None, size=None, time: float = 0.0,

@@ -7,6 +7,7 @@ distance (``froxel_read``). The volumetric fog and the light shafts march one; f
 from __future__ import annotations
 
 import math
+import struct
 
 import numpy as np
 
@@ -83,6 +84,7 @@ def froxel_lookup(volume: np.ndarray, uv, dist, range_: float, knee: float) -> n
 HISTORY_BLEND = 0.1          # the default least weight of a froxel volume's newest frame
 GOLDEN_U32 = 2654435769      # 2^32 / phi: the slices' jitter runs as frac(1/2 + n / phi) (Roberts' R1 sequence)
 HISTORY_BINDING = 1          # core/froxel_history.comp's History block, written once per resolve
+_HISTORY_BLOCK = struct.Struct("<3f4x3f4x3f4x3f4fi")   # its std140 layout (80 bytes)
 
 
 def history_field():
@@ -171,12 +173,10 @@ class FroxelHistory:
         prev = matrices if last is None else last[2]
         p = self.gpu.program(compute_shader="core/froxel_history.comp")
         out = self._volumes[1 - self._current]
-        block = np.zeros(20, np.float32)          # std140: mat3 as three vec4 columns, vec3 + float, 4 scalars
-        block[:12].reshape(3, 4)[:, :3] = prev.view_basis.T
-        block[12:19] = (*prev.camera_pos, math.dist(matrices.camera_pos, prev.camera_pos), range_, knee,
-                        max(1.0 / (self.frames + 1), blend))
-        block.view(np.int32)[19] = self.frames > 0
-        write_block(p, "History", HISTORY_BINDING, block.tobytes())
+        a, b, c = prev.view_basis.T.tolist()      # std140: mat3 as three vec4 columns, vec3 + float, 4 scalars
+        write_block(p, "History", HISTORY_BINDING, _HISTORY_BLOCK.pack(
+            *a, *b, *c, *prev.camera_pos, math.dist(matrices.camera_pos, prev.camera_pos), range_, knee,
+            max(1.0 / (self.frames + 1), blend), self.frames > 0))
         frame.dispatch(p, work_groups(size, (4, 4, 4)), textures={"fresh": fresh, "history": self._volumes[self._current]},
                        images={"resolved": out})
         self._current = 1 - self._current

@@ -15,6 +15,7 @@ from atmos.camera import Camera
 from atmos.defaults import DefaultPlugins
 from atmos.demo_registry import add_demo_camera
 from atmos.input import Input
+from atmos.plugins.antialias import AntialiasPlugin
 from atmos.keys import key
 from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
 from atmos.plugins.clouds.sprites import CloudRenderPlugin
@@ -64,7 +65,8 @@ def build_cloudscape(app, settings, *, hours: float, speed: float = 0.0, cloud_d
                     CloudShadowsPlugin(),
                     CloudRenderPlugin(size_factor=4.0, enabled=settings.clouds == "sprites"),
                     RaymarchCloudsPlugin(enabled=settings.clouds == "march"),
-                    LightShaftsPlugin(horizon_fade=0.03))   # the sun's own colour already fades at the horizon
+                    LightShaftsPlugin(horizon_fade=0.03),   # the sun's own colour already fades at the horizon
+                    AntialiasPlugin(mode="taa"))
     app.add_system(switch_key, "update", label="cloud_renderer_switch")
     add_demo_camera(app, settings)
     if horizon:

@@ -16,6 +16,7 @@ from atmos.lighting import Sun
 from atmos.plugins.fog import PAPER_RESOLUTIONS, FogPlugin
 from atmos.plugins.sky_gradient import SkyGradientPlugin
 from atmos.plugins.terrain import TerrainPlugin
+from atmos.plugins.antialias import AntialiasPlugin
 
 TITLE = "heterogeneous Perlin-turbulence fog over a 10,000-triangle valley (Zdrojewska 2004)"
 DEFAULT_FRAMES = 60
@@ -58,7 +59,8 @@ def build(app, settings, fog_preset: str | None = None) -> FogPlugin:
     fog = FogPlugin(sky="fog", tile_size=NOISE_TILE, seed=settings.seed, **preset(name))   # --seed: the noise lattice
     app.insert_resource(Sun.from_angles(elevation_deg=30.0, azimuth_deg=-30.0))
     terrain = TerrainPlugin(size=TERRAIN_SIZE, relief=10.0, rock_slope=0.6)   # steep grassy hills, as in the paper
-    app.add_plugins(DefaultPlugins(overlay=not settings.headless), SkyGradientPlugin(), terrain, fog)
+    app.add_plugins(DefaultPlugins(overlay=not settings.headless), SkyGradientPlugin(), terrain, fog,
+                    AntialiasPlugin(mode="taa"))
     cam = app.resource(Camera)
     cam.position = CAMERA_POS.copy()
     cam.far = terrain.far_plane()

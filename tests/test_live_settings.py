@@ -439,7 +439,10 @@ SPECS["clouds"] = _clouds_spec()
 SPECS["antialias"] = Spec(
     lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(), AntialiasPlugin()],
     AntialiasPlugin, look((0.0, 3.0, 10.0), yaw=0.3, pitch=0.02),
-    dict(span_max=1.0, reduce_mul=1.0, reduce_min=1.0))
+    dict(span_max=1.0, reduce_mul=1.0, reduce_min=1.0, mode="taa", history=0.5),
+    # the temporal mode past its running mean (1 / (n + 1) below the history's weight): the weight it blends with
+    before={"history": lambda app, plugin: [configure_first(mode="taa")(app, plugin)] + [render(app) for _ in range(12)]},
+    observe={"history": lambda app, plugin: plugin.taa.weight})
 def adapting_from(offset):
     """One frame's adaptation from ``offset`` EV off the metered target (the camera's speeds show there)."""
     def observe(app, plugin):

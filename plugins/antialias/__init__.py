@@ -1,27 +1,42 @@
-"""Anti-aliasing of the frame's edges (meshes, terrain, the horizon): FXAA (Lottes 2009) on the HDR
-colour just before ``present``, so the stair steps of every opaque edge are blurred along the edge
-and nothing else is touched: ``AntialiasPlugin(settings=None, **fields)`` with :class:`AntialiasSettings`.
-The pass copies ``color`` and draws the filtered image back over it (``shaders/antialias/fxaa.frag``;
-float64 reference: :mod:`.reference`)."""
+"""Anti-aliasing of the frame's edges (meshes, terrain, the horizon): ``AntialiasPlugin(settings=None,
+**fields)`` with :class:`AntialiasSettings`, in one of two modes (or ``"none"``), both on the HDR
+colour just before ``present``:
+
+- ``"fxaa"`` (FXAA, Lottes 2009): the stair steps of every opaque edge blurred along the edge, nothing
+  else touched; the pass copies ``color`` and draws the filtered image back over it
+  (``shaders/antialias/fxaa.frag``).
+- ``"taa"`` (temporal, :mod:`.temporal`): the geometry drawn a sub-pixel off each frame and the frames
+  blended through reprojection, so a still view converges to a supersampled one and the shading's
+  own aliasing (a checkerboard into the distance) goes too.
+
+float64 references: :mod:`.reference`."""
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from atmos.checks import CheckedSettings, num_field
+from atmos.checks import CheckedSettings, choice_field, num_field
 from atmos.graph import FullscreenPass, PassBuilder, PassContext, TextureDesc
 from atmos.gpu.uniforms import bind_textures, write_uniforms
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR
+from atmos.scene_view import FrameJitter
+from atmos.plugins.antialias.temporal import TemporalAAPass, jitter_offset, jitter_system
 
 SOURCE = "antialias_source"      # the copy of the frame's colour the filter reads
 
 
 @dataclass(frozen=True)
 class AntialiasSettings(CheckedSettings):
-    """FXAA's three constants (all live)."""
-    span_max: float = num_field(8.0, 1.0, 16.0, "pixels: the longest blur along an edge")
-    reduce_mul: float = num_field(1 / 8, 0.0, 1.0, "how much a bright neighbourhood shortens the blur")
-    reduce_min: float = num_field(1 / 128, 1e-4, 1.0, "the least shortening (keeps flat areas sharp)")
+    """The mode and its constants (all live)."""
+    mode: str = choice_field("fxaa", ("fxaa", "taa", "none"), "fxaa: a filter along the edges of each frame; taa: "
+                             "the geometry jittered every frame and the frames blended through reprojection; "
+                             "none: no pass")
+    history: float = num_field(0.1, 0.0, 1.0, "taa: the newest frame's least weight (a running mean of a still "
+                               "view until 1 / (n + 1) falls to it; smaller: smoother and slower to follow)",
+                               lo_open=True)
+    span_max: float = num_field(8.0, 1.0, 16.0, "fxaa: pixels: the longest blur along an edge")
+    reduce_mul: float = num_field(1 / 8, 0.0, 1.0, "fxaa: how much a bright neighbourhood shortens the blur")
+    reduce_min: float = num_field(1 / 128, 1e-4, 1.0, "fxaa: the least shortening (keeps flat areas sharp)")
 
 
 class AntialiasPass(FullscreenPass):
@@ -30,7 +45,12 @@ class AntialiasPass(FullscreenPass):
     phase = "present"
     fragment = "antialias/fxaa.frag"
 
+    def setup_key(self) -> tuple:
+        return (self.plugin.settings.mode, self.plugin.gpu.size)
+
     def setup(self, builder: PassBuilder) -> None:
+        if self.plugin.settings.mode != "fxaa":
+            return
         w, h = self.plugin.gpu.size
         builder.create(SOURCE, TextureDesc((w, h), components=4, dtype="f2"))
         builder.read(COLOR)
@@ -46,15 +66,19 @@ class AntialiasPass(FullscreenPass):
 
 
 class AntialiasPlugin(Plugin):
-    """Anti-aliases the frame (pass "antialias"); ``configure(**changes)`` changes the constants live."""
+    """Anti-aliases the frame (pass "antialias" in mode fxaa, "temporal_aa" and the geometry's jitter in
+    mode taa); ``configure(**changes)`` changes the mode and the constants live."""
 
     settings_class = AntialiasSettings
+    taa = None
 
     def build(self, app) -> None:
         if app.graph is None:
             raise ValueError("AntialiasPlugin needs an App with a GPU context (App(gpu))")
         self.gpu = app.gpu
         app.graph.add_pass(AntialiasPass(self))
+        self.taa = app.graph.add_pass(TemporalAAPass(self))
+        app.add_system(jitter_system(self, app.init_resource(FrameJitter)), "update", label="antialias_jitter")
 
 
-__all__ = ["AntialiasPass", "AntialiasPlugin", "AntialiasSettings"]
+__all__ = ["AntialiasPass", "AntialiasPlugin", "AntialiasSettings", "TemporalAAPass", "jitter_offset"]

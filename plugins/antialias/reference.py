@@ -50,3 +50,72 @@ def fxaa(image, reduce_min: float, reduce_mul: float, span_max: float) -> np.nda
     l_b = luma(b)
     out = np.where(((l_b < l_min) | (l_b > l_max))[..., None], a, b)
     return np.concatenate([out, m[..., 3:]], -1)
+
+
+# -- temporal anti-aliasing (shaders/antialias/taa_resolve.comp) --------------------------------------
+TAA_LUMA = np.array([0.2126, 0.7152, 0.0722])
+TAA_MOTION_GAIN = 0.2          # taa_resolve.comp's MOTION_GAIN: the newest frame's weight per pixel moved
+
+
+def halton(n: int, base: int) -> float:
+    """The n-th (from 1) point of the van der Corput sequence in ``base``, in (0, 1)."""
+    f, r, n = 1.0, 0.0, int(n)
+    while n > 0:
+        f /= base
+        r += f * (n % base)
+        n //= base
+    return r
+
+
+def catmull_rom(img, px, py) -> np.ndarray:
+    """``img`` (h, w, c) at pixel coordinates (px, py) by Catmull-Rom over the 4x4 nearest texels, clamped
+    to the edge (taa_resolve.comp history_at)."""
+    tx, ty = np.asarray(px, np.float64) - 0.5, np.asarray(py, np.float64) - 0.5
+    ix, iy = np.floor(tx).astype(np.int64), np.floor(ty).astype(np.int64)
+    def weights(f):
+        return (f * (-0.5 + f * (1.0 - 0.5 * f)), 1.0 + f * f * (-2.5 + 1.5 * f), f * (0.5 + f * (2.0 - 1.5 * f)),
+                f * f * (-0.5 + 0.5 * f))
+    wx, wy = weights(tx - ix), weights(ty - iy)
+    out = 0.0
+    for j in range(4):
+        for i in range(4):
+            out = out + (wx[i] * wy[j])[..., None] * _fetch(img, ix + i - 1, iy + j - 1)
+    return out
+
+
+def taa_resolve(color, depth, history, basis, position, near: float, far: float, prev_view_proj,
+                blend: float) -> np.ndarray:
+    """float64 (h, w, 4) of taa_resolve.comp: ``color`` (h, w, 4) and window ``depth`` (h, w) of this frame
+    (row 0 at the bottom) seen through ``basis`` (atmos.camera.view_basis) from ``position``; ``history``
+    (h, w, 4) the last output or None; ``prev_view_proj`` the previous frame's 4×4 view_proj."""
+    color = np.asarray(color, np.float64)
+    h, w = color.shape[:2]
+    out = color.copy()
+    if history is None:
+        return out
+    ys, xs = np.mgrid[0:h, 0:w]
+    pad = np.pad(color[..., :3], ((1, 1), (1, 1), (0, 0)), mode="edge")
+    dpad = np.pad(np.asarray(depth, np.float64), 1, mode="edge")
+    stack = np.stack([pad[1 + dy:1 + dy + h, 1 + dx:1 + dx + w] for dy in (-1, 0, 1) for dx in (-1, 0, 1)])
+    lo, hi = stack.min(axis=0), stack.max(axis=0)
+    d = np.min([dpad[1 + dy:1 + dy + h, 1 + dx:1 + dx + w] for dy in (-1, 0, 1) for dx in (-1, 0, 1)], axis=0)
+    uv = np.stack([(xs + 0.5) / w, (ys + 0.5) / h], -1)
+    ray = np.concatenate([uv * 2.0 - 1.0, np.ones((h, w, 1))], -1) @ np.asarray(basis, np.float64).T
+    with np.errstate(divide="ignore"):
+        z = near / ((1.0 - d) + d * (near / far))
+    point = np.where((d < 1.0)[..., None], np.asarray(position, np.float64) + z[..., None] * ray, ray)
+    clip = np.concatenate([point, (d < 1.0).astype(np.float64)[..., None]], -1) @ np.asarray(prev_view_proj, np.float64).T
+    valid = clip[..., 3] > 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        prev = clip[..., :2] / clip[..., 3:] * 0.5 + 0.5
+    valid &= np.all((prev >= 0.0) & (prev <= 1.0), axis=-1)
+    prev = np.where(valid[..., None], prev, 0.5)
+    past = np.clip(catmull_rom(np.asarray(history, np.float64)[..., :3], prev[..., 0] * w, prev[..., 1] * h), lo, hi)
+    now = color[..., :3]
+    moved = np.hypot(prev[..., 0] * w - (xs + 0.5), prev[..., 1] * h - (ys + 0.5))
+    a = np.maximum(blend, np.minimum(moved * TAA_MOTION_GAIN, 1.0))
+    wn = a / (1.0 + now @ TAA_LUMA)
+    wp = (1.0 - a) / (1.0 + past @ TAA_LUMA)
+    blended = (now * wn[..., None] + past * wp[..., None]) / (wn + wp)[..., None]
+    out[..., :3] = np.where(valid[..., None], blended, now)
+    return out

@@ -20,4 +20,11 @@ layout(std140, binding = 0) uniform Frame {
     vec2 jitter;           // 240  this frame's subpixel jitter in pixels (0: none)
     vec2 resolution;       // 248  frame width, height in pixels
 };                         // 256 bytes
+
+// A scene vertex's clip position moved by this frame's sub-pixel jitter (temporal antialiasing,
+// atmos.plugins.temporal_aa; jitter 0: unchanged). The scene's rasterised geometry (ground, terrain,
+// meshes) takes it; passes that march rays through pixel centres do not.
+vec4 jitter_clip(vec4 clip) {
+    return vec4(clip.xy + jitter * (2.0 / resolution) * clip.w, clip.zw);
+}
 #endif

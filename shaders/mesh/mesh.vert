@@ -14,5 +14,5 @@ void main() {
     vec4 world = in_model * vec4(in_position, 1.0);
     v_normal = transpose(inverse(mat3(in_model))) * in_normal;
     v_color = in_color;
-    gl_Position = view_proj * world;
+    gl_Position = jitter_clip(view_proj * world);
 }

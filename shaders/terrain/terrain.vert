@@ -9,5 +9,5 @@ out vec3 v_normal;
 void main() {
     v_world = in_position;
     v_normal = in_normal;
-    gl_Position = view_proj * vec4(in_position, 1.0);
+    gl_Position = jitter_clip(view_proj * vec4(in_position, 1.0));
 }
