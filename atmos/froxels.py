@@ -11,6 +11,7 @@ import struct
 
 import numpy as np
 
+from atmos.checks import num_field
 from atmos.gpu.uniforms import write_block
 from atmos.graph import TextureDesc, work_groups
 
@@ -89,7 +90,6 @@ _HISTORY_BLOCK = struct.Struct("<3f4x3f4x3f4x3f4fi")   # its std140 layout (80 b
 
 def history_field():
     """The ``froxel_history`` setting of an effect with a froxel volume (declared here once)."""
-    from atmos.checks import num_field
     return num_field(HISTORY_BLEND, 0.0, 1.0, "froxels: the least weight of the newest frame in the volume's "
                      "temporal accumulation (atmos.froxels.FroxelHistory: each slice sampled at a point that "
                      "moves every frame, the frames averaged through reprojection); 1: no history, every "
@@ -137,7 +137,7 @@ def history_reference(fresh, history, basis, position, prev_basis, prev_position
 
 class FroxelHistory:
     """A froxel volume's temporal accumulation (``shaders/core/froxel_history.comp``): the pass fills its
-    transient volume with each slice sampled at :meth:`jitter` and calls :meth:`resolve`, which blends it
+    transient volume with each slice sampled at :func:`froxel_jitter` (where :meth:`jittered`) and calls :meth:`resolve`, which blends it
     over the last output reprojected into this frame's view and returns the output to read (one of two
     3D textures kept across frames, freed by :meth:`release`). The newest frame weighs max(1 / (n + 1),
     ``blend``) after n frames (a running mean, then an exponential one); the history restarts when the
@@ -153,10 +153,6 @@ class FroxelHistory:
         history goes on from the frame before with a ``blend`` below 1; where it restarts the fill samples the
         middles (a first or single frame is unbiased)."""
         return blend < 1.0 and self._state is not None and self._state[1] == frame_index - 1
-
-    def jitter(self, frame_index: int, blend: float) -> float:
-        """The slice offset the fill samples at in frame ``frame_index`` (:func:`froxel_jitter`)."""
-        return froxel_jitter(frame_index, self.jittered(frame_index, blend))
 
     def resolve(self, frame, fresh, range_: float, knee: float, blend: float, key=()):
         """Blend ``fresh`` (a 3D texture the pass filled) over the history; return the resolved texture."""
@@ -197,8 +193,7 @@ class FroxelHistory:
         ctx = self.gpu.ctx
         self._volumes = []
         for _ in range(2):
-            tex = ctx.texture3d(size, 4, dtype="f2")
-            tex.write(bytes(size[0] * size[1] * size[2] * 8))
+            tex = ctx.texture3d(size, 4, dtype="f2")       # read only once written (has_history)
             tex.repeat_x = tex.repeat_y = tex.repeat_z = False
             self._volumes.append(self.gpu.track(tex))
         self._current, self._state, self.frames = 0, None, 0

@@ -11,7 +11,7 @@ from atmos.lighting import GroundSurface, Sun
 @dataclass
 class FrameJitter:
     """App resource: this frame's sub-pixel offset (x, y) in pixels of the scene's rasterised geometry,
-    set each frame by a temporal antialiasing plugin (:mod:`atmos.plugins.temporal_aa`); it reaches the
+    set each frame by a temporal antialiasing plugin (:mod:`atmos.plugins.antialias.temporal`); it reaches the
     frame block's ``jitter`` (``lib/frame.glsl`` ``jitter_clip``). Without the resource: (0, 0)."""
     pixels: tuple = (0.0, 0.0)
 

@@ -5,11 +5,12 @@ extremes stay finite; a resize restarts the history."""
 from __future__ import annotations
 
 import math
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from atmos import App, DefaultPlugins, MeshInstance, MeshPlugin, Transform, box
 from atmos.camera import Camera, camera_matrices
 from atmos.frame_constants import bind_frame
 from atmos.gpu import create_headless
@@ -18,11 +19,11 @@ from atmos.gpu.uniforms import bind_images, bind_textures, write_block
 from atmos.lighting import Sun
 from atmos.plugins.antialias import AntialiasPlugin, jitter_offset
 from atmos.plugins.antialias.reference import taa_resolve
-from atmos.plugins.antialias.temporal import TAA_BINDING
-from atmos.plugins.ground import GroundPlugin
-from atmos.plugins.sky_gradient import SkyGradientPlugin
-from atmos.render_core import CapturePass
+from atmos.plugins.antialias.temporal import TAA_BINDING, taa_block
 from atmos.scene_view import FrameJitter
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+from bench_antialias import scene, shown  # noqa: E402
 
 F16 = 2.0 ** -11
 
@@ -45,9 +46,8 @@ def gpu_resolve(gpu, color, depth, history, camera, prev, blend):
     textures = [texture(gpu.ctx, color), texture(gpu.ctx, depth), texture(gpu.ctx, past)]
     out = gpu.ctx.texture((w, h), 4, dtype="f2")
     try:
-        write_block(p, "TemporalAA", TAA_BINDING, camera_matrices(prev, w / h).gl("view_proj")
-                    + np.array([blend], np.float32).tobytes() + np.array([history is not None], np.int32).tobytes()
-                    + bytes(8))
+        write_block(p, "TemporalAA", TAA_BINDING, taa_block(camera_matrices(prev, w / h).gl("view_proj"), blend,
+                                                            history is not None))
         bind_textures(p, color_in=textures[0], depth_in=textures[1], history=textures[2])
         bind_images(p, resolved=out)
         dispatch(p, -(-w // 8), -(-h // 8))
@@ -116,17 +116,12 @@ def test_extremes_stay_finite(gpu, rng):
 
 
 def box_scene(gpu, *plugins):
-    app = App(gpu).add_plugins(DefaultPlugins(fly_camera=False), SkyGradientPlugin(), GroundPlugin(), MeshPlugin(),
-                               *plugins)
-    app.world.create_entity(Transform((0.0, 2.0, -8.0), yaw=0.5, roll=0.3), MeshInstance(box((3, 3, 3)), (0.9, 0.2, 0.1)))
+    """benchmarks/bench_antialias.py's scene (a box over the ground plane), seen from 2 m up."""
+    app, capture = scene(gpu, *plugins)
     cam = app.resource(Camera)
     cam.position = np.array([0.0, 2.0, 0.0])
     cam.yaw, cam.pitch = 0.0, -0.05
-    return app, app.graph.add_pass(CapturePass())
-
-
-def shown(hdr):
-    return np.clip(hdr[..., :3] / (1.0 + hdr[..., :3]), 0.0, 1.0) ** (1 / 2.2)
+    return app, capture
 
 
 def test_the_geometry_moves_by_the_jitter():

@@ -57,16 +57,6 @@ TAA_LUMA = np.array([0.2126, 0.7152, 0.0722])
 TAA_MOTION_GAIN = 0.2          # taa_resolve.comp's MOTION_GAIN: the newest frame's weight per pixel moved
 
 
-def halton(n: int, base: int) -> float:
-    """The n-th (from 1) point of the van der Corput sequence in ``base``, in (0, 1)."""
-    f, r, n = 1.0, 0.0, int(n)
-    while n > 0:
-        f /= base
-        r += f * (n % base)
-        n //= base
-    return r
-
-
 def catmull_rom(img, px, py) -> np.ndarray:
     """``img`` (h, w, c) at pixel coordinates (px, py) by Catmull-Rom over the 4x4 nearest texels, clamped
     to the edge (taa_resolve.comp history_at)."""

@@ -6,7 +6,7 @@ bloom and tone map read the colour) blends each frame over its reprojected histo
 kept (two rgba16f textures, one the last output, read by Catmull-Rom) for the next frame. A still view
 converges to the mean of its jittered frames (a running mean while 1 / (n + 1) > ``history``); a moving
 one keeps edges whole through the neighbourhood clamp, its newest frame weighing more the farther each
-point moved. float64 twins: :mod:`.reference` (``halton``, ``taa_resolve``)."""
+point moved. float64 twin: :mod:`.reference` (``taa_resolve``)."""
 from __future__ import annotations
 
 import struct
@@ -16,10 +16,25 @@ from atmos.graph import ComputePass, PassBuilder, PassContext
 from atmos.gpu.uniforms import write_block
 from atmos.render_core import COLOR, DEPTH
 from atmos.scene_view import FrameJitter
-from atmos.plugins.antialias.reference import halton
 
 TAA_BINDING = 1                 # taa_resolve.comp's TemporalAA block
 JITTER_SAMPLES = 8              # sub-pixel positions before the pattern repeats (Halton 2, 3)
+
+
+def halton(n: int, base: int) -> float:
+    """The n-th (from 1) point of the van der Corput sequence in ``base``, in (0, 1)."""
+    f, r, n = 1.0, 0.0, int(n)
+    while n > 0:
+        f /= base
+        r += f * (n % base)
+        n //= base
+    return r
+
+
+def taa_block(prev_view_proj: bytes, weight: float, has_history: bool) -> bytes:
+    """taa_resolve.comp's TemporalAA block (std140): the previous view_proj's column-major float32 bytes
+    (:meth:`atmos.camera.CameraMatrices.gl`), the newest frame's weight, whether there is a history."""
+    return prev_view_proj + struct.pack("<fi8x", weight, has_history)
 
 
 def jitter_offset(frame_index: int, samples: int = JITTER_SAMPLES) -> tuple[float, float]:
@@ -77,7 +92,7 @@ class TemporalAAPass(ComputePass):
         prev = matrices if self._prev is None else self._prev
         weight = max(1.0 / (self.frames + 1), self.plugin.settings.history)
         p, groups = self.resolve_program, self._groups
-        write_block(p, "TemporalAA", TAA_BINDING, prev.gl("view_proj") + struct.pack("<fi8x", weight, self.frames > 0))
+        write_block(p, "TemporalAA", TAA_BINDING, taa_block(prev.gl("view_proj"), weight, self.frames > 0))
         history, out = self._textures[self._current], self._textures[1 - self._current]
         frame.dispatch(p, groups, textures={"color_in": COLOR, "depth_in": DEPTH, "history": history},
                        images={"resolved": out})
@@ -96,5 +111,4 @@ def jitter_system(plugin, jitter: FrameJitter):
         elif jitter.pixels != (0.0, 0.0) or plugin.taa.frames:
             jitter.pixels = (0.0, 0.0)
             plugin.taa.release()
-    set_jitter.__name__ = "antialias_jitter"
     return set_jitter

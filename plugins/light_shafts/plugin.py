@@ -86,10 +86,11 @@ class LightShaftsPass(RenderPass):
 
     def execute(self, frame: PassContext) -> None:
         view, gpu, params = frame.view, frame.gpu, self.plugin.settings
-        if params.mode != "march" or not uses_froxels(params, self.plugin.fog):
+        froxels = params.mode == "march" and uses_froxels(params, self.plugin.fog)
+        if not froxels:
             self.froxels.history.release()              # no volume to accumulate: no history kept
         if params.mode == "march":
-            shafts = self.froxels if uses_froxels(params, self.plugin.fog) else self.marched
+            shafts = self.froxels if froxels else self.marched
             shafts.execute(frame, params, frame.declares(CLOUD_SETS), self.plugin.fog, self.plugin.aerial())
             return
         w, h = view.size

@@ -37,7 +37,8 @@ class LightShaftSettings(CheckedSettings):
     distance (``steps`` and ``downsample`` then unused): W·H·D samples whatever the frame's size, edges
     as soft as a column; each slice's sample moves every frame and the frames are averaged through
     reprojection (``froxel_history``), so a still view converges to the slices' mean, without bands.
-    None (or a heterogeneous fog): per texel at 1/``downsample`` resolution, ``steps`` jittered samples each (``benchmarks/bench_light_shafts.py`` compares both).
+    None (or a heterogeneous fog): per texel at 1/``downsample`` resolution, ``steps`` jittered samples
+    each (``benchmarks/bench_light_shafts.py`` compares both).
 
     Screen: sky pixels brighter than ``threshold`` near the sun (open to the sky: ``1 − color.a``)
     form a mask, blurred toward the sun's screen position and added to the colour (at most

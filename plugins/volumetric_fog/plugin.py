@@ -64,14 +64,15 @@ class VolumetricFogPass(ComputePass):
                 builder.read(name, access="storage")
                 builder.write(name, access="storage")
 
-    history: FroxelHistory | None = None       # the froxel volume's temporal accumulation (settings.froxels)
-
     def defines(self) -> dict:
         return {"LOCAL_MEDIA": int(self.plugin.composition.media)}
 
+    def prepare(self, gpu) -> None:
+        super().prepare(gpu)
+        self.history = FroxelHistory(gpu)      # the froxel volume's temporal accumulation (settings.froxels)
+
     def release(self) -> None:
-        if self.history is not None:
-            self.history.release()
+        self.history.release()
 
     def execute(self, frame: PassContext) -> None:
         view, settings = frame.view, self.plugin.settings
@@ -80,8 +81,7 @@ class VolumetricFogPass(ComputePass):
             images.update(media_light_image=MEDIA_LIGHT, media_transmittance_image=MEDIA_TRANSMITTANCE)
         color = frame.image(COLOR)
         if settings.froxels is None:
-            if self.history is not None:
-                self.history.release()                 # no volume to accumulate: no history kept
+            self.history.release()                     # no volume to accumulate: no history kept
             p = self.program
             set_camera_uniforms(p, view.camera, view.aspect)
             set_medium_uniforms(p, settings, view.sun, self.plugin.time(view), self.plugin.sky_ambient(view))
@@ -95,8 +95,6 @@ class VolumetricFogPass(ComputePass):
             set_camera_uniforms(p, view.camera, view.aspect)
             write_uniforms(p, froxel_knee=froxel_knee(settings.max_distance), max_distance=settings.max_distance)
         set_medium_uniforms(fill, settings, view.sun, self.plugin.time(view), self.plugin.sky_ambient(view))
-        if self.history is None:
-            self.history = FroxelHistory(self.gpu)
         index = view.clock.frame
         write_uniforms(fill, froxel_frame=index & 0xFFFFFFFF,
                        froxel_jittered=int(self.history.jittered(index, settings.froxel_history)))
