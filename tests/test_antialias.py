@@ -26,12 +26,15 @@ def gpu_fxaa(gpu, image, settings=SETTINGS):
 
 
 def edgy(rng, h=37, w=53):
-    """Random slanted edges between random HDR colours, a little noise, random alpha."""
+    """Random slanted edges through the image between random HDR colours, a little noise, random alpha.
+    The colours' brightness levels differ (FXAA sees luma only: two colours of one luma make no edge)."""
     y, x = np.mgrid[0:h, 0:w]
+    levels = rng.permutation([0.05, 0.5, 1.5, 4.0])
     image = np.zeros((h, w, 4))
-    for _ in range(3):
-        a, c = rng.uniform(-1, 1, 2), rng.uniform(0, 3, 3)
-        inside = a[0] * (x - rng.uniform(0, w)) + a[1] * (y - rng.uniform(0, h)) > 0
+    image[..., :3] = levels[0] * rng.uniform(0.6, 1.4, 3)
+    for level in levels[1:]:
+        a, c = rng.uniform(-1, 1, 2), level * rng.uniform(0.6, 1.4, 3)
+        inside = a[0] * (x - rng.uniform(0.25, 0.75) * w) + a[1] * (y - rng.uniform(0.25, 0.75) * h) > 0
         image[inside, :3] = c
     image[..., :3] += rng.uniform(0, 0.05, (h, w, 3))
     image[..., 3] = rng.uniform(0, 1, (h, w))
