@@ -53,6 +53,18 @@ def test_shear_warp_gpu_matches_numpy_scheme(gpu, ctx, rng, scale):
         np.testing.assert_allclose(got, want, atol=3e-5, err_msg=f"sun {sun}, sigma {sigma}")
 
 
+@pytest.mark.parametrize("shape", [(40, 9, 33), (7, 30, 5)])
+def test_columns_match_the_twin_at_grazing_suns_and_over_many_groups(gpu, ctx, rng, shape):
+    """Volumes wider than one 16x16 group of columns, suns at and around the horizon (rays leaving through
+    the lateral faces: many cells march their own ray) and on the 45-degree ties."""
+    density = smooth_field(rng, shape) * np.float32(rng.uniform(0.5, 3))
+    azimuth = rng.uniform(0, 360)
+    for sun in (direction(1, azimuth), direction(0, azimuth), direction(-3, azimuth), direction(45, 0),
+                direction(35.26, 45), direction(rng.uniform(-90, 90), azimuth)):
+        got = compute_transmittance(gpu, density, sun, 0.6)
+        np.testing.assert_allclose(got, R.shear_warp_scheme(density, sun, 0.6), atol=3e-5, err_msg=f"sun {sun}")
+
+
 def test_every_voxel_written(gpu, ctx, rng):
     density = smooth_field(rng)
     texture = upload_volume(gpu, density)
@@ -96,9 +108,9 @@ def test_raymarch_matches_exact_reference(gpu, ctx, rng):
         np.testing.assert_allclose(got, R.transmittance_exact(density, sun, sigma), atol=2e-6, rtol=1e-5)
 
 
-# Small random volumes with features ~3 cells tall: over 75 seeds x low suns the worst mean error of
-# the full-resolution shear-warp was 0.011 (the 0.005 goal is on 128x32x128, benchmarks/bench_shading.py).
-SMALL_VOLUME_MEAN_ERROR = 0.015
+# Small random volumes with features ~3 cells tall: over 12 seeds x 9 elevations the worst mean error of
+# the full-resolution shear-warp is 0.0015 (sun-aligned columns; the per-slice scheme before them: 0.0069).
+SMALL_VOLUME_MEAN_ERROR = 0.004
 
 
 @pytest.mark.parametrize("elevation", [90, 60, 45, 30, 10, 1, 0, -20, -90])
@@ -129,7 +141,9 @@ def test_straight_down_is_exact(gpu, ctx, rng):
 
 @pytest.mark.parametrize("pair", [("y", "x"), ("x", "z"), ("y", "z")])
 def test_45_degrees_both_axes_agree(gpu, ctx, rng, pair):
-    """Exactly on the case switch the tie goes to a fixed axis; nudging either way gives nearly the same."""
+    """Exactly on the case switch the tie goes to a fixed axis; nudging either way gives nearly the same:
+    each side within 0.08 of the exact transmittance everywhere (the largest over 120 random cases was
+    0.056: the columns' warp interpolates differently on the two sides), so they agree within that."""
     density = smooth_field(rng)
     axes = {"x": 0, "y": 1, "z": 2}
     base = np.zeros(3)
@@ -148,8 +162,10 @@ def test_45_degrees_both_axes_agree(gpu, ctx, rng, pair):
     assert results["tie"][0] == results["first"][0] == axes[pair[0]]
     assert results["second"][0] == axes[pair[1]]
     diff = np.abs(results["first"][1] - results["second"][1])
-    assert diff.mean() < 2e-3 and diff.max() < 0.05, (diff.mean(), diff.max())
+    assert diff.mean() < 2e-3 and diff.max() < 0.08, (diff.mean(), diff.max())
     exact = R.transmittance_exact(density, base, 0.5)
+    for name, (_, got) in results.items():
+        assert np.abs(got - exact).max() < 0.08, name
     assert np.abs(results["tie"][1] - exact).mean() < SMALL_VOLUME_MEAN_ERROR
 
 
@@ -191,10 +207,14 @@ def test_empty_and_tiny_volumes(gpu, ctx, rng):
 
 # -- energy sanity --------------------------------------------------------------------------------------
 def test_transmittance_never_increases_along_the_light_path(gpu, ctx, rng):
-    """Each voxel is at most as bright as the brightest of the four voxels one step toward the sun
-    (no new maxima: the bicubic lookup is limited); exactly so where the step hits a voxel."""
+    """Each voxel is at most as bright as the brightest of the four voxels one step toward the sun;
+    exactly so where the step hits a voxel (axis and diagonal suns). Between voxels T is not convex:
+    the exact transmittance itself exceeds those four by up to 0.004 in these fields, so for other
+    suns the bound allows 0.01."""
     density = smooth_field(rng) * 3
     for sun in [random_direction(rng) for _ in range(4)] + [(0, 1, 0), (1, 1, 0), (0, -1, -1)]:
+        on_voxels = sum(abs(x) for x in sun) in (1, 2) and all(abs(x) in (0, 1) for x in sun)
+        allowed = 1e-6 if on_voxels else 0.01
         t = compute_transmittance(gpu, density, sun, 0.5)
         assert t.min() >= 0 and t.max() <= 1
         plan = R.SlicePlan(SHAPE, R.check_sun_dir(sun))
@@ -209,7 +229,7 @@ def test_transmittance_never_increases_along_the_light_path(gpu, ctx, rng):
             prev = tp[j + plan.sign]
             brightest = np.max([prev[np.minimum(fb + i, nb - 1), np.minimum(fc + k, nc - 1)]
                                 for i in (0, 1) for k in (0, 1)], axis=0)
-            assert (tp[j][inside] <= brightest[inside] + 1e-6).all(), sun
+            assert (tp[j][inside] <= brightest[inside] + allowed).all(), sun
 
 
 # -- sliced (amortized) shading -------------------------------------------------------------------------

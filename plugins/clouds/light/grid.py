@@ -87,3 +87,24 @@ class SlicePlan:
     @property
     def count(self) -> int:
         return len(self.order)
+
+    # -- sun-aligned columns (the true-path shear-warp) ----------------------------------------------
+    @property
+    def lateral_step(self) -> np.ndarray:
+        """``v``: the index-space step toward the sun along the two lateral axes, per slice."""
+        return self.step[list(self.lateral)]
+
+    def column_shift(self) -> np.ndarray:
+        """(count, 2) ints: floor(k * v) for slice k (k-th in :attr:`order`), in float32 arithmetic as
+        the shader works it out. Column Q lies at lateral ``Q - k v`` on slice k, so the cells of slice k
+        take their depth from columns ``c + shift[k]`` (the tap at fraction ``k v - shift[k]``)."""
+        v = self.lateral_step.astype(np.float32)
+        return np.floor(np.arange(self.count, dtype=np.float32)[:, None] * v[None, :]).astype(np.int64)
+
+    def column_range(self) -> tuple[np.ndarray, np.ndarray]:
+        """(first column, column count) per lateral axis: every column a cell's bicubic taps (-1..+2
+        around ``c + shift``) reach, with one more on each side (float32 rounding of ``k v``)."""
+        shift = self.column_shift()
+        n = np.array([self.shape[a] for a in self.lateral])
+        first = shift.min(axis=0) - 2
+        return first, shift.max(axis=0) + n + 2 - first + 1

@@ -33,17 +33,6 @@ from atmos.plugins.clouds.light.grid import (LATERAL, MAJOR_ORDER, SCALES, SIGMA
                                 check_density, check_scale, check_sigma, shading_shape)
 
 
-# -- geometry --------------------------------------------------------------------------------------
-def exit_fraction(q, v: float, n: int):
-    """Fraction of one step ``v`` (one lateral axis) before a ray from integer ``q`` leaves [-0.5, n-0.5]."""
-    q = np.asarray(q, dtype=np.float64)
-    if v > 0:
-        return (n - 0.5 - q) / v
-    if v < 0:
-        return (q + 0.5) / -v
-    return np.full_like(q, np.inf)
-
-
 # -- interpolation ---------------------------------------------------------------------------------
 def multilinear(grid: np.ndarray, points: np.ndarray) -> np.ndarray:
     """Clamp-to-edge multilinear samples of an n-d ``grid`` at index-space ``points`` (..., n)."""
@@ -68,46 +57,6 @@ def catmull_rom(t: np.ndarray) -> tuple:
     """Catmull-Rom weights of the taps at -1, 0, 1, 2 for fractions ``t``."""
     t2, t3 = t * t, t * t * t
     return (0.5 * (-t3 + 2 * t2 - t), 0.5 * (3 * t3 - 5 * t2 + 2), 0.5 * (-3 * t3 + 4 * t2 + t), 0.5 * (t3 - t2))
-
-
-def taps(i: np.ndarray, n: int, v: float) -> tuple[np.ndarray, np.ndarray]:
-    """Index and sign of lateral tap ``i`` of a slice of ``n`` texels whose sun-facing side (the
-    one ``v`` points to) mirrors *oddly* about the face (optical depth 0 there, linear through it);
-    the other side clamps to the edge."""
-    sign = np.ones(np.shape(i))
-    if v > 0:
-        beyond = i > n - 1
-        i = np.where(beyond, 2 * n - 1 - i, i)
-        sign = np.where(beyond, -1.0, 1.0)
-    elif v < 0:
-        beyond = i < 0
-        i = np.where(beyond, -1 - i, i)
-        sign = np.where(beyond, -1.0, 1.0)
-    return np.clip(i, 0, n - 1), sign
-
-
-def cubic(plane: np.ndarray, y: np.ndarray, v=(0.0, 0.0)) -> np.ndarray:
-    """Bicubic (Catmull-Rom) samples of the previous slice's optical depth at (..., 2) positions.
-
-    Taps beyond a sun-facing face are odd mirrors (:func:`taps`); the result is limited to the range
-    of the four nearest taps and to >= 0, so optical depth never drops along a ray."""
-    n = plane.shape
-    i0 = np.floor(y).astype(np.int64)
-    fr = y - i0
-    w = catmull_rom(fr[..., 0]), catmull_rom(fr[..., 1])
-    out = np.zeros(y.shape[:-1])
-    lo = np.full(y.shape[:-1], np.inf)
-    hi = np.full(y.shape[:-1], -np.inf)
-    ta = [taps(i0[..., 0] + k - 1, n[0], v[0]) for k in range(4)]
-    tb = [taps(i0[..., 1] + k - 1, n[1], v[1]) for k in range(4)]
-    for i in range(4):
-        for k in range(4):
-            value = plane[ta[i][0], tb[k][0]] * ta[i][1] * tb[k][1]
-            out += w[0][i] * w[1][k] * value
-            if i in (1, 2) and k in (1, 2):
-                lo = np.minimum(lo, value)
-                hi = np.maximum(hi, value)
-    return np.maximum(np.clip(out, lo, hi), 0.0)
 
 
 def lerp_matrix(positions: np.ndarray, n: int) -> np.ndarray:
@@ -208,17 +157,18 @@ def shear_warp_scheme(density, sun_dir, sigma, scale: int = 1, fixed_ratio: bool
                       levels: int = 0) -> np.ndarray:
     """The GPU shear-warp algorithm in float64 (returns T on the fine grid of ``density``).
 
-    True-path model: for voxel q of slice j, ``f`` = the fraction of one step toward the sun before
-    the ray leaves the box (1 inside, 0.5 on the light-side slice, less near a lateral face)::
-
-        f >= 1:  tau = tau_prev(q + v) + sigma * L * (rho(q) + rho(q + v)) / 2
-        f <  1:  tau = sigma * f * L * (rho(q) + rho(q + f v)) / 2
-
-    ``tau_prev`` is bicubic in the previous slice, limited, odd-mirrored across a sun-facing face
-    (``cubic``: 0 on the face, no diffusion of the linear profile there), ``L``
-    the true length of one slice step. ``fixed_ratio``: the thesis's model, ``T = T_prev(q + v) *
-    exp(-sigma * rho(q + v))`` per slice whatever the angle, 1 on the light-side slice, optionally
-    rounded to ``levels`` steps (255: 8-bit storage).
+    True-path model (sun-aligned columns): column Q starts on the light-side slice at lateral ``Q`` and
+    lies at ``Q - k v`` on the k-th slice (``v`` the lateral step toward the sun per slice). Along its own
+    straight ray it adds, per slice, ``sigma * L * (t1 - t0) * (rho(t0) + rho(t1)) / 2`` over the part
+    ``[t0, t1]`` of the step toward the previous slice (t = 0 here, 1 there; half a step on the
+    light-side slice) that lies inside the box: no interpolation between columns, so no numerical
+    diffusion. The warp: cell c of slice k takes the depth of the columns around ``c + k v`` bicubically
+    (Catmull-Rom, limited to the four nearest), then ``T = exp(-depth)``. Where that cannot work (a tap
+    beyond a face, or taps whose rays leave the box through different faces, where the depth bends:
+    :func:`bends`) the cell marches its own ray toward the sun by the same steps. ``L`` is the true
+    length of one slice step. ``fixed_ratio``: the thesis's model, ``T = T_prev(q + v) * exp(-sigma * rho(q + v))``
+    per slice whatever the angle, 1 on the light-side slice, optionally rounded to ``levels`` steps
+    (255: 8-bit storage).
     """
     fine = check_density(density)
     u = check_sun_dir(sun_dir)
@@ -229,35 +179,120 @@ def shear_warp_scheme(density, sun_dir, sigma, scale: int = 1, fixed_ratio: bool
     plan = SlicePlan(d.shape, u, spacing)
     a, (b, c) = plan.axis, plan.lateral
     dp = np.transpose(d, (a, b, c))
-    na, nb, nc = dp.shape
-    vb, vc = plan.step[b], plan.step[c]
+    if fixed_ratio:
+        out = _fixed_ratio(dp, plan, sigma, levels)
+    else:
+        out = _columns(dp, plan, sigma)
+    result = np.transpose(out, np.argsort((a, b, c)))
+    return upsample(result, fine.shape) if scale > 1 else result
+
+
+def _fixed_ratio(dp: np.ndarray, plan: SlicePlan, sigma: float, levels: int) -> np.ndarray:
+    """The thesis's slice-by-slice model on the (axis, b, c)-ordered density ``dp``."""
+    _, nb, nc = dp.shape
+    vb, vc = plan.lateral_step
     qb, qc = np.meshgrid(np.arange(nb, dtype=np.float64), np.arange(nc, dtype=np.float64), indexing="ij")
-    fl = np.minimum(exit_fraction(qb, vb, nb), exit_fraction(qc, vc, nc))
     step = np.array([plan.sign, vb, vc])
     out = np.empty_like(dp)
     prev = None
     for j in plan.order:
         p = np.stack([np.full_like(qb, j), qb, qc], axis=-1)
-        y = np.stack([qb + vb, qc + vc], axis=-1)
-        if fixed_ratio:
-            if prev is None:
-                value = np.ones_like(qb)
-            else:
-                value = bilinear(prev, y) * np.exp(-sigma * trilinear(dp, p + step))
-                if levels:
-                    value = np.round(value * levels) / levels
-            out[j] = value
+        if prev is None:
+            value = np.ones_like(qb)
         else:
-            f = np.minimum(fl, 0.5 if prev is None else 1.0)
-            rho0 = dp[j]
-            with np.errstate(over="ignore", invalid="ignore"):
-                full = f >= 1
-                rho1 = trilinear(dp, p + np.where(full, 1.0, f)[..., None] * step)
-                tau = sigma * (0.5 * rho0 + 0.5 * rho1) * (np.where(full, 1.0, f) * plan.length)
-                if prev is not None:
-                    tau = tau + np.where(full, cubic(prev, y, (vb, vc)), 0.0)
-                value = np.minimum(tau, TAU_MAX)
-            out[j] = np.exp(-value)
-        prev = value
-    result = np.transpose(out, np.argsort((a, b, c)))
-    return upsample(result, fine.shape) if scale > 1 else result
+            value = bilinear(prev, np.stack([qb + vb, qc + vc], axis=-1)) * np.exp(-sigma * trilinear(dp, p + step))
+            if levels:
+                value = np.round(value * levels) / levels
+        out[j] = prev = value
+    return out
+
+
+def _step_depth(dp: np.ndarray, plan: SlicePlan, sigma: float, k, p: np.ndarray) -> np.ndarray:
+    """The optical depth of one step toward the sun from lateral points ``p`` (..., 2) on the k-th slice
+    (ordinal ``k``, an int or an array like ``p[..., 0]``): ``sigma * L * (t1 - t0) * (rho(t0) + rho(t1)) / 2``
+    over the part [t0, t1] of the step inside the box (half a step from the light-side slice)."""
+    n, v = np.array(dp.shape[1:]), plan.lateral_step
+    k = np.broadcast_to(np.asarray(k), p.shape[:-1])
+    lo, hi = np.zeros(p.shape[:-1]), np.where(k == 0, 0.5, 1.0)
+    for i in range(2):
+        if v[i] != 0:
+            t0, t1 = (-0.5 - p[..., i]) / v[i], (n[i] - 0.5 - p[..., i]) / v[i]
+            lo, hi = np.maximum(lo, np.minimum(t0, t1)), np.minimum(hi, np.maximum(t0, t1))
+        else:
+            hi = np.where((p[..., i] >= -0.5) & (p[..., i] <= n[i] - 0.5), hi, -1.0)
+    slice_at = np.asarray(plan.order)[np.clip(k, 0, plan.count - 1)]
+
+    def rho(t):
+        point = np.concatenate([(slice_at + t * plan.sign)[..., None], p + t[..., None] * v], axis=-1)
+        return np.minimum(trilinear(dp, point), 1e37)
+    with np.errstate(over="ignore", invalid="ignore"):
+        add = sigma * (0.5 * rho(lo) + 0.5 * rho(hi)) * ((hi - lo) * plan.length)
+    return np.where(hi > lo, add, 0.0)
+
+
+def _columns(dp: np.ndarray, plan: SlicePlan, sigma: float) -> np.ndarray:
+    """The true-path model (sun-aligned columns, see :func:`shear_warp_scheme`) on ``dp``."""
+    n = np.array(dp.shape[1:])
+    v = plan.lateral_step
+    shift = plan.column_shift()
+    kv = np.arange(plan.count, dtype=np.float32)[:, None] * v.astype(np.float32)[None, :]   # as the shader
+    first, count = plan.column_range()
+    q = np.stack(np.meshgrid(*(np.arange(f, f + m, dtype=np.float64) for f, m in zip(first, count)),
+                             indexing="ij"), axis=-1)
+    cells = np.stack(np.meshgrid(np.arange(n[0], dtype=np.float64), np.arange(n[1], dtype=np.float64),
+                                 indexing="ij"), axis=-1)
+    tau = np.zeros(q.shape[:-1])
+    out = np.empty_like(dp)
+    for k, j in enumerate(plan.order):
+        tau = np.minimum(tau + _step_depth(dp, plan, sigma, k, q - k * v), TAU_MAX)
+        # the warp: cell c of this slice from the columns c + shift - 1 .. c + shift + 2
+        fr = kv[k].astype(np.float64) - shift[k]
+        w = catmull_rom(fr[0]), catmull_rom(fr[1])
+        taps = [np.arange(m)[:, None] + np.arange(-1, 3)[None, :] + shift[k, i] - first[i] for i, m in enumerate(n)]
+        total = np.zeros(dp.shape[1:])
+        low, high = np.full(total.shape, np.inf), np.full(total.shape, -np.inf)
+        for tb in range(4):
+            for tc in range(4):
+                value = tau[np.ix_(taps[0][:, tb], taps[1][:, tc])]
+                total += w[0][tb] * w[1][tc] * value
+                if tb in (1, 2) and tc in (1, 2):
+                    low, high = np.minimum(low, value), np.maximum(high, value)
+        depth = np.clip(total, low, high)
+        band = bends(n, v, k, kv[k] - shift[k].astype(np.float32))   # own rays there
+        if band.any():
+            start = cells[band]
+            own = np.zeros(len(start))
+            for back in range(k + 1):          # from the cell toward the sun, slice by slice
+                own = np.minimum(own + _step_depth(dp, plan, sigma, k - back, start + back * v), TAU_MAX)
+            depth[band] = own
+        out[j] = np.exp(-np.maximum(depth, 0.0))
+    return out
+
+
+def bends(n, v, k: int, f) -> np.ndarray:
+    """(n_b, n_c) bools: the cells of the k-th slice whose depth the warp cannot interpolate, so that
+    they march their own ray: a tap (lateral ``c - 1 - f .. c + 2 - f``) lies beyond a face (along an axis
+    with ``v != 0``; with ``v == 0`` those taps weigh 0), or the taps do not all leave the box toward the
+    sun through the same face (the depth bends between them). A ray leaves through the light-side
+    face after ``k + 0.5`` steps, through the sun-facing face of lateral axis i after ``(face - x) / v_i``.
+    In float32, in the shader's order (``shear_warp.glsl bends``), so both take the same cells."""
+    f32 = np.float32
+    shape = (int(n[0]), int(n[1]))
+    light_side = f32(k) + f32(0.5)
+    low, high = [np.full(shape, f32(1e38)) for _ in range(2)], [np.full(shape, f32(1e38)) for _ in range(2)]
+    beyond = np.zeros(shape, bool)
+    for i in range(2):
+        vi = f32(v[i])
+        if vi == 0:
+            continue
+        c = np.arange(n[i], dtype=f32).reshape([-1 if a == i else 1 for a in range(2)])
+        first, last = c - f32(1.0) - f32(f[i]), c + f32(2.0) - f32(f[i])
+        beyond |= np.broadcast_to((first < f32(-0.5)) | (last > f32(n[i]) - f32(0.5)), shape)
+        face = f32(n[i]) - f32(0.5) if vi > 0 else f32(-0.5)
+        e0, e1 = (face - first) / vi, (face - last) / vi
+        low[i], high[i] = np.broadcast_to(np.minimum(e0, e1), shape), np.broadcast_to(np.maximum(e0, e1), shape)
+    one_face = light_side < np.minimum(low[0], low[1])
+    for i in range(2):
+        if f32(v[i]) != 0:
+            one_face |= high[i] < np.minimum(light_side, low[1 - i])
+    return beyond | ~one_face

@@ -1,13 +1,17 @@
-"""Transmittance toward the sun by inverse shear-warp (thesis sec. 5.2), on the GPU, a slice at a time.
+"""Transmittance toward the sun by shear-warp (thesis sec. 5.2) on the GPU: sun-aligned columns, one
+dispatch per run of slices.
 
 The slices run along the axis closest to the light (y, x or z, either direction; ties go to y, then
-x, then z), starting on the light side. Slice k reads only slice k-1's optical depth from one of two
-ping-pong ``r32f`` images and writes its own to the other, plus ``exp(-depth)`` into the result
-volume: no CPU round trip. Unlike the thesis (a fixed attenuation ratio per slice in 8 bits) each
-step adds ``sigma * mean density * true path length`` (slice spacing / |cos| of the angle to the
-axis) in float; the previous slice is read bicubically (limited, so depth never drops along a ray,
-odd-mirrored across a sun-facing face), which keeps the numerical diffusion of the shifted lookups
-small. The float64 twin is :func:`reference.shear_warp_scheme`.
+x, then z), starting on the light side. Each column of ``shear_warp.comp`` follows one straight ray
+away from the sun through the slices, adding ``sigma * mean density * true path length`` per step
+(trapezoid, partial where the ray crosses the box) in float, so no interpolation error builds up
+along a ray; the cells of each slice take their depth bicubically from the columns around them (the
+warp) and store ``exp(-depth)`` in the result volume. A group of 16×16 columns shares each slice's
+depths in shared memory (one ``barrier()`` per slice), and two ping-pong ``r32f`` images carry the
+columns' depths from one run of slices to the next: no CPU round trip, no memory barrier between
+slices. The float64 twin is :func:`reference.shear_warp_scheme`. The thesis's own model
+(``model="fixed-ratio"``: a fixed attenuation ratio per slice in 8 bits) runs a dispatch per slice
+(``fixed_ratio.comp``), for comparison.
 
 Sliced use (thesis sec. 7.1): :meth:`ShearWarpShader.begin` latches the density, sun direction and
 sigma (a sun moving later changes the *next* pass, never this one), then :meth:`run_slices` runs
@@ -17,6 +21,7 @@ any ``[i0, i1)`` of the :attr:`slice_count` slices in order; :class:`ShadingTask
 from __future__ import annotations
 
 import math
+import struct
 
 import moderngl
 import numpy as np
@@ -24,14 +29,18 @@ import numpy as np
 from atmos.checks import check_shape, check_sun_dir
 from atmos.slicing import SliceTask
 from atmos.gpu.context import GpuContext, require_gpu
-from atmos.gpu.uniforms import bind_images, bind_textures, write_uniforms
+from atmos.gpu.uniforms import bind_buffers, bind_images, bind_textures, write_block, write_uniforms
 import atmos.plugins.clouds.light.grid as grid
-from atmos.gpu.hazards import dispatch
+from atmos.gpu.hazards import dispatch, dispatch_indirect
 from atmos.gpu.block_table import BlockTable, ints
 
 _RESULT_FORMATS = {"f4": "r32f", "f2": "r16f"}
 _UNIT = ((1, 0, 0), (0, 1, 0), (0, 0, 1))      # axis_a/b/c by axis
-SLICE_BINDING = 1                               # shear_warp.comp's Slice block
+SLICE_BINDING = 1                               # fixed_ratio.comp's Slice block
+COLUMNS_BLOCK, COLUMNS_BINDING = "Columns", 1   # shear_warp.comp's block of one run's constants
+_COLUMNS = struct.Struct("<4i4i4i4f")            # std140: grid, axes, columns, light (see the shader)
+OWN = 13                                        # columns a 16x16 group writes per side (shear_warp.comp's OWN)
+_BAND_EMPTY = struct.pack("<4I", 0, 1, 1, 0)     # shear_warp.comp's band_args before a run: no groups, no cells
 
 
 def program(gpu: GpuContext, name: str, **defines):
@@ -87,12 +96,20 @@ class ShearWarpShader:
         side = max(self.shading_shape)
         self._objects = []
         self.result = self._track(self.ctx.texture3d(self.shading_shape, 1, dtype="f4"))
-        self._slices = [self._track(self.ctx.texture((side, side), 1, dtype="f4")) for _ in range(2)]
         self._coarse = (self._track(self.ctx.texture3d(self.shading_shape, 1, dtype="f4"))
                         if self.scale > 1 else None)
-        self._slice_table = BlockTable(gpu, SLICE_BINDING, [ints(j, first) for j in range(side) for first in (0, 1)])
-        self._objects.append(self._slice_table)
+        if model == "fixed-ratio":       # the previous slice's T, ping-pong; one Slice record per dispatch
+            self._slices = [self._track(self.ctx.texture((side, side), 1, dtype="f4")) for _ in range(2)]
+            self._slice_table = self._track(BlockTable(gpu, SLICE_BINDING,
+                                                       [ints(j, first) for j in range(side) for first in (0, 1)]))
+        else:       # each column's depth and last rho between runs, ping-pong: at most slices + side + 6 columns
+            carry = -(-(2 * side + 6) // OWN) * OWN
+            self._carry = [self._track(self.ctx.texture((carry, carry), 2, dtype="f4")) for _ in range(2)]
+            # the cells that march their own ray: the rays' dispatch arguments, then (x | y << 16, k) per cell
+            self._band = self._track(self.ctx.buffer(reserve=16 + 8 * int(np.prod(self.shading_shape))))
         self._plan = None
+        self._columns = None
+        self._flip = False
         self._next = 0
 
     def _track(self, obj):
@@ -121,6 +138,7 @@ class ShearWarpShader:
             density_texture = self._coarse
         spacing = np.array(self.shape) / np.array(self.shading_shape)
         self._plan = grid.SlicePlan(self.shading_shape, u, spacing)
+        self._columns = self._plan.column_range() if self.model == "true-path" else None
         self._density, self._sigma = density_texture, sigma
         self._target = self.result if target is None else target
         self._next = 0
@@ -154,14 +172,46 @@ class ShearWarpShader:
                              f"(the next slice) and i0 <= i1 <= {count}")
         if i0 == i1:
             return
-        plan = self._plan
-        defines = {"RESULT_FORMAT": _RESULT_FORMATS[self._target.dtype]}
         if self.model == "fixed-ratio":
-            defines.update(FIXED_RATIO=1, LEVELS=self.levels)
-        prog = program(self.gpu, "shear_warp", **defines)
+            self._run_fixed_ratio(i0, i1)
+        else:
+            self._run_columns(i0, i1)
+        self._next = i1
+
+    def _run_columns(self, i0: int, i1: int) -> None:
+        """Slices ``i0 .. i1-1``: one dispatch over the columns (``shear_warp.comp``), which lists the cells
+        its warp cannot interpolate, and one indirect dispatch over those (``shear_warp_rays.comp``:
+        their own rays); each writes its own cells of the result."""
+        plan = self._plan
+        first, count = self._columns
+        fmt = _RESULT_FORMATS[self._target.dtype]
+        (b, c), v = plan.lateral, plan.lateral_step
+        block = _COLUMNS.pack(*self.shading_shape, plan.count, plan.axis, b, c, plan.sign, int(first[0]),
+                              int(first[1]), i0, i1, float(v[0]), float(v[1]), plan.length, self._sigma)
+        carry_in, carry_out = self._carry if self._flip else self._carry[::-1]
+        self._flip = not self._flip
+        self._band.write(_BAND_EMPTY)
+        columns = program(self.gpu, "shear_warp", RESULT_FORMAT=fmt)
+        write_block(columns, COLUMNS_BLOCK, COLUMNS_BINDING, block)
+        bind_textures(columns, density=self._density)
+        bind_images(columns, carry_in=carry_in, carry_out=carry_out, result=self._target)
+        bind_buffers(columns, Band=self._band)
+        dispatch(columns, groups(count[0], OWN), groups(count[1], OWN))
+        rays = program(self.gpu, "shear_warp_rays", RESULT_FORMAT=fmt)
+        write_block(rays, COLUMNS_BLOCK, COLUMNS_BINDING, block)
+        bind_textures(rays, density=self._density)
+        bind_images(rays, result=self._target)
+        bind_buffers(rays, Band=self._band)
+        dispatch_indirect(rays, self._band)
+
+    def _run_fixed_ratio(self, i0: int, i1: int) -> None:
+        """Slices ``i0 .. i1-1`` of the thesis's model: a dispatch per slice (``fixed_ratio.comp``)."""
+        plan = self._plan
+        prog = program(self.gpu, "fixed_ratio", RESULT_FORMAT=_RESULT_FORMATS[self._target.dtype],
+                       LEVELS=self.levels)
         a, (b, c) = plan.axis, plan.lateral
         write_uniforms(prog, size=self.shading_shape, axis_a=_UNIT[a], axis_b=_UNIT[b], axis_c=_UNIT[c],
-                       step_dir=tuple(map(float, plan.step)), step_len=float(plan.length), sigma=self._sigma)
+                       step_dir=tuple(map(float, plan.step)), sigma=self._sigma)
         bind_textures(prog, density=self._density)
         bind_images(prog, result=self._target)
         gb, gc = groups(self.shading_shape[b], 8), groups(self.shading_shape[c], 8)
@@ -171,7 +221,6 @@ class ShearWarpShader:
             bind_images(prog, prev_slice=src, next_slice=dst)
             self._slice_table.use(2 * int(order[i]) + (i == 0))     # the Slice block: (slice, first)
             dispatch(prog, gb, gc)
-        self._next = i1
 
     def run_all(self) -> None:
         """Run the remaining slices of the current pass."""

@@ -1,110 +1,107 @@
 #version 430
-// One slice of the inverse shear-warp (plugins/shading/shear_warp.py; float64 twin: reference.shear_warp_scheme).
-// Voxel q of slice `slice`: optical depth = previous slice's (bicubic, limited, at q + step) + sigma *
-// trapezoid of the density over the true path length of the step; partial step where the ray leaves.
-// FIXED_RATIO: the thesis's model (T = T_prev(q + step) * exp(-sigma * rho), bilinear, LEVELS rounding).
-layout(local_size_x = 8, local_size_y = 8) in;
-#include "clouds/light/sample.glsl"
+// The true-path shear-warp as one dispatch of sun-aligned columns (plugins/clouds/light/shear_warp.py;
+// float64 twin: reference.shear_warp_scheme). Column Q starts on the light-side slice at lateral Q and lies
+// at Q - k v on the k-th slice (v: the lateral step toward the sun per slice). Along its own straight ray it
+// adds sigma * L * (t1 - t0) * (rho(t0) + rho(t1)) / 2 over the part [t0, t1] of the step toward the slice
+// before that lies inside the box (half a step on the light-side slice): no interpolation between columns.
+// The warp: cell c of slice k takes the depth of the 4x4 columns around c + k v (Catmull-Rom, limited to
+// the four nearest), except where that cannot work (bends(): listed in Band for shear_warp_rays.comp, which
+// marches those cells). A group marches TILE x TILE columns, shares BATCH slices' depths in shared memory
+// at a time (one barrier per batch) and writes the cells of its OWN x OWN inner columns; the depths carry
+// over to the next run's slices.
+layout(local_size_x = 16, local_size_y = 16) in;
+#include "clouds/light/shear_warp.glsl"
 
-layout(binding = 0) uniform sampler3D density;                         // shading grid, texelFetch only
-layout(r32f, binding = 0) uniform readonly image2D prev_slice;
-layout(r32f, binding = 1) uniform writeonly image2D next_slice;
-layout(RESULT_FORMAT, binding = 2) uniform writeonly image3D result;
+const int TILE = 16;
+const int OWN = TILE - 3;      // taps -1 .. +2 around the owner's column
+const int BATCH = 8;           // slices per barrier
 
-uniform ivec3 size;            // shading grid (x, y, z)
-uniform ivec3 axis_a;          // unit vectors: slicing axis and the two lateral axes
-uniform ivec3 axis_b;
-uniform ivec3 axis_c;
-layout(std140, binding = 1) uniform Slice {   // one record per (slice, first), bound per dispatch
-    int slice;
-    int first;                 // 1 on the light-side slice (no previous slice)
+layout(rg32f, binding = 0) uniform readonly image2D carry_in;   // per column after the last run: depth, rho (< 0: none)
+layout(rg32f, binding = 1) uniform writeonly image2D carry_out;
+
+layout(std430, binding = 0) buffer Band {     // the cells that march their own ray, appended
+    uvec4 band_args;           // dispatch of shear_warp_rays.comp (groups of 64, 1, 1); cells listed
+    uvec2 band[];              // (x | y << 16, k)
 };
-uniform vec3 step_dir;         // index-space step toward the sun, component along axis_a = +-1
-uniform float step_len;        // its true length in fine cells
-uniform float sigma;
 
-const float TAU_MAX = 1e30;
-
-float exit_fraction(float q, float v, int n) {
-    if (v > 0.0) return (float(n) - 0.5 - q) / v;
-    if (v < 0.0) return (q + 0.5) / -v;
-    return 1e30;
-}
-
-// lateral tap: odd mirror beyond the sun-facing face, clamp on the other side (reference.taps)
-int tap(int i, int n, float v, out float s) {
-    s = 1.0;
-    if (v > 0.0 && i > n - 1) { i = 2 * n - 1 - i; s = -1.0; }
-    if (v < 0.0 && i < 0) { i = -1 - i; s = -1.0; }
-    return clamp(i, 0, n - 1);
-}
+shared float depths[2][BATCH][TILE][TILE];
 
 vec4 catmull_rom(float t) {
     float t2 = t * t, t3 = t2 * t;
     return 0.5 * vec4(-t3 + 2.0 * t2 - t, 3.0 * t3 - 5.0 * t2 + 2.0, -3.0 * t3 + 4.0 * t2 + t, t3 - t2);
 }
 
-#ifndef FIXED_RATIO
-float previous_depth(vec2 y, ivec2 n, vec2 v) {
-    vec2 fl = floor(y);
-    vec2 t = y - fl;
-    ivec2 i0 = ivec2(fl);
-    vec4 wa = catmull_rom(t.x), wb = catmull_rom(t.y);
-    float sum = 0.0, lo = 1e38, hi = -1e38;
-    for (int k = 0; k < 4; ++k) {
-        float sb;
-        int ib = tap(i0.y + k - 1, n.y, v.y, sb);
-        for (int i = 0; i < 4; ++i) {
-            float sa;
-            int ia = tap(i0.x + i - 1, n.x, v.x, sa);
-            float value = imageLoad(prev_slice, ivec2(ia, ib)).r * sa * sb;
-            sum += wa[i] * wb[k] * value;
-            if (i == 1 || i == 2) {
-                if (k == 1 || k == 2) { lo = min(lo, value); hi = max(hi, value); }
+void main() {
+    ivec2 n = lateral_size();
+    ivec2 l = ivec2(gl_LocalInvocationID.xy);
+    ivec2 slot = ivec2(gl_WorkGroupID.xy) * OWN + l - 1;       // the column's place in the carry images
+    ivec2 column = columns.xy + slot;
+    bool owner = all(greaterThanEqual(l, ivec2(1))) && all(lessThanEqual(l, ivec2(OWN)));
+    vec2 v = light.xy;
+    float depth = 0.0;
+    float rho_before = -1.0;       // rho where this column crossed the slice before (t = 1 of this step); < 0: none
+    if (columns.z > 0 && all(greaterThanEqual(slot, ivec2(0))) && all(lessThan(slot, imageSize(carry_in)))) {
+        vec2 carried = imageLoad(carry_in, slot).rg;
+        depth = carried.x;
+        rho_before = carried.y;
+    }
+    vec2 group_low = vec2(columns.xy + ivec2(gl_WorkGroupID.xy) * OWN - 1);     // the group's first column
+    for (int start = columns.z; start < columns.w; start += BATCH) {
+        int end = min(start + BATCH, columns.w);
+        // the whole group outside the box on these slices (and the step before): nothing to add, no cell to
+        // write; the same for every invocation of the group, so the barrier is skipped by all of them. The
+        // group's columns move in a straight line through the convex box, so the batches it works on are
+        // consecutive and the two shared buffers still alternate between barriers.
+        vec2 a = group_low - float(max(start - 1, 0)) * v, b = group_low - float(end - 1) * v;
+        vec2 lo = min(a, b), hi = max(a, b) + float(TILE - 1);
+        if (any(lessThan(hi, vec2(-1.5))) || any(greaterThan(lo, vec2(n) + 0.5))) {
+            rho_before = -1.0;
+            continue;
+        }
+        int parity = (start / BATCH) & 1;          // two buffers: the next batch writes the other one
+        for (int k = start; k < end; ++k) {
+            vec2 p = vec2(column) - float(k) * v;
+            vec2 part = inside_part(k, p, n);
+            float rho_here = -1.0;
+            if (part.y > part.x) {
+                float r0 = rho_at(k, p, part.x);
+                if (part.x == 0.0) rho_here = r0;
+                float r1 = part.y == 1.0 && rho_before >= 0.0 ? rho_before : rho_at(k, p, part.y);
+                depth = min(depth + step_depth(part, r0, r1), TAU_MAX);
+            }
+            rho_before = rho_here;
+            depths[parity][k - start][l.y][l.x] = depth;
+        }
+        memoryBarrierShared();
+        barrier();
+        if (owner) {
+            for (int k = start; k < end; ++k) {
+                vec2 kv = float(k) * v;
+                ivec2 shift = ivec2(floor(kv));
+                ivec2 cell = column - shift;
+                vec2 f = kv - vec2(shift);
+                if (any(lessThan(cell, ivec2(0))) || any(greaterThanEqual(cell, n))) continue;
+                if (bends(k, cell, f, n)) {
+                    uint index = atomicAdd(band_args.w, 1u);
+                    if (index < uint(band.length())) {
+                        band[index] = uvec2(uint(cell.x) | (uint(cell.y) << 16), uint(k));
+                        atomicMax(band_args.x, index / 64u + 1u);
+                    }
+                    continue;
+                }
+                vec4 wb = catmull_rom(f.x), wc = catmull_rom(f.y);
+                float sum = 0.0, low = 1e38, high = -1e38;
+                for (int j = 0; j < 4; ++j) {
+                    for (int i = 0; i < 4; ++i) {
+                        float tap = depths[parity][k - start][l.y + j - 1][l.x + i - 1];
+                        sum += wb[i] * wc[j] * tap;
+                        if ((i == 1 || i == 2) && (j == 1 || j == 2)) { low = min(low, tap); high = max(high, tap); }
+                    }
+                }
+                float value = clamp(sum, low, high);
+                imageStore(result, ivec3(grid_point(float(slice_of(k)), vec2(cell))), vec4(exp(-max(value, 0.0))));
             }
         }
     }
-    return max(clamp(sum, lo, hi), 0.0);
-}
-#else
-float previous_transmittance(vec2 y, ivec2 n) {
-    y = clamp(y, vec2(0.0), vec2(n - 1));
-    vec2 fl = floor(y);
-    vec2 t = y - fl;
-    ivec2 i0 = ivec2(fl);
-    ivec2 i1 = min(i0 + 1, n - 1);
-    float a = shading_lerp(imageLoad(prev_slice, i0).r, imageLoad(prev_slice, ivec2(i0.x, i1.y)).r, t.y);
-    float b = shading_lerp(imageLoad(prev_slice, ivec2(i1.x, i0.y)).r, imageLoad(prev_slice, i1).r, t.y);
-    return shading_lerp(a, b, t.x);
-}
-#endif
-
-void main() {
-    ivec2 n = ivec2(dot(size, axis_b), dot(size, axis_c));
-    ivec2 q = ivec2(gl_GlobalInvocationID.xy);
-    if (q.x >= n.x || q.y >= n.y) return;
-    ivec3 cell = axis_a * slice + axis_b * q.x + axis_c * q.y;
-    vec3 p = vec3(cell);
-    vec2 v = vec2(dot(step_dir, vec3(axis_b)), dot(step_dir, vec3(axis_c)));
-    vec2 y = vec2(q) + v;
-#ifdef FIXED_RATIO
-    float value = 1.0;
-    if (first == 0) {
-        value = previous_transmittance(y, n) * exp(-sigma * shading_trilinear(density, size, p + step_dir));
-        if (LEVELS > 0) value = floor(value * float(LEVELS) + 0.5) / float(LEVELS);
-    }
-    float transmittance = value;
-#else
-    float f = first != 0 ? 0.5 : 1.0;
-    f = min(f, min(exit_fraction(float(q.x), v.x, n.x), exit_fraction(float(q.y), v.y, n.y)));
-    bool full = f >= 1.0;
-    float g = full ? 1.0 : f;
-    float rho = 0.5 * min(texelFetch(density, cell, 0).r, 1e37) + 0.5 * shading_trilinear(density, size, p + g * step_dir);
-    float value = (sigma * rho) * (g * step_len);      // sigma = 0 gives exactly 0, never 0 * inf
-    if (full) value += previous_depth(y, n, v);
-    value = min(value, TAU_MAX);
-    float transmittance = exp(-value);
-#endif
-    imageStore(next_slice, q, vec4(value));
-    imageStore(result, cell, vec4(transmittance));
+    if (owner && columns.w > columns.z) imageStore(carry_out, slot, vec4(depth, rho_before, 0.0, 0.0));
 }
