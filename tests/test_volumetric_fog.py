@@ -16,6 +16,7 @@ from atmos.plugins.volumetric_fog import reference
 from atmos.plugins.volumetric_fog.plugin import set_medium_uniforms, sun_terms
 from atmos.render_core import CapturePass
 from atmos.gpu.uniforms import bind_buffers
+from atmos.frame_constants import bind_frame
 
 EPS32 = 2.0 ** -24
 
@@ -49,6 +50,7 @@ def gpu_march(gpu, origins, dirs, limits, params, sun, time=0.0):
     dst = ctx.buffer(np.full((n, 4), np.nan, np.float32).tobytes())
     try:
         bind_buffers(prog, Rays=src, Results=dst)
+        bind_frame(gpu, sun=sun)                      # the sun's direction: the frame block's
         set_medium_uniforms(prog, params, sun, time)
         prog["count"].value = n
         prog.run(-(-n // 16))
@@ -306,15 +308,13 @@ def gpu_froxels(gpu, camera, aspect, froxels, params, sun, time=0.0, frame=None)
     from atmos.gpu.hazards import dispatch
     from atmos.gpu.uniforms import bind_images, write_uniforms
     from atmos.froxels import froxel_knee
-    from atmos.scene_uniforms import set_camera_uniforms
     w, h, d = froxels
     prog = gpu.program(compute_shader="volumetric_fog/froxels.comp")
     volume = gpu.ctx.texture3d((w, h, d + 1), 4, dtype="f2")
     try:
-        set_camera_uniforms(prog, camera, aspect)
+        bind_frame(gpu, camera, sun, (aspect, 1.0), frame_index=frame or 0)     # camera (its aspect), sun, frame
         set_medium_uniforms(prog, params, sun, time)
-        write_uniforms(prog, froxel_knee=froxel_knee(params.max_distance), froxel_frame=frame or 0,
-                       froxel_jittered=int(frame is not None))
+        write_uniforms(prog, froxel_knee=froxel_knee(params.max_distance), froxel_jittered=int(frame is not None))
         bind_images(prog, fog_volume=volume)
         dispatch(prog, -(-w // 8), -(-h // 8))
         data = np.frombuffer(volume.read(), np.float16).astype(np.float64)

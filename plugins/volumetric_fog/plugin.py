@@ -3,7 +3,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.scene_uniforms import set_camera_uniforms
 from atmos.composition import MEDIA_LIGHT, MEDIA_TRANSMITTANCE, composition
 from atmos.froxels import FroxelHistory, froxel_knee, volume_desc, volume_image
 from atmos.gpu.uniforms import write_uniforms
@@ -32,13 +31,14 @@ def sun_terms(sun: Sun, settings: VolumetricFogSettings, sky_ambient=None):
 
 
 def set_medium_uniforms(program, settings: VolumetricFogSettings, sun: Sun, time: float, sky_ambient=None) -> None:
-    """Write every uniform of ``volumetric_fog/medium.glsl``."""
-    s, sun_light, ambient_light = sun_terms(sun, settings, sky_ambient)
+    """Write every uniform of ``volumetric_fog/medium.glsl`` (the sun's direction it reads from the frame
+    block, ``lib/frame.glsl``: the frame's Sun, whose direction is ``sun``'s)."""
+    _, sun_light, ambient_light = sun_terms(sun, settings, sky_ambient)
     values = {"center": settings.center, "scale": settings.scale, "bias": settings.bias, "falloff": settings.falloff,
-              "frequency": settings.frequency, "wind": settings.wind, "time": float(time),
+              "frequency": settings.frequency, "wind": settings.wind, "fog_time": float(time),
               "octaves": settings.octaves, "seed": settings.seed, "absorption": settings.absorption,
               "steps": settings.steps, "light_steps": settings.light_steps, "light_step": settings.light_step,
-              "max_distance": settings.max_distance, "sun_dir": tuple(s), "sun_light": tuple(sun_light),
+              "max_distance": settings.max_distance, "sun_light": tuple(sun_light),
               "ambient_light": tuple(ambient_light)}
     write_uniforms(program, values)
 
@@ -83,7 +83,6 @@ class VolumetricFogPass(ComputePass):
         if settings.froxels is None:
             self.history.release()                     # no volume to accumulate: no history kept
             p = self.program
-            set_camera_uniforms(p, view.camera, view.aspect)
             set_medium_uniforms(p, settings, view.sun, self.plugin.time(view), self.plugin.sky_ambient(view))
             frame.dispatch(p, self.groups(color.size), textures={"scene_depth": DEPTH}, images=images)
             return
@@ -92,12 +91,9 @@ class VolumetricFogPass(ComputePass):
         apply = self.gpu.program(compute_shader="volumetric_fog/froxel_apply.comp", defines=defines)
         volume = volume_image(frame, FOG_VOLUME)
         for p in (fill, apply):
-            set_camera_uniforms(p, view.camera, view.aspect)
             write_uniforms(p, froxel_knee=froxel_knee(settings.max_distance), max_distance=settings.max_distance)
         set_medium_uniforms(fill, settings, view.sun, self.plugin.time(view), self.plugin.sky_ambient(view))
-        index = view.clock.frame
-        write_uniforms(fill, froxel_frame=index & 0xFFFFFFFF,
-                       froxel_jittered=int(self.history.jittered(index, settings.froxel_history)))
+        write_uniforms(fill, froxel_jittered=int(self.history.jittered(view.clock.frame, settings.froxel_history)))
         frame.dispatch(fill, work_groups(volume.size[:2], (8, 8)), images={"fog_volume": volume})
         volume = self.history.resolve(frame, volume, settings.max_distance, froxel_knee(settings.max_distance),
                                       settings.froxel_history)

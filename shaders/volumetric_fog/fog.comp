@@ -1,6 +1,7 @@
 #version 430
 // Volumetric FBM fog over the scene, stopped at scene depth, one invocation per pixel: the march
-// (volumetric_fog/medium.glsl) composited onto the colour in place (lib/media_image.glsl).
+// (volumetric_fog/medium.glsl) composited onto the colour in place (lib/media_image.glsl); the camera is
+// the frame block's (lib/frame.glsl).
 #include "lib/hash.glsl"
 #include "lib/value_noise.glsl"
 #include "lib/view_ray.glsl"
@@ -8,10 +9,6 @@
 #include "lib/media_image.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) uniform sampler2D scene_depth;
-uniform mat3 view_basis;       // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
-uniform vec3 camera_pos;
-uniform float near;
-uniform float far;
 
 void main() {
     ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);

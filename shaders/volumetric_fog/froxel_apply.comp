@@ -2,15 +2,13 @@
 // The volumetric fog from its froxel volume (volumetric_fog/froxels.comp), one invocation per pixel:
 // (light, transmittance) read trilinearly at the pixel's uv and the slice of its scene distance (capped
 // at max_distance, where the march ends), composited onto the colour in place (lib/media_image.glsl).
+#include "lib/frame.glsl"
 #include "lib/view_ray.glsl"
 #include "lib/froxel_slices.glsl"
 #include "lib/media_image.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) uniform sampler2D scene_depth;
 layout(binding = 1) uniform sampler3D fog_volume;
-uniform mat3 view_basis;
-uniform float near;
-uniform float far;
 uniform float max_distance;
 uniform float froxel_knee;
 

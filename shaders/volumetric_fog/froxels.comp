@@ -5,7 +5,8 @@
 // medium's bounding ellipsoid, at the share froxel_jitter of it (0.5: the middle; it moves every frame and
 // core/froxel_history.comp averages the frames) — the per-pixel march (volumetric_fog/medium.glsl fog_march) with the slices as its steps. Layer k holds (in-scattered light, transmittance) from the
 // camera to slice boundary k (layer 0: the camera, (0, 0, 0, 1)); froxel_apply.comp reads it
-// trilinearly. float64 twin: plugins/volumetric_fog/reference.py froxel_volume.
+// trilinearly. The camera is the frame block's (lib/frame.glsl). float64 twin: plugins/volumetric_fog/reference.py
+// froxel_volume.
 #include "lib/hash.glsl"
 #include "lib/value_noise.glsl"
 #include "lib/view_ray.glsl"
@@ -13,11 +14,9 @@
 #include "volumetric_fog/medium.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0, rgba16f) writeonly uniform image3D fog_volume;
-uniform mat3 view_basis;       // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
-uniform vec3 camera_pos;
 uniform float froxel_knee;     // m: slices are nearly even inside it, logarithmic beyond
-uniform uint froxel_frame;     // the frame's index (the clock's frame) and whether the slices' samples move with
-uniform int froxel_jittered;   // it (lib/froxel_slices.glsl froxel_jitter; 0: the middles)
+uniform int froxel_jittered;   // whether the slices' samples move with the frame block's frame_index
+                               // (lib/froxel_slices.glsl froxel_jitter; 0: the middles)
 
 void main() {
     ivec3 size = imageSize(fog_volume);
@@ -30,7 +29,7 @@ void main() {
     vec3 light = vec3(0.0);
     float trans = 1.0;
     imageStore(fog_volume, ivec3(c, 0), vec4(light, trans));
-    float d0 = 0.0, jitter = froxel_jitter(froxel_frame, froxel_jittered != 0);
+    float d0 = 0.0, jitter = froxel_jitter(frame_index, froxel_jittered != 0);
     for (int z = 1; z <= slices; ++z) {
         float d1 = froxel_distance(float(z) / float(slices), max_distance, froxel_knee);
         float a = max(d0, range.x), b = min(d1, range.y);

@@ -1,5 +1,5 @@
 #version 430
-// Test helper: fog_march for `count` rays (origin, direction, limit) into vec4 results.
+// Test helper: fog_march for `count` rays (origin, direction, limit) into vec4 results (the sun: the frame block).
 #include "lib/hash.glsl"
 #include "lib/value_noise.glsl"
 #include "volumetric_fog/medium.glsl"

@@ -1,8 +1,10 @@
 // The FBM fog medium and its ray march (fbm-raymarched-fog.txt); mirrored in float64 by
-// atmos/plugins/volumetric_fog/reference.py. Needs lib/hash.glsl and lib/value_noise.glsl first.
-//   density(p) = bias - falloff * |(p - center) / scale| + fbm(frequency * (p - center - wind * time))
+// atmos/plugins/volumetric_fog/reference.py. Needs lib/hash.glsl and lib/value_noise.glsl first; the sun's
+// direction is the frame block's (lib/frame.glsl).
+//   density(p) = bias - falloff * |(p - center) / scale| + fbm(frequency * (p - center - wind * fog_time))
 // Positive density only inside the ellipsoid |(p - center) / scale| < (bias + 1 - 2^-octaves) / falloff,
 // so the march covers the part of the ray inside it (and before the scene surface / max_distance).
+#include "lib/frame.glsl"
 
 uniform vec3 center;
 uniform vec3 scale;
@@ -10,7 +12,7 @@ uniform float bias;
 uniform float falloff;
 uniform float frequency;
 uniform vec3 wind;
-uniform float time;
+uniform float fog_time;       // s the noise has drifted (0 unless animated)
 uniform int octaves;
 uniform uint seed;
 uniform float absorption;      // extinction per metre at density 1
@@ -18,13 +20,12 @@ uniform int steps;             // view-ray samples
 uniform int light_steps;       // samples toward the sun per view sample
 uniform float light_step;      // metres between light samples
 uniform float max_distance;
-uniform vec3 sun_dir;          // toward the sun (normalized on the CPU)
 uniform vec3 sun_light;        // scattering colour * sun radiance
 uniform vec3 ambient_light;    // ambient colour
 
 float fog_density(vec3 p, uint key) {
     vec3 q = p - center;
-    return bias - falloff * length(q / scale) + value_fbm(frequency * (q - wind * time), octaves, key);
+    return bias - falloff * length(q / scale) + value_fbm(frequency * (q - wind * fog_time), octaves, key);
 }
 
 // [enter, leave] of the ray inside the medium's bounding ellipsoid, clipped to [0, limit]; enter >= leave: miss.
