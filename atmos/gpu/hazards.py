@@ -245,8 +245,13 @@ def dispatch(program, *groups: int) -> None:
     if hazards._need:
         hazards.issue(hazards._need)
     program.run(*groups)
-    if hazards._staged:                          # a dispatch without storage writes skips the call
-        hazards.commit()
+    staged = hazards._staged
+    if staged:                                   # Hazards.commit, inlined (a dispatch without storage writes skips it)
+        dirty = hazards._dirty
+        for key in staged:
+            obj, kind = staged[key]
+            dirty[key] = [weakref.ref(obj), kind, _ALL[kind]]
+        hazards._staged = {}
 
 
 def dispatch_indirect(program, args, offset: int = 0) -> None:
@@ -260,8 +265,13 @@ def dispatch_indirect(program, args, offset: int = 0) -> None:
     if hazards._need:                                    # with what the binds asked for: one barrier
         hazards.issue(hazards._need)
     program.run_indirect(args, offset)
-    if hazards._staged:                          # a dispatch without storage writes skips the call
-        hazards.commit()
+    staged = hazards._staged
+    if staged:                                   # Hazards.commit, inlined
+        dirty = hazards._dirty
+        for key in staged:
+            obj, kind = staged[key]
+            dirty[key] = [weakref.ref(obj), kind, _ALL[kind]]
+        hazards._staged = {}
 
 
 _GUARDED = False
