@@ -105,8 +105,7 @@ class ShearWarpShader:
         else:       # each column's depth and last rho between runs, ping-pong: at most slices + side + 6 columns
             carry = -(-(2 * side + 6) // OWN) * OWN
             self._carry = [self._track(self.ctx.texture((carry, carry), 2, dtype="f4")) for _ in range(2)]
-            # the cells that march their own ray: the rays' dispatch arguments, then (x | y << 16, k) per cell
-            self._band = self._track(self.ctx.buffer(reserve=16 + 8 * int(np.prod(self.shading_shape))))
+            self._band = None        # the cells that march their own ray (_band_for: grown to the longest run)
         self._plan = None
         self._columns = None
         self._flip = False
@@ -190,19 +189,31 @@ class ShearWarpShader:
                               int(first[1]), i0, i1, float(v[0]), float(v[1]), plan.length, self._sigma)
         carry_in, carry_out = self._carry if self._flip else self._carry[::-1]
         self._flip = not self._flip
-        self._band.write(_BAND_EMPTY)
+        band = self._band_for(self.shading_shape[b] * self.shading_shape[c] * (i1 - i0))
         columns = program(self.gpu, "shear_warp", RESULT_FORMAT=fmt)
         write_block(columns, COLUMNS_BLOCK, COLUMNS_BINDING, block)
         bind_textures(columns, density=self._density)
         bind_images(columns, carry_in=carry_in, carry_out=carry_out, result=self._target)
-        bind_buffers(columns, Band=self._band)
+        bind_buffers(columns, Band=band)
         dispatch(columns, groups(count[0], OWN), groups(count[1], OWN))
         rays = program(self.gpu, "shear_warp_rays", RESULT_FORMAT=fmt)
         write_block(rays, COLUMNS_BLOCK, COLUMNS_BINDING, block)
         bind_textures(rays, density=self._density)
         bind_images(rays, result=self._target)
-        bind_buffers(rays, Band=self._band)
-        dispatch_indirect(rays, self._band)
+        bind_buffers(rays, Band=band)
+        dispatch_indirect(rays, band)
+
+    def _band_for(self, cells: int):
+        """The list of cells that march their own ray, room for ``cells`` (every cell of the run's slices),
+        emptied: the rays' dispatch arguments (groups, 1, 1) and the count, then (x | y << 16, k) per cell."""
+        size = 16 + 8 * cells
+        if self._band is None or self._band.size < size:
+            if self._band is not None:
+                self._objects.remove(self._band)
+                self._band.release()
+            self._band = self._track(self.ctx.buffer(reserve=size))
+        self._band.write(_BAND_EMPTY)
+        return self._band
 
     def _run_fixed_ratio(self, i0: int, i1: int) -> None:
         """Slices ``i0 .. i1-1`` of the thesis's model: a dispatch per slice (``fixed_ratio.comp``)."""
