@@ -3,7 +3,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.scene_uniforms import set_camera_uniforms
 from atmos.composition import CLOUD_DISTANCE, composition, distance_desc
 from atmos.graph import ComputePass, PassContext
 from atmos.plugin import Plugin
@@ -55,7 +54,6 @@ class CloudFarFieldPass(ComputePass):
         layout = sim.layout()
         distance = frame.declares(CLOUD_DISTANCE)
         layer.use(p, view, sim)
-        set_camera_uniforms(p, view.camera, view.aspect)
         light = self.plugin.light_settings()       # the renderer's octaves; its field's weight where measured
         diffusion = light.ms_diffusion if layer.light.has_field else 0.0
         ground = None if view.ground is None else view.ground.albedo

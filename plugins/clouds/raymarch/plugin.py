@@ -24,7 +24,6 @@ import moderngl
 import numpy as np
 
 from atmos.blue_noise import blue_noise_texture
-from atmos.scene_uniforms import set_camera_uniforms
 from atmos.composition import CLOUD_DISTANCE, composition, distance_desc
 from atmos.graph import PassBuilder, PassContext, RenderPass, TextureDesc, work_groups
 from atmos.plugin import Plugin
@@ -223,7 +222,7 @@ class RaymarchPass(RenderPass):
                 "min_transmittance": s.min_transmittance, "skipping": int(s.empty_space_skipping),
                 "skip_cells": skip_cells, "max_skips": int(sum(grid)) + 3, "factor": s.resolution,
                 "sample_offset": tuple(offset), "frame_size": tuple(int(v) for v in view.size),
-                "jitter": int(s.jitter),    # turned per frame only where the resolve averages (r > 1, reprojection)
+                "jittered": int(s.jitter),    # turned per frame only where the resolve averages (r > 1, reprojection)
                 "jitter_shift": jitter_shift(self.frame_index, s.resolution) if s.resolution > 1 and s.reprojection else 0.0,
                 "sun_march": tuple(float(v) for v in sun * SUN_SPACING * cell.min()), "sun_growth": SUN_GROWTH,
                 "pixel_angle": pixel_angle(view), "cloud_type": -1.0 if s.cloud_type is None else float(s.cloud_type)}
@@ -236,7 +235,6 @@ class RaymarchPass(RenderPass):
         distance = frame.declares(CLOUD_DISTANCE)
         far = frame.declares(FAR_FIELD)
         p = self.program(far)
-        set_camera_uniforms(p, view.camera, view.aspect)
         layout = sim.layout(s.base_altitude)
         write_uniforms(p, self._uniforms(frame, sim, layout, offset))
         bind_volume(p, sim, self.sampler, view.sun, s.octaves, s.ms_diffusion, layout.heights, view.ground,

@@ -20,6 +20,8 @@
 // blend_over would: layer + (1 - alpha) colour, alpha too) and, FAR_DISTANCE 1, its distance (alpha *
 // distance to the hit, alpha) onto "cloud_distance" (atmos/composition.py) with the same weights;
 // FAR_DISTANCE 2 (its first writer, no clear before) stores it at every pixel, (0, 0) where no layer.
+// The camera is the frame block's (lib/frame.glsl).
+#include "lib/frame.glsl"
 #include "lib/view_ray.glsl"
 #include "clouds/far_field/field.glsl"
 #include "clouds/volume/volume.glsl"
@@ -30,10 +32,6 @@ layout(binding = 0, rgba16f) uniform image2D color_image;
 layout(binding = 1, rg32f) uniform image2D distance_image;
 #endif
 layout(binding = 9) uniform sampler2D scene_depth;
-uniform mat3 view_basis;
-uniform vec3 camera_pos;
-uniform float near;
-uniform float far;
 uniform vec2 footprint_min;    // the volume's footprint (world xz)
 uniform vec2 footprint_size;
 uniform float thickness;
@@ -109,11 +107,11 @@ void far_pixel(vec2 v_uv, out vec4 frag, out vec4 frag_distance) {
     }
     vec2 at = vec2(slanted.x, dir.y < 0.0 ? 0.25 : 0.75);  // row 0: seen from above, 1: from below
     // the sun's light moved by the relief: lit edges facing the sun, shaded ones behind, none added
-    float relief = far_relief(r, thickness * column_tau, sun_dir.y);
+    float relief = far_relief(r, thickness * column_tau, light_dir.y);
     vec4 sun = relief_light(clamp(pow(max(rank_lookup(far_sun_by_rank, at), 0.0), vec4(thickness)), 0.0, 1.0),
                             relief * octave_exponents());
     vec3 source = sun_source_at(rank_lookup(far_height_by_rank, at).r);
-    vec3 light = sun_part(octave_weights_of(sun), dot(dir, sun_dir), source) + ambient_source(0.5 * tau, 0.5 * tau, dir.y)
+    vec3 light = sun_part(octave_weights_of(sun), dot(dir, light_dir), source) + ambient_source(0.5 * tau, 0.5 * tau, dir.y)
                + (ms_diffusion > 0.0 ? diffusion_light(rank_lookup(far_field_light, at), dir, source) : vec3(0.0));
     frag = vec4(min(light, vec3(HDR_MAX)) * alpha, alpha);   // volume.glsl: never inf in float16
     frag_distance = vec4(alpha * length(hit - camera_pos), alpha, 0.0, alpha);

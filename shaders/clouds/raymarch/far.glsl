@@ -20,7 +20,7 @@
 // with a diffusion field, its light (diffusion_light) from the field's mean (phi, F) over the volume's
 // columns of rank r at height h (far_field_light_profile: light_by_rank.comp's field_profile).
 // under the sun's colour at its height (sun_source_at).
-// Requires shape.glsl and volume.glsl (sun_part, sun_source_at, octave_weights_of, octave_exponents, ambient_source, sun_dir, column_tau)
+// Requires shape.glsl and volume.glsl (sun_part, sun_source_at, octave_weights_of, octave_exponents, ambient_source, light_dir, column_tau)
 // included first.
 #include "clouds/far_field/field.glsl"
 
@@ -53,10 +53,10 @@ vec3 far_source(vec4 c, float h, vec3 dir) {
     vec2 at = vec2(c.x, clamp(h, 0.0, 1.0));
     vec3 source = sun_source_at(at.y);        // the volume's heights: the far layer is the same band
     vec4 sun = relief_light(textureLod(far_sun_profile, at, 0.0),
-                            far_relief(c, column_tau, sun_dir.y) * octave_exponents());
+                            far_relief(c, column_tau, light_dir.y) * octave_exponents());
     float column = column_tau * far_quantile(c.x), above = textureLod(far_profile, at, 0.0).g;
     float up = column * above, down = column * (1.0 - above);
     vec3 field = ms_diffusion > 0.0
                ? diffusion_light(textureLod(far_field_light_profile, at, 0.0), dir, source) : vec3(0.0);
-    return sun_part(octave_weights_of(sun), dot(dir, sun_dir), source) + ambient_source(up, down, dir.y) + field;
+    return sun_part(octave_weights_of(sun), dot(dir, light_dir), source) + ambient_source(up, down, dir.y) + field;
 }

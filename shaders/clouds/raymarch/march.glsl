@@ -1,7 +1,7 @@
 // The ray-marched cloud layer (plugins/clouds/raymarch), the body of clouds/raymarch/march.comp:
 // cloud_march(pixel) marches the ray through the full-res pixel centre pixel + 0.5, from the near plane
 // (or the layer's box) to the box's far side or the scene depth. Segments of length step_base +
-// step_growth * s (s: distance from the camera), one density sample per segment at `jitter` of its
+// step_growth * s (s: distance from the camera), one density sample per segment at sample_jitter() of its
 // length (0.5: the midpoint), extinction sigma_t * density, light J = volume.glsl's cloud_source.
 // Sprite groups x height bands whose dilated max map is 0 are jumped over; a ray stops once its
 // transmittance falls below min_transmittance or after `steps` samples. float64 reference:
@@ -22,13 +22,11 @@
 #if FAR_FIELD
 #include "clouds/raymarch/far.glsl"
 #endif
+#include "lib/frame.glsl"
 #include "lib/view_ray.glsl"
 layout(binding = 4) uniform sampler3D skip_map;   // (groups x, bands, groups z): 0 = no density within
 layout(binding = 9) uniform sampler2D scene_depth;
-uniform mat3 view_basis;       // atmos.camera.set_camera_uniforms (lib/view_ray.glsl)
-uniform vec3 camera_pos;
-uniform float near;
-uniform float far;
+// view_basis, camera_pos, near, far: the frame block (lib/frame.glsl)
 uniform vec3 layer_min;
 uniform vec3 layer_max;
 uniform vec3 cell_size;
@@ -41,7 +39,7 @@ uniform int skipping;          // 1: use skip_map
 uniform vec3 skip_cells;       // cells per skip-map texel (group x, band height, group z)
 uniform int max_skips;         // skip-map texels a ray can cross
 uniform ivec2 frame_size;      // full-res pixels
-uniform int jitter;            // 1: per-pixel first-sample offset (blue noise + jitter_shift); 0: midpoints
+uniform int jittered;          // 1: per-pixel first-sample offset (blue noise + jitter_shift); 0: midpoints
 uniform float jitter_shift;    // the frame's rotation of the offsets (0: fixed in time)
 uniform vec3 sun_march;        // toward the sun, times the sun march's first step (m)
 uniform float sun_growth;      // each sun-march step is this many times the last
@@ -65,7 +63,7 @@ float shaped_density(vec3 uvw, float ny) {
 // under the history a moving camera reprojects.
 layout(binding = 23) uniform sampler2D blue_noise;
 float sample_jitter(vec2 pixel) {
-    if (jitter == 0) return 0.5;
+    if (jittered == 0) return 0.5;
     return fract(texelFetch(blue_noise, ivec2(pixel) % textureSize(blue_noise, 0), 0).r + jitter_shift);
 }
 

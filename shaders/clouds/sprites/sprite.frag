@@ -41,7 +41,7 @@ void main() {
     vec3 ray = normalize(v_center + q.x * camera_right + q.y * camera_up - camera_pos);
     vec4 ai = octave_exponents();                                        // octave i: exp(e_i (h.pc - e_i var))
     vec4 across = exp(clamp(ai * (dot(v_slope.xy, pc) - ai * v_slope.z), -40.0, 40.0));
-    vec3 J = sun_part(v_octaves * across, dot(ray, sun_dir), v_sun) + diffusion_light(v_field, ray, v_sun) + v_ambient;
+    vec3 J = sun_part(v_octaves * across, dot(ray, light_dir), v_sun) + diffusion_light(v_field, ray, v_sun) + v_ambient;
     frag = vec4(min(J, vec3(HDR_MAX)) * a, a);   // volume.glsl: the blends never reach inf in float16
     frag_distance = vec4(a * length(v_center - camera_pos), a, 0.0, a);   // blends by its own alpha
 }

@@ -26,7 +26,7 @@ layout(std140, binding = 2) uniform CloudLight {   // the light that moves with 
     vec3 sky_source;                // albedo * sky radiance / 2
     vec3 ground_sky_source;         // albedo * the ground's sky-lit radiance / 2
     vec3 ground_sun_source;         // albedo * the ground's sunlit radiance / 2, were no cloud in the way
-    vec3 sun_dir;                   // toward the sun, unit
+    vec3 light_dir;                 // toward the sun, unit (the frame block's sun_dir for the scene's sun)
 };
 layout(std140, binding = 3) uniform CloudGround {  // written on the GPU (plugins/clouds/light/ground.py)
     vec4 cloud_ground;              // x: G, the ground's mean sun transmittance through the clouds
@@ -154,14 +154,14 @@ vec4 cloud_diffusion(vec3 uvw) {
 }
 
 // The field's share of J beside the octaves for a field value f = (phi, F) under the sun's `source`: source beta
-// max(phi - 3 g_mean F.ray, -c 2 H phi, 0) / 4pi (c = dot(ray, sun_dir); diffusion.field_radiance).
+// max(phi - 3 g_mean F.ray, -c 2 H phi, 0) / 4pi (c = dot(ray, light_dir); diffusion.field_radiance).
 // Against the sun the truncated P1 falls to 0 at a lit surface, where F runs with the sun's light; the
 // light a lit surface sends back fills only the outward hemisphere there (phi / 2pi, twice the
 // isotropic part), and scattering toward the outside takes the phase's share H of that hemisphere
 // (outward_share: 0.90 at the defaults), so J is never below -c 2 H phi / 4pi.
 vec3 diffusion_light(vec4 f, vec3 ray_dir, vec3 source) {
     if (ms_diffusion <= 0.0) return vec3(0.0);
-    float c = dot(ray_dir, sun_dir), back = -c * 2.0 * outward_share;
+    float c = dot(ray_dir, light_dir), back = -c * 2.0 * outward_share;
     float L = max(max(f.x - 3.0 * mean_cosine() * dot(f.yzw, ray_dir), back * f.x), 0.0) / (4.0 * PI);
     return source * (ms_diffusion * L);
 }
@@ -170,7 +170,7 @@ vec3 diffusion_part(vec3 uvw, vec3 ray_dir) {
     return ms_diffusion <= 0.0 ? vec3(0.0) : diffusion_light(cloud_diffusion(uvw), ray_dir, sun_source_at(uvw.y));
 }
 
-// source * sum_i w_i p(cos; c^i g): the sun's part of J for a view ray with dot(ray, sun_dir) = c
+// source * sum_i w_i p(cos; c^i g): the sun's part of J for a view ray with dot(ray, light_dir) = c
 // under the sun's `source` (sun_source_at the point's height).
 vec3 sun_part(vec4 w, float c, vec3 source) {
     float e = 1.0, sum = 0.0;
@@ -185,7 +185,7 @@ vec3 sun_part(vec4 w, float c, vec3 source) {
 // for the callers).
 vec3 cloud_source_with(vec3 uvw, vec3 ray_dir, float ny, float T) {
     vec2 c = cloud_columns(uvw);
-    return sun_part(octave_weights(T), dot(ray_dir, sun_dir), sun_source_at(uvw.y)) + diffusion_part(uvw, ray_dir)
+    return sun_part(octave_weights(T), dot(ray_dir, light_dir), sun_source_at(uvw.y)) + diffusion_part(uvw, ray_dir)
          + ambient_source(c.x, c.y, ray_dir.y);
 }
 
