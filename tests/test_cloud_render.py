@@ -10,6 +10,7 @@ from PIL import Image
 from atmos.app import App
 from atmos.camera import Camera
 from atmos.defaults import DefaultPlugins
+from atmos.frame_constants import bind_frame
 from atmos.gpu.shaders import load_source
 from atmos.lighting import Sun
 from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
@@ -148,7 +149,7 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale,
     sun.color_by_altitude = lambda direction, h: np.stack([np.ones_like(h), 0.4 + h / 2000.0, (h / 1500.0) ** 2], -1)
     parts = []
     try:
-        prog["view_proj"].write(np.asarray(vp, np.float32).T.tobytes())
+        bind_frame(gpu, cam, app.resource(Sun), (aspect, 1.0))     # the camera (view_proj = vp) and near, far
         for name, value in uniforms.items():
             if name in prog:                      # the camera's basis is the fragment shader's
                 prog[name].value = value

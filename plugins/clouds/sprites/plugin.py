@@ -138,7 +138,8 @@ COMMAND_BYTES = 20
 
 def sprite_uniforms(plugin, sim, layout: CloudLayout, camera: Camera, aspect: float, height: int,
                     point_limit: float) -> dict:
-    """The uniforms of ``clouds/sprites/sprite.vert`` but view_proj and the volume's (:func:`bind_volume`)."""
+    """The uniforms of ``clouds/sprites/sprite.vert`` but the volume's (:func:`bind_volume`), with the camera's
+    position, near and far that the shaders read from the frame block (for the float64 reference)."""
     cell = np.asarray(layout.cell, np.float64)
     tau_scale = plugin.extinction(sim) * cell.prod() / np.cbrt(cell.prod())     # sigma_t × V
     settings = plugin.settings
@@ -264,7 +265,7 @@ class CloudSpritePass(RenderPass):
             fbo = self.offscreen.begin(frame, factor, distance)
         # the soft particles' scene depth: the attached depth target's (sampled, never written)
         bind_textures(p, scene_depth=frame.resource(DEPTH if factor == 1 else self.offscreen.depth))
-        write_uniforms(p, uniforms, view_proj=matrices.gl("view_proj"))
+        write_uniforms(p, uniforms)
         fbo.depth_mask = False
         frame.blend_over()
         ctx.enable(moderngl.DEPTH_TEST | moderngl.PROGRAM_POINT_SIZE)

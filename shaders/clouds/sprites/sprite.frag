@@ -7,12 +7,11 @@
 // fades out across it instead of cutting a line (float64: reference.soft_fade; sprite.vert depth-tests
 // the sprite at its front). The scene
 // depth is the attached depth target's (depth writes are off): "depth", or off screen the block's farthest.
+#include "lib/frame.glsl"
 #include "clouds/volume/volume.glsl"
 #include "lib/view_ray.glsl"
 layout(binding = 5) uniform sampler2D scene_depth;
-uniform float near;
-uniform float far;
-uniform vec3 camera_pos;
+// near, far, camera_pos: the frame block (lib/frame.glsl)
 uniform vec3 camera_right;
 uniform vec3 camera_up;
 flat in vec4 v_octaves;

@@ -12,6 +12,7 @@
 // The light samples filter in float32 (volume.glsl texel_trilinear), not with a texture unit's 8-bit
 // sub-texel weights: once per sprite, and T falls by orders of magnitude between cells.
 #define CLOUD_EXACT_FILTER
+#include "lib/frame.glsl"
 #include "clouds/volume/volume.glsl"
 layout(location = 0) in ivec4 in_segment;
 uniform ivec3 volume_shape;
@@ -19,13 +20,11 @@ uniform ivec2 group_size;
 uniform vec3 layer_min;        // world corner of cell (0, 0, 0)
 uniform vec3 cell_size;
 uniform vec3 camera_cell;      // the camera in cells from the volume's corner
-uniform vec3 camera_pos;       // the camera in world space (the view ray to the sprite's centre)
-uniform mat4 view_proj;
+// camera_pos (the view ray to the sprite's centre), view_proj, near (sprites fade out before their centre
+// crosses it) and far: the frame block (lib/frame.glsl)
 uniform float base_diameter;   // world sprite diameter of one cell at density 1: size factor × max(cx, cz)
 uniform float pixel_scale;     // pixel diameter = world diameter × pixel_scale / clip.w
 uniform float max_point_size;
-uniform float near;            // the camera's near plane: sprites fade out before their centre crosses it
-uniform float far;
 uniform vec3 camera_right;     // the sprite's screen axes (the fragment shader's too)
 uniform vec3 camera_up;
 uniform float tau_scale;       // sigma_t × cell volume: the optical depth a unit of summed density spreads over the screen (m²)
