@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from atmos.glsl_math import catmull_rom_weights
+
 WEIGHTS = np.array([0.299, 0.587, 0.114])
 
 
@@ -62,10 +64,7 @@ def catmull_rom(img, px, py) -> np.ndarray:
     to the edge (taa_resolve.comp history_at)."""
     tx, ty = np.asarray(px, np.float64) - 0.5, np.asarray(py, np.float64) - 0.5
     ix, iy = np.floor(tx).astype(np.int64), np.floor(ty).astype(np.int64)
-    def weights(f):
-        return (f * (-0.5 + f * (1.0 - 0.5 * f)), 1.0 + f * f * (-2.5 + 1.5 * f), f * (0.5 + f * (2.0 - 1.5 * f)),
-                f * f * (-0.5 + 0.5 * f))
-    wx, wy = weights(tx - ix), weights(ty - iy)
+    wx, wy = catmull_rom_weights(tx - ix), catmull_rom_weights(ty - iy)
     out = 0.0
     for j in range(4):
         for i in range(4):

@@ -12,6 +12,7 @@
 // taa_resolve.
 #include "lib/frame.glsl"
 #include "lib/view_ray.glsl"
+#include "lib/catmull_rom.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) uniform sampler2D color_in;        // this frame's HDR colour (texelFetch)
 layout(binding = 1) uniform sampler2D depth_in;        // its depth (texelFetch)
@@ -30,13 +31,12 @@ vec3 history_at(vec2 uv) {
     vec2 t = uv * vec2(size) - 0.5;
     ivec2 base = ivec2(floor(t));
     vec2 f = t - floor(t);
-    vec2 w[4] = vec2[4](f * (-0.5 + f * (1.0 - 0.5 * f)), 1.0 + f * f * (-2.5 + 1.5 * f),
-                        f * (0.5 + f * (2.0 - 1.5 * f)), f * f * (-0.5 + 0.5 * f));
+    vec4 wx = catmull_rom_weights(f.x), wy = catmull_rom_weights(f.y);
     vec3 sum = vec3(0.0);
     for (int y = 0; y < 4; ++y) {
         for (int x = 0; x < 4; ++x) {
             ivec2 q = clamp(base + ivec2(x - 1, y - 1), ivec2(0), size - 1);
-            sum += w[x].x * w[y].y * texelFetch(history, q, 0).rgb;
+            sum += wx[x] * wy[y] * texelFetch(history, q, 0).rgb;
         }
     }
     return sum;

@@ -28,6 +28,7 @@ import math
 import numpy as np
 
 from atmos.checks import check_sun_dir
+from atmos.glsl_math import catmull_rom_weights
 # the input checks and the slice geometry are the GPU side's own (atmos.plugins.clouds.light.grid); kept here by name
 from atmos.plugins.clouds.light.grid import (LATERAL, MAJOR_ORDER, SCALES, SIGMA_MAX, TAU_MAX, SlicePlan,  # noqa: F401
                                 check_density, check_scale, check_sigma, shading_shape)
@@ -51,12 +52,6 @@ def multilinear(grid: np.ndarray, points: np.ndarray) -> np.ndarray:
 
 
 trilinear = bilinear = multilinear      # the names the 3D and 2D callers use
-
-
-def catmull_rom(t: np.ndarray) -> tuple:
-    """Catmull-Rom weights of the taps at -1, 0, 1, 2 for fractions ``t``."""
-    t2, t3 = t * t, t * t * t
-    return (0.5 * (-t3 + 2 * t2 - t), 0.5 * (3 * t3 - 5 * t2 + 2), 0.5 * (-3 * t3 + 4 * t2 + t), 0.5 * (t3 - t2))
 
 
 def lerp_matrix(positions: np.ndarray, n: int) -> np.ndarray:
@@ -247,7 +242,7 @@ def _columns(dp: np.ndarray, plan: SlicePlan, sigma: float) -> np.ndarray:
         tau = np.minimum(tau + _step_depth(dp, plan, sigma, k, q - k * v), TAU_MAX)
         # the warp: cell c of this slice from the columns c + shift - 1 .. c + shift + 2
         fr = kv[k].astype(np.float64) - shift[k]
-        w = catmull_rom(fr[0]), catmull_rom(fr[1])
+        w = catmull_rom_weights(fr[0]), catmull_rom_weights(fr[1])
         taps = [np.arange(m)[:, None] + np.arange(-1, 3)[None, :] + shift[k, i] - first[i] for i, m in enumerate(n)]
         total = np.zeros(dp.shape[1:])
         low, high = np.full(total.shape, np.inf), np.full(total.shape, -np.inf)

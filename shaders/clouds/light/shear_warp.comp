@@ -11,6 +11,7 @@
 // over to the next run's slices.
 layout(local_size_x = 16, local_size_y = 16) in;
 #include "clouds/light/shear_warp.glsl"
+#include "lib/catmull_rom.glsl"
 
 const int TILE = 16;
 const int OWN = TILE - 3;      // taps -1 .. +2 around the owner's column
@@ -25,11 +26,6 @@ layout(std430, binding = 0) buffer Band {     // the cells that march their own 
 };
 
 shared float depths[2][BATCH][TILE][TILE];
-
-vec4 catmull_rom(float t) {
-    float t2 = t * t, t3 = t2 * t;
-    return 0.5 * vec4(-t3 + 2.0 * t2 - t, 3.0 * t3 - 5.0 * t2 + 2.0, -3.0 * t3 + 4.0 * t2 + t, t3 - t2);
-}
 
 void main() {
     ivec2 n = lateral_size();
@@ -89,7 +85,7 @@ void main() {
                     }
                     continue;
                 }
-                vec4 wb = catmull_rom(f.x), wc = catmull_rom(f.y);
+                vec4 wb = catmull_rom_weights(f.x), wc = catmull_rom_weights(f.y);
                 float sum = 0.0, low = 1e38, high = -1e38;
                 for (int j = 0; j < 4; ++j) {
                     for (int i = 0; i < 4; ++i) {
