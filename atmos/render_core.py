@@ -29,7 +29,7 @@ shafts instead of casting them.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Callable
 
 import moderngl
@@ -49,6 +49,7 @@ COLOR = "color"
 DEPTH = "depth"
 CAMERA_EXPOSURE = "camera_exposure"  # buffer: the exposure (and bloom weight) written on the GPU (shaders/lib/camera.glsl)
 BLOOM = "bloom"                      # half-size blurred colour the present mixes in (plugins/physical_camera)
+MOTION = "motion"                    # moving geometry's world-space motion since the last frame (:class:`MotionTargets`)
 
 
 @dataclass
@@ -64,6 +65,40 @@ class PresentInputs:
 def present_inputs(app) -> PresentInputs:
     """The App's :class:`PresentInputs` (made on first use)."""
     return app.init_resource(PresentInputs)
+
+
+@dataclass
+class MotionTargets:
+    """App resource: who draws and who reads :data:`MOTION`, a texture of the frame's size whose pixel
+    holds (world position now − its position in the last frame, in metres; the depth the drawing
+    fragment wrote) where moving geometry was drawn, and alpha −1 elsewhere. The depth tags each motion
+    with its surface: a reader takes it only where it equals the depth buffer's within two steps of its
+    24 bits (an opaque pass drawn later over the mesh leaves a stale motion that no longer matches).
+
+    A pass cannot declare an optional read, so a pass that draws motion adds its name to ``writers``
+    in ``build`` and a reader registers ``readers[name]``, a zero-argument callable saying whether it
+    reads this frame; while both are there (:attr:`wanted`) the writer creates :data:`MOTION` (cleared
+    first) and the readers read it. A scene without moving geometry or without a reader allocates none."""
+    writers: set = field(default_factory=set)
+    readers: dict = field(default_factory=dict)
+
+    @property
+    def wanted(self) -> bool:
+        return bool(self.writers) and any(wants() for wants in self.readers.values())
+
+
+MOTION_NONE = (0.0, 0.0, 0.0, -1.0)      # the motion target's clear value: no moving surface (alpha −1)
+MOTION_DEPTH_TOLERANCE = 2.0 ** -23      # a motion's depth tag against the depth buffer: two 24-bit steps
+
+
+def motion_targets(app) -> MotionTargets:
+    """The App's :class:`MotionTargets` (made on first use)."""
+    return app.init_resource(MotionTargets)
+
+
+def motion_desc(size) -> TextureDesc:
+    """The motion target at ``size`` (w, h): rgba32f (the depth tag needs float32), sampled with texelFetch."""
+    return TextureDesc(tuple(size), components=4, dtype="f4", filter="nearest")
 
 
 def color_desc(gpu) -> TextureDesc:

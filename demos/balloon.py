@@ -100,7 +100,7 @@ def build(app, settings) -> None:
     app.add_plugins(DefaultPlugins(fly_camera=False), DaylightPlugin(hours=6.2, speed=0.05),
                     SkyPlugin(model=settings.sky), terrain, sky, MeshPlugin(), TextPlugin(design_height=540), chase,
                     FogPlugin(mode="height", density=0.006, height_base=0.0, scale_height=30.0, sky="keep",
-                              sun_scattering=0.12, color_from="sky", fog_color=(1.0, 1.0, 1.0)), AntialiasPlugin())
+                              sun_scattering=0.12, color_from="sky", fog_color=(1.0, 1.0, 1.0)), AntialiasPlugin(mode="taa"))
     cam = app.resource(Camera)
     cam.near, cam.far = 1.0, terrain.far_plane()
     balloon = app.world.create_entity(Transform(START.copy()), MeshInstance(sphere(9.0), (0.8, 0.2, 0.15)))

@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from atmos import Camera, ChaseCameraPlugin, DefaultPlugins, Input, Transform, key
+from atmos.plugins.antialias import AntialiasPlugin
 from atmos.plugins.clouds import CloudSky
 from atmos.plugins.daylight import DaylightPlugin, TimeOfDay
 from atmos.plugins.fog import FogPlugin
@@ -103,7 +104,7 @@ def build(app, settings) -> None:
     app.add_plugins(DefaultPlugins(overlay=False, fly_camera=False), DaylightPlugin(hours=16.5, speed=0.02),
                     SkyPlugin(model=settings.sky), terrain, CloudSky("fair_weather", seed=settings.seed, altitude=700.0),
                     FogPlugin(mode="exp", density=0.0001, sky="keep", color_from="sky", fog_color=(1.0, 1.0, 1.0)),
-                    MeshPlugin(), TextPlugin(), chase)
+                    MeshPlugin(), TextPlugin(), chase, AntialiasPlugin(mode="taa"))
     cam = app.resource(Camera)
     cam.near, cam.far = 1.0, terrain.far_plane()
     glider_entity = app.world.create_entity(Transform(START.copy()), MeshInstance(glider(6.0), (0.85, 0.25, 0.15)))

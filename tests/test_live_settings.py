@@ -39,6 +39,7 @@ from atmos.plugins.clouds.far_field import CloudFarFieldPlugin
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
 from atmos.plugins.clouds.presets import CloudSky, CloudWeatherPlugin
 from atmos.plugins.antialias import AntialiasPlugin
+from atmos.plugins.mesh import MeshPlugin
 from atmos.plugins.physical_camera import PhysicalCameraPlugin
 from atmos.plugins.clouds.simulation.top_view import CloudTopViewPlugin
 from atmos.plugins.daylight import DaylightPlugin, TimeOfDay
@@ -56,7 +57,7 @@ from atmos.plugins.volumetric_fog import VolumetricFogPlugin
 from atmos.plugins.clouds.weather import WeatherPlugin
 from atmos.plugins.clouds.light.scattering import Scattering
 from atmos.plugins.clouds.light.shear_warp import ShadingTask
-from atmos.render_core import CapturePass, RenderCorePlugin
+from atmos.render_core import MOTION, CapturePass, RenderCorePlugin
 
 SIZE = (64, 40)
 DAY = Sun.from_angles(30.0, 200.0)
@@ -437,12 +438,15 @@ def _aimed(app, plugin):
 
 SPECS["clouds"] = _clouds_spec()
 SPECS["antialias"] = Spec(
-    lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(), AntialiasPlugin()],
+    lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(), MeshPlugin(), AntialiasPlugin()],
     AntialiasPlugin, look((0.0, 3.0, 10.0), yaw=0.3, pitch=0.02),
-    dict(span_max=1.0, reduce_mul=1.0, reduce_min=1.0, mode="taa", history=0.5),
+    dict(span_max=1.0, reduce_mul=1.0, reduce_min=1.0, mode="taa", history=0.5, motion=False),
     # the temporal mode past its running mean (1 / (n + 1) below the history's weight): the weight it blends with
-    before={"history": lambda app, plugin: [configure_first(mode="taa")(app, plugin)] + [render(app) for _ in range(12)]},
-    observe={"history": lambda app, plugin: plugin.taa.weight})
+    before={"history": lambda app, plugin: [configure_first(mode="taa")(app, plugin)] + [render(app) for _ in range(12)],
+            "motion": configure_first(mode="taa")},
+    # the meshes' motion target: drawn (and read) only while the temporal pass follows it
+    observe={"history": lambda app, plugin: plugin.taa.weight,
+             "motion": lambda app, plugin: MOTION in app.graph.compile().resources})
 def adapting_from(offset):
     """One frame's adaptation from ``offset`` EV off the metered target (the camera's speeds show there)."""
     def observe(app, plugin):

@@ -14,11 +14,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from atmos.checks import CheckedSettings, choice_field, num_field
+from atmos.checks import CheckedSettings, bool_field, choice_field, num_field
 from atmos.graph import FullscreenPass, PassBuilder, PassContext, TextureDesc
 from atmos.gpu.uniforms import bind_textures, write_uniforms
 from atmos.plugin import Plugin
-from atmos.render_core import COLOR
+from atmos.render_core import COLOR, motion_targets
 from atmos.scene_view import FrameJitter
 from atmos.plugins.antialias.temporal import TemporalAAPass, jitter_offset, jitter_system
 
@@ -31,6 +31,9 @@ class AntialiasSettings(CheckedSettings):
     mode: str = choice_field("fxaa", ("fxaa", "taa", "none"), "fxaa: a filter along the edges of each frame; taa: "
                              "the geometry jittered every frame and the frames blended through reprojection; "
                              "none: no pass")
+    motion: bool = bool_field(True, "taa: follow moving meshes by their own motion since the last frame (a "
+                              "motion target the meshes draw; off: every point is reprojected by the camera's "
+                              "motion alone, and a moving mesh's history trails behind it until the clamp cuts it)")
     history: float = num_field(0.1, 0.0, 1.0, "taa: the newest frame's least weight (a running mean of a still "
                                "view until 1 / (n + 1) falls to it; smaller: smoother and slower to follow)",
                                lo_open=True)
@@ -76,8 +79,10 @@ class AntialiasPlugin(Plugin):
         if app.graph is None:
             raise ValueError("AntialiasPlugin needs an App with a GPU context (App(gpu))")
         self.gpu = app.gpu
+        self.motion = motion_targets(app)
         app.graph.add_pass(AntialiasPass(self))
         self.taa = app.graph.add_pass(TemporalAAPass(self))
+        self.motion.readers[self.taa.name] = self.taa.wants_motion
         app.add_system(jitter_system(self, app.init_resource(FrameJitter)), "update", label="antialias_jitter")
 
 

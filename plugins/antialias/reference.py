@@ -57,6 +57,7 @@ def fxaa(image, reduce_min: float, reduce_mul: float, span_max: float) -> np.nda
 # -- temporal anti-aliasing (shaders/antialias/taa_resolve.comp) --------------------------------------
 TAA_LUMA = np.array([0.2126, 0.7152, 0.0722])
 TAA_MOTION_GAIN = 0.2          # taa_resolve.comp's MOTION_GAIN: the newest frame's weight per pixel moved
+TAA_MOTION_DEPTH = 2.0 ** -23  # taa_resolve.comp's MOTION_DEPTH_TOLERANCE (atmos.render_core)
 
 
 def catmull_rom(img, px, py) -> np.ndarray:
@@ -73,10 +74,11 @@ def catmull_rom(img, px, py) -> np.ndarray:
 
 
 def taa_resolve(color, depth, history, basis, position, near: float, far: float, prev_view_proj,
-                blend: float) -> np.ndarray:
+                blend: float, motion=None) -> np.ndarray:
     """float64 (h, w, 4) of taa_resolve.comp: ``color`` (h, w, 4) and window ``depth`` (h, w) of this frame
     (row 0 at the bottom) seen through ``basis`` (atmos.camera.view_basis) from ``position``; ``history``
-    (h, w, 4) the last output or None; ``prev_view_proj`` the previous frame's 4×4 view_proj."""
+    (h, w, 4) the last output or None; ``prev_view_proj`` the previous frame's 4×4 view_proj; ``motion``
+    (h, w, 4) the motion target (world motion, depth tag) or None (the shader without MOTION)."""
     color = np.asarray(color, np.float64)
     h, w = color.shape[:2]
     out = color.copy()
@@ -87,12 +89,21 @@ def taa_resolve(color, depth, history, basis, position, near: float, far: float,
     dpad = np.pad(np.asarray(depth, np.float64), 1, mode="edge")
     stack = np.stack([pad[1 + dy:1 + dy + h, 1 + dx:1 + dx + w] for dy in (-1, 0, 1) for dx in (-1, 0, 1)])
     lo, hi = stack.min(axis=0), stack.max(axis=0)
-    d = np.min([dpad[1 + dy:1 + dy + h, 1 + dx:1 + dx + w] for dy in (-1, 0, 1) for dx in (-1, 0, 1)], axis=0)
+    offsets = [(0, 0)] + [(dy, dx) for dy in (-1, 0, 1) for dx in (-1, 0, 1)]    # the pixel first: ties keep it
+    depths = np.stack([dpad[1 + dy:1 + dy + h, 1 + dx:1 + dx + w] for dy, dx in offsets])
+    pick = np.argmin(depths, axis=0)
+    d = np.take_along_axis(depths, pick[None], 0)[0]
     uv = np.stack([(xs + 0.5) / w, (ys + 0.5) / h], -1)
     ray = np.concatenate([uv * 2.0 - 1.0, np.ones((h, w, 1))], -1) @ np.asarray(basis, np.float64).T
     with np.errstate(divide="ignore"):
         z = near / ((1.0 - d) + d * (near / far))
     point = np.where((d < 1.0)[..., None], np.asarray(position, np.float64) + z[..., None] * ray, ray)
+    if motion is not None:
+        dy, dx = np.array(offsets).T
+        qy, qx = np.clip(ys + dy[pick], 0, h - 1), np.clip(xs + dx[pick], 0, w - 1)
+        m = np.asarray(motion, np.float64)[qy, qx]
+        tagged = (np.abs(m[..., 3] - d) <= TAA_MOTION_DEPTH) & (d < 1.0)
+        point = point - np.where(tagged[..., None], m[..., :3], 0.0)
     clip = np.concatenate([point, (d < 1.0).astype(np.float64)[..., None]], -1) @ np.asarray(prev_view_proj, np.float64).T
     valid = clip[..., 3] > 0.0
     with np.errstate(divide="ignore", invalid="ignore"):

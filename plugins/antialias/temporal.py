@@ -6,7 +6,9 @@ bloom and tone map read the colour) blends each frame over its reprojected histo
 kept (two rgba16f textures, one the last output, read by Catmull-Rom) for the next frame. A still view
 converges to the mean of its jittered frames (a running mean while 1 / (n + 1) > ``history``); a moving
 one keeps edges whole through the neighbourhood clamp, its newest frame weighing more the farther each
-point moved. float64 twin: :mod:`.reference` (``taa_resolve``)."""
+point moved. Moving meshes are followed by their own motion (``AntialiasSettings.motion``: the
+motion target of :class:`atmos.render_core.MotionTargets`), not only the camera's. float64 twin:
+:mod:`.reference` (``taa_resolve``)."""
 from __future__ import annotations
 
 import struct
@@ -14,7 +16,7 @@ import struct
 from atmos.camera import camera_matrices
 from atmos.graph import ComputePass, PassBuilder, PassContext
 from atmos.gpu.uniforms import write_block
-from atmos.render_core import COLOR, DEPTH
+from atmos.render_core import COLOR, DEPTH, MOTION
 from atmos.scene_view import FrameJitter
 
 TAA_BINDING = 1                 # taa_resolve.comp's TemporalAA block
@@ -58,19 +60,27 @@ class TemporalAAPass(ComputePass):
         self._textures, self._current, self._prev, self.frames, self.weight = None, 0, None, 0, None
         self._size = self._groups = None
 
+    def wants_motion(self) -> bool:
+        """Whether this pass reads the moving geometry's motion (the App's MotionTargets asks)."""
+        s = self.plugin.settings
+        return s.mode == "taa" and s.motion
+
     def setup_key(self) -> tuple:
-        return (self.plugin.settings.mode,)
+        return (self.plugin.settings.mode, self.plugin.motion.wanted)
 
     def setup(self, builder: PassBuilder) -> None:
         if self.plugin.settings.mode != "taa":
             return
         builder.read(COLOR)
         builder.read(DEPTH)
+        if self.plugin.motion.wanted:
+            builder.read(MOTION)
         builder.write(COLOR, access="storage")
 
     def prepare(self, gpu) -> None:
         super().prepare(gpu)
         self.resolve_program = gpu.program(compute_shader="antialias/taa_resolve.comp")
+        self.motion_program = gpu.program(compute_shader="antialias/taa_resolve.comp", defines={"MOTION": 1})
         self.copy_program = gpu.program(compute_shader="antialias/taa_copy.comp")
 
     def release(self) -> None:
@@ -91,11 +101,14 @@ class TemporalAAPass(ComputePass):
             self._size, self._groups = size, self.groups(size)
         prev = matrices if self._prev is None else self._prev
         weight = max(1.0 / (self.frames + 1), self.plugin.settings.history)
-        p, groups = self.resolve_program, self._groups
+        moving = frame.declares(MOTION)
+        p, groups = self.motion_program if moving else self.resolve_program, self._groups
         write_block(p, "TemporalAA", TAA_BINDING, taa_block(prev.gl("view_proj"), weight, self.frames > 0))
         history, out = self._textures[self._current], self._textures[1 - self._current]
-        frame.dispatch(p, groups, textures={"color_in": COLOR, "depth_in": DEPTH, "history": history},
-                       images={"resolved": out})
+        textures = {"color_in": COLOR, "depth_in": DEPTH, "history": history}
+        if moving:
+            textures["motion_in"] = MOTION
+        frame.dispatch(p, groups, textures=textures, images={"resolved": out})
         frame.dispatch(self.copy_program, groups, textures={"resolved_in": out}, images={"color_image": COLOR})
         self._current, self._prev = 1 - self._current, matrices
         self.frames += 1

@@ -33,13 +33,15 @@ from atmos.collision import Hit, check_ray, bounds, ray_box, ray_triangles
 from atmos.graph import PassContext
 from atmos.plugin import Plugin
 from atmos.plugins.mesh.geometry import Mesh, box, capsule, cone, cylinder, glider, plane, revolve, sphere, torus
-from atmos.render_core import OpaquePass
+from atmos.render_core import COLOR, DEPTH, MOTION, MOTION_NONE, OpaquePass, motion_desc, motion_targets
 from atmos.transform import Parent, Transform, world_matrix
 
 __all__ = ["Mesh", "MeshInstance", "MeshPlugin", "Parent", "box", "capsule", "cone", "cylinder", "glider", "mesh_bounds",
            "plane", "raycast_instances", "revolve", "sphere", "torus"]
 
 EVICT_FRAMES = 120
+ROW = 35                  # floats per instance: model matrix, its change since the last frame, colour
+_NO_CHANGE = np.zeros(16)
 _CORNERS = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], np.float64)
 
 
@@ -94,14 +96,21 @@ def raycast_instances(world, origin, direction, max_distance=math.inf, ignore=()
     return best
 
 
-def collect_instances(world, alpha: float) -> dict:
-    """{mesh: float32 (k, 19) rows of model matrix (column-major) and colour} for every entity with
-    a Transform and a MeshInstance, posed ``alpha`` of the way from its last fixed step."""
+def collect_instances(world, alpha: float, previous: dict | None = None) -> dict:
+    """{mesh: float32 (k, 35) rows of model matrix, its change since the last frame (both column-major)
+    and colour} for every entity with a Transform and a MeshInstance, posed ``alpha`` of the way from
+    its last fixed step. ``previous`` (entity -> last frame's model matrix) gives the change, zero for an
+    entity it lacks, and is updated to this frame's poses (the entities drawn now, no others)."""
     groups: dict = {}
+    seen: dict = {}
+    last = previous if previous is not None else {}
     for entity, (transform, instance) in world.get_components(Transform, MeshInstance):
         m = world_matrix(world, entity, alpha) if world.has_component(entity, Parent) else \
             transform.interpolated(alpha).matrix(transform.scale)
-        groups.setdefault(instance.mesh, []).append((entity, np.concatenate([m.T.ravel(), instance.color])))
+        before = last.get(entity)
+        change = _NO_CHANGE if before is None else (m - before).T.ravel()
+        seen[entity] = m
+        groups.setdefault(instance.mesh, []).append((entity, np.concatenate([m.T.ravel(), change, instance.color])))
     out = {}
     for mesh, rows in groups.items():
         data = np.asarray([row for _, row in rows], np.float32)
@@ -110,10 +119,15 @@ def collect_instances(world, alpha: float) -> dict:
             raise ValueError(f"entity {bad}: its Transform is not finite (position, angles or scale), so its "
                              "MeshInstance cannot be drawn")
         out[mesh] = data
+    if previous is not None:
+        previous.clear()
+        previous.update(seen)
     return out
 
 
 class MeshPass(OpaquePass):
+    """Draws the instances; while a reader wants it (:class:`atmos.render_core.MotionTargets`), also their
+    motion since the last frame into :data:`~atmos.render_core.MOTION` (created here, cleared first)."""
     name = "meshes"
 
     def __init__(self, plugin: "MeshPlugin"):
@@ -122,20 +136,28 @@ class MeshPass(OpaquePass):
         self.buffers: dict[int, list] = {}       # mesh id -> [vbo, ibo, instance buffer, vao, last frame used, vertices]
         self.frame = 0
 
+    def setup_key(self) -> tuple:
+        return (self.plugin.motion.wanted, self.plugin.gpu.size) if self.plugin.motion.wanted else (False,)
+
+    def setup(self, builder) -> None:
+        super().setup(builder)
+        if self.plugin.motion.wanted:
+            builder.create(MOTION, motion_desc(self.plugin.gpu.size))
+
     def prepare(self, gpu) -> None:
         self.program = gpu.program(vertex_shader="mesh/mesh.vert", fragment_shader="mesh/mesh.frag")
 
     def _buffers(self, gpu, mesh: Mesh, rows: int) -> list:
         entry = self.buffers.get(mesh.id)
-        if entry is None or entry[2].size < rows * 19 * 4:
+        if entry is None or entry[2].size < rows * ROW * 4:
             if entry is not None:
                 self._release(mesh.id)
             ctx = gpu.ctx
             vbo = ctx.buffer(mesh.vertex_data)
             ibo = ctx.buffer(mesh.indices.tobytes())
-            inst = ctx.buffer(reserve=max(rows, 16) * 2 * 19 * 4)     # room to grow
+            inst = ctx.buffer(reserve=max(rows, 16) * 2 * ROW * 4)     # room to grow
             vao = ctx.vertex_array(self.program, [(vbo, "3f 3f", "in_position", "in_normal"),
-                                                  (inst, "16f 3f/i", "in_model", "in_color")],
+                                                  (inst, "16f 16f 3f/i", "in_model", "in_change", "in_color")],
                                    index_buffer=ibo, index_element_size=4)
             entry = self.buffers[mesh.id] = [vbo, ibo, inst, vao, 0, len(mesh.indices) * 3]
         entry[4] = self.frame
@@ -145,6 +167,9 @@ class MeshPass(OpaquePass):
         gpu = frame.gpu
         self.frame += 1
         self.begin(frame)
+        if frame.declares(MOTION):
+            frame.framebuffer(color=[MOTION]).clear(*MOTION_NONE)
+            frame.framebuffer(color=[COLOR, MOTION], depth=DEPTH).use()
         for mesh, data in self.plugin.instances.items():
             _, _, inst, vao, _, vertices = self._buffers(gpu, mesh, len(data))
             inst.write(data.tobytes())
@@ -168,13 +193,17 @@ class MeshPlugin(Plugin):
     def __init__(self):
         super().__init__()
         self.instances: dict = {}
+        self.previous: dict = {}           # entity -> its model matrix in the last frame drawn
         self.mesh_pass: MeshPass | None = None
 
     def build(self, app) -> None:
         app.add_system(self.collect, "render", label="collect_meshes", before="frame_scheduler")
         if app.graph is not None:
+            self.gpu = app.gpu
+            self.motion = motion_targets(app)
             self.mesh_pass = MeshPass(self)
+            self.motion.writers.add(self.mesh_pass.name)
             app.graph.add_pass(self.mesh_pass)
 
     def collect(self, app) -> None:
-        self.instances = collect_instances(app.world, app.clock.alpha)
+        self.instances = collect_instances(app.world, app.clock.alpha, self.previous)

@@ -3,7 +3,9 @@
 // each frame (lib/frame.glsl jitter_clip) and each pixel blends this frame's colour over the history
 // (the last output) read where the pixel's point was in the previous frame: the nearest depth of its 3x3
 // neighbourhood (edges follow the object in front) gives the point, or the ray's direction where it sees
-// the sky; prev_view_proj (unjittered) projects it. The history is clamped to the neighbourhood's colour
+// the sky; prev_view_proj (unjittered) projects it. With MOTION defined, a moving surface's own motion
+// (atmos.render_core.MotionTargets: world motion since the last frame, tagged with its depth) is taken
+// off the point first where the tag matches that depth. The history is clamped to the neighbourhood's colour
 // range (what it shows now) and the two are weighted by 1 / (1 + luma) (Karis 2014: a bright sample does
 // not flicker through), the newest with at least `blend`, more as the point moves (MOTION_GAIN); the
 // history is read by Catmull-Rom. Off the previous view, or with no history: the
@@ -17,6 +19,10 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) uniform sampler2D color_in;        // this frame's HDR colour (texelFetch)
 layout(binding = 1) uniform sampler2D depth_in;        // its depth (texelFetch)
 layout(binding = 2) uniform sampler2D history;         // the last output (texelFetch: history_at)
+#ifdef MOTION
+layout(binding = 3) uniform sampler2D motion_in;       // (world motion, depth tag); alpha -1: none (texelFetch)
+const float MOTION_DEPTH_TOLERANCE = 1.0 / 8388608.0;  // two steps of a 24-bit depth (render_core.py)
+#endif
 layout(binding = 0, rgba16f) writeonly uniform image2D resolved;     // kept: the next frame's history
 layout(std140, binding = 1) uniform TemporalAA {       // written once per frame (temporal.py TAA_BINDING)
     mat4 prev_view_proj;       // the previous frame's view_proj (no jitter)
@@ -58,20 +64,29 @@ void main() {
     vec4 now = texelFetch(color_in, p, 0);
     vec3 lo = now.rgb, hi = now.rgb;
     float depth = texelFetch(depth_in, p, 0).r;
+    ivec2 nearest = p;
     for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
             ivec2 q = clamp(p + ivec2(dx, dy), ivec2(0), size - 1);
             vec3 c = texelFetch(color_in, q, 0).rgb;
             lo = min(lo, c);
             hi = max(hi, c);
-            depth = min(depth, texelFetch(depth_in, q, 0).r);
+            float d = texelFetch(depth_in, q, 0).r;
+            if (d < depth) {
+                depth = d;
+                nearest = q;
+            }
         }
     }
     vec3 color = now.rgb;
     if (has_history != 0) {
         vec3 ray = view_ray((vec2(p) + 0.5) / vec2(size), view_basis);
-        vec4 clip = depth < 1.0 ? prev_view_proj * vec4(camera_pos + view_depth(depth, near, far) * ray, 1.0)
-                                : prev_view_proj * vec4(ray, 0.0);
+        vec3 point = camera_pos + view_depth(depth, near, far) * ray;
+#ifdef MOTION
+        vec4 m = texelFetch(motion_in, nearest, 0);
+        if (abs(m.a - depth) <= MOTION_DEPTH_TOLERANCE) point -= m.xyz;
+#endif
+        vec4 clip = depth < 1.0 ? prev_view_proj * vec4(point, 1.0) : prev_view_proj * vec4(ray, 0.0);
         if (clip.w > 0.0) {
             vec2 uv = clip.xy / clip.w * 0.5 + 0.5;
             if (all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0)))) {
