@@ -17,8 +17,9 @@ flux at a lit surface; bench_cloud_light "sun behind", cumulus: no floor -17.8 %
 +3.5 %).
 
 :func:`diffusion_reference` solves the system in float64 by Jacobi-preconditioned conjugate
-gradients (:func:`solve_cg`, the algorithm ``shaders/clouds/light/diffusion.comp`` runs in float32, two
-dispatches per iteration: :class:`DiffusionSolver`, sliced over frames by :class:`DiffusionTask`).
+gradients in Chronopoulos and Gear's form (:func:`solve_cg`: both inner products of an iteration in one
+reduction; the algorithm ``shaders/clouds/light/diffusion.comp`` runs in float32, one dispatch per
+iteration: :class:`DiffusionSolver`, sliced over frames by :class:`DiffusionTask`).
 Extinction is capped at :data:`SIGMA_MAX` (a millimetre's mean free path: opaque all the same) so no
 float32 sum overflows.
 """
@@ -42,6 +43,7 @@ from atmos.gpu.hazards import dispatch, dispatch_indirect
 from atmos.gpu.block_table import BlockTable, ints
 
 STEP_BINDING = 1        # diffusion.comp's Step block
+FIELDS = 15             # diffusion.comp's per-cell vectors: x, p, r, s, w (two copies of each of the last three), the system
 
 FLOOR = 1e-3               # 1/m: transport extinction floor (empty cells still conduct, finitely)
 TOLERANCE = 1e-4           # relative residual |b - A phi| / |b| the GPU solve stops at
@@ -126,26 +128,35 @@ def relative_residual(system: dict, x) -> float:
 
 def solve_cg(system: dict, x0=None, tol: float = 1e-10, iterations: int = 20000):
     """Jacobi-preconditioned conjugate gradients from ``x0`` (zeros) until |r| <= tol |b|:
-    (x, iterations run)."""
+    (x, iterations run). Chronopoulos and Gear's form (1989), as the shader runs it: u = r / diag and
+    w = A u are carried, s = A p follows p by recurrence, and an iteration's two inner products
+    gamma = (r, u), delta = (w, u) (and |r|^2, for the stop) are summed together; a step that would
+    not descend (a non-positive denominator) is 0."""
     diag, b = system["diag"], system["rhs"]
     x = np.zeros_like(b) if x0 is None else np.array(x0, np.float64)
     r = b - apply(system, x)
-    z = r / diag
-    p, rz = z.copy(), (r * z).sum()
+    u = r / diag
+    w = apply(system, u)
     limit = tol * tol * (b ** 2).sum()
+    p = s = None
+    gamma_old = alpha_old = 0.0
     for it in range(iterations):
-        if (r ** 2).sum() <= limit:
+        gamma, delta, rr = (r * u).sum(), (w * u).sum(), (r * r).sum()
+        if rr <= limit:
             return x, it
-        Ap = apply(system, p)
-        pAp = (p * Ap).sum()
-        if not pAp > 0:
-            return x, it
-        alpha = rz / pAp
-        x += alpha * p
-        r -= alpha * Ap
-        z = r / diag
-        rz, rz_old = (r * z).sum(), rz
-        p = z + (rz / rz_old) * p
+        beta, denom = 0.0, delta
+        if p is not None:
+            beta = gamma / gamma_old if gamma_old > 0 else 0.0
+            if alpha_old > 0:
+                denom = delta - beta * gamma / alpha_old
+        alpha = gamma / denom if denom > 0 else 0.0
+        p = u if p is None else u + beta * p
+        s = w if s is None else w + beta * s
+        x = x + alpha * p
+        r = r - alpha * s
+        u = r / diag
+        w = apply(system, u)
+        gamma_old, alpha_old = gamma, alpha
     return x, iterations
 
 
@@ -230,9 +241,9 @@ class DiffusionSolver:
         self.cells = int(np.prod(self.field_shape))
         self.groups = groups(self.cells, 256)
         ctx = self.gpu.ctx
-        self._cells = ctx.buffer(reserve=12 * 4 * self.cells)
+        self._cells = ctx.buffer(reserve=FIELDS * 4 * self.cells)
         self._cells.clear()
-        self._parts = ctx.buffer(reserve=6 * 4 * self.groups)
+        self._parts = ctx.buffer(reserve=(7 * self.groups + 4) * 4)
         self._parts.clear()
         self._args = ctx.buffer(np.array([self.groups, 1, 1], np.uint32).tobytes())
         self._steps = BlockTable(self.gpu, STEP_BINDING, [ints(stage, cur, first) for stage, cur, first
@@ -244,14 +255,14 @@ class DiffusionSolver:
         self.iterations = 0          # run since the last begin (each does nothing once converged)
 
     def _dispatch(self, stage: int, **values) -> None:
-        """Stages 2 and 3 (the iteration) run indirect: no groups once converged. The stage and the
+        """Stage 3 (the iteration) runs indirect: no groups once converged. The stage and the
         iteration's state come from the Step block's record (stage, cur, first): no uniform writes."""
         prog = self._program
         if values:
             write_uniforms(prog, values)
         self._steps.use(4 * stage + 2 * self._cur + int(self._first))
         use_buffers(prog, self._buffers)
-        if stage in (2, 3):
+        if stage == 3:
             dispatch_indirect(prog, self._args)
         else:
             dispatch(prog, self.groups)
@@ -274,18 +285,18 @@ class DiffusionSolver:
                   "cell": tuple(float(v) for v in coarse), "s": tuple(float(v) for v in -sun / n)}
         self._dispatch(0, cold=int(not warm), **common)
         self._dispatch(1)
+        self._dispatch(2)
 
     def iterate(self, count: int) -> None:
-        """``count`` iterations (stages 2 and 3, as :meth:`_dispatch`): the buffers are bound by the
-        first dispatch and stay bound; each dispatch still declares their uses (its barrier)."""
+        """``count`` iterations (stage 3, one dispatch each, as :meth:`_dispatch`): the buffers are bound
+        by the first dispatch and stay bound; each dispatch still declares their uses (its barrier)."""
         prog, steps, args, uses = self._program, self._steps, self._args, self._buffers
         bind = True
         for _ in range(int(count)):
-            for stage in (2, 3):
-                steps.use(4 * stage + 2 * self._cur + int(self._first))
-                use_buffers(prog, uses, bind)
-                bind = False
-                dispatch_indirect(prog, args)
+            steps.use(4 * 3 + 2 * self._cur + int(self._first))
+            use_buffers(prog, uses, bind)
+            bind = False
+            dispatch_indirect(prog, args)
             self._cur, self._first = 1 - self._cur, False
             self.iterations += 1
 
@@ -305,8 +316,9 @@ class DiffusionSolver:
 
     def relative_residual(self) -> float:
         """|r| / |b| after the iterations run (reads the partial sums back: a diagnostic)."""
-        parts = np.frombuffer(self._parts.read(), np.float32).astype(np.float64).reshape(6, self.groups)
-        rr, bb = parts[2 + self._cur].sum(), parts[5].sum()
+        parts = np.frombuffer(self._parts.read(), np.float32).astype(np.float64)[:7 * self.groups]
+        parts = parts.reshape(7, self.groups)
+        rr, bb = parts[4 + self._cur].sum(), parts[6].sum()
         return float(math.sqrt(rr / bb)) if bb > 0 else math.sqrt(rr)
 
     def release(self) -> None:

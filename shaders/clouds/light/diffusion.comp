@@ -1,17 +1,21 @@
 #version 430
 // The diffusion field (plugins/clouds/light/diffusion.py; float64 twin: diffusion_system + solve_cg + field):
 // a P1 solve of the sun's scattered fluence on the field's grid (the shading grid or coarser) by Jacobi-preconditioned conjugate
-// gradients, two dispatches per iteration. One invocation per cell (x fastest); per-cell vectors in
-// `cells` (fields at multiples of n_cells), per-workgroup partial sums in `parts`. Every workgroup sums
-// the partials in the same order, so all of them see the same scalars (no read-back, no host sync).
-// stage 0 assemble (x kept from the last solve unless cold), 1 init (r = b - A x), 2 p/Ap, 3 x/r/z,
-// 4 write (phi, F) into the rgba16f target. The iteration stops (stages 2 and 3 do nothing) once
-// |r| <= tolerance |b| (stage 3 then sets the indirect group count to 0: they cost nothing more).
+// gradients in Chronopoulos and Gear's form: ONE dispatch per iteration (its two inner products in one
+// reduction). One invocation per cell (x fastest); per-cell vectors in `cells` (fields at multiples of
+// n_cells; r, s = A p and w = A u twice, read at `cur` and written at 1 - cur), per-workgroup partial
+// sums in `parts`. Every workgroup sums the partials in the same order, so all of them see the same
+// scalars (no read-back, no host sync). w = A u needs the neighbours' new u, which their own
+// invocations write in the same dispatch: each invocation recomputes them from the last iteration's
+// r, s and w (pointwise), so no second dispatch waits on them.
+// stage 0 assemble (x kept from the last solve unless cold), 1 init (r = b - A x), 2 init (u, w = A u),
+// 3 iterate, 4 write (phi, F) into the rgba16f target. The iteration stops (stage 3 does nothing) once
+// |r| <= tolerance |b| (it then sets the indirect group count to 0: later iterations cost nothing more).
 layout(local_size_x = 256) in;
 #include "clouds/light/sample.glsl"
 layout(std140, binding = 1) uniform Step {   // one record per (stage, cur, first), bound per dispatch
     int stage;
-    int cur;                  // which of the two rz / rr partial arrays is the current one
+    int cur;                  // which of the two copies of r, s, w and the partials is the current one
     int first;                // the first iteration after init: beta = 0
 };
 uniform int cold;             // init from x = 0
@@ -30,7 +34,8 @@ layout(rgba16f, binding = 0) uniform writeonly image3D target;
 const float FLOOR = 1e-3;
 const float SIGMA_MAX = 1e3;  // diffusion.SIGMA_MAX
 const float AIR_DEPTH = 1.0;  // diffusion.AIR_DEPTH
-const int X = 0, R = 1, Z = 2, P = 3, AP = 4, DIAG = 5, RHS = 6, GX = 7, GY = 8, GZ = 9, DC = 10, QC = 11;
+const int X = 0, P = 1, R = 2, S = 4, W = 6, DIAG = 8, RHS = 9, GX = 10, GY = 11, GZ = 12, DC = 13, QC = 14;
+// (R, S and W hold two copies each: field R + cur)
 shared vec3 red[256];
 shared vec4 sums;
 
@@ -66,10 +71,11 @@ void partials(ivec3 o, vec3 v) {
     }
 }
 
-int RZ(int which) { return which * groups_n(); }
-int RR(int which) { return (2 + which) * groups_n(); }
-int PAP() { return 4 * groups_n(); }
-int BB() { return 5 * groups_n(); }
+int RU(int which) { return which * groups_n(); }              // gamma = (r, u)
+int WU(int which) { return (2 + which) * groups_n(); }        // delta = (w, u)
+int RR(int which) { return (4 + which) * groups_n(); }        // |r|^2
+int BB() { return 6 * groups_n(); }                           // |b|^2
+int SCALARS(int which) { return 7 * groups_n() + 2 * which; } // (gamma, alpha) of the last iteration
 
 float transmittance(ivec3 c) {
     vec3 h = vec3(trans_size) / vec3(size);
@@ -132,6 +138,17 @@ float apply(int field, ivec3 c, int i) {
 }
 
 
+// This iteration's s = w + beta s at cell j (the first iteration: w), from the last iteration's copies.
+float next_s(int j, float beta) {
+    return at(W + cur, j) + (first == 1 ? 0.0 : beta * at(S + cur, j));
+}
+
+// This iteration's new u = (r - alpha s) / diag at cell j: what j's own invocation computes, from the
+// last iteration's copies (pointwise), so a neighbour's is known without waiting for it.
+float next_u(int j, float alpha, float beta) {
+    return (at(R + cur, j) - alpha * next_s(j, beta)) / at(DIAG, j);
+}
+
 float gradient(ivec3 c, int i, int a) {
     int stride = a == 0 ? 1 : (a == 1 ? size.x : size.x * size.y);
     if (size[a] == 1) return 0.0;
@@ -150,44 +167,75 @@ void main() {
             if (cold == 1 || !(abs(at(X, i)) < 1e30)) put(X, i, 0.0);     // a NaN never carries over
         }
     } else if (stage == 1) {
-        float rz = 0.0, rr = 0.0, bb = 0.0;
+        float bb = 0.0;
         if (inside) {
-            float r = at(RHS, i) - apply(X, c, i), z = r / at(DIAG, i);
-            put(R, i, r); put(Z, i, z);
-            rz = r * z; rr = r * r; bb = at(RHS, i) * at(RHS, i);
+            put(R, i, at(RHS, i) - apply(X, c, i));
+            bb = at(RHS, i) * at(RHS, i);
         }
-        partials(ivec3(RZ(cur), RR(cur), BB()), vec3(rz, rr, bb));
+        partials(ivec3(BB(), -1, -1), vec3(bb, 0.0, 0.0));
     } else if (stage == 2) {
-        vec4 v = totals(ivec4(RR(cur), BB(), RZ(cur), RZ(1 - cur)));   // (rr, bb, rz, rz_old)
-        if (v.x <= tolerance * tolerance * v.y) return;   // converged: uniform over all invocations
-        float beta = first == 1 ? 0.0 : v.z / max(v.w, 1e-37);
-        float pap = 0.0;
+        float ru = 0.0, wu = 0.0, rr = 0.0;
         if (inside) {
-            float p = at(Z, i) + beta * (first == 1 ? 0.0 : at(P, i));
-            float ap = apply(Z, c, i) + (first == 1 ? 0.0 : beta * at(AP, i));
-            put(P, i, p); put(AP, i, ap);
-            pap = p * ap;
+            float r = at(R, i), u = r / at(DIAG, i);
+            float w = at(DIAG, i) * u;
+            int stride[3] = int[3](1, size.x, size.x * size.y);
+            int G[3] = int[3](GX, GY, GZ);
+            for (int a = 0; a < 3; ++a) {
+                if (c[a] + 1 < size[a]) w -= at(G[a], i) * (at(R, i + stride[a]) / at(DIAG, i + stride[a]));
+                if (c[a] > 0) w -= at(G[a], i - stride[a]) * (at(R, i - stride[a]) / at(DIAG, i - stride[a]));
+            }
+            put(W, i, w);
+            ru = r * u; wu = w * u; rr = r * r;
         }
-        partials(ivec3(PAP(), -1, -1), vec3(pap, 0.0, 0.0));
+        partials(ivec3(RU(0), WU(0), RR(0)), vec3(ru, wu, rr));
     } else if (stage == 3) {
-        vec4 v = totals(ivec4(RR(cur), BB(), RZ(cur), PAP()));        // (rr, bb, rz, pAp)
-        float rz = 0.0, rr = 0.0;
-        if (v.x <= tolerance * tolerance * v.y) {                                      // carry this workgroup's partials to the next array
+        vec4 v = totals(ivec4(RR(cur), BB(), RU(cur), WU(cur)));       // (rr, bb, gamma, delta)
+        int nxt = 1 - cur;
+        if (v.x <= tolerance * tolerance * v.y) {       // converged (uniform): carry the partials to the next copy
             if (gl_LocalInvocationID.x == 0u) {
-                if (gl_WorkGroupID.x == 0u) args[0] = 0u;       // later iterations dispatch nothing
                 int w = int(gl_WorkGroupID.x);
-                parts[RZ(1 - cur) + w] = parts[RZ(cur) + w];
-                parts[RR(1 - cur) + w] = parts[RR(cur) + w];
+                if (w == 0) {
+                    args[0] = 0u;                       // later iterations dispatch nothing
+                    parts[SCALARS(nxt)] = parts[SCALARS(cur)];
+                    parts[SCALARS(nxt) + 1] = parts[SCALARS(cur) + 1];
+                }
+                parts[RU(nxt) + w] = parts[RU(cur) + w];
+                parts[WU(nxt) + w] = parts[WU(cur) + w];
+                parts[RR(nxt) + w] = parts[RR(cur) + w];
             }
             return;
         }
-        float alpha = v.w > 0.0 ? v.z / v.w : 0.0;
-        if (inside) {
-            float x = at(X, i) + alpha * at(P, i), r = at(R, i) - alpha * at(AP, i), z = r / at(DIAG, i);
-            put(X, i, x); put(R, i, r); put(Z, i, z);
-            rz = r * z; rr = r * r;
+        float gamma = v.z, delta = v.w, beta = 0.0, denom = delta;
+        if (first == 0) {
+            float gamma_old = parts[SCALARS(cur)], alpha_old = parts[SCALARS(cur) + 1];
+            beta = gamma_old > 0.0 ? gamma / gamma_old : 0.0;
+            if (alpha_old > 0.0) denom = delta - beta * gamma / alpha_old;
         }
-        partials(ivec3(RZ(1 - cur), RR(1 - cur), -1), vec3(rz, rr, 0.0));
+        float alpha = denom > 0.0 ? gamma / denom : 0.0;
+        if (gl_GlobalInvocationID.x == 0u) {
+            parts[SCALARS(nxt)] = gamma;
+            parts[SCALARS(nxt) + 1] = alpha;
+        }
+        float ru = 0.0, wu = 0.0, rr = 0.0;
+        if (inside) {
+            float s_i = next_s(i, beta);
+            float p = at(R + cur, i) / at(DIAG, i) + (first == 1 ? 0.0 : beta * at(P, i));
+            put(P, i, p);
+            put(X, i, at(X, i) + alpha * p);
+            put(S + nxt, i, s_i);
+            float r = at(R + cur, i) - alpha * s_i, u = r / at(DIAG, i);
+            float w = at(DIAG, i) * u;
+            int stride[3] = int[3](1, size.x, size.x * size.y);
+            int G[3] = int[3](GX, GY, GZ);
+            for (int a = 0; a < 3; ++a) {
+                if (c[a] + 1 < size[a]) w -= at(G[a], i) * next_u(i + stride[a], alpha, beta);
+                if (c[a] > 0) w -= at(G[a], i - stride[a]) * next_u(i - stride[a], alpha, beta);
+            }
+            put(R + nxt, i, r);
+            put(W + nxt, i, w);
+            ru = r * u; wu = w * u; rr = r * r;
+        }
+        partials(ivec3(RU(nxt), WU(nxt), RR(nxt)), vec3(ru, wu, rr));
     } else if (inside) {
         float phi = at(X, i), D = at(DC, i);
         vec3 F = -D * vec3(gradient(c, i, 0), gradient(c, i, 1), gradient(c, i, 2)) + 3.0 * D * at(QC, i) * s;
