@@ -136,6 +136,25 @@ def test_the_field_lights_a_lit_surface_seen_with_the_sun_behind():
     assert half == pytest.approx(max(phi - 3 * g * field[1:] @ [0.0, -1.0, 0.0], 0.6 * 2 * share * phi) / (4 * np.pi))
 
 
+def test_an_iteration_is_one_dispatch_and_the_solve_matches_the_twins_iterations(gpu, ctx, rng, monkeypatch):
+    """Chronopoulos-Gear: one (indirect) dispatch per iteration; its float32 iterates follow the float64
+    twin's: after k iterations the GPU's residual is the twin's within float32's reach."""
+    import atmos.plugins.clouds.light.diffusion as diffusion
+    d = blob(rng, (12, 6, 10))
+    T = sun_transmittance(d)
+    calls = []
+    real = diffusion.dispatch_indirect
+    monkeypatch.setattr(diffusion, "dispatch_indirect", lambda *a: calls.append(a) or real(*a))
+    system = diffusion_system(d, 20.0, *MEDIUM, T, SUN)
+    for k in (3, 8):
+        calls.clear()
+        _, residual = gpu_field(gpu, d, T, iterations=k)
+        assert len(calls) == k
+        x, run = solve_cg(system, iterations=k)
+        want = np.sqrt(((system["rhs"] - apply(system, x)) ** 2).sum() / (system["rhs"] ** 2).sum())
+        assert run == k and residual == pytest.approx(want, rel=0.02, abs=1e-5), (k, residual, want)
+
+
 def test_bad_solver_input_is_refused(gpu, ctx):
     solver = DiffusionSolver(gpu, (6, 4, 6))
     tex = upload_volume(gpu, np.ones((6, 4, 6), np.float32))
