@@ -251,8 +251,15 @@ def nested_field(default, doc: str = ""):
     return _field(default, doc, check_type, cls=type(default))
 
 
-def check_type(owner: str, name: str, value, cls):
-    """An instance of ``cls``."""
+def type_field(default, cls, doc: str = "", *, optional: bool = False):
+    """A field holding an instance of ``cls`` (or None when ``optional``; :func:`check_type`)."""
+    return _field(default, doc, check_type, cls=cls, optional=optional)
+
+
+def check_type(owner: str, name: str, value, cls, optional: bool = False):
+    """An instance of ``cls`` (or None when ``optional``)."""
+    if value is None and optional:
+        return None
     if not isinstance(value, cls):
         article = "an" if cls.__name__[0] in "AEIOU" else "a"
         raise ValueError(f"{owner}.{name} must be {article} {cls.__name__}, got {type(value).__name__}")

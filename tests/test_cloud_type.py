@@ -1,6 +1,6 @@
 """The ray march's cloud type (plugins/clouds/raymarch/shape.py): the shader's profile and shaped density
-against their float64 twins on fresh random inputs, the march with each type against its reference, the
-profiles' shapes, skipping with a type, and the setting's checks."""
+against their float64 twins on fresh random inputs, the march with each type (and with types by region)
+against its reference, the profiles' shapes, skipping with a type, and the settings' checks."""
 import numpy as np
 import pytest
 
@@ -9,7 +9,7 @@ from atmos.plugins.clouds.light.diffusion import DIFFUSION, read_field
 from atmos.plugins.clouds.light.ground import ground_sun_of
 from atmos.plugins.clouds.raymarch import RaymarchCloudSettings, RaymarchCloudsPlugin
 from atmos.plugins.clouds.raymarch.reference import march_reference
-from atmos.plugins.clouds.raymarch.shape import CLOUD_TYPES, COLUMN_FULL, type_density, type_profile
+from atmos.plugins.clouds.raymarch.shape import CLOUD_TYPES, COLUMN_FULL, CloudTypeMap, type_density, type_profile
 from fullscreen_probe import run_fullscreen
 from test_cloud_raymarch import DAY, aim, linear, scene, shading_volume
 
@@ -88,6 +88,69 @@ def test_the_march_with_each_type_matches_its_float64_reference(gpu, ctx, rng, n
     app.close()
 
 
+def test_the_march_with_types_by_region_matches_its_float64_reference(gpu, ctx, rng):
+    """A random map of types over the volume (and past it: its edge texels hold beyond), with no single
+    type: the march against the reference reading the map's float64 twin."""
+    d = random_volume(rng)
+    app = scene(gpu, d, DAY, empty_space_skipping=False, min_transmittance=0.0, steps=128, step_growth=0.002)
+    march = next(p for p in app.plugins if isinstance(p, RaymarchCloudsPlugin))
+    sim = next(p for p in app.plugins if isinstance(p, CloudsPlugin)).simulation.sets()
+    layout = sim.layout()
+    lo, extent = np.asarray(layout.lo), np.asarray(layout.hi) - np.asarray(layout.lo)
+    types = rng.uniform(0.0, 1.0, (4, 5))
+    types[0, 0], types[-1, -1] = 0.0, 1.0                                   # the ends of the range
+    march.configure(cloud_type=None, type_map=CloudTypeMap(types, origin=(lo[0] + 60.0, lo[2] - 40.0),
+                                                           size=(0.7 * extent[0], extent[2] + 80.0)))
+    cam = aim(app, (80.0, 520.0, -220.0), target=(160.0, 470.0, 200.0))
+    image = linear(app)
+    ref = march_reference(d, shading_volume(sim), sim.settings, march.settings, layout, cam, DAY, gpu.size,
+                          field=read_field(sim.a[DIFFUSION]), ground_sun=ground_sun_of(sim))
+    assert (ref["alpha"] > 0.05).mean() > 0.02, "the view must see the clouds"
+    # as one type's march (the half-float columns), and the texture unit's bilinear weights (8 bits of
+    # sub-texel position on common hardware: the type off by up to 1/256 of a neighbour's difference)
+    light = ref["light"]
+    rmse = np.sqrt(np.mean((image[..., :3] - light) ** 2)) / np.sqrt(np.mean(light ** 2))
+    assert rmse < 0.004, f"colour off the reference: relative RMSE {rmse:.4f}"
+    off = np.abs(image[..., 3] - ref["alpha"])
+    assert np.percentile(off, 99.5) < 0.003, "coverage off the reference"
+    assert (off > 0.02).mean() < 0.002
+    one = march_reference(d, shading_volume(sim), sim.settings, march.settings.replace(type_map=None, cloud_type=0.5),
+                          layout, cam, DAY, gpu.size, field=read_field(sim.a[DIFFUSION]), ground_sun=ground_sun_of(sim))
+    assert np.abs(one["alpha"] - ref["alpha"]).max() > 0.1, "the map must shape the clouds otherwise than one type"
+    app.close()
+
+
+def test_a_type_map_reads_bilinearly_and_holds_its_edges():
+    m = CloudTypeMap(np.array([[0.0, 1.0], [0.5, 0.5]]), origin=(100.0, -50.0), size=(40.0, 20.0))
+    # texel centres at x 110, 130 and z -45, -35
+    assert m.at(110.0, -45.0) == 0.0 and m.at(130.0, -45.0) == 1.0 and m.at(120.0, -45.0) == 0.5
+    assert m.at(120.0, -40.0) == pytest.approx(0.5)
+    np.testing.assert_array_equal(m.at(np.array([-1e6, 1e6]), np.array([-45.0, -45.0])), [0.0, 1.0])   # the edges hold
+    assert m.types.dtype == np.float32 and not m.types.flags.writeable
+    assert m.at(np.zeros((3, 2)), np.zeros((3, 2))).shape == (3, 2)
+
+
+@pytest.mark.parametrize("types, fields, message", [
+    (np.full((2, 2), 1.5), {}, "in \\[0, 1\\]"),
+    (np.array([[0.2, np.nan]]), {}, "NaN"),
+    (np.zeros(4), {}, "2D array"),
+    (np.zeros((2, 0)), {}, "2D array"),
+    (np.array([["a"]]), {}, "numbers"),
+    (np.zeros((2, 2)), {"size": (0.0, 10.0)}, "CloudTypeMap.size"),
+    (np.zeros((2, 2)), {"origin": (float("inf"), 0.0)}, "CloudTypeMap.origin"),
+])
+def test_a_bad_type_map_is_refused_naming_what_is_wrong(types, fields, message):
+    with pytest.raises(ValueError, match=message):
+        CloudTypeMap(types, **fields)
+
+
+def test_the_type_map_setting_takes_a_map_or_none():
+    m = CloudTypeMap(np.zeros((2, 2)))
+    assert RaymarchCloudSettings(type_map=m).type_map is m and RaymarchCloudSettings().type_map is None
+    with pytest.raises(ValueError, match="type_map must be a CloudTypeMap"):
+        RaymarchCloudSettings(type_map=np.zeros((2, 2)))
+
+
 def test_with_a_type_skipping_keeps_the_columns_whole(gpu, ctx, rng):
     d = np.zeros((16, 8, 16), np.float32)
     d[4:12, 0:2, 4:12] = 1.0                 # density in the lowest band only: congestus lifts it to the top
@@ -120,3 +183,14 @@ def test_the_weather_demos_type_follows_the_weather():
     phases = np.linspace(0.0, 1.0, 101)
     kinds = np.array([cloud_type_at(p) for p in phases])
     assert np.all((kinds >= 0.0) & (kinds <= 1.0)) and np.all(np.abs(np.diff(kinds)) <= 0.021), "smooth in phase"
+
+
+def test_the_weather_demos_regions_spread_around_the_weathers_type():
+    from atmos.demos.weather import REGION_SPREAD, region_offsets, type_map_at
+    offsets = region_offsets(0)
+    assert np.abs(offsets).max() == pytest.approx(1.0) and offsets.std() > 0.2
+    np.testing.assert_array_equal(offsets, region_offsets(0))                       # replayable
+    m = type_map_at(CLOUD_TYPES["cumulus"], offsets)
+    assert m.types.min() < 0.5 - 0.5 * REGION_SPREAD and m.types.max() > 0.5 + 0.5 * REGION_SPREAD
+    stratus = type_map_at(0.0, offsets)
+    assert stratus.types.min() == 0.0 and stratus.types.max() <= REGION_SPREAD + 1e-6

@@ -32,6 +32,7 @@ from atmos.plugins.clouds.far_field.plugin import CloudFarFieldPlugin
 from atmos.plugins.clouds.raymarch.far import far_uniforms
 from atmos.plugins.clouds.raymarch.noise import pixel_angle
 from atmos.plugins.clouds.raymarch.settings import REFERENCE, SUN_GROWTH, SUN_SPACING, RaymarchCloudSettings
+from atmos.plugins.clouds.raymarch.shape import CloudTypeMap
 from atmos.plugins.clouds.raymarch.temporal import TemporalClouds, jitter, jitter_repeats, jitter_shift
 from atmos.gpu import clamp_sampler
 from atmos.plugins.clouds.light.ground import GROUND, ground_sun_pass
@@ -47,6 +48,17 @@ from atmos.gpu.uniforms import bind_textures, write_uniforms
 LOW_COLOR = "cloud_raymarch_color"
 LOW_DISTANCE = "cloud_raymarch_distance"
 LOW_DEPTH = "cloud_raymarch_depth"
+
+
+def type_uniforms(settings) -> dict:
+    """shape.glsl's uniforms: ``cloud_type`` (-1: untyped; with a map, typed whatever it says), whether the
+    map gives the type and where it lies."""
+    m = settings.type_map
+    typed = m is not None or settings.cloud_type is not None
+    t = -1.0 if not typed else float(settings.cloud_type if settings.cloud_type is not None else 0.5)
+    box = (0.0, 0.0, 1.0, 1.0) if m is None else (float(m.origin[0]), float(m.origin[1]),
+                                                  1.0 / float(m.size[0]), 1.0 / float(m.size[1]))
+    return {"cloud_type": t, "type_mapped": int(m is not None), "type_map_box": box}
 
 
 def skip_map(max_maps: np.ndarray) -> np.ndarray:
@@ -151,6 +163,7 @@ class RaymarchPass(RenderPass):
         self.plugin = plugin
         self.gpu = self.sampler = self.offscreen = self.skip = self.temporal = self.noise = self.jitter = None
         self._skip_key = None
+        self._types = None                  # (the CloudTypeMap, its texture)
         self.frame_index = 0
 
     def setup(self, builder: PassBuilder) -> None:
@@ -209,6 +222,22 @@ class RaymarchPass(RenderPass):
             self._skip_key = key
         return self.skip
 
+    def _type_texture(self, type_map: CloudTypeMap):
+        """The map's types as an R32F texture (linear, clamped to the edge), uploaded when the map changes."""
+        if self._types is None or self._types[0] is not type_map:
+            self._release_types()
+            nz, nx = type_map.types.shape
+            tex = self.gpu.ctx.texture((nx, nz), 1, type_map.types.tobytes(), dtype="f4")
+            tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+            tex.repeat_x = tex.repeat_y = False
+            self._types = (type_map, tex)
+        return self._types[1]
+
+    def _release_types(self) -> None:
+        if self._types is not None:
+            self._types[1].release()
+            self._types = None
+
     def _uniforms(self, frame: PassContext, sim: CloudSets, layout, offset) -> dict:
         s, view = self.plugin.settings, frame.view
         cell = np.asarray(layout.cell, np.float64)
@@ -225,7 +254,7 @@ class RaymarchPass(RenderPass):
                 "jittered": int(s.jitter),    # turned per frame only where the resolve averages (r > 1, reprojection)
                 "jitter_shift": jitter_shift(self.frame_index, s.resolution) if s.resolution > 1 and s.reprojection else 0.0,
                 "sun_march": tuple(float(v) for v in sun * SUN_SPACING * cell.min()), "sun_growth": SUN_GROWTH,
-                "pixel_angle": pixel_angle(view), "cloud_type": -1.0 if s.cloud_type is None else float(s.cloud_type)}
+                "pixel_angle": pixel_angle(view), **type_uniforms(s)}
 
     def execute(self, frame: PassContext) -> None:
         s, view = self.plugin.settings, frame.view
@@ -239,6 +268,10 @@ class RaymarchPass(RenderPass):
         write_uniforms(p, self._uniforms(frame, sim, layout, offset))
         bind_volume(p, sim, self.sampler, view.sun, s.octaves, s.ms_diffusion, layout.heights, view.ground,
                     ground_light=frame.resource(GROUND))
+        if s.type_map is not None:
+            bind_textures(p, cloud_type_map=self._type_texture(s.type_map))
+        else:
+            self._release_types()
         if s.empty_space_skipping:
             bind_textures(p, skip_map=self._skip_texture(sim))
         else:                               # nothing uploaded; the shader reads no skip map
@@ -315,6 +348,7 @@ class RaymarchPass(RenderPass):
             self.sampler.release()
         self.sampler = self.noise = None     # the noise textures belong to the context's cache
         self._release_skip()
+        self._release_types()
         if self.jitter is not None:
             self.jitter.release()
             self.jitter = None

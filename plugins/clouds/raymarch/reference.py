@@ -4,7 +4,8 @@ fall): the same segments (``step_base + step_growth · s``, s from the near plan
 to its far side or the scene), the density trilinear between cell centres (clamp to edge), the
 light J of :func:`atmos.plugins.clouds.light.medium.source_reference` with the column depths of
 :func:`atmos.plugins.clouds.sprites.reference.column_depth` and the set's diffusion field
-(``edge_fade`` 0: neither fades). With ``settings.cloud_type`` the density is
+(``edge_fade`` 0: neither fades). With ``settings.cloud_type`` (or ``settings.type_map``: the type at each
+point, :func:`~atmos.plugins.clouds.raymarch.shape.type_at`) the density is
 :func:`~atmos.plugins.clouds.raymarch.shape.type_density` of the column's mean density (the light volume's
 columns, as ``shape.glsl`` reads them), in the view march and the sun march alike."""
 from __future__ import annotations
@@ -13,7 +14,7 @@ import numpy as np
 
 from atmos.camera import view_basis
 from atmos.plugins.clouds.raymarch.settings import SUN_GROWTH, SUN_SPACING
-from atmos.plugins.clouds.raymarch.shape import TYPE_SUN_STEPS, type_density
+from atmos.plugins.clouds.raymarch.shape import TYPE_SUN_STEPS, type_at, type_density
 from atmos.plugins.clouds.volume.light import layer_sun, sun_source_at, unit_direction
 from atmos.plugins.clouds.sprites.reference import column_depth
 from atmos.plugins.clouds.light.diffusion import diffusion_radiance
@@ -57,11 +58,12 @@ def march_reference(density, transmittance, medium, settings, layout, camera, su
     sun_dir = unit_direction(sun)
     column_tau = medium.sigma_t * cell[1]
     lobes = medium.phase.lobes
-    density_at = shaped_density(d, settings.cloud_type, trans_volume.shape, extent[1] / cell[1])
+    density_at = shaped_density(d, settings.cloud_type, trans_volume.shape, extent[1] / cell[1],
+                                settings.type_map, lo, extent)
 
     def sample(i, p):
         uvw = (p - lo) / extent
-        typed = settings.cloud_type is not None and settings.sun_steps > 0
+        typed = (settings.cloud_type is not None or settings.type_map is not None) and settings.sun_steps > 0
         T = sun_transmittance(d, trans_volume, medium.sigma_t, lo, extent, SUN_SPACING * cell.min(),
                               settings.sun_steps + TYPE_SUN_STEPS * typed, sun_dir, p, density_at,
                               shading=not typed)
@@ -75,17 +77,20 @@ def march_reference(density, transmittance, medium, settings, layout, camera, su
                      settings.min_transmittance, medium.sigma_t, sample, (h, w))
 
 
-def shaped_density(density, cloud_type, shading_shape, ny: float):
+def shaped_density(density, cloud_type, shading_shape, ny: float, type_map=None, lo=None, extent=None):
     """``shape.glsl``'s shaped_density as a function of uvw (n, 3): the trilinear ``density`` (cloud_type
-    None), else type_density of the columns' (up + down) / ``ny`` (the layer's height in cells) of the
-    shading grid ``shading_shape``."""
+    and type_map None), else type_density of the columns' (up + down) / ``ny`` (the layer's height in
+    cells) of the shading grid ``shading_shape``, of the type at the point (``type_map`` read at world
+    lo + uvw extent, else ``cloud_type``)."""
     d = np.asarray(density, np.float64)
-    if cloud_type is None:
+    if cloud_type is None and type_map is None:
         return lambda uvw: multilinear(d, uvw * np.array(d.shape, np.float64) - 0.5)
 
     def at(uvw):
         up, down = column_depth(d, uvw, 1.0, shading_shape)
-        return type_density((up + down) / ny, uvw[:, 1], cloud_type)
+        t = cloud_type if type_map is None else type_at(None, type_map, lo[0] + uvw[:, 0] * extent[0],
+                                                        lo[2] + uvw[:, 2] * extent[2])
+        return type_density((up + down) / ny, uvw[:, 1], t)
     return at
 
 

@@ -3,8 +3,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from atmos.checks import bool_field, int_field, num_field, vec_field
-from atmos.plugins.clouds.raymarch.shape import CLOUD_TYPES
+from atmos.checks import bool_field, int_field, num_field, type_field, vec_field
+from atmos.plugins.clouds.raymarch.shape import CLOUD_TYPES, CloudTypeMap
 from atmos.plugins.clouds.raymarch.temporal import HISTORY_CLAMP, MOTION_LIMIT
 from atmos.plugins.clouds.volume.light import CloudLightSettings
 
@@ -14,7 +14,7 @@ MAX_SUN_STEPS = 16
 SUN_SPACING = 0.5        # cells (of the smallest side): the sun march's first step (march.glsl sun_transmittance)
 SUN_GROWTH = 2.0         # each next sun-march step this many times the last (4 steps reach 7.5 cells)
 REFERENCE = dict(resolution=1, jitter=False, reprojection=False, detail_octaves=0, step=0.25, step_growth=0.0,
-                 steps=MAX_STEPS, min_transmittance=0.0, cloud_type=None)
+                 steps=MAX_STEPS, min_transmittance=0.0, cloud_type=None, type_map=None)
 """The reference configuration (:meth:`RaymarchCloudsPlugin.reference`): every pixel marched, one sample
 at the midpoint of every quarter-cell step to the layer's end or the scene depth (at most 4096 samples
 in occupied space), no detail noise, jitter, history, early exit or cloud type (the simulation's own shape, as the sprites draw it); empty-space skipping stays on (it
@@ -78,6 +78,12 @@ class RaymarchCloudSettings(CloudLightSettings):
                                          "whole empty columns; the sun march takes 2 more (long) steps in place of "
                                          "the shading volume, which holds the simulation's own shape",
                                          optional=True)
+    type_map: CloudTypeMap | None = type_field(None, CloudTypeMap, "cloud types by region: a "
+                                               ":class:`~.shape.CloudTypeMap` of types over the ground "
+                                               "(world metres), read bilinearly at every density sample and "
+                                               "in the far field, in place of ``cloud_type`` (typed even when "
+                                               "that is None); None: ``cloud_type`` everywhere. Cost: one "
+                                               "filtered fetch per density sample", optional=True)
     detail_octaves: int = int_field(3, 0, 3, "noise channels the density is eroded by (0 = off; each one two "
                                     "more texture fetches per sample; ``shaders/clouds/raymarch/detail.glsl``)")
     detail_scale: float = num_field(8.0, 0.5, 1e4, "cells of the smallest side per base-noise tile (8: billows "

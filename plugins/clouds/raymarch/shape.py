@@ -16,10 +16,18 @@ flat; inside, the density is below the body density (noise.py COVERAGE) wherever
 tops, thin columns), so the detail noise carves there, through the volume, not only at its edge.
 ``shaders/clouds/raymarch/shape.glsl`` is the shader; :func:`type_profile` and :func:`type_density`
 are its float64 twins.
+
+Types by region: a :class:`CloudTypeMap` (``RaymarchCloudSettings.type_map``) gives t over the ground in
+world metres (stratus over the sea, congestus over the hills), sampled bilinearly at each density sample
+(the far field's too), in place of the one ``cloud_type``; :func:`type_at` is its twin.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
+
+from atmos.checks import check_vec
 
 CLOUD_TYPES = {"stratus": 0.0, "cumulus": 0.5, "congestus": 1.0}
 """The key types: t of each."""
@@ -61,3 +69,56 @@ def type_density(m, h, t) -> np.ndarray:
     t = np.asarray(t, np.float64)
     c = c ** (1.0 - ANVIL * np.clip(2.0 * t - 1.0, 0.0, 1.0) * _ramp(h, *ANVIL_FROM))
     return np.clip(type_profile(h, t) - (1.0 - c), 0.0, c)        # c · remap(P, 1 - c, 1, 0, 1)
+
+
+MAX_MAP_SIDE = 4096   # texels per side of a CloudTypeMap at most
+
+
+@dataclass(frozen=True, eq=False)
+class CloudTypeMap:
+    """Cloud types over the ground: ``types`` (nz, nx), each in [0, 1] (``CLOUD_TYPES``), row j along z and
+    column i along x, spread over ``size`` = (sx, sz) metres from the world corner ``origin`` = (x, z), texel
+    (i, j)'s centre at origin + ((i + 1/2) sx / nx, (j + 1/2) sz / nz). Read bilinearly between the
+    centres and held at the edge texels beyond them (outside the map: its nearest edge). Compared by
+    identity: hand a new map to change it (``configure(type_map=...)``)."""
+    types: np.ndarray
+    origin: tuple = (0.0, 0.0)
+    size: tuple = (1.0, 1.0)
+
+    def __post_init__(self):
+        t = np.asarray(self.types)
+        if t.ndim != 2 or not (1 <= min(t.shape) and max(t.shape) <= MAX_MAP_SIDE):
+            raise ValueError(f"CloudTypeMap.types must be a 2D array (nz, nx) of 1..{MAX_MAP_SIDE} texels per "
+                             f"side, got shape {t.shape}")
+        if t.dtype.kind not in "fiu" or t.dtype == bool:
+            raise ValueError(f"CloudTypeMap.types must hold numbers in [0, 1], got dtype {t.dtype}")
+        t = t.astype(np.float64)
+        if not (np.isfinite(t).all() and t.min() >= 0.0 and t.max() <= 1.0):
+            raise ValueError("CloudTypeMap.types must hold finite numbers in [0, 1] (0 stratus, 0.5 cumulus, "
+                             f"1 congestus), got values from {np.nanmin(t)} to {np.nanmax(t)}"
+                             f"{' and NaN or inf' if not np.isfinite(t).all() else ''}")
+        t = np.ascontiguousarray(t.astype(np.float32))
+        t.setflags(write=False)
+        object.__setattr__(self, "types", t)
+        object.__setattr__(self, "origin", check_vec("CloudTypeMap", "origin", self.origin, 2))
+        object.__setattr__(self, "size", check_vec("CloudTypeMap", "size", self.size, 2, "positive"))
+
+    def at(self, x, z) -> np.ndarray:
+        """float64 types at world points (x, z) (arrays of one shape): bilinear between texel centres,
+        clamped to the edge (shape.glsl cloud_type_at)."""
+        t = self.types.astype(np.float64)
+        nz, nx = t.shape
+        fx = (np.asarray(x, np.float64) - self.origin[0]) / self.size[0] * nx - 0.5
+        fz = (np.asarray(z, np.float64) - self.origin[1]) / self.size[1] * nz - 0.5
+        fx, fz = np.clip(fx, 0.0, nx - 1.0), np.clip(fz, 0.0, nz - 1.0)
+        i0, j0 = np.minimum(np.floor(fx).astype(np.int64), nx - 1), np.minimum(np.floor(fz).astype(np.int64), nz - 1)
+        i1, j1 = np.minimum(i0 + 1, nx - 1), np.minimum(j0 + 1, nz - 1)
+        wx, wz = fx - i0, fz - j0
+        return ((t[j0, i0] * (1 - wx) + t[j0, i1] * wx) * (1 - wz)
+                + (t[j1, i0] * (1 - wx) + t[j1, i1] * wx) * wz)
+
+
+def type_at(cloud_type, type_map, x, z):
+    """The type the march shapes with at world points (x, z): ``type_map``'s where one is given, else
+    ``cloud_type`` (None: no type, the simulation's own shape)."""
+    return type_map.at(x, z) if type_map is not None else cloud_type

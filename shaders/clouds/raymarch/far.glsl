@@ -9,7 +9,7 @@
 // column above), so the far layer is covered as often, as thick per cover and at the same heights as
 // the volume:
 //   density(r, h) = far_quantile(r) * far_profile(r, h).R       (h: height fraction, 0 base, 1 top)
-// or, with a cloud type, shape.glsl's type_density(far_quantile(r) / ny, h, cloud_type),
+// or, with a cloud type, shape.glsl's type_density(far_quantile(r) / ny, h, cloud_type_at(xz)),
 // which the march then erodes with the detail noise like the volume's density. Light (volume.glsl's
 // model): the octaves' sun transmittances are the volume's own mean at the point's rank and height
 // (far_sun_profile: light_by_rank.comp's sun_profile), so far clouds shade each other as much as the
@@ -39,11 +39,12 @@ float far_height(float y) {
     return (y - far_band.x) / far_band.y;
 }
 
-// The far field's density at rank r and height fraction h (0 outside the layer); with a cloud type
-// (shape.glsl, included first) the type's shape of the column sum at r over the layer's ny cells.
-float far_density(float r, float h, float ny) {
+// The far field's density at rank r and height fraction h (0 outside the layer) at world point xz; with a
+// cloud type (shape.glsl, included first) the type's (there) shape of the column sum at r over the layer's
+// ny cells.
+float far_density(float r, float h, float ny, vec2 xz) {
     if (h < 0.0 || h > 1.0) return 0.0;
-    if (cloud_type >= 0.0) return type_density(far_quantile(r) / ny, h, cloud_type);
+    if (cloud_type >= 0.0) return type_density(far_quantile(r) / ny, h, cloud_type_at(xz));
     return far_quantile(r) * textureLod(far_profile, vec2(r, h), 0.0).r;
 }
 

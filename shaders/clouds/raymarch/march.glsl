@@ -48,11 +48,13 @@ uniform float far_growth;      // FAR_FIELD: the step's growth per metre of dist
 uniform float pixel_angle;     // a full-res pixel's angle (rad): its width per metre of distance
 
 // The marched density at uvw (volume.glsl's cloud_density, cloud_columns, column_tau): with a cloud type
-// shape.glsl's type_density of the column's mean density (its up and down integrals over ny cells).
+// shape.glsl's type_density of the column's mean density (its up and down integrals over ny cells), of
+// the type at the point (cloud_type_at).
 float shaped_density(vec3 uvw, float ny) {
     if (cloud_type < 0.0) return cloud_density(uvw);
     vec2 c = cloud_columns(uvw);
-    return type_density((c.x + c.y) / (column_tau * ny), uvw.y, cloud_type);
+    float t = cloud_type_at(layer_min.xz + uvw.xz * (layer_max.xz - layer_min.xz));
+    return type_density((c.x + c.y) / (column_tau * ny), uvw.y, t);
 }
 
 // The blue noise (atmos/blue_noise.py) of the full-res pixel, tiled, rotated by jitter_shift (mod 1):
@@ -211,7 +213,7 @@ void cloud_march(ivec2 pixel, out vec4 color, out vec2 distance, out float depth
                 fw = far_weight((p.xz - layer_min.xz) / extent.xz);
                 if (fw > 0.0) {
                     fc = far_ranks(p.xz, sp);
-                    df = fw * far_density(fc.x, fh, ny);
+                    df = fw * far_density(fc.x, fh, ny, p.xz);
                 }
             }
 #endif
