@@ -17,7 +17,7 @@ from atmos.demo_registry import add_demo_camera
 from atmos.input import Input
 from atmos.plugins.antialias import AntialiasPlugin
 from atmos.keys import key
-from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
+from atmos.plugins.clouds.raymarch import CloudTypeMap, RaymarchCloudsPlugin
 from atmos.plugins.clouds.sprites import CloudRenderPlugin
 from atmos.plugins.clouds.far_field import CloudFarFieldPlugin
 from atmos.plugins.clouds.shadows import CloudShadowsPlugin
@@ -37,6 +37,8 @@ EDGE_FADE = 0.35        # outer fraction of the volume's half width over which i
 # the cloud shadow map's far cascade spans 1.25 x the camera's far plane (its texels grow with it).
 HORIZON = 40000.0
 REACH = 5000.0          # m: the cameras stay this near the origin (the far plane covers the ring from there)
+REGIONS = 24            # texels per side of the ray march's cloud-type maps (regional_types)
+REGION_SPAN = 12000.0   # m the type maps span, centred on the origin (the far field's clouds too)
 
 
 def build_cloudscape(app, settings, *, hours: float, speed: float = 0.0, cloud_density: int = 140,
@@ -78,6 +80,25 @@ def build_cloudscape(app, settings, *, hours: float, speed: float = 0.0, cloud_d
     cam.near, cam.far = 1.0, terrain.far_plane(within=REACH)
     cam.position = np.array([0.0, 250.0, 0.0])
     return cloud_plugin
+
+
+def region_offsets(seed: int) -> np.ndarray:
+    """(REGIONS, REGIONS) offsets in [-1, 1] of each region's cloud type from the scene's: smooth blobs a
+    few kilometres across (a coarse random grid, upsampled bilinearly and normalised)."""
+    coarse = np.random.default_rng(seed).uniform(-1.0, 1.0, (6, 6))
+    at = np.linspace(0.0, 5.0, REGIONS)
+    i = np.minimum(at.astype(int), 4)
+    f = at - i
+    rows = coarse[i] * (1 - f)[:, None] + coarse[i + 1] * f[:, None]
+    grid = rows[:, i] * (1 - f) + rows[:, i + 1] * f
+    return grid / np.abs(grid).max()
+
+
+def regional_types(kind: float, offsets: np.ndarray, spread: float) -> CloudTypeMap:
+    """The ray march's types by region around ``kind``: each region off it by ``spread`` × its offset
+    (:func:`region_offsets`), over REGION_SPAN metres around the origin."""
+    return CloudTypeMap(np.clip(kind + spread * offsets, 0.0, 1.0), origin=(-0.5 * REGION_SPAN,) * 2,
+                        size=(REGION_SPAN, REGION_SPAN))
 
 
 def follow_camera(app) -> None:

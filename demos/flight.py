@@ -1,17 +1,21 @@
-"""flight: a camera flying fast above, through and below the cloud layer in a holding pattern."""
+"""flight: a camera flying fast above, through and below the cloud layer in a holding pattern; with the ray
+march (``--clouds march``) the deck has relief: cumulus here, congestus towering above it there."""
 import math
 
 import numpy as np
 
 from atmos.camera import Camera
 from atmos.demo_registry import DemoSettings
-from atmos.demos._cloudscape import BASE_ALTITUDE, CELL, SHAPE, build_cloudscape, follow_camera
+from atmos.demos._cloudscape import (BASE_ALTITUDE, CELL, SHAPE, build_cloudscape, follow_camera, region_offsets,
+                                     regional_types)
+from atmos.plugins.clouds.raymarch import CLOUD_TYPES, RaymarchCloudsPlugin
 
 TITLE = "a fast camera flying a holding pattern above, through and below the cloud layer"
 DEFAULT_FRAMES = 300
 SPEED = 160.0        # m/s
 LEG = 2400.0         # m, straight legs of the racetrack
 RADIUS = 900.0       # m, the turns
+TYPE_SPREAD = 0.45   # the march's cloud types: cumulus ± this by region (congestus towers where it passes 0.5)
 
 
 def holding_pattern(t: float) -> tuple[np.ndarray, float]:
@@ -48,4 +52,6 @@ def fly(app) -> None:
 
 def build(app, settings) -> None:
     build_cloudscape(app, settings, hours=11.0, cloud_density=170, warmup_steps=30, haze=True)
+    march = next(p for p in app.plugins if isinstance(p, RaymarchCloudsPlugin))
+    march.configure(type_map=regional_types(CLOUD_TYPES["cumulus"], region_offsets(settings.seed), TYPE_SPREAD))
     app.add_system(fly, "update", label="fly", after="fly_camera")

@@ -7,18 +7,16 @@ import numpy as np
 
 from atmos.camera import Camera
 from atmos.demo_registry import DemoSettings
-from atmos.demos._cloudscape import build_cloudscape
+from atmos.demos._cloudscape import build_cloudscape, region_offsets, regional_types
 from atmos.plugins.clouds import CloudsPlugin
 from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
-from atmos.plugins.clouds.raymarch.shape import CLOUD_TYPES, CloudTypeMap
+from atmos.plugins.clouds.raymarch.shape import CLOUD_TYPES
 
 TITLE = ("sunny to overcast and back: the cloud density target rises and falls over time (the ray march: cumulus, "
          "congestus, stratus with it)")
 DEFAULT_FRAMES = 360
 SUNNY, OVERCAST = 20, 700      # ellipsoids
 PERIOD = 24.0                  # seconds for sunny → overcast → sunny
-REGIONS = 24                   # the type map's texels per side
-REGION_SPAN = 12000.0          # metres the type map spans, centred on the start (the far field's clouds too)
 REGION_SPREAD = 0.3            # how far a region's type lies from the weather's at most
 
 
@@ -30,28 +28,10 @@ def cloud_type_at(phase: float) -> float:
     return congestus + (stratus - congestus) * (2.0 * phase - 1.0)
 
 
-def region_offsets(seed: int) -> np.ndarray:
-    """(REGIONS, REGIONS) offsets in [-1, 1] of each region's type from the weather's: smooth blobs a few
-    kilometres across (a coarse random grid, upsampled and normalised)."""
-    coarse = np.random.default_rng(seed).uniform(-1.0, 1.0, (6, 6))
-    at = np.linspace(0.0, 5.0, REGIONS)
-    i = np.minimum(at.astype(int), 4)
-    f = at - i
-    rows = coarse[i] * (1 - f)[:, None] + coarse[i + 1] * f[:, None]
-    grid = rows[:, i] * (1 - f) + rows[:, i + 1] * f
-    return grid / np.abs(grid).max()
-
-
-def type_map_at(kind: float, offsets: np.ndarray) -> CloudTypeMap:
-    """The regions' types around the weather's ``kind``: each off it by REGION_SPREAD × its offset."""
-    return CloudTypeMap(np.clip(kind + REGION_SPREAD * offsets, 0.0, 1.0), origin=(-0.5 * REGION_SPAN,) * 2,
-                        size=(REGION_SPAN, REGION_SPAN))
-
-
 def weather_changer(clouds: CloudsPlugin, march: RaymarchCloudsPlugin, offsets: np.ndarray):
     """A system: the cloud density target follows a slow cosine from sunny to overcast and back, the
     march's cloud types with it (:func:`cloud_type_at` in steps of 0.01, spread over the regions by
-    :func:`type_map_at`)."""
+    :func:`~atmos.demos._cloudscape.regional_types`)."""
     current = [None]
 
     def change_weather(app) -> None:
@@ -61,7 +41,7 @@ def weather_changer(clouds: CloudsPlugin, march: RaymarchCloudsPlugin, offsets: 
             clouds.configure(weather={"cloud_density": density})
         kind = round(cloud_type_at(phase), 2)
         if kind != current[0]:
-            march.configure(cloud_type=kind, type_map=type_map_at(kind, offsets))
+            march.configure(cloud_type=kind, type_map=regional_types(kind, offsets, REGION_SPREAD))
             current[0] = kind
     return change_weather
 

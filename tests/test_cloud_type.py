@@ -9,7 +9,8 @@ from atmos.plugins.clouds.light.diffusion import DIFFUSION, read_field
 from atmos.plugins.clouds.light.ground import ground_sun_of
 from atmos.plugins.clouds.raymarch import RaymarchCloudSettings, RaymarchCloudsPlugin
 from atmos.plugins.clouds.raymarch.reference import march_reference
-from atmos.plugins.clouds.raymarch.shape import CLOUD_TYPES, COLUMN_FULL, CloudTypeMap, type_density, type_profile
+from atmos.plugins.clouds.raymarch.shape import (CLOUD_TYPES, COLUMN_FULL, TOWER, CloudTypeMap, march_top, type_density,
+                                                 type_profile)
 from fullscreen_probe import run_fullscreen
 from test_cloud_raymarch import DAY, aim, linear, scene, shading_volume
 
@@ -20,7 +21,7 @@ def test_the_shaders_profile_and_density_match_their_float64_twins(gpu, ctx, rng
     w, h = 64, 32
     m = rng.uniform(-0.1, 1.2, (h, w))
     m[:, :8] = rng.uniform(0.0, 0.02, (h, 8))                       # thin columns: the smallest coverages
-    points = np.stack([m, rng.uniform(-0.1, 1.1, (h, w)), rng.uniform(0.0, 1.0, (h, w))], -1)
+    points = np.stack([m, rng.uniform(-0.1, 2.7, (h, w)), rng.uniform(0.0, 1.0, (h, w))], -1)   # towers to 2.5
     points[0, :3, 2] = list(CLOUD_TYPES.values())                   # the key types exactly
     points = points.astype(np.float32)
     out = run_fullscreen(gpu, "test/type_probe.frag", (w, h), inputs={"probe_points": points}, nearest=True)
@@ -37,6 +38,11 @@ def test_the_profiles_have_the_types_shapes():
     stratus, cumulus, congestus = (type_profile(h, t) for t in CLOUD_TYPES.values())
     top = {name: h[type_profile(h, t) > 0].max() for name, t in CLOUD_TYPES.items()}
     assert top["stratus"] < 0.3 < top["cumulus"] < 0.75 < 0.95 < top["congestus"], top
+    # congestus towers above the simulated layer, to 1 + TOWER of its height; the others stay inside it
+    high = np.linspace(0.0, 3.0, 3001)
+    assert high[type_profile(high, 1.0) > 0].max() == pytest.approx(1 + TOWER, abs=2e-3)
+    assert march_top(CLOUD_TYPES["congestus"]) == 1 + TOWER and march_top(0.5) == march_top(None) == 1.0
+    assert march_top(np.array([0.1, 0.75])) == pytest.approx(0.5 * (0.7 + 1 + TOWER))
     for p in (stratus, cumulus, congestus):                 # flat bases: full density within 8 % of the base
         assert p[0] == 0.0 and p[h <= 0.08].max() == 1.0 and np.all(p <= 1.0) and np.all(p >= 0.0)
     # a thin column is a smaller cloud of the same type: it holds cloud over less height, never more
@@ -44,9 +50,9 @@ def test_the_profiles_have_the_types_shapes():
         thin, full = type_density(0.3 * COLUMN_FULL, h, t), type_density(COLUMN_FULL, h, t)
         assert np.all(thin <= full) and 0 < (thin > 0).sum() < (full > 0).sum(), name
         assert np.all(thin <= 0.3 + 1e-12), "a column's density is at most its coverage"
-    # congestus widens near the top (the anvil): there more of the columns hold cloud than its profile gives
+    # congestus widens near its top (the anvil): there more of the columns hold cloud than its profile gives
     c = np.linspace(0.0, 1.0, 1001)
-    for y in (0.85, 0.9):
+    for y in (0.85 * (1 + TOWER), 0.9 * (1 + TOWER)):
         no_anvil = np.clip(type_profile(y, 1.0) - (1.0 - c), 0.0, c)
         anvil = type_density(c * COLUMN_FULL, y, 1.0)
         assert np.all(anvil >= no_anvil) and (anvil > 0).mean() > (no_anvil > 0).mean() + 0.05, y
@@ -151,6 +157,25 @@ def test_the_type_map_setting_takes_a_map_or_none():
         RaymarchCloudSettings(type_map=np.zeros((2, 2)))
 
 
+def test_congestus_towers_above_the_simulated_layer(gpu, ctx):
+    """A layer full of cloud seen edge-on from above its top: congestus rises into the upper half of the
+    view, cumulus stays below the horizon line of its top."""
+    d = np.full((16, 6, 16), 0.8, np.float32)
+    app = scene(gpu, d, DAY, min_transmittance=0.0, cloud_type=CLOUD_TYPES["congestus"])
+    sim = next(p for p in app.plugins if isinstance(p, CloudsPlugin)).simulation.sets()
+    layout = sim.layout()
+    top = float(layout.hi[1])
+    aim(app, (160.0, top + 20.0, -400.0), target=(160.0, top + 20.0, 160.0))
+    tower = linear(app)[..., 3]
+    march = next(p for p in app.plugins if isinstance(p, RaymarchCloudsPlugin))
+    march.configure(cloud_type=CLOUD_TYPES["cumulus"])
+    flat = linear(app)[..., 3]
+    h = tower.shape[0]
+    upper = slice(h // 2 + 2, None)                               # rows looking up, above the camera's height
+    assert (tower[upper] > 0.5).mean() > 0.2 and (flat[upper] > 0.01).mean() == 0.0
+    app.close()
+
+
 def test_with_a_type_skipping_keeps_the_columns_whole(gpu, ctx, rng):
     d = np.zeros((16, 8, 16), np.float32)
     d[4:12, 0:2, 4:12] = 1.0                 # density in the lowest band only: congestus lifts it to the top
@@ -186,11 +211,12 @@ def test_the_weather_demos_type_follows_the_weather():
 
 
 def test_the_weather_demos_regions_spread_around_the_weathers_type():
-    from atmos.demos.weather import REGION_SPREAD, region_offsets, type_map_at
+    from atmos.demos._cloudscape import region_offsets, regional_types
+    from atmos.demos.weather import REGION_SPREAD
     offsets = region_offsets(0)
     assert np.abs(offsets).max() == pytest.approx(1.0) and offsets.std() > 0.2
     np.testing.assert_array_equal(offsets, region_offsets(0))                       # replayable
-    m = type_map_at(CLOUD_TYPES["cumulus"], offsets)
+    m = regional_types(CLOUD_TYPES["cumulus"], offsets, REGION_SPREAD)
     assert m.types.min() < 0.5 - 0.5 * REGION_SPREAD and m.types.max() > 0.5 + 0.5 * REGION_SPREAD
-    stratus = type_map_at(0.0, offsets)
+    stratus = regional_types(0.0, offsets, REGION_SPREAD)
     assert stratus.types.min() == 0.0 and stratus.types.max() <= REGION_SPREAD + 1e-6

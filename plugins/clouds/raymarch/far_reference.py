@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 
 from atmos.plugins.clouds.far_field.reference import column_at_rank, far_relief, field_fbm, field_rank, relief_light
-from atmos.plugins.clouds.raymarch.reference import integrate, rays
-from atmos.plugins.clouds.raymarch.shape import type_at, type_density
+from atmos.plugins.clouds.raymarch.reference import integrate, rays, typed_types
+from atmos.plugins.clouds.raymarch.shape import march_top, type_at, type_density
 from atmos.plugins.clouds.volume.light import cell_tau, layer_sun, sun_source_at, unit_direction
 from atmos.plugins.clouds.light.diffusion import field_radiance
 from atmos.plugins.clouds.light.medium import OCTAVES, octave_parameters, source_reference
@@ -103,7 +103,8 @@ def far_march_reference(field: FarField, medium, settings, band, camera, sun, si
     dirs, start = dirs.reshape(-1, 3), start.reshape(-1)
     pos = np.asarray(camera.position, np.float64)
     dy = np.where(np.abs(dirs[:, 1]) < 1e-12, 1e-12, dirs[:, 1])
-    b0, b1 = (band[0] - pos[1]) / dy, (band[0] + band[1] - pos[1]) / dy
+    top = march_top(typed_types(settings))                  # towers raise the band's top
+    b0, b1 = (band[0] - pos[1]) / dy, (band[0] + top * band[1] - pos[1]) / dy
     enter = np.maximum(np.minimum(b0, b1), start)
     leave = np.minimum(np.maximum(b0, b1), settings.far_distance)
     step_base = settings.step * float(np.min(medium.cell_size))

@@ -32,7 +32,7 @@ from atmos.plugins.clouds.far_field.plugin import CloudFarFieldPlugin
 from atmos.plugins.clouds.raymarch.far import far_uniforms
 from atmos.plugins.clouds.raymarch.noise import pixel_angle
 from atmos.plugins.clouds.raymarch.settings import REFERENCE, SUN_GROWTH, SUN_SPACING, RaymarchCloudSettings
-from atmos.plugins.clouds.raymarch.shape import CloudTypeMap
+from atmos.plugins.clouds.raymarch.shape import CloudTypeMap, march_top
 from atmos.plugins.clouds.raymarch.temporal import TemporalClouds, jitter, jitter_repeats, jitter_shift
 from atmos.gpu import clamp_sampler
 from atmos.plugins.clouds.light.ground import GROUND, ground_sun_pass
@@ -52,13 +52,14 @@ LOW_DEPTH = "cloud_raymarch_depth"
 
 def type_uniforms(settings) -> dict:
     """shape.glsl's uniforms: ``cloud_type`` (-1: untyped; with a map, typed whatever it says), whether the
-    map gives the type and where it lies."""
+    map gives the type and where it lies, and how high the types' towers reach (:func:`.shape.march_top`)."""
     m = settings.type_map
     typed = m is not None or settings.cloud_type is not None
     t = -1.0 if not typed else float(settings.cloud_type if settings.cloud_type is not None else 0.5)
     box = (0.0, 0.0, 1.0, 1.0) if m is None else (float(m.origin[0]), float(m.origin[1]),
                                                   1.0 / float(m.size[0]), 1.0 / float(m.size[1]))
-    return {"cloud_type": t, "type_mapped": int(m is not None), "type_map_box": box}
+    top = march_top(None if not typed else (m.types if m is not None else settings.cloud_type))
+    return {"cloud_type": t, "type_mapped": int(m is not None), "type_map_box": box, "march_top": top}
 
 
 def skip_map(max_maps: np.ndarray) -> np.ndarray:

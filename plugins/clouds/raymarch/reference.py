@@ -14,7 +14,7 @@ import numpy as np
 
 from atmos.camera import view_basis
 from atmos.plugins.clouds.raymarch.settings import SUN_GROWTH, SUN_SPACING
-from atmos.plugins.clouds.raymarch.shape import TYPE_SUN_STEPS, type_at, type_density
+from atmos.plugins.clouds.raymarch.shape import TYPE_SUN_STEPS, march_top, type_at, type_density
 from atmos.plugins.clouds.volume.light import layer_sun, sun_source_at, unit_direction
 from atmos.plugins.clouds.sprites.reference import column_depth
 from atmos.plugins.clouds.light.diffusion import diffusion_radiance
@@ -48,7 +48,8 @@ def march_reference(density, transmittance, medium, settings, layout, camera, su
     dirs, start = dirs.reshape(-1, 3), start.reshape(-1)
     pos = np.asarray(camera.position, np.float64)
     safe = np.where(np.abs(dirs) < 1e-12, 1e-12, dirs)
-    t0, t1 = (lo - pos) / safe, (hi - pos) / safe
+    top = march_top(typed_types(settings))                       # towers raise the box's top
+    t0, t1 = (lo - pos) / safe, (np.array([hi[0], lo[1] + top * extent[1], hi[2]]) - pos) / safe
     enter = np.maximum(np.minimum(t0, t1).max(-1), start)
     leave = np.maximum(t0, t1).min(-1)
     if scene is not None:
@@ -66,7 +67,7 @@ def march_reference(density, transmittance, medium, settings, layout, camera, su
         typed = (settings.cloud_type is not None or settings.type_map is not None) and settings.sun_steps > 0
         T = sun_transmittance(d, trans_volume, medium.sigma_t, lo, extent, SUN_SPACING * cell.min(),
                               settings.sun_steps + TYPE_SUN_STEPS * typed, sun_dir, p, density_at,
-                              shading=not typed)
+                              shading=not typed, top=top)
         up, down = column_depth(d, uvw, column_tau, trans_volume.shape)
         L = None if field is None else diffusion_radiance(field, uvw, dirs[i], lobes, sun_dir)
         return density_at(uvw), source_reference(
@@ -75,6 +76,13 @@ def march_reference(density, transmittance, medium, settings, layout, camera, su
 
     return integrate(pos, dirs, enter, leave, settings.steps, step_base, settings.step_growth,
                      settings.min_transmittance, medium.sigma_t, sample, (h, w))
+
+
+def typed_types(settings):
+    """The types the march shapes with (the map's texels, the one type, or None: untyped)."""
+    if settings.type_map is not None:
+        return settings.type_map.types
+    return settings.cloud_type
 
 
 def shaped_density(density, cloud_type, shading_shape, ny: float, type_map=None, lo=None, extent=None):
@@ -122,7 +130,7 @@ def integrate(pos, dirs, enter, leave, steps, step_base, growth, min_transmittan
 
 
 def sun_transmittance(density, transmittance, sigma_t, lo, extent, step, steps, sun_dir, p, density_at=None,
-                      shading: bool = True) -> np.ndarray:
+                      shading: bool = True, top: float = 1.0) -> np.ndarray:
     """march.glsl's sun_transmittance at world points ``p`` (n, 3): ``steps`` steps toward ``sun_dir``
     (unit), the first ``step`` m long and each next SUN_GROWTH times the last, the trilinear ``density``
     (or ``density_at(uvw)``: :func:`shaped_density`) at each step's midpoint (0 from the first midpoint
@@ -132,14 +140,14 @@ def sun_transmittance(density, transmittance, sigma_t, lo, extent, step, steps, 
     d, tv = np.asarray(density, np.float64), np.asarray(transmittance, np.float64)
     shape, tshape = np.array(d.shape, np.float64), np.array(tv.shape, np.float64)
 
-    def inside(uvw):
-        return np.all((uvw >= 0.0) & (uvw <= 1.0), axis=-1)
+    def inside(uvw, top=1.0):
+        return np.all((uvw >= 0.0) & (uvw <= np.array([1.0, top, 1.0])), axis=-1)
 
     tau, at, h = np.zeros(len(p)), 0.0, float(step)
     live = np.ones(len(p), bool)
     for _ in range(steps):
         uvw = (p + sun_dir * (at + 0.5 * h) - lo) / extent
-        live &= inside(uvw)
+        live &= inside(uvw, top)
         rho = multilinear(d, uvw * shape - 0.5) if density_at is None else density_at(uvw)
         tau += np.where(live, h * rho, 0.0)
         at, h = at + h, h * SUN_GROWTH

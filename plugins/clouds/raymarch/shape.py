@@ -1,15 +1,17 @@
 """The cloud type (Schneider's Nubis): a number in [0, 1] that gives the marched density its vertical shape.
 
 ``RaymarchCloudSettings.cloud_type`` t picks a height profile P(h, t) over the layer (h: height fraction,
-0 base, 1 top): a fast rise from the base (flat bases), a plateau, a fall to 0 of the form 1 - x²
-(round tops); the three key types ramp to the ends below and t between them mixes their breakpoints
-linearly. The simulation gives each column its coverage c = clamp(m / COLUMN_FULL, 0, 1), m the column's
+0 base, 1 the simulated layer's top): a fast rise from the base (flat bases), a plateau, a fall to 0 of
+the form 1 - x² (round tops); the three key types ramp to the ends below and t between them mixes their
+breakpoints linearly. Congestus towers above the simulated layer: its fall ends at 1 + TOWER, so types
+past cumulus rise above the box (:func:`march_top`: how far the march reaches up); there the columns'
+density is the whole column's. The simulation gives each column its coverage c = clamp(m / COLUMN_FULL, 0, 1), m the column's
 mean density (the light volume's column integral over the layer's height in cells), and the shaped density
 
     density(m, h, t) = c' · clamp((P(h, t) - (1 - c')) / c', 0, 1) = clamp(P - (1 - c'), 0, c')
                                          (Nubis' remap(P, 1 - c, 1, 0, 1) · c)
 
-with c' = c^(1 - ANVIL · max(2t - 1, 0) · ramp(h, ANVIL_FROM)) (congestus widens toward the top). A
+with c' = c^(1 - ANVIL · max(2t - 1, 0) · ramp(h, ANVIL_FROM × fall end)) (congestus widens toward its top). A
 column holds cloud from where P first exceeds 1 - c to where it falls below it: a thin column is a low
 small cloud, a full one fills the profile, so tops follow the coverage's round outline and bases stay
 flat; inside, the density is below the body density (noise.py COVERAGE) wherever P is below 1 (the
@@ -33,11 +35,12 @@ CLOUD_TYPES = {"stratus": 0.0, "cumulus": 0.5, "congestus": 1.0}
 """The key types: t of each."""
 PROFILES = ((0.05, 0.10, 0.28),   # stratus: (rise end, fall start, fall end) in height fraction: thin, flat
             (0.08, 0.20, 0.70),   # cumulus: flat base, rounded top at about two thirds of the layer
-            (0.06, 0.20, 1.00))   # congestus: towers to the top of the layer, tapering
+            (0.06, 0.20, 2.50))   # congestus: towers to 1 + TOWER layers, tapering
 """(rise end, fall start, fall end) of each key type, in the order of CLOUD_TYPES."""
+TOWER = 1.5           # congestus rises this many layer heights above the simulated layer's top
 COLUMN_FULL = 0.35    # a column whose mean density over the layer is this or more is fully covered
 ANVIL = 0.5           # the top's coverage exponent falls by up to this much at t = 1 (c^0.5: wider)
-ANVIL_FROM = (0.7, 0.95)   # over these height fractions
+ANVIL_FROM = (0.7, 0.95)   # over these fractions of the type's fall end (its top)
 TYPE_SUN_STEPS = 2    # with a type the sun march takes this many more steps and ends with 1, not the shading
                       # volume's T (which holds the simulation's own shape: march.glsl sun_transmittance)
 
@@ -55,19 +58,29 @@ def type_breakpoints(t) -> np.ndarray:
 
 
 def type_profile(h, t) -> np.ndarray:
-    """P(h, t) in [0, 1]: ramp(h, 0, rise end) · (1 - x²), x = ramp(h, fall start, fall end); 0 outside [0, 1]."""
+    """P(h, t) in [0, 1]: ramp(h, 0, rise end) · (1 - x²), x = ramp(h, fall start, fall end); 0 below the
+    base and from the fall end up."""
     h = np.asarray(h, np.float64)
     b = type_breakpoints(t)
     x = _ramp(h, b[..., 1], b[..., 2])
     p = _ramp(h, 0.0, b[..., 0]) * (1.0 - x * x)
-    return np.where((h >= 0.0) & (h <= 1.0), p, 0.0)
+    return np.where(h >= 0.0, p, 0.0)
+
+
+def march_top(types) -> float:
+    """The height fraction the march must reach for clouds of ``types`` (a number, an array, or None: no
+    type): the highest fall end, at least the layer's top (1)."""
+    if types is None:
+        return 1.0
+    return float(max(1.0, type_breakpoints(np.max(types))[2]))
 
 
 def type_density(m, h, t) -> np.ndarray:
     """The shaped density of a column of mean density ``m`` at height fraction ``h`` and type ``t``."""
     c = np.clip(np.nan_to_num(np.asarray(m, np.float64)) / COLUMN_FULL, 0.0, 1.0)
     t = np.asarray(t, np.float64)
-    c = c ** (1.0 - ANVIL * np.clip(2.0 * t - 1.0, 0.0, 1.0) * _ramp(h, *ANVIL_FROM))
+    top = type_breakpoints(t)[..., 2]
+    c = c ** (1.0 - ANVIL * np.clip(2.0 * t - 1.0, 0.0, 1.0) * _ramp(h, ANVIL_FROM[0] * top, ANVIL_FROM[1] * top))
     return np.clip(type_profile(h, t) - (1.0 - c), 0.0, c)        # c · remap(P, 1 - c, 1, 0, 1)
 
 

@@ -43,7 +43,7 @@ float far_height(float y) {
 // cloud type (shape.glsl, included first) the type's (there) shape of the column sum at r over the layer's
 // ny cells.
 float far_density(float r, float h, float ny, vec2 xz) {
-    if (h < 0.0 || h > 1.0) return 0.0;
+    if (h < 0.0 || h > march_top) return 0.0;
     if (cloud_type >= 0.0) return type_density(far_quantile(r) / ny, h, cloud_type_at(xz));
     return far_quantile(r) * textureLod(far_profile, vec2(r, h), 0.0).r;
 }

@@ -50,6 +50,16 @@ uniform float pixel_angle;     // a full-res pixel's angle (rad): its width per 
 // The marched density at uvw (volume.glsl's cloud_density, cloud_columns, column_tau): with a cloud type
 // shape.glsl's type_density of the column's mean density (its up and down integrals over ny cells), of
 // the type at the point (cloud_type_at).
+// The box the march covers: the layer's, its top raised to march_top (towers of a cloud type).
+vec3 march_max() {
+    return vec3(layer_max.x, layer_min.y + march_top * (layer_max.y - layer_min.y), layer_max.z);
+}
+
+// Whether uvw (layer texture coordinates, y past 1 up to march_top) lies in the marched box.
+bool in_march_box(vec3 uvw) {
+    return all(greaterThanEqual(uvw, vec3(0.0))) && all(lessThanEqual(uvw, vec3(1.0, march_top, 1.0)));
+}
+
 float shaped_density(vec3 uvw, float ny) {
     if (cloud_type < 0.0) return cloud_density(uvw);
     vec2 c = cloud_columns(uvw);
@@ -90,7 +100,7 @@ float sun_transmittance(vec3 p, vec3 uvw, vec3 extent, float footprint) {
     for (int k = 0; k < n; ++k, at += h, h *= sun_growth) {
         vec3 q = p + toward * (at + 0.5 * h);
         vec3 s = (q - layer_min) / extent;
-        if (any(lessThan(s, vec3(0.0))) || any(greaterThan(s, vec3(1.0)))) return exp(-sigma_t * tau);
+        if (!in_march_box(s)) return exp(-sigma_t * tau);
         tau += h * detail_density(shaped_density(s, extent.y / cell_size.y), q, k < SUN_STEPS ? footprint : max(footprint, h));
     }
     vec3 e = (p + toward * at - layer_min) / extent;
@@ -140,7 +150,7 @@ float skip_exit(ivec3 g, vec3 pos, vec3 inv_dir, vec3 dir) {
     vec3 hi = min(lo + skip_cells * cell_size, layer_max);
     if (cloud_type >= 0.0) {
         lo.y = layer_min.y;
-        hi.y = layer_max.y;
+        hi.y = march_max().y;
     }
     vec3 tt = (mix(lo, hi, step(0.0, dir)) - pos) * inv_dir;
     return max(min(min(tt.x, tt.y), tt.z), 0.0);
@@ -155,14 +165,14 @@ void cloud_march(ivec2 pixel, out vec4 color, out vec2 distance, out float depth
     float scene = view_ray_distance(uv, depth, view_basis, near, far, 1e30);
     vec3 safe = mix(dir, vec3(1e-12), lessThan(abs(dir), vec3(1e-12)));
     vec3 inv_dir = 1.0 / safe;
-    vec3 t0 = (layer_min - camera_pos) * inv_dir, t1 = (layer_max - camera_pos) * inv_dir;
+    vec3 t0 = (layer_min - camera_pos) * inv_dir, t1 = (march_max() - camera_pos) * inv_dir;
     float start = near * length(view_ray(uv, view_basis));          // the near plane along this ray
     float enter = max(max(max(min(t0.x, t1.x), min(t0.y, t1.y)), min(t0.z, t1.z)), start);
     float leave = min(min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z)), scene);
     float far_from = 1e30;                         // no far field: never reached
 #if FAR_FIELD
     {   // the band's part beyond the far field's entry, joined to the box's (the box is inside the band)
-        float b0 = (layer_min.y - camera_pos.y) * inv_dir.y, b1 = (layer_max.y - camera_pos.y) * inv_dir.y;
+        float b0 = (layer_min.y - camera_pos.y) * inv_dir.y, b1 = (march_max().y - camera_pos.y) * inv_dir.y;
         far_from = far_entry(dir);
         float fin = max(max(min(b0, b1), start), far_from);
         float fout = min(min(max(b0, b1), scene), far_distance);
@@ -204,7 +214,7 @@ void cloud_march(ivec2 pixel, out vec4 color, out vec2 distance, out float depth
             ++taken;
             vec3 p = camera_pos + dir * sp;
             vec3 uvw = (p - layer_min) / extent;
-            bool in_box = all(greaterThanEqual(uvw, vec3(0.0))) && all(lessThanEqual(uvw, vec3(1.0)));
+            bool in_box = in_march_box(uvw);
             float dv = in_box ? shaped_density(uvw, ny) : 0.0, df = 0.0;
 #if FAR_FIELD
             vec4 fc = vec4(0.0);
