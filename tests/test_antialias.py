@@ -27,13 +27,15 @@ def gpu_fxaa(gpu, image, settings=SETTINGS):
 
 def edgy(rng, h=37, w=53):
     """Random slanted edges through the image between random HDR colours, a little noise, random alpha.
-    The colours' brightness levels differ (FXAA sees luma only: two colours of one luma make no edge)."""
+    The colours' brightness levels differ (FXAA sees luma only: two colours of one luma make no edge), and
+    every edge lies 15..75 degrees off the axes (an edge along an axis has no stair steps to soften)."""
     y, x = np.mgrid[0:h, 0:w]
     levels = rng.permutation([0.05, 0.5, 1.5, 4.0])
     image = np.zeros((h, w, 4))
     image[..., :3] = levels[0] * rng.uniform(0.6, 1.4, 3)
     for level in levels[1:]:
-        a, c = rng.uniform(-1, 1, 2), level * rng.uniform(0.6, 1.4, 3)
+        angle = np.radians(rng.uniform(15.0, 75.0) + 90.0 * rng.integers(0, 4))
+        a, c = np.array([np.cos(angle), np.sin(angle)]), level * rng.uniform(0.6, 1.4, 3)
         inside = a[0] * (x - rng.uniform(0.25, 0.75) * w) + a[1] * (y - rng.uniform(0.25, 0.75) * h) > 0
         image[inside, :3] = c
     image[..., :3] += rng.uniform(0, 0.05, (h, w, 3))

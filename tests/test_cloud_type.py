@@ -13,7 +13,8 @@ from atmos.plugins.clouds.raymarch.reference import march_reference
 from atmos.plugins.clouds.raymarch.shape import (CLOUD_TYPES, COLUMN_FULL, TOWER, CloudTypeMap, march_top, type_density,
                                                  type_profile)
 from fullscreen_probe import run_fullscreen
-from test_cloud_raymarch import DAY, aim, linear, scene, shading_volume
+from atmos.plugins.clouds.volume.light import layer_sun, sun_source_at
+from test_cloud_raymarch import BY_ALTITUDE, DAY, aim, linear, scene, shading_volume
 
 F32 = 2.0 ** -23      # float32's unit roundoff (the probe computes in float32 from float32 inputs)
 
@@ -83,7 +84,7 @@ def test_the_march_with_each_type_matches_its_float64_reference(gpu, ctx, rng, n
     app.close()
 
 
-def march_against_reference(gpu, app, d, colour: float, coverage: float) -> dict:
+def march_against_reference(gpu, app, d, colour: float, coverage: float, sun=DAY) -> dict:
     """The scene's march of ``d`` seen from the test's view against march_reference: colour relative RMSE
     below ``colour``, alpha's 99.5th percentile off it below ``coverage``, only rays grazing the box's faces
     further off. Returns the reference."""
@@ -91,7 +92,7 @@ def march_against_reference(gpu, app, d, colour: float, coverage: float) -> dict
     image = linear(app)
     sim = next(p for p in app.plugins if isinstance(p, CloudsPlugin)).simulation.sets()
     settings = next(p for p in app.plugins if isinstance(p, RaymarchCloudsPlugin)).settings
-    ref = march_reference(d, shading_volume(sim), sim.settings, settings, sim.layout(), cam, DAY, gpu.size,
+    ref = march_reference(d, shading_volume(sim), sim.settings, settings, sim.layout(), cam, sun, gpu.size,
                           field=read_field(sim.a[DIFFUSION]), ground_sun=ground_sun_of(sim))
     assert (ref["alpha"] > 0.05).mean() > 0.02, "the view must see the clouds"
     light = ref["light"]
@@ -155,6 +156,18 @@ def test_the_type_map_setting_takes_a_map_or_none():
     assert RaymarchCloudSettings(type_map=m).type_map is m and RaymarchCloudSettings().type_map is None
     with pytest.raises(ValueError, match="type_map must be a CloudTypeMap"):
         RaymarchCloudSettings(type_map=np.zeros((2, 2)))
+
+
+def test_towers_take_the_sun_of_their_own_heights(gpu, ctx, rng):
+    """A sun whose colour changes with altitude: congestus towers above the layer take the colour of their
+    own heights (the light's sun colours span the towers), in the march and its reference alike."""
+    d = random_volume(rng)
+    app = scene(gpu, d, BY_ALTITUDE, empty_space_skipping=False, min_transmittance=0.0, steps=128,
+                step_growth=0.002, cloud_type=CLOUD_TYPES["congestus"])
+    march_against_reference(gpu, app, d, colour=0.003, coverage=0.002, sun=BY_ALTITUDE)
+    app.close()
+    sources, _, _ = layer_sun(BY_ALTITUDE, (400.0, 520.0), 1 + TOWER)
+    assert sun_source_at(sources, 1 + TOWER, 1 + TOWER)[0] == pytest.approx((400.0 + (1 + TOWER) * 120.0) / 500.0)
 
 
 def test_congestus_towers_above_the_simulated_layer(gpu, ctx):

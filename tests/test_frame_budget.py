@@ -117,6 +117,7 @@ layout(std140, binding = 2) uniform CloudLight {
     vec3 ground_sky_source;
     vec3 ground_sun_source;
     vec3 sun_dir;
+    float sun_span;
 };
 layout(std430, binding = 0) buffer Out { float o[]; };
 void main() {
@@ -126,6 +127,7 @@ void main() {
     for (int c = 0; c < 3; c++) o[k++] = ground_sky_source[c];
     for (int c = 0; c < 3; c++) o[k++] = ground_sun_source[c];
     for (int c = 0; c < 3; c++) o[k++] = sun_dir[c];
+    o[k++] = sun_span;
 }
 """
 
@@ -135,8 +137,9 @@ def test_cloud_light_block_is_std140(gpu):
     from atmos.plugins.clouds.volume.light import LIGHT_BINDING, LIGHT_BLOCK, write_light
     program = compile_program(gpu.ctx, {"compute_shader": _source(COPY_LIGHT)})
     values = {"sun_sources": [(1.0 + i, 2.0 + i, 3.0 + i) for i in range(5)], "sky_source": (0.1, 0.2, 0.3),
-              "ground_sky_source": (0.4, 0.5, 0.6), "ground_sun_source": (0.7, 0.8, 0.9), "sun_dir": (0.0, 0.6, -0.8)}
-    out = gpu.ctx.buffer(reserve=4 * 27)
+              "ground_sky_source": (0.4, 0.5, 0.6), "ground_sun_source": (0.7, 0.8, 0.9), "sun_dir": (0.0, 0.6, -0.8),
+              "sun_span": 2.5}
+    out = gpu.ctx.buffer(reserve=4 * 28)
     try:
         assert LIGHT_BINDING == 2 and program[LIGHT_BLOCK].binding == LIGHT_BINDING
         assert program[LIGHT_BLOCK].size == 144
@@ -148,7 +151,7 @@ def test_cloud_light_block_is_std140(gpu):
         dispatch(program, 1)
         got = np.frombuffer(out.read(), np.float32)
         want = [c for row in [*values["sun_sources"], values["sky_source"], values["ground_sky_source"],
-                              values["ground_sun_source"], values["sun_dir"]] for c in row]
+                              values["ground_sun_source"], values["sun_dir"]] for c in row] + [values["sun_span"]]
         assert got == pytest.approx(want)
     finally:
         out.release()

@@ -81,13 +81,15 @@ def far_source(field: FarField, medium, settings, p, dirs, band, sun, albedo=Non
     column = cell_tau(medium) * column_at_rank(c[:, 0], field.columns)
     above = sample_profile(field.profile, c[:, 0], h01)[..., 1]
     up, down = column * above, column * (1.0 - above)
-    by_height, sun_color, ambient = layer_sun(sun, (band[0], band[0] + band[1]))
+    top = march_top(typed_types(settings))                  # a cloud type's towers take their own heights' sun
+    by_height, sun_color, ambient = layer_sun(sun, (band[0], band[0] + band[1]), top)
+    h_sun = np.clip((p[:, 1] - band[0]) / band[1], 0.0, top)
     diffusion = None
     if field.field_profile is not None and settings.ms_diffusion > 0:       # the volume's field at this rank
         values = sample_profile(field.field_profile, c[:, 0], h01)
         diffusion = field_radiance(values, dirs, medium.phase.lobes, sun_dir)
     return source_reference(medium, settings, None, up, down, dirs @ sun_dir, dirs[:, 1], sun_color, ambient, sun_dir,
-                            diffusion, octaves=octaves, sun_colors=sun_source_at(by_height, h01), albedo=albedo,
+                            diffusion, octaves=octaves, sun_colors=sun_source_at(by_height, h_sun, top), albedo=albedo,
                             ground_sun=ground_sun)
 
 

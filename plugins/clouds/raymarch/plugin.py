@@ -266,9 +266,10 @@ class RaymarchPass(RenderPass):
         far = frame.declares(FAR_FIELD)
         p = self.program(far)
         layout = sim.layout(s.base_altitude)
-        write_uniforms(p, self._uniforms(frame, sim, layout, offset))
+        uniforms = self._uniforms(frame, sim, layout, offset)
+        write_uniforms(p, uniforms)
         bind_volume(p, sim, self.sampler, view.sun, s.octaves, s.ms_diffusion, layout.heights, view.ground,
-                    ground_light=frame.resource(GROUND))
+                    ground_light=frame.resource(GROUND), span=uniforms["march_top"])   # towers' sun too
         if s.type_map is not None:
             bind_textures(p, cloud_type_map=self._type_texture(s.type_map))
         else:

@@ -55,7 +55,7 @@ def march_reference(density, transmittance, medium, settings, layout, camera, su
     if scene is not None:
         leave = np.minimum(leave, np.asarray(scene, np.float64).reshape(-1))
     step_base = settings.step * cell.min()
-    by_height, sun_color, ambient = layer_sun(sun, layout.heights)
+    by_height, sun_color, ambient = layer_sun(sun, layout.heights, top)
     sun_dir = unit_direction(sun)
     column_tau = medium.sigma_t * cell[1]
     lobes = medium.phase.lobes
@@ -72,7 +72,7 @@ def march_reference(density, transmittance, medium, settings, layout, camera, su
         L = None if field is None else diffusion_radiance(field, uvw, dirs[i], lobes, sun_dir)
         return density_at(uvw), source_reference(
             medium, settings, T, up, down, dirs[i] @ sun_dir, dirs[i][:, 1], sun_color, ambient, sun_dir, L,
-            sun_colors=sun_source_at(by_height, uvw[:, 1]), albedo=albedo, ground_sun=ground_sun)
+            sun_colors=sun_source_at(by_height, uvw[:, 1], top), albedo=albedo, ground_sun=ground_sun)
 
     return integrate(pos, dirs, enter, leave, settings.steps, step_base, settings.step_growth,
                      settings.min_transmittance, medium.sigma_t, sample, (h, w))

@@ -15,13 +15,14 @@ SAMPLERS = ("density_a", "density_b", "trans_a", "trans_b", "columns_a", "column
 
 
 def bind_volume(program, sim, sampler, sun: Sun | None, octaves=DEFAULT_OCTAVES, diffusion: float = 0.0,
-                layer=None, ground=None, *, ground_light) -> float:
+                layer=None, ground=None, *, ground_light, span: float = 1.0) -> float:
     """Bind mix(A, B, t)'s textures (``sim``: the frame's CloudSets, or the CloudSimulation) to
     ``volume.glsl``'s samplers (density, transmittance, the light volume's columns, the diffusion field)
     with ``sampler`` and set ``t``, ``a_shift`` (A drawn where it was computed), ``has_shading`` and the
     light (:func:`light_uniforms` of the simulation's medium, the sun and the multiple-scattering
     ``octaves``; the diffusion field's weight ``diffusion``, 0 where the sets have no field; the sun's
-    colour taken over ``layer``, (base, top) world y; the ground below of the scene's ``ground``, a
+    colour taken over ``layer``, (base, top) world y, and ``span`` times its height for a cloud type's
+    towers; the ground below of the scene's ``ground``, a
     GroundSurface (None: the medium's albedo), in the clouds' shadow ``ground_light``, the frame's
     "cloud_ground" buffer (:mod:`atmos.plugins.clouds.light.ground`)); returns t. Call :func:`unbind_volume` when the
     draw is done."""
@@ -35,7 +36,7 @@ def bind_volume(program, sim, sampler, sun: Sun | None, octaves=DEFAULT_OCTAVES,
                   diffusion_b=b[spread])
     bind_ground(program, ground_light)
     write_light(program, light_uniforms(sim.settings, sun, octaves, diffusion if field else 0.0, layer,
-                                        None if ground is None else ground.albedo),
+                                        None if ground is None else ground.albedo, span),
                    a_shift=(sim if isinstance(sim, CloudSets) else sim.sets()).a_shift, has_shading=int(shading),
                    edge_fade=float(sim.settings.edge_fade), t=float(t))
     return float(t)

@@ -80,18 +80,24 @@ def sun_colors(sun: Sun | None, layer=None) -> np.ndarray:
     return sun.color_at(base + np.arange(SUN_HEIGHTS) / (SUN_HEIGHTS - 1) * (top - base))
 
 
-def layer_sun(sun: Sun | None, layer=None) -> tuple[np.ndarray, np.ndarray, tuple]:
-    """(the sun's colours at the layer's heights (:func:`sun_colors`), the middle's (the ground's
-    light takes it), the ambient): the sun every cloud renderer and reference lights a layer with."""
+def layer_sun(sun: Sun | None, layer=None, span: float = 1.0) -> tuple[np.ndarray, np.ndarray, tuple]:
+    """(the sun's colours at the layer's heights (:func:`sun_colors`; over ``span`` layer heights from its
+    base: a cloud type's towers), the middle's of the layer itself (the ground's light takes it), the
+    ambient): the sun every cloud renderer and reference lights a layer with."""
     colors = sun_colors(sun, layer)
-    return colors, colors[SUN_HEIGHTS // 2], sun_light(sun)[1]
+    middle = colors[SUN_HEIGHTS // 2]
+    if span != 1.0 and layer is not None:
+        base, top = map(float, layer)
+        colors = sun_colors(sun, (base, base + span * (top - base)))
+    return colors, middle, sun_light(sun)[1]
 
 
-def sun_source_at(sources, v) -> np.ndarray:
-    """(..., 3) float64: volume.glsl's ``sun_source_at`` of the (SUN_HEIGHTS, 3) ``sources`` at height
-    fractions ``v`` (...,) of the layer (0 base, 1 top; clamped), linear between the samples."""
+def sun_source_at(sources, v, span: float = 1.0) -> np.ndarray:
+    """(..., 3) float64: volume.glsl's ``sun_source_at`` of the (SUN_HEIGHTS, 3) ``sources`` (spanning
+    ``span`` layer heights) at height fractions ``v`` (...,) of the layer (0 base, 1 top; clamped to the
+    span), linear between the samples."""
     s = np.asarray(sources, np.float64)
-    x = np.clip(np.asarray(v, np.float64), 0.0, 1.0) * (len(s) - 1)
+    x = np.clip(np.asarray(v, np.float64) / max(span, 1.0), 0.0, 1.0) * (len(s) - 1)
     k = np.minimum(x.astype(np.int64), len(s) - 2)
     f = (x - k)[..., None]
     return s[k] * (1.0 - f) + s[k + 1] * f
@@ -110,22 +116,24 @@ def cell_tau(cloud_settings) -> float:
 
 
 def light_uniforms(cloud_settings, sun: Sun | None, octaves=DEFAULT_OCTAVES, diffusion: float = 0.0,
-                   layer=None, ground=None) -> dict:
+                   layer=None, ground=None, span: float = 1.0) -> dict:
     """The light uniforms of ``volume.glsl`` for a ``CloudSettings`` medium, the ``Sun``, the
     multiple-scattering octaves (a, b, c), the diffusion field's weight beta (scaled by the medium:
     ``medium.field_weight``) and the layer (base, top) world
     y (m) over which the clouds take the sun's colour (``sun_sources``: :func:`sun_colors`; the ground's
-    light takes the middle's; None: the camera's colour everywhere) and the ``ground``'s albedo (RGB;
-    None: the medium's ``ground_albedo``). The last few results are kept,
+    light takes the middle's; None: the camera's colour everywhere; ``span``: the colours reach that many
+    layer heights up, for a cloud type's towers) and the ``ground``'s albedo (RGB; None: the medium's
+    ``ground_albedo``). The last few results are kept,
     keyed by the identity of the settings, the Sun and its (immutable, assigned-anew) fields and by
     the values of the rest: every renderer of a frame asks for the same."""
     sun = sun or Sun()
     key = (cloud_settings, sun, sun.direction, sun.color, sun.ambient, sun.color_by_altitude)
-    rest = (tuple(octaves), diffusion, None if layer is None else tuple(layer), None if ground is None else tuple(ground))
+    rest = (tuple(octaves), diffusion, None if layer is None else tuple(layer), None if ground is None else tuple(ground),
+            span)
     for held, held_rest, values in _LIGHT_MEMO:
         if held_rest == rest and all(map(is_, held, key)):
             return dict(values)
-    values = _light_uniforms(cloud_settings, sun, octaves, diffusion, layer, ground)
+    values = _light_uniforms(cloud_settings, sun, octaves, diffusion, layer, ground, span)
     _LIGHT_MEMO.insert(0, (key, rest, values))
     del _LIGHT_MEMO[4:]
     return dict(values)
@@ -134,8 +142,8 @@ def light_uniforms(cloud_settings, sun: Sun | None, octaves=DEFAULT_OCTAVES, dif
 _LIGHT_MEMO: list = []      # (identities, values, uniforms), newest first
 
 
-def _light_uniforms(cloud_settings, sun: Sun, octaves, diffusion: float, layer, ground) -> dict:
-    colors, middle, ambient = layer_sun(sun, layer)
+def _light_uniforms(cloud_settings, sun: Sun, octaves, diffusion: float, layer, ground, span: float = 1.0) -> dict:
+    colors, middle, ambient = layer_sun(sun, layer, span)
     direction = unit_direction(sun)
     lit, sky_lit = ground_parts(cloud_settings, middle, ambient, direction, ground)
     s = cloud_settings
@@ -146,6 +154,7 @@ def _light_uniforms(cloud_settings, sun: Sun, octaves, diffusion: float, layer, 
             "ground_sky_source": tuple(map(float, 0.5 * s.albedo * sky_lit)),
             "ground_sun_source": tuple(map(float, 0.5 * s.albedo * lit)),
             "sun_dir": tuple(map(float, direction)),
+            "sun_span": float(span),
             "phase_lobes": s.phase.lobes,
             "outward_share": float(s.phase.hemisphere_share),
             "ms_octaves": octave_parameters(octaves, s),
@@ -155,14 +164,16 @@ def _light_uniforms(cloud_settings, sun: Sun, octaves, diffusion: float, layer, 
 
 
 LIGHT_BLOCK, LIGHT_BINDING = "CloudLight", 2      # volume.glsl's block of the light that changes with the sun
-LIGHT_MEMBERS = ("sun_sources", "sky_source", "ground_sky_source", "ground_sun_source", "sun_dir")
+LIGHT_MEMBERS = ("sun_sources", "sky_source", "ground_sky_source", "ground_sun_source", "sun_dir", "sun_span")
 
 
 def pack_light(values: dict) -> bytes:
     """volume.glsl's CloudLight block (std140: vec3 sun_sources[SUN_HEIGHTS], sky_source, ground_sky_source,
-    ground_sun_source, sun_dir, each in 16 bytes) from :func:`light_uniforms`' ``values``."""
-    rows = [*values["sun_sources"], *map(values.__getitem__, LIGHT_MEMBERS[1:])]
-    return struct.pack(f"<{4 * len(rows)}f", *[c for row in rows for c in (*row, 0.0)])
+    ground_sun_source, each in 16 bytes, then sun_dir and sun_span in 16) from :func:`light_uniforms`' ``values``."""
+    rows = [*values["sun_sources"], *map(values.__getitem__, LIGHT_MEMBERS[1:5])]
+    data = [c for row in rows for c in (*row, 0.0)]
+    data[-1] = values.get("sun_span", 1.0)
+    return struct.pack(f"<{len(data)}f", *data)
 
 
 def write_light(program, values: dict, **more) -> None:

@@ -52,7 +52,7 @@ float far_density(float r, float h, float ny, vec2 xz) {
 // dir.
 vec3 far_source(vec4 c, float h, vec3 dir) {
     vec2 at = vec2(c.x, clamp(h, 0.0, 1.0));
-    vec3 source = sun_source_at(at.y);        // the volume's heights: the far layer is the same band
+    vec3 source = sun_source_at(clamp(h, 0.0, march_top));   // the volume's heights: the same band (towers too)
     vec4 sun = relief_light(textureLod(far_sun_profile, at, 0.0),
                             far_relief(c, column_tau, light_dir.y) * octave_exponents());
     float column = column_tau * far_quantile(c.x), above = textureLod(far_profile, at, 0.0).g;

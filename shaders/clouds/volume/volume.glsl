@@ -27,6 +27,8 @@ layout(std140, binding = 2) uniform CloudLight {   // the light that moves with 
     vec3 ground_sky_source;         // albedo * the ground's sky-lit radiance / 2
     vec3 ground_sun_source;         // albedo * the ground's sunlit radiance / 2, were no cloud in the way
     vec3 light_dir;                 // toward the sun, unit (the frame block's sun_dir for the scene's sun)
+    float sun_span;                 // sun_sources' heights span this many layer heights (1; more for a
+                                    // cloud type's towers above the layer: raymarch/shape.py march_top)
 };
 layout(std140, binding = 3) uniform CloudGround {  // written on the GPU (plugins/clouds/light/ground.py)
     vec4 cloud_ground;              // x: G, the ground's mean sun transmittance through the clouds
@@ -86,11 +88,11 @@ vec2 cloud_columns(vec3 uvw) {
     return column_tau * cloud_edge_weight(uvw.xz, edge_fade) * c;
 }
 
-// albedo * the sun's irradiance at height fraction v of the volume (uvw.y: 0 base, 1 top), linear
-// between the SUN_HEIGHTS samples (light.py sun_source_at): clouds' tops see a less reddened sun than
-// their bases, and keep it after the bases' sunset.
+// albedo * the sun's irradiance at height fraction v of the volume (uvw.y: 0 base, 1 top; towers up to
+// sun_span), linear between the SUN_HEIGHTS samples (light.py sun_source_at): clouds' tops see a less
+// reddened sun than their bases, and keep it after the bases' sunset.
 vec3 sun_source_at(float v) {
-    float x = clamp(v, 0.0, 1.0) * float(SUN_HEIGHTS - 1);
+    float x = clamp(v / max(sun_span, 1.0), 0.0, 1.0) * float(SUN_HEIGHTS - 1);
     int k = min(int(x), SUN_HEIGHTS - 2);
     return mix(sun_sources[k], sun_sources[k + 1], x - float(k));
 }
