@@ -54,7 +54,7 @@ SIZES = {   # full: what the thesis and the goals name; quick: the same code sma
                fog_frames=2, pacing_frames=6, pacing_iterations=8, sunset_frames=4, python_frames=3,
                raymarch_frames=((160, 90),), raymarch_rounds=1),
 }
-SECTIONS = ("automaton", "tasks", "shading", "clouds", "fog", "pacing", "sunset", "raymarch")
+SECTIONS = ("automaton", "tasks", "shading", "clouds", "fog", "pacing", "sunset", "raymarch", "additions")
 
 
 # -- sections: each returns {"title", "columns", "rows", "notes"} ------------------------------------
@@ -275,8 +275,61 @@ def raymarch(cfg) -> dict:
                       "anchor: Nubis ≈ 2 ms per frame on a PS4, 1/16 of the pixels marched per frame"]}
 
 
+def _pass_ms(app, names, frames: int) -> dict:
+    """Median GPU ms of the passes ``names`` over ``frames`` frames (after the timer ring fills)."""
+    from atmos.graph.timing import RING
+    app.run_frames(RING + 1, 1 / 30)
+    seen = {name: [] for name in names}
+    for _ in range(frames):
+        app.update(1 / 30)
+        for name in names:
+            timing = app.graph.timings.get(name)
+            if timing:
+                seen[name].append(timing[0])
+    return {name: statistics.median(v) if v else float("nan") for name, v in seen.items()}
+
+
+def additions(cfg) -> dict:
+    """What two additions cost a frame on the GPU, each beside what it replaced in one App: the temporal
+    AA following moving meshes by their own motion (glider) and the ray march's cloud types by region
+    with towers (flight with the march)."""
+    from atmos.demo_registry import DemoSettings
+    from atmos.gpu import create_headless
+    from atmos.plugins.antialias import AntialiasPlugin
+    from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
+    from atmos.runner import build_app
+    rows = []
+    cases = (("glider", None, AntialiasPlugin, ("meshes", "temporal_aa"),
+              (("meshes' motion target", {}), ("camera motion only", {"motion": False}))),
+             ("flight", "march", RaymarchCloudsPlugin, ("cloud_raymarch",),
+              (("types by region, towers", {}), ("one type (cumulus)", {"type_map": None}))))
+    for demo, renderer, kind, names, variants in cases:
+        gpu = create_headless(cfg["frame"])
+        try:
+            settings = DemoSettings(size=cfg["frame"], headless=True, **({"clouds": renderer} if renderer else {}))
+            app = build_app(demo, settings, gpu)
+            try:
+                plugin = next(p for p in app.plugins if isinstance(p, kind))
+                own = plugin.settings
+                app.graph.timings_enabled = True
+                touched = {name for _, changes in variants for name in changes}
+                for label, changes in variants:        # each from the demo's own settings
+                    plugin.configure(**{**{name: getattr(own, name) for name in touched}, **changes})
+                    for name, ms in _pass_ms(app, names, cfg["render_frames"]).items():
+                        rows.append({"demo": demo, "variant": label, "pass": name, "gpu_ms": ms})
+            finally:
+                app.close()
+        finally:
+            gpu.release()
+    return {"title": f"Additions at {_shape(cfg['frame'])}: the TAA's motion target, cloud types by region",
+            "columns": [("demo", "demo"), ("variant", "variant"), ("pass", "pass"), ("GPU ms (timer query)", "gpu_ms")],
+            "rows": rows,
+            "notes": ["the meshes draw the motion target only while the TAA follows it; the march's box rises to "
+                      "the towers' top where a type passes cumulus (shape.march_top)"]}
+
+
 RUNNERS = {"automaton": automaton, "tasks": tasks, "shading": shading, "clouds": clouds, "fog": fog,
-           "pacing": pacing, "sunset": sunset, "raymarch": raymarch}
+           "pacing": pacing, "sunset": sunset, "raymarch": raymarch, "additions": additions}
 
 
 # -- the report --------------------------------------------------------------------------------------

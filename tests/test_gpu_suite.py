@@ -16,7 +16,8 @@ def test_the_gpu_suite_runs_quick_and_writes_markdown_and_json(tmp_path):
     assert run.returncode == 0, run.stdout[-2000:] + run.stderr[-4000:]
     report = json.loads((tmp_path / "gpu_suite.json").read_text())
     sections = report["sections"]
-    assert list(sections) == ["automaton", "tasks", "shading", "clouds", "fog", "pacing", "sunset", "raymarch"]
+    assert list(sections) == ["automaton", "tasks", "shading", "clouds", "fog", "pacing", "sunset", "raymarch",
+                              "additions"]
     for name, section in sections.items():
         assert "error" not in section, (name, section.get("error"))
         assert section["rows"], f"section {name} has no rows"
@@ -29,6 +30,9 @@ def test_the_gpu_suite_runs_quick_and_writes_markdown_and_json(tmp_path):
     march = {r["renderer"]: r for r in sections["raymarch"]["rows"]}
     assert set(march) == {"sprites", "march"} and march["march"]["pass"] == "cloud_raymarch"
     assert all(r["frame_ms"] > 0 and r["pass_gpu_ms"] > 0 for r in march.values()), march
+    added = {(r["demo"], r["variant"], r["pass"]) for r in sections["additions"]["rows"]}
+    assert ("glider", "camera motion only", "temporal_aa") in added and ("flight", "one type (cumulus)", "cloud_raymarch") in added
+    assert all(r["gpu_ms"] > 0 for r in sections["additions"]["rows"])
     text = (tmp_path / "gpu_suite.md").read_text()
     for figure in ("Table 8.1", "Tables 8.2–8.4", "sec. 8.2", "Nubis", "12.5", "118", "20 fps"):
         assert figure in text, figure
