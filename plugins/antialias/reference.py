@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from atmos.glsl_math import catmull_rom_weights
+from atmos.render_core import MOTION_DEPTH_TOLERANCE
 
 WEIGHTS = np.array([0.299, 0.587, 0.114])
 
@@ -57,7 +58,7 @@ def fxaa(image, reduce_min: float, reduce_mul: float, span_max: float) -> np.nda
 # -- temporal anti-aliasing (shaders/antialias/taa_resolve.comp) --------------------------------------
 TAA_LUMA = np.array([0.2126, 0.7152, 0.0722])
 TAA_MOTION_GAIN = 0.2          # taa_resolve.comp's MOTION_GAIN: the newest frame's weight per pixel moved
-TAA_MOTION_DEPTH = 2.0 ** -23  # taa_resolve.comp's MOTION_DEPTH_TOLERANCE (atmos.render_core)
+TAA_MOTION_DEPTH = MOTION_DEPTH_TOLERANCE    # taa_resolve.comp's: a motion's depth tag against the depth buffer
 
 
 def catmull_rom(img, px, py) -> np.ndarray:

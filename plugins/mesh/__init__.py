@@ -137,7 +137,8 @@ class MeshPass(OpaquePass):
         self.frame = 0
 
     def setup_key(self) -> tuple:
-        return (self.plugin.motion.wanted, self.plugin.gpu.size) if self.plugin.motion.wanted else (False,)
+        wanted = self.plugin.motion.wanted
+        return (True, self.plugin.gpu.size) if wanted else (False,)
 
     def setup(self, builder) -> None:
         super().setup(builder)
