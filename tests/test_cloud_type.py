@@ -127,6 +127,22 @@ def test_the_march_with_types_by_region_matches_its_float64_reference(gpu, ctx, 
     app.close()
 
 
+def test_a_one_texel_map_is_its_type_everywhere(gpu, ctx, rng):
+    """The smallest map (one texel, held everywhere) draws exactly what the one type draws: the texture's
+    float32 value is the uniform's."""
+    d = random_volume(rng)
+    kind = float(np.float32(rng.uniform(0.55, 1.0)))              # towers, exactly representable
+    app = scene(gpu, d, DAY, min_transmittance=0.0, cloud_type=kind)
+    aim(app, (80.0, 520.0, -220.0), target=(160.0, 470.0, 200.0))
+    one = linear(app)
+    march = next(p for p in app.plugins if isinstance(p, RaymarchCloudsPlugin))
+    march.configure(cloud_type=None, type_map=CloudTypeMap(np.array([[kind]]), origin=(-1e5, -1e5), size=(1.0, 1.0)))
+    mapped = linear(app)
+    assert (one[..., 3] > 0.05).mean() > 0.02
+    np.testing.assert_array_equal(mapped, one)
+    app.close()
+
+
 def test_a_type_map_reads_bilinearly_and_holds_its_edges():
     m = CloudTypeMap(np.array([[0.0, 1.0], [0.5, 0.5]]), origin=(100.0, -50.0), size=(40.0, 20.0))
     # texel centres at x 110, 130 and z -45, -35
