@@ -237,6 +237,34 @@ def test_a_sliding_mesh_is_followed_by_its_own_motion():
     assert err["taa"] < err["none"] and err["taa"] < 0.5 * err["camera only"], err
 
 
+def test_a_failed_build_takes_its_motion_registration_out_again():
+    """A MeshPlugin whose add_plugins call fails leaves no writer behind: the TAA does not wait for a motion
+    target nobody makes (the graph still compiles and runs); added again, it draws the target."""
+    from atmos import App, DefaultPlugins, MeshPlugin
+    from atmos.plugin import Plugin
+    from atmos.plugins.ground import GroundPlugin
+    from atmos.plugins.sky_gradient import SkyGradientPlugin
+
+    class Broken(Plugin):
+        def build(self, app):
+            raise RuntimeError("broken on purpose")
+    gpu = create_headless((48, 27))
+    try:
+        app = App(gpu).add_plugins(DefaultPlugins(fly_camera=False), SkyGradientPlugin(), GroundPlugin(),
+                                   AntialiasPlugin(mode="taa"))
+        app.update(0.0)
+        with pytest.raises(RuntimeError, match="broken on purpose"):
+            app.add_plugins(MeshPlugin(), Broken())
+        app.update(0.0)
+        assert MOTION not in app.graph.compile().resources and gpu.ctx.error == "GL_NO_ERROR"
+        app.add_plugins(MeshPlugin())
+        app.update(0.0)
+        assert MOTION in app.graph.compile().resources
+        app.close()
+    finally:
+        gpu.release()
+
+
 def test_the_mesh_motion_is_the_change_of_each_model_matrix():
     from atmos import MeshInstance, Transform, box
     from atmos.world import World

@@ -85,5 +85,10 @@ class AntialiasPlugin(Plugin):
         self.motion.readers[self.taa.name] = self.taa.wants_motion
         app.add_system(jitter_system(self, app.init_resource(FrameJitter)), "update", label="antialias_jitter")
 
+    def cleanup(self, app) -> None:
+        motion = getattr(self, "motion", None)
+        if motion is not None and self.taa is not None:
+            motion.readers.pop(self.taa.name, None)
+
 
 __all__ = ["AntialiasPass", "AntialiasPlugin", "AntialiasSettings", "TemporalAAPass", "jitter_offset"]

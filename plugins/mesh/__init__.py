@@ -206,5 +206,10 @@ class MeshPlugin(Plugin):
             self.motion.writers.add(self.mesh_pass.name)
             app.graph.add_pass(self.mesh_pass)
 
+    def cleanup(self, app) -> None:
+        motion = getattr(self, "motion", None)
+        if motion is not None and self.mesh_pass is not None:
+            motion.writers.discard(self.mesh_pass.name)
+
     def collect(self, app) -> None:
         self.instances = collect_instances(app.world, app.clock.alpha, self.previous)
