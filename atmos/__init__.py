@@ -54,6 +54,7 @@ _EXPORTS = {
     # the effects and game pieces (their own packages stay importable: atmos.plugins.<name>)
     "CloudSky": "atmos.plugins.clouds", "CloudsPlugin": "atmos.plugins.clouds", "CloudSettings": "atmos.plugins.clouds",
     "CloudRenderPlugin": "atmos.plugins.clouds.sprites", "RaymarchCloudsPlugin": "atmos.plugins.clouds.raymarch",
+    "CloudTypeMap": "atmos.plugins.clouds.raymarch",
     "CloudFarFieldPlugin": "atmos.plugins.clouds.far_field", "CloudShadowsPlugin": "atmos.plugins.clouds.shadows",
     "WeatherPlugin": "atmos.plugins.clouds.weather", "DaylightPlugin": "atmos.plugins.daylight",
     "DaylightSettings": "atmos.plugins.daylight", "TimeOfDay": "atmos.plugins.daylight",

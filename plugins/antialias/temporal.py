@@ -21,6 +21,7 @@ from atmos.scene_view import FrameJitter
 
 TAA_BINDING = 1                 # taa_resolve.comp's TemporalAA block
 JITTER_SAMPLES = 8              # sub-pixel positions before the pattern repeats (Halton 2, 3)
+MOTION_DEFINES = {"MOTION": 1}  # taa_resolve.comp's variant that reads the meshes' motion target
 
 
 def halton(n: int, base: int) -> float:
@@ -80,7 +81,6 @@ class TemporalAAPass(ComputePass):
     def prepare(self, gpu) -> None:
         super().prepare(gpu)
         self.resolve_program = gpu.program(compute_shader="antialias/taa_resolve.comp")
-        self.motion_program = gpu.program(compute_shader="antialias/taa_resolve.comp", defines={"MOTION": 1})
         self.copy_program = gpu.program(compute_shader="antialias/taa_copy.comp")
 
     def release(self) -> None:
@@ -102,7 +102,9 @@ class TemporalAAPass(ComputePass):
         prev = matrices if self._prev is None else self._prev
         weight = max(1.0 / (self.frames + 1), self.plugin.settings.history)
         moving = frame.declares(MOTION)
-        p, groups = self.motion_program if moving else self.resolve_program, self._groups
+        p = (frame.gpu.program(compute_shader="antialias/taa_resolve.comp", defines=MOTION_DEFINES) if moving
+             else self.resolve_program)               # the variant only a scene with moving meshes compiles
+        groups = self._groups
         write_block(p, "TemporalAA", TAA_BINDING, taa_block(prev.gl("view_proj"), weight, self.frames > 0))
         history, out = self._textures[self._current], self._textures[1 - self._current]
         textures = {"color_in": COLOR, "depth_in": DEPTH, "history": history}

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from atmos.plugins.clouds.far_field.reference import column_at_rank, far_relief, field_fbm, field_rank, relief_light
-from atmos.plugins.clouds.raymarch.reference import integrate, rays, typed_types
+from atmos.plugins.clouds.raymarch.reference import integrate, rays, tallest_type
 from atmos.plugins.clouds.raymarch.shape import march_top, type_at, type_density
 from atmos.plugins.clouds.volume.light import cell_tau, layer_sun, sun_source_at, unit_direction
 from atmos.plugins.clouds.light.diffusion import field_radiance
@@ -81,7 +81,7 @@ def far_source(field: FarField, medium, settings, p, dirs, band, sun, albedo=Non
     column = cell_tau(medium) * column_at_rank(c[:, 0], field.columns)
     above = sample_profile(field.profile, c[:, 0], h01)[..., 1]
     up, down = column * above, column * (1.0 - above)
-    top = march_top(typed_types(settings))                  # a cloud type's towers take their own heights' sun
+    top = march_top(tallest_type(settings))                  # a cloud type's towers take their own heights' sun
     by_height, sun_color, ambient = layer_sun(sun, (band[0], band[0] + band[1]), top)
     h_sun = np.clip((p[:, 1] - band[0]) / band[1], 0.0, top)
     diffusion = None
@@ -105,7 +105,7 @@ def far_march_reference(field: FarField, medium, settings, band, camera, sun, si
     dirs, start = dirs.reshape(-1, 3), start.reshape(-1)
     pos = np.asarray(camera.position, np.float64)
     dy = np.where(np.abs(dirs[:, 1]) < 1e-12, 1e-12, dirs[:, 1])
-    top = march_top(typed_types(settings))                  # towers raise the band's top
+    top = march_top(tallest_type(settings))                  # towers raise the band's top
     b0, b1 = (band[0] - pos[1]) / dy, (band[0] + top * band[1] - pos[1]) / dy
     enter = np.maximum(np.minimum(b0, b1), start)
     leave = np.minimum(np.maximum(b0, b1), settings.far_distance)

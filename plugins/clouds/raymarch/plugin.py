@@ -58,7 +58,7 @@ def type_uniforms(settings) -> dict:
     t = -1.0 if not typed else float(settings.cloud_type if settings.cloud_type is not None else 0.5)
     box = (0.0, 0.0, 1.0, 1.0) if m is None else (float(m.origin[0]), float(m.origin[1]),
                                                   1.0 / float(m.size[0]), 1.0 / float(m.size[1]))
-    top = march_top(None if not typed else (m.types if m is not None else settings.cloud_type))
+    top = march_top(None if not typed else (m.highest if m is not None else settings.cloud_type))
     return {"cloud_type": t, "type_mapped": int(m is not None), "type_map_box": box, "march_top": top}
 
 

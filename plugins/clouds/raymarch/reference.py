@@ -40,7 +40,6 @@ def march_reference(density, transmittance, medium, settings, layout, camera, su
     the ground below (:func:`atmos.plugins.clouds.light.medium.environment`). Returns ``light`` (h, w, 3), ``alpha`` (h, w) and ``distance`` (h, w): a·distance."""
     d = np.asarray(density, np.float64)
     trans_volume = np.asarray(transmittance, np.float64)
-    shape = np.array(d.shape, np.float64)
     lo, hi = np.asarray(layout.lo, np.float64), np.asarray(layout.hi, np.float64)
     extent, cell = hi - lo, np.asarray(layout.cell, np.float64)
     dirs, start = rays(camera, size)
@@ -48,7 +47,7 @@ def march_reference(density, transmittance, medium, settings, layout, camera, su
     dirs, start = dirs.reshape(-1, 3), start.reshape(-1)
     pos = np.asarray(camera.position, np.float64)
     safe = np.where(np.abs(dirs) < 1e-12, 1e-12, dirs)
-    top = march_top(typed_types(settings))                       # towers raise the box's top
+    top = march_top(tallest_type(settings))                       # towers raise the box's top
     t0, t1 = (lo - pos) / safe, (np.array([hi[0], lo[1] + top * extent[1], hi[2]]) - pos) / safe
     enter = np.maximum(np.minimum(t0, t1).max(-1), start)
     leave = np.maximum(t0, t1).min(-1)
@@ -78,10 +77,10 @@ def march_reference(density, transmittance, medium, settings, layout, camera, su
                      settings.min_transmittance, medium.sigma_t, sample, (h, w))
 
 
-def typed_types(settings):
-    """The types the march shapes with (the map's texels, the one type, or None: untyped)."""
+def tallest_type(settings):
+    """The tallest type the march shapes with (the map's, the one type, or None: untyped)."""
     if settings.type_map is not None:
-        return settings.type_map.types
+        return settings.type_map.highest
     return settings.cloud_type
 
 

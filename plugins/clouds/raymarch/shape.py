@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from atmos.checks import check_vec
+from atmos.plugins.clouds.light.reference import bilinear
 
 CLOUD_TYPES = {"stratus": 0.0, "cumulus": 0.5, "congestus": 1.0}
 """The key types: t of each."""
@@ -69,7 +70,7 @@ def type_profile(h, t) -> np.ndarray:
 
 def march_top(types) -> float:
     """The height fraction the march must reach for clouds of ``types`` (a number, an array, or None: no
-    type): the highest fall end, at least the layer's top (1)."""
+    type; the renderer passes a map's ``highest``): the highest fall end, at least the layer's top (1)."""
     if types is None:
         return 1.0
     return float(max(1.0, type_breakpoints(np.max(types))[2]))
@@ -113,22 +114,17 @@ class CloudTypeMap:
         t = np.ascontiguousarray(t.astype(np.float32))
         t.setflags(write=False)
         object.__setattr__(self, "types", t)
+        object.__setattr__(self, "highest", float(t.max()))     # the tallest type (march_top): read per frame
         object.__setattr__(self, "origin", check_vec("CloudTypeMap", "origin", self.origin, 2))
         object.__setattr__(self, "size", check_vec("CloudTypeMap", "size", self.size, 2, "positive"))
 
     def at(self, x, z) -> np.ndarray:
         """float64 types at world points (x, z) (arrays of one shape): bilinear between texel centres,
         clamped to the edge (shape.glsl cloud_type_at)."""
-        t = self.types.astype(np.float64)
-        nz, nx = t.shape
+        nz, nx = self.types.shape
         fx = (np.asarray(x, np.float64) - self.origin[0]) / self.size[0] * nx - 0.5
         fz = (np.asarray(z, np.float64) - self.origin[1]) / self.size[1] * nz - 0.5
-        fx, fz = np.clip(fx, 0.0, nx - 1.0), np.clip(fz, 0.0, nz - 1.0)
-        i0, j0 = np.minimum(np.floor(fx).astype(np.int64), nx - 1), np.minimum(np.floor(fz).astype(np.int64), nz - 1)
-        i1, j1 = np.minimum(i0 + 1, nx - 1), np.minimum(j0 + 1, nz - 1)
-        wx, wz = fx - i0, fz - j0
-        return ((t[j0, i0] * (1 - wx) + t[j0, i1] * wx) * (1 - wz)
-                + (t[j1, i0] * (1 - wx) + t[j1, i1] * wx) * wz)
+        return bilinear(self.types.astype(np.float64), np.stack(np.broadcast_arrays(fz, fx), -1))
 
 
 def type_at(cloud_type, type_map, x, z):

@@ -149,6 +149,20 @@ float next_u(int j, float alpha, float beta) {
     return (at(R + cur, j) - alpha * next_s(j, beta)) / at(DIAG, j);
 }
 
+// w = A u at cell c (index i, its own u given), the neighbours' u: r / diag at init (stage 2), else
+// next_u (stage 3).
+float a_times_u(ivec3 c, int i, float u, bool init, float alpha, float beta) {
+    float w = at(DIAG, i) * u;
+    int stride[3] = int[3](1, size.x, size.x * size.y);
+    int G[3] = int[3](GX, GY, GZ);
+    for (int a = 0; a < 3; ++a) {
+        int up = i + stride[a], down = i - stride[a];
+        if (c[a] + 1 < size[a]) w -= at(G[a], i) * (init ? at(R, up) / at(DIAG, up) : next_u(up, alpha, beta));
+        if (c[a] > 0) w -= at(G[a], down) * (init ? at(R, down) / at(DIAG, down) : next_u(down, alpha, beta));
+    }
+    return w;
+}
+
 float gradient(ivec3 c, int i, int a) {
     int stride = a == 0 ? 1 : (a == 1 ? size.x : size.x * size.y);
     if (size[a] == 1) return 0.0;
@@ -177,13 +191,7 @@ void main() {
         float ru = 0.0, wu = 0.0, rr = 0.0;
         if (inside) {
             float r = at(R, i), u = r / at(DIAG, i);
-            float w = at(DIAG, i) * u;
-            int stride[3] = int[3](1, size.x, size.x * size.y);
-            int G[3] = int[3](GX, GY, GZ);
-            for (int a = 0; a < 3; ++a) {
-                if (c[a] + 1 < size[a]) w -= at(G[a], i) * (at(R, i + stride[a]) / at(DIAG, i + stride[a]));
-                if (c[a] > 0) w -= at(G[a], i - stride[a]) * (at(R, i - stride[a]) / at(DIAG, i - stride[a]));
-            }
+            float w = a_times_u(c, i, u, true, 0.0, 0.0);
             put(W, i, w);
             ru = r * u; wu = w * u; rr = r * r;
         }
@@ -224,13 +232,7 @@ void main() {
             put(X, i, at(X, i) + alpha * p);
             put(S + nxt, i, s_i);
             float r = at(R + cur, i) - alpha * s_i, u = r / at(DIAG, i);
-            float w = at(DIAG, i) * u;
-            int stride[3] = int[3](1, size.x, size.x * size.y);
-            int G[3] = int[3](GX, GY, GZ);
-            for (int a = 0; a < 3; ++a) {
-                if (c[a] + 1 < size[a]) w -= at(G[a], i) * next_u(i + stride[a], alpha, beta);
-                if (c[a] > 0) w -= at(G[a], i - stride[a]) * next_u(i - stride[a], alpha, beta);
-            }
+            float w = a_times_u(c, i, u, false, alpha, beta);
             put(R + nxt, i, r);
             put(W + nxt, i, w);
             ru = r * u; wu = w * u; rr = r * r;
