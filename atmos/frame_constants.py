@@ -12,6 +12,7 @@ import numpy as np
 
 from atmos.camera import Camera, camera_matrices
 from atmos.gpu.shaders import FRAME_BINDING, FRAME_BLOCK   # (the compiler check keeps binding 0 for it)
+from atmos.gpu.uniforms import std140_mat3
 from atmos.lighting import Sun
 
 __all__ = ["FRAME_BINDING", "FRAME_BLOCK", "FRAME_SIZE", "LAYOUT", "FrameConstants", "bind_frame",
@@ -33,7 +34,7 @@ def pack_frame(camera: Camera, sun: Sun, size, time: float = 0.0, frame_index: i
     f = np.zeros(FRAME_SIZE // 4, np.float32)
     f[0:16] = np.frombuffer(matrices.gl("view_proj"), np.float32)
     f[16:32] = np.frombuffer(matrices.gl("inv_view_proj"), np.float32)
-    f[32:44].reshape(3, 4)[:, :3] = np.frombuffer(matrices.gl("view_basis"), np.float32).reshape(3, 3)
+    f[32:44] = std140_mat3(matrices.gl("view_basis"))
     f[44:47] = matrices.camera_pos
     f[47] = camera.near
     f[48:51] = sun.direction

@@ -153,15 +153,24 @@ def test_the_detail_scrolls_with_the_wind_and_nothing_else(gpu, ctx, rng):
         assert np.abs(still - now).mean() > 5 * np.abs(later - now).mean()   # it does move
 
 
-def test_bind_sets_only_the_uniforms_the_program_has(gpu, ctx):
+def test_bind_writes_the_detail_block_and_the_samplers_the_program_has(gpu, ctx):
+    """The Detail block's bytes as detail.glsl lays them out (std140 offsets in its comments): the scroll
+    is detail_offsets' and the rest follows from the settings."""
+    import struct
+    from atmos.plugins.clouds.raymarch.noise import BAND_STRENGTH, COVERAGE, DETAIL_BLOCK, DETAIL_RATIO, band_width
     noise = DetailNoise(gpu, BASE, FINE, seed=5)
     for octaves in (0, 1, 3):
         program = gpu.program(vertex_shader="lib/fullscreen.vert", fragment_shader="test/detail_probe.frag",
                               defines=detail_defines(octaves))
-        noise.bind(program, 10.0, (3.0, 0.0, 1.0), SCALE, STRENGTH)
+        noise.bind(program, 10.0, (3.0, 0.0, 1.0), SCALE, STRENGTH, layer=(500.0, 400.0))
         if octaves == 3:
-            assert program["detail_band_strength"].value == pytest.approx(0.4)
-            assert program["detail_band_width"].value == pytest.approx(1.0 - 0.75 * STRENGTH)
+            assert program[DETAIL_BLOCK].size == 64
+            got = struct.unpack("<3ff3ff2ff3f8x", program.extra["blocks"][DETAIL_BLOCK][1])
+            base, fine = detail_offsets(10.0, (3.0, 0.0, 1.0), SCALE)
+            want = (*base, 1.0 / SCALE, *fine, DETAIL_RATIO / SCALE, 500.0, 1.0 / 400.0, STRENGTH,
+                    BAND_STRENGTH * STRENGTH, COVERAGE, band_width(STRENGTH))
+            np.testing.assert_allclose(got, want, rtol=1e-6)
+            assert got[11] == pytest.approx(0.4) and got[13] == pytest.approx(1.0 - 0.75 * STRENGTH)
         if octaves == 1:
             assert program.get("detail_fine_noise", None) is None
 

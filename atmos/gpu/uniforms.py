@@ -271,6 +271,14 @@ def use_buffers(program, uses: tuple, bind: bool = True) -> None:
                 buffer.bind_to_storage_buffer(binding)
 
 
+def std140_mat3(data: bytes) -> np.ndarray:
+    """float32 (12,): a column-major mat3 (36 bytes, as :func:`atmos.camera.gl_matrix` writes it) laid out
+    as a uniform block holds it under std140: three vec4 columns, each padded to 16 bytes."""
+    out = np.zeros((3, 4), np.float32)
+    out[:, :3] = np.frombuffer(data, np.float32).reshape(3, 3)
+    return out.reshape(-1)
+
+
 def write_block(program, name: str, binding: int, data: bytes) -> bool:
     """Bind ``program``'s own buffer of uniform block ``name`` at ``binding`` with ``data`` (std140,
     packed by the caller), written only when it changed (the buffer is kept in ``program.extra`` and

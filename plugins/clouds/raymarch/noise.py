@@ -1,5 +1,5 @@
 """The ray march's detail noise: two tileable 3D textures built once per GPU context on the GPU
-(``shaders/clouds/raymarch/noise.comp``), and the uniforms of ``shaders/clouds/raymarch/detail.glsl``.
+(``shaders/clouds/raymarch/noise.comp``), and the uniform block of ``shaders/clouds/raymarch/detail.glsl``.
 
 * ``base`` (``base_size``^3, default 128^3): R = Perlin–Worley (Perlin FBM at 4 cells per tile dilated
   by the Worley FBM at 4), G/B/A = Worley FBM at 4, 8 and 16 cells per tile (1×, 2×, 4×).
@@ -21,6 +21,7 @@ as the pixel grows past its features (:func:`detail_fade`), so far clouds keep t
 from __future__ import annotations
 
 import math
+import struct
 import time as _time
 import weakref
 
@@ -28,7 +29,7 @@ import moderngl
 import numpy as np
 
 from atmos.gpu.context import GpuContext, require_gpu
-from atmos.gpu.uniforms import bind_images, bind_textures, write_uniforms
+from atmos.gpu.uniforms import bind_images, bind_textures, write_block
 from atmos.gpu.hazards import dispatch
 
 NOISE_RULE = 0xC1D           # stream id of the noise's hashes: stream_key(seed, 0, NOISE_RULE, plane)
@@ -37,6 +38,8 @@ DETAIL_RATIO = 8             # base tile / detail tile
 PW_RANGE = (0.45, 0.85)      # stored channels: clamp((v - lo) / (hi - lo)) of the raw noise, so the
 WORLEY_RANGE = (0.2, 0.75)   # 8 bits and the erosion thresholds span [0, 1] (~0.5 % clipped each end)
 COVERAGE = 0.6              # detail.glsl's K: densities at or above it are a cloud's body, never eroded
+DETAIL_BLOCK, DETAIL_BINDING = "Detail", 4   # detail.glsl's block of the noise's scroll and settings
+_DETAIL_LAYOUT = struct.Struct("<3ff3ff2ff3f8x")   # its std140 layout (64 bytes)
 BAND_STRENGTH = 0.5          # the detail band (octave 3) erodes by BAND_STRENGTH × detail_strength
 BAND_WIDTH = 0.25            # W: at full strength the shape band remaps coverage e..e + W to 0..1
 DETAIL_FADE = (1 / 16, 1 / 4)   # a band's strength fades from 1 to 0 as the pixel's width grows over this many of its tiles
@@ -139,18 +142,17 @@ class DetailNoise:
         return tuple(made)
 
     def bind(self, program, time: float, wind, scale: float, strength: float, layer=(0.0, 1.0)) -> None:
-        """Bind ``base`` and ``detail`` to ``detail.glsl``'s samplers and set the uniforms
-        that ``program`` has (a compiler drops unused ones): the scroll of ``wind`` (m/s, 3 numbers)
+        """Bind ``base`` and ``detail`` to ``detail.glsl``'s samplers and write its Detail block
+        (where ``program`` has it; written only when it changed): the scroll of ``wind`` (m/s, 3 numbers)
         over ``time`` (s), the base tile ``scale`` (m), the ``strength`` (0..1) and ``layer``, the
         layer's (base y, height) in m (the height gradient)."""
         bind_textures(program, detail_base_noise=self.base, detail_fine_noise=self.detail)
         offset_base, offset_fine = detail_offsets(time, wind, scale)
         strength = float(strength)
-        write_uniforms(program, detail_offset_base=tuple(offset_base), detail_offset_fine=tuple(offset_fine),
-                       detail_inv_scale=1.0 / scale, detail_inv_scale_fine=DETAIL_RATIO / scale,
-                       detail_strength=strength, detail_band_strength=BAND_STRENGTH * strength,
-                       detail_band_width=band_width(strength),
-                       detail_layer=(float(layer[0]), 1.0 / max(float(layer[1]), 1e-6)), detail_coverage=COVERAGE)
+        write_block(program, DETAIL_BLOCK, DETAIL_BINDING, _DETAIL_LAYOUT.pack(
+            *offset_base, 1.0 / scale, *offset_fine, DETAIL_RATIO / scale,
+            float(layer[0]), 1.0 / max(float(layer[1]), 1e-6), strength, BAND_STRENGTH * strength,
+            COVERAGE, band_width(strength)))
 
     def read(self) -> tuple[np.ndarray, np.ndarray]:
         """Both textures as float64 in [0, 1], (n, n, n, 4) indexed [x, y, z, channel] (tests, pictures)."""

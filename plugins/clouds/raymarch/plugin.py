@@ -18,6 +18,7 @@ a depth-aware upsample of this frame's samples is composited instead —
 """
 from __future__ import annotations
 
+import struct
 from functools import lru_cache
 
 import moderngl
@@ -43,11 +44,13 @@ from atmos.plugins.clouds.volume.field_demand import field_demand
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CLOUD_VOLUME, CloudSets
 from atmos.plugins.clouds.simulation.chain import CloudSimulation
 from atmos.render_core import COLOR, DEPTH
-from atmos.gpu.uniforms import bind_textures, write_uniforms
+from atmos.gpu.uniforms import bind_textures, write_block, write_uniforms
 
 LOW_COLOR = "cloud_raymarch_color"
 LOW_DISTANCE = "cloud_raymarch_distance"
 LOW_DEPTH = "cloud_raymarch_depth"
+MARCH_BLOCK, MARCH_BINDING = "March", 1        # march.glsl's block of what changes every frame
+_MARCH_LAYOUT = struct.Struct("<3ff2i8x")       # its std140 layout (32 bytes)
 
 
 def type_uniforms(settings) -> dict:
@@ -88,7 +91,7 @@ def low_descs(size, r: int) -> tuple:
 
 def sample_offset(frame_index: int, r: int) -> tuple[int, int]:
     """The jitter offset o of a frame: the temporal resolve's sequence (all r² offsets every r² frames)."""
-    return tuple(int(v) for v in jitter(frame_index, r))
+    return jitter(frame_index, r)
 
 
 class RaymarchCloudsPlugin(Plugin):
@@ -165,6 +168,7 @@ class RaymarchPass(RenderPass):
         self.gpu = self.sampler = self.offscreen = self.skip = self.temporal = self.noise = self.jitter = None
         self._skip_key = None
         self._types = None                  # (the CloudTypeMap, its texture)
+        self._typed = (None, None)          # (the settings, their type_uniforms): worked out once per change
         self.frame_index = 0
 
     def setup(self, builder: PassBuilder) -> None:
@@ -239,23 +243,32 @@ class RaymarchPass(RenderPass):
             self._types[1].release()
             self._types = None
 
-    def _uniforms(self, frame: PassContext, sim: CloudSets, layout, offset) -> dict:
+    def _uniforms(self, frame: PassContext, sim: CloudSets, layout) -> dict:
         s, view = self.plugin.settings, frame.view
         cell = np.asarray(layout.cell, np.float64)
         maps = sim.maps_of(sim.view()[0])
         skip_cells = (float(layout.group[0]), float(maps.band_height), float(layout.group[1]))
         grid = (layout.grid[0], -(-layout.shape[1] // maps.band_height), layout.grid[1])
-        sun = unit_direction(view.sun)
         return {"layer_min": tuple(float(v) for v in layout.lo), "layer_max": tuple(float(v) for v in layout.hi),
                 "cell_size": tuple(float(c) for c in cell), "sigma_t": self.plugin.sigma_t(sim),
                 "steps": s.steps, "step_base": float(s.step * cell.min()), "step_growth": s.step_growth,
                 "min_transmittance": s.min_transmittance, "skipping": int(s.empty_space_skipping),
                 "skip_cells": skip_cells, "max_skips": int(sum(grid)) + 3, "factor": s.resolution,
-                "sample_offset": tuple(offset), "frame_size": tuple(int(v) for v in view.size),
-                "jittered": int(s.jitter),    # turned per frame only where the resolve averages (r > 1, reprojection)
-                "jitter_shift": jitter_shift(self.frame_index, s.resolution) if s.resolution > 1 and s.reprojection else 0.0,
-                "sun_march": tuple(float(v) for v in sun * SUN_SPACING * cell.min()), "sun_growth": SUN_GROWTH,
-                "pixel_angle": pixel_angle(view), **type_uniforms(s)}
+                "frame_size": tuple(int(v) for v in view.size), "jittered": int(s.jitter), "sun_growth": SUN_GROWTH,
+                "pixel_angle": pixel_angle(view), **self._type_uniforms(s)}
+
+    def _type_uniforms(self, s: RaymarchCloudSettings) -> dict:
+        if self._typed[0] is not s:
+            self._typed = (s, type_uniforms(s))
+        return self._typed[1]
+
+    def _march_block(self, frame: PassContext, cell, offset) -> bytes:
+        """march.glsl's March block: the sun march's first step, the jitter's turn (per frame only where
+        the resolve averages: r > 1 with reprojection) and the pixel marched in each r × r block."""
+        s = self.plugin.settings
+        sun = unit_direction(frame.view.sun) * (SUN_SPACING * float(np.min(cell)))
+        shift = jitter_shift(self.frame_index, s.resolution) if s.resolution > 1 and s.reprojection else 0.0
+        return _MARCH_LAYOUT.pack(*sun.tolist(), shift, int(offset[0]), int(offset[1]))
 
     def execute(self, frame: PassContext) -> None:
         s, view = self.plugin.settings, frame.view
@@ -266,8 +279,9 @@ class RaymarchPass(RenderPass):
         far = frame.declares(FAR_FIELD)
         p = self.program(far)
         layout = sim.layout(s.base_altitude)
-        uniforms = self._uniforms(frame, sim, layout, offset)
+        uniforms = self._uniforms(frame, sim, layout)
         write_uniforms(p, uniforms)
+        write_block(p, MARCH_BLOCK, MARCH_BINDING, self._march_block(frame, layout.cell, offset))
         bind_volume(p, sim, self.sampler, view.sun, s.octaves, s.ms_diffusion, layout.heights, view.ground,
                     ground_light=frame.resource(GROUND), span=uniforms["march_top"])   # towers' sun too
         if s.type_map is not None:

@@ -66,6 +66,7 @@ fragment pass; under a still camera also 9 drift-flag fetches, after the low-res
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import moderngl
 import numpy as np
@@ -74,9 +75,10 @@ from atmos.camera import camera_matrices, gl_matrix
 from atmos.graph import work_groups
 from atmos.offscreen import EDGE
 from atmos.gpu.hazards import dispatch
-from atmos.gpu.uniforms import bind_images, bind_textures, write_uniforms
+from atmos.gpu.uniforms import bind_images, bind_textures, std140_mat3, write_block, write_uniforms
 
 RESOLUTIONS = (1, 2, 4)
+RESOLVE_BLOCK, RESOLVE_BINDING, RESOLVE_SIZE = "Resolve", 1, 144   # temporal.comp's block of one resolve's camera and state
 HISTORY_CLAMP = 1.0        # default clamp weight of moving history (0..1)
 MOTION_LIMIT = 16.0        # default pixels of motion per frame at which history is dropped
 CLAMP_MOTION = 1.0         # pixels of motion per frame below which the clamp is loosened linearly to 0 ...
@@ -114,8 +116,14 @@ def jitter(frame_index: int, r: int) -> tuple[int, int]:
     r = check_resolution(r)
     if isinstance(frame_index, bool) or not isinstance(frame_index, (int, np.integer)) or frame_index < 0:
         raise ValueError(f"jitter's frame_index must be an integer >= 0, got {frame_index!r}")
-    y, x = np.argwhere(bayer(r) == int(frame_index) % (r * r))[0]
-    return int(x), int(y)
+    return _offsets(r)[int(frame_index) % (r * r)]
+
+
+@lru_cache(maxsize=None)
+def _offsets(r: int) -> tuple:
+    """The r² offsets (ox, oy) in the order :func:`jitter` visits them (per frame: one lookup)."""
+    b = bayer(r)
+    return tuple((int(x), int(y)) for y, x in (np.argwhere(b == k)[0] for k in range(r * r)))
 
 
 def jitter_shift(frame_index: int, r: int) -> float:
@@ -238,22 +246,24 @@ class TemporalClouds:
         prev, write = self._sets[self._current], self._sets[1 - self._current]
         p = self.gpu.program(compute_shader="clouds/raymarch/temporal.comp",
                              defines={"COMPOSITE": int(onto is not None), "COMPOSITE_DISTANCE": int(onto_distance is not None)})
-        p["view_basis"].write(matrices.gl("view_basis"))
-        write_uniforms(p, near=float(camera.near), far=float(camera.far), r=r, offset=(int(ox), int(oy)),
-                       has_depth=depth is not None,
+        write_uniforms(p, r=r, has_depth=depth is not None,
                        edge=EDGE if depth is not None and low_depth is not None else 1e30)
         valid = self._valid and self._prev is not None and not self.is_cut(camera, self._prev[2], self._prev[3])
-        write_uniforms(p, history_valid=valid)
         detect = valid and state == self._prev[0] and detects_change(self.still_frames + 1, r, repeats)
         if detect:
             self._flag_drift(low_color, prev, r, (int(ox), int(oy)), depth, matrices, camera)
+        block = np.zeros(RESOLVE_SIZE // 4, np.float32)
+        block[0:12] = std140_mat3(matrices.gl("view_basis"))
+        block[27], block[30] = camera.near, camera.far
+        block.view(np.int32)[28:30] = (int(ox), int(oy))
         if valid:
             prev_state, prev_matrices, prev_position, _ = self._prev
             proj, view = prev_matrices.projection, prev_matrices.view
-            write_uniforms(p, still=state == prev_state, detect_change=detect)
-            p["prev_proj"].write(gl_matrix(proj[[0, 1, 3], :3] @ view[:3, :3]))
-            write_uniforms(p, cam_delta=tuple(float(c) for c in np.asarray(camera.position) - prev_position),
-                           history_clamp=float(history_clamp), motion_limit=float(motion_limit))
+            block[12:24] = std140_mat3(gl_matrix(proj[[0, 1, 3], :3] @ view[:3, :3]))
+            block[24:27] = np.asarray(camera.position, np.float64) - prev_position
+            block[31:33] = history_clamp, motion_limit
+            block.view(np.uint32)[33:36] = (1, int(state == prev_state), int(detect))
+        write_block(p, RESOLVE_BLOCK, RESOLVE_BINDING, block.tobytes())
         bind_textures(p, low_color=low_color, low_distance=low_distance, hist_color=prev[0], hist_distance=prev[1],
                       hist_scene=prev[2], hist_sample=prev[3], drift=self._drift,               # drift: read when detect_change
                       low_depth=low_depth if low_depth is not None else low_color)     # low_depth: read at edge < 1e30

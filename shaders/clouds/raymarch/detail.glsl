@@ -36,15 +36,17 @@
 
 layout(binding = 12) uniform sampler3D detail_base_noise;   // RGBA8, repeat, linear
 layout(binding = 13) uniform sampler3D detail_fine_noise;
-uniform vec3 detail_offset_base;       // wind·time in base tiles, mod 1
-uniform vec3 detail_offset_fine;       // wind·time in detail tiles, mod 1
-uniform float detail_inv_scale;        // 1 / detail_scale (1/m)
-uniform float detail_inv_scale_fine;   // 8 / detail_scale
-uniform float detail_strength;         // band 1's strength
-uniform float detail_band_strength;    // band 3: 0.5 detail_strength
-uniform vec2 detail_layer;             // (base y m, 1 / height m) of the layer
-uniform float detail_coverage;         // K: the density at and above which nothing is eroded
-uniform float detail_band_width;       // w = 1 - (1 - W) strength: the shape band's remap width
+layout(std140, binding = 4) uniform Detail {   // written by noise.py DetailNoise.bind (DETAIL_BLOCK), once per change
+    vec3 detail_offset_base;       //  0  wind·time in base tiles, mod 1
+    float detail_inv_scale;        // 12  1 / detail_scale (1/m)
+    vec3 detail_offset_fine;       // 16  wind·time in detail tiles, mod 1
+    float detail_inv_scale_fine;   // 28  8 / detail_scale
+    vec2 detail_layer;             // 32  (base y m, 1 / height m) of the layer
+    float detail_strength;         // 40  band 1's strength
+    float detail_band_strength;    // 44  band 3: 0.5 detail_strength
+    float detail_coverage;         // 48  K: the density at and above which nothing is eroded
+    float detail_band_width;       // 52  w = 1 - (1 - W) strength: the shape band's remap width
+};                                 // 64 bytes
 const vec2 DETAIL_FADE = vec2(1.0 / 16.0, 0.25);   // noise.py DETAIL_FADE (pixel footprint in tiles)
 
 float detail_fade(float tiles) {

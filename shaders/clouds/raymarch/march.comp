@@ -26,7 +26,6 @@ layout(binding = 1, rg32f) writeonly uniform image2D distance_image;
 layout(binding = 2, r32f) writeonly uniform image2D depth_image;
 #endif
 uniform int factor;            // resolution divisor r
-uniform ivec2 sample_offset;   // the frame's jitter offset o in [0, r)^2
 
 void main() {
     ivec2 texel = ivec2(gl_GlobalInvocationID.xy);

@@ -40,8 +40,11 @@ uniform vec3 skip_cells;       // cells per skip-map texel (group x, band height
 uniform int max_skips;         // skip-map texels a ray can cross
 uniform ivec2 frame_size;      // full-res pixels
 uniform int jittered;          // 1: per-pixel first-sample offset (blue noise + jitter_shift); 0: midpoints
-uniform float jitter_shift;    // the frame's rotation of the offsets (0: fixed in time)
-uniform vec3 sun_march;        // toward the sun, times the sun march's first step (m)
+layout(std140, binding = 1) uniform March {   // what changes every frame (plugin.py MARCH_BLOCK), one write
+    vec3 sun_march;        //  0  toward the sun, times the sun march's first step (m)
+    float jitter_shift;    // 12  the frame's rotation of the offsets (0: fixed in time)
+    ivec2 sample_offset;   // 16  the frame's jitter offset o in [0, r)^2 (march.comp)
+};                         // 32 bytes
 uniform float sun_growth;      // each sun-march step is this many times the last
 uniform float far_distance;    // FAR_FIELD: the march ends this far from the camera (m)
 uniform float far_growth;      // FAR_FIELD: the step's growth per metre of distance in the far field

@@ -20,20 +20,22 @@ layout(binding = 6) uniform sampler2D low_depth;      // the scene depth each sa
 layout(binding = 7) uniform sampler2D hist_sample;    // each pixel's last marched sample (carried for drift.comp)
 layout(binding = 8) uniform sampler2D drift;          // low-res: 1 where this frame's samples moved (drift.comp; detect_change)
 
-uniform mat3 view_basis;      // this frame's rays (lib/view_ray.glsl)
-uniform float near, far;
 uniform int r;
-uniform ivec2 offset;
 uniform bool has_depth;
 uniform float edge;           // the depth-aware upsample's edge (offscreen.EDGE; 1e30: bilinear)
-uniform bool history_valid;
-uniform bool still;           // the camera did not change: the history is at this very pixel
-uniform bool detect_change;   // still for r² frames: every pixel's last sample is real, a change is the clouds'
-
-uniform mat3 prev_proj;       // v (m, relative to the previous camera) -> (clip x, clip y, clip w) then
-uniform vec3 cam_delta;       // this camera's position - the previous one's
-uniform float history_clamp;
-uniform float motion_limit;
+layout(std140, binding = 1) uniform Resolve {   // written once per resolve (temporal.py RESOLVE_BLOCK)
+    mat3 view_basis;          //   0  this frame's rays (lib/view_ray.glsl)
+    mat3 prev_proj;           //  48  v (m, relative to the previous camera) -> (clip x, clip y, clip w)
+    vec3 cam_delta;           //  96  this camera's position - the previous one's
+    float near;               // 108
+    ivec2 offset;             // 112  the pixel marched in each r x r block
+    float far;                // 120
+    float history_clamp;      // 124
+    float motion_limit;       // 128
+    bool history_valid;       // 132
+    bool still;               // 136  the camera did not change: the history is at this very pixel
+    bool detect_change;       // 140  still for r² frames: every pixel's last sample is real, a change is the clouds'
+};                            // 144 bytes
 
 const float CLAMP_MOTION = 1.0;      // temporal.py's constants
 const float DEPTH_TOLERANCE = 0.1;
