@@ -5,7 +5,7 @@ import argparse
 import os
 import sys
 
-from atmos.demo_registry import (CLOUD_RENDERERS, DEFAULT_DEMO, EXPOSURES, HAZES, SKY_MODELS, DemoSettings, haze_conflict,
+from atmos.demo_registry import (CLOUD_RENDERERS, DEFAULT_CLOUDS, DEFAULT_DEMO, EXPOSURES, HAZES, SKY_MODELS, DemoSettings, haze_conflict,
                                  list_demos, load_demo)
 
 
@@ -100,9 +100,9 @@ def _run_options(command, frames_default: str) -> None:
 
 
 def _clouds_option(command) -> None:
-    command.add_argument("--clouds", choices=CLOUD_RENDERERS, default="sprites",
+    command.add_argument("--clouds", choices=CLOUD_RENDERERS, default=DEFAULT_CLOUDS,
                          help="cloud renderer of the cloud scenes (sunset, flight, weather): point sprites "
-                              "or the ray march (default sprites; key C flips it in a window)")
+                              f"or the ray march (default {DEFAULT_CLOUDS}; key C flips it in a window)")
     command.add_argument("--sky", choices=SKY_MODELS, default="physical",
                          help="sky model of the demos with a sky: the Preetham analytic sky or the physical "
                               "atmosphere after Hillaire 2020, which also lights the sun and ambient (default physical)")

@@ -9,6 +9,7 @@ from atmos.checks import check_choice
 
 DEFAULT_DEMO = "sunset"
 CLOUD_RENDERERS = ("sprites", "march")
+DEFAULT_CLOUDS = "march"      # the cloud renderer a cloud scene uses unless told (DemoSettings, atmos.run, --clouds)
 SKY_MODELS = ("preetham", "physical")      # atmos.plugins.sky.MODELS (kept here so the CLI imports no plugin)
 HAZES = ("fog", "air", "both")   # the hazy demos' distance haze: a FogPlugin toward the sky, the physical sky's
                                  # aerial perspective, or both mixed along each ray (atmos.composition)
@@ -30,7 +31,7 @@ class DemoSettings:
     seed: int = 0
     frames: int | None = None     # None: until the window closes (headless: the demo's DEFAULT_FRAMES)
     headless: bool = False
-    clouds: str = "sprites"       # the cloud scenes' renderer: point sprites or the ray march (key C flips it)
+    clouds: str = DEFAULT_CLOUDS  # the cloud scenes' renderer: the ray march or point sprites (key C flips it)
     sky: str = "physical"         # the sky's model in the demos with a sky (SkySettings.model)
     haze: str = "fog"             # sunset's and flight's haze: "fog" (FogPlugin toward the sky), "air" (aerial perspective) or "both"
     exposure: str = "auto"        # the outdoor demos' camera: "auto" (metered EV100 and bloom) or "fixed" (exposure 1)

@@ -6,7 +6,7 @@ import os
 import sys
 
 from atmos.app import App
-from atmos.demo_registry import CLOUD_RENDERERS, EXPOSURES, HAZES, SKY_MODELS, DemoSettings, haze_conflict, load_demo
+from atmos.demo_registry import CLOUD_RENDERERS, DEFAULT_CLOUDS, EXPOSURES, HAZES, SKY_MODELS, DemoSettings, haze_conflict, load_demo
 from atmos.gpu import create_headless
 
 _FILES: dict = {}      # game files loaded so far, by resolved path: each runs once per process
@@ -210,7 +210,7 @@ def run_window(name, settings: DemoSettings, title: str | None = None, script=No
 
 
 def run(game, *, size: tuple[int, int] = (960, 540), title: str | None = None, headless: bool | None = None,
-        frames: int | None = None, out: str | None = None, seed: int = 0, clouds: str = "sprites",
+        frames: int | None = None, out: str | None = None, seed: int = 0, clouds: str = DEFAULT_CLOUDS,
         sky: str = "physical", haze: str = "fog", exposure: str = "auto", progress: bool = False, script=None, shots=None) -> dict | None:
     """Run a game: ``game`` is ``build(app, settings)`` (a function, a module that defines it, a path
     to a ``.py`` file, or a demo name). The App is made for you on a window's context (the window must
@@ -218,8 +218,8 @@ def run(game, *, size: tuple[int, int] = (960, 540), title: str | None = None, h
     when ``out`` is given, or when no display can be reached (a notice on stderr says why).
 
     ``settings`` (:class:`atmos.DemoSettings`) carries ``size``, ``seed``, ``frames``, ``headless`` and
-    ``clouds``: the cloud renderer a cloud scene uses, "sprites" (point sprites) or "march" (the ray
-    march), like ``atmos demo --clouds`` (the demos ``sunset``, ``flight`` and ``weather`` read it);
+    ``clouds``: the cloud renderer a cloud scene uses, "march" (the ray march, the default) or "sprites"
+    (the thesis's point sprites), like ``atmos demo --clouds`` (the demos ``sunset``, ``flight`` and ``weather`` read it);
     ``sky``: "preetham" or "physical", like ``atmos demo --sky`` (the demos with a sky read it);
     ``haze``: "fog", "air" (the physical sky's aerial perspective) or "both", like ``atmos demo --haze``.
     ``exposure``: "auto" (a metered, adapting physical camera with bloom) or "fixed", like ``atmos demo --exposure``.

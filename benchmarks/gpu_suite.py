@@ -14,7 +14,7 @@ Sections (each reuses its benchmark module's functions, so the numbers are the s
 * ``fog``        — homogeneous and heterogeneous fog at 1920×1080 (bench_fog), beside the paper's 20 fps;
   ``volumetric fog`` at 32 and 64 steps per pixel and from froxel volumes (bench_volumetric_fog);
 * ``pacing``     — the heavy sliced job: sliced vs naive frame times (bench_frame_pacing);
-* ``sunset``     — the full sunset frame at 1920×1080: the render graph's per-pass GPU timer table
+* ``sunset``     — the full sunset frame at 1920×1080 (its default clouds: the ray march): the render graph's per-pass GPU timer table
   (``app.graph.timings``), the simulation slices (timer queries), the whole frame in one timer
   query and by wall clock with glFinish, beside Nubis (≈ 2 ms per frame on a PS4); and Python per
   frame (bench_python_frame);

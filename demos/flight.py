@@ -1,5 +1,5 @@
 """flight: a camera flying fast above, through and below the cloud layer in a holding pattern; with the ray
-march (``--clouds march``) the deck has relief: cumulus here, congestus towering above it there."""
+march (the default) the deck has relief: cumulus here, congestus towering above it there."""
 import math
 
 import numpy as np

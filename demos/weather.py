@@ -1,5 +1,5 @@
 """weather: sunny to overcast and back, by changing the cloud density over time; with the ray march
-(``--clouds march``) the cloud type follows: fair-weather cumulus, towering congestus as the sky fills,
+(the default) the cloud type follows: fair-weather cumulus, towering congestus as the sky fills,
 a stratus deck when overcast; region by region (a CloudTypeMap), so some places tower before others."""
 import math
 

@@ -81,7 +81,8 @@ SCENES = {
 
 def rolled_frames(name, size=48):
     gpu = create_headless((size, size))
-    app = build_app(name, DemoSettings(size=gpu.size, headless=True), gpu)
+    # the sprites: the march's r x r sample pattern lies in screen space (a rolled frame samples other rays)
+    app = build_app(name, DemoSettings(size=gpu.size, headless=True, clouds="sprites"), gpu)
     try:
         setup = SCENES[name][1]
         if setup is not None:

@@ -74,23 +74,23 @@ def test_graph_of_the_cloud_demo_runs_no_simulation(capsys, monkeypatch):
     assert code == 0
     for phase in ("[sky]", "[opaque]", "[shadows]", "[translucent]", "[post]", "[present]"):
         assert phase in out
-    assert "cloud_sets@0" in out and "(plugins/clouds/sprites/plugin.py:" in out
+    assert "cloud_sets@0" in out and "(plugins/clouds/raymarch/plugin.py:" in out
     kept, culled = out.split("culled:")[0], out.split("culled:")[1].split("resources:")[0]
-    assert ". cloud_render " in kept and "- cloud_raymarch " in culled, "sprites by default, the ray march off"
+    assert ". cloud_raymarch " in kept and "- cloud_render " in culled, "the ray march by default, the sprites off"
 
 
-def test_graph_of_the_cloud_demo_with_the_ray_march(capsys):
-    code, out, _ = run(capsys, "graph", "sunset", "--clouds", "march")
+def test_graph_of_the_cloud_demo_with_the_sprites(capsys):
+    code, out, _ = run(capsys, "graph", "sunset", "--clouds", "sprites")
     assert code == 0
     kept, culled = out.split("culled:")[0], out.split("culled:")[1].split("resources:")[0]
-    assert ". cloud_raymarch " in kept and "(plugins/clouds/raymarch/plugin.py:" in kept
-    assert "- cloud_render " in culled and ". cloud_render " not in kept, "the sprites are off (culled)"
+    assert ". cloud_render " in kept and "(plugins/clouds/sprites/plugin.py:" in kept
+    assert "- cloud_raymarch " in culled and ". cloud_raymarch " not in kept, "the march is off (culled)"
 
 
 def test_graph_of_the_hazy_demo_with_the_air(capsys):
     code, out, _ = run(capsys, "graph", "sunset", "--haze", "air")
     assert code == 0
-    kept, culled = out.split("culled:")[0], out.split("culled:")[1].split("resources:")[0]
+    kept = out.split("culled:")[0]
     assert ". aerial_perspective " in kept and ". fog " not in kept, "the air instead of the haze fog"
 
 

@@ -46,7 +46,7 @@ def scenes():
     apps = {}
     try:
         for demo in ("sunset", "flight"):
-            app = build_app(demo, DemoSettings(size=gpu.size, headless=True), gpu)
+            app = build_app(demo, DemoSettings(size=gpu.size, headless=True, clouds="sprites"), gpu)
             app.run_frames(4, 1 / 30)
             apps[(demo, "sprites")] = app
         yield gpu, apps
@@ -284,7 +284,7 @@ def test_far_field_is_as_bright_per_cover_as_the_volume_from_above_at_sunset():
     alone (r 1..3) is as bright per cover with its light-march channels collapsed (light_step 0: no
     relief) within 5 % (with exp(−relief), convex, it was 1.24x and 1.31x)."""
     gpu = create_headless(SIZE)
-    app = build_app("sunset", DemoSettings(size=gpu.size, headless=True), gpu)
+    app = build_app("sunset", DemoSettings(size=gpu.size, headless=True, clouds="sprites"), gpu)
     try:
         plugin(app, AntialiasPlugin).configure(mode="none")      # each render alone: no history between views
         app.run_frames(4, 1 / 30)

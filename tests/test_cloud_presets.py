@@ -27,11 +27,22 @@ def test_bad_preset_changes_are_named():
         cloud_settings(colour=1)
 
 
-def test_a_cloud_sky_forms_overhead_and_follows_the_camera():
+def test_a_cloud_sky_marches_its_clouds_unless_told_and_refuses_a_bad_renderer():
+    from atmos import CloudRenderPlugin, RaymarchCloudsPlugin
+    assert isinstance(CloudSky().renderer, RaymarchCloudsPlugin)
+    sprites = CloudSky("broken", renderer="sprites")
+    assert isinstance(sprites.renderer, CloudRenderPlugin) and sprites.renderer in list(sprites)
+    assert not any(isinstance(p, RaymarchCloudsPlugin) for p in sprites)
+    with pytest.raises(ValueError, match="CloudSky.renderer must be one of 'sprites', 'march', got 'voxels'"):
+        CloudSky(renderer="voxels")
+
+
+@pytest.mark.parametrize("renderer", ["march", "sprites"])
+def test_a_cloud_sky_forms_overhead_and_follows_the_camera(renderer):
     gpu = create_headless((48, 27))
     try:
         app = App(gpu)
-        app.add_plugins(DefaultPlugins(overlay=False, fly_camera=False), SkyGradientPlugin(), CloudSky("broken"))
+        app.add_plugins(DefaultPlugins(overlay=False, fly_camera=False), SkyGradientPlugin(), CloudSky("broken", renderer=renderer))
         cam = app.resource(Camera)
         cam.position, cam.pitch, cam.near, cam.far = np.array([5000.0, 300.0, -3000.0]), 0.9, 1.0, 20000.0
         app.run_frames(2, 1 / 30)

@@ -25,27 +25,30 @@ def kept(app) -> set:
 
 
 @pytest.mark.parametrize("name", ["sunset", "flight", "weather"])
-def test_cloud_demos_render_with_the_ray_march_and_key_c_switches_the_renderer(name):
+def test_cloud_demos_march_by_default_render_with_sprites_and_key_c_switches_the_renderer(name):
     from atmos.demos._cloudscape import cloud_renderer
     from atmos.input import Input
     from atmos.keys import key
     gpu = create_headless((64, 40))
     try:
-        app = build_app(name, DemoSettings(size=gpu.size, headless=True, frames=2, clouds="march"), gpu)
+        app = build_app(name, DemoSettings(size=gpu.size, headless=True, frames=2), gpu, start=False)
+        assert cloud_renderer(app) == "march"           # the default
+        app.close()
+        app = build_app(name, DemoSettings(size=gpu.size, headless=True, frames=2, clouds="sprites"), gpu)
         app.run_frames(2, 1 / 30)
         image = gpu.read_pixels().astype(float)
         assert gpu.ctx.error == "GL_NO_ERROR"
-        assert image.max() > 20 and image.std() > 3, f"demo {name} with the ray march renders a blank image"
-        assert cloud_renderer(app) == "march"
-        assert "cloud_raymarch" in kept(app) and "cloud_render" not in kept(app)   # the sprites are culled
+        assert image.max() > 20 and image.std() > 3, f"demo {name} with the sprites renders a blank image"
+        assert cloud_renderer(app) == "sprites"
+        assert "cloud_render" in kept(app) and "cloud_raymarch" not in kept(app)   # the march is culled
         inp = app.resource(Input)
         inp.press(key.C)
         app.update(1 / 30)
         inp.release(key.C)
-        assert cloud_renderer(app) == "sprites"
-        assert "cloud_render" in kept(app) and "cloud_raymarch" not in kept(app)
+        assert cloud_renderer(app) == "march"
+        assert "cloud_raymarch" in kept(app) and "cloud_render" not in kept(app)
         app.update(1 / 30)                          # held, not pressed again: no flip
-        assert cloud_renderer(app) == "sprites"
+        assert cloud_renderer(app) == "march"
         app.close()
     finally:
         gpu.release()

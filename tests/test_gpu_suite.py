@@ -25,7 +25,7 @@ def test_the_gpu_suite_runs_quick_and_writes_markdown_and_json(tmp_path):
     assert {"none", "VFD", "VFD+ESS", "1/2 res, VFD+ESS", "1/2 res, VFD+ESS+LOD 4px"} <= configs
     assert {r["cover"] for r in sections["clouds"]["rows"]} == {"low", "medium", "high"}
     parts = [r["part"] for r in sections["sunset"]["rows"]]
-    assert "pass cloud_render" in parts and "whole frame (one timer query)" in parts
+    assert "pass cloud_raymarch" in parts and "whole frame (one timer query)" in parts
     assert all(r["gpu_ms"] > 0 for r in sections["sunset"]["rows"] if r["part"].startswith("pass "))
     march = {r["renderer"]: r for r in sections["raymarch"]["rows"]}
     assert set(march) == {"sprites", "march"} and march["march"]["pass"] == "cloud_raymarch"

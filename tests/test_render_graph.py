@@ -231,7 +231,7 @@ def test_passes_with_setup_keys_follow_live_changes():
     from atmos.plugins.physical_camera import PhysicalCameraPlugin
     from atmos.runner import build_app
     gpu = create_headless((64, 36))
-    app = build_app("sunset", DemoSettings(size=(64, 36), headless=True), gpu)
+    app = build_app("sunset", DemoSettings(size=(64, 36), headless=True, clouds="sprites"), gpu)
     try:
         app.run_frames(2, 1 / 30)
         graph = app.graph

@@ -17,6 +17,8 @@ from dataclasses import dataclass, replace
 from atmos.camera import Camera
 from atmos.checks import CheckedSettings, check_choice, check_num, choice_field, num_field
 from atmos.plugin import Plugin, PluginGroup
+from atmos.demo_registry import CLOUD_RENDERERS, DEFAULT_CLOUDS
+from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
 from atmos.plugins.clouds.sprites import CloudRenderPlugin
 from atmos.plugins.clouds.weather.example import example_weather
 from atmos.plugins.clouds.shadows import CloudShadowsPlugin
@@ -193,13 +195,16 @@ class CloudWeatherPlugin(Plugin):
 
 class CloudSky(PluginGroup):
     """A cloudy sky for a game: ``CloudSky("fair_weather" | "broken" | "overcast", seed=0,
-    warmup_steps=12, transition=20, **preset_changes)`` (see :func:`cloud_settings`); ``sky.weather``
-    (:class:`CloudWeatherPlugin`) changes it while playing."""
+    warmup_steps=12, transition=20, renderer="march", **preset_changes)`` (see :func:`cloud_settings`);
+    ``renderer``: "march" (the ray march, :class:`RaymarchCloudsPlugin`) or "sprites" (the thesis's point
+    sprites, :class:`CloudRenderPlugin`), the plugin in ``sky.renderer``; ``sky.weather``
+    (:class:`CloudWeatherPlugin`) changes the sky while playing."""
 
     def __init__(self, preset: str = "fair_weather", *, seed: int = 0, warmup_steps: int = WARMUP_STEPS,
-                 transition: float = 20.0, **changes):
+                 transition: float = 20.0, renderer: str = DEFAULT_CLOUDS, **changes):
+        check_choice("CloudSky", "renderer", renderer, CLOUD_RENDERERS)
         settings = cloud_settings(preset, **changes)
         clouds = CloudsPlugin(settings, seed=seed, warmup_steps=warmup_steps)
         self.weather = CloudWeatherPlugin(clouds=clouds, preset=preset, cover=changes.get("cover"), transition=transition)
-        super().__init__(clouds, CloudRenderPlugin(size_factor=4.0), CloudShadowsPlugin(), FollowCameraPlugin(clouds),
-                         self.weather)
+        self.renderer = RaymarchCloudsPlugin() if renderer == "march" else CloudRenderPlugin(size_factor=4.0)
+        super().__init__(clouds, self.renderer, CloudShadowsPlugin(), FollowCameraPlugin(clouds), self.weather)

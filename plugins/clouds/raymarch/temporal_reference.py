@@ -167,6 +167,7 @@ def resolve_reference(history, low_color, low_distance, depth, size, r: int, off
         sampled = sampled + moved * correction
         clamp_w = np.where(fresh[..., None], history_clamp, history_clamp * moved)   # a marched pixel's mean: the box
         sampled = sampled + clamp_w * (np.clip(sampled, lo, hi) - sampled)
+        sampled = np.clip(sampled, 0.0, [np.inf, np.inf, np.inf, 1.0, np.inf, 1.0])   # light, a.d >= 0; a in [0, 1]
         trust = 1.0 - np.clip(2.0 * change / CHANGE_TOLERANCE - 1.0, 0.0, 1.0)     # drifting clouds: the upsample
         keep = np.where(inside & same, trust * np.clip(1.0 - motion / motion_limit, 0.0, 1.0), 0.0)[..., None]
         out = out + keep * (sampled - out)

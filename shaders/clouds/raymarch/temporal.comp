@@ -188,6 +188,10 @@ void resolve(ivec2 pix, vec2 size, out vec4 out_color, out vec2 out_distance, ou
     float clamp_w = history_clamp * (fresh ? 1.0 : moved);     // a marched pixel's mean: to this frame's box
     hc = mix(hc, clamp(hc, lo_c, hi_c), clamp_w);
     hd = mix(hd, clamp(hd, lo_d, hi_d), clamp_w);
+    // what a layer can hold (the correction moves history by differences taken elsewhere): light and
+    // a.d at least 0, coverage in [0, 1]
+    hc = clamp(hc, vec4(0.0), vec4(vec3(3.4e38), 1.0));
+    hd = clamp(hd, vec2(0.0), vec2(3.4e38, 1.0));
     // drifting clouds: the history is stale where its sample changed, the upsample of this frame's
     // samples is nearer (all of it from CHANGE_TOLERANCE, none below half)
     float trust = 1.0 - clamp(2.0 * change / CHANGE_TOLERANCE - 1.0, 0.0, 1.0);
