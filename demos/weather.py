@@ -10,7 +10,7 @@ from atmos.demo_registry import DemoSettings
 from atmos.demos._cloudscape import build_cloudscape, region_offsets, regional_types
 from atmos.plugins.clouds import CloudsPlugin
 from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
-from atmos.plugins.clouds.raymarch.shape import CLOUD_TYPES
+from atmos.plugins.clouds.volume.shape import CLOUD_TYPES
 
 TITLE = ("sunny to overcast and back: the cloud density target rises and falls over time (the ray march: cumulus, "
          "congestus, stratus with it)")

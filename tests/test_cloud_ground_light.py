@@ -13,7 +13,7 @@ from atmos.plugins.clouds.light.medium import environment
 from atmos.plugins.clouds.shadows import CloudShadowSettings
 from atmos.plugins.clouds.simulation.chain import CloudSettings
 from atmos.plugins.clouds.volume.light import light_uniforms
-from test_cloud_shadows import shadow_app, write_sums
+from test_cloud_shadows import draw_typed, shadow_app, write_sums
 
 
 class GroundCapture(RenderPass):
@@ -30,11 +30,13 @@ class GroundCapture(RenderPass):
         self.value = np.frombuffer(frame.resource(GROUND).read(), np.float32).astype(np.float64)
 
 
-@pytest.mark.parametrize("fade", [0.0, 0.35])
-def test_gpu_ground_sun_matches_float64(gpu, ctx, rng, fade):
+@pytest.mark.parametrize("fade, typed", [(0.0, None), (0.35, None), (0.0, "type"), (0.35, "map")])
+def test_gpu_ground_sun_matches_float64(gpu, ctx, rng, fade, typed):
     """G from random column sums of A and B (t between them) within float32's rounding of a 4,096-term
-    mean of values in [0, 1]; more shadow, smaller G."""
+    mean of values in [0, 1]; more shadow, smaller G; with the clouds drawn with a cloud type (one, or a
+    map) each column is the shape drawn (typed_column)."""
     app, sim, _, _ = shadow_app(gpu, CloudShadowSettings())
+    types = draw_typed(app, sim, rng, typed)
     sim.settings = dataclasses.replace(sim.settings, edge_fade=fade)      # as CloudsPlugin.configure does
     ground_sun_pass(app.graph)
     capture = GroundCapture()
@@ -51,7 +53,7 @@ def test_gpu_ground_sun_matches_float64(gpu, ctx, rng, fade):
         write_sums(sim, b, sums[1])
         app.render()
         sets = sim.sets()
-        want = ground_sun_reference(sums[0][0], sums[1][0], sets.t, sets.layout(), sim.settings.sigma, fade)
+        want = ground_sun_reference(sums[0][0], sums[1][0], sets.t, sets.layout(), sim.settings.sigma, fade, **types)
         assert capture.value[0] == pytest.approx(want, abs=2e-6), (capture.value, want)
         assert np.all(capture.value[1:] == 0.0)
         got.append(want)

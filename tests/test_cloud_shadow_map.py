@@ -4,6 +4,7 @@ the shadow pass on the map against lookup_reference."""
 import math
 
 import numpy as np
+import pytest
 
 from atmos.camera import Camera
 from atmos.graph import RenderPass
@@ -13,7 +14,7 @@ from atmos.plugins.clouds.shadows.probe import ShadowMapProbe
 from atmos.plugins.clouds.shadows.shadow_map import (FORMAT_ERROR, SHADOW_MAP, SHADOW_SPACE, bake_reference,
                                                      lookup_reference, shadow_space)
 from atmos.plugins.clouds.volume.layout import CloudLayout
-from test_cloud_shadows import shadow_app, write_sums
+from test_cloud_shadows import draw_typed, shadow_app, write_sums
 
 
 def edge_derivatives(shape, fade: float):
@@ -95,12 +96,16 @@ class MapCapture(RenderPass):
         self.space = type(s)(s.size, s.cascades.copy(), s.lo.copy(), s.cell.copy(), s.shape, s.frame)
 
 
-def test_gpu_bake_and_lookup_match_float64(gpu, ctx, rng):
+@pytest.mark.parametrize("typed", [None, "type", "map"])
+def test_gpu_bake_and_lookup_match_float64(gpu, ctx, rng, typed):
     """The bake against bake_reference within rg16f's rounding (2^-11 relative) and float32's; the GPU
     lookup (one bilinear fetch) against lookup_reference on the GPU's own map within the filter's
-    weight precision (8 fractional bits on some GPUs: 2^-9 of the largest neighbour difference)."""
+    weight precision (8 fractional bits on some GPUs: 2^-9 of the largest neighbour difference). With
+    the clouds drawn with a cloud type (one, or a map) the columns are the shape drawn, in the bake and
+    in the exact path alike."""
     cell = tuple(rng.uniform([3.0, 1.0, 3.0], [8.0, 3.0, 8.0]))
     app, sim, fill, _ = shadow_app(gpu, CloudShadowSettings(), cell_size=cell)
+    types = draw_typed(app, sim, rng, typed)
     capture, probe = MapCapture(), ShadowMapProbe(app.graph)
     app.graph.add_pass(capture)
     app.graph.add_pass(probe)
@@ -128,25 +133,51 @@ def test_gpu_bake_and_lookup_match_float64(gpu, ctx, rng):
     points = probe.points
     app.render()
     space = capture.space
-    want = bake_reference(space, sums[0][0], sums[1][0], t, layout, sets.a_shift, sim.settings.edge_fade)
+    want = bake_reference(space, sums[0][0], sums[1][0], t, layout, sets.a_shift, sim.settings.edge_fade, **types)
     scale = want[..., 0].max()
     # float32 texel positions v0 + j step (v0 and step rounded to float32 on upload) move a sample by a few
     # ulps of |v0| + |j step|, which for the far cascade (v0 thousands of texels off) exceeds |v|'s: times
     # the columns' steepest slope per texel (their largest neighbour difference)
     from atmos.plugins.clouds.shadows.shadow_map import texel_positions
     slope = max(np.abs(np.diff(m[0], axis=a)).max() for m in sums for a in (0, 1))
+    if typed is not None:     # a typed column moves by its steepest derivative in the sum times that
+        from atmos.plugins.clouds.volume.shape import typed_column
+        col = np.linspace(0.0, ny, 4001)
+        tt = [types["cloud_type"]] if typed == "type" else np.linspace(0.0, 1.0, 21)
+        slope *= max(np.abs(np.diff(typed_column(col, 0.0, 0.0, ny, t_, None))).max() / (col[1] - col[0]) for t_ in tt)
     v = texel_positions(space)
     start = np.repeat(space.cascades[:, :2], space.size, axis=0)[:, None, :]       # each row's cascade's v0
     moved = 4 * 2.0 ** -24 * (np.abs(start) + np.abs(v - start)).max(-1, keepdims=True) * slope
-    error = np.abs(capture.map - want) - 2 * FORMAT_ERROR * np.abs(want) - 1e-5 * scale - moved
+    # (typed: 32 float32 terms of the profile, each a few roundings: 2^-16 of the column)
+    error = np.abs(capture.map - want) - (2 * FORMAT_ERROR + (2.0 ** -16 if typed else 0.0)) * np.abs(want) - 1e-5 * scale - moved
     assert error.max() <= 0.0, f"bake error over the bound by {error.max()} at {np.unravel_index(error.argmax(), error.shape)}"
     exact, got = probe.result[:, 0], probe.result[:, 1]
     mine = lookup_reference(space, capture.map, points, s, probe.weights)
     step = max(np.abs(np.diff(capture.map[..., 0], axis=a)).max() for a in (0, 1)) * probe.weights[0]
     assert np.all(np.abs(got - mine) <= 2.0 ** -9 * 2 * step + 1e-5 * scale * probe.weights[0])
-    # the map against the exact sums on the GPU: edge fade off (sim's default), the columns are exact
+    # the map against the exact sums on the GPU: edge fade off (sim's default), the columns are exact;
+    # typed, the map interpolates typed(sum) between its texels where the exact path types the
+    # interpolated sum: a convex mix of corner sums spread over L, of a function whose slope lies in
+    # [0, g'max], errs by at most g'max L / 4; L <= the sums' steepest step per volume texel x (h_x + h_z),
+    # h the cascade's texel in volume texels; and the exact path against its float64 twin
+    interp = 0.0
+    if typed is not None:
+        g1 = max(np.abs(np.diff(typed_column(col, 0.0, 0.0, ny, t_, None))).max() / (col[1] - col[0]) for t_ in tt)
+        run = np.maximum(space.mid - points[:, 1], 0.0) / s[1]
+        v = (points[:, [0, 2]] + run[:, None] * s[[0, 2]] - space.lo[[0, 2]]) / space.cell[[0, 2]] - 0.5
+        j = (v - space.cascades[0, :2]) / space.cascades[0, 2:]
+        near = np.all((j >= 0) & (j <= space.size - 1), axis=-1)
+        h = np.where(near[:, None], space.cascades[0, 2:], space.cascades[1, 2:])
+        raw = max(np.abs(np.diff(m[0], axis=a)).max() for m in sums for a in (0, 1))
+        interp = g1 * raw * h.sum(-1) / 4.0 * probe.weights[0]
+        print(f"typed: |map - exact| max {np.abs(got - exact).max():.3g}, bound median {np.median(interp):.3g}")
+        want_exact = reference.sun_optical_depth(points, sums[0][0], sums[1][0], t, s, probe.weights[0], layout,
+                                                 sets.a_shift, sim.settings.edge_fade, **types)
+        # float32 point positions move the projected texel by a few ulps of |v| (times the typed slope)
+        ulps = 8 * 2.0 ** -24 * np.abs(v).max() * slope * probe.weights[0]
+        np.testing.assert_allclose(exact, want_exact, rtol=2.0 ** -16, atol=1e-5 * scale * probe.weights[0] + ulps)
     assert np.all(np.abs(got - exact) <= 2.0 ** -9 * 2 * step + 2 * FORMAT_ERROR * np.abs(exact)
-                  + 1e-5 * scale * probe.weights[0])
+                  + 1e-5 * scale * probe.weights[0] + interp)
     assert (exact > 0.1).mean() > 0.1, "the points are under clouds"
     app.close()
 

@@ -108,6 +108,31 @@ def shadow_app(gpu, params: CloudShadowSettings, wp=None, cell_size=(1.0, 1.0, 1
     return app, app.resource(CloudSimulation), fill, probe
 
 
+def draw_typed(app, sim, rng, kind):
+    """Have the scene's clouds drawn with a cloud type, as a ray march with one would publish it
+    (:class:`~atmos.plugins.clouds.volume.shape.DrawnShape`): ``kind`` None (as simulated), "type" (one
+    random type) or "map" (a random CloudTypeMap over the volume's footprint, its texture made here).
+    Returns the float64 twins' keywords (cloud_type, type_map)."""
+    import moderngl
+    from atmos.plugins.clouds.volume.shape import CloudTypeMap, drawn_shape
+    shape = drawn_shape(app)
+    if kind is None:
+        shape.source = None
+        return {"cloud_type": None, "type_map": None}
+    if kind == "type":
+        t = float(rng.uniform(0.0, 1.0))
+        shape.source = lambda: (t, None, None)
+        return {"cloud_type": t, "type_map": None}
+    layout = sim.sets().layout()
+    size = (layout.hi - layout.lo)[[0, 2]]
+    type_map = CloudTypeMap(rng.uniform(0.0, 1.0, (5, 7)), tuple(layout.lo[[0, 2]] + 0.1 * size), tuple(0.8 * size))
+    tex = app.gpu.ctx.texture((7, 5), 1, type_map.types.tobytes(), dtype="f4")
+    tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+    tex.repeat_x = tex.repeat_y = False
+    shape.source = lambda: (None, type_map, tex)
+    return {"cloud_type": None, "type_map": type_map}
+
+
 def write_sums(sim, texture_set, sums: np.ndarray) -> None:
     """Overwrite a set's top-view maps with ``sums`` (layers, nx, nz)."""
     sim.maps_of(texture_set).sums.write(np.ascontiguousarray(sums.transpose(0, 2, 1), np.float32).tobytes())

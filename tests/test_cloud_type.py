@@ -1,4 +1,4 @@
-"""The ray march's cloud type (plugins/clouds/raymarch/shape.py): the shader's profile and shaped density
+"""The ray march's cloud type (plugins/clouds/volume/shape.py): the shader's profile and shaped density
 against their float64 twins on fresh random inputs, the march with each type (and with types by region)
 against its reference, the profiles' shapes, skipping with a type, and the settings' checks."""
 import numpy as np
@@ -10,7 +10,7 @@ from atmos.plugins.clouds.light.diffusion import DIFFUSION, read_field
 from atmos.plugins.clouds.light.ground import ground_sun_of
 from atmos.plugins.clouds.raymarch import RaymarchCloudSettings, RaymarchCloudsPlugin
 from atmos.plugins.clouds.raymarch.reference import march_reference
-from atmos.plugins.clouds.raymarch.shape import (CLOUD_TYPES, COLUMN_FULL, TOWER, CloudTypeMap, march_top, type_density,
+from atmos.plugins.clouds.volume.shape import (CLOUD_TYPES, COLUMN_FULL, TOWER, CloudTypeMap, march_top, type_density,
                                                  type_profile)
 from fullscreen_probe import run_fullscreen
 from atmos.plugins.clouds.volume.light import layer_sun, sun_source_at
@@ -249,3 +249,57 @@ def test_the_weather_demos_regions_spread_around_the_weathers_type():
     assert m.types.min() < 0.5 - 0.5 * REGION_SPREAD and m.types.max() > 0.5 + 0.5 * REGION_SPREAD
     stratus = regional_types(0.0, offsets, REGION_SPREAD)
     assert stratus.types.min() == 0.0 and stratus.types.max() <= REGION_SPREAD + 1e-6
+
+
+def test_typed_columns_hold_the_shape_drawn():
+    """typed_column (column.glsl's twin): the simulated column where no type is drawn; a thin stratus sheet
+    holds less than the simulated column, a towering congestus more; its midpoint sum is the profile's
+    integral within the rule's error (checked against 4,000 points): at most a step's worth of the column's
+    largest density c at each of the two edges of where it holds cloud."""
+    from atmos.plugins.clouds.volume.shape import TYPED_STEPS, typed_column
+    ny = 8
+    sums = np.array([0.0, 0.2, 1.0, 2.8, 8.0])
+    assert np.array_equal(typed_column(sums, 0.0, 0.0, ny), sums)
+    full = [typed_column(2.8, 0.0, 0.0, ny, CLOUD_TYPES[k]) for k in ("stratus", "cumulus", "congestus")]
+    assert full[0] < 2.8 < full[2] and full[0] < full[1] < full[2], full
+    for t in (0.0, 0.3, 0.5, 0.8, 1.0):
+        top = max(march_top(t), 1.0)
+        h = (np.arange(4000) + 0.5) / 4000 * top
+        fine = np.array([ny * type_density(s / ny, h, t).sum() * top / 4000 for s in sums])
+        c = np.minimum(sums / ny / COLUMN_FULL, 1.0)
+        assert np.all(np.abs(typed_column(sums, 0.0, 0.0, ny, t) - fine) <= 2 * ny * top / TYPED_STEPS * c + 1e-12)
+    types = CloudTypeMap(np.array([[0.0, 1.0]]), (0.0, 0.0), (200.0, 100.0))
+    x = np.array([0.0, 200.0])                      # the map's two edge texels: stratus, congestus
+    np.testing.assert_allclose(typed_column(np.full(2, 2.8), x, np.zeros(2), ny, type_map=types), full[::2])
+
+
+def test_the_march_publishes_the_type_its_columns_shadow_with(gpu, ctx):
+    """A scene marching its clouds with a type has every column reader (ground shadows, shadow map,
+    shafts, the light from below) shape the columns like it (DrawnShape); off, untyped, or drawn by the
+    sprites: the simulation's own columns."""
+    from atmos import App, DefaultPlugins
+    from atmos.plugins.clouds.sprites import CloudRenderPlugin
+    from atmos.plugins.clouds.volume.shape import DrawnShape
+    density = np.zeros((8, 4, 8), np.float32)
+    density[2:6, :2, 2:6] = 1.0
+    march = RaymarchCloudsPlugin(cloud_type=1.0)
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(density=density), march)
+    try:
+        shape = app.resource(DrawnShape)
+        assert shape.current() == (1.0, None, None)
+        types = CloudTypeMap(np.array([[0.0, 1.0]]))
+        march.configure(type_map=types)
+        cloud_type, type_map, texture = shape.current()
+        assert type_map is types and texture is not None and texture.size == (2, 1)
+        march.configure(cloud_type=None, type_map=None)
+        assert shape.current() is None
+        march.configure(cloud_type=0.5, enabled=False)
+        assert shape.current() is None
+    finally:
+        app.close()
+    assert shape.source is None, "the march takes its source out when it goes"
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(density=density), CloudRenderPlugin())
+    try:
+        assert app.resource(DrawnShape).current() is None
+    finally:
+        app.close()

@@ -40,7 +40,7 @@ from atmos.plugins.clouds import CloudSettings, CloudsPlugin
 from atmos.plugins.clouds.presets import CloudSky, CloudWeatherPlugin
 from atmos.plugins.antialias import AntialiasPlugin
 from atmos.plugins.mesh import MeshPlugin
-from atmos.plugins.clouds.raymarch.shape import CloudTypeMap
+from atmos.plugins.clouds.volume.shape import CloudTypeMap
 from atmos.plugins.physical_camera import PhysicalCameraPlugin
 from atmos.plugins.clouds.simulation.top_view import CloudTopViewPlugin
 from atmos.plugins.daylight import DaylightPlugin, TimeOfDay

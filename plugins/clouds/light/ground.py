@@ -17,7 +17,7 @@ import numpy as np
 
 from atmos.graph import BufferDesc, ComputePass
 from atmos.gpu.uniforms import bind_blocks
-from atmos.plugins.clouds.volume.column import column_uniforms
+from atmos.plugins.clouds.volume.column import column_uniforms, drawn_types
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS
 
 GROUND = "cloud_ground"                # buffer: vec4 (G, 0, 0, 0)
@@ -61,17 +61,23 @@ def bind_ground(program, buffer) -> None:
     bind_blocks(program, {GROUND_BLOCK: buffer})
 
 
-def ground_sun_reference(sums_a, sums_b, t: float, layout, extinction: float, edge_fade: float = 0.0) -> float:
+def ground_sun_reference(sums_a, sums_b, t: float, layout, extinction: float, edge_fade: float = 0.0,
+                         cloud_type=None, type_map=None) -> float:
     """float64 G: ground.comp's mix over t of each set's edge-weighted mean of exp(−extinction × column
     sum) over its points (``sums_a``/``sums_b``: the (nx, nz) top-view sums of sets A and B, each at its
-    own placement; ``layout``: the volume's shape and cells)."""
+    own placement; ``layout``: the volume's shape and cells); each sum the shape drawn with ``cloud_type``
+    / ``type_map`` (:func:`~atmos.plugins.clouds.volume.shape.typed_column`; both None: as simulated)."""
     from atmos.plugins.clouds.shadows.reference import zero_border_bilinear
     from atmos.plugins.clouds.volume.edge import edge_weight
+    from atmos.plugins.clouds.volume.shape import typed_column
     shape = np.array([layout.shape[0], layout.shape[2]], np.float64)
     k = np.arange(GRID, dtype=np.float64) + 0.5
     v = np.stack(np.meshgrid(k * shape[0] / GRID - 0.5, k * shape[1] / GRID - 0.5, indexing="xy"), -1)
     w = edge_weight((v + 0.5) / shape, edge_fade)
-    g = [(w * np.exp(-extinction * zero_border_bilinear(np.asarray(s, np.float64), v))).sum() / w.sum()
+    lo, cell = np.asarray(layout.lo, np.float64), np.asarray(layout.cell, np.float64)
+    x, z = lo[0] + (v[..., 0] + 0.5) * cell[0], lo[2] + (v[..., 1] + 0.5) * cell[2]
+    g = [(w * np.exp(-extinction * typed_column(zero_border_bilinear(np.asarray(s, np.float64), v), x, z,
+                                                 layout.shape[1], cloud_type, type_map))).sum() / w.sum()
          for s in (sums_a, sums_b)]
     return float((1.0 - t) * g[0] + t * g[1])
 
@@ -86,4 +92,4 @@ def ground_sun_of(sets) -> float:
         nx, nz = tex.size[:2]
         sums.append(np.frombuffer(tex.read(), np.float32).reshape(-1, nz, nx)[0].T.astype(np.float64))
     return ground_sun_reference(sums[0], sums[1], t, sets.layout(), float(sets.settings.sigma),
-                                float(sets.settings.edge_fade))
+                                float(sets.settings.edge_fade), **drawn_types(sets))

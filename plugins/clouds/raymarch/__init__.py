@@ -6,6 +6,6 @@ cumulus, congestus, one or by region with a :class:`CloudTypeMap`: :mod:`.shape`
 temporal reprojection (:mod:`.temporal`)."""
 from atmos.plugins.clouds.raymarch.plugin import RaymarchCloudsPlugin, RaymarchPass
 from atmos.plugins.clouds.raymarch.settings import RaymarchCloudSettings
-from atmos.plugins.clouds.raymarch.shape import CLOUD_TYPES, CloudTypeMap
+from atmos.plugins.clouds.volume.shape import CLOUD_TYPES, CloudTypeMap
 
 __all__ = ["CLOUD_TYPES", "CloudTypeMap", "RaymarchCloudSettings", "RaymarchCloudsPlugin", "RaymarchPass"]

@@ -7,7 +7,7 @@ import numpy as np
 
 from atmos.plugins.clouds.far_field.reference import column_at_rank, far_relief, field_fbm, field_rank, relief_light
 from atmos.plugins.clouds.raymarch.reference import integrate, rays, tallest_type
-from atmos.plugins.clouds.raymarch.shape import march_top, type_at, type_density
+from atmos.plugins.clouds.volume.shape import march_top, type_at, type_density
 from atmos.plugins.clouds.volume.light import cell_tau, layer_sun, sun_source_at, unit_direction
 from atmos.plugins.clouds.light.diffusion import field_radiance
 from atmos.plugins.clouds.light.medium import OCTAVES, octave_parameters, source_reference
@@ -55,7 +55,7 @@ class FarField:
 
     def density(self, rank, h, cloud_type=None, ny: float = 1.0) -> np.ndarray:
         """far.glsl's far_density: the column sum at ``rank`` × the profile's R at height fraction ``h``;
-        with a ``cloud_type`` (one, or one per point), :func:`~atmos.plugins.clouds.raymarch.shape.type_density` of the column
+        with a ``cloud_type`` (one, or one per point), :func:`~atmos.plugins.clouds.volume.shape.type_density` of the column
         sum / ``ny`` (the layer's height in cells)."""
         h = np.asarray(h, np.float64)
         if cloud_type is not None:

@@ -33,7 +33,7 @@ from atmos.plugins.clouds.far_field.plugin import CloudFarFieldPlugin
 from atmos.plugins.clouds.raymarch.far import far_uniforms
 from atmos.plugins.clouds.raymarch.noise import pixel_angle
 from atmos.plugins.clouds.raymarch.settings import REFERENCE, SUN_GROWTH, SUN_SPACING, RaymarchCloudSettings
-from atmos.plugins.clouds.raymarch.shape import CloudTypeMap, march_top
+from atmos.plugins.clouds.volume.shape import CloudTypeMap, drawn_shape, march_top, shape_uniforms
 from atmos.plugins.clouds.raymarch.temporal import TemporalClouds, jitter, jitter_repeats, jitter_shift
 from atmos.gpu import clamp_sampler
 from atmos.plugins.clouds.light.ground import GROUND, ground_sun_pass
@@ -54,15 +54,12 @@ _MARCH_LAYOUT = struct.Struct("<3ff2i8x")       # its std140 layout (32 bytes)
 
 
 def type_uniforms(settings) -> dict:
-    """shape.glsl's uniforms: ``cloud_type`` (-1: untyped; with a map, typed whatever it says), whether the
-    map gives the type and where it lies, and how high the types' towers reach (:func:`.shape.march_top`)."""
+    """shape.glsl's uniforms (:func:`~atmos.plugins.clouds.volume.shape.shape_uniforms`) and how high the
+    types' towers reach (:func:`~atmos.plugins.clouds.volume.shape.march_top`)."""
     m = settings.type_map
     typed = m is not None or settings.cloud_type is not None
-    t = -1.0 if not typed else float(settings.cloud_type if settings.cloud_type is not None else 0.5)
-    box = (0.0, 0.0, 1.0, 1.0) if m is None else (float(m.origin[0]), float(m.origin[1]),
-                                                  1.0 / float(m.size[0]), 1.0 / float(m.size[1]))
     top = march_top(None if not typed else (m.highest if m is not None else settings.cloud_type))
-    return {"cloud_type": t, "type_mapped": int(m is not None), "type_map_box": box, "march_top": top}
+    return {**shape_uniforms(settings.cloud_type, m), "march_top": top}
 
 
 def skip_map(max_maps: np.ndarray) -> np.ndarray:
@@ -103,7 +100,7 @@ class RaymarchCloudsPlugin(Plugin):
 
     def __init__(self, settings: RaymarchCloudSettings | None = None, **fields):
         super().__init__(settings, **fields)
-        self.gpu = self.composition = self.far = self.demand = None
+        self.gpu = self.composition = self.far = self.demand = self.shape = self.pass_ = None
         self.simulated = False
 
     @classmethod
@@ -119,10 +116,13 @@ class RaymarchCloudsPlugin(Plugin):
         self.gpu = app.gpu
         self.composition = composition(app)
         self.composition.writers.add(RaymarchPass.name)     # the fog gets the clouds' own distance
-        app.graph.add_pass(RaymarchPass(self))
+        self.pass_ = RaymarchPass(self)
+        app.graph.add_pass(self.pass_)
         ground_sun_pass(app.graph)
         self.demand = field_demand(app)
         self.demand.readers.add(self)
+        self.shape = drawn_shape(app)
+        self.shape.source = self.drawn_type        # the columns' readers shape their shadows like the march
 
     def finish(self, app) -> None:
         self.simulated = app.get_resource(CloudSimulation) is not None     # weather-driven, not static
@@ -136,7 +136,17 @@ class RaymarchCloudsPlugin(Plugin):
         s = self.settings
         return bool(s.enabled and s.far_field and self.far is not None and self.far.settings.enabled)
 
+    def drawn_type(self):
+        """(shape.glsl's uniforms, the type map's texture or None) while the march draws with a cloud type,
+        else None (:class:`~atmos.plugins.clouds.volume.shape.DrawnShape`)."""
+        s = self.settings
+        if not s.enabled or self.pass_ is None or (s.cloud_type is None and s.type_map is None):
+            return None
+        return s.cloud_type, s.type_map, self.pass_._type_texture(s.type_map) if s.type_map is not None else None
+
     def cleanup(self, app) -> None:
+        if self.shape is not None and self.shape.source == self.drawn_type:
+            self.shape.source = None
         if self.demand is not None:
             self.demand.readers.discard(self)
         if self.composition is not None:
@@ -232,7 +242,7 @@ class RaymarchPass(RenderPass):
         if self._types is None or self._types[0] is not type_map:
             self._release_types()
             nz, nx = type_map.types.shape
-            tex = self.gpu.ctx.texture((nx, nz), 1, type_map.types.tobytes(), dtype="f4")
+            tex = self.plugin.gpu.ctx.texture((nx, nz), 1, type_map.types.tobytes(), dtype="f4")   # (any pass may ask first)
             tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
             tex.repeat_x = tex.repeat_y = False
             self._types = (type_map, tex)

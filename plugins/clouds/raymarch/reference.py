@@ -5,8 +5,8 @@ to its far side or the scene), the density trilinear between cell centres (clamp
 light J of :func:`atmos.plugins.clouds.light.medium.source_reference` with the column depths of
 :func:`atmos.plugins.clouds.sprites.reference.column_depth` and the set's diffusion field
 (``edge_fade`` 0: neither fades). With ``settings.cloud_type`` (or ``settings.type_map``: the type at each
-point, :func:`~atmos.plugins.clouds.raymarch.shape.type_at`) the density is
-:func:`~atmos.plugins.clouds.raymarch.shape.type_density` of the column's mean density (the light volume's
+point, :func:`~atmos.plugins.clouds.volume.shape.type_at`) the density is
+:func:`~atmos.plugins.clouds.volume.shape.type_density` of the column's mean density (the light volume's
 columns, as ``shape.glsl`` reads them), in the view march and the sun march alike."""
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ import numpy as np
 
 from atmos.camera import view_basis
 from atmos.plugins.clouds.raymarch.settings import SUN_GROWTH, SUN_SPACING
-from atmos.plugins.clouds.raymarch.shape import TYPE_SUN_STEPS, march_top, type_at, type_density
+from atmos.plugins.clouds.volume.shape import TYPE_SUN_STEPS, march_top, type_at, type_density
 from atmos.plugins.clouds.volume.light import layer_sun, sun_source_at, unit_direction
 from atmos.plugins.clouds.sprites.reference import column_depth
 from atmos.plugins.clouds.light.diffusion import diffusion_radiance

@@ -4,7 +4,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from atmos.checks import bool_field, int_field, num_field, type_field, vec_field
-from atmos.plugins.clouds.raymarch.shape import CLOUD_TYPES, CloudTypeMap
+from atmos.plugins.clouds.volume.shape import CLOUD_TYPES, CloudTypeMap
 from atmos.plugins.clouds.raymarch.temporal import HISTORY_CLAMP, MOTION_LIMIT
 from atmos.plugins.clouds.volume.light import CloudLightSettings
 

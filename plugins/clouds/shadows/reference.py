@@ -13,6 +13,7 @@ import numpy as np
 
 from atmos.plugins.clouds.volume.edge import edge_weight, footprint_uv
 from atmos.plugins.clouds.volume.layout import CloudLayout
+from atmos.plugins.clouds.volume.shape import typed_column
 from atmos.plugins.clouds.light.reference import bilinear
 from atmos.lighting import unit_sun
 from atmos.plugins.clouds.shadows.plugin import direct_weight  # noqa: F401  (the pass's own)
@@ -38,7 +39,8 @@ def shifted(plane: np.ndarray, shift) -> np.ndarray:
 
 
 def shadow_factor(points, sums_a, sums_b, t: float, sun_direction, weight: float, extinction: float,
-                  layout: CloudLayout, a_shift=(0, 0, 0), edge_fade: float = 0.0, far=None) -> np.ndarray:
+                  layout: CloudLayout, a_shift=(0, 0, 0), edge_fade: float = 0.0, far=None,
+                  cloud_type=None, type_map=None) -> np.ndarray:
     """Factor (...,) the colour at world ``points`` (..., 3) is multiplied by; ``sums_a/b`` (nx, nz)
     the all-heights top-view maps of sets A and B; ``extinction`` = sigma·strength; ``layout`` B's
     world placement (the sprite renderer's rule); ``a_shift`` cells from B's column to A's
@@ -47,18 +49,22 @@ def shadow_factor(points, sums_a, sums_b, t: float, sun_direction, weight: float
     s = unit_sun(sun_direction)
     if s is None or weight <= 0.0:
         return np.ones(points.shape[:-1])
-    tau = sun_optical_depth(points, sums_a, sums_b, t, s, extinction, layout, a_shift, edge_fade, far)
+    tau = sun_optical_depth(points, sums_a, sums_b, t, s, extinction, layout, a_shift, edge_fade, far,
+                            cloud_type, type_map)
     return 1.0 - weight * (1.0 - np.exp(-tau))
 
 
 def sun_optical_depth(points, sums_a, sums_b, t: float, sun_dir, extinction: float, layout: CloudLayout,
-                      a_shift=(0, 0, 0), edge_fade: float = 0.0, far=None) -> np.ndarray:
+                      a_shift=(0, 0, 0), edge_fade: float = 0.0, far=None, cloud_type=None,
+                      type_map=None) -> np.ndarray:
     """Optical depth (...,) from world ``points`` (..., 3) toward the sun (``sun_dir`` unit, y > 0)
     through the clouds: ``extinction · column · above`` (module docstring; shaders/clouds/volume/column.glsl);
     ``far``: None, or a function of world xz (..., 2) giving the far field's column optical depth there
     (``column_tau·strength·column_at_rank(rank)``, the column far.comp draws:
     :func:`atmos.plugins.clouds.far_field.reference.far_field_alpha`),
-    added with the complementary edge weight ``(1 − edge)·above``."""
+    added with the complementary edge weight ``(1 − edge)·above``. ``cloud_type``/``type_map``: the shape the
+    clouds are drawn with (column.glsl typed_column, :func:`~atmos.plugins.clouds.volume.shape.typed_column`;
+    both None: as simulated) turns the volume's column (``far`` gives its own, shaped by the caller)."""
     points, s = np.asarray(points, np.float64), np.asarray(sun_dir, np.float64)
     sums = (1.0 - t) * shifted(np.asarray(sums_a, np.float64), a_shift) + t * np.asarray(sums_b, np.float64)
     lo, hi, cell = layout.lo, layout.hi, np.asarray(layout.cell, np.float64)
@@ -67,7 +73,8 @@ def sun_optical_depth(points, sums_a, sums_b, t: float, sun_dir, extinction: flo
     q = points + run[..., None] * s
     texel = (q[..., [0, 2]] - lo[[0, 2]]) / cell[[0, 2]] - 0.5        # map texel (i, k) centred at (i, k)
     edge = edge_weight(footprint_uv(layout, q[..., [0, 2]]), edge_fade)
-    column = zero_border_bilinear(sums, texel) * edge
+    column = typed_column(zero_border_bilinear(sums, texel), q[..., 0], q[..., 2], layout.shape[1], cloud_type,
+                          type_map) * edge
     above = np.clip((hi[1] - y) / (hi[1] - lo[1]), 0.0, 1.0)
     tau = extinction * column * above
     if far is not None:

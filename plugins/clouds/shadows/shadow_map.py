@@ -178,19 +178,23 @@ def texel_positions(space: ShadowMapSpace) -> np.ndarray:
 
 
 def bake_reference(space: ShadowMapSpace, sums_a, sums_b, t: float, layout, a_shift=(0, 0, 0),
-                   edge_fade: float = 0.0, far=None) -> np.ndarray:
+                   edge_fade: float = 0.0, far=None, cloud_type=None, type_map=None) -> np.ndarray:
     """The map (2N, N, 2) in float64: per texel (column sum × fade, far(xz) × (1 − fade)); ``far``: None
-    or the far field's column per unit optical depth at world xz (..., 2)."""
+    or the far field's column per unit optical depth at world xz (..., 2); both columns the shape drawn
+    with ``cloud_type``/``type_map`` (:func:`~atmos.plugins.clouds.volume.shape.typed_column`)."""
     from atmos.plugins.clouds.shadows.reference import shifted, zero_border_bilinear
     from atmos.plugins.clouds.volume.edge import edge_weight
+    from atmos.plugins.clouds.volume.shape import typed_column
     v = texel_positions(space)
     sums = (1.0 - t) * shifted(np.asarray(sums_a, np.float64), a_shift) + t * np.asarray(sums_b, np.float64)
     shape = np.array([space.shape[0], space.shape[2]], np.float64)
     fade = edge_weight((v + 0.5) / shape, edge_fade)
     out = np.zeros(v.shape)
-    out[..., 0] = zero_border_bilinear(sums, v) * fade
+    xz = space.lo[[0, 2]] + (v + 0.5) * space.cell[[0, 2]]
+    ny, x, z = space.shape[1], xz[..., 0], xz[..., 1]
+    out[..., 0] = typed_column(zero_border_bilinear(sums, v), x, z, ny, cloud_type, type_map) * fade
     if far is not None:
-        out[..., 1] = far(space.lo[[0, 2]] + (v + 0.5) * space.cell[[0, 2]]) * (1.0 - fade)
+        out[..., 1] = typed_column(far(xz), x, z, ny, cloud_type, type_map) * (1.0 - fade)
     return out
 
 

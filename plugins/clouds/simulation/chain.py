@@ -157,6 +157,7 @@ class CloudSimulation:
         if settings is not None and not isinstance(settings, CloudSettings):
             raise ValueError(f"CloudSimulation settings must be a CloudSettings, got {type(settings).__name__}")
         self.settings = settings or CloudSettings()      # read live: CloudsPlugin.configure replaces it
+        self.drawn = None                # the DrawnShape its CloudSets carry (CloudsPlugin sets it)
         shape = self.settings.weather.volume_shape
         self.shape = shape
         self.world = world
@@ -288,7 +289,7 @@ class CloudSimulation:
         here = self.origin.as_tuple()
         return CloudSets(a, b, float(t), self._maps[id(a)], self._maps[id(b)], self._max_maps[id(a)],
                          self._max_maps[id(b)], self._placement.get(id(a), here), self._placement.get(id(b), here),
-                         here, self.settings, tuple(self.shape), self._wind_travel(a, b, t))
+                         here, self.settings, tuple(self.shape), self._wind_travel(a, b, t), self.drawn)
 
     def _wind_travel(self, a, b, t: float) -> tuple:
         """(x, z) cells the drawn contents mix(A, B, t) have moved with the wind (the far field follows it)."""

@@ -4,6 +4,7 @@ from __future__ import annotations
 from atmos.lighting import Sun
 from atmos.plugin import Plugin
 from atmos.plugins.clouds.volume.field_demand import field_demand
+from atmos.plugins.clouds.volume.shape import drawn_shape
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS
 from atmos.plugins.clouds.simulation.chain import CloudSettings, CloudSimulation
 from atmos.checks import check_int
@@ -54,10 +55,12 @@ class CloudsPlugin(Plugin):
             return (app.get_resource(Sun) or default_sun).direction
         if self.density is not None:
             self.simulation = StaticClouds(app.gpu, self.density, self.settings, origin, sun, field_demand(app))
+            self.simulation.drawn = drawn_shape(app)
             app.insert_resource(origin)
             app.graph.import_resource(CLOUD_SETS, self.simulation.sets)
             return
         self.simulation = CloudSimulation(app.gpu, app.world, self.settings, self.seed, origin, sun, field_demand(app))
+        self.simulation.drawn = drawn_shape(app)
         app.insert_resource(origin)
         app.insert_resource(self.simulation)
         app.graph.import_resource(CLOUD_SETS, self.simulation.sets)

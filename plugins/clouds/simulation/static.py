@@ -30,6 +30,7 @@ class StaticClouds:
         self.shape = tuple(volume.shape)
         self.settings, self.origin, self.sun = settings, origin, sun
         self.demand = demand or FieldDemand()
+        self.drawn = None                # the DrawnShape its CloudSets carry (CloudsPlugin sets it)
         s = settings
         descs = {"density": TextureDesc(self.shape, 1, "f4"), COLUMNS: column_desc(self.shape, s.shading_scale)}
         if s.shading:
@@ -71,7 +72,7 @@ class StaticClouds:
         self._shade()
         here = self.origin.as_tuple()
         return CloudSets(self.set, self.set, 0.0, self.maps, self.maps, self._max, self._max, here, here, here,
-                         self.settings, self.shape)
+                         self.settings, self.shape, drawn=self.drawn)
 
     def view(self):
         return self.set, self.set, 0.0

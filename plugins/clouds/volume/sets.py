@@ -39,6 +39,7 @@ class CloudSets:
     settings: object             # the simulation's CloudSettings
     shape: tuple
     wind_travel: tuple = (0.0, 0.0)   # (x, z) cells the contents have moved with the wind, mix(A's, B's, t)
+    drawn: object = None         # the DrawnShape (volume/shape.py) column readers shape the columns by; None: none
 
     def view(self) -> tuple[TextureSet, TextureSet, float]:
         return self.a, self.b, self.t

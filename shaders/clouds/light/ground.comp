@@ -5,7 +5,8 @@
 // with τ = extinction × the set's column sum there (bilinear, zero outside), weighted by the volume's
 // edge weight (its core counts fully; the far field continues the same statistics beyond it); sets A
 // and B each over their own footprint, mixed by t (so G runs on smoothly when a step arrives at a
-// moved placement), summed by one group in a fixed order.
+// moved placement), summed by one group in a fixed order. Each column sum is the shape drawn
+// (column.glsl typed_column, at B's placement's world point for both sets).
 #include "clouds/volume/column.glsl"
 layout(local_size_x = 256) in;
 layout(std430, binding = 4) writeonly buffer CloudGround { vec4 ground; };   // (G, 0, 0, 0)
@@ -30,7 +31,9 @@ void main() {
     for (uint k = i; k < GRID * GRID; k += 256u) {
         vec2 v = (vec2(k % GRID, k / GRID) + 0.5) * step - 0.5;     // volume texel coordinates (centre i at i)
         float w = cloud_edge_weight((v + 0.5) / vec2(shape.xz), edge_fade);
-        float g = mix(exp(-extinction * own_sum(sums_a, v)), exp(-extinction * own_sum(sums_b, v)), t);
+        vec2 xz = layer_min.xz + (v + 0.5) * cell_size.xz;
+        float g = mix(exp(-extinction * typed_column(own_sum(sums_a, v), xz)),
+                      exp(-extinction * typed_column(own_sum(sums_b, v), xz)), t);
         acc += w * vec2(g, 1.0);
     }
     partial[i] = acc;

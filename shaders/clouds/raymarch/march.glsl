@@ -15,7 +15,7 @@
 // distance from the camera (m, atmos/composition.py); the scene's window depth the ray stopped at.
 #include "clouds/volume/volume.glsl"
 #include "clouds/raymarch/detail.glsl"
-#include "clouds/raymarch/shape.glsl"
+#include "clouds/volume/shape.glsl"
 #ifndef FAR_FIELD
 #define FAR_FIELD 0
 #endif

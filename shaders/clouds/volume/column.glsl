@@ -9,6 +9,10 @@
 // into the cloud shadow map (clouds/shadows/bake.comp), which the ground shadows and light shafts read;
 // their exact paths (CLOUD_SHADOW_EXACT, SHAFT_EXACT_SHADOWS) still call it;
 // plugins/clouds/shadows/reference.py sun_optical_depth is the same in numpy.
+// Where the clouds are drawn with a cloud type (clouds/volume/shape.glsl: cloud_type >= 0, set by
+// column.py column_uniforms from what the renderer publishes), every column sum becomes the column of
+// the shape drawn (typed_column): a stratus deck's shadow as thin as the sheet drawn, a congestus's as
+// deep as its tower.
 layout(binding = 0) uniform sampler2DArray sums_a;
 layout(binding = 1) uniform sampler2DArray sums_b;
 uniform float extinction;      // sigma × strength, per cell of summed density
@@ -19,11 +23,26 @@ uniform vec3 cell_size;
 uniform ivec3 shape;
 uniform float edge_fade;       // CloudSettings.edge_fade: columns fade with the volume's edge (clouds/volume/edge.glsl)
 #include "clouds/volume/edge.glsl"
+#include "clouds/volume/shape.glsl"
 #ifdef CLOUD_FAR_FIELD
 #include "clouds/far_field/field.glsl"
 #endif
 
 const float MIN_SUN_HEIGHT = 1e-4;
+const int TYPED_STEPS = 32;    // column.py TYPED_STEPS: midpoint samples of the type's profile
+
+// The column sum (summed density over the layer's shape.y cells) of the shape drawn over world point
+// xz for a simulated column sum `sum`: shape.y x the integral over the height fraction h in [0, top]
+// of type_density(sum / shape.y, h, t) (midpoint rule; top the type's highest point, towers
+// included); `sum` itself where no type is drawn (cloud_type < 0).
+float typed_column(float sum, vec2 xz) {
+    if (cloud_type < 0.0 || sum <= 0.0) return sum;
+    float t = cloud_type_at(xz);
+    float ny = float(shape.y), dh = max(type_breakpoints(t).z, 1.0) / float(TYPED_STEPS), s = 0.0;
+    for (int k = 0; k < TYPED_STEPS; ++k)
+        s += type_density(sum / ny, (float(k) + 0.5) * dh, t);
+    return ny * dh * s;
+}
 
 bool outside(ivec2 c) {
     return any(lessThan(c, ivec2(0))) || any(greaterThanEqual(c, shape.xz));
@@ -52,10 +71,10 @@ float column_sum(vec2 p) {
 // map (clouds/shadows/bake.comp) bakes exactly this.
 vec2 sun_columns(vec2 v, vec2 xz) {
     float fade = cloud_edge_weight((v + 0.5) / vec2(shape.xz), edge_fade);
-    vec2 c = vec2(column_sum(v) * fade, 0.0);
+    vec2 c = vec2(typed_column(column_sum(v), xz) * fade, 0.0);
 #ifdef CLOUD_FAR_FIELD
     // beyond the volume the far field's cover continues with the complementary weight (field.glsl)
-    c.y = far_quantile(far_field_rank(xz, 0.0).x) * (1.0 - fade);
+    c.y = typed_column(far_quantile(far_field_rank(xz, 0.0).x), xz) * (1.0 - fade);
 #endif
     return c;
 }

@@ -28,7 +28,7 @@ layout(std140, binding = 2) uniform CloudLight {   // the light that moves with 
     vec3 ground_sun_source;         // albedo * the ground's sunlit radiance / 2, were no cloud in the way
     vec3 light_dir;                 // toward the sun, unit (the frame block's sun_dir for the scene's sun)
     float sun_span;                 // sun_sources' heights span this many layer heights (1; more for a
-                                    // cloud type's towers above the layer: raymarch/shape.py march_top)
+                                    // cloud type's towers above the layer: volume/shape.py march_top)
 };
 layout(std140, binding = 3) uniform CloudGround {  // written on the GPU (plugins/clouds/light/ground.py)
     vec4 cloud_ground;              // x: G, the ground's mean sun transmittance through the clouds

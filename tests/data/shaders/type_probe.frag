@@ -1,6 +1,6 @@
 #version 430
 // Test probe: (type_profile(h, t), type_density(m, h, t)) with (m, h, t) = texel.xyz of unit 0's input.
-#include "clouds/raymarch/shape.glsl"
+#include "clouds/volume/shape.glsl"
 
 layout(binding = 0) uniform sampler2D probe_points;
 out vec4 frag;

@@ -1,8 +1,10 @@
-// The cloud type's vertical shape of the marched density (Nubis), what and why:
-// plugins/clouds/raymarch/shape.py (the float64 twins type_profile and type_density, the constants).
+// The cloud type's vertical shape of the drawn density (Nubis), what and why:
+// plugins/clouds/volume/shape.py (the float64 twins type_profile and type_density, the constants).
 // type_density(m, h, t): a column of mean density m over the layer, at height fraction h, of type t
 // (0 stratus, 0.5 cumulus, 1 congestus), t from cloud_type_at (a uniform, or a map over the ground).
 // cloud_type < 0: the simulation's own vertical shape (march.glsl shaped_density applies it).
+#ifndef SHAPE_GLSL_INCLUDED
+#define SHAPE_GLSL_INCLUDED
 
 uniform float cloud_type;      // RaymarchCloudSettings.cloud_type; -1: None (and no map)
 uniform int type_mapped;       // 1: cloud_type_map gives the type (RaymarchCloudSettings.type_map)
@@ -47,3 +49,4 @@ float type_density(float m, float h, float t) {
     c = pow(c, 1.0 - ANVIL * clamp(2.0 * t - 1.0, 0.0, 1.0) * type_ramp(h, ANVIL_FROM.x * top, ANVIL_FROM.y * top));
     return clamp(type_profile(h, t) - (1.0 - c), 0.0, c);    // c remap(P, 1 - c, 1, 0, 1)
 }
+#endif

@@ -16,16 +16,23 @@ column holds cloud from where P first exceeds 1 - c to where it falls below it: 
 small cloud, a full one fills the profile, so tops follow the coverage's round outline and bases stay
 flat; inside, the density is below the body density (noise.py COVERAGE) wherever P is below 1 (the
 tops, thin columns), so the detail noise carves there, through the volume, not only at its edge.
-``shaders/clouds/raymarch/shape.glsl`` is the shader; :func:`type_profile` and :func:`type_density`
+``shaders/clouds/volume/shape.glsl`` is the shader; :func:`type_profile` and :func:`type_density`
 are its float64 twins.
 
 Types by region: a :class:`CloudTypeMap` (``RaymarchCloudSettings.type_map``) gives t over the ground in
 world metres (stratus over the sea, congestus over the hills), sampled bilinearly at each density sample
 (the far field's too), in place of the one ``cloud_type``; :func:`type_at` is its twin.
+
+Shadows of the shape drawn: the renderer that draws with a type publishes it (:class:`DrawnShape`), and
+every reader of the column sums (``shaders/clouds/volume/column.glsl``: the ground shadows, the shadow
+map, the light shafts, the clouds' light from below) turns each column into the column of the shape
+drawn (:func:`typed_column`): a stratus sheet holds 0.2–0.6 of its simulated column, cumulus 0.6–1.4,
+a congestus tower up to 4.9 times it, so shadows are as deep as the clouds drawn.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -125,6 +132,55 @@ class CloudTypeMap:
         fx = (np.asarray(x, np.float64) - self.origin[0]) / self.size[0] * nx - 0.5
         fz = (np.asarray(z, np.float64) - self.origin[1]) / self.size[1] * nz - 0.5
         return bilinear(self.types.astype(np.float64), np.stack(np.broadcast_arrays(fz, fx), -1))
+
+
+TYPED_STEPS = 32     # column.glsl typed_column: midpoint samples of a type's profile per column
+
+
+def typed_column(sums, x, z, ny: int, cloud_type=None, type_map=None) -> np.ndarray:
+    """float64 twin of ``column.glsl`` typed_column: the column sums (summed density over the layer's ``ny``
+    cells) of the shape drawn over world points (x, z) for simulated column sums ``sums`` (arrays of one
+    shape): ny × the midpoint sum over h in [0, top] of type_density(sums / ny, h, t), t the type there
+    (:func:`type_at`), top its highest point (at least the layer's top); ``sums`` itself untyped."""
+    sums = np.asarray(sums, np.float64)
+    if cloud_type is None and type_map is None:
+        return sums
+    t = np.broadcast_to(np.asarray(type_at(0.5 if cloud_type is None else cloud_type, type_map, x, z),
+                                   np.float64), sums.shape)
+    dh = np.maximum(type_breakpoints(t)[..., 2], 1.0) / TYPED_STEPS
+    total = np.zeros(sums.shape)
+    for k in range(TYPED_STEPS):
+        total += type_density(sums / ny, (k + 0.5) * dh, t)
+    return np.where(sums > 0.0, ny * dh * total, sums)
+
+
+@dataclass
+class DrawnShape:
+    """App resource: the cloud type the clouds are drawn with, for the passes that read the columns
+    (``column.glsl``: ground shadows, the shadow map, light shafts, the clouds' light from below), so
+    their shadows are the shape drawn. ``source``: a zero-argument callable, set by the renderer that
+    shapes the density with a type (the ray march), giving (cloud_type, type_map, the map's texture or
+    None) as its settings say while it does, else None."""
+    source: Callable | None = None
+
+    def current(self):
+        """The source's (cloud_type, type_map, texture), or None: the simulation's own shape."""
+        return self.source() if self.source is not None else None
+
+
+def shape_uniforms(cloud_type, type_map) -> dict:
+    """shape.glsl's uniforms: ``cloud_type`` (-1: untyped; with a map, typed whatever it says), whether the
+    map gives the type and where it lies."""
+    typed = type_map is not None or cloud_type is not None
+    t = -1.0 if not typed else float(cloud_type if cloud_type is not None else 0.5)
+    box = (0.0, 0.0, 1.0, 1.0) if type_map is None else (
+        float(type_map.origin[0]), float(type_map.origin[1]), 1.0 / float(type_map.size[0]), 1.0 / float(type_map.size[1]))
+    return {"cloud_type": t, "type_mapped": int(type_map is not None), "type_map_box": box}
+
+
+def drawn_shape(app) -> DrawnShape:
+    """The App's :class:`DrawnShape` (made on first use)."""
+    return app.init_resource(DrawnShape)
 
 
 def type_at(cloud_type, type_map, x, z):
