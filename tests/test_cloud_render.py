@@ -228,7 +228,12 @@ def test_sprite_vertices_match_the_numpy_reference(gpu, ctx, rng, shading_scale,
         np.testing.assert_allclose(got[:, column], ref[name], rtol=3e-3)
     # log T's slope across the sprite and its half variance: a float32 log of 8 taps, through the footprint
     slope_tol = 1e-3 if shading_scale == 1 else 2e-2
-    np.testing.assert_allclose(got[:, 23:26], ref["slope"], rtol=slope_tol, atol=slope_tol * np.abs(ref["slope"]).max())
+    # T is stored in float16: below its smallest normal (2^-14) its step is 2^-24, up to percents of T
+    # (seed 2236490445: T 3.9e-6, a step of 1.5 %, the slope 1.4 % off), and log T's slope inherits it
+    subnormal = 2.0 * 2.0 ** -24 / np.maximum(ref["octaves"][:, :1], 2.0 ** -24)
+    off = np.abs(got[:, 23:26] - ref["slope"])
+    bound = (slope_tol + subnormal) * np.abs(ref["slope"]) + slope_tol * np.abs(ref["slope"]).max()
+    assert (off <= bound).all(), f"log T's slope off by {(off - bound).max()} over its bound"
     np.testing.assert_allclose(got[:, 26:29], ref["sun"], rtol=1e-5, atol=1e-6)
     assert np.ptp(ref["sun"][vis, 2]) > 0.1 * ref["sun"][vis, 2].max(), "the sprites see the sun's colour at their heights"
     assert np.abs(ref["slope"][vis, :2]).max() > 0.1, "T varies across the sprites"
