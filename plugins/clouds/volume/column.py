@@ -9,7 +9,7 @@ from atmos.plugins.clouds.volume.sets import CloudSets
 from atmos.plugins.clouds.volume.shape import shape_uniforms
 
 
-UNTYPED = {"cloud_type": -1.0, "type_mapped": 0}      # shape.glsl's uniforms where no type is drawn
+UNTYPED = shape_uniforms(None, None)      # shape.glsl's uniforms where no type is drawn (worked out once)
 
 
 def column_uniforms(program, sim: CloudSets, layout: CloudLayout, extinction: float) -> None:
