@@ -27,14 +27,15 @@ def test_edge_weight_is_one_inside_zero_on_the_circle_and_smooth():
     assert np.all(edge_weight(np.random.default_rng(0).random((50, 2)), 0.0) == 1.0)
 
 
-def check_profile_matches_numpy(layer, sets, fade, quantiles):
-    """cover.comp's vertical profile by rank against column_profile (ranked by the GPU's quantiles):
-    each interval's shape R per unit column sum and share above G; and it is the volume's shape (the
-    clouds of this volume sit mid-layer: little density in the lowest and highest quarter). A sprite
-    scene measures no profile (only a march's far field uses it): measured here on request."""
+def check_profile_matches_numpy(layer, sets, fade):
+    """cover.comp's vertical profile by rank of mix(A, B, t) against column_profile (ranked by the GPU's
+    quantiles): each interval's shape R per unit column sum and share above G; and it is the volume's
+    shape (the clouds of this volume sit mid-layer: little density in the lowest and highest quarter).
+    A sprite scene measures no profile (only a march's far field uses it): measured here on request."""
     assert layer.profile is None, "no profile measured for the sprites"
     layer.measure_cover(sets, profile=True)
     gpu_profile = layer.read_profile()
+    _, quantiles = layer.read_cover()
     density = [read_volume(s["density"]) for s in (sets.a, sets.b)]
     ref = column_profile(density[0], density[1], sets.t, sets.a_shift, fade, quantiles)
     assert gpu_profile.shape == ref.shape == (32, sets.shape[1], 2)
@@ -56,16 +57,24 @@ def test_sunset_has_clouds_below_9_degrees_around_the_sun_and_cover_matches_nump
         sets = sim.sets()
         gpu_cover, gpu_columns = far.layer.read_cover()
         sums = [sets.maps_of(s).read_sums()[0] for s in (sets.a, sets.b)]
-        expected = volume_cover(sums[0], sums[1], sets.t, sets.a_shift, sim.settings.cover_threshold,
-                                sim.settings.edge_fade)
-        assert 0.0 < expected < 1.0 and abs(gpu_cover - expected) < 1e-4
-        # the column-sum quantiles the march's far field takes (cover.comp's histogram: within a bin)
-        columns = column_quantiles(sums[0], sums[1], sets.t, sets.a_shift, sim.settings.edge_fade)
+        assert sets.a is not sets.b and 0.0 < sets.t < 1.0, "a frame between two steps"
+        fade, threshold, t = sim.settings.edge_fade, sim.settings.cover_threshold, sets.t
+        # measured once per step of each set alone (A's kept from when it was B), mixed at the frame's t
+        alone = [volume_cover(s, s, 1.0, (0, 0, 0), threshold, fade) for s in sums]
+        expected = (1.0 - t) * alone[0] + t * alone[1]
+        assert 0.0 < expected < 1.0 and abs(gpu_cover - expected) < 1e-4, (gpu_cover, expected)
+        of_mix = volume_cover(sums[0], sums[1], t, sets.a_shift, threshold, fade)
+        assert abs(gpu_cover - of_mix) < 0.02, (gpu_cover, of_mix)          # the cover mix(A, B, t) shows
+        # the column-sum quantiles the march's far field takes (cover.comp's histogram: within a bin),
+        # mixed rank by rank; their mean is the mean column of mix(A, B, t)
+        columns = sum(w * column_quantiles(s, s, 1.0, (0, 0, 0), fade) for w, s in zip((1.0 - t, t), sums))
         bin_width = sets.shape[1] / 256
         assert columns[-1] > 1.0 and np.all(np.diff(gpu_columns) >= 0.0)
         assert np.abs(gpu_columns - columns).max() < 1.5 * bin_width, np.c_[gpu_columns, columns]
-        assert abs(np.mean(gpu_columns > sim.settings.cover_threshold) - expected) < 2.0 / 32   # covered at the same ranks
-        check_profile_matches_numpy(far.layer, sets, sim.settings.edge_fade, gpu_columns)
+        shown = column_quantiles(sums[0], sums[1], t, sets.a_shift, fade)
+        assert abs(np.trapezoid(gpu_columns, dx=1 / 32) - np.trapezoid(shown, dx=1 / 32)) < 1.5 * bin_width
+        assert abs(np.mean(gpu_columns > threshold) - expected) < 2.0 / 32   # covered at the same ranks
+        check_profile_matches_numpy(far.layer, sets, fade)
         cam = app.resource(Camera)
         with_far = app.read_linear()
         far.configure(enabled=False)
@@ -80,6 +89,69 @@ def test_sunset_has_clouds_below_9_degrees_around_the_sun_and_cover_matches_nump
     finally:
         app.close()
         gpu.release()
+
+
+def test_the_far_field_is_measured_once_per_step_of_each_set_and_mixed_each_frame():
+    """Sunset with the march (cover, profile and light by rank all measured): a set is measured alone
+    when first shown as B and kept while it is A (no measure in a frame without a new step), and
+    again when the settings the measure takes change; each frame's measure is A's and B's mixed at the
+    frame's t (rank_mix.comp, to float32's rounding); B's own cover is its float64 cover."""
+    from atmos.plugins.clouds.far_field.layer import RankMeasure, _transitions
+    gpu = create_headless((96, 54))
+    app = build_app("sunset", DemoSettings(size=gpu.size, headless=True), gpu)
+    try:
+        app.run_frames(2, 1 / 30)
+        far = next(p for p in app.plugins if isinstance(p, CloudFarFieldPlugin))
+        sim, layer = app.resource(CloudSimulation), far.layer
+        measured = []
+        real = layer.measure_cover
+
+        def counted(sets, profile=None, into=None):
+            measured.append((sets.b, into))
+            return real(sets, profile, into)
+        layer.measure_cover = counted
+        last, steps, between = (sim.sets().b, sim.sets().b.version), 0, None
+        for _ in range(40):
+            before = len(measured)
+            app.update(1 / 30)
+            sets = sim.sets()
+            new_step = (sets.b, sets.b.version) != last
+            last, steps = (sets.b, sets.b.version), steps + new_step
+            assert len(measured) - before == int(new_step), "one measure per new B, none between steps"
+            if new_step:
+                assert measured[-1][0] is sets.b and isinstance(measured[-1][1], RankMeasure)
+            if 0.2 < sets.t < 0.8 and sets.a is not sets.b:
+                between = sets
+                frame = (np.frombuffer(layer.cover.read(), np.float32), layer.read_profile(), layer.light.read())
+                own = {m.of[0]: m for m in layer._steps if m.of is not None}
+                parts = [(np.frombuffer(own[x].cover.read(), np.float32), read_rank(own[x].profile), own[x].light.read())
+                         for x in (sets.a, sets.b)]
+        assert steps >= 2 and between is not None, (steps, between)
+        t = between.t
+        for got, a, b in zip(frame[:2], parts[0][:2], parts[1][:2]):
+            want = (1.0 - t) * a.astype(np.float64) + t * b.astype(np.float64)
+            assert np.abs(got - want).max() <= 1e-6 * max(np.abs(want).max(), 1.0)
+        assert set(frame[2]) == set(parts[0][2]) and "sun_profile" in frame[2]
+        for name, got in frame[2].items():
+            want = (1.0 - t) * parts[0][2][name] + t * parts[1][2][name]
+            assert np.abs(got - want).max() <= 1e-6 * max(np.abs(want).max(), 1.0), name
+        sums = between.maps_of(between.b).read_sums()[0]
+        own_cover = volume_cover(sums, sums, 1.0, (0, 0, 0), sim.settings.cover_threshold, sim.settings.edge_fade)
+        assert abs(parts[1][0][0] - own_cover) < 1e-4 and _transitions(layer._steps[0].cover)[1] >= 0.0
+        before = len(measured)
+        far.configure(enabled=False)        # no far field drawn: neither its shape nor its light taken
+        app.update(1 / 30)
+        sets = sim.sets()
+        again = {id(b) for b, _ in measured[before:]}
+        assert {id(sets.a), id(sets.b)} <= again, "a new key: both shown sets measured anew"
+    finally:
+        app.close()
+        gpu.release()
+
+
+def read_rank(texture):
+    from atmos.plugins.clouds.far_field.columns import read_rank_texture
+    return read_rank_texture(texture)
 
 
 @pytest.mark.parametrize("shape, base", [((16, 8, 16), 0.25), ((16, 80, 16), 0.6), ((16, 8, 16), None)])

@@ -134,8 +134,9 @@ def draw_typed(app, sim, rng, kind):
 
 
 def write_sums(sim, texture_set, sums: np.ndarray) -> None:
-    """Overwrite a set's top-view maps with ``sums`` (layers, nx, nz)."""
+    """Overwrite a set's top-view maps with ``sums`` (layers, nx, nz): its contents are new (``version``)."""
     sim.maps_of(texture_set).sums.write(np.ascontiguousarray(sums.transpose(0, 2, 1), np.float32).tobytes())
+    texture_set.version += 1
 
 
 def test_gpu_matches_reference_on_random_scenes(gpu, ctx, rng):

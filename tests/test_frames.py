@@ -75,11 +75,14 @@ def test_triple_rotation_order(gpu, ctx):
     assert len({id(s[n]) for s in (s0, s1, s2) for n in ("density", "light")}) == 6
     assert isinstance(s0, TextureSet) and s0["density"].size == (4, 4, 4) and "light" in s0
     expected = [(s0, s1, s2), (s1, s2, s0), (s2, s0, s1), (s0, s1, s2)]
+    versions = {id(s): 0 for s in (s0, s1, s2)}
     for generation, (a, b, c) in enumerate(expected):
         assert triple.generation == generation
         assert (triple.a, triple.b, triple.c) == (a, b, c)
         assert all(x is y for x, y in zip(triple.sets, (a, b, c)))
+        assert all(s.version == versions[id(s)] for s in (a, b, c)), "only a set made anew (the new B) counts"
         triple.rotate()
+        versions[id(c)] += 1
     with pytest.raises(KeyError, match="no texture 'fog'.*density, light"):
         triple.a["fog"]
     triple.release()

@@ -20,11 +20,15 @@ def make_texture(gpu, desc: TextureDesc, clear: bool = True):
 
 
 class TextureSet:
-    """Named textures of one completed (or in-progress) result: ``textures[name]`` or ``set[name]``."""
+    """Named textures of one completed (or in-progress) result: ``textures[name]`` or ``set[name]``.
+
+    ``version`` counts the times its contents were made anew as a whole (:meth:`TripleSet.rotate` for the
+    new B, a static set re-shaded): what a reader derives from a set once it keeps under (set, version)."""
 
     def __init__(self, textures: Mapping[str, object], label: str = ""):
         self.textures: dict[str, object] = dict(textures)
         self.label = label
+        self.version = 0
 
     @classmethod
     def create(cls, gpu, descs: Mapping[str, object], label: str = "") -> "TextureSet":
@@ -91,6 +95,7 @@ class TripleSet:
         """A←B, B←C, C←old A: the just-completed C becomes the newest shown result."""
         self.a, self.b, self.c = self.b, self.c, self.a
         self.generation += 1
+        self.b.version += 1
 
     def release(self) -> None:
         for texture_set in (self.a, self.b, self.c):

@@ -103,8 +103,8 @@ class MarchedShafts:
         p = self.program(clouds and frame.declares(FAR_FIELD), fog, aerial)
         if self.jitter is None:
             self.jitter = blue_noise_texture(self.gpu.ctx)
+        self.set_medium(frame, p, settings, clouds, irradiance, fog, aerial)    # first: it may prepare the far field
         bind_textures(p, low_depth=frame.resource(SHAFT_DEPTH), blue_noise=self.jitter)
-        self.set_medium(frame, p, settings, clouds, irradiance, fog, aerial)
         write_uniforms(p, steps=settings.steps, factor=factor, frame_size=tuple(float(v) for v in frame.view.size))
         shafts = frame.image(SHAFT_COLOR)
         frame.dispatch(p, work_groups(shafts.size, (8, 8)), images={"shafts": shafts})
@@ -121,10 +121,11 @@ class MarchedShafts:
             use_shadow_map(frame, p, sim.settings.sigma, field_tau)
         elif clouds:
             sim: CloudSets = frame.resource(CLOUD_SETS)
-            column_uniforms(p, sim, sim.layout(), sim.settings.sigma)
-            if far_field:
-                layer = frame.resource(FAR_FIELD)
+            layer = frame.resource(FAR_FIELD) if far_field else None
+            if layer is not None:               # first: its measure dispatches programs of its own
                 layer.prepare(view, sim)
+            column_uniforms(p, sim, sim.layout(), sim.settings.sigma)
+            if layer is not None:
                 layer.use(p, view, sim)
         write_uniforms(p, has_clouds=int(clouds), irradiance=tuple(map(float, irradiance)),
                        lobes=settings.phase.lobes, scattering=settings.scattering, max_distance=settings.max_distance)

@@ -8,13 +8,15 @@ measure read back once per simulation step, a step after it was taken: no frame 
 pass draws them; the ground shadows (:mod:`atmos.plugins.clouds.shadows`) darken the ground under them
 with the same function (``shaders/clouds/far_field/field.glsl``). The plugin imports this object as the
 graph resource ``"far_field"``; each pass that uses it calls :meth:`prepare` (re-bakes the octaves
-when the sun turned, measures the cover) and :meth:`use`. The same measure gives the volume's vertical
+when the sun turned, measures each shown set's cover once per simulation step and mixes the two for the
+frame: :class:`RankMeasure`) and :meth:`use`. The same measure gives the volume's vertical
 shape by rank (:attr:`FarFieldLayer.profile`, :meth:`read_profile`), which the ray march's volumetric
 far field takes its density from; a second dispatch its light by rank (:attr:`FarFieldLayer.light`,
 :mod:`.rank_light`), which both far fields light their columns with.
 """
 from __future__ import annotations
 
+from dataclasses import replace
 from operator import is_
 
 import moderngl
@@ -78,22 +80,53 @@ def rank_table_texture(gpu, table):
     return texture
 
 
+class RankMeasure:
+    """One measure of the far field's inputs (GL objects of one GpuContext): ``cover`` (float32: cover,
+    QUANTILES column-sum quantiles, transitions: cover.comp's Cover), ``profile`` (the volume's shape by
+    rank, rg32f, or None) and ``light`` (:class:`.rank_light.RankLight`); ``of``: what it was taken of
+    (a set, its version and the settings it was taken with), None when it holds no step's measure."""
+
+    def __init__(self, gpu):
+        self.gpu = gpu
+        self.cover = gpu.track(gpu.ctx.buffer(reserve=4 * (2 + QUANTILES)))
+        self.profile = None
+        self.light = RankLight(gpu)
+        self.of = None
+
+    def profile_texture(self, heights: int):
+        """:attr:`profile`, made (again) with ``heights`` rows."""
+        if self.profile is None or self.profile.size[1] != heights:
+            if self.profile is not None:
+                self.profile.release()
+            self.profile = rank_texture(self.gpu, heights, 2)
+        return self.profile
+
+    def release(self) -> None:
+        for obj in (self.cover, self.profile, self.light):
+            if obj is not None:
+                obj.release()
+        self.cover = self.profile = self.light = self.of = None
+
+
 class FarFieldLayer:
-    """The octave textures and the measured cover of the far field (GL objects of one GpuContext)."""
+    """The octave textures and the measured cover of the far field (GL objects of one GpuContext).
+
+    The measure is taken once per simulation step: of each shown set alone (A's kept from the step it
+    was B), into one of two :class:`RankMeasure`; each frame one dispatch mixes the two at the frame's
+    t into the frame's own (``shaders/clouds/far_field/rank_mix.comp``), which every pass reads."""
 
     def __init__(self, gpu, plugin):
         self.gpu, self.plugin = gpu, plugin
         self.octaves = OctaveTextures(gpu)
-        self.cover = gpu.track(gpu.ctx.buffer(reserve=4 * (2 + QUANTILES)))   # cover, column_quantiles, transitions
-        self._staged = gpu.track(gpu.ctx.buffer(reserve=self.cover.size))      # a copy of one step's measure
+        self.frame = RankMeasure(gpu)        # the frame's measure: what the far fields, shadows and shafts read
+        self._steps = (RankMeasure(gpu), RankMeasure(gpu))     # the shown sets' own, one step each
+        self._staged = gpu.track(gpu.ctx.buffer(reserve=self.frame.cover.size))   # a copy of one step's measure
         self._staged_for = None              # the set B whose measure is staged (held: never a reused id)
         self._measure = None                 # [partials, histogram, profile sums]: the measure's own buffers
         self._target = None                  # the matched tile the drawn one follows (m)
         self.tile_size = float(self.plugin.settings.tile_size or 8000.0)    # metres per tile as drawn (update_tile)
         self._tile_time = None               # App time of the last update_tile
         self._matched = False                # tile_size follows a measure (else the first one sets it)
-        self.profile = None                  # (INTERVALS, heights) rg32f: the volume's shape by rank (cover.comp)
-        self.light = RankLight(gpu)          # the volume's light by rank (light_by_rank.comp)
         self._prepared = None                # the SceneView of the frame prepared last (held: never a reused id)
         self._uniforms = None                # (view, sim, tile size, settings) and the field uniforms for them
         self.ranks = None                    # far_rank_table (rank_table_texture) of the texture setting _ranks_for
@@ -103,10 +136,27 @@ class FarFieldLayer:
     def settings(self):
         return self.plugin.settings
 
+    @property
+    def cover(self):
+        """The frame's cover buffer (float32: cover, QUANTILES column-sum quantiles, transitions)."""
+        return self.frame.cover
+
+    @property
+    def profile(self):
+        """(INTERVALS, heights) rg32f: the volume's shape by rank (cover.comp), None until measured."""
+        return self.frame.profile
+
+    @property
+    def light(self) -> RankLight:
+        """The volume's light by rank (light_by_rank.comp), as mixed for the frame."""
+        return self.frame.light
+
     def prepare(self, view, sim: CloudSets) -> None:
-        """Bake (when needed), measure the cover and, while a far field is drawn, the light by rank (small
-        dispatches), once per frame: every user (the far-field pass or the march, the shadows, the
-        shafts) calls it, the first one does it."""
+        """Bake (when needed), measure the shown sets (once per simulation step) and mix their measures
+        for the frame (small dispatches), once per frame: every user (the far-field pass or the march,
+        the shadows, the shafts) calls it, the first one does it. The volume's shape by rank is measured
+        while the ray march draws the far field, its light while a far field is drawn (not just shadows).
+        A user calls it before binding anything of its own: it dispatches programs of its own."""
         if view is self._prepared:
             return
         self._prepared = view
@@ -114,11 +164,74 @@ class FarFieldLayer:
         sun_dir = tuple(map(float, unit_direction(view.sun)))     # light_uniforms' sun_dir
         if self.octaves.needs_bake(params, sun_dir, REBAKE_TOLERANCE):
             self.octaves.bake(params, sun_dir, octave_frequencies(params.base_frequency), rotations(), CHANNEL_STEPS)
-        self.measure_cover(sim)
-        if self.plugin.drawn_by_march() or params.enabled:      # a far field is drawn (not just shadows)
-            self.light.measure(sim, self.cover, octave_parameters(self.plugin.light_settings().octaves, sim.settings)[0],
-                               profile_heights(sim.shape[1]))
+        profile = self.plugin.drawn_by_march()
+        light = self.plugin.light_settings() if profile or params.enabled else None
+        a, b = self._step_measures(sim, (profile, light, sim.settings, tuple(sim.shape)))
+        self._mix(float(sim.t), a, b, profile, light is not None)
         self.update_tile(sim, float(view.time))
+
+    def _step_measures(self, sim: CloudSets, key: tuple) -> tuple[RankMeasure, RankMeasure]:
+        """The measures of A alone and of B alone, each taken when first shown (B's kept for when it is A)."""
+        found = [None, None]
+        for i, s in enumerate((sim.a, sim.b)):
+            for m in self._steps:
+                of = m.of
+                if of is not None and of[0] is s and of[1] == s.version and of[2] == key:
+                    found[i] = m
+        if sim.b is sim.a and found[0] is not None:
+            found[1] = found[0]
+        for i, (s, maps, placement) in enumerate(((sim.a, sim.maps_a, sim.placement_a),
+                                                  (sim.b, sim.maps_b, sim.placement_b))):
+            if found[i] is not None:
+                continue
+            if i == 1 and sim.b is sim.a:
+                found[1] = found[0]
+                continue
+            m = next(m for m in self._steps if m is not found[1 - i])
+            alone = replace(sim, a=s, b=s, t=1.0, maps_a=maps, maps_b=maps, placement_a=placement, placement_b=placement)
+            profile, light = key[0], key[1]
+            self.measure_cover(alone, profile, into=m)
+            if light is not None:
+                m.light.measure(alone, m.cover, octave_parameters(light.octaves, sim.settings)[0],
+                                profile_heights(sim.shape[1]))
+            m.of = (s, s.version, key)
+            found[i] = m
+        return found[0], found[1]
+
+    def _mix(self, t: float, a: RankMeasure, b: RankMeasure, profile: bool, light: bool) -> None:
+        """The frame's measure: ``a`` and ``b`` mixed at ``t`` (rank_mix.comp, one dispatch)."""
+        field = light and a.light.has_field and b.light.has_field
+        c = self.gpu.program(compute_shader="clouds/far_field/rank_mix.comp",
+                             defines={"PROFILE": int(profile), "LIGHT": int(light), "FIELD": int(field)})
+        rows = 2
+        textures, images = {}, {}
+        if profile:
+            heights = a.profile.size[1]
+            textures.update(profile_a=a.profile, profile_b=b.profile)
+            images["column_profile"] = self.frame.profile_texture(heights)
+            rows = max(rows, heights)
+        if light:
+            out, la, lb = self.frame.light, a.light, b.light
+            out.has_field = field
+            bins = la.sun_profile.size[1]
+            out.allocate(bins)
+            textures.update(sun_a=la.sun, sun_b=lb.sun, thickness_a=la.thickness, thickness_b=lb.thickness,
+                            height_a=la.height, height_b=lb.height, sun_profile_a=la.sun_profile,
+                            sun_profile_b=lb.sun_profile)
+            images.update(sun_by_rank=out.sun, thickness_by_rank=out.thickness, height_by_rank=out.height,
+                          sun_profile=out.sun_profile)
+            if field:
+                textures.update(field_a=la.field, field_b=lb.field, field_profile_a=la.field_profile,
+                                field_profile_b=lb.field_profile)
+                images.update(field_column=out.field, field_profile=out.field_profile)
+            rows = max(rows, bins)
+        if textures:
+            bind_textures(c, textures)
+        if images:
+            bind_images(c, images)
+        bind_buffers(c, Cover=self.frame.cover, CoverA=a.cover, CoverB=b.cover)
+        write_uniforms(c, t=t)
+        dispatch(c, 1, -(-rows // 4))
 
     def update_tile(self, sim: CloudSets, time: float) -> None:
         """:attr:`tile_size` from the last measure: ``settings.tile_size`` when set, else the tile at which
@@ -158,13 +271,15 @@ class FarFieldLayer:
         self._staged_for = sim.b
         return _transitions(self._staged) if first else measured
 
-    def measure_cover(self, sim: CloudSets, profile: bool | None = None) -> None:
+    def measure_cover(self, sim: CloudSets, profile: bool | None = None, into: RankMeasure | None = None) -> None:
         """The simulation's edge-weighted cover and column-sum quantiles into the buffer the shaders
         read (float32: cover, then QUANTILES column sums in cells; :meth:`read_cover`), and with
         ``profile`` (None: when the ray march draws the far field, ``drawn_by_march()``; it reads the
         sets' density) the covered columns' vertical profile per rank interval into :attr:`profile`
-        (:meth:`read_profile`). Many groups measure the columns, one sums them (cover.comp's passes)."""
+        (:meth:`read_profile`). Many groups measure the columns, one sums them (cover.comp's passes).
+        ``into``: the :class:`RankMeasure` written (default: the frame's, :attr:`frame`)."""
         profile = self.plugin.drawn_by_march() if profile is None else bool(profile)
+        into = self.frame if into is None else into
         columns = int(sim.shape[0]) * int(sim.shape[2])
         groups = max(1, min(MAX_GROUPS, -(-columns // COLUMNS_PER_GROUP)))
         if self._measure is None:       # zero-filled; the passes that read the sums zero them again
@@ -178,7 +293,7 @@ class FarFieldLayer:
         dispatch(c, groups)
         c = self.gpu.program(compute_shader="clouds/far_field/cover.comp")
         write_uniforms(c, groups=groups, max_sum=float(sim.shape[1]))
-        bind_buffers(c, Cover=self.cover, CoverPartials=partials, CoverHistogram=histogram)
+        bind_buffers(c, Cover=into.cover, CoverPartials=partials, CoverHistogram=histogram)
         dispatch(c, 1)
         if not profile:
             return
@@ -186,20 +301,13 @@ class FarFieldLayer:
         c = self.gpu.program(compute_shader="clouds/far_field/cover_profile.comp")
         use_columns(c, sim, density=True)
         write_uniforms(c, heights=heights)
-        bind_buffers(c, Cover=self.cover, CoverProfile=acc)
+        bind_buffers(c, Cover=into.cover, CoverProfile=acc)
         dispatch(c, groups)
         c = self.gpu.program(compute_shader="clouds/far_field/cover_profile_finish.comp")
         write_uniforms(c, heights=heights, layer_rows=int(sim.shape[1]))
         bind_buffers(c, CoverProfile=acc)
-        bind_images(c, column_profile=self._profile_texture(heights))
+        bind_images(c, column_profile=into.profile_texture(heights))
         dispatch(c, 1)
-
-    def _profile_texture(self, heights: int):
-        if self.profile is None or self.profile.size[1] != heights:
-            if self.profile is not None:
-                self.profile.release()
-            self.profile = rank_texture(self.gpu, heights, 2)
-        return self.profile
 
     def read_profile(self) -> np.ndarray:
         """(INTERVALS, heights, 2) as last measured: [k, j] = (density per unit column sum, share of the
@@ -267,16 +375,12 @@ class FarFieldLayer:
         if self.octaves is not None:
             self.octaves.release()
             self.octaves = None
-        for buffer in (self.cover, self._staged, *(self._measure or ())):
+        for buffer in (self._staged, *(self._measure or ())):
             if buffer is not None:
                 buffer.release()
-        self.cover = self._staged = self._staged_for = self._measure = None
-        if self.profile is not None:
-            self.profile.release()
-            self.profile = None
-        if self.light is not None:
-            self.light.release()
-            self.light = None
+        self._staged = self._staged_for = self._measure = None
+        for measure in (self.frame, *self._steps):
+            measure.release()
         if self.ranks is not None:
             self.ranks.release()
             self.ranks = self._ranks_for = None

@@ -8,7 +8,7 @@ transmittances of the octaves (``medium.octave_transmittances``) and, where the 
 volumetric far field; the height their light comes from (where the 2D far field takes the sun's
 colour); and the clouds' thickness (the height their density spans), how high the 2D
 far field's clouds stand when seen at a slant (``far.comp`` slant_rank). So the far field is as bright per cover as the volume at every sun, not a guess
-from a slanted column. Two small dispatches per frame after the cover (:meth:`FarFieldLayer.prepare`).
+from a slanted column. Two small dispatches after the cover, once per simulation step and shown set (:meth:`FarFieldLayer.prepare`).
 """
 from __future__ import annotations
 
@@ -41,7 +41,7 @@ class RankLight:
         self.has_field = DIFFUSION in sim.a and DIFFUSION in sim.b
         shading = "transmittance" in sim.a and "transmittance" in sim.b
         bins = min(int(heights), FIELD_BINS)
-        self._allocate(bins)
+        self.allocate(bins)
         inputs = {f"{sampler}_{x}": s[name] for name, sampler in READS.items() if name in sim.a and name in sim.b
                   for x, s in (("a", sim.a), ("b", sim.b))}
         values = dict(heights=int(heights), bins=bins, has_shading=int(shading), attenuation=float(attenuation),
@@ -61,7 +61,8 @@ class RankLight:
                     bind_images(c, field_column=self.field, field_profile=self.field_profile)
             dispatch(c, groups)
 
-    def _allocate(self, bins: int) -> None:
+    def allocate(self, bins: int) -> None:
+        """The textures for ``bins`` height bins (the field's while :attr:`has_field`), kept while they fit."""
         if self.sun is None:
             self.sun, self.thickness = rank_texture(self.gpu, 2, 4), rank_texture(self.gpu, 1, 1)
             self.height = rank_texture(self.gpu, 2, 1)

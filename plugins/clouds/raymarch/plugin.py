@@ -287,6 +287,8 @@ class RaymarchPass(RenderPass):
         offset = sample_offset(self.frame_index, r) if r > 1 else (0, 0)
         distance = frame.declares(CLOUD_DISTANCE)
         far = frame.declares(FAR_FIELD)
+        if far:                             # first: the layer's measure dispatches programs of its own
+            frame.resource(FAR_FIELD).prepare(view, sim)
         p = self.program(far)
         layout = sim.layout(s.base_altitude)
         uniforms = self._uniforms(frame, sim, layout)
@@ -330,8 +332,7 @@ class RaymarchPass(RenderPass):
     def _bind_far(self, frame: PassContext, p, sim: CloudSets) -> None:
         """The far field's textures, cover and uniforms (field.glsl, far.glsl) for this frame."""
         view, s = frame.view, self.plugin.settings
-        layer = frame.resource(FAR_FIELD)
-        layer.prepare(view, sim)
+        layer = frame.resource(FAR_FIELD)         # prepared in execute
         layer.use(p, view, sim)
         write_uniforms(p, far_uniforms(s, layer.settings, sim.layout(s.base_altitude), view, layer.tile_size))
 

@@ -86,10 +86,11 @@ class CloudShadowsPass(ComputePass):
             field_tau = column_tau(frame.resource(FAR_FIELD).settings, sim) if frame.declares(FAR_FIELD) else 0.0
             use_shadow_map(frame, p, sigma * params.strength, field_tau * params.strength)
         else:
-            column_uniforms(p, sim, layout, sigma * params.strength)
-            if frame.declares(FAR_FIELD):
-                layer = frame.resource(FAR_FIELD)
+            layer = frame.resource(FAR_FIELD) if frame.declares(FAR_FIELD) else None
+            if layer is not None:               # first: its measure dispatches programs of its own
                 layer.prepare(view, sim)
+            column_uniforms(p, sim, layout, sigma * params.strength)
+            if layer is not None:
                 layer.use(p, view, sim)
                 write_uniforms(p, field_column_tau=column_tau(layer.settings, sim) * params.strength)
         frame.dispatch(p, self.groups(frame.image(COLOR).size), textures={"scene_depth": DEPTH},

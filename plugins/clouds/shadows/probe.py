@@ -44,10 +44,11 @@ class ShadowMapProbe(ComputePass):
         ctx, p = self.gpu.ctx, self.program
         sim = frame.resource(CLOUD_SETS)
         field_tau = column_tau(frame.resource(FAR_FIELD).settings, sim) if frame.declares(FAR_FIELD) else 0.0
-        column_uniforms(p, sim, sim.layout(), sim.settings.sigma)
-        if frame.declares(FAR_FIELD):
-            layer = frame.resource(FAR_FIELD)
+        layer = frame.resource(FAR_FIELD) if frame.declares(FAR_FIELD) else None
+        if layer is not None:                   # first: its measure dispatches programs of its own
             layer.prepare(frame.view, sim)
+        column_uniforms(p, sim, sim.layout(), sim.settings.sigma)
+        if layer is not None:
             layer.use(p, frame.view, sim)
             p["field_column_tau"].value = field_tau
         use_shadow_map(frame, p, sim.settings.sigma, field_tau)

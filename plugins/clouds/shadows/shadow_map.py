@@ -138,10 +138,11 @@ class CloudShadowMapPass(ComputePass):
         sun = np.array([0.0, 1.0, 0.0]) if sun is None else sun
         shadow_space(layout, view.camera.position, sun, view.camera.far, self.size, space=self.space)
         self.space.frame += 1
-        column_uniforms(p, sim, layout, 1.0)
-        if frame.declares(FAR_FIELD):
-            layer = frame.resource(FAR_FIELD)
+        layer = frame.resource(FAR_FIELD) if frame.declares(FAR_FIELD) else None
+        if layer is not None:                   # first: its measure dispatches programs of its own
             layer.prepare(view, sim)
+        column_uniforms(p, sim, layout, 1.0)
+        if layer is not None:
             layer.use(p, view, sim)
         write_uniforms(p, cascades=self.space.cascades.astype("f4").tobytes())
         image = frame.image(SHADOW_MAP)

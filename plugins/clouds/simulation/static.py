@@ -66,6 +66,7 @@ class StaticClouds:
                           self.settings.shading_sigma(sun), target=self.set["transmittance"])
         self.shader.run_all()
         self.field.solve(self.set)
+        self.set.version += 1           # its light is new: what was derived from it is out of date
         self._shaded = key
 
     def sets(self) -> CloudSets:
