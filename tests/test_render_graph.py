@@ -422,7 +422,7 @@ def test_culled_passes_compile_no_shaders_and_allocate_no_textures(gpu, graph, s
     assert culled.prepared == culled.executed == 0
     assert kept.prepared == 1 and kept.executed == 3
     assert graph.pool.allocations == 1 and graph.pool.in_use == 0
-    assert odd not in graph.pool._free
+    assert odd.key not in graph.pool._free
 
 
 # -- transient textures ---------------------------------------------------------------------------

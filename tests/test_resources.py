@@ -58,7 +58,7 @@ def test_pool_evicts_a_desc_unused_for_keep_frames(gpu, ctx):
     assert pool.textures == 1 and not dead(a)
     assert pool.end_frame() == 1        # frame 3: unused in frames 1, 2, 3
     assert pool.textures == 0 and pool.evictions == 1 and pool.frame == 4 and dead(a)
-    assert A not in pool._free
+    assert A.key not in pool._free
     b = pool.acquire(A)                 # the desc comes back: a new texture
     assert b is not a and pool.allocations == 2
     pool.release(b)

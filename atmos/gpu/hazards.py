@@ -319,12 +319,18 @@ def _flushing(method):
 
 
 def _copy_use(method, uses):
+    bits = {kind: sum({_BITS.get((kind, access), 0) for access in uses}) for kind in ("texture", "buffer")}
+
     def transfer(self, *args, **kwargs):
         tracker = _LAST[0]
         if tracker is None or tracker._ctx() is not self.ctx:
             tracker = _tracker(self.ctx)
-        if tracker is not None and id(self) in tracker._dirty:
-            tracker.use(reads=[(self, access) for access in uses])
+        if tracker is not None:
+            entry = tracker._dirty.get(id(self))       # Hazards.use of (self, each of uses), inlined
+            if entry is not None and entry[0]() is self:
+                need = (entry[2] & bits[entry[1]]) | tracker._need
+                if need:
+                    tracker.issue(need)
         return method(self, *args, **kwargs)
     transfer._atmos_copy_use = True
     transfer.__name__, transfer.__qualname__, transfer.__doc__ = method.__name__, method.__qualname__, method.__doc__

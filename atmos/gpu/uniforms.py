@@ -9,6 +9,7 @@ moderngl, where :class:`atmos.gpu.gl_meter.GLMeter` and the hazard guard see the
 from __future__ import annotations
 
 from collections.abc import Mapping
+from struct import pack as _pack
 
 import moderngl
 import numpy as np
@@ -80,6 +81,8 @@ def write_uniforms(program, values: Mapping[str, object] | None = None, /, **mor
             member.write(value)
         elif kind is list:
             member.value = value[:member.array_length] if member.array_length > 1 else value[0]
+        elif member.array_length == 1:          # Uniform.value's packing, without its Python setter
+            member.write(_pack(member.fmt, *value) if member.dimension > 1 else _pack(member.fmt, value))
         else:
             member.value = value
 

@@ -143,8 +143,12 @@ class PassContext:
 
     def image(self, name: str):
         """The texture ``name`` for image load/store: the pass must have declared it with ``storage`` access."""
-        value = self.resource(name)
         access = self._access
+        if name in self._declared and name in access and "storage" in access[name]:   # a texture: no checks left
+            value = self._resources.get(name)
+            if type(value) in _PLAIN:
+                return value
+        value = self.resource(name)
         if name not in access or "storage" not in access[name]:
             raise GraphError(f"pass '{self.pass_name}' uses '{name}' as an image but declared it without "
                              "access='storage' (builder.read/write(name, access='storage'))")

@@ -57,8 +57,9 @@ class TextureDesc:
             raise ValueError(f"a storage TextureDesc (written as an image) must have 1, 2 or 4 components and "
                              f"not be depth, got components={self.components}, depth={self.depth}; a depth "
                              "made by compute is components=1, dtype='f4' (r32f)")
-        object.__setattr__(self, "_hash", hash((self.size, self.components, self.dtype, self.depth, self.filter,
-                                                self.storage)))
+        key = (TextureDesc, self.size, self.components, self.dtype, self.depth, self.filter, self.storage)
+        object.__setattr__(self, "key", key)          # the pool's key: a tuple, hashed and compared in C
+        object.__setattr__(self, "_hash", hash(key))
 
     def __hash__(self) -> int:
         """The fields' hash, worked out once (a desc is the pool's key, looked up every frame)."""
@@ -113,7 +114,9 @@ class BufferDesc:
             raise ValueError(f"BufferDesc.size must be a positive int (bytes), got {self.size!r}")
         if not isinstance(self.clear, bool):
             raise ValueError(f"BufferDesc.clear must be True or False, got {self.clear!r}")
-        object.__setattr__(self, "_hash", hash((self.size, self.clear)))
+        key = (BufferDesc, self.size, self.clear)
+        object.__setattr__(self, "key", key)          # the pool's key: a tuple, hashed and compared in C
+        object.__setattr__(self, "_hash", hash(key))
 
     def __hash__(self) -> int:
         """The fields' hash, worked out once (a desc is the pool's key)."""
@@ -152,15 +155,15 @@ class TexturePool:
         self.frame = 0        # frames ended so far (end_frame calls)
         self.allocations = 0  # textures ever created
         self.evictions = 0    # textures released by end_frame
-        self._free: dict[TextureDesc, list] = {}
+        self._free: dict[tuple, list] = {}      # desc.key -> free textures (buffers) of that desc
         self._desc: dict[int, tuple[TextureDesc, object]] = {}  # id(texture) -> (desc, texture), all pooled
         self._in_use: dict[int, object] = {}    # id(texture) -> texture, acquired and not released
         self._used: dict[int, int] = {}  # id(texture) -> frame it was last acquired or released
 
     def acquire(self, desc: TextureDesc | BufferDesc):
         """A texture (or buffer) matching ``desc``, free until :meth:`release` gives it back."""
-        try:                                 # one lookup: a desc's hash is a Python call
-            texture = self._free[desc].pop()
+        try:
+            texture = self._free[desc.key].pop()
         except (KeyError, IndexError):
             texture = self._create(desc)
         if type(desc) is BufferDesc and desc.clear:
@@ -179,7 +182,7 @@ class TexturePool:
             raise ValueError("TexturePool.release: this texture was already released")
         del self._in_use[key]
         self._used[key] = self.frame
-        desc = self._desc[key][0]
+        desc = self._desc[key][0].key
         try:
             self._free[desc].append(texture)
         except KeyError:

@@ -51,6 +51,13 @@ class LightShaftsPass(RenderPass):
         """Whether the march reads cloud shadows (a clouds plugin imported "cloud_sets")."""
         return self.plugin.graph.imports(CLOUD_SETS)
 
+    def setup_key(self) -> tuple:
+        plugin, fog, aerial = self.plugin, self.plugin.fog, self.plugin.aerial()
+        graph = plugin.graph
+        return (plugin.settings, plugin.gpu.size, graph.imports(CLOUD_SETS), graph.imports(FAR_FIELD),
+                fog is not None and (fog.settings, fog.reads_cloud_distance),
+                aerial is not None and aerial.reads_cloud_distance)
+
     def setup(self, builder: PassBuilder) -> None:
         w, h = self.plugin.gpu.size
         d = self.plugin.settings.downsample

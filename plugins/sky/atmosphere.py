@@ -126,7 +126,7 @@ def horizon_mu(rg: float, r):
 
 def sun_visibility(rg: float, r, mu_s):
     """0 in the planet's shadow, 1 outside, smooth over the sun's disc."""
-    t = ((np.asarray(mu_s, np.float64) - horizon_mu(rg, r)) / SUN_EDGE * 0.5 + 0.5).clip(0.0, 1.0)
+    t = np.minimum(np.maximum((np.asarray(mu_s, np.float64) - horizon_mu(rg, r)) / SUN_EDGE * 0.5 + 0.5, 0.0), 1.0)
     return t * t * (3.0 - 2.0 * t)
 
 
@@ -226,7 +226,7 @@ def ms_uv(m: dict, r, mu_s, n: int = MS_SIZE):
 
 
 def clamp_radius(m: dict, r):
-    return np.asarray(r, np.float64).clip(m["rg"] + RADIUS_EPS, m["rt"] - RADIUS_EPS)   # np.clip, without its wrappers
+    return np.minimum(np.maximum(np.asarray(r, np.float64), m["rg"] + RADIUS_EPS), m["rt"] - RADIUS_EPS)   # a clip in ufuncs
 
 
 def march(m: dict, tlut: np.ndarray, r, mu, mu_s, nu, t_max, steps: int, mslut: np.ndarray | None = None,
@@ -366,7 +366,7 @@ def view_angles(view_dirs, sun_dir) -> tuple[np.ndarray, np.ndarray, float, np.n
     sh = math.hypot(s[0], s[2])
     dot = v[..., 0] * s[0] + v[..., 2] * s[2]
     cos_az = np.where((vh > 1e-9) & (sh > 1e-9), dot / np.maximum(vh * sh, 1e-300), 1.0)
-    return v[..., 1], cos_az.clip(-1.0, 1.0), float(s[1]), v @ s
+    return v[..., 1], np.minimum(np.maximum(cos_az, -1.0), 1.0), float(s[1]), v @ s
 
 
 def sky_view_lut(settings: AtmosphereSettings, tlut, mslut, altitude: float, sun_y: float,

@@ -94,9 +94,9 @@ def horizon_radiance(directions, sun_dir, altitude: float, settings: AtmosphereS
     azimuth from the sun; plus the night term as the pass draws it."""
     d = np.asarray(directions, np.float64)
     s = ref.unit(sun_dir)
-    elevation = float(np.arcsin(d[0, 1].clip(-1.0, 1.0)))
+    elevation = math.asin(min(max(float(d[0, 1]), -1.0), 1.0))
     _, cos_az, _, _ = ref.view_angles(d, s)
-    x = np.arccos(cos_az.clip(-1.0, 1.0)) / math.pi * (HORIZON_AZIMUTHS - 1)
+    x = np.arccos(np.minimum(np.maximum(cos_az, -1.0), 1.0)) / math.pi * (HORIZON_AZIMUTHS - 1)
     i0 = np.minimum(np.floor(x).astype(int), HORIZON_AZIMUTHS - 2)
     f = (x - i0)[:, None]
     total = 0.0

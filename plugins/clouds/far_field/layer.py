@@ -25,7 +25,7 @@ import numpy as np
 from atmos.plugins.clouds.far_field.columns import INTERVALS, rank_texture, read_rank_texture, use_columns
 from atmos.plugins.clouds.far_field.cover import LEVELS, QUANTILES, level_ranks, matched_tile_size, pattern_crossings
 from atmos.plugins.clouds.far_field.pattern import CHANNEL_STEPS, PERIODS, octave_frequencies, octave_offsets, rotations, turns_bytes
-from atmos.plugins.clouds.far_field.rank_light import RankLight
+from atmos.plugins.clouds.far_field.rank_light import FIELD_BINS, RankLight
 from atmos.plugins.clouds.light.medium import octave_parameters
 from atmos.plugins.clouds.volume.light import cell_tau, unit_direction
 from atmos.plugins.clouds.volume.sets import CloudSets
@@ -90,15 +90,16 @@ class RankMeasure:
         self.gpu = gpu
         self.cover = gpu.track(gpu.ctx.buffer(reserve=4 * (2 + QUANTILES)))
         self.profile = None
+        self._rows = 0                       # the profile's rows (its height samples)
         self.light = RankLight(gpu)
         self.of = None
 
     def profile_texture(self, heights: int):
         """:attr:`profile`, made (again) with ``heights`` rows."""
-        if self.profile is None or self.profile.size[1] != heights:
+        if self.profile is None or self._rows != heights:
             if self.profile is not None:
                 self.profile.release()
-            self.profile = rank_texture(self.gpu, heights, 2)
+            self.profile, self._rows = rank_texture(self.gpu, heights, 2), heights
         return self.profile
 
     def release(self) -> None:
@@ -167,7 +168,7 @@ class FarFieldLayer:
         profile = self.plugin.drawn_by_march()
         light = self.plugin.light_settings() if profile or params.enabled else None
         a, b = self._step_measures(sim, (profile, light, sim.settings, tuple(sim.shape)))
-        self._mix(float(sim.t), a, b, profile, light is not None)
+        self._mix(float(sim.t), a, b, profile, light is not None, profile_heights(sim.shape[1]))
         self.update_tile(sim, float(view.time))
 
     def _step_measures(self, sim: CloudSets, key: tuple) -> tuple[RankMeasure, RankMeasure]:
@@ -198,22 +199,22 @@ class FarFieldLayer:
             found[i] = m
         return found[0], found[1]
 
-    def _mix(self, t: float, a: RankMeasure, b: RankMeasure, profile: bool, light: bool) -> None:
-        """The frame's measure: ``a`` and ``b`` mixed at ``t`` (rank_mix.comp, one dispatch)."""
+    def _mix(self, t: float, a: RankMeasure, b: RankMeasure, profile: bool, light: bool, heights: int) -> None:
+        """The frame's measure: ``a`` and ``b`` (taken at ``heights`` samples per column) mixed at ``t``
+        (rank_mix.comp, one dispatch)."""
         field = light and a.light.has_field and b.light.has_field
         c = self.gpu.program(compute_shader="clouds/far_field/rank_mix.comp",
                              defines={"PROFILE": int(profile), "LIGHT": int(light), "FIELD": int(field)})
         rows = 2
         textures, images = {}, {}
         if profile:
-            heights = a.profile.size[1]
             textures.update(profile_a=a.profile, profile_b=b.profile)
             images["column_profile"] = self.frame.profile_texture(heights)
             rows = max(rows, heights)
         if light:
             out, la, lb = self.frame.light, a.light, b.light
             out.has_field = field
-            bins = la.sun_profile.size[1]
+            bins = min(heights, FIELD_BINS)
             out.allocate(bins)
             textures.update(sun_a=la.sun, sun_b=lb.sun, thickness_a=la.thickness, thickness_b=lb.thickness,
                             height_a=la.height, height_b=lb.height, sun_profile_a=la.sun_profile,

@@ -33,6 +33,7 @@ class RankLight:
         self.gpu = gpu
         self.sun = self.thickness = self.height = self.sun_profile = self.field = self.field_profile = self.sums = None
         self.has_field = False           # the last measure took a diffusion field
+        self._bins = 0                   # the profiles' height bins
 
     def measure(self, sim, cover_buffer, attenuation: float, heights: int) -> None:
         """Measure mix(A, B, t) of ``sim`` (the frame's CloudSets) ranked by the quantiles in
@@ -67,9 +68,9 @@ class RankLight:
             self.sun, self.thickness = rank_texture(self.gpu, 2, 4), rank_texture(self.gpu, 1, 1)
             self.height = rank_texture(self.gpu, 2, 1)
             self.sums = self.gpu.track(self.gpu.ctx.buffer(bytes(4 * SUMS)))    # zero; STAGE 1 clears it
-        if self.sun_profile is None or self.sun_profile.size[1] != bins:
+        if self.sun_profile is None or self._bins != bins:
             self._release_profiles()
-            self.sun_profile = rank_texture(self.gpu, bins, 4)
+            self.sun_profile, self._bins = rank_texture(self.gpu, bins, 4), bins
         if self.has_field and self.field_profile is None:
             self.field, self.field_profile = rank_texture(self.gpu, 2, 4), rank_texture(self.gpu, bins, 4)
 

@@ -181,6 +181,10 @@ class RaymarchPass(RenderPass):
         self._typed = (None, None)          # (the settings, their type_uniforms): worked out once per change
         self.frame_index = 0
 
+    def setup_key(self) -> tuple:
+        plugin = self.plugin
+        return (plugin.settings, plugin.marches_far_field(), plugin.composition.distance, plugin.gpu.size)
+
     def setup(self, builder: PassBuilder) -> None:
         s = self.plugin.settings
         if not s.enabled:

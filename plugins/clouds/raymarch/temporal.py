@@ -65,6 +65,8 @@ fragment pass; under a still camera also 9 drift-flag fetches, after the low-res
 """
 from __future__ import annotations
 
+from operator import is_
+
 import math
 from functools import lru_cache
 
@@ -182,6 +184,7 @@ class TemporalClouds:
         self._sets: list | None = None     # [(color, distance, scene, last sample)] × 2
         self._drift = None                 # the low-res drift flags (r8)
         self._key = None                   # (size, r) the history was made for
+        self._checked = None               # ((size, r), the textures resolve last checked for them; held)
         self._current = 0                  # which set holds the last output
         self._valid = False
         self._prev = None                  # (camera_state, CameraMatrices, position) of the last resolve
@@ -204,6 +207,21 @@ class TemporalClouds:
         """Forget the history (a camera cut): the next resolve uses this frame's samples alone."""
         self._valid = False
 
+    @staticmethod
+    def _check_sizes(size, r: int, low_color, low_distance, depth, low_depth, onto, onto_distance) -> None:
+        low = low_size(size, r)
+        for name, tex in (("low_color", low_color), ("low_distance", low_distance)):
+            if tuple(tex.size) != low:
+                raise ValueError(f"TemporalClouds.resolve: {name} must be {low[0]}x{low[1]} (size {size} / {r}), "
+                                 f"got {tex.size[0]}x{tex.size[1]}")
+        if depth is not None and tuple(depth.size) != size:
+            raise ValueError(f"TemporalClouds.resolve: depth must be {size[0]}x{size[1]}, got {depth.size}")
+        if low_depth is not None and tuple(low_depth.size) != low:
+            raise ValueError(f"TemporalClouds.resolve: low_depth must be {low[0]}x{low[1]}, got {low_depth.size}")
+        for name, tex in (("onto", onto), ("onto_distance", onto_distance)):
+            if tex is not None and tuple(tex.size) != size:
+                raise ValueError(f"TemporalClouds.resolve: {name} must be {size[0]}x{size[1]}, got {tex.size}")
+
     def resolve(self, low_color, low_distance, size, r: int, offset, camera, aspect: float, depth=None,
                 history_clamp: float = HISTORY_CLAMP, motion_limit: float = MOTION_LIMIT, low_depth=None,
                 onto=None, onto_distance=None, repeats: bool = True):
@@ -222,21 +240,13 @@ class TemporalClouds:
         ox, oy = offset
         if not (0 <= ox < r and 0 <= oy < r):
             raise ValueError(f"TemporalClouds.resolve: offset must lie in [0, {r})², got {offset!r}")
-        low = low_size(size, r)
-        for name, tex in (("low_color", low_color), ("low_distance", low_distance)):
-            if tuple(tex.size) != low:
-                raise ValueError(f"TemporalClouds.resolve: {name} must be {low[0]}x{low[1]} (size {size} / {r}), "
-                                 f"got {tex.size[0]}x{tex.size[1]}")
-        if depth is not None and tuple(depth.size) != size:
-            raise ValueError(f"TemporalClouds.resolve: depth must be {size[0]}x{size[1]}, got {depth.size}")
-        if low_depth is not None and tuple(low_depth.size) != low:
-            raise ValueError(f"TemporalClouds.resolve: low_depth must be {low[0]}x{low[1]}, got {low_depth.size}")
+        textures = (low_color, low_distance, depth, low_depth, onto, onto_distance)
+        if self._checked is None or self._checked[0] != (size, r) or not all(map(is_, self._checked[1], textures)):
+            self._check_sizes(size, r, *textures)          # the textures a frame passes are checked when new
+            self._checked = ((size, r), textures)
         if not 0.0 <= history_clamp <= 1.0 or not motion_limit > 0.0:
             raise ValueError(f"TemporalClouds.resolve: history_clamp must be in [0, 1] and motion_limit > 0, "
                              f"got {history_clamp!r}, {motion_limit!r}")
-        for name, tex in (("onto", onto), ("onto_distance", onto_distance)):
-            if tex is not None and tuple(tex.size) != size:
-                raise ValueError(f"TemporalClouds.resolve: {name} must be {size[0]}x{size[1]}, got {tex.size}")
         if onto_distance is not None and onto is None:
             raise ValueError("TemporalClouds.resolve: onto_distance needs onto (the colour it composites with)")
         if self._key != (size, r):

@@ -27,13 +27,19 @@ def bind_volume(program, sim, sampler, sun: Sun | None, octaves=DEFAULT_OCTAVES,
     "cloud_ground" buffer (:mod:`atmos.plugins.clouds.light.ground`)); returns t. Call :func:`unbind_volume` when the
     draw is done."""
     a, b, t = sim.view()
-    shading = "transmittance" in a
+    ta, tb = a.textures, b.textures                        # the sets' own dicts (their names are checked below)
+    shading = "transmittance" in ta
     light = "transmittance" if shading else "density"      # without shading: a placeholder, unread
-    field = DIFFUSION in a and DIFFUSION in b
+    field = DIFFUSION in ta and DIFFUSION in tb
     spread = DIFFUSION if field else COLUMNS               # without a field: a placeholder, unread
-    bind_textures(program, sampler=sampler, density_a=a["density"], density_b=b["density"], trans_a=a[light],
-                  trans_b=b[light], columns_a=a[COLUMNS], columns_b=b[COLUMNS], diffusion_a=a[spread],
-                  diffusion_b=b[spread])
+    try:
+        textures = dict(density_a=ta["density"], density_b=tb["density"], trans_a=ta[light], trans_b=tb[light],
+                        columns_a=ta[COLUMNS], columns_b=tb[COLUMNS], diffusion_a=ta[spread], diffusion_b=tb[spread])
+    except KeyError:
+        for s in (a, b):
+            s["density"], s[light], s[COLUMNS]             # the error that names what the set lacks
+        raise
+    bind_textures(program, textures, sampler=sampler)
     bind_ground(program, ground_light)
     write_light(program, light_uniforms(sim.settings, sun, octaves, diffusion if field else 0.0, layer,
                                         None if ground is None else ground.albedo, span),

@@ -9,6 +9,7 @@ holds the cells ``x in [gi * gx, min((gi + 1) * gx, nx))`` and likewise z, all h
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -24,10 +25,12 @@ class CloudLayout:
     group: tuple
     pad: float = 0.0
 
-    @property
+    @cached_property
     def lo(self) -> np.ndarray:
-        """World corner of the layer's cell (0, 0, 0) face."""
-        return np.array([self.origin_xz[0] * self.cell[0], self.base, self.origin_xz[1] * self.cell[2]])
+        """World corner of the layer's cell (0, 0, 0) face (read-only: worked out once)."""
+        lo = np.array([self.origin_xz[0] * self.cell[0], self.base, self.origin_xz[1] * self.cell[2]])
+        lo.flags.writeable = False
+        return lo
 
     @property
     def heights(self) -> tuple[float, float]:
@@ -35,9 +38,12 @@ class CloudLayout:
         (``Sun.color_at``, :func:`atmos.plugins.clouds.volume.light.sun_colors`)."""
         return float(self.base), float(self.base + self.shape[1] * self.cell[1])
 
-    @property
+    @cached_property
     def hi(self) -> np.ndarray:
-        return self.lo + np.asarray(self.shape, float) * np.asarray(self.cell, float)
+        """World corner of the layer's far top face (read-only: worked out once)."""
+        hi = self.lo + np.asarray(self.shape, float) * np.asarray(self.cell, float)
+        hi.flags.writeable = False
+        return hi
 
     @property
     def grid(self) -> tuple[int, int]:

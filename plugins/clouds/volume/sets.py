@@ -63,7 +63,17 @@ class CloudSets:
         return np.maximum(shifted_max(self.max_a, self.a_shift, self.settings.group_size), self.max_b)
 
     def layout(self, base_altitude: float | None = None, cell_size=None, pad: float = 0.0) -> CloudLayout:
-        """Where the sets are drawn: B's placement (see :meth:`CloudSimulation.layout`)."""
+        """Where the sets are drawn: B's placement (see :meth:`CloudSimulation.layout`); the default one
+        worked out once per frame's sets."""
+        if base_altitude is None and cell_size is None and pad == 0.0:
+            try:
+                return self.__dict__["_layout"]
+            except KeyError:
+                layout = self.__dict__["_layout"] = self._layout_of(None, None, 0.0)
+                return layout
+        return self._layout_of(base_altitude, cell_size, pad)
+
+    def _layout_of(self, base_altitude, cell_size, pad: float) -> CloudLayout:
         s = self.settings
         cell = tuple(map(float, s.cell_size if cell_size is None else cell_size))
         base = float(s.base_altitude if base_altitude is None else base_altitude)

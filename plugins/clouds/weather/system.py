@@ -21,6 +21,7 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass
+from operator import itemgetter
 
 import numpy as np
 
@@ -64,7 +65,7 @@ def wind_field_at(field, lo, hi, x, z) -> np.ndarray:
 
 
 def _sorted_ellipsoids(world) -> list:
-    return sorted(world.get_component(Ellipsoid), key=lambda pair: pair[0])
+    return sorted(world.get_component(Ellipsoid), key=itemgetter(0))
 
 
 def _shrink(e: Ellipsoid, shrink_time: float) -> None:
