@@ -26,7 +26,9 @@ where a local medium writes (``media_writers``) and the aerial perspective reads
 cleared to 1); each local medium blends its (L, T) onto them as onto the colour (so they hold the local
 media composited), and the aerial perspective mixes the air with them along the ray in proportion
 (:func:`media_mix`, ``shaders/lib/media_mix.glsl``): exact for two homogeneous media, each alone as
-before.
+before. A local medium that writes every pixel when it runs says so in ``media_covers``; while it is the
+only one and runs, it creates the two targets and stores its (L, T) instead of blending them onto a
+clear (``LOCAL_MEDIA`` 2 in ``shaders/lib/media_image.glsl``), and the clear is culled.
 """
 from __future__ import annotations
 
@@ -74,6 +76,7 @@ class Composition:
     covers: dict = field(default_factory=dict)     # name -> () -> bool: the first writer writes every pixel
     media_writers: set = field(default_factory=set)
     media_readers: set = field(default_factory=set)
+    media_covers: dict = field(default_factory=dict)   # name -> () -> bool: that medium writes every pixel
 
     @property
     def distance(self) -> bool:
@@ -89,6 +92,24 @@ class Composition:
     def media(self) -> bool:
         """True when a local medium writes the media targets and a pass reads them."""
         return bool(self.media_writers) and bool(self.media_readers)
+
+    @property
+    def media_first(self) -> str | None:
+        """The local medium that creates the media targets (storing its own (L, T), nothing cleared): the
+        only one that writes them, when it writes every pixel and runs this frame; else None."""
+        if not self.media or len(self.media_writers) != 1:
+            return None
+        (name,) = self.media_writers
+        runs = self.media_covers.get(name)
+        return name if runs is not None and runs() else None
+
+
+def media_targets(size) -> tuple:
+    """(name, TextureDesc, clear value) of the media targets at ``size``: ``"media_light"`` (RGBA float32,
+    clear 0) and ``"media_transmittance"`` (R float32, clear 1)."""
+    size = tuple(size)
+    return ((MEDIA_LIGHT, TextureDesc(size, components=4, dtype="f4", filter="nearest", storage=True), 0.0),
+            (MEDIA_TRANSMITTANCE, TextureDesc(size, components=1, dtype="f4", filter="nearest", storage=True), 1.0))
 
 
 class CompositionClear(RenderPass):
@@ -125,13 +146,12 @@ class ClearDistance(CompositionClear):
 
 class ClearMedia(CompositionClear):
     """Pass "media_clear": ``"media_light"`` (RGBA float32, cleared to 0) and ``"media_transmittance"``
-    (R float32, cleared to 1) when the Composition's media are written and read."""
+    (R float32, cleared to 1) when the Composition's media are written and read, and no one medium
+    makes them (:attr:`Composition.media_first`)."""
     name = "media_clear"
 
     def __init__(self, comp: Composition, gpu):
-        super().__init__(gpu, lambda: comp.media, lambda size: (
-            (MEDIA_LIGHT, TextureDesc(size, components=4, dtype="f4", filter="nearest", storage=True), 0.0),
-            (MEDIA_TRANSMITTANCE, TextureDesc(size, components=1, dtype="f4", filter="nearest", storage=True), 1.0)))
+        super().__init__(gpu, lambda: comp.media and comp.media_first is None, media_targets)
 
 
 def composition(app) -> Composition:

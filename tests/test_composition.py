@@ -249,3 +249,25 @@ def test_media_mix_reduces_to_each_medium_alone_and_never_counts_light_twice(rng
     thin = media_mix(c_a * 1e-6, np.full(n, 1 - 1e-6), c_b * 1e-6, np.full(n, 1 - 1e-6))
     assert np.allclose(thin, (c_a + c_b) * 1e-6, rtol=1e-5)
     assert np.isfinite(media_mix(l_a, np.zeros(n), l_b, np.zeros(n))).all()
+
+
+def test_the_only_local_medium_that_covers_every_pixel_makes_the_media_targets():
+    """Composition.media_first: the media targets are made by the one local medium that writes every
+    pixel while it runs (no clear); with a second local medium, none reading them, or the first not
+    running this frame, nobody makes them and media_clear clears them for blending."""
+    from atmos.composition import Composition
+    runs = {"fog": True}
+    comp = Composition(media_writers={"fog"}, media_readers={"aerial_perspective"},
+                       media_covers={"fog": lambda: runs["fog"]})
+    assert comp.media and comp.media_first == "fog"
+    runs["fog"] = False
+    assert comp.media_first is None
+    runs["fog"] = True
+    comp.media_writers.add("volumetric_fog")
+    assert comp.media_first is None, "two local media: both blend onto the cleared targets"
+    comp.media_writers.discard("volumetric_fog")
+    comp.media_readers.clear()
+    assert not comp.media and comp.media_first is None
+    comp.media_readers.add("aerial_perspective")
+    comp.media_covers.clear()
+    assert comp.media_first is None, "a medium that does not say it covers every pixel blends"

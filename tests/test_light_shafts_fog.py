@@ -97,7 +97,9 @@ def aerial_frame(gpu, density, shafts: bool, aerial: bool = True, fog_color=None
         app.run_frames(1)
         kept = app.graph.compile().kept
         assert ("aerial_perspective" in kept) == aerial and ("light_shafts" in kept) == shafts
-        assert ("media_clear" in kept) == (aerial and fog_color is not None)
+        media = app.graph.compile().resources
+        assert "media_clear" not in kept and ("media_light" in media) == (aerial and fog_color is not None), \
+            "the media targets with the fog and the air, made by the fog (the only local medium)"
         return app.read_linear()[..., :3].astype(np.float64)
     finally:
         app.close()

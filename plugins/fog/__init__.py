@@ -34,14 +34,16 @@ class FogPlugin(Plugin):
     def __init__(self, settings: FogSettings | None = None, **fields):
         super().__init__(settings, **fields)
         self.fog_pass: FogPass | None = None
-        self.composition = None
+        self.composition = self.gpu = None
         self._sky = None
         self._table = None                  # (SceneView, its sky table): held, never a reused id
 
     def build(self, app) -> None:
+        self.gpu = app.gpu
         self.composition = composition(app)
         self.composition.readers.add("fog")       # clouds fogged by their own distance
         self.composition.media_writers.add("fog")  # a local medium the aerial perspective mixes with
+        self.composition.media_covers["fog"] = lambda: True     # its dispatch writes every pixel, every frame
         self.fog_pass = FogPass(self)
         app.graph.add_pass(self.fog_pass)
         app.insert_resource(FogMedium(self))
@@ -69,6 +71,7 @@ class FogPlugin(Plugin):
         if self.composition is not None:
             self.composition.readers.discard("fog")
             self.composition.media_writers.discard("fog")
+            self.composition.media_covers.pop("fog", None)
         if self.fog_pass is not None:
             self.fog_pass.release()
 

@@ -6,7 +6,7 @@ import math
 import numpy as np
 
 from atmos.lighting import sun_and_day
-from atmos.composition import CLOUD_DISTANCE, MEDIA_LIGHT, MEDIA_TRANSMITTANCE
+from atmos.composition import CLOUD_DISTANCE, MEDIA_LIGHT, MEDIA_TRANSMITTANCE, media_targets
 from atmos.graph import PassBuilder, PassContext, RenderPass, work_groups
 from atmos.graph.frame import BLEND_TRANSMITTANCE, blend
 from atmos.plugins.fog.noise import NoiseVolumes, octave_key
@@ -20,10 +20,10 @@ COMPUTE = "fog/fog.comp"
 VERTEX = "lib/fullscreen.vert"
 
 
-def fog_program(gpu, settings, from_depth: bool, clouds: bool = False, media: bool = False):
+def fog_program(gpu, settings, from_depth: bool, clouds: bool = False, media: int = 0):
     """The fog program for ``settings`` from ``gpu``'s cache (one variant per mode, octave count,
     noise kind, colour source, whether clouds give their own distance and whether it also writes the
-    media targets, :mod:`atmos.composition`)."""
+    media targets, :mod:`atmos.composition`: 1 blended onto them, 2 stored as their first writer)."""
     defines = {"FOG_MODE": MODES[settings.mode], "FOG_OCTAVES": settings.octaves,
                "FOG_PROCEDURAL": int(settings.noise == "procedural"), "FOG_FROM_DEPTH": int(from_depth),
                "FOG_CLOUDS": int(clouds), "FOG_SKY_COLOR": int(settings.color_from == "sky"),
@@ -88,17 +88,24 @@ class FogPass(RenderPass):
         self.plugin = plugin
         self.gpu = None
         self.volumes: NoiseVolumes | None = None
+        self.makes_media = False               # it creates the media targets (setup)
 
     def setup_key(self) -> tuple:
-        return (self.plugin.composition.distance, self.plugin.composition.media)
+        comp = self.plugin.composition
+        return (comp.distance, comp.media, comp.media_first == self.name, self.plugin.gpu.size)
 
     def setup(self, builder: PassBuilder) -> None:
+        comp = self.plugin.composition
         builder.read(DEPTH)
         builder.read(COLOR, access="storage")          # composites onto it in place
         builder.write(COLOR, access="storage")
-        if self.plugin.composition.distance:   # the clouds' own distance (atmos.composition)
+        if comp.distance:                      # the clouds' own distance (atmos.composition)
             builder.read(CLOUD_DISTANCE)
-        if self.plugin.composition.media:      # the aerial perspective mixes the air with it
+        self.makes_media = comp.media and comp.media_first == self.name
+        if self.makes_media:                   # the only local medium: it makes the media targets
+            for name, desc, _ in media_targets(self.plugin.gpu.size):
+                builder.create(name, desc, access="storage")
+        elif comp.media:                       # the aerial perspective mixes the air with it
             for name in (MEDIA_LIGHT, MEDIA_TRANSMITTANCE):
                 builder.read(name, access="storage")
                 builder.write(name, access="storage")
@@ -107,8 +114,9 @@ class FogPass(RenderPass):
         self.gpu = gpu
         self._sync(self.plugin.settings)
 
-    def _sync(self, settings, clouds: bool = False, media: bool = False):
-        """Compile the variant and (re)make noise volumes when the settings need other ones."""
+    def _sync(self, settings, clouds: bool = False, media: int = 0):
+        """Compile the variant and (re)make noise volumes when the settings need other ones (``media``:
+        0 none, 1 blended onto the media targets, 2 stored into them)."""
         prog = fog_program(self.gpu, settings, from_depth=True, clouds=clouds, media=media)
         wants = settings.heterogeneous and settings.noise == "texture"
         if self.volumes is not None and (not wants or not self.volumes.matches(settings)):
@@ -122,7 +130,7 @@ class FogPass(RenderPass):
         view = frame.view
         settings = self.plugin.settings
         clouds, media = frame.declares(CLOUD_DISTANCE), frame.declares(MEDIA_LIGHT)
-        prog = self._sync(settings, clouds, media)
+        prog = self._sync(settings, clouds, 2 if self.makes_media else int(media))
         textures = {"scene_depth": DEPTH}
         if clouds:
             textures["cloud_distance"] = CLOUD_DISTANCE

@@ -161,7 +161,7 @@ class FarFieldLayer:
         if view is self._prepared:
             return
         self._prepared = view
-        params = self.settings
+        params = self.plugin.settings
         sun_dir = tuple(map(float, unit_direction(view.sun)))     # light_uniforms' sun_dir
         if self.octaves.needs_bake(params, sun_dir, REBAKE_TOLERANCE):
             self.octaves.bake(params, sun_dir, octave_frequencies(params.base_frequency), rotations(), CHANNEL_STEPS)
@@ -240,7 +240,7 @@ class FarFieldLayer:
         transitions per cell / the cell size; :func:`.cover.matched_tile_size`; :meth:`_step_measure`),
         followed with the time constant TILE_TIME (the pattern zooms slowly, never jumps; a first measure
         is taken at once)."""
-        params = self.settings
+        params = self.plugin.settings
         dt = time - self._tile_time if self._tile_time is not None else 0.0
         self._tile_time = time
         if params.tile_size is not None:
@@ -330,7 +330,7 @@ class FarFieldLayer:
 
     def use(self, program, view, sim: CloudSets) -> None:
         """Bind field.glsl's textures and cover and set its uniforms."""
-        params = self.settings
+        params = self.plugin.settings
         self.octaves.bind(program)
         bind_buffers(program, Cover=self.cover)
         if self.profile is not None:
@@ -345,7 +345,7 @@ class FarFieldLayer:
 
     def _field_uniforms(self, view, sim: CloudSets) -> dict:
         """field.glsl's uniforms for ``view`` (what :meth:`use` writes)."""
-        params = self.settings
+        params = self.plugin.settings
         time = float(view.time) if params.animate else 0.0
         layout = sim.layout()
         camera = np.asarray(view.camera.position, np.float64)
@@ -363,7 +363,7 @@ class FarFieldLayer:
 
     def _rank_table(self) -> tuple:
         """(span, first level) of :attr:`ranks`, baked anew when the texture setting changed."""
-        params = self.settings
+        params = self.plugin.settings
         key = (int(params.base_frequency), int(params.seed), int(params.size))
         table, span, first = level_ranks(*key)
         if key != self._ranks_for:
