@@ -319,3 +319,46 @@ def test_the_light_shafts_march_is_a_compute_dispatch_into_a_storage_target(gpu,
     assert runs[1][1] == runs[0][1] + (1 if froxels is None else 0)
     target = "light_shafts_march  transient" if froxels is None else "light_shafts_volume  transient 40x24x33"
     assert target in dump and "storage" in dump, dump
+
+
+def test_pending_bits_follow_writes_and_barriers_on_random_sequences(gpu, ctx, rng):
+    """Hazards' bookkeeping (each issued bit touches only the entries that still hold it) against a
+    plain model: a storage write makes every use of its kind pending, a barrier clears its bits from
+    every object, a use asks for exactly the pending bits its kind of use needs; objects released and
+    dropped leave nothing behind."""
+    hazards = Hazards(ctx)
+    objects = [ctx.buffer(reserve=16) for _ in range(4)] + [ctx.texture((2, 2), 1, dtype="f4") for _ in range(4)]
+    kinds = ["buffer"] * 4 + ["texture"] * 4
+    every = {kind: {bit for bit in (1 << i for i in range(16)) if bit & sum(
+        barrier_bit(kind, a) for a in ("sampled", "storage", "attachment", "copy", "indirect", "uniform", "vertex"))}
+        for kind in ("buffer", "texture")}
+    model = [set() for _ in objects]
+    accesses = ("sampled", "storage", "attachment", "copy", "indirect", "uniform", "vertex")
+    for _ in range(300):
+        i = int(rng.integers(len(objects)))
+        action = rng.integers(3)
+        if action == 0:
+            hazards.wrote_storage([objects[i]])
+            model[i] = set(every[kinds[i]])
+        elif action == 1:
+            access = accesses[int(rng.integers(len(accesses)))]
+            bit = barrier_bit(kinds[i], access)
+            want = sum(b for b in model[i] if b & bit)
+            assert hazards.use(reads=[(objects[i], access)]) == want
+            for m in model:
+                m -= {b for b in set(m) if b & want}
+        else:
+            bits = int(sum(1 << int(b) for b in rng.choice(14, size=int(rng.integers(1, 4)), replace=False)))
+            hazards.issue(bits)
+            for m in model:
+                m -= {b for b in set(m) if b & bits}
+        for obj, m in zip(objects, model):
+            assert hazards.pending(obj) == bit_names(sum(m)), (hazards.pending(obj), bit_names(sum(m)))
+    for obj in objects:
+        obj.release()
+    del objects, obj
+    import gc
+    gc.collect()
+    hazards._purge_at = 0
+    hazards.issue(moderngl.TEXTURE_FETCH_BARRIER_BIT)
+    assert not hazards._dirty and not any(hazards._pending.values()), "dead objects leave no entries"

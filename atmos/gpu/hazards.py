@@ -51,6 +51,7 @@ _ALL = {kind: sum({bits for (k, _), bits in _BITS.items() if k == kind}) for kin
 
 BIT_NAMES = {bit: name.removesuffix("_BARRIER_BIT").lower() for name in dir(moderngl)
              if name.endswith("_BARRIER_BIT") and (bit := getattr(moderngl, name))}
+_KIND_BITS = {kind: tuple(bit for bit in sorted(BIT_NAMES) if _ALL[kind] & bit) for kind in _ALL}
 _BIT_ORDER = sorted(BIT_NAMES.items())
 _KINDS = {moderngl.Buffer: "buffer", **{cls: "texture" for cls in
           (moderngl.Texture, moderngl.Texture3D, moderngl.TextureArray, moderngl.TextureCube)}}
@@ -106,6 +107,16 @@ class Hazards:
         self._dirty: dict[int, list] = {}     # id(obj) -> [weakref, kind, bits still to issue]
         self._staged: dict[int, tuple] = {}   # bound for a storage write by the coming dispatch: id -> (ref, kind)
         self._need = 0                        # bits the binds of the coming work asked for (issued by flush)
+        self._pending = {bit: {} for bit in BIT_NAMES}   # bit -> {id: None} whose entry may still hold it (dicts:
+        # filled by subscript, no method call per write)
+        self._sets = {kind: tuple(self._pending[bit] for bit in bits) for kind, bits in _KIND_BITS.items()}
+        self._purge_at = 64                   # entries in _dirty past which dead ones are dropped
+
+    def mark(self, key: int, obj, kind: str) -> None:
+        """``obj`` (id ``key``, of ``kind``) was just written by storage: every use's barrier pending."""
+        self._dirty[key] = [weakref.ref(obj), kind, _ALL[kind]]
+        for keys in self._sets[kind]:
+            keys[key] = None
 
     def stage(self, obj) -> None:
         """``obj`` is bound for a storage write by the next :meth:`commit`-ed work (a bind does this)."""
@@ -119,10 +130,10 @@ class Hazards:
 
     def commit(self) -> None:
         """The work just recorded ran: what was staged for writing is now dirty."""
-        staged, dirty = self._staged, self._dirty
+        staged, mark = self._staged, self.mark
         for key in staged:
             obj, kind = staged[key]
-            dirty[key] = [weakref.ref(obj), kind, _ALL[kind]]
+            mark(key, obj, kind)
         self._staged = {}
 
     def use(self, reads=(), writes=()) -> int:
@@ -159,15 +170,18 @@ class Hazards:
         """The work just recorded wrote ``writes``; those with ``storage`` access are now dirty."""
         for obj, kind, access in _uses(writes, "storage", "storage"):
             if access == "storage":
-                self._dirty[id(obj)] = [weakref.ref(obj), kind, _ALL[kind]]
+                self.mark(id(obj), obj, kind)
 
     def wrote_storage(self, objects) -> None:
         """The work just recorded made storage writes to ``objects`` (textures, buffers): now dirty."""
-        dirty = self._dirty
+        dirty, sets = self._dirty, self._sets
         for obj in objects:
             kind = _KINDS[type(obj)] if type(obj) in _KINDS else kind_of(obj)
             if kind is not None:
-                dirty[id(obj)] = [weakref.ref(obj), kind, _ALL[kind]]
+                key = id(obj)
+                dirty[key] = [weakref.ref(obj), kind, _ALL[kind]]     # mark, inlined
+                for keys in sets[kind]:
+                    keys[key] = None
 
     def issue(self, bits: int) -> None:
         """One glMemoryBarrier with ``bits``; every pending write is then visible to those uses. The one
@@ -176,14 +190,33 @@ class Hazards:
         self._need = 0
         self.barriers += 1
         self._issued[bits] += 1
-        dirty, keep = self._dirty, ~bits
-        for key in list(dirty):
-            entry = dirty[key]
-            left = entry[2] & keep
-            if left and entry[0]() is not None:
-                entry[2] = left
-            else:
-                del dirty[key]
+        dirty, pending, rest, dropped = self._dirty, self._pending, bits, None
+        while rest:                           # only the entries that still held an issued bit are touched
+            bit = rest & -rest
+            rest ^= bit
+            keys = pending[bit] if bit in pending else None
+            if not keys:
+                continue
+            for key in keys:
+                if key not in dirty:          # (an id reused by an object of the other kind, dropped since)
+                    continue
+                entry = dirty[key]
+                left = entry[2] & ~bit
+                if left and entry[0]() is not None:
+                    entry[2] = left
+                else:
+                    dropped = [key] if dropped is None else dropped + [key]
+            keys.clear()
+        if len(dirty) > self._purge_at:       # entries of dead objects whose bits are never issued
+            dropped = (dropped or []) + [k for k, e in dirty.items() if e[0]() is None]
+            self._purge_at = max(64, 2 * (len(dirty) - len(dropped)))
+        if dropped:
+            sets = self._sets
+            for key in dropped:
+                if key in dirty:
+                    for keys in sets[dirty.pop(key)[1]]:
+                        if key in keys:
+                            del keys[key]
 
     @property
     def bits_issued(self) -> dict[str, int]:
@@ -206,6 +239,8 @@ class Hazards:
             self.issue(need)
         else:
             self._dirty.clear()
+            for keys in self._pending.values():
+                keys.clear()
         return need
 
     def pending(self, obj) -> list[str]:
@@ -247,10 +282,12 @@ def dispatch(program, *groups: int) -> None:
     program.run(*groups)
     staged = hazards._staged
     if staged:                                   # Hazards.commit, inlined (a dispatch without storage writes skips it)
-        dirty = hazards._dirty
+        dirty, sets = hazards._dirty, hazards._sets
         for key in staged:
             obj, kind = staged[key]
-            dirty[key] = [weakref.ref(obj), kind, _ALL[kind]]
+            dirty[key] = [weakref.ref(obj), kind, _ALL[kind]]     # Hazards.mark, inlined
+            for keys in sets[kind]:
+                keys[key] = None
         hazards._staged = {}
 
 
@@ -267,10 +304,12 @@ def dispatch_indirect(program, args, offset: int = 0) -> None:
     program.run_indirect(args, offset)
     staged = hazards._staged
     if staged:                                   # Hazards.commit, inlined
-        dirty = hazards._dirty
+        dirty, sets = hazards._dirty, hazards._sets
         for key in staged:
             obj, kind = staged[key]
-            dirty[key] = [weakref.ref(obj), kind, _ALL[kind]]
+            dirty[key] = [weakref.ref(obj), kind, _ALL[kind]]     # Hazards.mark, inlined
+            for keys in sets[kind]:
+                keys[key] = None
         hazards._staged = {}
 
 
