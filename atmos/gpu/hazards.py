@@ -109,14 +109,14 @@ class Hazards:
         self._need = 0                        # bits the binds of the coming work asked for (issued by flush)
         self._pending = {bit: {} for bit in BIT_NAMES}   # bit -> {id: None} whose entry may still hold it (dicts:
         # filled by subscript, no method call per write)
-        self._sets = {kind: tuple(self._pending[bit] for bit in bits) for kind, bits in _KIND_BITS.items()}
         self._purge_at = 64                   # entries in _dirty past which dead ones are dropped
 
     def mark(self, key: int, obj, kind: str) -> None:
         """``obj`` (id ``key``, of ``kind``) was just written by storage: every use's barrier pending."""
         self._dirty[key] = [weakref.ref(obj), kind, _ALL[kind]]
-        for keys in self._sets[kind]:
-            keys[key] = None
+        pending = self._pending
+        for bit in _KIND_BITS[kind]:
+            pending[bit][key] = None
 
     def stage(self, obj) -> None:
         """``obj`` is bound for a storage write by the next :meth:`commit`-ed work (a bind does this)."""
@@ -174,14 +174,14 @@ class Hazards:
 
     def wrote_storage(self, objects) -> None:
         """The work just recorded made storage writes to ``objects`` (textures, buffers): now dirty."""
-        dirty, sets = self._dirty, self._sets
+        dirty, pending = self._dirty, self._pending
         for obj in objects:
             kind = _KINDS[type(obj)] if type(obj) in _KINDS else kind_of(obj)
             if kind is not None:
                 key = id(obj)
                 dirty[key] = [weakref.ref(obj), kind, _ALL[kind]]     # mark, inlined
-                for keys in sets[kind]:
-                    keys[key] = None
+                for bit in _KIND_BITS[kind]:
+                    pending[bit][key] = None
 
     def issue(self, bits: int) -> None:
         """One glMemoryBarrier with ``bits``; every pending write is then visible to those uses. The one
@@ -206,15 +206,17 @@ class Hazards:
                     entry[2] = left
                 else:
                     dropped = [key] if dropped is None else dropped + [key]
-            keys.clear()
+            pending[bit] = {}                 # (a new dict: no method call)
         if len(dirty) > self._purge_at:       # entries of dead objects whose bits are never issued
             dropped = (dropped or []) + [k for k, e in dirty.items() if e[0]() is None]
             self._purge_at = max(64, 2 * (len(dirty) - len(dropped)))
         if dropped:
-            sets = self._sets
             for key in dropped:
                 if key in dirty:
-                    for keys in sets[dirty.pop(key)[1]]:
+                    kind = dirty[key][1]
+                    del dirty[key]
+                    for bit in _KIND_BITS[kind]:
+                        keys = pending[bit]
                         if key in keys:
                             del keys[key]
 
@@ -282,12 +284,12 @@ def dispatch(program, *groups: int) -> None:
     program.run(*groups)
     staged = hazards._staged
     if staged:                                   # Hazards.commit, inlined (a dispatch without storage writes skips it)
-        dirty, sets = hazards._dirty, hazards._sets
+        dirty, pending = hazards._dirty, hazards._pending
         for key in staged:
             obj, kind = staged[key]
             dirty[key] = [weakref.ref(obj), kind, _ALL[kind]]     # Hazards.mark, inlined
-            for keys in sets[kind]:
-                keys[key] = None
+            for bit in _KIND_BITS[kind]:
+                pending[bit][key] = None
         hazards._staged = {}
 
 
@@ -304,12 +306,12 @@ def dispatch_indirect(program, args, offset: int = 0) -> None:
     program.run_indirect(args, offset)
     staged = hazards._staged
     if staged:                                   # Hazards.commit, inlined
-        dirty, sets = hazards._dirty, hazards._sets
+        dirty, pending = hazards._dirty, hazards._pending
         for key in staged:
             obj, kind = staged[key]
             dirty[key] = [weakref.ref(obj), kind, _ALL[kind]]     # Hazards.mark, inlined
-            for keys in sets[kind]:
-                keys[key] = None
+            for bit in _KIND_BITS[kind]:
+                pending[bit][key] = None
         hazards._staged = {}
 
 
