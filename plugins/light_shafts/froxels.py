@@ -43,8 +43,8 @@ class FroxelShafts:
         if irradiance is None:
             return
         far_field = clouds and frame.declares(FAR_FIELD)
-        fill, apply = (self.medium.program(far_field, fog, aerial, f"light_shafts/{name}.comp")
-                       for name in ("froxels", "froxel_apply"))
+        fill = self.medium.program(far_field, fog, aerial, "light_shafts/froxels.comp")
+        apply = self.medium.program(far_field, fog, aerial, "light_shafts/froxel_apply.comp")
         knee = froxel_knee(settings.max_distance)
         self.medium.set_medium(frame, fill, settings, clouds, irradiance, fog, aerial)
         write_uniforms(fill, froxel_knee=knee, froxel_jittered=int(self.history.jittered(frame.view.clock.frame,

@@ -83,7 +83,9 @@ def sky_ambient(sun_dir, altitude: float, settings: AtmosphereSettings, night=(0
     """(3,) ``Sun.ambient``: the sky's irradiance / π (interpolated between nodes) plus ``night`` × the
     pass's night weight."""
     s = ref.unit(sun_dir)
-    total = sum(w * _ambient_node(settings, _clamped(i), j) for w, i, j in _nodes(s[1], altitude))
+    total = 0.0
+    for w, i, j in _nodes(s[1], altitude):
+        total = total + w * _ambient_node(settings, _clamped(i), j)
     return total + np.asarray(night, np.float64) * (1.0 - float(daylight(s[1])))
 
 

@@ -115,7 +115,10 @@ class CloudFarFieldPlugin(Plugin):
         """Whether a cloud renderer marches the far field itself this frame (a registered renderer's
         ``marches_far_field()``, e.g. RaymarchCloudsPlugin with ``far_field``): the 2D pass then
         declares nothing and is culled; the layer stays imported for the shadows and the march."""
-        return any(m.marches_far_field() for m in getattr(self, "marchers", ()))
+        for marcher in getattr(self, "marchers", ()):
+            if marcher.marches_far_field():
+                return True
+        return False
 
     def finish(self, app) -> None:
         """Run before every other translucent pass (the cloud renderers draw nearer clouds over it)."""

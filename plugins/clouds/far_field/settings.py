@@ -1,11 +1,14 @@
 """CloudFarFieldSettings: the far field's look, checked as a whole before any of it is used (all live)."""
 from __future__ import annotations
 
+from operator import attrgetter
+
 from dataclasses import dataclass
 
 from atmos.checks import CheckedSettings, bool_field, int_field, num_field, vec_field
 
 TEXTURE_SETTINGS = ("size", "base_frequency", "seed", "light_step")   # changing one re-bakes the octaves
+_TEXTURE_KEY = attrgetter(*TEXTURE_SETTINGS)
 
 
 @dataclass(frozen=True)
@@ -46,4 +49,4 @@ class CloudFarFieldSettings(CheckedSettings):
 
     def texture_key(self) -> tuple:
         """The settings the baked octave textures depend on (what ``OctaveTextures`` asks of its settings)."""
-        return tuple(getattr(self, name) for name in TEXTURE_SETTINGS)
+        return _TEXTURE_KEY(self)

@@ -263,12 +263,12 @@ class RaymarchPass(RenderPass):
         maps = sim.maps_of(sim.view()[0])
         skip_cells = (float(layout.group[0]), float(maps.band_height), float(layout.group[1]))
         grid = (layout.grid[0], -(-layout.shape[1] // maps.band_height), layout.grid[1])
-        return {"layer_min": tuple(float(v) for v in layout.lo), "layer_max": tuple(float(v) for v in layout.hi),
-                "cell_size": tuple(float(c) for c in cell), "sigma_t": self.plugin.sigma_t(sim),
+        return {"layer_min": tuple(layout.lo.tolist()), "layer_max": tuple(layout.hi.tolist()),
+                "cell_size": tuple(cell.tolist()), "sigma_t": self.plugin.sigma_t(sim),
                 "steps": s.steps, "step_base": float(s.step * cell.min()), "step_growth": s.step_growth,
                 "min_transmittance": s.min_transmittance, "skipping": int(s.empty_space_skipping),
                 "skip_cells": skip_cells, "max_skips": int(sum(grid)) + 3, "factor": s.resolution,
-                "frame_size": tuple(int(v) for v in view.size), "jittered": int(s.jitter), "sun_growth": SUN_GROWTH,
+                "frame_size": tuple(map(int, view.size)), "jittered": int(s.jitter), "sun_growth": SUN_GROWTH,
                 "pixel_angle": pixel_angle(view), **self._type_uniforms(s)}
 
     def _type_uniforms(self, s: RaymarchCloudSettings) -> dict:

@@ -156,7 +156,7 @@ def detects_change(still_frames: int, r: int, repeats: bool = True) -> bool:
 
 def camera_state(camera, aspect: float) -> tuple:
     """What a camera's image depends on: two frames with the same state need no reprojection."""
-    return (float(aspect), tuple(float(c) for c in camera.position), float(camera.yaw), float(camera.pitch),
+    return (float(aspect), tuple(map(float, camera.position)), float(camera.yaw), float(camera.pitch),
             float(camera.roll), float(camera.fov_y), float(camera.near), float(camera.far))
 
 
