@@ -729,3 +729,27 @@ def test_the_sun_by_height_stays_finite_at_the_extremes():
             assert np.isfinite(sources).all() and sources.min() >= 0.0
             if elevation <= -30.0:
                 assert colors.max() == 0.0, "a sun 30 deg down has set for every layer"
+
+
+def test_a_sun_crossing_a_light_table_node_finds_it_baked_ahead(gpu, ctx):
+    """The sun's ambient and the fog's horizon rings interpolate nodes 0.5° of sun elevation apart, each
+    3-5 ms of float64 marching: the nodes one step from those in use are baked ahead, one a frame, so
+    the sun rising through four nodes (and the fog's rings with it) never bakes more than one node in a
+    frame once under way; the values are the nodes' own (as baked when first used)."""
+    from atmos.plugins.sky import sun_light
+    app = physical_app(gpu, FogPlugin(mode="exp", density=1e-4, color_from="sky"), sun=sun_at(10.0))
+    try:
+        app.run_frames(4, 1 / 30)
+        sun, grew = app.resource(Sun), []
+        for k in range(1, 41):                       # 10° -> 12°: four node crossings, 10 frames apart
+            sun.direction = sun_at(10.0 + 0.05 * k)
+            before = len(sun_light._NODES)
+            app.update(1 / 30)
+            grew.append(len(sun_light._NODES) - before)
+        assert max(grew) <= 1, f"nodes baked per frame {grew}: a crossing baked several at once"
+        assert sum(grew) >= 4, "the crossings' nodes were baked (ahead)"
+        s = next(p for p in app.plugins if isinstance(p, SkyPlugin)).settings.atmosphere
+        direct = sun_light._bake_ambient(s, 24, 0)
+        assert np.array_equal(sun_light._ambient_node(s, 24, 0), direct)
+    finally:
+        app.close()

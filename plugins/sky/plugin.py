@@ -170,6 +170,7 @@ class SkyPlugin(Plugin):
         sun.color = tuple(sun_light.sun_color(sun.direction, altitude, s.atmosphere))
         sun.ambient = tuple(sun_light.sky_ambient(sun.direction, altitude, s.atmosphere, s.night))
         sun.color_by_altitude = self.sun_color_at
+        sun_light.bake_ahead()              # one node next to those in use: no frame bakes several
 
     def sun_color_at(self, direction, altitudes) -> np.ndarray:
         """``Sun.color_by_altitude`` of the physical sky: (n, 3) the sun's colour at ``altitudes`` (n,) m."""

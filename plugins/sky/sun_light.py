@@ -13,12 +13,15 @@ writes, for the Sun's direction and the camera's altitude:
 The ambient and the horizon table depend only on the sun's elevation and the camera's altitude (the
 sky is symmetric about the sun's vertical): both are computed at nodes ``ELEVATION_STEP`` apart in
 sun elevation and at altitudes ``(k · ALTITUDE_ROOT_STEP)²`` m, each node once per settings, and
-interpolated bilinearly between them.
+interpolated bilinearly between them. A node takes 3–5 ms of float64 marching: the nodes one elevation
+step from those a frame used are baked ahead, at most one a frame (:func:`bake_ahead`, called by the sky
+plugin's system), so a sun crossing a node finds it ready instead of baking five in one frame.
 """
 from __future__ import annotations
 
 import math
 from functools import lru_cache
+from typing import Callable
 
 import numpy as np
 
@@ -36,18 +39,72 @@ def _sun_at(elevation_deg: float) -> np.ndarray:
     return np.array([math.cos(e), math.sin(e), 0.0])
 
 
-@lru_cache(maxsize=4096)
-def _ambient_node(settings: AtmosphereSettings, i_elevation: int, k_altitude: int) -> np.ndarray:
+MAX_NODES = 8192                # nodes kept (the oldest dropped first)
+_NODES: dict = {}               # (bake, id(settings), *args) -> (settings, node): held, never a reused id
+_USED: dict = {}                # keys used since the last bake_ahead -> their settings
+_SEEN: dict = {}                # keys whose neighbours were noted -> None
+_AHEAD: dict = {}               # keys of neighbours to bake ahead -> their settings (newest last)
+
+
+def _node(bake: Callable, settings, *args) -> np.ndarray:
+    """``bake(settings, *args)``, baked on first use and kept (MAX_NODES; keyed by the settings' identity:
+    hashed in C, a settings object being replaced on any change)."""
+    key = (bake, id(settings), *args)
+    _USED[key] = settings
+    entry = _NODES[key] if key in _NODES else None
+    if entry is None or entry[0] is not settings:
+        entry = _NODES[key] = (settings, bake(settings, *args))
+        if len(_NODES) > MAX_NODES:
+            del _NODES[next(iter(_NODES))]
+    return entry[1]
+
+
+def bake_ahead(nodes: int = 1) -> int:
+    """Bake up to ``nodes`` of the nodes one elevation step from those used since the last call (the
+    newest noted first): a frame's spare work, so that a sun crossing a node finds it baked. Returns how
+    many were baked."""
+    for key, settings in _USED.items():
+        if key in _SEEN:
+            continue
+        _SEEN[key] = None
+        bake, sid, i, *rest = key
+        for n in (_clamped(i - 1), _clamped(i + 1)):
+            ahead = (bake, sid, n, *rest)
+            if ahead not in _NODES or _NODES[ahead][0] is not settings:
+                _AHEAD[ahead] = settings
+    _USED.clear()
+    if len(_SEEN) > MAX_NODES:
+        _SEEN.clear()
+    baked = 0
+    while _AHEAD and baked < nodes:
+        key = next(reversed(_AHEAD))
+        settings = _AHEAD.pop(key)
+        if key not in _NODES or _NODES[key][0] is not settings:
+            _NODES[key] = (settings, key[0](settings, *key[2:]))     # baked, not used: no neighbours noted
+            baked += 1
+    while len(_AHEAD) > 64:            # noted long ago: the sun has moved on
+        del _AHEAD[next(iter(_AHEAD))]
+    return baked
+
+
+def _bake_ambient(settings: AtmosphereSettings, i_elevation: int, k_altitude: int) -> np.ndarray:
     return ref.ambient(_sun_at(i_elevation * ELEVATION_STEP), (k_altitude * ALTITUDE_ROOT_STEP) ** 2, settings)
 
 
-@lru_cache(maxsize=4096)
-def _horizon_node(settings: AtmosphereSettings, i_elevation: int, k_altitude: int, elevation: float) -> np.ndarray:
+def _ambient_node(settings: AtmosphereSettings, i_elevation: int, k_altitude: int) -> np.ndarray:
+    return _node(_bake_ambient, settings, i_elevation, k_altitude)
+
+
+def _bake_horizon(settings: AtmosphereSettings, i_elevation: int, k_altitude: int, elevation: float) -> np.ndarray:
     """(HORIZON_AZIMUTHS, 3) radiance at ``elevation`` rad above the horizon, azimuths 0..π from the sun."""
     a = np.linspace(0.0, math.pi, HORIZON_AZIMUTHS)
     c = math.cos(elevation)
     dirs = np.stack([np.cos(a) * c, np.full_like(a, math.sin(elevation)), np.sin(a) * c], axis=-1)
     return ref.sky_radiance(dirs, _sun_at(i_elevation * ELEVATION_STEP), (k_altitude * ALTITUDE_ROOT_STEP) ** 2, settings)
+
+
+def _horizon_node(settings: AtmosphereSettings, i_elevation: int, k_altitude: int, elevation: float) -> np.ndarray:
+    return _node(_bake_horizon, settings, i_elevation, k_altitude, elevation)
 
 
 def _nodes(sun_y: float, altitude: float):
@@ -85,7 +142,7 @@ def sky_ambient(sun_dir, altitude: float, settings: AtmosphereSettings, night=(0
     s = ref.unit(sun_dir)
     total = 0.0
     for w, i, j in _nodes(s[1], altitude):
-        total = total + w * _ambient_node(settings, _clamped(i), j)
+        total = total + w * _node(_bake_ambient, settings, _clamped(i), j)
     return total + np.asarray(night, np.float64) * (1.0 - float(daylight(s[1])))
 
 
@@ -103,6 +160,6 @@ def horizon_radiance(directions, sun_dir, altitude: float, settings: AtmosphereS
     f = (x - i0)[:, None]
     total = 0.0
     for w, i, j in _nodes(s[1], altitude):
-        table = _horizon_node(settings, _clamped(i), j, elevation)
+        table = _node(_bake_horizon, settings, _clamped(i), j, elevation)
         total = total + w * ((1 - f) * table[i0] + f * table[i0 + 1])
     return total + np.asarray(night, np.float64) * (1.0 - float(daylight(s[1])))
