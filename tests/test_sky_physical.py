@@ -750,6 +750,6 @@ def test_a_sun_crossing_a_light_table_node_finds_it_baked_ahead(gpu, ctx):
         assert sum(grew) >= 4, "the crossings' nodes were baked (ahead)"
         s = next(p for p in app.plugins if isinstance(p, SkyPlugin)).settings.atmosphere
         direct = sun_light._bake_ambient(s, 24, 0)
-        assert np.array_equal(sun_light._ambient_node(s, 24, 0), direct)
+        assert np.array_equal(sun_light._node(sun_light._bake_ambient, s, 24, 0), direct)
     finally:
         app.close()

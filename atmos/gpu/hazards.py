@@ -190,7 +190,7 @@ class Hazards:
         self._need = 0
         self.barriers += 1
         self._issued[bits] += 1
-        dirty, pending, rest, dropped = self._dirty, self._pending, bits, None
+        dirty, pending, rest, dropped = self._dirty, self._pending, bits, []
         while rest:                           # only the entries that still held an issued bit are touched
             bit = rest & -rest
             rest ^= bit
@@ -205,20 +205,19 @@ class Hazards:
                 if left and entry[0]() is not None:
                     entry[2] = left
                 else:
-                    dropped = [key] if dropped is None else dropped + [key]
+                    dropped += (key,)         # (no method call)
             pending[bit] = {}                 # (a new dict: no method call)
         if len(dirty) > self._purge_at:       # entries of dead objects whose bits are never issued
-            dropped = (dropped or []) + [k for k, e in dirty.items() if e[0]() is None]
+            dropped += [k for k, e in dirty.items() if e[0]() is None]
             self._purge_at = max(64, 2 * (len(dirty) - len(dropped)))
-        if dropped:
-            for key in dropped:
-                if key in dirty:
-                    kind = dirty[key][1]
-                    del dirty[key]
-                    for bit in _KIND_BITS[kind]:
-                        keys = pending[bit]
-                        if key in keys:
-                            del keys[key]
+        for key in dropped:
+            if key in dirty:
+                kind = dirty[key][1]
+                del dirty[key]
+                for bit in _KIND_BITS[kind]:
+                    keys = pending[bit]
+                    if key in keys:
+                        del keys[key]
 
     @property
     def bits_issued(self) -> dict[str, int]:

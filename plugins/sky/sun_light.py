@@ -42,8 +42,6 @@ def _sun_at(elevation_deg: float) -> np.ndarray:
 MAX_NODES = 8192                # nodes kept (the oldest dropped first)
 _NODES: dict = {}               # (bake, id(settings), *args) -> (settings, node): held, never a reused id
 _USED: dict = {}                # keys used since the last bake_ahead -> their settings
-_SEEN: dict = {}                # keys whose neighbours were noted -> None
-_AHEAD: dict = {}               # keys of neighbours to bake ahead -> their settings (newest last)
 
 
 def _node(bake: Callable, settings, *args) -> np.ndarray:
@@ -60,39 +58,22 @@ def _node(bake: Callable, settings, *args) -> np.ndarray:
 
 
 def bake_ahead(nodes: int = 1) -> int:
-    """Bake up to ``nodes`` of the nodes one elevation step from those used since the last call (the
-    newest noted first): a frame's spare work, so that a sun crossing a node finds it baked. Returns how
-    many were baked."""
+    """Bake up to ``nodes`` of the nodes one elevation step from those used since the last call: a
+    frame's spare work, so that a sun crossing a node finds it baked. Returns how many were baked."""
+    baked, limit = 0, _ELEVATION_LIMIT
     for key, settings in _USED.items():
-        if key in _SEEN:
-            continue
-        _SEEN[key] = None
         bake, sid, i, *rest = key
-        for n in (_clamped(i - 1), _clamped(i + 1)):
+        for n in (max(i - 1, -limit), min(i + 1, limit)):
             ahead = (bake, sid, n, *rest)
-            if ahead not in _NODES or _NODES[ahead][0] is not settings:
-                _AHEAD[ahead] = settings
+            if baked < nodes and (ahead not in _NODES or _NODES[ahead][0] is not settings):
+                _NODES[ahead] = (settings, bake(settings, n, *rest))     # baked, not used
+                baked += 1
     _USED.clear()
-    if len(_SEEN) > MAX_NODES:
-        _SEEN.clear()
-    baked = 0
-    while _AHEAD and baked < nodes:
-        key = next(reversed(_AHEAD))
-        settings = _AHEAD.pop(key)
-        if key not in _NODES or _NODES[key][0] is not settings:
-            _NODES[key] = (settings, key[0](settings, *key[2:]))     # baked, not used: no neighbours noted
-            baked += 1
-    while len(_AHEAD) > 64:            # noted long ago: the sun has moved on
-        del _AHEAD[next(iter(_AHEAD))]
     return baked
 
 
 def _bake_ambient(settings: AtmosphereSettings, i_elevation: int, k_altitude: int) -> np.ndarray:
     return ref.ambient(_sun_at(i_elevation * ELEVATION_STEP), (k_altitude * ALTITUDE_ROOT_STEP) ** 2, settings)
-
-
-def _ambient_node(settings: AtmosphereSettings, i_elevation: int, k_altitude: int) -> np.ndarray:
-    return _node(_bake_ambient, settings, i_elevation, k_altitude)
 
 
 def _bake_horizon(settings: AtmosphereSettings, i_elevation: int, k_altitude: int, elevation: float) -> np.ndarray:
@@ -101,10 +82,6 @@ def _bake_horizon(settings: AtmosphereSettings, i_elevation: int, k_altitude: in
     c = math.cos(elevation)
     dirs = np.stack([np.cos(a) * c, np.full_like(a, math.sin(elevation)), np.sin(a) * c], axis=-1)
     return ref.sky_radiance(dirs, _sun_at(i_elevation * ELEVATION_STEP), (k_altitude * ALTITUDE_ROOT_STEP) ** 2, settings)
-
-
-def _horizon_node(settings: AtmosphereSettings, i_elevation: int, k_altitude: int, elevation: float) -> np.ndarray:
-    return _node(_bake_horizon, settings, i_elevation, k_altitude, elevation)
 
 
 def _nodes(sun_y: float, altitude: float):
@@ -117,9 +94,11 @@ def _nodes(sun_y: float, altitude: float):
                                       ((1 - fe) * fk, e0, k0 + 1), (fe * fk, e0 + 1, k0 + 1)) if w > 0]
 
 
+_ELEVATION_LIMIT = round(90.0 / ELEVATION_STEP)     # the nodes at the zenith and the nadir
+
+
 def _clamped(i: int) -> int:
-    limit = round(90.0 / ELEVATION_STEP)
-    return min(max(i, -limit), limit)
+    return min(max(i, -_ELEVATION_LIMIT), _ELEVATION_LIMIT)
 
 
 def sun_color(sun_dir, altitude, settings: AtmosphereSettings) -> np.ndarray:

@@ -167,37 +167,28 @@ class FarFieldLayer:
             self.octaves.bake(params, sun_dir, octave_frequencies(params.base_frequency), rotations(), CHANNEL_STEPS)
         profile = self.plugin.drawn_by_march()
         light = self.plugin.light_settings() if profile or params.enabled else None
-        a, b = self._step_measures(sim, (profile, light, sim.settings, tuple(sim.shape)))
-        self._mix(float(sim.t), a, b, profile, light is not None, profile_heights(sim.shape[1]))
+        heights = profile_heights(sim.shape[1])
+        a, b = self._step_measures(sim, profile, light, heights)
+        self._mix(float(sim.t), a, b, profile, light is not None, heights)
         self.update_tile(sim, float(view.time))
 
-    def _step_measures(self, sim: CloudSets, key: tuple) -> tuple[RankMeasure, RankMeasure]:
-        """The measures of A alone and of B alone, each taken when first shown (B's kept for when it is A)."""
-        found = [None, None]
-        for i, s in enumerate((sim.a, sim.b)):
-            for m in self._steps:
-                of = m.of
-                if of is not None and of[0] is s and of[1] == s.version and of[2] == key:
-                    found[i] = m
-        if sim.b is sim.a and found[0] is not None:
-            found[1] = found[0]
-        for i, (s, maps, placement) in enumerate(((sim.a, sim.maps_a, sim.placement_a),
-                                                  (sim.b, sim.maps_b, sim.placement_b))):
+    def _step_measures(self, sim: CloudSets, profile: bool, light, heights: int) -> tuple[RankMeasure, RankMeasure]:
+        """The measures of A alone and of B alone, each taken when first shown (B's kept for when it is A;
+        a static set, shown as both, measured once); ``light``: the light settings, None for no light."""
+        key = (profile, light, sim.settings, tuple(sim.shape))
+        shown = ((sim.a, sim.maps_a, sim.placement_a), (sim.b, sim.maps_b, sim.placement_b))[:1 if sim.b is sim.a else 2]
+        found = [next((m for m in self._steps if m.of is not None and m.of[0] is s and m.of[1] == s.version
+                       and m.of[2] == key), None) for s, _, _ in shown]
+        for i, (s, maps, placement) in enumerate(shown):
             if found[i] is not None:
                 continue
-            if i == 1 and sim.b is sim.a:
-                found[1] = found[0]
-                continue
-            m = next(m for m in self._steps if m is not found[1 - i])
+            m = found[i] = next(m for m in self._steps if m not in found)     # not the other set's kept one
             alone = replace(sim, a=s, b=s, t=1.0, maps_a=maps, maps_b=maps, placement_a=placement, placement_b=placement)
-            profile, light = key[0], key[1]
             self.measure_cover(alone, profile, into=m)
             if light is not None:
-                m.light.measure(alone, m.cover, octave_parameters(light.octaves, sim.settings)[0],
-                                profile_heights(sim.shape[1]))
+                m.light.measure(alone, m.cover, octave_parameters(light.octaves, sim.settings)[0], heights)
             m.of = (s, s.version, key)
-            found[i] = m
-        return found[0], found[1]
+        return found[0], found[-1]
 
     def _mix(self, t: float, a: RankMeasure, b: RankMeasure, profile: bool, light: bool, heights: int) -> None:
         """The frame's measure: ``a`` and ``b`` (taken at ``heights`` samples per column) mixed at ``t``
@@ -205,7 +196,7 @@ class FarFieldLayer:
         field = light and a.light.has_field and b.light.has_field
         c = self.gpu.program(compute_shader="clouds/far_field/rank_mix.comp",
                              defines={"PROFILE": int(profile), "LIGHT": int(light), "FIELD": int(field)})
-        rows = 2
+        rows = 2                              # the cover buffer's 35 floats: two rows of 32 invocations
         textures, images = {}, {}
         if profile:
             textures.update(profile_a=a.profile, profile_b=b.profile)
