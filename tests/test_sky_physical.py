@@ -737,6 +737,8 @@ def test_a_sun_crossing_a_light_table_node_finds_it_baked_ahead(gpu, ctx):
     the sun rising through four nodes (and the fog's rings with it) never bakes more than one node in a
     frame once under way; the values are the nodes' own (as baked when first used)."""
     from atmos.plugins.sky import sun_light
+    sun_light._NODES.clear()                         # the nodes are kept per process: earlier tests may hold these
+    sun_light._USED.clear()
     app = physical_app(gpu, FogPlugin(mode="exp", density=1e-4, color_from="sky"), sun=sun_at(10.0))
     try:
         app.run_frames(4, 1 / 30)
