@@ -1,6 +1,8 @@
 """Volumetric fog: image error against a 1024-step march versus time per frame, 8..128 view steps per
 pixel and froxel volumes of several sizes (VolumetricFogSettings.froxels), each frame alone
-(froxel_history 1) and with the temporal history after the frames measured (the default).
+(froxel_history 1) and with the temporal history after the frames measured (the default); then the
+noise (VolumetricFogSettings.noise): the FBM hashed per lattice corner and from the baked lattice,
+filtered (one fetch per octave), per 2^20 points, and the demo's march and froxels with each.
 
 Plain script: prints a table and writes out/bench_volumetric_fog.png. On llvmpipe only the ratios
 between rows mean anything; absolute numbers need a real GPU.
@@ -47,6 +49,39 @@ class ReadColor(RenderPass):
         self.image = np.frombuffer(frame.resource(COLOR).read(), np.float16).reshape(h, w, 4)[..., :3].astype(float)
 
 
+def fbm_ms(gpu, kind: str, octaves: int, repeats: int = 5, count: int = 1 << 20) -> float:
+    """Median wall ms of volumetric_fog/fbm_points.comp over ``count`` points (the GPU waited for each
+    time): the volumetric fog's FBM, ``kind`` "hash" or "filtered"."""
+    from atmos.gpu.hazards import dispatch
+    from atmos.gpu.uniforms import bind_buffers, bind_textures, write_uniforms
+    from atmos.plugins.volumetric_fog import VolumetricFogSettings
+    from atmos.plugins.volumetric_fog.noise import Lattice, noise_defines
+    ctx = gpu.ctx
+    lattice = None
+    prog = gpu.program(compute_shader="volumetric_fog/fbm_points.comp",
+                       defines=noise_defines(VolumetricFogSettings(noise=kind), gpu))
+    if kind == "filtered":
+        lattice = Lattice(gpu)
+        bind_textures(prog, fog_lattice=lattice.sync(0))
+    rng = np.random.default_rng(0)
+    points = np.zeros((count, 4), np.float32)
+    points[:, :3] = rng.uniform(-300.0, 300.0, (count, 3)) * 0.15
+    src, dst = ctx.buffer(points.tobytes()), ctx.buffer(reserve=4 * count)
+    bind_buffers(prog, Points=src, Values=dst)
+    write_uniforms(prog, count=count, octaves=octaves, seed=0)
+    times = []
+    for _ in range(repeats + 1):
+        ctx.finish()
+        start = time.perf_counter()
+        dispatch(prog, -(-count // 64))
+        ctx.finish()
+        times.append((time.perf_counter() - start) * 1000)
+    src.release(), dst.release()
+    if lattice is not None:
+        lattice.release()
+    return float(np.median(times[1:]))
+
+
 def measure(app, plugin, reader, steps: int, frames: int, froxels=None, history: float = HISTORY_BLEND):
     """(image, median wall ms per frame, fog pass GPU ms) with ``steps`` view samples per pixel, or
     with a froxel volume of ``froxels`` (W, H, D) and ``froxel_history`` ``history`` (the image: the last
@@ -85,6 +120,7 @@ def main() -> None:
     gpu = create_headless(size)
     app, plugin, reader = make_scene(gpu)
 
+    plugin.configure(noise="hash")         # the reference and the step and froxel rows: the hashed noise
     reference, ref_wall, ref_gpu = measure(app, plugin, reader, REFERENCE_STEPS, max(1, args.frames // 2))
     signal = np.sqrt(np.mean(reference ** 2))
     rows = []
@@ -100,6 +136,15 @@ def main() -> None:
             rmse = float(np.sqrt(np.mean((image - reference) ** 2)))
             name = "x".join(map(str, froxels)) + (" history" if history < 1.0 else "")
             froxel_rows.append((name, rmse, rmse / signal, wall, gpu_ms))
+    noise_rows = []                        # the demo's noise: the reference above is the exact noise's
+    for kind in ("hash", "filtered"):
+        plugin.configure(noise=kind)
+        for steps, froxels in ((32, None), (1, FROXELS[-1])):
+            image, wall, gpu_ms = measure(app, plugin, reader, steps, args.frames, froxels)
+            rmse = float(np.sqrt(np.mean((image - reference) ** 2)))
+            name = f"{kind} " + ("x".join(map(str, froxels)) if froxels else f"{steps} steps")
+            noise_rows.append((name, rmse, rmse / signal, wall, gpu_ms))
+    fbm_rows = [(kind, fbm_ms(gpu, kind, FOG["octaves"])) for kind in ("hash", "filtered")]
     info = gpu.info()
     app.close()
     gpu.release()
@@ -112,6 +157,11 @@ def main() -> None:
     print(f"{'froxels':>19} {'RMSE':>10} {'rel. RMSE':>10} {'ms/frame':>10} {'fog GPU ms':>11}")
     for name, rmse, rel, wall, gpu_ms in froxel_rows:
         print(f"{name:>19} {rmse:>10.5f} {rel:>10.5f} {wall:>10.2f} {gpu_ms:>11.2f}")
+    print(f"{'noise':>25} {'RMSE':>10} {'rel. RMSE':>10} {'ms/frame':>10} {'fog GPU ms':>11}")
+    for name, rmse, rel, wall, gpu_ms in noise_rows:
+        print(f"{name:>25} {rmse:>10.5f} {rel:>10.5f} {wall:>10.2f} {gpu_ms:>11.2f}")
+    print(f"FBM of {FOG['octaves']} octaves at 2^20 points, ms: "
+          + ", ".join(f"{kind} {ms:.2f}" for kind, ms in fbm_rows))
 
     import matplotlib
     matplotlib.use("Agg")

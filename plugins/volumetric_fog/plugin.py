@@ -11,6 +11,7 @@ from atmos.lighting import Sun, sun_and_day
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
 from atmos.plugins.sky import SkyLight
+from atmos.plugins.volumetric_fog.noise import Lattice, noise_defines, noise_kind
 from atmos.plugins.volumetric_fog.settings import VolumetricFogSettings
 
 HORIZON_SAMPLES = 16      # azimuths of the sky's horizon radiance averaged into the ambient
@@ -65,14 +66,16 @@ class VolumetricFogPass(ComputePass):
                 builder.write(name, access="storage")
 
     def defines(self) -> dict:
-        return {"LOCAL_MEDIA": int(self.plugin.composition.media)}
+        return {"LOCAL_MEDIA": int(self.plugin.composition.media), **noise_defines(self.plugin.settings, self.gpu)}
 
     def prepare(self, gpu) -> None:
         super().prepare(gpu)
         self.history = FroxelHistory(gpu)      # the froxel volume's temporal accumulation (settings.froxels)
+        self.lattice = Lattice(gpu)            # the filtered noise's lattice, baked once per seed
 
     def release(self) -> None:
         self.history.release()
+        self.lattice.release()
 
     def execute(self, frame: PassContext) -> None:
         view, settings = frame.view, self.plugin.settings
@@ -80,21 +83,27 @@ class VolumetricFogPass(ComputePass):
         if frame.declares(MEDIA_LIGHT):
             images.update(media_light_image=MEDIA_LIGHT, media_transmittance_image=MEDIA_TRANSMITTANCE)
         color = frame.image(COLOR)
+        noise = {}
+        if noise_kind(settings, self.gpu) == "filtered":
+            noise["fog_lattice"] = self.lattice.sync(settings.seed)
+        else:
+            self.lattice.release()
         if settings.froxels is None:
             self.history.release()                     # no volume to accumulate: no history kept
             p = self.program
             set_medium_uniforms(p, settings, view.sun, self.plugin.time(view), self.plugin.sky_ambient(view))
-            frame.dispatch(p, self.groups(color.size), textures={"scene_depth": DEPTH}, images=images)
+            frame.dispatch(p, self.groups(color.size), textures={"scene_depth": DEPTH, **noise},
+                           images=images)
             return
-        defines = self.defines()
-        fill = self.gpu.program(compute_shader="volumetric_fog/froxels.comp")
-        apply = self.gpu.program(compute_shader="volumetric_fog/froxel_apply.comp", defines=defines)
+        fill = self.gpu.program(compute_shader="volumetric_fog/froxels.comp", defines=noise_defines(settings, self.gpu))
+        apply = self.gpu.program(compute_shader="volumetric_fog/froxel_apply.comp",
+                                 defines={"LOCAL_MEDIA": int(self.plugin.composition.media)})
         volume = volume_image(frame, FOG_VOLUME)
         for p in (fill, apply):
             write_uniforms(p, froxel_knee=froxel_knee(settings.max_distance), max_distance=settings.max_distance)
         set_medium_uniforms(fill, settings, view.sun, self.plugin.time(view), self.plugin.sky_ambient(view))
         write_uniforms(fill, froxel_jittered=int(self.history.jittered(view.clock.frame, settings.froxel_history)))
-        frame.dispatch(fill, work_groups(volume.size[:2], (8, 8)), images={"fog_volume": volume})
+        frame.dispatch(fill, work_groups(volume.size[:2], (8, 8)), images={"fog_volume": volume}, textures=noise)
         volume = self.history.resolve(frame, volume, settings.max_distance, froxel_knee(settings.max_distance),
                                       settings.froxel_history)
         frame.dispatch(apply, self.groups(color.size), images=images,

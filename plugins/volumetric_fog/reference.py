@@ -5,14 +5,16 @@ import numpy as np
 
 from atmos.froxels import column_rays, froxel_distance
 from atmos.value_noise import fbm
+from atmos.plugins.volumetric_fog.noise import LATTICE
 from atmos.plugins.volumetric_fog.settings import VolumetricFogSettings
 
 
 def density(points: np.ndarray, settings: VolumetricFogSettings, time: float = 0.0) -> np.ndarray:
-    """bias − falloff·‖(p − center)/scale‖ + fbm(frequency·(p − center − wind·time)); points (..., 3)."""
+    """bias − falloff·‖(p − center)/scale‖ + fbm(frequency·(p − center − wind·time)) on the lattice
+    repeating every LATTICE cells (the baked noise's, exact); points (..., 3)."""
     q = np.asarray(points, np.float64) - settings.center
     envelope = settings.bias - settings.falloff * np.linalg.norm(q / settings.scale, axis=-1)
-    return envelope + fbm(settings.frequency * (q - np.multiply(settings.wind, time)), settings.octaves, settings.seed)
+    return envelope + fbm(settings.frequency * (q - np.multiply(settings.wind, time)), settings.octaves, settings.seed, LATTICE)
 
 
 def march_range(origins, dirs, limits, settings: VolumetricFogSettings):

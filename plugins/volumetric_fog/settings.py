@@ -48,6 +48,12 @@ class VolumetricFogSettings(CheckedSettings):
                                      "height; sky: ambient ⊙ the App's sky's mean horizon radiance (a SkyPlugin's "
                                      "light at the camera's altitude: dawn-coloured at dawn, dark at night; "
                                      "ambient=(1, 1, 1) for the sky's own colour)")
+    noise: str = choice_field("auto", ("auto", "filtered", "hash"), "the FBM's lattice (64 cells a side, "
+                              "then it repeats; atmos.plugins.volumetric_fog.noise): filtered: baked once per "
+                              "seed into a 3D texture, one trilinear fetch per octave (within "
+                              "noise.filtered_error of the hashed FBM: the texture unit's blend weights); hash: "
+                              "8 corners hashed per octave; auto: filtered on a GPU, hash on a software "
+                              "renderer")
     froxels: tuple | None = None
     froxel_history: float = history_field()
 

@@ -23,7 +23,6 @@ void main() {
     ivec2 c = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(c, size.xy))) return;
     vec3 dir = view_ray_dir((vec2(c) + 0.5) / vec2(size.xy), view_basis);
-    uint key = vn_key(seed);
     vec2 range = fog_range(camera_pos, dir, max_distance);
     int slices = size.z - 1;
     vec3 light = vec3(0.0);
@@ -35,10 +34,10 @@ void main() {
         float a = max(d0, range.x), b = min(d1, range.y);
         if (b > a && trans > 0.01) {
             vec3 p = camera_pos + dir * mix(a, b, jitter);
-            float d = fog_density(p, key);
+            float d = fog_density(p);
             if (d > 0.0) {
                 float step_t = exp(-absorption * d * (b - a));
-                light += trans * (1.0 - step_t) * (ambient_light + sun_light * fog_sun_transmittance(p, key));
+                light += trans * (1.0 - step_t) * (ambient_light + sun_light * fog_sun_transmittance(p));
                 trans *= step_t;
             }
         }

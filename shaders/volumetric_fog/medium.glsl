@@ -1,10 +1,11 @@
 // The FBM fog medium and its ray march (fbm-raymarched-fog.txt); mirrored in float64 by
 // atmos/plugins/volumetric_fog/reference.py. Needs lib/hash.glsl and lib/value_noise.glsl first; the sun's
-// direction is the frame block's (lib/frame.glsl).
+// direction is the frame block's (lib/frame.glsl); the noise is volumetric_fog/lattice.glsl's.
 //   density(p) = bias - falloff * |(p - center) / scale| + fbm(frequency * (p - center - wind * fog_time))
 // Positive density only inside the ellipsoid |(p - center) / scale| < (bias + 1 - 2^-octaves) / falloff,
 // so the march covers the part of the ray inside it (and before the scene surface / max_distance).
 #include "lib/frame.glsl"
+#include "volumetric_fog/lattice.glsl"
 
 uniform vec3 center;
 uniform vec3 scale;
@@ -14,7 +15,6 @@ uniform float frequency;
 uniform vec3 wind;
 uniform float fog_time;       // s the noise has drifted (0 unless animated)
 uniform int octaves;
-uniform uint seed;
 uniform float absorption;      // extinction per metre at density 1
 uniform int steps;             // view-ray samples
 uniform int light_steps;       // samples toward the sun per view sample
@@ -23,9 +23,9 @@ uniform float max_distance;
 uniform vec3 sun_light;        // scattering colour * sun radiance
 uniform vec3 ambient_light;    // ambient colour
 
-float fog_density(vec3 p, uint key) {
+float fog_density(vec3 p) {
     vec3 q = p - center;
-    return bias - falloff * length(q / scale) + value_fbm(frequency * (q - wind * fog_time), octaves, key);
+    return bias - falloff * length(q / scale) + lattice_fbm(frequency * (q - wind * fog_time), octaves);
 }
 
 // [enter, leave] of the ray inside the medium's bounding ellipsoid, clipped to [0, limit]; enter >= leave: miss.
@@ -43,10 +43,10 @@ vec2 fog_range(vec3 ro, vec3 dir, float limit) {
 }
 
 // The sun's transmittance from p: light_steps samples light_step apart toward the sun (stops at 0.01).
-float fog_sun_transmittance(vec3 p, uint key) {
+float fog_sun_transmittance(vec3 p) {
     float tl = 1.0;
     for (int j = 0; j < light_steps; ++j) {
-        float dl = fog_density(p + sun_dir * (float(j) * light_step), key);
+        float dl = fog_density(p + sun_dir * (float(j) * light_step));
         if (dl > 0.0) {
             tl *= exp(-absorption * dl * light_step);
             if (tl <= 0.01) break;
@@ -57,7 +57,6 @@ float fog_sun_transmittance(vec3 p, uint key) {
 
 // Premultiplied result: rgb = in-scattered light, a = transmittance along the ray up to `limit`.
 vec4 fog_march(vec3 ro, vec3 dir, float limit) {
-    uint key = vn_key(seed);
     vec2 range = fog_range(ro, dir, limit);
     vec3 light = vec3(0.0);
     float trans = 1.0;
@@ -65,10 +64,10 @@ vec4 fog_march(vec3 ro, vec3 dir, float limit) {
     float dt = (range.y - range.x) / float(steps);
     for (int i = 0; i < steps; ++i) {
         vec3 p = ro + dir * (range.x + (float(i) + 0.5) * dt);
-        float d = fog_density(p, key);
+        float d = fog_density(p);
         if (d <= 0.0) continue;
         float step_t = exp(-absorption * d * dt);
-        light += trans * (1.0 - step_t) * (ambient_light + sun_light * fog_sun_transmittance(p, key));
+        light += trans * (1.0 - step_t) * (ambient_light + sun_light * fog_sun_transmittance(p));
         trans *= step_t;
         if (trans <= 0.01) break;
     }
