@@ -14,9 +14,11 @@ A pass cannot declare an optional read, so the plugins meet in the App resource
 :class:`ClearDistance` (phase clear, added with the Composition) creates ``"cloud_distance"`` and
 clears it to 0, every layer reads and writes it (the far field, then the sprites over it), and the
 readers read it: a scene without fog allocates no distance target, a fog without clouds reads none.
-A first writer that writes every pixel when it runs (the far field's compute pass) says so in
-``covers`` (name -> whether it runs this frame); while it runs, it creates the target instead, writing
-its distance without reading one, and the clear is culled.
+A writer that writes every pixel when it runs (the far field's compute pass, the ray march's) says so in
+``covers`` (name -> whether it runs this frame), and one drawn behind every other layer (the far field)
+also in ``behind``. The first of them (:attr:`Composition.distance_first`: the one behind, else the only
+one that runs) creates the target instead, storing its distance without reading one, and the clear is
+culled.
 
 Local media and the air. A local medium (the fog) blends its (light L, transmittance T) over the colour;
 the aerial perspective, which spans the whole ray, would then add the air's light over the fog as if the
@@ -73,7 +75,8 @@ class Composition:
     media write ``"media_light"``/``"media_transmittance"`` and which passes read them."""
     writers: set = field(default_factory=set)
     readers: set = field(default_factory=set)
-    covers: dict = field(default_factory=dict)     # name -> () -> bool: the first writer writes every pixel
+    covers: dict = field(default_factory=dict)     # name -> () -> bool: that writer writes every pixel
+    behind: set = field(default_factory=set)       # covering writers drawn behind every other layer
     media_writers: set = field(default_factory=set)
     media_readers: set = field(default_factory=set)
     media_covers: dict = field(default_factory=dict)   # name -> () -> bool: that medium writes every pixel
@@ -84,9 +87,21 @@ class Composition:
         return bool(self.writers) and bool(self.readers)
 
     @property
+    def distance_first(self) -> str | None:
+        """The writer that creates the distance this frame (storing its own, nothing cleared): of the
+        covering writers that run, the one drawn behind the others (``behind``), else the only one; None
+        when the distance is not wanted or no such writer runs."""
+        if not self.distance:
+            return None
+        running = [name for name, runs in self.covers.items() if runs()]
+        behind = [name for name in running if name in self.behind]
+        first = behind or running
+        return first[0] if len(first) == 1 else None
+
+    @property
     def distance_cleared(self) -> bool:
         """True when the distance is wanted and no first writer that covers every pixel runs: the clear makes it."""
-        return self.distance and not any(runs() for runs in self.covers.values())
+        return self.distance and self.distance_first is None
 
     @property
     def media(self) -> bool:

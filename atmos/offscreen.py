@@ -80,16 +80,18 @@ class OffscreenLayer:
         return fbo
 
     def end(self, frame: PassContext, factor: int, near: float, far: float, distance: bool = False,
-            medium: bool = False, offset=None) -> None:
+            medium: bool = False, offset=None, first: bool = False) -> None:
         """Composite the low-res clouds onto "color" in place (premultiplied: layer + (1 − a) · colour,
         as :meth:`PassContext.blend_over` would), and their distance onto the cleared "cloud_distance"
-        with the same weights when ``distance``; ``medium``: the low-res target holds (in-scattered light,
+        with the same weights when ``distance`` (``first``: the pass made "cloud_distance", its first
+        writer: the distance is stored, nothing cleared); ``medium``: the low-res target holds (in-scattered light,
         transmittance) of a medium instead (L + T · colour, alpha kept). ``offset`` (ox, oy): low-res
         texel (i, j) holds the frame's pixel (i·factor + ox, j·factor + oy); None: the block's centre.
         One compute dispatch (``core/offscreen_composite.comp``)."""
         frame.reset_state()                 # the sprites' depth test and point size are done
         p = self.gpu.program(compute_shader="core/offscreen_composite.comp",
-                             defines={"COMPOSITE_MEDIUM": int(medium), "COMPOSITE_DISTANCE": int(distance)})
+                             defines={"COMPOSITE_MEDIUM": int(medium),
+                                      "COMPOSITE_DISTANCE": (2 if first else 1) if distance else 0})
         centre = 0.5 * (factor - 1)
         write_uniforms(p, factor=factor, inv_near_far=(1.0 / near, 1.0 / far), edge=EDGE,
                        sample_offset=(centre, centre) if offset is None else tuple(float(v) for v in offset))

@@ -271,3 +271,66 @@ def test_the_only_local_medium_that_covers_every_pixel_makes_the_media_targets()
     comp.media_readers.add("aerial_perspective")
     comp.media_covers.clear()
     assert comp.media_first is None, "a medium that does not say it covers every pixel blends"
+
+
+def test_the_first_covering_distance_writer_is_the_one_behind_else_the_only_one():
+    """Composition.distance_first: of the writers that store every pixel while they run, the one drawn
+    behind the others makes "cloud_distance"; else the only one that runs; two that are not behind, none
+    running, or no reader: nobody, and the clear makes it."""
+    runs = {"cloud_far_field": True, "cloud_raymarch": True}
+    comp = Composition(writers={"cloud_far_field", "cloud_raymarch"}, readers={"fog"},
+                       covers={name: (lambda name=name: runs[name]) for name in runs}, behind={"cloud_far_field"})
+    assert comp.distance_first == "cloud_far_field" and not comp.distance_cleared
+    runs["cloud_far_field"] = False
+    assert comp.distance_first == "cloud_raymarch", "the far field off: the march is the only one"
+    runs["cloud_raymarch"] = False
+    assert comp.distance_first is None and comp.distance_cleared
+    runs["cloud_raymarch"] = runs["cloud_far_field"] = True
+    comp.behind.clear()
+    assert comp.distance_first is None, "two covering writers, neither behind: both blend onto the clear"
+    comp.behind.add("cloud_far_field")
+    comp.readers.clear()
+    assert comp.distance_first is None and not comp.distance_cleared, "nobody reads it: nothing is made"
+
+
+@pytest.mark.parametrize("fields", [dict(resolution=1), dict(resolution=2), dict(resolution=2, reprojection=False)],
+                         ids=["full", "temporal", "upsampled"])
+def test_a_ray_march_makes_the_distance_itself_as_the_clear_and_blend_would(gpu, ctx, fields):
+    """The ray march writes every pixel: with fog, it creates "cloud_distance" (no clear pass) and stores
+    what blending onto the cleared target gave, colour and distance, bit for bit."""
+    from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
+    density = np.zeros(SHAPE, np.float32)
+    density[4:12, 1:3, 4:12] = 1.0
+    density[6:10, 0:4, 6:10] = 2.0
+    results = []
+    for cleared in (False, True):
+        settings = CloudSettings(cell_size=CELL, base_altitude=BASE, group_size=(8, 8), smoothing_slices=1,
+                                 sigma_t=0.01)
+        fog = FogPlugin(mode="exp", density=4e-4, sky="keep", fog_color=(0.9, 0.6, 0.3))
+        app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(settings, density=density),
+                                   RaymarchCloudsPlugin(jitter=False, detail_octaves=0, **fields), fog)
+        readback = app.graph.add_pass(DistanceReadback())
+        comp = app.resource(Composition)
+        comp.readers.add("distance_readback")
+        origin = app.resource(VolumeOrigin)
+        origin.x, origin.z = 0.0, 0.0
+        app.insert_resource(Sun.from_angles(40.0, 70.0))
+        app.startup()
+        if cleared:
+            comp.covers.pop("cloud_raymarch")            # as before: the clear, and the march blends onto it
+        cam = app.resource(Camera)
+        cam.position = np.array([320.0, 150.0, 1400.0])
+        cam.look_at(np.array([320.0, 680.0, 320.0]))
+        cam.near, cam.far = 1.0, 20000.0
+        app.run_frames(3)
+        w, h = gpu.size
+        readback.texture.write(np.full((h, w, 2), np.nan, np.float32).tobytes())     # last frame's, pooled
+        app.render()
+        creator = app.graph.compile().resources[CLOUD_DISTANCE].creator
+        assert creator == (ClearDistance.name if cleared else "cloud_raymarch")
+        results.append((app.read_linear(), readback.value.copy()))
+        app.close()
+    (image, distance), (image_cleared, distance_cleared) = results
+    a = distance[..., 1]
+    assert np.isfinite(distance).all() and a.max() > 0.5 and (a == 0).mean() > 0.2, "clouds and open sky"
+    assert np.array_equal(distance, distance_cleared) and np.array_equal(image, image_cleared)

@@ -28,12 +28,12 @@ class CloudFarFieldPass(ComputePass):
     writes = (COLOR,)
 
     def setup(self, builder) -> None:
-        if self.plugin.drawn_by_march():
-            return                          # a ray march draws the far field volumetrically: culled
+        if not self.plugin.runs():
+            return                          # off, or a ray march draws the far field volumetrically: culled
         super().setup(builder)
         builder.read(GROUND, access="uniform")
         comp = self.plugin.composition
-        if comp.distance and not comp.distance_cleared:        # the first writer: every pixel written
+        if comp.distance_first == self.name:                   # the first writer: every pixel written
             builder.create(CLOUD_DISTANCE, distance_desc(self.plugin.gpu.size), access="storage")
         elif comp.distance:
             builder.read(CLOUD_DISTANCE, access="storage")
@@ -41,7 +41,7 @@ class CloudFarFieldPass(ComputePass):
 
     def defines(self) -> dict:
         comp = self.plugin.composition
-        return {"FAR_DISTANCE": 0 if not comp.distance else 1 if comp.distance_cleared else 2}
+        return {"FAR_DISTANCE": 0 if not comp.distance else 2 if comp.distance_first == self.name else 1}
 
     def execute(self, frame: PassContext) -> None:
         params = self.plugin.settings
@@ -83,7 +83,8 @@ class CloudFarFieldPlugin(Plugin):
             raise ValueError("CloudFarFieldPlugin needs an App with a GPU context (App(gpu))")
         self.composition = composition(app)
         self.composition.writers.add("cloud_far_field")   # the fog gets the layer's own distance
-        self.composition.covers["cloud_far_field"] = self.runs    # and it writes all of it (no clear)
+        self.composition.covers["cloud_far_field"] = self.runs    # and it writes all of it (no clear),
+        self.composition.behind.add("cloud_far_field")            # behind every other cloud layer
         self.gpu = app.gpu
         self.layer = FarFieldLayer(app.gpu, self)          # also read by the ground shadows
         self.demand = field_demand(app)                    # the cloud renderers (light_settings)
@@ -101,6 +102,7 @@ class CloudFarFieldPlugin(Plugin):
         if comp is not None:
             comp.writers.discard("cloud_far_field")
             comp.covers.pop("cloud_far_field", None)
+            comp.behind.discard("cloud_far_field")
 
     def light_settings(self) -> CloudLightSettings:
         """The octaves and field weight the far field is lit with: the cloud renderer's (FieldDemand.light;

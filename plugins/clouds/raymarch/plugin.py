@@ -115,7 +115,8 @@ class RaymarchCloudsPlugin(Plugin):
             raise ValueError("RaymarchCloudsPlugin needs an App with a GPU context (App(gpu))")
         self.gpu = app.gpu
         self.composition = composition(app)
-        self.composition.writers.add(RaymarchPass.name)     # the fog gets the clouds' own distance
+        self.composition.writers.add(RaymarchPass.name)     # the fog gets the clouds' own distance,
+        self.composition.covers[RaymarchPass.name] = self.runs     # every pixel of it (the first writer: no clear)
         self.pass_ = RaymarchPass(self)
         app.graph.add_pass(self.pass_)
         ground_sun_pass(app.graph)
@@ -129,6 +130,10 @@ class RaymarchCloudsPlugin(Plugin):
         self.far = next((p for p in app.plugins if isinstance(p, CloudFarFieldPlugin)), None)
         if self.far is not None:
             self.far.marchers.add(self)     # its 2D pass steps aside while this marches the far field
+
+    def runs(self) -> bool:
+        """Whether the march draws this frame (``enabled``): then it writes every pixel of its outputs."""
+        return bool(self.settings.enabled)
 
     def marches_far_field(self) -> bool:
         """Whether the march goes on through the volumetric far field (``far_field`` on, enabled, and a
@@ -151,6 +156,7 @@ class RaymarchCloudsPlugin(Plugin):
             self.demand.readers.discard(self)
         if self.composition is not None:
             self.composition.writers.discard(RaymarchPass.name)
+            self.composition.covers.pop(RaymarchPass.name, None)
         if self.far is not None:
             self.far.marchers.discard(self)
             self.far = None
@@ -183,7 +189,12 @@ class RaymarchPass(RenderPass):
 
     def setup_key(self) -> tuple:
         plugin = self.plugin
-        return (plugin.settings, plugin.marches_far_field(), plugin.composition.distance, plugin.gpu.size)
+        comp = plugin.composition
+        return (plugin.settings, plugin.marches_far_field(), comp.distance, comp.distance_first, plugin.gpu.size)
+
+    def first_distance(self) -> bool:
+        """Whether this pass makes "cloud_distance" (its first writer, :attr:`Composition.distance_first`)."""
+        return self.plugin.composition.distance_first == self.name
 
     def setup(self, builder: PassBuilder) -> None:
         s = self.plugin.settings
@@ -197,7 +208,9 @@ class RaymarchPass(RenderPass):
         # composited onto in place: by the march (resolution 1), the temporal resolve or the upsample
         builder.read(COLOR, access="storage")
         builder.write(COLOR, access="storage")
-        if self.plugin.composition.distance:
+        if self.first_distance():           # every pixel stored: nothing cleared before
+            builder.create(CLOUD_DISTANCE, distance_desc(tuple(self.plugin.gpu.size)), access="storage")
+        elif self.plugin.composition.distance:
             builder.read(CLOUD_DISTANCE, access="storage")
             builder.write(CLOUD_DISTANCE, access="storage")
         if s.resolution > 1:
@@ -217,13 +230,13 @@ class RaymarchPass(RenderPass):
         dict lookup)."""
         s = self.plugin.settings
         onto = s.resolution == 1
-        distance = onto and self.plugin.composition.distance
+        distance = (2 if self.first_distance() else 1) if onto and self.plugin.composition.distance else 0
         return self.gpu.program(compute_shader="clouds/raymarch/march.comp",
                                 defines={"DETAIL_OCTAVES": s.detail_octaves,
                                          "SUN_STEPS": s.sun_steps,
                                          "FAR_FIELD": int(far),
                                          "MARCH_ONTO": int(onto),
-                                         "MARCH_DISTANCE": int(distance)})
+                                         "MARCH_DISTANCE": distance})
 
     def _skip_texture(self, sim: CloudSets):
         """The dilated skip map as a small r32f 3D texture, re-uploaded when the max maps change."""
@@ -362,10 +375,12 @@ class RaymarchPass(RenderPass):
                                   motion_limit=s.motion_limit, low_depth=frame.resource(LOW_DEPTH),
                                   onto=frame.resource(COLOR),
                                   onto_distance=frame.resource(CLOUD_DISTANCE) if distance else None,
-                                  repeats=not s.jitter or jitter_repeats(self.frame_index, s.resolution))
+                                  repeats=not s.jitter or jitter_repeats(self.frame_index, s.resolution),
+                                  store_distance=distance and self.first_distance())
             return
         self.temporal.release()
-        self.offscreen.end(frame, s.resolution, camera.near, camera.far, distance, offset=offset)
+        self.offscreen.end(frame, s.resolution, camera.near, camera.far, distance, offset=offset,
+                           first=distance and self.first_distance())
 
     def _release_skip(self) -> None:
         if self.skip is not None:

@@ -224,7 +224,7 @@ class TemporalClouds:
 
     def resolve(self, low_color, low_distance, size, r: int, offset, camera, aspect: float, depth=None,
                 history_clamp: float = HISTORY_CLAMP, motion_limit: float = MOTION_LIMIT, low_depth=None,
-                onto=None, onto_distance=None, repeats: bool = True):
+                onto=None, onto_distance=None, repeats: bool = True, store_distance: bool = False):
         """Resolve this frame at full-res ``size`` (w, h) from the low-res ``low_color`` (RGBA
         premultiplied) and ``low_distance`` ((a·d, a)) textures marched at ``offset`` with divisor
         ``r``, seen by ``camera`` at ``aspect``; ``depth``: the scene's depth texture at ``size``
@@ -233,7 +233,8 @@ class TemporalClouds:
         resolve (they are the history it reads). ``onto``: a full-res RGBA16F texture (the frame's
         colour) the same dispatch composites the result onto in place, premultiplied as
         :meth:`~atmos.graph.PassContext.blend_over` would; ``onto_distance`` (with ``onto``): an RG32F
-        texture ("cloud_distance") the distance goes onto the same way. ``repeats``: whether the samples
+        texture ("cloud_distance") the distance goes onto the same way (``store_distance``: stored instead,
+        the pass being its first writer: what compositing onto a clear gives). ``repeats``: whether the samples
         were marched with the jitter of r² frames before (:func:`jitter_repeats`; False: no drift test)."""
         r = check_resolution(r)
         size = (int(size[0]), int(size[1]))
@@ -255,7 +256,8 @@ class TemporalClouds:
         matrices = camera_matrices(camera, aspect)
         prev, write = self._sets[self._current], self._sets[1 - self._current]
         p = self.gpu.program(compute_shader="clouds/raymarch/temporal.comp",
-                             defines={"COMPOSITE": int(onto is not None), "COMPOSITE_DISTANCE": int(onto_distance is not None)})
+                             defines={"COMPOSITE": int(onto is not None),
+                                      "COMPOSITE_DISTANCE": (2 if store_distance else 1) if onto_distance is not None else 0})
         write_uniforms(p, r=r, has_depth=depth is not None,
                        edge=EDGE if depth is not None and low_depth is not None else 1e30)
         valid = self._valid and self._prev is not None and not self.is_cut(camera, self._prev[2], self._prev[3])

@@ -5,7 +5,7 @@
 // a) into "cloud_raymarch_distance" and the scene's window depth the ray saw into "cloud_raymarch_depth"
 // (r32f), every texel written. MARCH_ONTO 1 (factor 1): composites onto "color" in place as blend_over
 // would (layer + (1 - a) colour, alpha too) and, MARCH_DISTANCE 1, its distance onto "cloud_distance"
-// with its own alpha (atmos/composition.py).
+// with its own alpha (atmos/composition.py); MARCH_DISTANCE 2 (its first writer, no clear before) stores it.
 #include "clouds/raymarch/march.glsl"
 #include "lib/over.glsl"
 #ifndef MARCH_ONTO
@@ -17,8 +17,10 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 #if MARCH_ONTO
 layout(binding = 0, rgba16f) uniform image2D color_image;
-#if MARCH_DISTANCE
+#if MARCH_DISTANCE == 1
 layout(binding = 1, rg32f) uniform image2D distance_image;
+#elif MARCH_DISTANCE == 2
+layout(binding = 1, rg32f) writeonly uniform image2D distance_image;
 #endif
 #else
 layout(binding = 0, rgba16f) writeonly uniform image2D color_image;
@@ -36,8 +38,10 @@ void main() {
     cloud_march(min(texel * factor + sample_offset, frame_size - 1), color, distance, depth);
 #if MARCH_ONTO
     imageStore(color_image, texel, over(color, imageLoad(color_image, texel)));
-#if MARCH_DISTANCE
+#if MARCH_DISTANCE == 1
     imageStore(distance_image, texel, vec4(over(distance, imageLoad(distance_image, texel).rg), 0.0, 0.0));
+#elif MARCH_DISTANCE == 2
+    imageStore(distance_image, texel, vec4(distance, 0.0, 0.0));
 #endif
 #else
     imageStore(color_image, texel, color);

@@ -55,8 +55,10 @@ layout(binding = 3, rgba16f) uniform writeonly image2D next_sample;
 #if COMPOSITE
 layout(binding = 4, rgba16f) uniform image2D color_image;             // the frame's colour
 #endif
-#if COMPOSITE_DISTANCE
+#if COMPOSITE_DISTANCE == 1
 layout(binding = 5, rg32f) uniform image2D distance_image;            // the frame's "cloud_distance"
+#elif COMPOSITE_DISTANCE == 2
+layout(binding = 5, rg32f) writeonly uniform image2D distance_image;  // made here (its first writer)
 #endif
 
 // Bilinear sample of a colour and a distance texture at texel-centre coordinates p, clamped to the edge
@@ -225,7 +227,9 @@ void main() {
     vec4 held = imageLoad(next_color, pix);     // as stored (float16, rounded as the GL rounds): this invocation's own write
     imageStore(color_image, pix, over(held, imageLoad(color_image, pix)));
 #endif
-#if COMPOSITE_DISTANCE
+#if COMPOSITE_DISTANCE == 1
     imageStore(distance_image, pix, vec4(over(distance, imageLoad(distance_image, pix).rg), 0.0, 0.0));
+#elif COMPOSITE_DISTANCE == 2
+    imageStore(distance_image, pix, vec4(distance, 0.0, 0.0));    // what over() onto the clear (0, 0) gives
 #endif
 }
