@@ -109,12 +109,25 @@ def test_the_far_field_march_matches_its_float64_reference(gpu, ctx, yaw, fields
     app.close()
 
 
-def test_the_2d_pass_is_culled_while_the_march_draws_the_far_field(gpu, ctx):
-    app = scene(gpu)
+@pytest.mark.parametrize("far_first", [False, True])
+def test_the_2d_pass_is_culled_while_the_march_draws_the_far_field(gpu, ctx, far_first):
+    """In either plugin order (they meet in FarFieldLink), and again as soon as the march stops."""
+    if far_first:
+        medium = CloudSettings(cell_size=CELL, base_altitude=BASE, group_size=(4, 4), smoothing_slices=1,
+                               edge_fade=0.2)
+        app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudFarFieldPlugin(**FAR),
+                                   CloudsPlugin(medium, density=columns()), RaymarchCloudsPlugin(resolution=1))
+        app.startup()
+    else:
+        app = scene(gpu)
     names = lambda: [p.name for p in app.graph.compile().order]
     app.render()
     assert "cloud_far_field" not in names() and "cloud_raymarch" in names()
-    march = of(app, RaymarchCloudsPlugin)
+    march, far = of(app, RaymarchCloudsPlugin), of(app, CloudFarFieldPlugin)
+    far.configure(enabled=False)
+    app.render()
+    assert not march.marches_far_field() and "cloud_far_field" not in names(), "no far field: none marched"
+    far.configure(enabled=True)
     for change in (dict(far_field=False), dict(far_field=True, enabled=False)):
         march.configure(**change)
         app.render()

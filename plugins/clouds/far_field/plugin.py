@@ -11,6 +11,7 @@ from atmos.plugins.clouds.light.ground import GROUND, bind_ground, ground_sun_pa
 from atmos.plugins.clouds.volume.sets import FAR_FIELD
 from atmos.plugins.clouds.far_field.settings import CloudFarFieldSettings
 from atmos.plugins.clouds.volume.light import CloudLightSettings, light_uniforms, write_light
+from atmos.plugins.clouds.volume.far_link import far_field_link
 from atmos.plugins.clouds.volume.field_demand import field_demand
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CloudSets
 from atmos.render_core import COLOR, DEPTH
@@ -88,7 +89,8 @@ class CloudFarFieldPlugin(Plugin):
         self.gpu = app.gpu
         self.layer = FarFieldLayer(app.gpu, self)          # also read by the ground shadows
         self.demand = field_demand(app)                    # the cloud renderers (light_settings)
-        self.marchers = set()       # renderers that may march the far field themselves (drawn_by_march)
+        self.link = far_field_link(app)                    # and those that may march it (drawn_by_march)
+        self.link.shown = lambda: bool(self.settings.enabled)
         app.graph.import_resource(FAR_FIELD, self.layer)
         self.pass_ = CloudFarFieldPass(self)
         app.graph.add_pass(self.pass_)
@@ -103,6 +105,9 @@ class CloudFarFieldPlugin(Plugin):
             comp.writers.discard("cloud_far_field")
             comp.covers.pop("cloud_far_field", None)
             comp.behind.discard("cloud_far_field")
+        link = getattr(self, "link", None)
+        if link is not None:
+            link.shown = None
 
     def light_settings(self) -> CloudLightSettings:
         """The octaves and field weight the far field is lit with: the cloud renderer's (FieldDemand.light;
@@ -117,10 +122,8 @@ class CloudFarFieldPlugin(Plugin):
         """Whether a cloud renderer marches the far field itself this frame (a registered renderer's
         ``marches_far_field()``, e.g. RaymarchCloudsPlugin with ``far_field``): the 2D pass then
         declares nothing and is culled; the layer stays imported for the shadows and the march."""
-        for marcher in getattr(self, "marchers", ()):
-            if marcher.marches_far_field():
-                return True
-        return False
+        link = getattr(self, "link", None)
+        return link is not None and link.marched()
 
     def finish(self, app) -> None:
         """Run before every other translucent pass (the cloud renderers draw nearer clouds over it)."""

@@ -29,7 +29,6 @@ from atmos.composition import CLOUD_DISTANCE, composition, distance_desc
 from atmos.graph import PassBuilder, PassContext, RenderPass, TextureDesc, work_groups
 from atmos.plugin import Plugin
 from atmos.plugins.clouds.volume.sets import FAR_FIELD
-from atmos.plugins.clouds.far_field.plugin import CloudFarFieldPlugin
 from atmos.plugins.clouds.raymarch.far import far_uniforms
 from atmos.plugins.clouds.raymarch.noise import pixel_angle
 from atmos.plugins.clouds.raymarch.settings import REFERENCE, SUN_GROWTH, SUN_SPACING, RaymarchCloudSettings
@@ -40,6 +39,7 @@ from atmos.plugins.clouds.light.ground import GROUND, ground_sun_pass
 from atmos.plugins.clouds.volume.binding import bind_volume, unbind_volume
 from atmos.plugins.clouds.volume.light import unit_direction
 from atmos.offscreen import OffscreenLayer, low_size
+from atmos.plugins.clouds.volume.far_link import far_field_link
 from atmos.plugins.clouds.volume.field_demand import field_demand
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CLOUD_VOLUME, CloudSets
 from atmos.plugins.clouds.simulation.chain import CloudSimulation
@@ -100,7 +100,7 @@ class RaymarchCloudsPlugin(Plugin):
 
     def __init__(self, settings: RaymarchCloudSettings | None = None, **fields):
         super().__init__(settings, **fields)
-        self.gpu = self.composition = self.far = self.demand = self.shape = self.pass_ = None
+        self.gpu = self.composition = self.link = self.demand = self.shape = self.pass_ = None
         self.simulated = False
 
     @classmethod
@@ -124,12 +124,11 @@ class RaymarchCloudsPlugin(Plugin):
         self.demand.readers.add(self)
         self.shape = drawn_shape(app)
         self.shape.source = self.drawn_type        # the columns' readers shape their shadows like the march
+        self.link = far_field_link(app)
+        self.link.marchers.add(self)    # a far field's 2D pass steps aside while this marches it
 
     def finish(self, app) -> None:
         self.simulated = app.get_resource(CloudSimulation) is not None     # weather-driven, not static
-        self.far = next((p for p in app.plugins if isinstance(p, CloudFarFieldPlugin)), None)
-        if self.far is not None:
-            self.far.marchers.add(self)     # its 2D pass steps aside while this marches the far field
 
     def runs(self) -> bool:
         """Whether the march draws this frame (``enabled``): then it writes every pixel of its outputs."""
@@ -139,7 +138,7 @@ class RaymarchCloudsPlugin(Plugin):
         """Whether the march goes on through the volumetric far field (``far_field`` on, enabled, and a
         CloudFarFieldPlugin, whose cover it uses, in the scene and enabled)."""
         s = self.settings
-        return bool(s.enabled and s.far_field and self.far is not None and self.far.settings.enabled)
+        return bool(s.enabled and s.far_field and self.link is not None and self.link.present())
 
     def drawn_type(self):
         """(shape.glsl's uniforms, the type map's texture or None) while the march draws with a cloud type,
@@ -157,9 +156,9 @@ class RaymarchCloudsPlugin(Plugin):
         if self.composition is not None:
             self.composition.writers.discard(RaymarchPass.name)
             self.composition.covers.pop(RaymarchPass.name, None)
-        if self.far is not None:
-            self.far.marchers.discard(self)
-            self.far = None
+        if self.link is not None:
+            self.link.marchers.discard(self)
+            self.link = None
 
     def sigma_t(self, sim: CloudSets) -> float:
         """Extinction in 1/m at density 1: the medium's."""
