@@ -76,6 +76,28 @@ def test_cloud_shadows_show_as_darker_rays_in_the_fog(fog_gpu, froxels):
     assert (dark <= inscatter + 4e-3).all()
 
 
+def test_under_a_kept_sky_the_rays_show_against_the_sky(fog_gpu, froxels):
+    """sky="keep": the fog leaves the sky as drawn (it holds the air's haze itself); the shafts take the
+    fog's sunlit in-scatter out of it where the clouds shadow the first max_distance of the ray, so the
+    lit gap shows as a ray against a darker sky, never below black and never more than the fog's share."""
+    volume = columns_volume()
+    bare = frame(fog_gpu, volume, False, fog=False, froxels=froxels)
+    alone = frame(fog_gpu, volume, False, sky="keep", froxels=froxels)
+    both = frame(fog_gpu, volume, True, sky="keep", froxels=froxels)
+    sky = np.all(bare == alone, -1)                    # the pixels the kept fog leaves alone
+    assert sky.mean() > 0.3
+    dark = (alone - both).mean(-1)
+    assert np.isfinite(both).all() and both.min() >= 0.0 and dark.min() > -2e-3, "only light taken away"
+    share = 0.8 * np.array([0.9, 0.9, 1.0]) * (1.0 - math.exp(-1.5e-3 * 3000.0))     # fog_sun_share C (1 − f)
+    assert ((alone - both)[sky] <= share + 4e-3).all()
+    lost = np.where(sky, dark, np.nan)[sky.any(1)]
+    lost = np.nanmean(lost, axis=0)                    # per image column, sky rows only
+    w = lost.size
+    centre = lost[int(0.47 * w):int(0.53 * w)].mean()
+    sides = np.concatenate([lost[int(0.02 * w):int(0.2 * w)], lost[int(0.8 * w):int(0.98 * w)]]).mean()
+    assert sides > 0.1 and sides > 5.0 * centre, f"the sky behind shadowed air darker ({sides:.3f}) than the ray ({centre:.3f})"
+
+
 def aerial_frame(gpu, density, shafts: bool, aerial: bool = True, fog_color=None, froxels=None) -> np.ndarray:
     """The gap view under the physical sky, its aerial perspective on (or off), with or without shafts;
     ``fog_color``: under an exponential fog of that colour too (mixed with the air along the ray,

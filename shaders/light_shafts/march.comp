@@ -14,8 +14,9 @@
 //   L = -fog_sun_share * C_fog(dir) * sum_i w(s_i) [f(s_i) - f(s_i+1)] (1 - V(s_i)),  T = 1,
 // f = fog/factor.glsl (at the fog's end point: the sum of [f(s_i) - f(s_i+1)] telescopes to the fog's own
 // 1 - f), V = exp(-tau_sun) the sun's visibility through the clouds, w the share of the fog in front of
-// s_i (a cloud in front, "cloud_distance": a before it, 1 - a behind; sky="keep" sky: none). It never
-// exceeds the fog's in-scatter (tests/test_light_shafts_fog.py).
+// s_i (a cloud in front, "cloud_distance": a before it, 1 - a behind). It never exceeds the fog's
+// in-scatter (tests/test_light_shafts_fog.py); a sky="keep" sky, which holds the air's haze itself and
+// is not fogged, loses the fog's share over the first max_distance (the rays seen against the sky).
 // SHAFT_AERIAL 1 (no fog; the sky's aerial perspective owns the air's light, sky/aerial.comp): the same,
 // for the atmosphere's single-scattered sunlight, lost where the clouds shadow the air,
 //   L = -sum_i w(s_i) T(s_i) E_sun(p_i) [s_ray(p_i) p_R(cos) + s_mie(p_i) p_M(cos)] (1 - V(s_i)) ds,  T = 1,
@@ -54,8 +55,8 @@ vec4 march(ivec2 q) {
     float r = atm_clamp_radius(view_r), nu = dot(dir, sun_dir);
 #endif
 #if SHAFT_FOG
-    // the fog's own distance: the scene's, the sky's far plane, or (keep) none above the horizon and
-    // the ground plane's below it (fog.frag)
+    // the fog's own distance (shaft_fog_behind: the scene's, the far plane's, or under sky "keep" the ground
+    // plane's below the horizon and max_distance above it)
     float behind = shaft_fog_behind(texelFetch(low_depth, q, 0).r, d, dir, length(ray));
     float reach = max(behind, a > 0.0 ? dc : 0.0);
     vec3 end = camera_pos + dir * reach;

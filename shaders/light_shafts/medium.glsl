@@ -40,10 +40,12 @@ float shaft_sun_tau(vec3 p) {
 
 #if SHAFT_FOG
 // The fog's own distance along `dir` for a pixel whose scene distance is d (z: its depth): the scene's,
-// the sky's far plane, or (sky "keep") none above the horizon and the ground plane's below it (fog.comp).
+// the sky's far plane, or (sky "keep") the ground plane's below the horizon (fog.comp) and max_distance
+// above it: a kept sky holds the air's haze already (the fog adds none there), and the clouds' shadow
+// takes the fog's sunlit in-scatter out of it over the marched reach (the rays seen against the sky).
 float shaft_fog_behind(float z, float d, vec3 dir, float ray_length) {
     return z < 1.0 ? d : (fog_sky_keep == 0 ? far * ray_length
-         : (dir.y < 0.0 && camera_pos.y > 0.0 ? camera_pos.y / max(-dir.y, 1e-6) : 0.0));
+         : (dir.y < 0.0 && camera_pos.y > 0.0 ? camera_pos.y / max(-dir.y, 1e-6) : max_distance));
 }
 #endif
 
