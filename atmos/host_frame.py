@@ -5,7 +5,7 @@ The game renders its scene into a colour texture and a depth texture of its own 
 App's context), and gives them to ``HostFramePlugin(color, depth)`` (textures, or zero-argument
 callables returning the current ones, e.g. after a resize). Each frame, first thing (phase
 ``clear``), they are copied into atmos's ``color`` and ``depth``; the skies then draw only where the
-depth is still 1 (nothing drawn, :func:`atmos.render_core.where_nothing_was_drawn`), and clouds,
+depth is still 1 (nothing drawn: each sky pixel tests its depth), and clouds,
 shadows and fog use the game's depth like the terrain's. The colour is taken as linear radiance
 (``srgb=True``: decoded from sRGB first), then tone-mapped with the rest by ``present``.
 

@@ -9,8 +9,8 @@ Every pass that writes ``color`` keeps to it; the light shafts' occlusion mask r
 shafts instead of casting them.
 
 - The clear pass clears alpha to 0 (nothing drawn is open sky); the sky passes (``sky``,
-  ``sky_gradient``) write alpha 0, only where nothing was drawn (depth 1: :func:`where_nothing_was_drawn`),
-  so a frame the game drew first (:mod:`atmos.host_frame`) keeps its pixels.
+  ``sky_gradient``, compute) write alpha 0, only where nothing was drawn (each pixel tests its depth
+  for 1), so a frame the game drew first (:mod:`atmos.host_frame`) keeps its pixels.
 - Opaque geometry (``ground``, ``terrain``, the clouds' top view) writes alpha 1 (blending off).
 - Layers that cover the sky blend premultiplied ``(light, coverage a)`` with (ONE, ONE_MINUS_SRC_ALPHA)
   on colour *and* alpha (:meth:`PassContext.blend_over`): ``alpha = a + (1 − a) · alpha``. The cloud
@@ -167,19 +167,6 @@ def present_levels(hdr, exposure: float = 1.0, dither: bool = True) -> np.ndarra
     if dither:
         x = x + DITHER_STEP * dither_offsets(x.shape[1], x.shape[0])
     return np.clip(np.floor(x * 255.0 + 0.5), 0.0, 255.0)
-
-
-def where_nothing_was_drawn(frame: PassContext):
-    """Bind ``color`` over ``depth`` so a pass on the far plane (``vertex = "lib/fullscreen_far.vert"``)
-    draws only where the depth is still 1, where nothing was drawn: depth test ``<=``, depth writes
-    off. The skies draw so, behind whatever a game drew before them (a host frame, see
-    :mod:`atmos.host_frame`); such a pass reads ``depth``."""
-    fbo = frame.framebuffer(color=[COLOR], depth=DEPTH)
-    fbo.use()
-    fbo.depth_mask = False
-    frame.gpu.ctx.enable(moderngl.DEPTH_TEST)
-    frame.gpu.ctx.depth_func = "<="
-    return fbo
 
 
 class PresentPass(ComputePass):

@@ -28,7 +28,7 @@ def test_scene_without_an_effect_runs_compiles_and_allocates_none_of_it(fresh_gp
     app = scene(fresh_gpu, TemplateVolumePlugin(resolution=(16, 8, 16), slices=4))
     app.run_frames(3)
     assert "template_volume" in app.graph.dump()
-    assert {"template_volume/density.comp", "template_volume/march.frag"} <= fresh_gpu.compiled_files
+    assert {"template_volume/density.comp", "template_volume/march.comp"} <= fresh_gpu.compiled_files
     assert app.graph.pool.allocations >= allocated
     app.close()
 

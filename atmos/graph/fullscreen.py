@@ -5,8 +5,8 @@ from atmos.graph.passes import PassBuilder, PluginPass
 
 
 class FullscreenPass(PluginPass):
-    """Subclass with ``name``, ``phase``, ``fragment`` (a shader file; ``vertex``, the fullscreen
-    triangle, is ``lib/fullscreen_far.vert`` for a pass drawn behind everything), ``reads`` and ``writes``
+    """Subclass with ``name``, ``phase``, ``fragment`` (a shader file; ``vertex`` is the fullscreen
+    triangle), ``reads`` and ``writes``
     (resource names) and, if needed, :meth:`defines`; ``execute`` binds a target and calls
     ``frame.fullscreen(self.program)``. ``plugin`` is the plugin that made the pass (its settings).
 
@@ -15,7 +15,7 @@ class FullscreenPass(PluginPass):
     A pass that blends onto ``color`` lists it in ``reads`` and ``writes``.
     """
     fragment: str = ""
-    vertex: str = "lib/fullscreen.vert"     # lib/fullscreen_far.vert: on the far plane (skies)
+    vertex: str = "lib/fullscreen.vert"
     reads: tuple[str, ...] = ()
     writes: tuple[str, ...] = ("color",)
 

@@ -3,8 +3,8 @@
 colour just before ``present``:
 
 - ``"fxaa"`` (FXAA, Lottes 2009): the stair steps of every opaque edge blurred along the edge, nothing
-  else touched; the pass copies ``color`` and draws the filtered image back over it
-  (``shaders/antialias/fxaa.frag``).
+  else touched; the pass copies ``color`` and writes the filtered image back into it, one compute
+  invocation per pixel (``shaders/antialias/fxaa.comp``).
 - ``"taa"`` (temporal, :mod:`.temporal`): the geometry drawn a sub-pixel off each frame and the frames
   blended through reprojection, so a still view converges to a supersampled one and the shading's
   own aliasing (a checkerboard into the distance) goes too.
@@ -15,8 +15,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from atmos.checks import CheckedSettings, bool_field, choice_field, num_field
-from atmos.graph import FullscreenPass, PassBuilder, PassContext, TextureDesc
-from atmos.gpu.uniforms import bind_textures, write_uniforms
+from atmos.graph import ComputePass, PassBuilder, PassContext, TextureDesc
+from atmos.gpu.uniforms import write_uniforms
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, motion_targets
 from atmos.scene_view import FrameJitter
@@ -42,11 +42,11 @@ class AntialiasSettings(CheckedSettings):
     reduce_min: float = num_field(1 / 128, 1e-4, 1.0, "fxaa: the least shortening (keeps flat areas sharp)")
 
 
-class AntialiasPass(FullscreenPass):
+class AntialiasPass(ComputePass):
     """Reads and writes ``color`` in phase ``present`` (so before the tone mapping reads it)."""
     name = "antialias"
     phase = "present"
-    fragment = "antialias/fxaa.frag"
+    compute = "antialias/fxaa.comp"
 
     def setup_key(self) -> tuple:
         return (self.plugin.settings.mode, self.plugin.gpu.size)
@@ -56,16 +56,15 @@ class AntialiasPass(FullscreenPass):
             return
         w, h = self.plugin.gpu.size
         builder.create(SOURCE, TextureDesc((w, h), components=4, dtype="f2"))
-        builder.read(COLOR)
-        builder.write(COLOR)
+        builder.read(COLOR, access="attachment")      # copied as a framebuffer
+        builder.write(COLOR, access="storage")
 
     def execute(self, frame: PassContext) -> None:
         s, p = self.plugin.settings, self.program
         frame.gpu.ctx.copy_framebuffer(frame.resource(SOURCE), frame.framebuffer(color=[COLOR]))
-        frame.framebuffer(color=[COLOR]).use()
-        bind_textures(p, source=frame.resource(SOURCE))
         write_uniforms(p, span_max=s.span_max, reduce_mul=s.reduce_mul, reduce_min=s.reduce_min)
-        frame.fullscreen(p)
+        color = frame.image(COLOR)
+        frame.dispatch(p, self.groups(color.size), textures={"source": SOURCE}, images={"color_image": color})
 
 
 class AntialiasPlugin(Plugin):

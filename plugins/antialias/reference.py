@@ -1,4 +1,4 @@
-"""float64 reference of ``shaders/antialias/fxaa.frag`` on an (h, w, 4) image whose row 0 is the bottom
+"""float64 reference of ``shaders/antialias/fxaa.comp`` on an (h, w, 4) image whose row 0 is the bottom
 (the texture's own order)."""
 from __future__ import annotations
 

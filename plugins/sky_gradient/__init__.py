@@ -5,10 +5,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from atmos.checks import vec_field
-from atmos.graph import FullscreenPass, PassContext
+from atmos.graph import ComputePass, PassContext
 from atmos.gpu.uniforms import write_uniforms
 from atmos.plugin import Plugin
-from atmos.render_core import DEPTH, where_nothing_was_drawn
+from atmos.render_core import COLOR, DEPTH
 from atmos.glsl_math import smoothstep
 from atmos.sun_disc import SUN_DISC_DEFINES, SunDiscSettings, disc_chord, sun_disc
 
@@ -38,24 +38,25 @@ def gradient_sky(view_dir, sun_dir, sun_color, settings: SkyGradientSettings | N
     return sky + np.asarray(sun_color, np.float64) * day * (glow + disc * (1.0 - smoothstep(0.0, -0.01, up)))
 
 
-class SkyGradientPass(FullscreenPass):
-    """The gradient where nothing was drawn (depth 1)."""
+class SkyGradientPass(ComputePass):
+    """The gradient where nothing was drawn (depth 1), one compute invocation per pixel
+    (``sky_gradient/sky.comp``)."""
     name = "sky_gradient"
     phase = "sky"
-    fragment = "sky_gradient/sky.frag"
-    vertex = "lib/fullscreen_far.vert"
+    compute = "sky_gradient/sky.comp"
     reads = (DEPTH,)
+    writes = (COLOR,)
 
     def defines(self) -> dict:
         return SUN_DISC_DEFINES
 
     def execute(self, frame: PassContext) -> None:
-        where_nothing_was_drawn(frame)
-        settings, view = self.plugin.settings, frame.view
-        write_uniforms(self.program, zenith=settings.zenith, horizon=settings.horizon, ground=settings.ground,
+        settings, view, p = self.plugin.settings, frame.view, self.program
+        write_uniforms(p, zenith=settings.zenith, horizon=settings.horizon, ground=settings.ground,
                        sun_look=(disc_chord(settings.sun_size_deg), settings.sun_gain, settings.sun_glare,
                                  view.camera.fov_y / max(1, view.size[1])))
-        frame.fullscreen(self.program)
+        color = frame.image(COLOR)
+        frame.dispatch(p, self.groups(color.size), textures={"scene_depth": DEPTH}, images={"color_image": color})
 
 
 class SkyGradientPlugin(Plugin):

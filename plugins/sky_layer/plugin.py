@@ -3,11 +3,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from atmos.graph import FullscreenPass, PassContext
+from atmos.graph import ComputePass, PassContext
 from atmos.lighting import Sun, sun_and_day
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
-from atmos.gpu.uniforms import bind_textures
+from atmos.gpu.uniforms import write_uniforms
 from atmos.tile_octaves import OctaveTextures
 from atmos.plugins.sky_layer.settings import SkyLayerSettings
 
@@ -23,14 +23,16 @@ def scroll_offsets(wind, time: float) -> np.ndarray:
     return np.mod(np.asarray(wind, np.float64) * float(time), 1.0)
 
 
-class SkyLayerPass(FullscreenPass):
-    """Phase sky, after the sky itself (it blends onto ``color``); reads ``depth`` and draws where it
-    is 1 (so it also composes over geometry drawn before it), premultiplied (ONE,
-    ONE_MINUS_SRC_ALPHA on colour and alpha), so ``color.a`` gains their cover of the sky."""
+class SkyLayerPass(ComputePass):
+    """Phase sky, after the sky itself (it composites onto ``color``); reads ``depth`` and draws where it
+    is 1 (so it also composes over geometry drawn before it), one compute invocation per pixel
+    (``sky_layer/layer.comp``), premultiplied over colour and alpha, so ``color.a`` gains their cover of
+    the sky."""
     name = "sky_layer"
     phase = "sky"
-    fragment = "sky_layer/layer.frag"
+    compute = "sky_layer/layer.comp"
     reads = (COLOR, DEPTH)
+    writes = (COLOR,)
 
     def prepare(self, gpu) -> None:
         super().prepare(gpu)
@@ -42,16 +44,14 @@ class SkyLayerPass(FullscreenPass):
         s, light = layer_light(view.sun)
         if plugin.octaves.needs_bake(params, s, params.rebake_tolerance):
             plugin.octaves.bake(params, s)
-        frame.framebuffer(color=[COLOR]).use()
-        frame.blend_over()
         plugin.octaves.bind(p)
-        bind_textures(p, scene_depth=frame.resource(DEPTH))
         p["offsets"].write(scroll_offsets(params.wind, plugin.time(view)).astype("f4").tobytes())
-        for name in ("altitude", "tile_size", "horizon_fade", "emptiness", "sharpness", "thickness",
-                     "color", "lit_color"):
-            p[name].value = getattr(params, name)
-        p["light"].value = tuple(light)
-        frame.fullscreen(p)
+        write_uniforms(p, light=tuple(light), lod_scale=float(params.size / params.tile_size * 2.0
+                                                               * np.tan(view.camera.fov_y / 2) / max(view.size[1], 1)),
+                       **{name: getattr(params, name) for name in ("altitude", "tile_size", "horizon_fade", "emptiness",
+                                                                   "sharpness", "thickness", "color", "lit_color")})
+        color = frame.image(COLOR)
+        frame.dispatch(p, self.groups(color.size), textures={"scene_depth": DEPTH}, images={"color_image": color})
 
     def release(self) -> None:
         if self.plugin.octaves is not None:

@@ -6,10 +6,10 @@ from dataclasses import dataclass
 
 from atmos.checks import CheckedSettings, check_int, check_shape, int_field, num_field, vec_field
 from atmos.slicing import SlicedJob, SliceTask, TripleSet
-from atmos.graph import FullscreenPass, PassContext, TextureDesc
+from atmos.graph import ComputePass, PassContext, TextureDesc
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
-from atmos.gpu.uniforms import bind_images, bind_textures
+from atmos.gpu.uniforms import bind_images, write_uniforms
 from atmos.gpu.hazards import dispatch
 
 TEMPLATE_VOLUME_SETS = "template_volume_sets"     # the imported (A, B, t) of the template volume's texture sets
@@ -97,13 +97,15 @@ class TemplateVolumePlugin(Plugin):
             self.triple = None
 
 
-class TemplateVolumePass(FullscreenPass):
-    """Ray-marches mix(A, B, t) inside the box, occluded by scene depth, blended over the colour
-    premultiplied (:meth:`PassContext.blend_over`): it covers the sky like a cloud."""
+class TemplateVolumePass(ComputePass):
+    """Ray-marches mix(A, B, t) inside the box, occluded by scene depth, one compute invocation per pixel,
+    composited over the colour premultiplied (``template_volume/march.comp``): it covers the sky like a
+    cloud."""
     name = "template_volume"
     phase = "translucent"
-    fragment = "template_volume/march.frag"
+    compute = "template_volume/march.comp"
     reads = (COLOR, DEPTH, TEMPLATE_VOLUME_SETS)
+    writes = (COLOR,)
 
     def defines(self) -> dict:
         return {"MARCH_STEPS": self.plugin.settings.march_steps}
@@ -111,11 +113,9 @@ class TemplateVolumePass(FullscreenPass):
     def execute(self, frame: PassContext) -> None:
         p = self.program
         a, b, t = frame.resource(TEMPLATE_VOLUME_SETS)
-        frame.framebuffer(color=[COLOR]).use()
-        frame.blend_over()
-        bind_textures(p, density_a=a["density"], density_b=b["density"], scene_depth=frame.resource(DEPTH))
-        p["t"].value = t
         box = self.plugin.settings.box
-        p["box_min"].value = tuple(c - s / 2 for c, s in zip(box.center, box.size))
-        p["box_max"].value = tuple(c + s / 2 for c, s in zip(box.center, box.size))
-        frame.fullscreen(p)
+        write_uniforms(p, t=t, box_min=tuple(c - s / 2 for c, s in zip(box.center, box.size)),
+                       box_max=tuple(c + s / 2 for c, s in zip(box.center, box.size)))
+        color = frame.image(COLOR)
+        frame.dispatch(p, self.groups(color.size), textures={"density_a": a["density"], "density_b": b["density"],
+                                                             "scene_depth": DEPTH}, images={"color_image": color})

@@ -3,8 +3,8 @@
 //   d      = (clamp(fbm, emptiness, sharpness) - emptiness) / (sharpness - emptiness)
 //   amount = dot(max(d - (0, 0.2, 0.4, 0.6), 0), 1/4)
 //   alpha  = clamp(thickness * amount, 0, 1) * fade;  rgb = mix(lit_color, color, amount) * light
-// Returned premultiplied with its coverage, for blending ONE, ONE_MINUS_SRC_ALPHA on colour and alpha
-// (PassContext.blend_over): (rgb * alpha, alpha); color.a then gains the layer's cover of the sky.
+// Returned premultiplied with its coverage, (rgb * alpha, alpha), composited over colour and alpha
+// (lib/over.glsl): color.a then gains the layer's cover of the sky.
 
 const vec4 SKY_LAYER_WEIGHTS = vec4(0.5, 0.25, 0.125, 0.0625);
 const vec4 SKY_LAYER_RAY = vec4(0.0, 0.2, 0.4, 0.6);

@@ -3,10 +3,11 @@
 // direction; two taps along it (and two more, farther) blur across the stair steps, and the wider blur
 // is kept unless its luma leaves the neighbourhood's range. Luma of HDR colour compressed l / (1 + l).
 // Taps are bilinear by hand from exact texel fetches (hardware filtering weights are 8-bit on some
-// GPUs); plugins/antialias/reference.py is the float64 reference.
-in vec2 v_uv;
-out vec4 frag;
+// GPUs); plugins/antialias/reference.py is the float64 reference. One compute invocation per pixel, from
+// a copy of the colour into the colour.
+layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0) uniform sampler2D source;   // the frame's colour before this pass (a copy)
+layout(binding = 0, rgba16f) writeonly uniform image2D color_image;
 uniform float reduce_min;
 uniform float reduce_mul;
 uniform float span_max;
@@ -28,7 +29,8 @@ vec4 bilinear(vec2 p) {                          // p in pixels; texel centres a
 }
 
 void main() {
-    ivec2 c = ivec2(gl_FragCoord.xy);
+    ivec2 c = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(c, imageSize(color_image)))) return;
     vec2 p = vec2(c) + 0.5;
     vec4 m = fetch(c);
     float l_nw = luma(fetch(c + ivec2(-1, 1)).rgb), l_ne = luma(fetch(c + ivec2(1, 1)).rgb);
@@ -43,5 +45,5 @@ void main() {
     float l_min = min(l_m, min(min(l_nw, l_ne), min(l_sw, l_se)));
     float l_max = max(l_m, max(max(l_nw, l_ne), max(l_sw, l_se)));
     float l_b = luma(b);
-    frag = vec4(l_b < l_min || l_b > l_max ? a : b, m.a);      // alpha: the sky occlusion, kept
+    imageStore(color_image, c, vec4(l_b < l_min || l_b > l_max ? a : b, m.a));   // alpha: the sky occlusion, kept
 }

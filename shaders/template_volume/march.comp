@@ -1,12 +1,14 @@
 #version 430
-// Test volume ray march: density = mix(A, B, t); Beer-Lambert extinction, a short light march toward
-// the sun, stopped at scene depth. Output premultiplied: rgb = in-scattered light, a = coverage
-// 1 - transmittance (PassContext.blend_over gives light + transmittance * scene, and adds the
-// coverage to color.a, the sky occlusion of atmos/render_core.py: the volume is a cloud).
+// Template volume ray march, one compute invocation per pixel: density = mix(A, B, t); Beer-Lambert
+// extinction, a short light march toward the sun, stopped at scene depth. The premultiplied result,
+// rgb = in-scattered light, a = coverage 1 - transmittance, is composited over the colour in place
+// (lib/over.glsl: light + transmittance * scene, the coverage added to color.a, the sky occlusion of
+// atmos/render_core.py: the volume is a cloud).
 // view_basis, camera_pos, near, far, sun_dir, sun_color: the frame block (lib/frame.glsl)
 #include "lib/frame.glsl"
-in vec2 v_uv;
-out vec4 frag;
+#include "lib/over.glsl"
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(binding = 0, rgba16f) uniform image2D color_image;
 layout(binding = 0) uniform sampler3D density_a;
 layout(binding = 1) uniform sampler3D density_b;
 layout(binding = 2) uniform sampler2D scene_depth;
@@ -25,8 +27,12 @@ float density(vec3 world) {
 }
 
 void main() {
+    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 size = imageSize(color_image);
+    if (any(greaterThanEqual(px, size))) return;
+    vec2 v_uv = (vec2(px) + 0.5) / vec2(size);
     vec3 dir = view_ray_dir(v_uv, view_basis);
-    float z = texelFetch(scene_depth, ivec2(gl_FragCoord.xy), 0).r;
+    float z = texelFetch(scene_depth, px, 0).r;
     float scene_dist = view_ray_distance(v_uv, z, view_basis, near, far, 1e30);
 
     vec3 inv = 1.0 / dir;
@@ -52,5 +58,5 @@ void main() {
             trans *= step_t;
         }
     }
-    frag = vec4(light, 1.0 - trans);
+    if (trans < 1.0) imageStore(color_image, px, over(vec4(light, 1.0 - trans), imageLoad(color_image, px)));
 }
