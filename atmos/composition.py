@@ -91,11 +91,13 @@ class Composition:
         """The writer that creates the distance this frame (storing its own, nothing cleared): of the
         covering writers that run, the one drawn behind the others (``behind``), else the only one; None
         when the distance is not wanted or no such writer runs."""
-        if not self.distance:
+        if not (self.writers and self.readers):
             return None
-        running = [name for name, runs in self.covers.items() if runs()]
-        behind = [name for name in running if name in self.behind]
-        first = behind or running
+        behind, others = [], []
+        for name, runs in self.covers.items():      # a loop, not comprehensions: this runs every frame
+            if runs():
+                (behind if name in self.behind else others).append(name)
+        first = behind or others
         return first[0] if len(first) == 1 else None
 
     @property

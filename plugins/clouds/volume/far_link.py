@@ -19,11 +19,15 @@ class FarFieldLink:
 
     def present(self) -> bool:
         """True while a far-field plugin is in the scene and enabled."""
-        return self.shown is not None and bool(self.shown())
+        shown = self.shown
+        return shown is not None and bool(shown())
 
     def marched(self) -> bool:
         """True while a registered renderer marches the far field itself this frame."""
-        return any(m.marches_far_field() for m in self.marchers)
+        for marcher in self.marchers:               # a loop, not any(generator): this runs every frame
+            if marcher.marches_far_field():
+                return True
+        return False
 
 
 def far_field_link(app) -> FarFieldLink:
