@@ -4,7 +4,8 @@ starts with an underscore).
 Terrain under a Preetham sky driven by the time of day; the cloud chain (weather → automaton →
 smoothing → density maps → shading) sliced over frames; the clouds drawn as point sprites with both
 cullings or ray-marched with detail noise (``DemoSettings.clouds``; key C flips them live: both
-plugins are added, the unused one disabled, so its pass is culled); their ground shadows and light shafts. 40 m cells: a 128×16×128 volume covers 5 km × 640 m × 5 km
+plugins are added; under the march the sprites are disabled, their pass culled; under the sprites the
+march draws the far field alone); their ground shadows and light shafts. 40 m cells: a 128×16×128 volume covers 5 km × 640 m × 5 km
 from 900 m up, centred on the camera.
 """
 from __future__ import annotations
@@ -66,7 +67,7 @@ def build_cloudscape(app, settings, *, hours: float, speed: float = 0.0, cloud_d
                     cloud_plugin,
                     CloudShadowsPlugin(),
                     CloudRenderPlugin(size_factor=4.0, enabled=settings.clouds == "sprites"),
-                    RaymarchCloudsPlugin(enabled=settings.clouds == "march"),
+                    RaymarchCloudsPlugin(volume=settings.clouds == "march"),   # else the far field alone
                     LightShaftsPlugin(horizon_fade=0.03),   # the sun's own colour already fades at the horizon
                     AntialiasPlugin(mode="taa"))
     app.add_system(switch_key, "update", label="cloud_renderer_switch")
@@ -112,18 +113,20 @@ def follow_camera(app) -> None:
 
 def cloud_renderer(app) -> str:
     """"sprites" or "march": the renderer drawing the clouds now."""
-    return "march" if _renderers(app)[1].settings.enabled else "sprites"
+    return "march" if _renderers(app)[1].settings.volume else "sprites"
 
 
 def switch_clouds(app, clouds: str | None = None) -> str:
     """Draw the clouds with ``clouds`` ("sprites" or "march"; None: the other one); returns it. The
-    other renderer is disabled: its pass declares nothing and is culled from the next frame."""
+    sprites are disabled under the march (their pass declares nothing and is culled from the next
+    frame); under the sprites the march draws the far field alone (``volume=False``), so the far
+    clouds look the same with either renderer."""
     from atmos.demo_registry import DemoSettings
     clouds = clouds if clouds is not None else ("sprites" if cloud_renderer(app) == "march" else "march")
     DemoSettings(clouds=clouds)                      # checks the name
     sprites, march = _renderers(app)
     sprites.configure(enabled=clouds == "sprites")
-    march.configure(enabled=clouds == "march")
+    march.configure(volume=clouds == "march")
     return clouds
 
 

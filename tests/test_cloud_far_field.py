@@ -49,8 +49,11 @@ def check_profile_matches_numpy(layer, sets, fade):
 
 def test_sunset_has_clouds_below_9_degrees_around_the_sun_and_cover_matches_numpy():
     gpu = create_headless((160, 90))
-    app = build_app("sunset", DemoSettings(size=gpu.size, headless=True, clouds="sprites"), gpu)   # the 2D far field
+    app = build_app("sunset", DemoSettings(size=gpu.size, headless=True, clouds="sprites"), gpu, start=False)
     try:
+        from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
+        next(p for p in app.plugins if isinstance(p, RaymarchCloudsPlugin)).configure(enabled=False)  # the 2D far field
+        app.startup()
         app.run_frames(4, 1 / 30)
         far = next(p for p in app.plugins if isinstance(p, CloudFarFieldPlugin))
         sim = app.resource(CloudSimulation)

@@ -168,3 +168,51 @@ def test_far_field_extremes_stay_finite_and_sensible(gpu, ctx, case):
     else:
         assert rgb[alpha > 0.3].mean() > 0.05, "lit, not black"
     app.close()
+
+
+def test_the_far_field_alone_is_the_marchs_far_field_drawn_behind_the_sprites(gpu, ctx):
+    """``volume=False``: the march draws only the far field (the same samples where the rays miss the
+    volume), before the sprites and not their alternative; the 2D pass steps aside, the march makes the
+    fog's distance, publishes no cloud type; without a far field it is culled."""
+    from atmos.graph import GraphError
+    from atmos.plugins.clouds.sprites import CloudRenderPlugin
+    from atmos.plugins.fog import FogPlugin
+    from atmos.composition import CLOUD_DISTANCE
+    from atmos.plugins.clouds.volume.shape import DrawnShape
+    app = scene(gpu, steps=256, cloud_type=None)    # untyped: the shadows on the ground alike either way
+    aim(app, (-2500.0, BASE + 900.0, 200.0), yaw=-np.pi / 2, pitch=-0.3)     # away from the volume
+    whole = app.read_linear()
+    march = of(app, RaymarchCloudsPlugin)
+    march.configure(volume=False)
+    alone = app.read_linear()
+    assert (alone[..., 3] > 0.05).mean() > 0.05, "far clouds in view"
+    assert np.array_equal(alone, whole), "the rays never meet the volume: the same far field"
+    app.close()
+
+    medium = CloudSettings(cell_size=CELL, base_altitude=BASE, group_size=(4, 4), smoothing_slices=1, sigma_t=0.02,
+                           edge_fade=0.2)
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), CloudsPlugin(medium, density=columns()),
+                               CloudRenderPlugin(), RaymarchCloudsPlugin(volume=False, cloud_type=1.0),
+                               CloudFarFieldPlugin(**FAR), FogPlugin(mode="exp", density=1e-4, sky="keep"))
+    app.insert_resource(DAY)
+    app.startup()
+    aim(app, (-600.0, BASE + 200.0, 320.0), yaw=np.pi / 2, pitch=0.05)        # the volume and the far field beyond
+    image = app.read_linear()
+    compiled = app.graph.compile()
+    order = [p.name for p in compiled.order]
+    assert "cloud_far_field" not in order and order.index("cloud_raymarch") < order.index("cloud_render")
+    assert compiled.resources[CLOUD_DISTANCE].creator == "cloud_raymarch"
+    assert app.resource(DrawnShape).source is None or app.resource(DrawnShape).source() is None, \
+        "the sprites draw the volume: no type for its shadows"
+    assert np.isfinite(image).all() and (image[..., 3] > 0.05).mean() > 0.05
+    march = of(app, RaymarchCloudsPlugin)
+    of(app, CloudRenderPlugin).configure(ms_diffusion=1.0)      # the field's heavier reader ...
+    assert of(app, CloudFarFieldPlugin).light_settings() is march.settings, "... but the march lights its far field"
+    march.configure(volume=True)                                 # beside the sprites: refused
+    with pytest.raises(GraphError, match="exclusive group 'cloud volume'"):
+        app.render()
+    march.configure(volume=False)
+    of(app, CloudFarFieldPlugin).configure(enabled=False)
+    app.render()
+    assert "cloud_raymarch" not in [p.name for p in app.graph.compile().order], "nothing to march: culled"
+    app.close()

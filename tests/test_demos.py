@@ -3,6 +3,7 @@ import pytest
 
 from atmos.demo_registry import DemoSettings, list_demos
 from atmos.gpu import create_headless
+from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
 from atmos.runner import build_app
 
 
@@ -40,7 +41,9 @@ def test_cloud_demos_march_by_default_render_with_sprites_and_key_c_switches_the
         assert gpu.ctx.error == "GL_NO_ERROR"
         assert image.max() > 20 and image.std() > 3, f"demo {name} with the sprites renders a blank image"
         assert cloud_renderer(app) == "sprites"
-        assert "cloud_render" in kept(app) and "cloud_raymarch" not in kept(app)   # the march is culled
+        march = next(p for p in app.plugins if isinstance(p, RaymarchCloudsPlugin))
+        assert "cloud_render" in kept(app) and not march.settings.volume    # the march: the far field alone
+        assert "cloud_raymarch" in kept(app) and "cloud_far_field" not in kept(app)   # no 2D far-field pass
         inp = app.resource(Input)
         inp.press(key.C)
         app.update(1 / 30)

@@ -533,7 +533,8 @@ SPECS["cloud_raymarch"] = Spec(
     dict(base_altitude=250.0, steps=2, step=4.0, step_growth=0.05, empty_space_skipping=False, min_transmittance=0.5,
          jitter=True, resolution=2, reprojection=False, history_clamp=0.0, motion_limit=1.0, detail_octaves=1, detail_scale=300.0, detail_strength=0.5,
          sun_steps=2, wind=(400.0, 0.0, 0.0), ms_attenuation=0.9, ms_contribution=1.0, ms_eccentricity=0.0,
-         ms_diffusion=0.0, far_field=False, far_distance=1000.0, far_step_growth=0.3, cloud_type=1.0, enabled=False,
+         ms_diffusion=0.0, far_field=False, far_distance=1000.0, far_step_growth=0.3, cloud_type=1.0, volume=False,
+         enabled=False,
          # stratus over the west half of the volume, congestus over the east (the default: cumulus)
          type_map=CloudTypeMap(np.array([[0.0, 0.0, 1.0, 1.0]]), origin=(0.0, -1e4), size=(320.0, 2e4))),
     observe={"resolution": resource_size(RAYMARCH_LOW_COLOR), "reprojection": raymarch_history,

@@ -110,8 +110,13 @@ class CloudFarFieldPlugin(Plugin):
             link.shown = None
 
     def light_settings(self) -> CloudLightSettings:
-        """The octaves and field weight the far field is lit with: the cloud renderer's (FieldDemand.light;
-        the defaults without one), so the far clouds continue the volume's light."""
+        """The octaves and field weight the far field is lit with: the renderer's that marches it
+        (FarFieldLink.marcher), else the cloud renderer's (FieldDemand.light; the defaults without one), so
+        the far clouds continue the volume's light."""
+        link = getattr(self, "link", None)
+        marcher = link.marcher() if link is not None else None
+        if marcher is not None:                 # the renderer that marches the far field lights it
+            return marcher.settings
         return self.demand.light() or CloudLightSettings()
 
     def runs(self) -> bool:

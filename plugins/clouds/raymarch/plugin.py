@@ -129,10 +129,15 @@ class RaymarchCloudsPlugin(Plugin):
 
     def finish(self, app) -> None:
         self.simulated = app.get_resource(CloudSimulation) is not None     # weather-driven, not static
+        # far field only (volume False): drawn behind the volume's renderers (their exclusive group)
+        self.pass_.behind = tuple(p.name for p in app.graph.passes
+                                  if p.phase == RaymarchPass.phase and p.exclusive == CLOUD_VOLUME and p is not self.pass_)
 
     def runs(self) -> bool:
-        """Whether the march draws this frame (``enabled``): then it writes every pixel of its outputs."""
-        return bool(self.settings.enabled)
+        """Whether the march draws this frame (``enabled``, and the volume or the far field to march):
+        then it writes every pixel of its outputs."""
+        s = self.settings
+        return bool(s.enabled and (s.volume or self.marches_far_field()))
 
     def marches_far_field(self) -> bool:
         """Whether the march goes on through the volumetric far field (``far_field`` on, enabled, and a
@@ -147,7 +152,7 @@ class RaymarchCloudsPlugin(Plugin):
         """(shape.glsl's uniforms, the type map's texture or None) while the march draws with a cloud type,
         else None (:class:`~atmos.plugins.clouds.volume.shape.DrawnShape`)."""
         s = self.settings
-        if not s.enabled or self.pass_ is None or (s.cloud_type is None and s.type_map is None):
+        if not (s.enabled and s.volume) or self.pass_ is None or (s.cloud_type is None and s.type_map is None):
             return None
         return s.cloud_type, s.type_map, self.pass_._type_texture(s.type_map) if s.type_map is not None else None
 
@@ -176,10 +181,21 @@ class RaymarchCloudsPlugin(Plugin):
 
 
 class RaymarchPass(RenderPass):
-    """Pass "cloud_raymarch"; see the module docstring. ``enabled`` False: declares nothing (culled)."""
+    """Pass "cloud_raymarch"; see the module docstring. ``enabled`` False: declares nothing (culled).
+    ``volume`` False: the far field alone, before the volume's renderers and not their alternative."""
     name = "cloud_raymarch"
     phase = "translucent"
-    exclusive = CLOUD_VOLUME                # never on beside the sprites (a GraphError names both)
+    behind: tuple = ()                      # the volume's renderers' passes (RaymarchCloudsPlugin.finish)
+
+    @property
+    def exclusive(self) -> str:
+        """Never on beside the sprites while it draws the volume (a GraphError names both)."""
+        return CLOUD_VOLUME if self.plugin.settings.volume else ""
+
+    @property
+    def before(self) -> tuple:
+        """The far field alone is drawn behind the volume's renderers."""
+        return () if self.plugin.settings.volume else self.behind
 
     def __init__(self, plugin: RaymarchCloudsPlugin):
         self.plugin = plugin
@@ -200,8 +216,8 @@ class RaymarchPass(RenderPass):
 
     def setup(self, builder: PassBuilder) -> None:
         s = self.plugin.settings
-        if not s.enabled:
-            return
+        if not self.plugin.runs():
+            return                          # off, or the far field alone with none to march
         builder.read(DEPTH)
         builder.read(CLOUD_SETS)
         builder.read(GROUND, access="uniform")
@@ -237,6 +253,7 @@ class RaymarchPass(RenderPass):
                                 defines={"DETAIL_OCTAVES": s.detail_octaves,
                                          "SUN_STEPS": s.sun_steps,
                                          "FAR_FIELD": int(far),
+                                         "MARCH_VOLUME": int(s.volume),
                                          "MARCH_ONTO": int(onto),
                                          "MARCH_DISTANCE": distance})
 

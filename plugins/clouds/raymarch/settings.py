@@ -125,6 +125,10 @@ class RaymarchCloudSettings(CloudLightSettings):
     far_step_growth: float = num_field(0.02, 0.0, 1.0, "the step's growth with distance in the far field (0.02 "
                                        "with 40 m cells: 70 m steps at 2.5 km, 420 m at 20 km; halving it about "
                                        "doubles the far samples)")
+    volume: bool = bool_field(True, "march the simulated volume; False: only the far field beyond it (``far_field`` "
+                              "with a CloudFarFieldPlugin, else the pass is culled), drawn behind the renderer of "
+                              "the volume, e.g. the sprites, which then get the march's volumetric far field "
+                              "instead of the 2D pass's")
     enabled: bool = bool_field(True, "False declares nothing (the pass is culled, allocates nothing)")
 
     def __post_init__(self):

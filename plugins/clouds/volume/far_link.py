@@ -2,7 +2,8 @@
 
 The far-field plugin says in :attr:`FarFieldLink.shown` whether it draws (set in ``build``: enabled);
 a renderer that can march the far field volumetrically (the ray march's ``far_field``) adds itself to
-``marchers`` and answers ``marches_far_field()``. While one does, the 2D pass steps aside. The plugins
+``marchers`` and answers ``marches_far_field()``. While one does, the 2D pass steps aside and the far
+field is lit with that renderer's settings. The plugins
 meet in this App resource in any order, as in :mod:`atmos.composition`, never through each other.
 """
 from __future__ import annotations
@@ -22,12 +23,17 @@ class FarFieldLink:
         shown = self.shown
         return shown is not None and bool(shown())
 
-    def marched(self) -> bool:
-        """True while a registered renderer marches the far field itself this frame."""
+    def marcher(self):
+        """The registered renderer that marches the far field itself this frame (None: none does); its
+        ``settings`` light the far field."""
         for marcher in self.marchers:               # a loop, not any(generator): this runs every frame
             if marcher.marches_far_field():
-                return True
-        return False
+                return marcher
+        return None
+
+    def marched(self) -> bool:
+        """True while a registered renderer marches the far field itself this frame."""
+        return self.marcher() is not None
 
 
 def far_field_link(app) -> FarFieldLink:

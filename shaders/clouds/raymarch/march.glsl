@@ -11,6 +11,8 @@
 // through the volumetric far field (clouds/raymarch/far.glsl) weighted by 1 - the volume's edge weight
 // (so the two cross-fade over the edge fade); from where the ray first reaches the fade ring the step
 // grows by mix(step_growth, far_growth, that weight) of the distance and nothing is skipped.
+// MARCH_VOLUME 0 (RaymarchCloudSettings.volume False, with FAR_FIELD 1): the far field alone, from where
+// the ray reaches the fade ring on, the volume's density never sampled (another renderer draws it).
 // Out: premultiplied (light, 1 - T); (a * distance, a) with distance the transmittance-weighted
 // distance from the camera (m, atmos/composition.py); the scene's window depth the ray stopped at.
 #include "clouds/volume/volume.glsl"
@@ -18,6 +20,9 @@
 #include "clouds/volume/shape.glsl"
 #ifndef FAR_FIELD
 #define FAR_FIELD 0
+#endif
+#ifndef MARCH_VOLUME
+#define MARCH_VOLUME 1
 #endif
 #if FAR_FIELD
 #include "clouds/raymarch/far.glsl"
@@ -173,6 +178,9 @@ void cloud_march(ivec2 pixel, out vec4 color, out vec2 distance, out float depth
     float enter = max(max(max(min(t0.x, t1.x), min(t0.y, t1.y)), min(t0.z, t1.z)), start);
     float leave = min(min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z)), scene);
     float far_from = 1e30;                         // no far field: never reached
+#if !MARCH_VOLUME
+    leave = enter;                                 // the box is not marched: the far band alone
+#endif
 #if FAR_FIELD
     {   // the band's part beyond the far field's entry, joined to the box's (the box is inside the band)
         float b0 = (layer_min.y - camera_pos.y) * inv_dir.y, b1 = (march_max().y - camera_pos.y) * inv_dir.y;
@@ -217,7 +225,7 @@ void cloud_march(ivec2 pixel, out vec4 color, out vec2 distance, out float depth
             ++taken;
             vec3 p = camera_pos + dir * sp;
             vec3 uvw = (p - layer_min) / extent;
-            bool in_box = in_march_box(uvw);
+            bool in_box = MARCH_VOLUME != 0 && in_march_box(uvw);
             float dv = in_box ? shaped_density(uvw, ny) : 0.0, df = 0.0;
 #if FAR_FIELD
             vec4 fc = vec4(0.0);
