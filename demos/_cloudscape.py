@@ -23,6 +23,7 @@ from atmos.plugins.clouds.sprites import CloudRenderPlugin
 from atmos.plugins.clouds.far_field import CloudFarFieldPlugin
 from atmos.plugins.clouds.shadows import CloudShadowsPlugin
 from atmos.plugins.clouds import CloudSettings, CloudsPlugin
+from atmos.plugins.clouds.presets import EDGE_FADE
 from atmos.plugins.daylight import DaylightPlugin
 from atmos.plugins.fog import FogPlugin
 from atmos.plugins.light_shafts import LightShaftsPlugin
@@ -33,7 +34,6 @@ from atmos.plugins.clouds.weather import VolumeOrigin, example_weather
 SHAPE = (128, 16, 128)
 CELL = (40.0, 40.0, 40.0)
 BASE_ALTITUDE = 900.0
-EDGE_FADE = 0.35        # outer fraction of the volume's half width over which it gives way to the far field
 # m: the terrain's far ring. Nearer than TerrainSettings' default: the haze hides what lies beyond, and
 # the cloud shadow map's far cascade spans 1.25 x the camera's far plane (its texels grow with it).
 HORIZON = 40000.0

@@ -92,6 +92,9 @@ def rolled_frames(name, size=48):
         from atmos.plugins.light_shafts import LightShaftsPlugin
         for shafts in (p for p in app.plugins if isinstance(p, LightShaftsPlugin)):
             shafts.configure(steps=128, downsample=1)   # the march's jitter and low-res blocks are screen-space patterns
+        from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
+        for march in (p for p in app.plugins if isinstance(p, RaymarchCloudsPlugin)):
+            march.configure(resolution=1, jitter=False)  # the far field's march: r x r blocks and jitter too
         from atmos.plugins.antialias import AntialiasPlugin
         for aa in (p for p in app.plugins if isinstance(p, AntialiasPlugin)):
             aa.configure(mode="none")                   # the temporal mode's jitter is a screen-space offset

@@ -45,10 +45,6 @@ def scenes():
     gpu = create_headless(SIZE)
     apps = {}
     try:
-        for demo in ("sunset", "flight"):
-            app = build_app(demo, DemoSettings(size=gpu.size, headless=True, clouds="sprites"), gpu)
-            app.run_frames(4, 1 / 30)
-            apps[(demo, "sprites")] = app
         yield gpu, apps
     finally:
         for app in apps.values():
@@ -61,10 +57,15 @@ def plugin(app, kind):
 
 
 def scene(scenes, demo, clouds="sprites"):
-    """The demo's App (built with ``clouds``, the renderer, on first use), run 4 frames."""
+    """The demo's App (built with ``clouds``, the renderer, on first use; "sprites2d": the sprites with
+    the march off, so the 2D far-field pass draws the far field), run 4 frames."""
     gpu, apps = scenes
     if (demo, clouds) not in apps:
-        app = build_app(demo, DemoSettings(size=gpu.size, headless=True, clouds=clouds), gpu)
+        app = build_app(demo, DemoSettings(size=gpu.size, headless=True, clouds=clouds.removesuffix("2d")), gpu,
+                        start=False)
+        if clouds == "sprites2d":
+            plugin(app, RaymarchCloudsPlugin).configure(enabled=False)
+        app.startup()
         app.run_frames(4, 1 / 30)
         apps[(demo, clouds)] = app
     return apps[(demo, clouds)]
@@ -96,10 +97,11 @@ def plane_radius(app, cam: Camera, reach: bool = False) -> np.ndarray:
 
 
 def render(app, *, far=True, clouds=True):
-    """The linear frame with the clouds (the enabled renderer: sprites + 2D far field, or the march with
-    its volumetric far field) and the far field each on or off."""
+    """The linear frame with the clouds (the renderer of the volume: the sprites, or the march; the far
+    field the march's, volumetric, behind either, or with the march off the 2D pass) and the far field
+    each on or off."""
     far_plugin, sprites, march = (plugin(app, k) for k in (CloudFarFieldPlugin, CloudRenderPlugin, RaymarchCloudsPlugin))
-    renderer = march if march.settings.enabled else sprites
+    renderer = march if march.settings.enabled and march.settings.volume else sprites
     far_plugin.configure(enabled=far and clouds)
     renderer.configure(enabled=clouds, **({"far_field": far} if renderer is march else {}))
     try:
@@ -221,7 +223,8 @@ def across_the_border(app, look, metric, seeds=SEEDS) -> tuple[float, float]:
 @pytest.mark.parametrize("demo, view, clouds", [
     ("sunset", "ground", "sprites"), ("sunset", "above", "sprites"), ("sunset", "ground", "march"),
     ("sunset", "above", "march"), ("flight", "ground", "sprites"), ("flight", "above", "sprites"),
-    ("flight", "ground", "march"), ("flight", "above", "march"),
+    ("flight", "ground", "march"), ("flight", "above", "march"), ("sunset", "above", "sprites2d"),
+    ("flight", "ground", "sprites2d"),
 ])
 def test_clouds_have_no_step_at_the_volume_edge(scenes, demo, view, clouds):
     """From the ground: the coverage (sky occlusion); from 2 km above the layer: what the clouds change
@@ -230,8 +233,8 @@ def test_clouds_have_no_step_at_the_volume_edge(scenes, demo, view, clouds):
     elevations (camera moved back: ``behind``; a 3D field covers more of the sky nearer the horizon, so
     the band well inside, seen more steeply, is no measure of it) within TOLERANCE; and no column along
     the border more of an outlier than the field's columns are inside the volume or outside it
-    (OUTLIER_FACTOR, the default seed). Both renderers: the sprites with the 2D far field, the march with
-    its volumetric one."""
+    (OUTLIER_FACTOR, the default seed). Both renderers, the far field marched behind either; and the
+    sprites with the 2D far-field pass (the march off)."""
     app = scene(scenes, demo, clouds)
     look, metric = (ground_view, coverage) if view == "ground" else (above_view, cloud_change)
     border, elsewhere = seam_outliers(*panorama(app, look, metric))
@@ -284,8 +287,10 @@ def test_far_field_is_as_bright_per_cover_as_the_volume_from_above_at_sunset():
     alone (r 1..3) is as bright per cover with its light-march channels collapsed (light_step 0: no
     relief) within 5 % (with exp(−relief), convex, it was 1.24x and 1.31x)."""
     gpu = create_headless(SIZE)
-    app = build_app("sunset", DemoSettings(size=gpu.size, headless=True, clouds="sprites"), gpu)
+    app = build_app("sunset", DemoSettings(size=gpu.size, headless=True, clouds="sprites"), gpu, start=False)
     try:
+        plugin(app, RaymarchCloudsPlugin).configure(enabled=False)   # the 2D far field, calibrated to the sprites
+        app.startup()
         plugin(app, AntialiasPlugin).configure(mode="none")      # each render alone: no history between views
         app.run_frames(4, 1 / 30)
         for name in [p.name for p in app.graph.passes if p.phase == "opaque" or p.name in ("fog", "light_shafts")]:

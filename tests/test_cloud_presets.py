@@ -4,7 +4,8 @@ import pytest
 
 from atmos import App, Camera, DefaultPlugins
 from atmos.gpu import create_headless
-from atmos.plugins.clouds.presets import PRESETS, SHAPE, CloudSky, cloud_settings
+from atmos.plugins.clouds import CloudsPlugin
+from atmos.plugins.clouds.presets import EDGE_FADE, PRESETS, SHAPE, CloudSky, cloud_settings
 from atmos.plugins.sky_gradient import SkyGradientPlugin
 from atmos.plugins.clouds.weather import VolumeOrigin
 
@@ -32,9 +33,40 @@ def test_a_cloud_sky_marches_its_clouds_unless_told_and_refuses_a_bad_renderer()
     assert isinstance(CloudSky().renderer, RaymarchCloudsPlugin)
     sprites = CloudSky("broken", renderer="sprites")
     assert isinstance(sprites.renderer, CloudRenderPlugin) and sprites.renderer in list(sprites)
-    assert not any(isinstance(p, RaymarchCloudsPlugin) for p in sprites)
+    marchers = [p for p in sprites if isinstance(p, RaymarchCloudsPlugin)]
+    assert len(marchers) == 1 and not marchers[0].settings.volume, "the march draws the far field alone"
+    assert not any(isinstance(p, RaymarchCloudsPlugin) for p in CloudSky("broken", renderer="sprites", horizon=False))
     with pytest.raises(ValueError, match="CloudSky.renderer must be one of 'sprites', 'march', got 'voxels'"):
         CloudSky(renderer="voxels")
+    with pytest.raises(ValueError, match="CloudSky.horizon must be True or False, got 1"):
+        CloudSky(horizon=1)
+
+
+@pytest.mark.parametrize("renderer", ["march", "sprites"])
+def test_a_cloud_sky_reaches_the_horizon(renderer):
+    """With ``horizon`` (the default) the far field continues the clouds past the volume's 5 km: the low
+    sky holds clouds that are not there without it; the volume fades into it (edge fade)."""
+    gpu = create_headless((64, 36))
+    images = {}
+    try:
+        for horizon in (True, False):
+            sky = CloudSky("broken", renderer=renderer, horizon=horizon)
+            app = App(gpu).add_plugins(DefaultPlugins(overlay=False, fly_camera=False), SkyGradientPlugin(), sky)
+            cam = app.resource(Camera)
+            cam.position, cam.pitch, cam.near, cam.far = np.array([0.0, 300.0, 0.0]), 0.12, 1.0, 40000.0
+            app.run_frames(3, 1 / 30)
+            assert (sky.far_field is not None) == horizon
+            images[horizon] = app.read_linear()[::-1, :, :3].astype(np.float64)
+            fade = next(p for p in sky if isinstance(p, CloudsPlugin)).settings.edge_fade
+            assert fade == (EDGE_FADE if horizon else 0.0)
+            app.close()
+    finally:
+        gpu.release()
+    rows = np.arange(36)
+    elevation = 0.12 + np.arctan((1.0 - 2.0 * (rows + 0.5) / 36) * np.tan(cam.fov_y / 2))
+    low = (elevation > np.radians(1.0)) & (elevation < np.radians(10.0))     # beyond the volume's reach
+    changed = np.abs(images[True][low] - images[False][low]).max(-1) > 0.02
+    assert np.isfinite(images[True]).all() and changed.mean() > 0.2, f"far clouds in {changed.mean():.0%} of the low sky"
 
 
 @pytest.mark.parametrize("renderer", ["march", "sprites"])

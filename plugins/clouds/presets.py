@@ -1,8 +1,8 @@
 """Clouds for a game: named skies in metres, and a simulation volume that follows the camera by itself.
 
 ``CloudSky("fair_weather")`` is the whole cloud chain as one plugin group: the simulation
-(:class:`CloudsPlugin`), its sprites (:class:`CloudRenderPlugin`), their ground shadows
-(:class:`CloudShadowsPlugin`), :class:`FollowCameraPlugin`, which keeps the volume centred on
+(:class:`CloudsPlugin`), its renderer (the ray march or the sprites), a far field to the horizon,
+the ground shadows (:class:`CloudShadowsPlugin`), :class:`FollowCameraPlugin`, which keeps the volume centred on
 the camera in whole cells (the automaton advects by the move, so clouds stay where they are in
 the world), and :class:`CloudWeatherPlugin` (``sky.weather``), which changes the weather while the
 game runs: ``sky.weather.configure(preset="overcast", transition=30)`` or ``configure(cover=0.6)``
@@ -15,9 +15,10 @@ import math
 from dataclasses import dataclass, replace
 
 from atmos.camera import Camera
-from atmos.checks import CheckedSettings, check_choice, check_num, choice_field, num_field
+from atmos.checks import CheckedSettings, check_bool, check_choice, check_num, choice_field, num_field
 from atmos.plugin import Plugin, PluginGroup
 from atmos.demo_registry import CLOUD_RENDERERS, DEFAULT_CLOUDS
+from atmos.plugins.clouds.far_field import CloudFarFieldPlugin
 from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
 from atmos.plugins.clouds.sprites import CloudRenderPlugin
 from atmos.plugins.clouds.weather.example import example_weather
@@ -28,6 +29,7 @@ from atmos.plugins.clouds.weather import VolumeOrigin
 
 SHAPE = (128, 16, 128)          # cells of every preset's volume: x, height, z
 FULL_COVER = 700                # weather ellipsoids over 128 x 128 columns that close the sky
+EDGE_FADE = 0.35                # outer fraction of the volume's half width over which it gives way to the far field
 
 
 @dataclass(frozen=True)
@@ -195,16 +197,24 @@ class CloudWeatherPlugin(Plugin):
 
 class CloudSky(PluginGroup):
     """A cloudy sky for a game: ``CloudSky("fair_weather" | "broken" | "overcast", seed=0,
-    warmup_steps=12, transition=20, renderer="march", **preset_changes)`` (see :func:`cloud_settings`);
-    ``renderer``: "march" (the ray march, :class:`RaymarchCloudsPlugin`) or "sprites" (the thesis's point
-    sprites, :class:`CloudRenderPlugin`), the plugin in ``sky.renderer``; ``sky.weather``
+    warmup_steps=12, transition=20, renderer="march", horizon=True, **preset_changes)`` (see
+    :func:`cloud_settings`); ``renderer``: "march" (the ray march, :class:`RaymarchCloudsPlugin`) or
+    "sprites" (the thesis's point sprites, :class:`CloudRenderPlugin`), the plugin in ``sky.renderer``;
+    ``horizon``: a far field continues the clouds to the horizon (:class:`CloudFarFieldPlugin`,
+    ``sky.far_field``; the volume fades into it over its outer EDGE_FADE; the march marches it, also
+    behind the sprites, ``RaymarchCloudsPlugin(volume=False)``); ``sky.weather``
     (:class:`CloudWeatherPlugin`) changes the sky while playing."""
 
     def __init__(self, preset: str = "fair_weather", *, seed: int = 0, warmup_steps: int = WARMUP_STEPS,
-                 transition: float = 20.0, renderer: str = DEFAULT_CLOUDS, **changes):
+                 transition: float = 20.0, renderer: str = DEFAULT_CLOUDS, horizon: bool = True, **changes):
         check_choice("CloudSky", "renderer", renderer, CLOUD_RENDERERS)
+        horizon = check_bool("CloudSky", "horizon", horizon)
         settings = cloud_settings(preset, **changes)
+        if horizon:
+            settings = replace(settings, edge_fade=EDGE_FADE)
         clouds = CloudsPlugin(settings, seed=seed, warmup_steps=warmup_steps)
         self.weather = CloudWeatherPlugin(clouds=clouds, preset=preset, cover=changes.get("cover"), transition=transition)
         self.renderer = RaymarchCloudsPlugin() if renderer == "march" else CloudRenderPlugin(size_factor=4.0)
-        super().__init__(clouds, self.renderer, CloudShadowsPlugin(), FollowCameraPlugin(clouds), self.weather)
+        self.far_field = CloudFarFieldPlugin() if horizon else None
+        far = [self.far_field] + ([RaymarchCloudsPlugin(volume=False)] if renderer == "sprites" else []) if horizon else []
+        super().__init__(clouds, self.renderer, CloudShadowsPlugin(), FollowCameraPlugin(clouds), self.weather, *far)
