@@ -471,8 +471,10 @@ SPECS["physical_camera"] = Spec(
                 for name in ("compensation", "ev_range", "metering_filter")}},
     before={"ev100": configure_first(auto_exposure=False), "bloom_levels": configure_first(bloom=0.5)})
 SPECS["cloud_weather"] = Spec(
-    # the sprites: one frame is the next at dt 0 (the march turns its samples every frame)
-    lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), CloudSky("fair_weather", warmup_steps=1, renderer="sprites")],
+    # the sprites, no far field: one frame is the next at dt 0 (the march, which would draw the far field,
+    # turns its samples every frame)
+    lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(),
+             CloudSky("fair_weather", warmup_steps=1, renderer="sprites", horizon=False)],
     CloudWeatherPlugin, look((0.0, 300.0, 0.0), pitch=0.9, far=20000.0),
     dict(preset="overcast", cover=0.9, transition=5.0),
     observe={"preset": _aimed, "cover": _aimed, "transition": lambda app, plugin: plugin.settings.transition},
