@@ -121,10 +121,7 @@ class CloudFarFieldPlugin(Plugin):
 
     def runs(self) -> bool:
         """Whether the 2D pass draws this frame (enabled, not marched by a cloud renderer)."""
-        if not self.settings.enabled:
-            return False
-        link = getattr(self, "link", None)          # drawn_by_march, inlined: this runs every frame
-        return link is None or not link.marched()
+        return self.settings.enabled and not self.drawn_by_march()
 
     def drawn_by_march(self) -> bool:
         """Whether a cloud renderer marches the far field itself this frame (a registered renderer's

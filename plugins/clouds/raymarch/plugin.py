@@ -143,10 +143,7 @@ class RaymarchCloudsPlugin(Plugin):
         """Whether the march goes on through the volumetric far field (``far_field`` on, enabled, and a
         CloudFarFieldPlugin, whose cover it uses, in the scene and enabled)."""
         s = self.settings
-        if not (s.enabled and s.far_field and self.link is not None):
-            return False
-        shown = self.link.shown                 # FarFieldLink.present, inlined: this runs every frame
-        return shown is not None and bool(shown())
+        return bool(s.enabled and s.far_field and self.link is not None and self.link.present())
 
     def drawn_type(self):
         """(shape.glsl's uniforms, the type map's texture or None) while the march draws with a cloud type,
