@@ -53,12 +53,12 @@ class OffscreenLayer:
     @staticmethod
     def declare(builder: PassBuilder, size, factor: int, distance: bool = False, color: str = CLOUD_COLOR,
                 depth: str = CLOUD_DEPTH, storage: bool = False) -> None:
-        """``storage``: a compute pass writes the low-res colour as an image (it then needs no clear)."""
+        """``storage``: a compute pass writes the low-res colour (and distance) as images (then no clear)."""
         color_desc, depth_desc, low_distance = _low_descs(tuple(size), factor, storage)
         builder.create(color, color_desc, access="storage" if storage else None)
         builder.create(depth, depth_desc)
         if distance:
-            builder.create(CLOUD_LOW_DISTANCE, low_distance)
+            builder.create(CLOUD_LOW_DISTANCE, low_distance, access="storage" if storage else None)
 
     def begin(self, frame: PassContext, factor: int, distance: bool = False, clear: bool = True):
         """Write the low-res depth, clear the low-res colour (``clear``; a compute pass that writes every

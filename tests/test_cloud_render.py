@@ -35,7 +35,7 @@ BASE = 300.0
 
 
 def scene(gpu, cloud_density=60, shading_scale=1, warmup=25, seed=3, sun=(25.0, 40.0), reference=False, adaption=4,
-          **render):
+          extra=(), **render):
     settings = CloudSettings(smoothing_slices=2, group_size=(16, 16), cell_size=CELL, base_altitude=BASE,
                              shading_scale=shading_scale)      # the medium and the base both renderers use
     app = App(gpu)
@@ -45,7 +45,7 @@ def scene(gpu, cloud_density=60, shading_scale=1, warmup=25, seed=3, sun=(25.0, 
                CloudsPlugin(settings, weather=example_weather(SHAPE, cloud_density, density_adaption=adaption), seed=seed, warmup_steps=warmup), renderer]
     if reference:
         plugins.append(RaymarchCloudsPlugin.reference(enabled=False))
-    app.add_plugins(*plugins)
+    app.add_plugins(*plugins, *extra)
     app.startup()
     return app, renderer
 

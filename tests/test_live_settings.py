@@ -91,6 +91,12 @@ def culling_counters(app, plugin):
     return s.columns_frustum_culled, s.segments_frustum_culled, s.columns_empty, s.segments_empty, s.sprites
 
 
+def splatted(app, plugin):
+    """The sprites the compute splat recorded in the last frame (0 while the points draw them: the same image)."""
+    splat = plugin.sprite_pass.splat
+    return 0 if splat is None else int(np.frombuffer(splat.counters.read(), np.uint32)[0])
+
+
 STEPS: list = []        # (settings, dt) of every weather step, newest last (the scenes' step_weather records)
 
 
@@ -385,9 +391,9 @@ SPECS = {
         look((320.0, 60.0, 500.0), target=(320.0, 360.0, 100.0), far=6000.0),     # some columns out of view
         dict(base_altitude=200.0, size_factor=6.0, sigma=0.05, frustum_culling=False, empty_space_skipping=False,
              max_point_size=1.0, downsample=4, lod_pixels=40.0, ms_attenuation=0.1, ms_contribution=1.0,
-             ms_eccentricity=0.0, ms_diffusion=2.0, enabled=False),
+             ms_eccentricity=0.0, ms_diffusion=2.0, splat="compute", enabled=False),
         observe={"frustum_culling": culling_counters, "empty_space_skipping": culling_counters,
-                 "downsample": resource_size(CLOUD_COLOR)}),
+                 "downsample": resource_size(CLOUD_COLOR), "splat": splatted}),
     "cloud_far_field": Spec(
         lambda: [DefaultPlugins(overlay=False), clouds(cover=20, edge_fade=0.5), SkyGradientPlugin(), GroundPlugin(),
                  CloudRenderPlugin(), CloudFarFieldPlugin(size=32)],

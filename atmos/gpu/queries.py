@@ -262,3 +262,57 @@ def query_pool(ctx) -> QueryPool:
     if pool is None:
         pool = _POOLS[ctx] = QueryPool(ctx)
     return pool
+
+
+GL_SYNC_GPU_COMMANDS_COMPLETE = 0x9117
+GL_ALREADY_SIGNALED, GL_CONDITION_SATISFIED = 0x911A, 0x911C
+_SYNC: dict = {}                                     # get_proc -> (FenceSync, ClientWaitSync, DeleteSync) or None
+
+
+def _sync_functions():
+    """glFenceSync, glClientWaitSync and glDeleteSync of the current context's API, or None."""
+    for api in ("egl", "glx"):
+        try:
+            current, get_proc = _loader(api)
+            if not current():
+                continue
+        except (OSError, AttributeError):
+            continue
+        if api not in _SYNC:
+            names = [get_proc(n) for n in (b"glFenceSync", b"glClientWaitSync", b"glDeleteSync")]
+            _SYNC[api] = None if not all(names) else (
+                ctypes.CFUNCTYPE(ctypes.c_void_p, ctypes.c_uint, ctypes.c_uint)(names[0]),
+                ctypes.CFUNCTYPE(ctypes.c_uint, ctypes.c_void_p, ctypes.c_uint, ctypes.c_uint64)(names[1]),
+                ctypes.CFUNCTYPE(None, ctypes.c_void_p)(names[2]))
+        return _SYNC[api]
+    return None
+
+
+class Fence:
+    """A GL fence after the commands queued so far: :meth:`done` says, never waiting, whether the GPU has
+    finished them (a buffer they wrote can then be read without a stall). Where the sync functions do not
+    resolve, done() is True the second time it is asked."""
+
+    __slots__ = ("_fns", "_sync", "_asked")
+
+    def __init__(self):
+        self._fns = _sync_functions()
+        self._sync = self._fns[0](GL_SYNC_GPU_COMMANDS_COMPLETE, 0) if self._fns else None
+        self._asked = 0
+
+    def done(self) -> bool:
+        if self._sync is None:
+            self._asked += 1
+            return self._asked > 1
+        status = self._fns[1](self._sync, 0, 0)
+        if status in (GL_ALREADY_SIGNALED, GL_CONDITION_SATISFIED):
+            self.delete()
+            return True
+        return False
+
+    def delete(self) -> None:
+        """Delete the GL sync object (its context must be current); later calls do nothing."""
+        if self._sync is not None:
+            self._fns[2](self._sync)
+            self._sync = None
+            self._asked = 1

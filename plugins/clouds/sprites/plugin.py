@@ -38,7 +38,7 @@ import moderngl
 import numpy as np
 
 from atmos.camera import Camera, camera_matrices
-from atmos.checks import bool_field, int_field, num_field
+from atmos.checks import bool_field, choice_field, int_field, num_field
 from atmos.composition import CLOUD_DISTANCE, composition
 from atmos.graph import PassBuilder, PassContext, RenderPass
 from atmos.plugin import Plugin
@@ -46,9 +46,10 @@ from atmos.gpu import clamp_sampler
 from atmos.plugins.clouds.light.ground import GROUND, ground_sun_pass
 from atmos.plugins.clouds.volume.binding import bind_volume, unbind_volume
 from atmos.plugins.clouds.volume.light import CloudLightSettings
-from atmos.offscreen import MAX_DOWNSAMPLE, OffscreenLayer, low_size
+from atmos.offscreen import CLOUD_COLOR, CLOUD_LOW_DISTANCE, MAX_DOWNSAMPLE, OffscreenLayer, low_size
 from atmos.plugins.clouds.volume.layout import CloudLayout
 from atmos.plugins.clouds.sprites.segments import MAX_LEVEL, SegmentStats, select_segments, unpack
+from atmos.plugins.clouds.sprites.splat import SpriteSplat
 from atmos.plugins.clouds.volume.field_demand import field_demand
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS, CLOUD_VOLUME, CloudSets
 from atmos.render_core import COLOR, DEPTH
@@ -81,6 +82,11 @@ class CloudRenderSettings(CloudLightSettings):
     lod_pixels: float | None = num_field(None, 0.0, doc="level of detail: columns where a block of 2^L cells "
                                          "spans at most this many target pixels are drawn one sprite per block "
                                          "(L ≤ 2, :mod:`.segments`); None: every cell", lo_open=True, optional=True)
+    splat: str = choice_field("auto", ("auto", "compute", "points"), "how the sprites reach the pixels: compute "
+                              "(binned into 16×16 tiles, sorted and blended front to back until T < 1/255, "
+                              ":mod:`.splat`: the cost follows the pixels covered, not the overdraw), points (one "
+                              "blended point per sprite, back to front), auto: compute on a GPU, points on a software "
+                              "renderer (where blending is as cheap as compute and the image the same)")
     enabled: bool = bool_field(True, "False declares nothing (the pass is culled, allocates nothing)")
 
 
@@ -104,7 +110,7 @@ class CloudRenderPlugin(Plugin):
         self.gpu = app.gpu
         self.composition = composition(app)
         self.composition.writers.add("cloud_render")     # the sprites give the fog their own distance
-        app.graph.add_pass(CloudSpritePass(self))
+        self.sprite_pass = app.graph.add_pass(CloudSpritePass(self))
         ground_sun_pass(app.graph)
         self.demand = field_demand(app)
         self.demand.readers.add(self)
@@ -115,6 +121,11 @@ class CloudRenderPlugin(Plugin):
         comp = getattr(self, "composition", None)
         if comp is not None:
             comp.writers.discard("cloud_render")
+
+    def splats(self) -> bool:
+        """Whether the sprites are splatted in compute (``splat``; auto: on a GPU, not a software renderer)."""
+        mode = self.settings.splat
+        return mode == "compute" or (mode == "auto" and not self.gpu.software)
 
     # -- shared with the reference ray marcher --------------------------------------------------
     def layout(self, sim: CloudSets) -> CloudLayout:
@@ -163,10 +174,11 @@ class CloudSpritePass(RenderPass):
     name = "cloud_render"
     phase = "translucent"
     exclusive = CLOUD_VOLUME                # never on beside the ray march (a GraphError names both)
+    clip_centres = False    # the splat drops sprites whose centre is off screen, as GL clips points (to compare)
 
     def __init__(self, plugin: CloudRenderPlugin):
         self.plugin = plugin
-        self.program = self.sampler = self.offscreen = None
+        self.program = self.sampler = self.offscreen = self.splat = None
         self.instances = self.commands = self.vao = None
         self._group = self._uploaded = self._drawn = None   # _drawn: (segments, group, commands) written
 
@@ -179,15 +191,17 @@ class CloudSpritePass(RenderPass):
         builder.read(DEPTH)
         builder.read(CLOUD_SETS)
         builder.read(GROUND, access="uniform")
-        builder.read(COLOR)                 # blends onto it
-        builder.write(COLOR)
         downsample = self.plugin.settings.downsample
         distance = self.plugin.composition.distance
+        splat = self.plugin.splats()
+        onto = "storage" if splat and downsample == 1 else None     # the splat's blend writes the frame itself
+        builder.read(COLOR, access=onto)    # blends onto it
+        builder.write(COLOR, access=onto)
         if distance:                        # a media pass reads it: blend onto it (atmos.composition)
-            builder.read(CLOUD_DISTANCE)
-            builder.write(CLOUD_DISTANCE)
+            builder.read(CLOUD_DISTANCE, access=onto)
+            builder.write(CLOUD_DISTANCE, access=onto)
         if downsample > 1:
-            OffscreenLayer.declare(builder, self.plugin.gpu.size, downsample, distance)
+            OffscreenLayer.declare(builder, self.plugin.gpu.size, downsample, distance, storage=splat)
 
     def prepare(self, gpu) -> None:
         self.program = gpu.program(vertex_shader="clouds/sprites/sprite.vert", fragment_shader="clouds/sprites/sprite.frag")
@@ -258,6 +272,9 @@ class CloudSpritePass(RenderPass):
         if segments is not self._uploaded:          # select_segments hands back the same array when nothing moved
             self.instances.write(segments.tobytes())
             self._uploaded = segments
+        if plugin.splats():
+            self._splat(frame, sim, layout, uniforms, segments, distance)
+            return
         if factor == 1:
             fbo = frame.framebuffer(color=[COLOR, CLOUD_DISTANCE] if distance else [COLOR], depth=DEPTH)
             fbo.use()
@@ -279,6 +296,43 @@ class CloudSpritePass(RenderPass):
         if factor > 1:
             self.offscreen.end(frame, factor, camera.near, camera.far, distance)
 
+    def _splat(self, frame: PassContext, sim: CloudSets, layout: CloudLayout, uniforms: dict, segments, distance: bool) -> None:
+        """The sprites splatted in compute (:mod:`.splat`) onto "color" (and "cloud_distance"), or off screen
+        into the low-res targets and composited."""
+        settings, view, gpu = self.plugin.settings, frame.view, frame.gpu
+        factor = settings.downsample
+        if self.splat is None:
+            self.splat = SpriteSplat(gpu)
+        if factor == 1:
+            size, depth = gpu.size, DEPTH
+            images = {"color_image": frame.image(COLOR)}
+            if distance:
+                images["distance_image"] = frame.image(CLOUD_DISTANCE)
+        else:
+            self.offscreen.begin(frame, factor, distance, clear=False)     # the blend writes every low-res texel
+            frame.reset_state()
+            size, depth = low_size(gpu.size, factor), self.offscreen.depth
+            images = {"color_image": frame.image(CLOUD_COLOR)}
+            if distance:
+                images["distance_image"] = frame.image(CLOUD_LOW_DISTANCE)
+        defines = {"setup": {"SPLAT_CLIP_CENTRES": int(self.clip_centres)}, "scan": None, "bin": None,
+                   "blend": {"SPLAT_OVER": int(factor == 1), "SPLAT_DISTANCE": int(distance)}}
+        programs = tuple(gpu.program(compute_shader=f"clouds/sprites/splat_{stage}.comp", defines=defines[stage])
+                         for stage in defines)
+        lit = (programs[0], programs[3])
+        for p in lit:
+            write_uniforms(p, uniforms)
+            bind_volume(p, sim, self.sampler, view.sun, settings.octaves, settings.ms_diffusion, layout.heights,
+                        view.ground, ground_light=frame.resource(GROUND))
+        try:
+            self.splat.draw(frame, programs, self.instances, len(segments), layout.group, self.plugin.stats.sprites,
+                            size, {"scene_depth": depth}, images)
+        finally:
+            for p in lit:
+                unbind_volume(p, self.sampler)
+        if factor > 1:
+            self.offscreen.end(frame, factor, view.camera.near, view.camera.far, distance)
+
     def _release_buffers(self) -> None:
         for obj in (self.vao, self.instances, self.commands):
             if obj is not None:
@@ -288,6 +342,9 @@ class CloudSpritePass(RenderPass):
 
     def release(self) -> None:
         self._release_buffers()
+        if self.splat is not None:
+            self.splat.release()
+            self.splat = None
         if self.sampler is not None:
             self.sampler.release()
         self.sampler = None

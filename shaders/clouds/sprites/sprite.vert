@@ -1,177 +1,40 @@
 #version 430
-// One cloud particle per cell of a sprite group (thesis 6.2), or per block of s³ cells at level of
-// detail L (s = 2^L). Each instance is one segment (group x, slice or block y, group z, code): code
-// packs L | (span x − 1) << 2 | (span z − 1) << 3, a unit of 1 or 2 groups per side (columns merged
-// across a boundary the camera stands on, see segments.py). gl_VertexID is a block's place in the
-// unit's drawing order: rows along the axis the camera is farther off, each axis walked toward the
-// camera, so of two neighbouring sprites the farther is always drawn first (blending is in vertex
-// order). The sprite sits at the block's centre of mass; its density is the block's mean of mix(A, B, t)
-// (cells past the volume's edge count as empty;
-// the grid is B's placement, A's cell is c + a_shift);
-// empty blocks and blocks past the edge are thrown out of the view volume.
-// The light samples filter in float32 (volume.glsl texel_trilinear), not with a texture unit's 8-bit
-// sub-texel weights: once per sprite, and T falls by orders of magnitude between cells.
+// One cloud particle per instance's block (sprite.glsl): each instance is one segment, gl_VertexID a
+// block's place in its unit's drawing order (blending is in vertex order, so of two neighbouring
+// sprites the farther is drawn first); culled sprites are thrown out of the view volume.
 #define CLOUD_EXACT_FILTER
 #include "lib/frame.glsl"
 #include "clouds/volume/volume.glsl"
+#include "clouds/sprites/sprite.glsl"
 layout(location = 0) in ivec4 in_segment;
-uniform ivec3 volume_shape;
-uniform ivec2 group_size;
-uniform vec3 layer_min;        // world corner of cell (0, 0, 0)
-uniform vec3 cell_size;
-uniform vec3 camera_cell;      // the camera in cells from the volume's corner
-// camera_pos (the view ray to the sprite's centre), view_proj, near (sprites fade out before their centre
-// crosses it) and far: the frame block (lib/frame.glsl)
-uniform float base_diameter;   // world sprite diameter of one cell at density 1: size factor × max(cx, cz)
-uniform float pixel_scale;     // pixel diameter = world diameter × pixel_scale / clip.w
-uniform float max_point_size;
-uniform vec3 camera_right;     // the sprite's screen axes (the fragment shader's too)
-uniform vec3 camera_up;
-uniform float tau_scale;       // sigma_t × cell volume: the optical depth a unit of summed density spreads over the screen (m²)
-flat out vec4 v_octaves;      // b^i P_i(T): the sun's light per octave (volume.glsl octave_weights)
-flat out vec3 v_slope;        // log T's slope h across the sprite (per unit pc) and h^T cov h / 2
-flat out vec3 v_ambient;      // sky and ground light at the sprite, dimmed by the columns above and below
-flat out vec4 v_field;        // the diffusion field (phi, F) at the sprite's centre (0 when its weight is 0)
-flat out vec3 v_sun;          // the sun's source at the sprite's height (volume.glsl sun_source_at)
-flat out vec3 v_center;       // world centre and radius: the fragment's view ray for the phase function
+flat out vec4 v_octaves;
+flat out vec3 v_slope;
+flat out vec3 v_ambient;
+flat out vec4 v_field;
+flat out vec3 v_sun;
+flat out vec3 v_center;
 flat out float v_radius;
 flat out float v_tau;
-flat out vec3 v_conic;         // the footprint's inverse covariance (xx, xy, yy) on the screen axes, in radii
-flat out float v_falloff;      // k of the profile (exp(-Q/2) - exp(-k)) / (1 - exp(-k)), Q = p^T conic p
-flat out float v_coverage;     // < 1 for sprites smaller than a pixel (their area in pixels) or near the near plane
-flat out float v_stretch;      // the point's half side over the radius, in the screen-parallel plane (>= 1 off-axis)
-
-const vec4 CULLED = vec4(0.0, 0.0, 2.0, 1.0);   // z > w: outside the clip volume
-// per axis (cells²): the trilinear hat's 1/6 around a cell centre, widened to the quadratic B-spline's 1/4
-// (the hat convolved with one cell) so a Gaussian this wide leaves < 1 % ripple on the grid (particle.py)
-const float CELL_VARIANCE = 0.25;
-const float MIN_FALLOFF = 1e-2;         // q this small is a 1 - r² disc: the profile's limit
-const float MAX_OFF_AXIS = 4.0;         // |x/z|, |y/z| of the Jacobian's m (76°): beyond, centres are far off screen
-// A cell's mass is its density times the trilinear hat around its centre; the sprite's light is the
-// mean of J over that mass, not J at the centre (T is convex: a centre sample is too dark on the lit
-// side, by up to ~20 % at an optical depth of 1 per cell). Per axis, the mean of the trilinear T under
-// the hat is exactly the average of two samples at ±1/3 cell, so 8 samples at the block's centre of
-// mass ± sqrt(variance of its cells + 1/9) cells (exact for one cell, the mass's spread for a block).
-const float HAT_SPREAD = 1.0 / 9.0;
-const float MIN_T = 1e-30;              // log T's floor
-const float MAX_SLOPE = 8.0;            // |log T change| per half side at most: e^8 across a sprite
-
-// The block drawn k-th of n (size s) along an axis with the camera c cells from the group's start:
-// each side of the camera walked toward it, the side whose innermost block is farther first.
-int toward(int k, int n, float c, int s) {
-    float x = c / float(s);
-    int before = int(clamp(ceil(x - 0.5), 0.0, float(n)));     // blocks whose centre is before c
-    int after = n - before;
-    if (x >= float(before))                                     // c in block `before`: its left neighbour is farther
-        return k < before ? k : n - 1 - (k - before);
-    return k < after ? n - 1 - k : k - after;
-}
+flat out vec3 v_conic;
+flat out float v_falloff;
+flat out float v_coverage;
+flat out float v_stretch;
 
 void main() {
-    int s = 1 << (in_segment.w & 3);
-    ivec2 extent = group_size * (1 + ((ivec2(in_segment.w) >> ivec2(2, 3)) & 1));
-    ivec2 n = extent / s;
-    ivec2 origin = in_segment.xz * group_size;
-    vec2 cam = camera_cell.xz - vec2(origin);
-    vec2 off = abs(cam - 0.5 * vec2(extent));
-    ivec2 block = off.x >= off.y
-        ? ivec2(toward(gl_VertexID / n.y, n.x, cam.x, s), toward(gl_VertexID % n.y, n.y, cam.y, s))
-        : ivec2(toward(gl_VertexID % n.x, n.x, cam.x, s), toward(gl_VertexID / n.x, n.y, cam.y, s));
-    ivec3 cell = ivec3(origin.x + block.x * s, in_segment.y * s, origin.y + block.y * s);
-    v_octaves = vec4(0.0);
-    v_slope = vec3(0.0);
-    v_ambient = vec3(0.0);
-    v_sun = vec3(0.0);
-    v_center = vec3(0.0);
-    v_radius = 0.0;
-    v_tau = 0.0;
-    v_falloff = 1.0;
-    v_conic = vec3(1.0, 0.0, 1.0);
-    v_coverage = 0.0;
-    v_stretch = 1.0;
-    gl_PointSize = 1.0;
-    gl_Position = CULLED;
-    if (any(greaterThanEqual(cell, volume_shape))) return;
-    float sum = 0.0;
-    vec3 first = vec3(0.0), second = vec3(0.0);   // density-weighted cell centres from the block's corner, and squares
-    for (int z = 0; z < s; ++z)
-        for (int y = 0; y < s; ++y)
-            for (int x = 0; x < s; ++x) {
-                ivec3 c = cell + ivec3(x, y, z);
-                ivec3 ca = c + a_shift;              // A's cell at the same world point; past its edge: empty
-                float da = all(greaterThanEqual(ca, ivec3(0))) && all(lessThan(ca, volume_shape))
-                    ? texelFetch(density_a, ca, 0).r : 0.0;
-                if (all(lessThan(c, volume_shape))) {
-                    float dc = mix(da, texelFetch(density_b, c, 0).r, t);
-                    vec3 o = vec3(x, y, z) + 0.5;
-                    sum += dc;
-                    first += dc * o;
-                    second += dc * o * o;
-                }
-            }
-    if (!(sum > 0.0)) return;
-    // the sprite at the block's centre of mass, lit by the mean J of its mass (HAT_SPREAD)
-    vec3 mean = first / sum;
-    vec3 cells_var = max(second / sum - mean * mean, 0.0);      // of the block's cell centres, cells²
-    vec3 spread = sqrt(cells_var + HAT_SPREAD);
-    vec3 center = vec3(cell) + mean;
-    sum *= cloud_edge_weight((vec2(cell.xz) + 0.5 * float(s)) / vec2(volume_shape.xz), edge_fade);
-    if (!(sum > 0.0)) return;
-    vec3 world = layer_min + center * cell_size;
-    vec4 clip = view_proj * vec4(world, 1.0);
-    float diameter = float(s) * base_diameter;
-    // the perspective's Jacobian at the sprite (EWA splatting): off-axis a blob's depth projects
-    // sideways, so its footprint and the spacing of its neighbours stretch by up to sqrt(1 + |m|²)
-    // radially; without it the footprint is too narrow there and the grid shows (particle.py)
-    vec3 rel = world - camera_pos, forward = cross(camera_up, camera_right);
-    vec2 m = clamp(vec2(dot(rel, camera_right), dot(rel, camera_up)) / max(dot(rel, forward), near),
-                   -MAX_OFF_AXIS, MAX_OFF_AXIS);       // behind the camera: culled anyway, no degenerate axes
-    float stretch = sqrt(1.0 + dot(m, m));
-    vec3 axis_x = (camera_right - m.x * forward) / stretch, axis_y = (camera_up - m.y * forward) / stretch;
-    float px = stretch * diameter * pixel_scale / max(clip.w, 1e-6);
-    float c = clamp(px, 0.0, 1.0);
-    v_coverage = c * c * clamp((clip.w - near) / diameter, 0.0, 1.0);   // no pop when the near plane clips it
-    gl_PointSize = clamp(px, 1.0, max_point_size);
-    // the footprint: the block's mass (its cells' spread + each cell's, world m², diagonal) through
-    // the Jacobian (axis_x, axis_y), in the point's half sides (stretch radii); the profile is that
-    // Gaussian cut to 0 at the iso-line whose long axis is the half side (particle.py)
-    float radius = 0.5 * diameter;
-    vec3 mass_var = (cells_var + CELL_VARIANCE) * cell_size * cell_size / (radius * radius);
-    vec3 cov = vec3(dot(axis_x * axis_x, mass_var), dot(axis_x * axis_y, mass_var), dot(axis_y * axis_y, mass_var));
-    float det = cov.x * cov.z - cov.y * cov.y;
-    float longest = 0.5 * (cov.x + cov.z) + sqrt(0.25 * (cov.x - cov.z) * (cov.x - cov.z) + cov.y * cov.y);
-    float k = max(0.5 / longest, MIN_FALLOFF), e = exp(-k);
-    v_conic = vec3(cov.z, -cov.y, cov.x) / det;
-    v_falloff = k;
-    v_tau = tau_scale * sum * (1.0 - e) / (2.0 * PI * sqrt(det) * radius * radius * stretch * (1.0 - e - k * e));
-    v_stretch = stretch;
-    vec3 ray = normalize(world - camera_pos);
-    vec3 uvw = center / vec3(volume_shape);
-    vec2 col = cloud_columns(uvw);
-    float up = col.x, down = col.y;
-    vec4 octaves = vec4(0.0);
-    vec3 slope = vec3(0.0);                        // sum of side × log T over the taps
-    for (int i = 0; i < 8; ++i) {
-        vec3 side = vec3((i & 1) == 0 ? -1.0 : 1.0, (i & 2) == 0 ? -1.0 : 1.0, (i & 4) == 0 ? -1.0 : 1.0);
-        float T = cloud_transmittance(uvw + side * spread / vec3(volume_shape));
-        octaves += octave_weights(T);
-        slope += side * log(max(T, MIN_T));
-    }
-    // log T's gradient (1/m) fitted to the taps, on the sprite's screen axes per unit of point coordinate
-    // (sprite.frag's pc: a half side stretch × radius long): the sun's light varies across the sprite as
-    // T does, exp(e_i (h.pc - e_i h^T cov h / 2)) per octave (e = octave_exponents()), a mean of 1 over the footprint's Gaussian
-    vec3 g = slope / (8.0 * spread * cell_size);
-    vec2 h = clamp(stretch * 0.5 * diameter * vec2(dot(g, camera_right), dot(g, camera_up)), -MAX_SLOPE, MAX_SLOPE);
-    v_slope = vec3(h, 0.5 * dot(h, vec2(cov.x * h.x + cov.y * h.y, cov.y * h.x + cov.z * h.y)));
-    v_octaves = octaves / 8.0;
-    v_ambient = ambient_source(up, down, ray.y);
-    v_field = ms_diffusion > 0.0 ? cloud_diffusion(uvw) : vec4(0.0);
-    v_sun = sun_source_at(uvw.y);
-    v_center = world;
-    v_radius = 0.5 * diameter;
-    // depth-tested at its front (the centre pulled a radius toward the camera, x and y unmoved): a
-    // sprite whose centre is just behind a surface still shows the part of its mass in front (sprite.frag)
-    float front = max(clip.w - v_radius, near);
-    float ndc = (far + near) / (far - near) - 2.0 * far * near / ((far - near) * front);
-    gl_Position = vec4(clip.xy, min(ndc, 1.0) * clip.w, clip.w);
+    Sprite o;
+    sprite_setup(in_segment, gl_VertexID, o);
+    gl_Position = o.position;
+    gl_PointSize = o.point_size;
+    v_octaves = o.octaves;
+    v_slope = o.slope;
+    v_ambient = o.ambient;
+    v_field = o.field;
+    v_sun = o.sun;
+    v_center = o.center;
+    v_radius = o.radius;
+    v_tau = o.tau;
+    v_conic = o.conic;
+    v_falloff = o.falloff;
+    v_coverage = o.coverage;
+    v_stretch = o.stretch;
 }
