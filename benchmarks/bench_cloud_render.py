@@ -8,7 +8,8 @@ A plain script (``python benchmarks/bench_cloud_render.py [--quick]``):
    (VFD), VFD + empty-space skipping (ESS), full resolution) and ours (the sprites off screen at
    1/2 resolution, plus levels of detail); render-graph time of the whole frame (sky, ground,
    clouds; no simulation slices), ``ctx.finish()`` per frame, median of 20 frames; printed beside
-   the thesis's fps and speed-ups.
+   the thesis's fps and speed-ups. "ms" draws blended points, "splat ms" the same sprites splatted in
+   compute (``splat="compute"``), side by side.
 2. 96×16×96 cells at 480×360: RMSE (display values 0..1) of the sprite image against the
    reference ray march of the same volume (``RaymarchCloudsPlugin.reference()``) against frame time, per group size × sprite size
    factor × culling, and per downsample × level of detail; a table and ``out/bench_cloud_render.png``.
@@ -107,9 +108,13 @@ def culling_rows(gpu, shape, frames: int = 20, cell=(20.0, 10.0, 20.0)) -> list[
         none_ms = {}
         for i, (label, config) in enumerate(CONFIGS.items()):
             configure(renderer, *config)
+            renderer.configure(splat="compute")
+            splat_ms = render_ms(app, frames)
+            renderer.configure(splat="points")
             ms = render_ms(app, frames)
             none_ms.setdefault(config[2], ms)                # the first row at each resolution is "none"
             rows.append({"cover": level, "actual_cover": cover, "config": label, "ms": ms, "fps": 1e3 / ms,
+                         "splat_ms": splat_ms, "x_splat": ms / splat_ms,
                          "sprites": renderer.stats.sprites, "x_none": none_ms[1] / ms,
                          "x_same_res_none": none_ms[config[2]] / ms,
                          "thesis_fps": THESIS[level][i] if i < 3 else None,
@@ -125,13 +130,13 @@ def culling_table(quick: bool) -> None:
           f"{gpu.ctx.info['GL_RENDERER']}" + ("  [--quick: SMALLER than the thesis's setup]" if quick else ""))
     print("   thesis rows: full resolution, no LOD (Tables 8.2-8.4); ours add the off-screen 1/2-res target "
           "and levels of detail")
-    print(f"{'cover':>6} {'actual':>6} | {'config':>25} {'ms':>7} {'fps':>6} {'sprites':>8} {'x none':>6} "
-          f"{'x same-res none':>15} | {'thesis fps':>10} {'thesis x':>8}")
+    print(f"{'cover':>6} {'actual':>6} | {'config':>25} {'ms':>7} {'fps':>6} {'splat ms':>8} {'x splat':>7} "
+          f"{'sprites':>8} {'x none':>6} {'x same-res none':>15} | {'thesis fps':>10} {'thesis x':>8}")
     rows = culling_rows(gpu, shape, 8 if quick else 20)
     for r in rows:
         thesis = f"{r['thesis_fps']:>10} {r['thesis_x']:>7.1f}x" if r["thesis_fps"] else ""
         print(f"{r['cover']:>6} {r['actual_cover']:>6.0%} | {r['config']:>25} {r['ms']:>7.1f} {r['fps']:>6.1f} "
-              f"{r['sprites']:>8} {r['x_none']:>5.1f}x {r['x_same_res_none']:>14.1f}x | {thesis}")
+              f"{r['splat_ms']:>8.1f} {r['x_splat']:>6.2f}x {r['sprites']:>8} {r['x_none']:>5.1f}x {r['x_same_res_none']:>14.1f}x | {thesis}")
         if r["config"] == list(CONFIGS)[-1]:
             print(f"{'':>6} {'':>6} | goal: culling speed-up >= thesis x{THESIS_SPEEDUP[r['cover']]}")
     gpu.release()
