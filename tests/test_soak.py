@@ -19,9 +19,9 @@ def census():
 
 
 def test_a_short_soak_has_no_errors_and_flat_gl_objects(census):
-    result = bench_soak.soak(1200, seed=1, census=census)
+    result = bench_soak.soak(600, seed=1, census=census)        # 5 cycles of the 6 window sizes
     assert result["errors"] == []
-    assert result["refused"] == 5 and result["warnings"] == result["bad_ellipsoids"] == 2
+    assert result["refused"] == 3 and result["warnings"] == result["bad_ellipsoids"] == 1
     first, last = bench_soak.quarter_max(result["objects"])
     assert last <= first, f"live GL objects grew from {first} to {last} over the soak"
     assert result["objects"][-1] <= first
