@@ -84,7 +84,7 @@ def frame_without(app, renderer, gpu):
 
 def test_long_tile_lists_sort_and_stop_at_an_opaque_front(gpu, ctx, monkeypatch):
     """Full cover seen from below through the whole layer: hundreds of sprites per tile to sort, most of
-    them behind an opaque front."""
+    them behind an opaque front; sorted in shared memory or in place, the same image."""
     monkeypatch.setattr(CloudSpritePass, "clip_centres", True)
     app, renderer = scene(gpu, cloud_density=1000, warmup=10, size_factor=6.0)
     look(app, (480.0, 60.0, 480.0), (480.0, 400.0, 470.0))
@@ -94,6 +94,9 @@ def test_long_tile_lists_sort_and_stop_at_an_opaque_front(gpu, ctx, monkeypatch)
     n = int(np.prod([-(-s // 16) for s in gpu.size]))
     assert np.diff(tiles[:n + 1].astype(np.int64)).max() > 256      # more than one entry per invocation to sort
     assert_same(points, splat, "full_cover")
+    monkeypatch.setattr(CloudSpritePass, "shared_sort", 64)         # the lists sorted in place instead
+    app.render()
+    np.testing.assert_array_equal(gpu.read_pixels().astype(float), splat)
     app.close()
 
 

@@ -175,6 +175,7 @@ class CloudSpritePass(RenderPass):
     phase = "translucent"
     exclusive = CLOUD_VOLUME                # never on beside the ray march (a GraphError names both)
     clip_centres = False    # the splat drops sprites whose centre is off screen, as GL clips points (to compare)
+    shared_sort = 2048      # the splat sorts tile lists up to this long in shared memory (16 KiB), longer in place
 
     def __init__(self, plugin: CloudRenderPlugin):
         self.plugin = plugin
@@ -316,7 +317,8 @@ class CloudSpritePass(RenderPass):
             if distance:
                 images["distance_image"] = frame.image(CLOUD_LOW_DISTANCE)
         defines = {"setup": {"SPLAT_CLIP_CENTRES": int(self.clip_centres)}, "scan": None, "bin": None,
-                   "blend": {"SPLAT_OVER": int(factor == 1), "SPLAT_DISTANCE": int(distance)}}
+                   "blend": {"SPLAT_OVER": int(factor == 1), "SPLAT_DISTANCE": int(distance),
+                             "SPLAT_SHARED_SORT": int(self.shared_sort)}}
         programs = tuple(gpu.program(compute_shader=f"clouds/sprites/splat_{stage}.comp", defines=defines[stage])
                          for stage in defines)
         lit = (programs[0], programs[3])

@@ -1,8 +1,8 @@
 #version 430
-// The compute splat, 4 of 4: one work group per tile sorts the tile's entries by key (a bitonic sort
-// in place, every compare-exchange putting the smaller first, so the list's padding to a power of two
-// stays virtual), then each pixel blends its sprites front to back (premultiplied: C += T (J a),
-// T *= 1 − a) and stops once T < 1/255. The point's rasterization, its depth test at the sprite's front
+// The compute splat, 4 of 4: one work group per tile sorts the tile's entries by key (a bitonic sort,
+// in shared memory up to SPLAT_SHARED_SORT entries, else in place; every compare-exchange puts the
+// smaller first, so the list's padding to a power of two stays virtual), then each pixel blends its
+// sprites front to back (premultiplied: C += T (J a), T *= 1 − a) and stops once T < 1/255. The point's rasterization, its depth test at the sprite's front
 // (<=) and the fragment (sprite.glsl sprite_shade) are the point draw's. Then onto the target: over
 // it (SPLAT_OVER: the frame's colour, C + T · colour) or stored (a low-res target, alpha 1 − T); the
 // distance (a·distance, a) likewise onto "cloud_distance" with SPLAT_DISTANCE.
@@ -18,50 +18,106 @@ layout(binding = 0, rgba16f) uniform image2D color_image;
 layout(binding = 1, rg32f) uniform image2D distance_image;
 #endif
 const float OPAQUE = 1.0 / 255.0;       // T below this: the sprites behind are not looked at
+const uint GROUP = 256u;
+#ifndef SPLAT_SHARED_SORT
+#define SPLAT_SHARED_SORT 2048          // lists up to this long are sorted in shared memory (16 KiB)
+#endif
+shared uvec2 sorting[SPLAT_SHARED_SORT];
+shared ivec4 batch_rect[GROUP];         // a batch of the list, front first: what the pixels test before shading
+shared vec4 batch_head[GROUP];
+shared uint batch_record[GROUP];
+shared uint finished;                   // pixels of the tile done (opaque, or outside the target)
+
+// The compare-exchange pairs of stage k, step j of the bitonic sort whose every pair puts the smaller
+// first: the first step of a stage pairs mirror images in blocks of k ("flip"), the others halves.
+uvec2 bitonic_pair(uint t, uint k, uint j) {
+    uint base = (t / j) * 2u * j, off = t % j;
+    return uvec2(base + off, j == k >> 1 ? base + 2u * j - 1u - off : base + off + j);
+}
 
 void main() {
     uint tile = gl_WorkGroupID.y * uint(tiles.x) + gl_WorkGroupID.x, id = gl_LocalInvocationIndex;
     uint cap = entry_capacity;
     uint begin = min(tile_offset[tile], cap), n = min(tile_offset[tile + 1u], cap) - begin;
+    // the sort (barriers in main only, in uniform control flow: n is the work group's)
     uint size = 1u;
     while (size < n) size <<= 1;
-    for (uint k = 2u; k <= size; k <<= 1)
-        for (uint j = k >> 1; j > 0u; j >>= 1) {
-            for (uint t = id; t < size >> 1; t += 256u) {
-                uint base = (t / j) * 2u * j, off = t % j;
-                uint a = base + off, b = j == k >> 1 ? base + 2u * j - 1u - off : a + j;   // flip, then halves
-                if (b < n) {
-                    uvec2 ea = entries[begin + a], eb = entries[begin + b];
-                    if (ea.x > eb.x) {
-                        entries[begin + a] = eb;
-                        entries[begin + b] = ea;
+    if (n <= uint(SPLAT_SHARED_SORT)) {
+        for (uint i = id; i < n; i += GROUP)
+            sorting[i] = entries[begin + i];
+        barrier();
+        for (uint k = 2u; k <= size; k <<= 1)
+            for (uint j = k >> 1; j > 0u; j >>= 1) {
+                for (uint t = id; t < size >> 1; t += GROUP) {
+                    uvec2 ab = bitonic_pair(t, k, j);
+                    if (ab.y < n && sorting[ab.x].x > sorting[ab.y].x) {
+                        uvec2 e = sorting[ab.x];
+                        sorting[ab.x] = sorting[ab.y];
+                        sorting[ab.y] = e;
                     }
                 }
+                barrier();
             }
-            memoryBarrierBuffer();
-            barrier();
-        }
+    } else {
+        for (uint k = 2u; k <= size; k <<= 1)
+            for (uint j = k >> 1; j > 0u; j >>= 1) {
+                for (uint t = id; t < size >> 1; t += GROUP) {
+                    uvec2 ab = bitonic_pair(t, k, j);
+                    if (ab.y < n) {
+                        uvec2 ea = entries[begin + ab.x], eb = entries[begin + ab.y];
+                        if (ea.x > eb.x) {
+                            entries[begin + ab.x] = eb;
+                            entries[begin + ab.y] = ea;
+                        }
+                    }
+                }
+                memoryBarrierBuffer();
+                barrier();
+            }
+    }
+    memoryBarrierBuffer();
+    barrier();
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
-    if (any(greaterThanEqual(px, target_size))) return;
-    float depth = texelFetch(scene_depth, px, 0).r, scene = view_depth(depth, near, far);
+    bool inside = all(lessThan(px, target_size));
+    float depth = inside ? texelFetch(scene_depth, px, 0).r : 1.0, scene = view_depth(depth, near, far);
     vec2 centre = vec2(px) + 0.5;
     vec3 C = vec3(0.0);
     vec2 D = vec2(0.0);
     float T = 1.0;
-    for (uint e = n; e > 0u && T >= OPAQUE; --e) {
-        uint r = entries[begin + e - 1u].y * uint(RECORD);
-        ivec4 rect = floatBitsToInt(records[r + 9u]);
-        if (any(lessThan(px, rect.xy)) || any(greaterThan(px, rect.zw))) continue;
-        vec4 r0 = records[r];
-        if (r0.w > depth) continue;                          // the point draw's depth test (<=)
-        vec4 r1 = records[r + 1u], r2 = records[r + 2u], r3 = records[r + 3u];
-        Sprite o = Sprite(vec4(0.0), 2.0 * r0.z, records[r + 4u], records[r + 5u].xyz, records[r + 6u].xyz,
-                          records[r + 7u], records[r + 8u].xyz, r3.xyz, r2.w, r2.x, r1.xyz, r1.w, r2.y, r2.z);
-        vec4 s = sprite_shade(o, (centre - r0.xy) / r0.z, scene, r3.w);
-        C += T * s.rgb;
-        D += T * vec2(s.a * length(o.center - camera_pos), s.a);
-        T *= 1.0 - s.a;
+    bool done = !inside;
+    // batches of GROUP entries from the front of the list: loaded together into shared memory, tested
+    // by every pixel there (rectangle, depth), shaded from the record where one covers; once every
+    // pixel of the tile is opaque the rest of the list is left
+    for (uint end = n; end > 0u; end -= min(end, GROUP)) {
+        uint count = min(end, GROUP);
+        if (id == 0u) finished = 0u;
+        barrier();
+        if (id < count) {
+            uint at = end - 1u - id, record = n <= uint(SPLAT_SHARED_SORT) ? sorting[at].y : entries[begin + at].y;
+            batch_record[id] = record;
+            batch_rect[id] = floatBitsToInt(records[record * uint(RECORD) + 9u]);
+            batch_head[id] = records[record * uint(RECORD)];
+        }
+        if (done) atomicAdd(finished, 1u);
+        barrier();
+        if (finished == GROUP) break;
+        for (uint k = 0u; k < count && !done; ++k) {
+            ivec4 rect = batch_rect[k];
+            vec4 r0 = batch_head[k];
+            if (any(lessThan(px, rect.xy)) || any(greaterThan(px, rect.zw)) || r0.w > depth) continue;  // <=: the depth test
+            uint r = batch_record[k] * uint(RECORD);
+            vec4 r1 = records[r + 1u], r2 = records[r + 2u], r3 = records[r + 3u];
+            Sprite o = Sprite(vec4(0.0), 2.0 * r0.z, records[r + 4u], records[r + 5u].xyz, records[r + 6u].xyz,
+                              records[r + 7u], records[r + 8u].xyz, r3.xyz, r2.w, r2.x, r1.xyz, r1.w, r2.y, r2.z);
+            vec4 s = sprite_shade(o, (centre - r0.xy) / r0.z, scene, r3.w);
+            C += T * s.rgb;
+            D += T * vec2(s.a * length(o.center - camera_pos), s.a);
+            T *= 1.0 - s.a;
+            done = T < OPAQUE;
+        }
+        barrier();
     }
+    if (!inside) return;
 #if SPLAT_OVER
     vec4 under = imageLoad(color_image, px);
     imageStore(color_image, px, vec4(C + T * under.rgb, 1.0 - T + T * under.a));
