@@ -221,3 +221,18 @@ def test_a_time_budget_reads_slice_timer_queries_without_waiting(fresh_gpu, monk
     assert app.frames.slices_last_frame == 4                  # the budget runs on the costs that came in
     app.close()
     assert fresh_gpu.queries.in_use == 0
+
+
+def test_a_fence_says_when_the_gpu_is_done_without_waiting(ctx, monkeypatch):
+    from atmos.gpu import queries
+    buffer = ctx.buffer(reserve=4 << 20)
+    buffer.clear()
+    fence = queries.Fence()
+    assert fence._sync is not None, "the sync functions resolve on an EGL context"
+    ctx.finish()
+    assert fence.done() and fence._sync is None and fence.done()     # deleted once done, still done
+    fence.delete()
+    buffer.release()
+    monkeypatch.setattr(queries, "_sync_functions", lambda: None)     # no sync functions: done the second time
+    fallback = queries.Fence()
+    assert not fallback.done() and fallback.done()

@@ -67,23 +67,31 @@ def _library(*names):
     raise OSError(f"none of {names} loads")
 
 
-def gl_functions():
-    """The query functions for the context current in this thread (EGL or GLX), or None where
-    neither API has a current context or the functions do not resolve."""
+def _current_api():
+    """(api, get_proc) of the API (EGL or GLX) with a context current in this thread, or None."""
     for api in ("egl", "glx"):
         try:
             current, get_proc = _loader(api)
-            if not current():
-                continue
+            if current():
+                return api, get_proc
         except (OSError, AttributeError):
             continue
-        if api not in _LOADED:
-            try:
-                _LOADED[api] = _GL(get_proc)
-            except OSError:
-                _LOADED[api] = None
-        return _LOADED[api]
     return None
+
+
+def gl_functions():
+    """The query functions for the context current in this thread (EGL or GLX), or None where
+    neither API has a current context or the functions do not resolve."""
+    found = _current_api()
+    if found is None:
+        return None
+    api, get_proc = found
+    if api not in _LOADED:
+        try:
+            _LOADED[api] = _GL(get_proc)
+        except OSError:
+            _LOADED[api] = None
+    return _LOADED[api]
 
 
 class TimerQuery:
@@ -266,26 +274,22 @@ def query_pool(ctx) -> QueryPool:
 
 GL_SYNC_GPU_COMMANDS_COMPLETE = 0x9117
 GL_ALREADY_SIGNALED, GL_CONDITION_SATISFIED = 0x911A, 0x911C
-_SYNC: dict = {}                                     # get_proc -> (FenceSync, ClientWaitSync, DeleteSync) or None
+_SYNC: dict = {}                                     # api -> (FenceSync, ClientWaitSync, DeleteSync) or None
 
 
 def _sync_functions():
     """glFenceSync, glClientWaitSync and glDeleteSync of the current context's API, or None."""
-    for api in ("egl", "glx"):
-        try:
-            current, get_proc = _loader(api)
-            if not current():
-                continue
-        except (OSError, AttributeError):
-            continue
-        if api not in _SYNC:
-            names = [get_proc(n) for n in (b"glFenceSync", b"glClientWaitSync", b"glDeleteSync")]
-            _SYNC[api] = None if not all(names) else (
-                ctypes.CFUNCTYPE(ctypes.c_void_p, ctypes.c_uint, ctypes.c_uint)(names[0]),
-                ctypes.CFUNCTYPE(ctypes.c_uint, ctypes.c_void_p, ctypes.c_uint, ctypes.c_uint64)(names[1]),
-                ctypes.CFUNCTYPE(None, ctypes.c_void_p)(names[2]))
-        return _SYNC[api]
-    return None
+    found = _current_api()
+    if found is None:
+        return None
+    api, get_proc = found
+    if api not in _SYNC:
+        names = [get_proc(n) for n in (b"glFenceSync", b"glClientWaitSync", b"glDeleteSync")]
+        _SYNC[api] = None if not all(names) else (
+            ctypes.CFUNCTYPE(ctypes.c_void_p, ctypes.c_uint, ctypes.c_uint)(names[0]),
+            ctypes.CFUNCTYPE(ctypes.c_uint, ctypes.c_void_p, ctypes.c_uint, ctypes.c_uint64)(names[1]),
+            ctypes.CFUNCTYPE(None, ctypes.c_void_p)(names[2]))
+    return _SYNC[api]
 
 
 class Fence:
