@@ -202,7 +202,8 @@ def cloud_change(app, img):
     return np.abs(luminance(img) - luminance(render(app, clouds=False)))
 
 
-SEEDS = range(4)              # realisations of the far field's pattern the outside band is averaged over
+SEEDS = range(4)              # realisations of the far field's pattern the outside band is averaged over (at most
+                              # 0.26 of the volume off over the cases, TOLERANCE 0.35)
 
 
 def across_the_border(app, look, metric, seeds=SEEDS) -> tuple[float, float]:
@@ -239,7 +240,6 @@ def test_clouds_have_no_step_at_the_volume_edge(scenes, demo, view, clouds):
     look, metric = (ground_view, coverage) if view == "ground" else (above_view, cloud_change)
     border, elsewhere = seam_outliers(*panorama(app, look, metric))
     outside, volume = across_the_border(app, look, metric)
-    print(f"MARGIN {demo} {view} {clouds}: far {outside:.3f} volume {volume:.3f} rel {abs(outside - volume) / volume:.3f} border {border:.2f} elsewhere {elsewhere:.2f}")
     assert volume > 0.01, f"{demo}: the volume is seen ({volume:.3f})"
     assert abs(outside - volume) < TOLERANCE * volume, f"{demo} {view}: far field {outside:.3f} vs the volume {volume:.3f}"
     assert border < OUTLIER_FACTOR * elsewhere, f"{demo} {view}: column outlier {border:.1f} at the border vs {elsewhere:.1f} elsewhere"
