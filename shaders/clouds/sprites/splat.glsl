@@ -7,10 +7,14 @@ const int RECORD = 10;
 const uint SPRITES = 0u;      // counters: drawn sprites
 const uint ENTRIES = 1u;      // counters: entries the tiles need (entry_capacity holds what fits)
 layout(std430, binding = 0) buffer SplatCounters { uint counters[]; };
-layout(std430, binding = 1) buffer SplatRecords { vec4 records[]; };
+layout(std430, binding = 1) buffer SplatRecords { uvec4 records[]; };   // floats as their bits: keys and rectangles
+                                                                       // stay integers (no float path to flush them)
 layout(std430, binding = 2) buffer SplatTiles { uint tile_count[]; };   // per tile: its count, then its cursor
 layout(std430, binding = 3) buffer SplatOffsets { uint tile_offset[]; };  // per tile + 1: exclusive sums
 layout(std430, binding = 4) buffer SplatEntries { uvec2 entries[]; };
 uniform ivec2 target_size;    // pixels of the target drawn into
 uniform ivec2 tiles;          // tiles per row and column
 uniform uint entry_capacity;  // entries the list holds
+
+vec4 record(uint i) { return uintBitsToFloat(records[i]); }
+void put_record(uint i, vec4 v) { records[i] = floatBitsToUint(v); }

@@ -9,8 +9,8 @@ void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= counters[SPRITES]) return;
     uint r = i * uint(RECORD);
-    uint key = floatBitsToUint(records[r + 5u].w);
-    ivec4 rect = floatBitsToInt(records[r + 9u]);
+    uint key = records[r + 6u].w;
+    ivec4 rect = ivec4(records[r + 9u]);
     ivec2 t0 = rect.xy / TILE, t1 = rect.zw / TILE;
     for (int y = t0.y; y <= t1.y; ++y)
         for (int x = t0.x; x <= t1.x; ++x) {

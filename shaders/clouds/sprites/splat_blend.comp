@@ -93,10 +93,10 @@ void main() {
         if (id == 0u) finished = 0u;
         barrier();
         if (id < count) {
-            uint at = end - 1u - id, record = n <= uint(SPLAT_SHARED_SORT) ? sorting[at].y : entries[begin + at].y;
-            batch_record[id] = record;
-            batch_rect[id] = floatBitsToInt(records[record * uint(RECORD) + 9u]);
-            batch_head[id] = records[record * uint(RECORD)];
+            uint at = end - 1u - id, index = n <= uint(SPLAT_SHARED_SORT) ? sorting[at].y : entries[begin + at].y;
+            batch_record[id] = index;
+            batch_rect[id] = ivec4(records[index * uint(RECORD) + 9u]);
+            batch_head[id] = record(index * uint(RECORD));
         }
         if (done) atomicAdd(finished, 1u);
         barrier();
@@ -106,9 +106,9 @@ void main() {
             vec4 r0 = batch_head[k];
             if (any(lessThan(px, rect.xy)) || any(greaterThan(px, rect.zw)) || r0.w > depth) continue;  // <=: the depth test
             uint r = batch_record[k] * uint(RECORD);
-            vec4 r1 = records[r + 1u], r2 = records[r + 2u], r3 = records[r + 3u];
-            Sprite o = Sprite(vec4(0.0), 2.0 * r0.z, records[r + 4u], records[r + 5u].xyz, records[r + 6u].xyz,
-                              records[r + 7u], records[r + 8u].xyz, r3.xyz, r2.w, r2.x, r1.xyz, r1.w, r2.y, r2.z);
+            vec4 r1 = record(r + 1u), r2 = record(r + 2u), r3 = record(r + 3u);
+            Sprite o = Sprite(vec4(0.0), 2.0 * r0.z, record(r + 4u), record(r + 5u).xyz, record(r + 6u).xyz,
+                              record(r + 7u), record(r + 8u).xyz, r3.xyz, r2.w, r2.x, r1.xyz, r1.w, r2.y, r2.z);
             vec4 s = sprite_shade(o, (centre - r0.xy) / r0.z, scene, r3.w);
             C += T * s.rgb;
             D += T * vec2(s.a * length(o.center - camera_pos), s.a);

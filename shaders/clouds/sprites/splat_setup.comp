@@ -38,16 +38,16 @@ void main() {
     uint i = atomicAdd(counters[SPRITES], 1u);
     if (i >= record_capacity) return;
     uint r = i * uint(RECORD);
-    records[r] = vec4(c, half_side, p.z / p.w * 0.5 + 0.5);
-    records[r + 1u] = vec4(o.conic, o.falloff);
-    records[r + 2u] = vec4(o.tau, o.coverage, o.stretch, o.radius);
-    records[r + 3u] = vec4(o.center, p.w);
-    records[r + 4u] = o.octaves;
-    records[r + 5u] = vec4(o.slope, uintBitsToFloat(uint(segment * unit_blocks + block)));
-    records[r + 6u] = vec4(o.ambient, 0.0);
-    records[r + 7u] = o.field;
-    records[r + 8u] = vec4(o.sun, 0.0);
-    records[r + 9u] = intBitsToFloat(ivec4(lo, hi));
+    put_record(r, vec4(c, half_side, p.z / p.w * 0.5 + 0.5));
+    put_record(r + 1u, vec4(o.conic, o.falloff));
+    put_record(r + 2u, vec4(o.tau, o.coverage, o.stretch, o.radius));
+    put_record(r + 3u, vec4(o.center, p.w));
+    put_record(r + 4u, o.octaves);
+    put_record(r + 5u, vec4(o.slope, 0.0));
+    records[r + 6u] = uvec4(floatBitsToUint(o.ambient), uint(segment * unit_blocks + block));   // w: the key
+    put_record(r + 7u, o.field);
+    put_record(r + 8u, vec4(o.sun, 0.0));
+    records[r + 9u] = uvec4(ivec4(lo, hi));
     ivec2 t0 = lo / TILE, t1 = hi / TILE;
     for (int y = t0.y; y <= t1.y; ++y)
         for (int x = t0.x; x <= t1.x; ++x)
