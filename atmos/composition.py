@@ -72,7 +72,8 @@ def media_mix(light_a, t_a, light_b, t_b) -> np.ndarray:
 @dataclass
 class Composition:
     """App resource: which plugins write ``"cloud_distance"`` and which read it (names); which local
-    media write ``"media_light"``/``"media_transmittance"`` and which passes read them."""
+    media write ``"media_light"``/``"media_transmittance"`` and which passes read them; which passes fill
+    the colour's background."""
     writers: set = field(default_factory=set)
     readers: set = field(default_factory=set)
     covers: dict = field(default_factory=dict)     # name -> () -> bool: that writer writes every pixel
@@ -80,6 +81,8 @@ class Composition:
     media_writers: set = field(default_factory=set)
     media_readers: set = field(default_factory=set)
     media_covers: dict = field(default_factory=dict)   # name -> () -> bool: that medium writes every pixel
+    backgrounds: set = field(default_factory=set)      # passes that write every pixel of "color" before the
+    #                                                    geometry (a sky: the depth is all 1 then), so the colour needs no clear
 
     @property
     def distance(self) -> bool:

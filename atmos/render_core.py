@@ -36,6 +36,7 @@ import moderngl
 import numpy as np
 
 from atmos.checks import CheckedSettings, bool_field, num_field, vec_field
+from atmos.composition import composition
 from atmos.hashing import lowbias32
 
 from atmos.graph import ComputePass, PassBuilder, PassContext, RenderPass, TextureDesc
@@ -112,13 +113,16 @@ def depth_desc(gpu) -> TextureDesc:
 
 class ClearPass(RenderPass):
     """Creates the scene's HDR ``color`` and ``depth`` textures and clears them: colour to
-    ``(*clear_color, 0)`` (alpha 0: open sky, see the module docstring), depth to 1."""
+    ``(*clear_color, 0)`` (alpha 0: open sky, see the module docstring), depth to 1. The colour is left
+    uncleared where a pass fills every pixel of it before the geometry (``Composition.backgrounds``: a sky,
+    which then writes every pixel, or the game's own frame)."""
     name = "clear"
     phase = "clear"
 
-    def __init__(self, gpu, plugin: "RenderCorePlugin"):
+    def __init__(self, gpu, plugin: "RenderCorePlugin", composition=None):
         self.gpu = gpu
         self.plugin = plugin
+        self.composition = composition
 
     def setup_key(self) -> tuple:
         return (self.gpu.size,)
@@ -128,6 +132,9 @@ class ClearPass(RenderPass):
         builder.create(DEPTH, depth_desc(self.gpu))
 
     def execute(self, frame: PassContext) -> None:
+        if self.composition is not None and self.composition.backgrounds:
+            frame.framebuffer(depth=DEPTH).clear(depth=1.0)
+            return
         fbo = frame.framebuffer(color=[COLOR], depth=DEPTH)
         fbo.use()
         fbo.clear(*self.plugin.settings.clear_color, 0.0, depth=1.0)
@@ -301,5 +308,5 @@ class RenderCorePlugin(Plugin):
         self.gpu = app.gpu
         self.inputs = present_inputs(app)
         app.graph.import_resource(SCREEN, lambda: app.gpu.target)
-        app.graph.add_pass(ClearPass(app.gpu, self))
+        app.graph.add_pass(ClearPass(app.gpu, self, composition(app)))
         app.graph.add_pass(PresentPass(self))

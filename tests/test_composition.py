@@ -334,3 +334,40 @@ def test_a_ray_march_makes_the_distance_itself_as_the_clear_and_blend_would(gpu,
     a = distance[..., 1]
     assert np.isfinite(distance).all() and a.max() > 0.5 and (a == 0).mean() > 0.2, "clouds and open sky"
     assert np.array_equal(distance, distance_cleared) and np.array_equal(image, image_cleared)
+
+
+@pytest.mark.parametrize("sky", ["sky", "sky_gradient"])
+def test_a_sky_fills_the_colour_so_the_clear_leaves_it(gpu, ctx, monkeypatch, sky):
+    """With a sky (which writes every pixel: the depth is all 1 before the geometry) the clear pass clears
+    the depth alone; the frame is bit-identical to one whose colour was cleared too. Without a sky the
+    colour is cleared."""
+    import moderngl
+
+    from atmos.plugins.ground import GroundPlugin
+    from atmos.plugins.sky import SkyPlugin
+    from atmos.plugins.sky_gradient import SkyGradientPlugin
+    cleared = []
+    clear = moderngl.Framebuffer.clear
+
+    def spy(self, *args, **kwargs):
+        cleared.append(len(self.color_attachments))
+        return clear(self, *args, **kwargs)
+
+    monkeypatch.setattr(moderngl.Framebuffer, "clear", spy)
+    app = App(gpu).add_plugins(DefaultPlugins(overlay=False), SkyPlugin() if sky == "sky" else SkyGradientPlugin(),
+                               GroundPlugin())
+    app.startup()
+    cam = app.resource(Camera)
+    cam.position, cam.pitch = np.array([0.0, 30.0, 0.0]), 0.1
+    comp = app.resource(Composition)
+    assert comp.backgrounds == {sky}
+    cleared.clear()
+    app.update(1 / 60)
+    kept = gpu.read_pixels()
+    assert cleared == [0], "the depth alone"
+    comp.backgrounds.clear()
+    cleared.clear()
+    app.update(0.0)
+    assert cleared == [1], "colour and depth"
+    np.testing.assert_array_equal(gpu.read_pixels(), kept)
+    app.close()

@@ -5,6 +5,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from atmos.checks import vec_field
+from atmos.composition import composition
 from atmos.graph import ComputePass, PassContext
 from atmos.gpu.uniforms import write_uniforms
 from atmos.plugin import Plugin
@@ -67,3 +68,10 @@ class SkyGradientPlugin(Plugin):
 
     def build(self, app) -> None:
         app.graph.add_pass(SkyGradientPass(self))
+        self.composition = composition(app)
+        self.composition.backgrounds.add("sky_gradient")     # it writes every pixel after the depth clear
+
+    def cleanup(self, app) -> None:
+        comp = getattr(self, "composition", None)
+        if comp is not None:
+            comp.backgrounds.discard("sky_gradient")
