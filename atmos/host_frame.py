@@ -18,6 +18,7 @@ import moderngl
 import numpy as np
 
 from atmos.checks import check_bool
+from atmos.composition import composition
 from atmos.graph import FullscreenPass, PassContext
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
@@ -90,3 +91,10 @@ class HostFramePlugin(Plugin):
         app.graph.import_resource(HOST_COLOR, self.color)
         app.graph.import_resource(HOST_DEPTH, self.depth)
         app.graph.add_pass(HostFramePass(self))
+        self.composition = composition(app)
+        self.composition.backgrounds.add(HostFramePass.name)    # the copy writes every pixel of the colour
+
+    def cleanup(self, app) -> None:
+        comp = getattr(self, "composition", None)
+        if comp is not None:
+            comp.backgrounds.discard(HostFramePass.name)
