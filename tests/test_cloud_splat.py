@@ -138,3 +138,38 @@ def test_auto_splats_on_a_gpu_and_draws_points_on_a_software_renderer(gpu, ctx):
     assert CloudRenderPlugin(splat="compute").settings.splat == "compute"
     with pytest.raises(ValueError, match="CloudRenderSettings.splat"):
         CloudRenderPlugin(splat="tiles")
+
+
+def test_the_tiles_hold_exactly_the_sprites_whose_squares_reach_them(gpu, ctx):
+    """The setup's records and the bin's lists against numpy: each sprite's pixel rectangle is the pixels
+    whose centres lie inside its point square (clamped to the target), each tile's list holds exactly the
+    sprites whose rectangles reach it, with their keys, and the keys are unique (the draw order is total)."""
+    app, renderer = scene(gpu, warmup=10, splat="compute", downsample=1)
+    look(app, *BELOW)
+    frame(app, gpu)
+    splat = renderer.sprite_pass.splat
+    n, needed = (int(v) for v in np.frombuffer(splat.counters.read(), np.uint32))
+    raw = np.frombuffer(splat.records.read(), np.uint32)[:n * 40].reshape(n, 10, 4)
+    head = raw[:, 0].view(np.float32)
+    c, half = head[:, :2], head[:, 2:3]
+    w, h = gpu.size
+    lo = np.maximum(np.ceil(c - half - np.float32(0.5)), 0).astype(np.int64)
+    hi = np.minimum(np.ceil(c + half - np.float32(0.5)) - 1, np.array([w - 1, h - 1])).astype(np.int64)
+    rect = raw[:, 9].view(np.int32).astype(np.int64)
+    np.testing.assert_array_equal(rect, np.concatenate([lo, hi], 1))
+    assert (lo <= hi).all() and n > 100
+    keys = raw[:, 6, 3]
+    assert len(np.unique(keys)) == n
+    tiles_x, tiles_y = -(-w // 16), -(-h // 16)
+    offsets = np.frombuffer(splat.tile_offset.read(), np.uint32)[:tiles_x * tiles_y + 1].astype(np.int64)
+    entries = np.frombuffer(splat.entries.read(), np.uint32)[:2 * needed].reshape(-1, 2)
+    assert offsets[-1] == needed and np.all(np.diff(offsets) >= 0)
+    t0, t1 = rect[:, :2] // 16, rect[:, 2:] // 16
+    for ty in range(tiles_y):
+        for tx in range(tiles_x):
+            tile = ty * tiles_x + tx
+            want = np.flatnonzero((t0[:, 0] <= tx) & (tx <= t1[:, 0]) & (t0[:, 1] <= ty) & (ty <= t1[:, 1]))
+            got = entries[offsets[tile]:offsets[tile + 1]]
+            np.testing.assert_array_equal(np.sort(got[:, 1]), want)
+            np.testing.assert_array_equal(got[:, 0], keys[got[:, 1]])
+    app.close()
