@@ -1,7 +1,8 @@
 """Point-sprite cloud rendering: frame time by cloud cover and culling (thesis Tables 8.2–8.4), and
 the sprite image's error against a ray-marched reference versus frame time.
 
-A plain script (``python benchmarks/bench_cloud_render.py [--quick]``):
+A plain script (``python benchmarks/bench_cloud_render.py [--quick | --work]``; ``--work`` alone: the
+sprites' per-frame work in sunset and flight at 1920×1080, points against the compute splat, as counts):
 
 1. 256×32×256 cells at 1024×768 (``--quick``: 128×16×128 at 512×384, labelled), low / medium /
    high cover (cover measured with ``sim.cover()``): the thesis's rows (no culling, frustum culling
@@ -251,8 +252,50 @@ def plot(rows) -> None:
     print(f"wrote {OUT}")
 
 
+def splat_work(demos=("sunset", "flight"), size=(1920, 1080), frames: int = 4) -> list[dict]:
+    """Per-frame work of the sprites in the demos (``--clouds sprites``) at ``size``: the pixels their point
+    squares cover (what blended points fill: the overdraw) against the sprite-pixel pairs the compute
+    splat tests and shades front to back (``SpriteSplat.count``); counts, not times, so the same on any
+    machine."""
+    from atmos.demo_registry import DemoSettings
+    from atmos.plugins.clouds.sprites.splat import SpriteSplat
+    from atmos.runner import build_app
+    rows = []
+    SpriteSplat.count = True
+    try:
+        for demo in demos:
+            gpu = create_headless(size)
+            app = build_app(demo, DemoSettings(size=size, headless=True, clouds="sprites"), gpu)
+            renderer = next(p for p in app.plugins if isinstance(p, CloudRenderPlugin))
+            renderer.configure(splat="compute")
+            app.run_frames(frames, 1 / 30)
+            work = renderer.sprite_pass.splat.work()
+            factor = renderer.settings.downsample
+            pixels = -(-size[0] // factor) * -(-size[1] // factor)
+            rows.append({"demo": demo, "pixels": pixels, **work, "overdraw": work["covered"] / pixels,
+                         "x_covered": work["covered"] / max(work["shaded"], 1)})
+            app.close()
+            gpu.release()
+    finally:
+        SpriteSplat.count = False
+    return rows
+
+
+def work_table() -> None:
+    print("\nsprite work per frame at 1920x1080 (off screen at 1/2): points fill every covered pixel, the "
+          "splat shades front to back until opaque")
+    print(f"{'demo':>8} {'pixels':>9} {'sprites':>9} {'covered':>11} {'overdraw':>8} {'tested':>11} {'shaded':>11} "
+          f"{'covered/shaded':>14}")
+    for r in splat_work():
+        print(f"{r['demo']:>8} {r['pixels']:>9} {r['sprites']:>9} {r['covered']:>11} {r['overdraw']:>8.1f} "
+              f"{r['tested']:>11} {r['shaded']:>11} {r['x_covered']:>13.1f}x")
+
+
 def main() -> None:
     quick = "--quick" in sys.argv
+    if "--work" in sys.argv:
+        work_table()
+        return
     start = time.perf_counter()
     culling_table(quick)
     plot(error_table())

@@ -140,15 +140,17 @@ def test_auto_splats_on_a_gpu_and_draws_points_on_a_software_renderer(gpu, ctx):
         CloudRenderPlugin(splat="tiles")
 
 
-def test_the_tiles_hold_exactly_the_sprites_whose_squares_reach_them(gpu, ctx):
+def test_the_tiles_hold_exactly_the_sprites_whose_squares_reach_them(gpu, ctx, monkeypatch):
     """The setup's records and the bin's lists against numpy: each sprite's pixel rectangle is the pixels
     whose centres lie inside its point square (clamped to the target), each tile's list holds exactly the
     sprites whose rectangles reach it, with their keys, and the keys are unique (the draw order is total)."""
+    monkeypatch.setattr(SpriteSplat, "count", True)
     app, renderer = scene(gpu, warmup=10, splat="compute", downsample=1)
     look(app, *BELOW)
     frame(app, gpu)
     splat = renderer.sprite_pass.splat
-    n, needed = (int(v) for v in np.frombuffer(splat.counters.read(), np.uint32))
+    work = splat.work()
+    n, needed = work["sprites"], work["entries"]
     raw = np.frombuffer(splat.records.read(), np.uint32)[:n * 40].reshape(n, 10, 4)
     head = raw[:, 0].view(np.float32)
     c, half = head[:, :2], head[:, 2:3]
@@ -158,6 +160,8 @@ def test_the_tiles_hold_exactly_the_sprites_whose_squares_reach_them(gpu, ctx):
     rect = raw[:, 9].view(np.int32).astype(np.int64)
     np.testing.assert_array_equal(rect, np.concatenate([lo, hi], 1))
     assert (lo <= hi).all() and n > 100
+    assert work["covered"] == int(np.prod(hi - lo + 1, axis=1).sum())      # what blended points would fill
+    assert 0 < work["shaded"] <= work["covered"] and work["shaded"] <= work["tested"]
     keys = raw[:, 6, 3]
     assert len(np.unique(keys)) == n
     tiles_x, tiles_y = -(-w // 16), -(-h // 16)

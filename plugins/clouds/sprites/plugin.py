@@ -316,9 +316,10 @@ class CloudSpritePass(RenderPass):
             images = {"color_image": frame.image(CLOUD_COLOR)}
             if distance:
                 images["distance_image"] = frame.image(CLOUD_LOW_DISTANCE)
-        defines = {"setup": {"SPLAT_CLIP_CENTRES": int(self.clip_centres)}, "scan": None, "bin": None,
-                   "blend": {"SPLAT_OVER": int(factor == 1), "SPLAT_DISTANCE": int(distance),
-                             "SPLAT_SHARED_SORT": int(self.shared_sort)}}
+        count = int(self.splat.count)
+        defines = {"setup": {"SPLAT_CLIP_CENTRES": int(self.clip_centres), "SPLAT_COUNT": count}, "scan": None,
+                   "bin": None, "blend": {"SPLAT_OVER": int(factor == 1), "SPLAT_DISTANCE": int(distance),
+                                          "SPLAT_SHARED_SORT": int(self.shared_sort), "SPLAT_COUNT": count}}
         programs = tuple(gpu.program(compute_shader=f"clouds/sprites/splat_{stage}.comp", defines=defines[stage])
                          for stage in defines)
         lit = (programs[0], programs[3])

@@ -38,10 +38,11 @@ class SpriteSplat:
     """The compute splat's programs' use and its buffers, for one :class:`CloudSpritePass`."""
 
     first_entries = 8    # list entries per submitted block before a frame's need has come back
+    count = False        # SPLAT_COUNT: the blend counts its work for :meth:`work` (a benchmark's; costs atomics)
     def __init__(self, gpu):
         self.gpu = gpu
         ctx = gpu.ctx
-        self.counters = ctx.buffer(reserve=8)
+        self.counters = ctx.buffer(reserve=20)
         self.records = self.tile_count = self.tile_offset = self.entries = None
         self.ring = [ctx.buffer(reserve=8) for _ in range(RING)]
         self.fences: list = [None] * RING
@@ -108,6 +109,13 @@ class SpriteSplat:
             frame.gpu.ctx.copy_buffer(ring, self.counters, 8)
             self.fences[self.slot] = Fence()
             self.slot = (self.slot + 1) % RING
+
+    def work(self) -> dict:
+        """The last frame's counts (waits for the GPU: a benchmark's, with ``count`` on): sprites drawn, the
+        pixels their point squares cover (what blended points fill), the sprite-pixel pairs the blend
+        tested and shaded, list entries."""
+        sprites, entries, covered, tested, shaded = (int(v) for v in np.frombuffer(self.counters.read(), np.uint32))
+        return {"sprites": sprites, "entries": entries, "covered": covered, "tested": tested, "shaded": shaded}
 
     def release(self) -> None:
         for fence in self.fences:

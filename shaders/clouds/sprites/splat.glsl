@@ -6,6 +6,11 @@ const int TILE = 16;
 const int RECORD = 10;
 const uint SPRITES = 0u;      // counters: drawn sprites
 const uint ENTRIES = 1u;      // counters: entries the tiles need (entry_capacity holds what fits)
+// with SPLAT_COUNT (a benchmark's work counts, splat.py SpriteSplat.work): the pixels the sprites' point
+// squares cover (what blended points would fill), the sprite-pixel pairs the blend tests, and those it shades
+const uint COVERED = 2u;
+const uint TESTED = 3u;
+const uint SHADED = 4u;
 layout(std430, binding = 0) buffer SplatCounters { uint counters[]; };
 layout(std430, binding = 1) buffer SplatRecords { uvec4 records[]; };   // floats as their bits: keys and rectangles
                                                                        // stay integers (no float path to flush them)

@@ -85,6 +85,9 @@ void main() {
     vec2 D = vec2(0.0);
     float T = 1.0;
     bool done = !inside;
+#if SPLAT_COUNT
+    uint tested = 0u, shaded = 0u;
+#endif
     // batches of GROUP entries from the front of the list: loaded together into shared memory, tested
     // by every pixel there (rectangle, depth), shaded from the record where one covers; once every
     // pixel of the tile is opaque the rest of the list is left
@@ -104,7 +107,13 @@ void main() {
         for (uint k = 0u; k < count && !done; ++k) {
             ivec4 rect = batch_rect[k];
             vec4 r0 = batch_head[k];
+#if SPLAT_COUNT
+            ++tested;
+#endif
             if (any(lessThan(px, rect.xy)) || any(greaterThan(px, rect.zw)) || r0.w > depth) continue;  // <=: the depth test
+#if SPLAT_COUNT
+            ++shaded;
+#endif
             uint r = batch_record[k] * uint(RECORD);
             vec4 r1 = record(r + 1u), r2 = record(r + 2u), r3 = record(r + 3u);
             Sprite o = Sprite(vec4(0.0), 2.0 * r0.z, record(r + 4u), record(r + 5u).xyz, record(r + 6u).xyz,
@@ -117,6 +126,10 @@ void main() {
         }
         barrier();
     }
+#if SPLAT_COUNT
+    atomicAdd(counters[TESTED], tested);
+    atomicAdd(counters[SHADED], shaded);
+#endif
     if (!inside) return;
 #if SPLAT_OVER
     vec4 under = imageLoad(color_image, px);

@@ -48,6 +48,9 @@ void main() {
     put_record(r + 7u, o.field);
     put_record(r + 8u, vec4(o.sun, 0.0));
     records[r + 9u] = uvec4(ivec4(lo, hi));
+#if SPLAT_COUNT
+    atomicAdd(counters[COVERED], uint((hi.x - lo.x + 1) * (hi.y - lo.y + 1)));
+#endif
     ivec2 t0 = lo / TILE, t1 = hi / TILE;
     for (int y = t0.y; y <= t1.y; ++y)
         for (int x = t0.x; x <= t1.x; ++x)
