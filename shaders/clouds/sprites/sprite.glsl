@@ -177,6 +177,7 @@ vec4 sprite_shade(Sprite o, vec2 pc, float scene, float depth) {
     float e = exp(-o.falloff), form = dot(pc * pc, o.conic.xz) + 2.0 * o.conic.y * pc.x * pc.y;
     float profile = max(exp(-0.5 * form) - e, 0.0) / (1.0 - e);
     float a = (1.0 - exp(-o.tau * profile)) * o.coverage * soft;
+    if (!(a > 0.0)) return vec4(0.0);              // past the footprint's cut (the square's corners) or behind the scene
     vec2 q = pc * (o.radius * o.stretch);          // the point's side spans stretch × diameter
     vec3 ray = normalize(o.center + q.x * camera_right + q.y * camera_up - camera_pos);
     vec4 ai = octave_exponents();                                        // octave i: exp(e_i (h.pc - e_i var))
