@@ -177,3 +177,18 @@ def test_the_tiles_hold_exactly_the_sprites_whose_squares_reach_them(gpu, ctx, m
             np.testing.assert_array_equal(np.sort(got[:, 1]), want)
             np.testing.assert_array_equal(got[:, 0], keys[got[:, 1]])
     app.close()
+
+
+def test_closing_the_app_releases_every_splat_object(gpu, ctx):
+    """The lists and the readback ring go with the pass, its fences deleted: nothing of the splat
+    outlives the App (its programs belong to the context's cache)."""
+    import moderngl
+    app, renderer = scene(gpu, warmup=10, splat="compute")
+    look(app, *BELOW)
+    app.run_frames(4)
+    splat = renderer.sprite_pass.splat
+    owned = [splat.counters, splat.records, splat.tile_count, splat.tile_offset, splat.entries, *splat.ring]
+    assert any(fence is not None for fence in splat.fences)
+    app.close()
+    assert all(isinstance(obj.mglo, moderngl.InvalidObject) for obj in owned)
+    assert renderer.sprite_pass.splat is None and all(fence is None for fence in splat.fences)
