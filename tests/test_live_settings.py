@@ -94,7 +94,7 @@ def culling_counters(app, plugin):
 def splatted(app, plugin):
     """The sprites the compute splat recorded in the last frame (0 while the points draw them: the same image)."""
     splat = plugin.sprite_pass.splat
-    return 0 if splat is None else int(np.frombuffer(splat.counters.read(), np.uint32)[0])
+    return 0 if splat is None else splat.work()["sprites"]
 
 
 STEPS: list = []        # (settings, dt) of every weather step, newest last (the scenes' step_weather records)

@@ -42,20 +42,22 @@ class SpriteSplat:
     def __init__(self, gpu):
         self.gpu = gpu
         ctx = gpu.ctx
-        self.counters = ctx.buffer(reserve=20)
+        self.counters = ctx.buffer(bytes(16))         # zero: the scan leaves it so for the next frame
         self.records = self.tile_count = self.tile_offset = self.entries = None
         self.ring = [ctx.buffer(reserve=8) for _ in range(RING)]
         self.fences: list = [None] * RING
         self.slot = 0
         self.needed = 0                  # the most entries a frame was seen to need
+        self.tiles = 0                   # the last frame's tiles
         self.dropped = 0                 # frames whose list was too short (read back late)
 
-    def _grow(self, name: str, nbytes: int):
+    def _grow(self, name: str, nbytes: int, zero: bool = False):
+        """Buffer ``name`` holding at least ``nbytes`` (made anew, zero-filled with ``zero``, when smaller)."""
         buffer, nbytes = getattr(self, name), max(int(nbytes), 16)
         if buffer is None or buffer.size < nbytes:
             if buffer is not None:
                 buffer.release()
-            buffer = self.gpu.ctx.buffer(reserve=nbytes)
+            buffer = self.gpu.ctx.buffer(bytes(nbytes)) if zero else self.gpu.ctx.buffer(reserve=nbytes)
             setattr(self, name, buffer)
         return buffer
 
@@ -63,7 +65,7 @@ class SpriteSplat:
         """The entries needed by frames whose fence is done (never waits)."""
         for i, fence in enumerate(self.fences):
             if fence is not None and fence.done():
-                needed = int(np.frombuffer(self.ring[i].read(), np.uint32)[1])
+                needed = int(np.frombuffer(self.ring[i].read(), np.uint32)[0])
                 if needed > self.entries.size // ENTRY_BYTES:
                     self.dropped += 1
                 self.needed = max(self.needed, needed)
@@ -77,18 +79,18 @@ class SpriteSplat:
         setup, scan, binning, blend = programs
         w, h = int(size[0]), int(size[1])
         tiles = (-(-w // TILE), -(-h // TILE))
-        count = tiles[0] * tiles[1]
+        count = self.tiles = tiles[0] * tiles[1]
         records = _pow2(max(sprites, 1))
         if self.entries is not None:
             self._read_back()
         capacity = _pow2(max(self.first_entries * records, self.needed + self.needed // 4, 1 << 10))
         self._grow("records", records * RECORD_BYTES)
-        self._grow("tile_count", 4 * count)
-        self._grow("tile_offset", 4 * (count + 1))
+        self._grow("tile_count", 4 * count, zero=True)       # the blend leaves it at 0 for the next frame
+        self._grow("tile_offset", 4 * (count + 2))
         self._grow("entries", capacity * ENTRY_BYTES)
         capacity = self.entries.size // ENTRY_BYTES
-        self.counters.clear()
-        self.tile_count.clear()
+        if self.count:
+            self.counters.write(bytes(16))      # the work counts (a benchmark's: it waits for the GPU)
         buffers = {"SplatCounters": self.counters, "SplatRecords": self.records, "SplatTiles": self.tile_count,
                    "SplatOffsets": self.tile_offset, "SplatEntries": self.entries}
         common = {"target_size": (w, h), "tiles": tiles, "entry_capacity": capacity}
@@ -104,9 +106,9 @@ class SpriteSplat:
         write_uniforms(blend, common)
         frame.dispatch(blend, tiles, textures=textures, images=images, buffers=buffers)
         if self.fences[self.slot] is None:
-            ring = self.ring[self.slot]
-            hazards_of(frame.gpu.ctx).use(reads=[(self.counters, "copy")], writes=[(ring, "copy")])
-            frame.gpu.ctx.copy_buffer(ring, self.counters, 8)
+            ring = self.ring[self.slot]             # the totals behind the offsets: (entries, sprites)
+            hazards_of(frame.gpu.ctx).use(reads=[(self.tile_offset, "copy")], writes=[(ring, "copy")])
+            frame.gpu.ctx.copy_buffer(ring, self.tile_offset, 8, read_offset=4 * count)
             self.fences[self.slot] = Fence()
             self.slot = (self.slot + 1) % RING
 
@@ -114,7 +116,8 @@ class SpriteSplat:
         """The last frame's counts (waits for the GPU: a benchmark's, with ``count`` on): sprites drawn, the
         pixels their point squares cover (what blended points fill), the sprite-pixel pairs the blend
         tested and shaded, list entries."""
-        sprites, entries, covered, tested, shaded = (int(v) for v in np.frombuffer(self.counters.read(), np.uint32))
+        entries, sprites = (int(v) for v in np.frombuffer(self.tile_offset.read(8, offset=4 * self.tiles), np.uint32))
+        _, covered, tested, shaded = (int(v) for v in np.frombuffer(self.counters.read(), np.uint32))
         return {"sprites": sprites, "entries": entries, "covered": covered, "tested": tested, "shaded": shaded}
 
     def release(self) -> None:

@@ -7,7 +7,8 @@ layout(local_size_x = 64) in;
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
-    if (i >= counters[SPRITES]) return;
+    uint drawn = min(tile_offset[uint(tiles.x * tiles.y) + 1u], uint(records.length()) / uint(RECORD));
+    if (i >= drawn) return;                              // the sprites drawn (the scan's total), as recorded
     uint r = i * uint(RECORD);
     uint key = records[r + 6u].w;
     ivec4 rect = ivec4(records[r + 9u]);

@@ -39,6 +39,7 @@ void main() {
     uint tile = gl_WorkGroupID.y * uint(tiles.x) + gl_WorkGroupID.x, id = gl_LocalInvocationIndex;
     uint cap = entry_capacity;
     uint begin = min(tile_offset[tile], cap), n = min(tile_offset[tile + 1u], cap) - begin;
+    if (id == 0u) tile_count[tile] = 0u;                 // the bin's cursor, back to 0 for the next frame
     // the sort (barriers in main only, in uniform control flow: n is the work group's)
     uint size = 1u;
     while (size < n) size <<= 1;

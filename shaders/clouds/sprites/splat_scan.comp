@@ -1,6 +1,7 @@
 #version 430
 // The compute splat, 2 of 4: the tiles' exclusive prefix sums of their counts (one work group, each
-// invocation a run of tiles), their total, and every count set back to 0 as the bin's cursor.
+// invocation a run of tiles), then the totals (entries, sprites drawn); every count set back to 0 as
+// the bin's cursor, and the sprites' counter for the next frame.
 layout(local_size_x = 1024) in;
 #include "clouds/sprites/splat.glsl"
 shared uint sums[1024];
@@ -28,6 +29,7 @@ void main() {
     }
     if (id == 1023u) {
         tile_offset[n] = sums[id];
-        counters[ENTRIES] = sums[id];
+        tile_offset[n + 1u] = counters[SPRITES];
+        counters[SPRITES] = 0u;                      // for the next frame's setup
     }
 }
