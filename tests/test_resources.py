@@ -245,3 +245,25 @@ def test_50_apps_on_one_context_reuse_the_same_queries(fresh_gpu, count_queries)
     # a pass takes a second query of its ring only while the first one's result is still out
     assert 0 < made[0] and made[-1] <= RING * kept, made
     assert fresh_gpu.queries.made == made[-1] and fresh_gpu.queries.in_use == 0
+
+
+def test_a_cleared_buffer_is_zeroed_by_a_queued_write_never_a_mapping(gpu, monkeypatch):
+    """A pooled buffer with ``clear`` comes back zero-filled each time, through glBufferSubData: moderngl's
+    Buffer.clear maps the buffer, which waits for the GPU to finish with it."""
+    import numpy as np
+
+    from atmos.graph import BufferDesc
+
+    def mapping(self, *args, **kwargs):
+        raise AssertionError("Buffer.clear maps the buffer (a wait for the GPU)")
+
+    pool = TexturePool(gpu)
+    desc = BufferDesc(64, clear=True)
+    buffer = pool.acquire(desc)
+    buffer.write(np.arange(16, dtype=np.uint32).tobytes())
+    pool.release(buffer)
+    monkeypatch.setattr(moderngl.Buffer, "clear", mapping)
+    again = pool.acquire(desc)
+    assert again is buffer and not any(again.read())
+    pool.release(again)
+    pool.release_all()

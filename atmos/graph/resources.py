@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import moderngl
 
@@ -101,6 +102,11 @@ class TextureDesc:
         return f"{size} {self.components}x{self.dtype} {self.filter}" + (" storage" if self.storage else "")
 
 
+@lru_cache(maxsize=32)
+def _zeros(size: int) -> bytes:
+    return bytes(size)
+
+
 @dataclass(frozen=True)
 class BufferDesc:
     """A transient GPU buffer of ``size`` bytes (a compute pass's list, counters or indirect arguments);
@@ -128,6 +134,11 @@ class BufferDesc:
     @property
     def nbytes(self) -> int:
         return self.size
+
+    @property
+    def zeros(self) -> bytes:
+        """``size`` zero bytes (what a cleared buffer is filled with), made once per size."""
+        return _zeros(self.size)
 
     def create(self, ctx: moderngl.Context, clear: bool = False):
         """A new moderngl buffer of this size (zero-filled)."""
@@ -167,7 +178,7 @@ class TexturePool:
         except (KeyError, IndexError):
             texture = self._create(desc)
         if type(desc) is BufferDesc and desc.clear:
-            texture.clear()
+            texture.write(desc.zeros)       # glBufferSubData: queued (moderngl's clear() maps it, waiting for the GPU)
         key = id(texture)
         self._in_use[key] = texture
         self._used[key] = self.frame
