@@ -7,11 +7,12 @@ its point square covers; ``scan`` turns the counts into offsets; ``bin`` writes 
 tiles' lists (the key: its place in the point draw's back-to-front order); ``blend`` sorts each tile's
 list by key and blends every pixel's sprites front to back until T < 1/255, then over the target (or,
 off screen, into it). The image is the point draw's up to float16 rounding of each blend there and the
-1/255 left out here.
+1/255 left out here, except that a sprite centred off screen (which GL clips) still draws its part.
 
 The lists' buffers belong to the pass: records for every block submitted, entries for 8 per block to
 start; the entries a frame needed come back through a ring of small buffers read once a fence says the
-GPU is done with them (never waiting), and the list grows to hold them from then on.
+GPU is done with them (never waiting), and the list grows to hold them from then on. Nothing is cleared
+from the CPU (a mapped clear waits for the GPU): the scan and the blend leave the counts at 0.
 """
 from __future__ import annotations
 
@@ -23,7 +24,7 @@ from atmos.gpu.uniforms import write_uniforms
 from atmos.graph import work_groups
 
 TILE = 16                # splat.glsl
-RECORD_BYTES = 160       # splat.glsl: RECORD vec4
+RECORD_BYTES = 160       # splat.glsl: RECORD uvec4
 ENTRY_BYTES = 8
 SETUP_GROUP = 64
 MAX_GROUPS_Y = 65535     # the least maximum work-group count GL guarantees per axis
@@ -31,6 +32,7 @@ RING = 3                 # readbacks of the entries needed in flight
 
 
 def _pow2(n: int) -> int:
+    """The least power of two >= n (at least 2): buffer sizes that settle instead of following every frame."""
     return 1 << max(int(n) - 1, 1).bit_length()
 
 
@@ -39,6 +41,7 @@ class SpriteSplat:
 
     first_entries = 8    # list entries per submitted block before a frame's need has come back
     count = False        # SPLAT_COUNT: the blend counts its work for :meth:`work` (a benchmark's; costs atomics)
+
     def __init__(self, gpu):
         self.gpu = gpu
         ctx = gpu.ctx
