@@ -102,7 +102,8 @@ def _run_options(command, frames_default: str) -> None:
 def _clouds_option(command) -> None:
     command.add_argument("--clouds", choices=CLOUD_RENDERERS, default=DEFAULT_CLOUDS,
                          help="cloud renderer of the cloud scenes (sunset, flight, weather): point sprites "
-                              f"or the ray march (default {DEFAULT_CLOUDS}; key C flips it in a window)")
+                              f"or the ray march (default {DEFAULT_CLOUDS}; key C flips it in a window, key X the sprites "
+                              "between compute splatting and blended points)")
     command.add_argument("--sky", choices=SKY_MODELS, default="physical",
                          help="sky model of the demos with a sky: the Preetham analytic sky or the physical "
                               "atmosphere after Hillaire 2020, which also lights the sun and ambient (default physical)")

@@ -5,7 +5,8 @@ Terrain under a Preetham sky driven by the time of day; the cloud chain (weather
 smoothing → density maps → shading) sliced over frames; the clouds drawn as point sprites with both
 cullings or ray-marched with detail noise (``DemoSettings.clouds``; key C flips them live: both
 plugins are added; under the march the sprites are disabled, their pass culled; under the sprites the
-march draws the far field alone); their ground shadows and light shafts. 40 m cells: a 128×16×128 volume covers 5 km × 640 m × 5 km
+march draws the far field alone; key X flips the sprites between compute splatting and blended points);
+their ground shadows and light shafts. 40 m cells: a 128×16×128 volume covers 5 km × 640 m × 5 km
 from 900 m up, centred on the camera.
 """
 from __future__ import annotations
@@ -130,10 +131,20 @@ def switch_clouds(app, clouds: str | None = None) -> str:
     return clouds
 
 
+def switch_splat(app) -> str:
+    """Flip how the sprites reach the pixels: splatted in compute or drawn as blended points (the
+    default picks compute on a GPU, points on a software renderer); returns the new ``splat``."""
+    sprites = _renderers(app)[0]
+    return sprites.configure(splat="points" if sprites.splats() else "compute").splat
+
+
 def switch_key(app) -> None:
-    """Key C flips the cloud renderer."""
-    if key.C in app.resource(Input).pressed:
+    """Key C flips the cloud renderer; key X the sprites' splat (compute or points)."""
+    pressed = app.resource(Input).pressed
+    if key.C in pressed:
         switch_clouds(app)
+    if key.X in pressed:
+        switch_splat(app)
 
 
 def _renderers(app) -> tuple:

@@ -1,9 +1,11 @@
 """Every demo renders a few headless frames that are not blank (the CLI tests cover the file output)."""
+import numpy as np
 import pytest
 
 from atmos.demo_registry import DemoSettings, list_demos
 from atmos.gpu import create_headless
 from atmos.plugins.clouds.raymarch import RaymarchCloudsPlugin
+from atmos.plugins.clouds.sprites import CloudRenderPlugin
 from atmos.runner import build_app
 
 
@@ -45,6 +47,14 @@ def test_cloud_demos_march_by_default_render_with_sprites_and_key_c_switches_the
         assert "cloud_render" in kept(app) and not march.settings.volume    # the march: the far field alone
         assert "cloud_raymarch" in kept(app) and "cloud_far_field" not in kept(app)   # no 2D far-field pass
         inp = app.resource(Input)
+        sprites = next(p for p in app.plugins if isinstance(p, CloudRenderPlugin))
+        splats = sprites.splats()
+        inp.press(key.X)                                # the sprites' splat flips (compute, points)
+        app.update(1 / 30)
+        inp.release(key.X)
+        assert sprites.splats() is not splats and gpu.ctx.error == "GL_NO_ERROR"
+        assert splats or sprites.sprite_pass.splat is not None          # turned on: the splat ran
+        assert np.abs(gpu.read_pixels().astype(float) - image).mean() < 10, "the same clouds either way"
         inp.press(key.C)
         app.update(1 / 30)
         inp.release(key.C)
