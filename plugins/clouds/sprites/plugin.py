@@ -29,6 +29,9 @@ detail blocks now carry their own mass's spread, narrower than their spacing, so
 (stripes 2^L cells apart) and stay off by default. Sprites under a pixel are drawn 1 pixel wide with their opacity scaled
 by their area in pixels; sprites within one diameter of the near plane fade out linearly, so the
 near plane never clips a visible sprite away (no pop).
+
+On a GPU (``splat``) the same stages run in compute instead (:mod:`.splat`): binned into tiles and blended
+front to back until opaque, the same image at the cost of the pixels covered rather than the overdraw.
 """
 from __future__ import annotations
 
