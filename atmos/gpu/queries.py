@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import ctypes
 import weakref
+from functools import lru_cache
 
 _POOLS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()  # moderngl.Context -> QueryPool
 
@@ -45,8 +46,10 @@ class _GL:
             setattr(self, name[2:], ctypes.CFUNCTYPE(None, *args)(address))
 
 
+@lru_cache(maxsize=2)
 def _loader(api: str):
-    """(is a context current, get_proc) of ``api``; raises OSError where its library is missing."""
+    """(is a context current, get_proc) of ``api``, loaded once per process; raises OSError where its
+    library is missing."""
     if api == "egl":
         lib = _library("libEGL.so.1", "libEGL.so")
         current, get_proc = lib.eglGetCurrentContext, lib.eglGetProcAddress
