@@ -119,7 +119,7 @@ class ClearPass(RenderPass):
     name = "clear"
     phase = "clear"
 
-    def __init__(self, gpu, plugin: "RenderCorePlugin", composition=None):
+    def __init__(self, gpu, plugin: "RenderCorePlugin", composition):
         self.gpu = gpu
         self.plugin = plugin
         self.composition = composition
@@ -132,7 +132,7 @@ class ClearPass(RenderPass):
         builder.create(DEPTH, depth_desc(self.gpu))
 
     def execute(self, frame: PassContext) -> None:
-        if self.composition is not None and self.composition.backgrounds:
+        if self.composition.backgrounds:
             frame.framebuffer(depth=DEPTH).clear(depth=1.0)
             return
         fbo = frame.framebuffer(color=[COLOR], depth=DEPTH)

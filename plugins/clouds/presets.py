@@ -216,5 +216,9 @@ class CloudSky(PluginGroup):
         self.weather = CloudWeatherPlugin(clouds=clouds, preset=preset, cover=changes.get("cover"), transition=transition)
         self.renderer = RaymarchCloudsPlugin() if renderer == "march" else CloudRenderPlugin(size_factor=4.0)
         self.far_field = CloudFarFieldPlugin() if horizon else None
-        far = [self.far_field] + ([RaymarchCloudsPlugin(volume=False)] if renderer == "sprites" else []) if horizon else []
+        far = []
+        if horizon:
+            far.append(self.far_field)
+            if renderer == "sprites":
+                far.append(RaymarchCloudsPlugin(volume=False))      # the march draws the far field behind them
         super().__init__(clouds, self.renderer, CloudShadowsPlugin(), FollowCameraPlugin(clouds), self.weather, *far)

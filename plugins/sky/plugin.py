@@ -108,7 +108,7 @@ class SkyPlugin(Plugin):
         self.composition = composition(app)
         app.graph.add_pass(SkyLutsPass(self))
         app.graph.add_pass(SkyPass(self))
-        self.composition.backgrounds.add("sky")      # it writes every pixel after the depth clear
+        self.composition.backgrounds.add(SkyPass.name)      # it writes every pixel after the depth clear
         app.graph.add_pass(AerialPerspectivePass(self))
         app.graph.import_resource(SKY_LUTS, self._luts)
         app.insert_resource(SkyLight(self))
@@ -139,7 +139,7 @@ class SkyPlugin(Plugin):
     def cleanup(self, app) -> None:
         self._release_luts()
         if self.composition is not None:
-            self.composition.backgrounds.discard("sky")
+            self.composition.backgrounds.discard(SkyPass.name)
             self.composition.readers.discard(AERIAL)
             self.composition.media_readers.discard(AERIAL)
         self._drop_sun_path(app.get_resource(Sun))

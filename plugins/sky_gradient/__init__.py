@@ -69,9 +69,9 @@ class SkyGradientPlugin(Plugin):
     def build(self, app) -> None:
         app.graph.add_pass(SkyGradientPass(self))
         self.composition = composition(app)
-        self.composition.backgrounds.add("sky_gradient")     # it writes every pixel after the depth clear
+        self.composition.backgrounds.add(SkyGradientPass.name)     # it writes every pixel after the depth clear
 
     def cleanup(self, app) -> None:
         comp = getattr(self, "composition", None)
         if comp is not None:
-            comp.backgrounds.discard("sky_gradient")
+            comp.backgrounds.discard(SkyGradientPass.name)

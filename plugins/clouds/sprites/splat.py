@@ -47,6 +47,7 @@ class SpriteSplat:
         ctx = gpu.ctx
         self.counters = ctx.buffer(bytes(16))         # zero: the scan leaves it so for the next frame
         self.records = self.tile_count = self.tile_offset = self.entries = None
+        self._binds = None                      # storage block name -> buffer, made again when one grows
         self.ring = [ctx.buffer(reserve=8) for _ in range(RING)]
         self.fences: list = [None] * RING
         self.slot = 0
@@ -62,6 +63,7 @@ class SpriteSplat:
                 buffer.release()
             buffer = self.gpu.ctx.buffer(bytes(nbytes)) if zero else self.gpu.ctx.buffer(reserve=nbytes)
             setattr(self, name, buffer)
+            self._binds = None
         return buffer
 
     def _read_back(self) -> None:
@@ -94,8 +96,11 @@ class SpriteSplat:
         capacity = self.entries.size // ENTRY_BYTES
         if self.count:
             self.counters.write(bytes(16))      # the work counts (a benchmark's: it waits for the GPU)
-        buffers = {"SplatCounters": self.counters, "SplatRecords": self.records, "SplatTiles": self.tile_count,
-                   "SplatOffsets": self.tile_offset, "SplatEntries": self.entries}
+        buffers = self._binds
+        if buffers is None:                     # the storage blocks' buffers, named once per (re)allocation
+            buffers = self._binds = {"SplatCounters": self.counters, "SplatRecords": self.records,
+                                     "SplatTiles": self.tile_count, "SplatOffsets": self.tile_offset,
+                                     "SplatEntries": self.entries}
         common = {"target_size": (w, h), "tiles": tiles, "entry_capacity": capacity}
         unit_blocks = 4 * int(group[0]) * int(group[1])
         gy = min(segment_count, MAX_GROUPS_Y)
@@ -131,5 +136,5 @@ class SpriteSplat:
         for obj in (self.counters, self.records, self.tile_count, self.tile_offset, self.entries, *self.ring):
             if obj is not None:
                 obj.release()
-        self.counters = self.records = self.tile_count = self.tile_offset = self.entries = None
+        self.counters = self.records = self.tile_count = self.tile_offset = self.entries = self._binds = None
         self.ring = []
