@@ -104,7 +104,7 @@ def main() -> None:
     for name in fog_valley.PRESETS:
         image, _, _ = render(gpu, size, 1, preset=name)
         Image.fromarray((image * 255).round().astype(np.uint8)).save(OUT / f"fog_valley_{name}.png")
-    print(f"paper presets: {OUT}/fog_valley_fig6..fig10.png")
+    print(f"presets: {OUT}/fog_valley_{{valley,fig6..fig10}}.png")
     gpu.release()
 
 

@@ -1,6 +1,7 @@
-"""fog_valley: a ~10,000-triangle terrain and its far ring under Zdrojewska's heterogeneous fog (figures 6-10 presets).
+"""fog_valley: a ~10,000-triangle terrain and its far ring under Zdrojewska's heterogeneous fog.
 
-Pick the paper's settings with ATMOS_FOG_PRESET=fig6 ... fig10 (default fig6), or keys 1-5 in a window.
+By default height fog pooled in the valley with the paper's turbulence (preset ``valley``); the paper's
+figures 6-10 with ATMOS_FOG_PRESET=fig6 ... fig10. In a window keys 1-6 switch: 1 the valley, 2-6 the figures.
 """
 import math
 import os
@@ -21,16 +22,18 @@ from atmos.plugins.antialias import AntialiasPlugin
 TITLE = "heterogeneous Perlin-turbulence fog over a 10,000-triangle valley (Zdrojewska 2004)"
 DEFAULT_FRAMES = 60
 
-PRESETS = {  # the paper's figures (FogSettings fields): eq. (7) = hetero_exp2, eq. (6) = hetero_exp
+PRESETS = {  # FogSettings fields
+    # the default, not the paper's: height fog pooled in the valley, thinning upward, with its turbulence
+    "valley": dict(mode="hetero_height", density=0.15, height_base=0.0, scale_height=2.0,
+                   resolutions=PAPER_RESOLUTIONS["coarse"]),
+    # the paper's figures: eq. (7) = hetero_exp2, eq. (6) = hetero_exp; fog thick enough to hide the hills
     "fig6": dict(mode="hetero_exp2", density=0.044, resolutions=PAPER_RESOLUTIONS["fine"]),
     "fig7": dict(mode="hetero_exp", density=0.044, resolutions=PAPER_RESOLUTIONS["fine"]),
     "fig8": dict(mode="hetero_exp2", density=0.044, resolutions=PAPER_RESOLUTIONS["coarse"]),
     "fig9": dict(mode="hetero_exp", density=0.044, resolutions=PAPER_RESOLUTIONS["coarse"]),
     "fig10": dict(mode="hetero_exp", density=0.06, resolutions=PAPER_RESOLUTIONS["coarse"]),
-    # not the paper's: height fog pooled in the valley, thinning upward, with the same turbulence
-    "valley": dict(mode="hetero_height", density=0.15, height_base=0.0, scale_height=2.0,
-                   resolutions=PAPER_RESOLUTIONS["coarse"]),
 }
+DEFAULT_PRESET = "valley"
 TERRAIN_SIZE = 112.0
 NOISE_TILE = 112.0  # metres per noise tile: the lowest octave's 16 cells are 7 m
 CAMERA_POS = np.array([-3.0, 4.5, 44.0])
@@ -55,7 +58,7 @@ def place_camera(app) -> None:
 
 
 def build(app, settings, fog_preset: str | None = None) -> FogPlugin:
-    name = fog_preset or os.environ.get("ATMOS_FOG_PRESET", "fig6")
+    name = fog_preset or os.environ.get("ATMOS_FOG_PRESET", DEFAULT_PRESET)
     fog = FogPlugin(sky="fog", tile_size=NOISE_TILE, seed=settings.seed, **preset(name))   # --seed: the noise lattice
     app.insert_resource(Sun.from_angles(elevation_deg=30.0, azimuth_deg=-30.0))
     terrain = TerrainPlugin(size=TERRAIN_SIZE, relief=10.0, rock_slope=0.6)   # steep grassy hills, as in the paper

@@ -560,5 +560,5 @@ def test_a_bad_environment_setting_of_a_demo_is_a_message_not_a_traceback(capsys
     code = main(["demo", "fog_valley", "--headless", "--frames", "1", "--size", "32x18", "--quiet",
                  "--out", str(tmp_path / "x.png")])
     err = capsys.readouterr().err
-    assert code == 1 and "atmos: unknown fog preset 'fig99'; allowed: fig6" in err and "Traceback" not in err
+    assert code == 1 and "atmos: unknown fog preset 'fig99'; allowed: valley, fig6" in err and "Traceback" not in err
     assert list(tmp_path.iterdir()) == []
