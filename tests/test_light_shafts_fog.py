@@ -15,6 +15,7 @@ from atmos.plugins.clouds import CloudSettings, CloudsPlugin
 from atmos.plugins.fog import FogPlugin
 from atmos.plugins.ground import GroundPlugin
 from atmos.plugins.light_shafts import LightShaftsPlugin
+from atmos.plugins.light_shafts.plugin import LightShaftsPass
 from atmos.plugins.sky_gradient import SkyGradientPlugin
 from tests.test_light_shafts_march import BASE, CELL, SIZE, columns_volume
 
@@ -32,15 +33,17 @@ def froxels(request):
     return request.param
 
 
-def frame(gpu, density, shafts: bool, sky="fog", fog=True, color=(0.9, 0.9, 1.0), froxels=None) -> np.ndarray:
-    """Linear colour of the gap view (test_light_shafts_march) under an exponential fog, with or without shafts."""
+def frame(gpu, density, shafts: bool, sky="fog", fog=True, color=(0.9, 0.9, 1.0), froxels=None, kept=None,
+          sun=(0.0, 1.0, 0.25)) -> np.ndarray:
+    """Linear colour of the gap view (test_light_shafts_march) under an exponential fog, with or without shafts
+    (``kept``: a list given the passes the graph kept)."""
     extra = [LightShaftsPlugin(steps=48, max_distance=3000.0, froxels=froxels)] if shafts else []
     if fog:
         extra.append(FogPlugin(mode="exp", density=1.5e-3, sky=sky, fog_color=color))
     app = App(gpu).add_plugins(DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(),
                                CloudsPlugin(CloudSettings(cell_size=CELL, base_altitude=BASE, shading=False,
                                                           sigma_t=0.05), density=density), *extra)
-    app.insert_resource(Sun(np.array([0.0, 1.0, 0.25]), (1.0, 0.95, 0.9)))
+    app.insert_resource(Sun(np.array(sun, np.float64), (1.0, 0.95, 0.9)))
     app.startup()
     cam = app.resource(Camera)
     cam.position = np.array([320.0, 60.0, 20.0])
@@ -48,6 +51,8 @@ def frame(gpu, density, shafts: bool, sky="fog", fog=True, color=(0.9, 0.9, 1.0)
     try:
         app.render()
         assert gpu.ctx.error == "GL_NO_ERROR"
+        if kept is not None:
+            kept.extend(app.graph.compile().kept)
         return app.read_linear()[..., :3].astype(np.float64)
     finally:
         app.close()
@@ -122,6 +127,8 @@ def aerial_frame(gpu, density, shafts: bool, aerial: bool = True, fog_color=None
         media = app.graph.compile().resources
         assert "media_clear" not in kept and ("media_light" in media) == (aerial and fog_color is not None), \
             "the media targets with the fog and the air, made by the fog (the only local medium)"
+        if fog_color is not None and aerial:
+            assert "fog" in kept, "the air mixes with the fog after its pass: the shafts' apply leaves it alone"
         return app.read_linear()[..., :3].astype(np.float64)
     finally:
         app.close()
@@ -208,3 +215,25 @@ def test_a_heterogeneous_fog_keeps_the_per_texel_march_and_the_froxels_switch_li
         assert targets() == (False, True)
     finally:
         app.close()
+
+
+@pytest.mark.parametrize("sky", ["fog", "keep"])
+@pytest.mark.parametrize("sun", [(0.0, 1.0, 0.25), (0.0, -0.2, 1.0)], ids=["day", "sun_down"])
+def test_the_froxels_apply_composites_the_fog_as_the_fogs_own_pass_did(fog_gpu, monkeypatch, sky, sun):
+    """The fog the only local medium: the shafts' froxel apply composites it (exactly, per pixel) and takes
+    the shadowed share away in one write, the fog's pass culled; with the sun down the fog alone. The frame
+    equals the fog's pass then the apply, up to the float16 rounding of the colour between them."""
+    volume, kept, apart_kept = columns_volume(), [], []
+    fused = frame(fog_gpu, volume, True, sky=sky, froxels=(40, 24, 64), kept=kept, sun=sun)
+    monkeypatch.setattr(LightShaftsPass, "fuse_fog", False)
+    apart = frame(fog_gpu, volume, True, sky=sky, froxels=(40, 24, 64), kept=apart_kept, sun=sun)
+    assert "fog" not in kept and "light_shafts" in kept and "fog" in apart_kept
+    assert np.isfinite(fused).all() and fused.min() >= 0.0
+    step = 2.0 ** -10 * (np.abs(apart) + np.abs(fused)) + 1e-6      # float16's step, rounding toward zero
+    assert (np.abs(fused - apart) <= 2.0 * step).all(), np.abs(fused - apart).max()
+    fog_alone = frame(fog_gpu, volume, False, sky=sky, sun=sun)
+    if sun[1] < 0.0:                                   # no sunlit haze: the fog alone, as its own pass draws it
+        assert (np.abs(fused - fog_alone) <= 2.0 * step).all()
+    else:
+        assert (fog_alone - fused).mean() > 1e-3, "the shafts still take the shadowed share away"
+

@@ -34,6 +34,7 @@ class FogPlugin(Plugin):
     def __init__(self, settings: FogSettings | None = None, **fields):
         super().__init__(settings, **fields)
         self.fog_pass: FogPass | None = None
+        self.medium: FogMedium | None = None   # the fog as other effects see it (published)
         self.composition = self.gpu = None
         self._sky = None
         self._table = None                  # (SceneView, its sky table): held, never a reused id
@@ -44,9 +45,10 @@ class FogPlugin(Plugin):
         self.composition.readers.add("fog")       # clouds fogged by their own distance
         self.composition.media_writers.add("fog")  # a local medium the aerial perspective mixes with
         self.composition.media_covers["fog"] = lambda: True     # its dispatch writes every pixel, every frame
+        self.medium = FogMedium(self)
         self.fog_pass = FogPass(self)
         app.graph.add_pass(self.fog_pass)
-        app.insert_resource(FogMedium(self))
+        app.insert_resource(self.medium)
 
     def finish(self, app) -> None:
         self._sky = app.get_resource(SkyLight)

@@ -13,6 +13,18 @@ class FogMedium:
 
     def __init__(self, plugin):
         self._plugin = plugin
+        self._compositor = None         # () -> bool: another pass composites the fog this frame
+
+    def composite_elsewhere(self, wants) -> None:
+        """Let another pass composite the fog (the light shafts' froxel apply, exactly as the fog's own
+        pass would, with what it takes away in one write) while ``wants()`` is true; the fog's own pass
+        is then culled. None gives the fog back to its pass."""
+        self._compositor = wants
+
+    @property
+    def composited_elsewhere(self) -> bool:
+        """Whether another pass composites the fog this frame (:meth:`composite_elsewhere`)."""
+        return self._compositor is not None and self._compositor()
 
     @property
     def settings(self):

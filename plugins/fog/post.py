@@ -80,7 +80,8 @@ def restore_state(ctx) -> None:
 
 class FogPass(RenderPass):
     """The fog over the scene, one compute invocation per pixel composited onto the colour in place
-    (fog/fog.comp): distance and position from the scene depth and the camera."""
+    (fog/fog.comp): distance and position from the scene depth and the camera. Culled while another
+    pass composites the fog (:meth:`.medium.FogMedium.composite_elsewhere`)."""
     name = "fog"
     phase = "media"
 
@@ -92,10 +93,14 @@ class FogPass(RenderPass):
 
     def setup_key(self) -> tuple:
         comp = self.plugin.composition
-        return (comp.distance, comp.media, comp.media_first == self.name, self.plugin.gpu.size)
+        return (comp.distance, comp.media, comp.media_first == self.name, self.plugin.gpu.size,
+                self.plugin.medium.composited_elsewhere)
 
     def setup(self, builder: PassBuilder) -> None:
         comp = self.plugin.composition
+        self.makes_media = False
+        if self.plugin.medium.composited_elsewhere:
+            return                              # declares nothing: culled
         builder.read(DEPTH)
         builder.read(COLOR, access="storage")          # composites onto it in place
         builder.write(COLOR, access="storage")

@@ -9,7 +9,8 @@ from atmos.plugin import Plugin
 from atmos.plugins.clouds import CLOUD_SETS, FAR_FIELD
 from atmos.plugins.clouds.shadows.shadow_map import shadow_map_pass
 from atmos.plugins.fog import FogMedium
-from atmos.plugins.light_shafts.froxels import FroxelShafts, uses_froxels
+from atmos.composition import Composition
+from atmos.plugins.light_shafts.froxels import FroxelShafts, composites_fog, uses_froxels
 from atmos.plugins.light_shafts.march import MarchedShafts
 from atmos.plugins.light_shafts.settings import LightShaftSettings, blur_scale
 from atmos.plugins.light_shafts.screen_sun import screen_sun
@@ -42,6 +43,7 @@ class LightShaftsPass(RenderPass):
     """
     name = "light_shafts"
     phase = "post"
+    fuse_fog = True     # False: the fog keeps its own pass even where the froxels' apply could composite it (tests)
 
     def __init__(self, plugin: "LightShaftsPlugin"):
         self.plugin = plugin
@@ -56,7 +58,7 @@ class LightShaftsPass(RenderPass):
         graph = plugin.graph
         return (plugin.settings, plugin.gpu.size, graph.imports(CLOUD_SETS), graph.imports(FAR_FIELD),
                 fog is not None and (fog.settings, fog.reads_cloud_distance),
-                aerial is not None and aerial.reads_cloud_distance)
+                aerial is not None and aerial.reads_cloud_distance, plugin.composites_fog())
 
     def setup(self, builder: PassBuilder) -> None:
         w, h = self.plugin.gpu.size
@@ -96,9 +98,12 @@ class LightShaftsPass(RenderPass):
         froxels = params.mode == "march" and uses_froxels(params, self.plugin.fog)
         if not froxels:
             self.froxels.history.release()              # no volume to accumulate: no history kept
+        if froxels:
+            self.froxels.execute(frame, params, frame.declares(CLOUD_SETS), self.plugin.fog, self.plugin.aerial(),
+                                 self.plugin.composites_fog())
+            return
         if params.mode == "march":
-            shafts = self.froxels if froxels else self.marched
-            shafts.execute(frame, params, frame.declares(CLOUD_SETS), self.plugin.fog, self.plugin.aerial())
+            self.marched.execute(frame, params, frame.declares(CLOUD_SETS), self.plugin.fog, self.plugin.aerial())
             return
         w, h = view.size
         where = screen_sun(view.camera, view.aspect, view.sun.direction, params)
@@ -143,6 +148,7 @@ class LightShaftsPlugin(Plugin):
         self.gpu = self.graph = None
         self.fog = None                 # the App's FogMedium (finish), whose in-scatter the march shadows
         self.sky = None                 # the App's SkyLight (finish): its aerial perspective, when on
+        self.composition = None         # the App's Composition (finish): which local media there are
 
     def build(self, app) -> None:
         if app.graph is None:
@@ -154,6 +160,18 @@ class LightShaftsPlugin(Plugin):
     def finish(self, app) -> None:
         self.fog = app.get_resource(FogMedium)
         self.sky = app.get_resource(SkyLight)
+        self.composition = app.get_resource(Composition)
+        if self.fog is not None:
+            self.fog.composite_elsewhere(self.composites_fog)
+
+    def cleanup(self, app) -> None:
+        if self.fog is not None:
+            self.fog.composite_elsewhere(None)
+
+    def composites_fog(self) -> bool:
+        """Whether the froxels' apply composites the fog this frame (its own pass culled):
+        :func:`.froxels.composites_fog`."""
+        return LightShaftsPass.fuse_fog and composites_fog(self.settings, self.fog, self.aerial(), self.composition)
 
     def aerial(self):
         """The SkyLight when its aerial perspective is on (the march then takes away the air's

@@ -5,6 +5,9 @@
 // the light lost in cloud shadow is taken away, read where march.comp's weights put it: a cloud covering a
 // of the pixel at its own distance d_c, the rest at the scene's (the fog's own distance for the fog),
 //   rgb -= a S(d_c) + (1 - a) S(d)   (S: the volume's sums; the fog's times fog_sun_share C_fog(dir)).
+// SHAFT_FOG_COMPOSITE 1 (the fog the only local medium, atmos/composition.py): this pass composites the fog
+// too (fog/over.glsl, exact per pixel), then takes the shadowed share away, in one write (the fog's own
+// pass culled): rgb = L_fog + f rgb - taken. shafts_lit 0 (the sun down): the fog alone, the volume unread.
 #include "light_shafts/medium.glsl"
 #include "lib/froxel_slices.glsl"
 #include "lib/media_image.glsl"
@@ -12,6 +15,9 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 2) uniform sampler2D scene_depth;
 layout(binding = 4) uniform sampler3D shaft_volume;
 uniform float froxel_knee;
+#if SHAFT_FOG_COMPOSITE
+uniform int shafts_lit;        // 0: no sunlit haze to shadow (the volume is not read)
+#endif
 
 vec4 sums_at(vec2 uv, float d) {
     return froxel_read(shaft_volume, uv, d, max_distance, froxel_knee);
@@ -29,8 +35,15 @@ void main() {
     vec3 dir = normalize(ray);
     vec2 cloud = cloud_cover_distance(has_cloud_distance != 0 ? texelFetch(cloud_distance, pixel, 0).rg : vec2(0.0));
     float a = cloud.x;
-    vec4 in_cloud = a > 0.0 ? a * sums_at(uv, cloud.y) : vec4(0.0);
     vec3 taken = vec3(0.0);
+#if SHAFT_FOG_COMPOSITE
+    float fog_d;
+    vec3 fog_end;
+    bool sky = fog_ray_end(z, ray, fog_d, fog_end);
+    vec4 fog = fog_over(fog_d, fog_end, dir, camera_pos, sky, cloud);
+    if (shafts_lit != 0) {
+#endif
+    vec4 in_cloud = a > 0.0 ? a * sums_at(uv, cloud.y) : vec4(0.0);
 #if SHAFT_FOG
     float behind = shaft_fog_behind(z, d, dir, length(ray));
     taken += fog_sun_share * in_color(dir) * (in_cloud.a + (1.0 - a) * sums_at(uv, behind).a);
@@ -38,7 +51,12 @@ void main() {
 #if SHAFT_AERIAL
     taken += in_cloud.rgb + (1.0 - a) * sums_at(uv, d).rgb;
 #endif
+#if SHAFT_FOG_COMPOSITE
+    }
+    blend_medium(pixel, vec4(fog.rgb - taken, fog.a));
+#else
     blend_medium(pixel, vec4(-taken, 1.0));
+#endif
 #else
     vec4 shafts = sums_at(uv, d);
     blend_medium(pixel, vec4(min(shafts.rgb, vec3(HDR_MAX)), shafts.a));

@@ -23,9 +23,7 @@ uniform int has_cloud_distance;   // 1: cloud_distance is bound
 layout(binding = 3) uniform sampler2D cloud_distance;
 #endif
 #if SHAFT_FOG
-#include "fog/factor.glsl"
-#include "fog/color.glsl"
-uniform int fog_sky_keep;
+#include "fog/over.glsl"
 uniform float fog_sun_share;   // LightShaftSettings.fog_sun_share
 #endif
 #if SHAFT_AERIAL
