@@ -237,3 +237,32 @@ def test_the_froxels_apply_composites_the_fog_as_the_fogs_own_pass_did(fog_gpu, 
     else:
         assert (fog_alone - fused).mean() > 1e-3, "the shafts still take the shadowed share away"
 
+
+
+def test_the_fog_moves_between_its_pass_and_the_shafts_apply_live(fog_gpu):
+    """Live changes that decide who composites the fog (the shafts' froxels on and off, their mode, a
+    heterogeneous fog) move it on the next frame, each frame fogged once: as a fresh App with those settings."""
+    shafts = LightShaftsPlugin(max_distance=3000.0, froxels=(40, 24, 64))
+    fog = FogPlugin(mode="exp", density=1.5e-3)
+    app = App(fog_gpu).add_plugins(DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(), shafts, fog)
+    app.insert_resource(Sun(np.array([0.0, 0.4, 1.0])))
+    app.startup()
+    app.resource(Camera).position = np.array([0.0, 30.0, 0.0])
+    try:
+        for changes, fused in ((dict(), True), (dict(froxels=None), False), (dict(froxels=(40, 24, 64)), True),
+                               (dict(mode="screen"), False), (dict(mode="march"), True)):
+            shafts.configure(**changes)
+            app.render()
+            kept = app.graph.compile().kept
+            assert ("fog" not in kept) == fused and "light_shafts" in kept, changes
+            assert gpu_ok(app)
+        fog.configure(mode="hetero_exp")
+        app.render()
+        assert "fog" in app.graph.compile().kept and gpu_ok(app)
+    finally:
+        app.close()
+
+
+def gpu_ok(app) -> bool:
+    """No GL error and a finite frame."""
+    return app.gpu.ctx.error == "GL_NO_ERROR" and bool(np.isfinite(app.read_linear()).all())
