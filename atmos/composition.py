@@ -124,6 +124,22 @@ class Composition:
         return name if runs is not None and runs() else None
 
 
+class CompositedElsewhere:
+    """Mixed into a medium's published resource (the fog's FogMedium, the sky's SkyLight): another pass may
+    composite the medium instead of its own pass (the light shafts' froxel apply, with what it takes away
+    in one write) while ``wants()`` says so; the medium's own pass is then culled."""
+    _compositor = None                  # () -> bool
+
+    def composite_elsewhere(self, wants) -> None:
+        """Let another pass composite this medium while ``wants()`` is true; None gives it back to its pass."""
+        self._compositor = wants
+
+    @property
+    def composited_elsewhere(self) -> bool:
+        """Whether another pass composites this medium this frame (:meth:`composite_elsewhere`)."""
+        return self._compositor is not None and self._compositor()
+
+
 def media_targets(size) -> tuple:
     """(name, TextureDesc, clear value) of the media targets at ``size``: ``"media_light"`` (RGBA float32,
     clear 0) and ``"media_transmittance"`` (R float32, clear 1)."""

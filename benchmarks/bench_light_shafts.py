@@ -38,22 +38,23 @@ def pass_ms(mode: str, frames: int = 30, froxels=None) -> float:
     return total / frames
 
 
-def media_ms(fuse: bool, frames: int = 30) -> tuple[float, float]:
-    """(GPU ms of the fog's pass + the shafts', passes kept) in sunset, the froxels' apply compositing the
-    fog (``fuse``) or the fog in its own pass before it."""
-    LightShaftsPass.fuse_fog = fuse
+def media_ms(fuse: bool, frames: int = 30, haze: str = "fog") -> tuple[float, float]:
+    """(GPU ms of the media passes + the shafts', passes kept) in sunset with ``haze`` (fog, air, both), the
+    froxels' apply compositing the media (``fuse``) or the media in their own passes before it."""
+    LightShaftsPass.fuse_media = fuse
     gpu = create_headless(SIZE)
-    app = build_app("sunset", DemoSettings(size=SIZE, headless=True), gpu)
+    app = build_app("sunset", DemoSettings(size=SIZE, headless=True, haze=haze), gpu)
     try:
         app.graph.timings_enabled = True
         app.run_frames(5, 1 / 30)
         total = 0.0
         for _ in range(frames):
             app.run_frames(1, 1 / 30)
-            total += sum(app.graph.timings[name][0] for name in ("fog", "light_shafts") if name in app.graph.timings)
+            total += sum(app.graph.timings[name][0] for name in ("fog", "aerial_perspective", "light_shafts")
+                         if name in app.graph.timings)
         return total / frames, len(app.graph.compile().kept)
     finally:
-        LightShaftsPass.fuse_fog = True
+        LightShaftsPass.fuse_media = True
         app.close()
         gpu.release()
 
@@ -202,10 +203,12 @@ def main() -> None:
         print(f"  {mode:6s}            {pass_ms(mode):8.2f}")
     for froxels in ((40, 23, 32), (80, 45, 64), (160, 90, 64)):
         print(f"  froxels {'x'.join(map(str, froxels)):>10s} {pass_ms('march', froxels=froxels):8.2f}")
-    print(f"the fog and the shafts, sunset {SIZE[0]}x{SIZE[1]}, GPU ms of both (mean of 30 frames), passes kept:")
-    for fuse, name in ((False, "fog pass, then the apply"), (True, "the apply composites the fog")):
-        ms, kept = media_ms(fuse)
-        print(f"  {name:30s} {ms:8.2f}   {kept} passes")
+    print(f"the media and the shafts, sunset {SIZE[0]}x{SIZE[1]}, GPU ms of the fog, air and shafts passes (mean of "
+          "30 frames), passes kept:")
+    for haze in ("fog", "air", "both"):
+        for fuse, name in ((False, "their passes, then the apply"), (True, "the apply composites them")):
+            ms, kept = media_ms(fuse, haze=haze)
+            print(f"  {haze:5s} {name:30s} {ms:8.2f}   {kept} passes")
     print("froxel volume error vs size, 128x72 pixels (relative RMSE of the in-scattered light vs a 256-step")
     print("march per pixel; per pixel, after a 3x3 blur, and one frame's slice middles against the history of")
     print(f"{HISTORY_FRAMES} still frames of jittered slices, froxel_history {HISTORY_BLEND}):")

@@ -90,8 +90,10 @@ def test_graph_of_the_cloud_demo_with_the_sprites(capsys):
 def test_graph_of_the_hazy_demo_with_the_air(capsys):
     code, out, _ = run(capsys, "graph", "sunset", "--haze", "air")
     assert code == 0
-    kept = out.split("culled:")[0]
-    assert ". aerial_perspective " in kept and ". fog " not in kept, "the air instead of the haze fog"
+    kept, culled = out.split("culled:")[0], out.split("culled:")[1].split("resources:")[0]
+    assert ". fog " not in kept and "- aerial_perspective " in culled, \
+        "the air instead of the haze fog, composited by the light shafts' froxel apply"
+    assert "aerial_volume" in kept.split(". light_shafts ")[1].splitlines()[0], "the shafts fill the air's froxels"
 
 
 def test_headless_demo_frames_are_not_blank_and_move(tmp_path, capsys):

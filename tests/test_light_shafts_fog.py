@@ -123,12 +123,13 @@ def aerial_frame(gpu, density, shafts: bool, aerial: bool = True, fog_color=None
     try:
         app.run_frames(1)
         kept = app.graph.compile().kept
-        assert ("aerial_perspective" in kept) == aerial and ("light_shafts" in kept) == shafts
+        fused = shafts and froxels is not None and LightShaftsPass.fuse_media   # the apply composites the media
+        assert ("aerial_perspective" in kept) == (aerial and not fused) and ("light_shafts" in kept) == shafts
+        assert ("fog" in kept) == (fog_color is not None and not fused)
         media = app.graph.compile().resources
-        assert "media_clear" not in kept and ("media_light" in media) == (aerial and fog_color is not None), \
-            "the media targets with the fog and the air, made by the fog (the only local medium)"
-        if fog_color is not None and aerial:
-            assert "fog" in kept, "the air mixes with the fog after its pass: the shafts' apply leaves it alone"
+        assert "media_clear" not in kept and ("media_light" in media) == (aerial and fog_color is not None
+                                                                          and not fused), \
+            "the media targets with the fog and the air in their own passes, made by the fog (the only local medium)"
         return app.read_linear()[..., :3].astype(np.float64)
     finally:
         app.close()
@@ -225,7 +226,7 @@ def test_the_froxels_apply_composites_the_fog_as_the_fogs_own_pass_did(fog_gpu, 
     equals the fog's pass then the apply, up to the float16 rounding of the colour between them."""
     volume, kept, apart_kept = columns_volume(), [], []
     fused = frame(fog_gpu, volume, True, sky=sky, froxels=(40, 24, 64), kept=kept, sun=sun)
-    monkeypatch.setattr(LightShaftsPass, "fuse_fog", False)
+    monkeypatch.setattr(LightShaftsPass, "fuse_media", False)
     apart = frame(fog_gpu, volume, True, sky=sky, froxels=(40, 24, 64), kept=apart_kept, sun=sun)
     assert "fog" not in kept and "light_shafts" in kept and "fog" in apart_kept
     assert np.isfinite(fused).all() and fused.min() >= 0.0
@@ -266,3 +267,18 @@ def test_the_fog_moves_between_its_pass_and_the_shafts_apply_live(fog_gpu):
 def gpu_ok(app) -> bool:
     """No GL error and a finite frame."""
     return app.gpu.ctx.error == "GL_NO_ERROR" and bool(np.isfinite(app.read_linear()).all())
+
+
+@pytest.mark.parametrize("fog_color", [None, (1.0, 0.9, 0.8)], ids=["air", "fog_and_air"])
+def test_the_froxels_apply_composites_the_air_and_the_fog_as_their_passes_did(fog_gpu, monkeypatch, fog_color):
+    """The sky's aerial perspective on (and a fog, mixed with it along the ray): the shafts' froxel apply
+    composites both and takes the shadowed share away in one write, the fog's and the sky's passes and
+    the media targets gone (aerial_frame checks); the frame equals those passes then the apply, up to the
+    float16 rounding of the colour between them."""
+    volume = columns_volume()
+    fused = aerial_frame(fog_gpu, volume, True, fog_color=fog_color, froxels=(40, 24, 64))
+    monkeypatch.setattr(LightShaftsPass, "fuse_media", False)
+    apart = aerial_frame(fog_gpu, volume, True, fog_color=fog_color, froxels=(40, 24, 64))
+    assert np.isfinite(fused).all() and min(fused.min(), apart.min()) >= 0.0 and fused.max() > 0.0
+    step = 2.0 ** -10 * (np.abs(apart) + np.abs(fused)) + 1e-6      # float16's step, rounding toward zero
+    assert (np.abs(fused - apart) <= 3.0 * step).all(), np.abs(fused - apart).max()

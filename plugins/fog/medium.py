@@ -3,28 +3,18 @@ shadows or mixes the fog's in-scattered light (the light shafts' march) needs of
 reaching into the fog's modules."""
 from __future__ import annotations
 
+from atmos.composition import CompositedElsewhere
 from atmos.plugins.fog.post import set_fog_uniforms
 from atmos.plugins.fog.settings import MODES
 from atmos.plugins.fog.sky_color import SAMPLES
 
 
-class FogMedium:
-    """``plugin`` is the FogPlugin that publishes it."""
+class FogMedium(CompositedElsewhere):
+    """``plugin`` is the FogPlugin that publishes it; another pass may composite the fog
+    (:class:`atmos.composition.CompositedElsewhere`, fog/over.glsl: exactly as the fog's own pass)."""
 
     def __init__(self, plugin):
         self._plugin = plugin
-        self._compositor = None         # () -> bool: another pass composites the fog this frame
-
-    def composite_elsewhere(self, wants) -> None:
-        """Let another pass composite the fog (the light shafts' froxel apply, exactly as the fog's own
-        pass would, with what it takes away in one write) while ``wants()`` is true; the fog's own pass
-        is then culled. None gives the fog back to its pass."""
-        self._compositor = wants
-
-    @property
-    def composited_elsewhere(self) -> bool:
-        """Whether another pass composites the fog this frame (:meth:`composite_elsewhere`)."""
-        return self._compositor is not None and self._compositor()
 
     @property
     def settings(self):

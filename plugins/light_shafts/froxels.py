@@ -4,8 +4,8 @@ pixel reads its sums at its own distance (froxel_apply.comp) — W·H·D samples
 Each slice's sample moves every frame and the frames are averaged (:class:`atmos.froxels.FroxelHistory`,
 ``LightShaftSettings.froxel_history``).
 A heterogeneous fog, whose factor along a ray depends on the ray's end, keeps the per-texel march.
-With the fog as the only local medium the apply composites the fog as well (:func:`composites_fog`):
-one write per pixel for both, the fog's own pass culled. float64 twin: :func:`.reference.froxel_shafts`."""
+With no local medium but the fog, the apply composites the fog and the air's aerial perspective as well
+(:func:`composites_media`): one write per pixel for all, their own passes culled. float64 twin: :func:`.reference.froxel_shafts`."""
 from __future__ import annotations
 
 from atmos.froxels import FroxelHistory, froxel_knee, volume_desc, volume_image
@@ -23,13 +23,13 @@ def uses_froxels(settings, fog=None) -> bool:
     return settings.froxels is not None and not (fog is not None and fog.settings.heterogeneous)
 
 
-def composites_fog(settings, fog, aerial, composition) -> bool:
-    """Whether the froxels' apply composites the fog itself (exactly as the fog's pass does, then what the
-    shafts take away, in one write): marched shafts from the froxel volume, a fog (the FogMedium) that is
-    the only local medium (``composition``'s media writers; no volumetric fog to keep in order with it)
-    and no aerial perspective (which mixes the air with the local media in its own pass)."""
-    return (fog is not None and aerial is None and settings.mode == "march" and uses_froxels(settings, fog)
-            and composition is not None and composition.media_writers == {"fog"})
+def composites_media(settings, fog, aerial, composition) -> bool:
+    """Whether the froxels' apply composites the media itself, the fog (the FogMedium) and the air (the
+    SkyLight, its aerial perspective on) that there are, exactly as their own passes do, then what the
+    shafts take away, in one write: marched shafts from the froxel volume, and no local medium but the
+    fog (``composition``'s media writers; none, e.g. a volumetric fog, to keep in order with them)."""
+    return ((fog is not None or aerial is not None) and settings.mode == "march" and uses_froxels(settings, fog)
+            and composition is not None and not composition.media_writers - {"fog"})
 
 
 class FroxelShafts:
@@ -41,23 +41,28 @@ class FroxelShafts:
         self.history = FroxelHistory(gpu)
 
     @staticmethod
-    def declare(builder: PassBuilder, froxels, clouds: bool, far_field: bool = False, fog=None, aerial=None) -> None:
+    def declare(builder: PassBuilder, froxels, clouds: bool, far_field: bool = False, fog=None, aerial=None,
+                composite: bool = False) -> None:
+        """``composite``: the apply composites the media (:func:`composites_media`), the air's read too."""
         builder.create(SHAFT_VOLUME, volume_desc(froxels), access="storage")
+        if composite and aerial is not None:
+            aerial.declare_pixel(builder)
         builder.read(DEPTH)
         builder.read(COLOR, access="storage")
         builder.write(COLOR, access="storage")
         MarchedShafts.declare_medium(builder, clouds, far_field, fog, aerial)
 
     def execute(self, frame: PassContext, settings, clouds: bool, fog=None, aerial=None,
-                composite_fog: bool = False) -> None:
-        """Fill the volume, resolve its history and apply it; with ``composite_fog`` (:func:`composites_fog`)
-        the apply composites the fog too, and alone while the sun is down (no shafts to shadow)."""
+                composite: bool = False) -> None:
+        """Fill the volume, resolve its history and apply it; with ``composite`` (:func:`composites_media`)
+        the apply composites the fog and the air too, and them alone while the sun is down (no shafts)."""
         irradiance = march_irradiance(frame.view.sun, settings)
         far_field = clouds and frame.declares(FAR_FIELD)
-        apply = self.medium.program(far_field, fog, aerial, "light_shafts/froxel_apply.comp", composite_fog)
+        apply = self.medium.program(far_field, fog, aerial, "light_shafts/froxel_apply.comp", composite)
         if irradiance is None:
-            if composite_fog:
-                self.apply(frame, apply, settings, fog, aerial, frame.resource(SHAFT_VOLUME), lit=False)
+            if composite:
+                self.apply(frame, apply, settings, fog, aerial, frame.resource(SHAFT_VOLUME), lit=False,
+                           composite=True)
             return
         fill = self.medium.program(far_field, fog, aerial, "light_shafts/froxels.comp")
         knee = froxel_knee(settings.max_distance)
@@ -68,18 +73,22 @@ class FroxelShafts:
         frame.dispatch(fill, work_groups(volume.size[:2], (8, 8)), images={"shaft_volume": volume})
         volume = self.history.resolve(frame, volume, settings.max_distance, knee, settings.froxel_history,
                                       key=(far_field, fog is not None, aerial is not None, clouds))
-        self.apply(frame, apply, settings, fog, aerial, volume, lit=True)
+        self.apply(frame, apply, settings, fog, aerial, volume, lit=True, composite=composite)
 
-    def apply(self, frame: PassContext, apply, settings, fog, aerial, volume, lit: bool) -> None:
+    def apply(self, frame: PassContext, apply, settings, fog, aerial, volume, lit: bool, composite: bool) -> None:
         """Dispatch the apply over every pixel: it reads the sums (no shadows, sun or phase), the fog's
-        colour and the clouds' distance where it takes light away; ``lit`` is its shafts_lit where it
-        composites the fog (False: the fog alone, the volume unread)."""
+        colour and the clouds' distance where it takes light away; with ``composite`` the air's aerial
+        perspective too (its froxel volume filled here), ``lit`` its shafts_lit (False: the media alone,
+        the volume unread)."""
         write_uniforms(apply, froxel_knee=froxel_knee(settings.max_distance), max_distance=settings.max_distance,
                        shafts_lit=int(lit))
         if fog is not None:
             self.medium.fog_uniforms(frame, apply, fog, settings)
         elif aerial is not None:
             bind_cloud_distance(frame, apply)
+        units = aerial.use_pixel(frame, apply) if composite and aerial is not None else []
         color = frame.image(COLOR)
         frame.dispatch(apply, work_groups(color.size, (8, 8)), images={"color_image": color},
                        textures={"scene_depth": DEPTH, "shaft_volume": volume})
+        if units:
+            aerial.clear_pixel(units)

@@ -50,13 +50,17 @@ class MarchedShafts:
             self.jitter = None
 
     def program(self, far_field: bool, fog=None, aerial=None, shader: str = "light_shafts/march.comp",
-                composite_fog: bool = False):
+                composite: bool = False):
         """``shader`` (the march, or the froxels' fill and apply) with the far field's shadows beyond the volume
         (column.glsl's CLOUD_FAR_FIELD) or without; ``fog`` (the FogMedium): the variant that shadows the fog's
-        in-scatter (SHAFT_FOG), and with ``composite_fog`` the froxels' apply that composites the fog too
-        (SHAFT_FOG_COMPOSITE); ``aerial`` (the SkyLight): the variant that shadows the sky's aerial
-        perspective (SHAFT_AERIAL)."""
-        defines = {"SHAFT_FOG_COMPOSITE": 1} if composite_fog else {}
+        in-scatter (SHAFT_FOG); ``aerial`` (the SkyLight): the variant that shadows the sky's aerial
+        perspective (SHAFT_AERIAL); with ``composite`` the froxels' apply that composites them too
+        (SHAFT_FOG_COMPOSITE, SHAFT_AIR_COMPOSITE)."""
+        defines = {}
+        if composite and fog is not None:
+            defines["SHAFT_FOG_COMPOSITE"] = 1
+        if composite and aerial is not None:
+            defines.update(SHAFT_AIR_COMPOSITE=1, **aerial.pixel_defines())
         if self.exact:
             defines.update(SHAFT_EXACT_SHADOWS=1, **({"CLOUD_FAR_FIELD": 1} if far_field else {}))
         if aerial is not None:

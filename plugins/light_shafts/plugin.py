@@ -10,7 +10,7 @@ from atmos.plugins.clouds import CLOUD_SETS, FAR_FIELD
 from atmos.plugins.clouds.shadows.shadow_map import shadow_map_pass
 from atmos.plugins.fog import FogMedium
 from atmos.composition import Composition
-from atmos.plugins.light_shafts.froxels import FroxelShafts, composites_fog, uses_froxels
+from atmos.plugins.light_shafts.froxels import FroxelShafts, composites_media, uses_froxels
 from atmos.plugins.light_shafts.march import MarchedShafts
 from atmos.plugins.light_shafts.settings import LightShaftSettings, blur_scale
 from atmos.plugins.light_shafts.screen_sun import screen_sun
@@ -43,7 +43,7 @@ class LightShaftsPass(RenderPass):
     """
     name = "light_shafts"
     phase = "post"
-    fuse_fog = True     # False: the fog keeps its own pass even where the froxels' apply could composite it (tests)
+    fuse_media = True   # False: the fog and the air keep their passes where the froxels' apply could composite them (tests)
 
     def __init__(self, plugin: "LightShaftsPlugin"):
         self.plugin = plugin
@@ -58,7 +58,7 @@ class LightShaftsPass(RenderPass):
         graph = plugin.graph
         return (plugin.settings, plugin.gpu.size, graph.imports(CLOUD_SETS), graph.imports(FAR_FIELD),
                 fog is not None and (fog.settings, fog.reads_cloud_distance),
-                aerial is not None and aerial.reads_cloud_distance, plugin.composites_fog())
+                aerial is not None and aerial.reads_cloud_distance, plugin.composites_media())
 
     def setup(self, builder: PassBuilder) -> None:
         w, h = self.plugin.gpu.size
@@ -66,7 +66,7 @@ class LightShaftsPass(RenderPass):
         settings, fog = self.plugin.settings, self.plugin.fog
         if settings.mode == "march" and uses_froxels(settings, fog):
             FroxelShafts.declare(builder, settings.froxels, self.clouds(), self.plugin.graph.imports(FAR_FIELD),
-                                 fog, self.plugin.aerial())
+                                 fog, self.plugin.aerial(), self.plugin.composites_media())
             return
         if settings.mode == "march":
             MarchedShafts.declare(builder, (w, h), d, self.clouds(), self.plugin.graph.imports(FAR_FIELD),
@@ -100,7 +100,7 @@ class LightShaftsPass(RenderPass):
             self.froxels.history.release()              # no volume to accumulate: no history kept
         if froxels:
             self.froxels.execute(frame, params, frame.declares(CLOUD_SETS), self.plugin.fog, self.plugin.aerial(),
-                                 self.plugin.composites_fog())
+                                 self.plugin.composites_media())
             return
         if params.mode == "march":
             self.marched.execute(frame, params, frame.declares(CLOUD_SETS), self.plugin.fog, self.plugin.aerial())
@@ -161,17 +161,20 @@ class LightShaftsPlugin(Plugin):
         self.fog = app.get_resource(FogMedium)
         self.sky = app.get_resource(SkyLight)
         self.composition = app.get_resource(Composition)
-        if self.fog is not None:
-            self.fog.composite_elsewhere(self.composites_fog)
+        for medium in (self.fog, self.sky):
+            if medium is not None:
+                medium.composite_elsewhere(self.composites_media)
 
     def cleanup(self, app) -> None:
-        if self.fog is not None:
-            self.fog.composite_elsewhere(None)
+        for medium in (self.fog, self.sky):
+            if medium is not None:
+                medium.composite_elsewhere(None)
 
-    def composites_fog(self) -> bool:
-        """Whether the froxels' apply composites the fog this frame (its own pass culled):
-        :func:`.froxels.composites_fog`."""
-        return LightShaftsPass.fuse_fog and composites_fog(self.settings, self.fog, self.aerial(), self.composition)
+    def composites_media(self) -> bool:
+        """Whether the froxels' apply composites the fog and the air this frame (their own passes culled):
+        :func:`.froxels.composites_media`."""
+        return LightShaftsPass.fuse_media and composites_media(self.settings, self.fog, self.aerial(),
+                                                               self.composition)
 
     def aerial(self):
         """The SkyLight when its aerial perspective is on (the march then takes away the air's

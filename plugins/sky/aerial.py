@@ -9,7 +9,9 @@ its orange at sunset, with no fog colour to choose. Clouds that give the media p
 (:mod:`atmos.composition`) are hazed by it. It runs after the other media passes (local fog lies in
 front of the surfaces it covers; the atmosphere spans the whole ray); with a fog it mixes the air with
 the fog along the ray (:mod:`atmos.composition` media_mix): an opaque fog hides the air behind it, and
-neither medium's light is counted twice. Culled with Preetham or off.
+neither medium's light is counted twice. Culled with Preetham or off, and while another pass composites
+the air (:class:`atmos.composition.CompositedElsewhere`: the light shafts' froxel apply runs
+``shaders/sky/aerial_pixel.glsl`` itself, through :meth:`declare_pixel` and :meth:`use_pixel`).
 
 With ``SkySettings.aerial_froxels`` (default (32, 32, 64)) the pass first fills the transient
 "aerial_volume", a froxel volume: each froxel column's ray marched slice by slice (slices squared out
@@ -71,32 +73,41 @@ class AerialPerspectivePass(ComputePass):
         return self.plugin.composition.media
 
     def defines(self) -> dict:
+        return {**self.pixel_defines(), "AERIAL_CLOUDS": int(self.clouds()), "AERIAL_MEDIA": int(self.media())}
+
+    def pixel_defines(self) -> dict:
+        """sky/aerial_pixel.glsl's variant: the atmosphere's, its step count and whether it reads the froxels."""
         return {**atmosphere_defines(), "AERIAL_STEPS": self.plugin.settings.aerial_steps,
-                "AERIAL_CLOUDS": int(self.clouds()), "AERIAL_VOLUME": int(self.froxels() is not None),
-                "AERIAL_MEDIA": int(self.media())}
+                "AERIAL_VOLUME": int(self.froxels() is not None)}
 
     def froxels(self):
         return self.plugin.settings.aerial_froxels
 
     def setup(self, builder) -> None:
-        if not active(self.plugin.settings):
+        if not active(self.plugin.settings) or self.plugin.light.composited_elsewhere:
             return                              # declares nothing: culled, nothing allocated
-        if self.froxels() is not None:
-            builder.create(AERIAL_VOLUME, TextureDesc(tuple(self.froxels()), components=4, dtype="f4", storage=True),
-                           access="storage")
+        self.declare_pixel(builder)
         builder.read(DEPTH)
         builder.read(COLOR, access="storage")   # composites onto it in place
         builder.write(COLOR, access="storage")
-        builder.read(SKY_LUTS)
         if self.clouds():
             builder.read(CLOUD_DISTANCE)
         if self.media():                        # a fog in front: the air mixed with it (atmos.composition)
             builder.read(MEDIA_LIGHT)
             builder.read(MEDIA_TRANSMITTANCE)
 
+    def declare_pixel(self, builder) -> None:
+        """What sky/aerial_pixel.glsl reads, declared by the pass that runs it: the LUTs, and the froxel
+        volume it fills (created by that pass)."""
+        if self.froxels() is not None:
+            builder.create(AERIAL_VOLUME, TextureDesc(tuple(self.froxels()), components=4, dtype="f4", storage=True),
+                           access="storage")
+        builder.read(SKY_LUTS)
+
     def prepare(self, gpu) -> None:
         super().prepare(gpu)
-        self.sampler = clamp_sampler(gpu.ctx)
+        if getattr(self, "sampler", None) is None:
+            self.sampler = clamp_sampler(gpu.ctx)
 
     def release(self) -> None:
         sampler = getattr(self, "sampler", None)
@@ -106,28 +117,41 @@ class AerialPerspectivePass(ComputePass):
         super().release()
 
     def execute(self, frame: PassContext) -> None:
-        view, p = frame.view, self.program
-        settings = self.plugin.settings
-        frame.resource(SKY_LUTS).bind(p)
-        values = dict(view_r=view_radius(settings.atmosphere, view.camera),
-                      aerial_range=volume_range(view.camera, view.aspect, settings.atmosphere))
-        volume = frame.resource(AERIAL_VOLUME) if frame.declares(AERIAL_VOLUME) else None
-        if volume is not None:
-            self._fill(volume, view, values)
-        units = bind_textures(p, sampler=self.sampler, aerial_volume=volume) if volume is not None else []
-        set_atmosphere_uniforms(p, settings.atmosphere)
-        write_uniforms(p, values)
+        p = self.program
+        units = self.use_pixel(frame, p)
         # graph resources under the names the shader's samplers carry (atmos.composition)
         textures = {name: name for name in (DEPTH, CLOUD_DISTANCE, MEDIA_LIGHT, MEDIA_TRANSMITTANCE)
                     if frame.declares(name)}
         textures["scene_depth"] = textures.pop(DEPTH)
         frame.dispatch(p, self.groups(frame.image(COLOR).size), textures=textures, images={"color_image": COLOR})
+        self.clear_sampler(units)
+
+    def use_pixel(self, frame: PassContext, program) -> list[int]:
+        """Everything sky/aerial_pixel.glsl reads, for ``program`` in a pass that declared it
+        (:meth:`declare_pixel`): the froxel volume filled and bound (clamped), the LUTs, the atmosphere's
+        uniforms, ``view_r`` and ``aerial_range``. Returns the units to :meth:`clear_sampler` after the dispatch."""
+        if getattr(self, "sampler", None) is None:
+            self.sampler = clamp_sampler(frame.gpu.ctx)     # a pass other than this one may run it first
+        view, settings = frame.view, self.plugin.settings
+        frame.resource(SKY_LUTS).bind(program)
+        values = dict(view_r=view_radius(settings.atmosphere, view.camera),
+                      aerial_range=volume_range(view.camera, view.aspect, settings.atmosphere))
+        volume = frame.resource(AERIAL_VOLUME) if frame.declares(AERIAL_VOLUME) else None
+        if volume is not None:
+            self._fill(frame.gpu, volume, values)
+        units = bind_textures(program, sampler=self.sampler, aerial_volume=volume) if volume is not None else []
+        set_atmosphere_uniforms(program, settings.atmosphere)
+        write_uniforms(program, values)
+        return units
+
+    def clear_sampler(self, units) -> None:
+        """Unbind the clamping sampler from ``units`` (:meth:`use_pixel`'s)."""
         for unit in units:
             self.sampler.clear(unit)
 
-    def _fill(self, volume, view, values) -> None:
+    def _fill(self, gpu, volume, values) -> None:
         """The froxel volume: one invocation per froxel column, marching through the slices (aerial_volume.comp)."""
-        c = self.gpu.program(compute_shader="sky/aerial_volume.comp", defines=atmosphere_defines())
+        c = gpu.program(compute_shader="sky/aerial_volume.comp", defines=atmosphere_defines())
         set_atmosphere_uniforms(c, self.plugin.settings.atmosphere)
         write_uniforms(c, values)
         bind_images(c, aerial_volume=volume)

@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 import atmos.plugins.sky.radiance as radiance
+from atmos.composition import CompositedElsewhere
 from atmos.gpu.uniforms import write_uniforms
 from atmos.plugins.sky.aerial import active
 from atmos.plugins.sky.luts import SKY_LUTS, atmosphere_defines, set_atmosphere_uniforms, view_radius
@@ -40,8 +41,10 @@ def horizon_colors(sun, sky_settings, n: int, altitude: float = 0.0) -> np.ndarr
                                  sky_settings.turbidity, sky_settings.scale, sky_settings.night)
 
 
-class SkyLight:
-    """See the module docstring; ``plugin`` is the SkyPlugin that publishes it."""
+class SkyLight(CompositedElsewhere):
+    """See the module docstring; ``plugin`` is the SkyPlugin that publishes it. Another pass may composite
+    the air's aerial perspective (:class:`atmos.composition.CompositedElsewhere`; ``declare_pixel``,
+    ``pixel_defines``, ``use_pixel``: sky/aerial_pixel.glsl in that pass)."""
 
     def __init__(self, plugin):
         self._plugin = plugin
@@ -80,6 +83,21 @@ class SkyLight:
 
     def aerial_defines(self) -> dict:
         return atmosphere_defines()
+
+    def declare_pixel(self, builder) -> None:
+        """A pass that composites the air itself (sky/aerial_pixel.glsl) reads the LUTs and fills the froxel volume."""
+        self._plugin.aerial_pass.declare_pixel(builder)
+
+    def pixel_defines(self) -> dict:
+        """sky/aerial_pixel.glsl's variant (the atmosphere's defines, its steps, whether froxels)."""
+        return self._plugin.aerial_pass.pixel_defines()
+
+    def use_pixel(self, frame, program) -> list[int]:
+        """Fill and bind what sky/aerial_pixel.glsl reads for ``program``; the units to :meth:`clear_pixel` after."""
+        return self._plugin.aerial_pass.use_pixel(frame, program)
+
+    def clear_pixel(self, units) -> None:
+        self._plugin.aerial_pass.clear_sampler(units)
 
     def set_aerial_uniforms(self, frame, program) -> None:
         """The atmosphere's uniforms, its LUTs bound and the camera's radius (``view_r``)."""

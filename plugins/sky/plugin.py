@@ -101,6 +101,8 @@ class SkyPlugin(Plugin):
         super().__init__(settings, **fields)
         self.luts: AtmosphereLuts | None = None
         self.gpu = self.graph = self.composition = None
+        self.aerial_pass: AerialPerspectivePass | None = None
+        self.light: SkyLight | None = None    # the sky's light as other effects see it (published)
 
     def build(self, app) -> None:
         self.gpu = app.gpu
@@ -109,9 +111,11 @@ class SkyPlugin(Plugin):
         app.graph.add_pass(SkyLutsPass(self))
         app.graph.add_pass(SkyPass(self))
         self.composition.backgrounds.add(SkyPass.name)      # it writes every pixel after the depth clear
-        app.graph.add_pass(AerialPerspectivePass(self))
+        self.aerial_pass = AerialPerspectivePass(self)
+        app.graph.add_pass(self.aerial_pass)
         app.graph.import_resource(SKY_LUTS, self._luts)
-        app.insert_resource(SkyLight(self))
+        self.light = SkyLight(self)
+        app.insert_resource(self.light)
         self._read_distance()
 
     def configure(self, **changes) -> SkySettings:

@@ -5,6 +5,8 @@
 // Where in its slice a froxel fill samples in frame `frame` (the frame block's frame_index): 0 the near
 // boundary, 1 the far one; frac(1/2 + frame / phi) in 32-bit fixed point (Roberts' R1 sequence, exact for any
 // frame; the middle in frame 0), or the middle (0.5) where not `jittered` (atmos/froxels.py froxel_jitter).
+#ifndef FROXEL_SLICES_INCLUDED
+#define FROXEL_SLICES_INCLUDED
 float froxel_jitter(uint frame, bool jittered) {
     return jittered ? float((2147483648u + frame * 2654435769u) >> 8u) / 16777216.0 : 0.5;
 }
@@ -24,3 +26,4 @@ vec4 froxel_read(sampler3D volume, vec2 uv, float d, float range, float knee) {
     float w = froxel_w(min(d, range), range, knee) * (layers - 1.0);
     return textureLod(volume, vec3(uv, (w + 0.5) / layers), 0.0);
 }
+#endif
