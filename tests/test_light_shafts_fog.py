@@ -103,7 +103,8 @@ def test_under_a_kept_sky_the_rays_show_against_the_sky(fog_gpu, froxels):
     assert sides > 0.1 and sides > 5.0 * centre, f"the sky behind shadowed air darker ({sides:.3f}) than the ray ({centre:.3f})"
 
 
-def aerial_frame(gpu, density, shafts: bool, aerial: bool = True, fog_color=None, froxels=None) -> np.ndarray:
+def aerial_frame(gpu, density, shafts: bool, aerial: bool = True, fog_color=None, froxels=None,
+                 sun=(0.0, 1.0, 0.25), aerial_froxels=(32, 32, 64)) -> np.ndarray:
     """The gap view under the physical sky, its aerial perspective on (or off), with or without shafts;
     ``fog_color``: under an exponential fog of that colour too (mixed with the air along the ray,
     atmos.composition)."""
@@ -112,10 +113,11 @@ def aerial_frame(gpu, density, shafts: bool, aerial: bool = True, fog_color=None
     if fog_color is not None:
         extra.append(FogPlugin(mode="exp", density=1.5e-3, sky="keep", fog_color=fog_color))
     app = App(gpu).add_plugins(DefaultPlugins(overlay=False), SkyPlugin(model="physical", stars=False,
-                                                                         aerial_perspective=aerial), GroundPlugin(),
+                                                                         aerial_perspective=aerial,
+                                                                         aerial_froxels=aerial_froxels), GroundPlugin(),
                                CloudsPlugin(CloudSettings(cell_size=CELL, base_altitude=BASE, shading=False,
                                                           sigma_t=0.05), density=density), *extra)
-    app.insert_resource(Sun(np.array([0.0, 1.0, 0.25])))
+    app.insert_resource(Sun(np.array(sun, np.float64)))
     app.startup()
     cam = app.resource(Camera)
     cam.position = np.array([320.0, 60.0, 20.0])
@@ -270,15 +272,21 @@ def gpu_ok(app) -> bool:
 
 
 @pytest.mark.parametrize("fog_color", [None, (1.0, 0.9, 0.8)], ids=["air", "fog_and_air"])
-def test_the_froxels_apply_composites_the_air_and_the_fog_as_their_passes_did(fog_gpu, monkeypatch, fog_color):
+@pytest.mark.parametrize("sun, aerial_froxels", [((0.0, 1.0, 0.25), (32, 32, 64)), ((0.0, 1.0, 0.25), None),
+                                                 ((0.0, -0.05, 1.0), (32, 32, 64))],
+                         ids=["froxel_air", "marched_air", "sun_down"])
+def test_the_froxels_apply_composites_the_air_and_the_fog_as_their_passes_did(fog_gpu, monkeypatch, fog_color, sun,
+                                                                               aerial_froxels):
     """The sky's aerial perspective on (and a fog, mixed with it along the ray): the shafts' froxel apply
     composites both and takes the shadowed share away in one write, the fog's and the sky's passes and
     the media targets gone (aerial_frame checks); the frame equals those passes then the apply, up to the
     float16 rounding of the colour between them."""
     volume = columns_volume()
-    fused = aerial_frame(fog_gpu, volume, True, fog_color=fog_color, froxels=(40, 24, 64))
+    fused = aerial_frame(fog_gpu, volume, True, fog_color=fog_color, froxels=(40, 24, 64), sun=sun,
+                         aerial_froxels=aerial_froxels)
     monkeypatch.setattr(LightShaftsPass, "fuse_media", False)
-    apart = aerial_frame(fog_gpu, volume, True, fog_color=fog_color, froxels=(40, 24, 64))
+    apart = aerial_frame(fog_gpu, volume, True, fog_color=fog_color, froxels=(40, 24, 64), sun=sun,
+                         aerial_froxels=aerial_froxels)
     assert np.isfinite(fused).all() and min(fused.min(), apart.min()) >= 0.0 and fused.max() > 0.0
     step = 2.0 ** -10 * (np.abs(apart) + np.abs(fused)) + 1e-6      # float16's step, rounding toward zero
     assert (np.abs(fused - apart) <= 3.0 * step).all(), np.abs(fused - apart).max()
