@@ -15,6 +15,7 @@ from atmos.plugins.light_shafts.march import MarchedShafts, bind_cloud_distance,
 from atmos.render_core import COLOR, DEPTH
 from atmos.gpu.uniforms import write_uniforms
 
+FOG_ONLY = frozenset({"fog"})               # the local media the apply can composite (atmos.composition)
 SHAFT_VOLUME = "light_shafts_volume"      # (W, H, D + 1) sums from the camera to each slice boundary
 
 
@@ -29,7 +30,7 @@ def composites_media(settings, fog, aerial, composition) -> bool:
     shafts take away, in one write: marched shafts from the froxel volume, and no local medium but the
     fog (``composition``'s media writers; none, e.g. a volumetric fog, to keep in order with them)."""
     return ((fog is not None or aerial is not None) and settings.mode == "march" and uses_froxels(settings, fog)
-            and composition is not None and not composition.media_writers - {"fog"})
+            and composition is not None and composition.media_writers <= FOG_ONLY)
 
 
 class FroxelShafts:

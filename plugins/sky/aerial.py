@@ -60,6 +60,7 @@ class AerialPerspectivePass(ComputePass):
     name = AERIAL
     phase = "media"
     compute = "sky/aerial.comp"
+    sampler = None          # the clamping sampler of the froxel volume, made on first use (use_pixel)
 
     @property
     def after(self) -> tuple[str, ...]:
@@ -104,15 +105,9 @@ class AerialPerspectivePass(ComputePass):
                            access="storage")
         builder.read(SKY_LUTS)
 
-    def prepare(self, gpu) -> None:
-        super().prepare(gpu)
-        if getattr(self, "sampler", None) is None:
-            self.sampler = clamp_sampler(gpu.ctx)
-
     def release(self) -> None:
-        sampler = getattr(self, "sampler", None)
-        if sampler is not None:
-            sampler.release()
+        if self.sampler is not None:
+            self.sampler.release()
             self.sampler = None
         super().release()
 
@@ -130,8 +125,8 @@ class AerialPerspectivePass(ComputePass):
         """Everything sky/aerial_pixel.glsl reads, for ``program`` in a pass that declared it
         (:meth:`declare_pixel`): the froxel volume filled and bound (clamped), the LUTs, the atmosphere's
         uniforms, ``view_r`` and ``aerial_range``. Returns the units to :meth:`clear_sampler` after the dispatch."""
-        if getattr(self, "sampler", None) is None:
-            self.sampler = clamp_sampler(frame.gpu.ctx)     # a pass other than this one may run it first
+        if self.sampler is None:                # whichever pass runs it first (this one or the shafts')
+            self.sampler = clamp_sampler(frame.gpu.ctx)
         view, settings = frame.view, self.plugin.settings
         frame.resource(SKY_LUTS).bind(program)
         values = dict(view_r=view_radius(settings.atmosphere, view.camera),

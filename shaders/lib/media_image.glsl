@@ -16,8 +16,8 @@ layout(binding = 1, rgba32f) uniform image2D media_light_image;
 layout(binding = 2, r32f) uniform image2D media_transmittance_image;
 #endif
 
-void blend_medium(ivec2 pixel, vec4 medium) {
-    vec4 c = imageLoad(color_image, pixel);
+// c: the colour at the pixel, loaded by a caller that needed it already.
+void blend_medium(ivec2 pixel, vec4 medium, vec4 c) {
     imageStore(color_image, pixel, vec4(medium.rgb + medium.a * c.rgb, c.a));
 #if LOCAL_MEDIA == 2
     imageStore(media_light_image, pixel, medium);
@@ -28,4 +28,8 @@ void blend_medium(ivec2 pixel, vec4 medium) {
     float t = imageLoad(media_transmittance_image, pixel).r;
     imageStore(media_transmittance_image, pixel, vec4(medium.a * t));
 #endif
+}
+
+void blend_medium(ivec2 pixel, vec4 medium) {
+    blend_medium(pixel, medium, imageLoad(color_image, pixel));
 }

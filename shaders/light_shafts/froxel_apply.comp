@@ -79,8 +79,9 @@ void main() {
 #endif
     // never more than the pixel's light: the fog's colour taken out of a kept sky of another hue could
     // leave a channel below black
-    taken = min(taken, max(medium.rgb + medium.a * imageLoad(color_image, pixel).rgb, vec3(0.0)));
-    blend_medium(pixel, vec4(medium.rgb - taken, medium.a));
+    vec4 c = imageLoad(color_image, pixel);
+    taken = min(taken, max(medium.rgb + medium.a * c.rgb, vec3(0.0)));
+    blend_medium(pixel, vec4(medium.rgb - taken, medium.a), c);
 #else
     vec4 shafts = sums_at(uv, d);
     blend_medium(pixel, vec4(min(shafts.rgb, vec3(HDR_MAX)), shafts.a));
