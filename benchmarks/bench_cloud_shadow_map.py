@@ -15,7 +15,7 @@ from atmos.demo_registry import DemoSettings
 from atmos.lighting import Sun, unit_sun
 from atmos.plugins.clouds.shadows import CloudShadowsPass
 from atmos.plugins.clouds.shadows.probe import ShadowMapProbe
-from atmos.plugins.clouds.shadows.shadow_map import MAP_SIZE
+from atmos.plugins.clouds.shadows.shadow_map import MAP_SIZE, NEAR_RATIO
 from atmos.plugins.light_shafts import LightShaftSettings
 from atmos.plugins.light_shafts.march import MarchedShafts
 from atmos.runner import build_app
@@ -66,7 +66,7 @@ def accuracy(frames: int = 4) -> None:
         cells = [errors(r[m]) if m.any() else (0.0, 0.0) for m in (near, ~near)]
         print(f"{name:22s} {len(pts):7d} {cells[0][0]:10.4f} {cells[0][1]:8.4f} {cells[1][0]:10.4f} {cells[1][1]:8.4f}")
     n = space.size
-    print(f"map {n}x{2 * n} rg16f; near {1 / space.cascades[0, 2]:.0f} texels per cell "
+    print(f"map {n}x{2 * n} rg16f; near {1 / space.cascades[0, 2]:.0f} texels per cell, {space.near}x{space.near} in use "
           f"({space.cell[0] * space.cascades[0, 2]:.1f} m), far {space.cell[0] * space.cascades[1, 2]:.1f} m texels")
     app.close()
     gpu.release()
@@ -76,7 +76,7 @@ def in_near(space, pts, sun) -> np.ndarray:
     run = np.maximum(space.mid - pts[:, 1], 0.0) / max(sun[1], 1e-4)
     v = (pts[:, [0, 2]] + run[:, None] * sun[[0, 2]] - space.lo[[0, 2]]) / space.cell[[0, 2]] - 0.5
     j = (v - space.cascades[0, :2]) / space.cascades[0, 2:]
-    return np.all((j >= 0) & (j <= space.size - 1), axis=-1)
+    return np.all((j >= 0) & (j <= space.near - 1), axis=-1)
 
 
 def work() -> None:
@@ -86,7 +86,8 @@ def work() -> None:
     print(f"  exact: 8 column fetches (4 bilinear taps x A, B) + 4 octaves + 1 rank table = 13; "
           f"per shaft texel x {steps} steps = {13 * steps}")
     print(f"  map:   1 bilinear fetch; per shaft texel x {steps} steps = {steps}; "
-          f"+ 1 bake dispatch of {n}x{2 * n} = {2 * n * n} texels x 13 fetches")
+          f"+ 1 bake dispatch: {n}x{n} far texels and the near cascade's in use (at most {NEAR_RATIO} per cell "
+          f"each way) x 13 fetches")
 
 
 def timings(frames: int = 30) -> None:

@@ -55,7 +55,7 @@ def test_float64_lookup_matches_sun_optical_depth_within_the_derived_bound(rng):
     run = np.maximum(space.mid - pts[:, 1], 0.0) / sun[1]
     v = (pts[:, [0, 2]] + run[:, None] * sun[[0, 2]] - space.lo[[0, 2]]) / space.cell[[0, 2]] - 0.5
     j = [(v - c[:2]) / c[2:] for c in space.cascades]
-    near = np.all((j[0] >= 0) & (j[0] <= space.size - 1), axis=-1)
+    near = np.all((j[0] >= 0) & (j[0] <= space.near - 1), axis=-1)
     inside = near | np.all((j[1] >= 0) & (j[1] <= space.size - 1), axis=-1)
     h = np.where(near[:, None], space.cascades[0, 2:], space.cascades[1, 2:])
     sums = (1 - t) * reference.shifted(sums_a, a_shift) + t * sums_b
@@ -93,7 +93,7 @@ class MapCapture(RenderPass):
         w, h = texture.size
         self.map = np.frombuffer(texture.read(), "f2").reshape(h, w, 2).astype(np.float64)
         s = frame.resource(SHADOW_SPACE)
-        self.space = type(s)(s.size, s.cascades.copy(), s.lo.copy(), s.cell.copy(), s.shape, s.frame)
+        self.space = type(s)(s.size, s.cascades.copy(), s.lo.copy(), s.cell.copy(), s.shape, s.frame, s.near)
 
 
 @pytest.mark.parametrize("typed", [None, "type", "map"])
@@ -166,7 +166,7 @@ def test_gpu_bake_and_lookup_match_float64(gpu, ctx, rng, typed):
         run = np.maximum(space.mid - points[:, 1], 0.0) / s[1]
         v = (points[:, [0, 2]] + run[:, None] * s[[0, 2]] - space.lo[[0, 2]]) / space.cell[[0, 2]] - 0.5
         j = (v - space.cascades[0, :2]) / space.cascades[0, 2:]
-        near = np.all((j >= 0) & (j <= space.size - 1), axis=-1)
+        near = np.all((j >= 0) & (j <= space.near - 1), axis=-1)
         h = np.where(near[:, None], space.cascades[0, 2:], space.cascades[1, 2:])
         raw = max(np.abs(np.diff(m[0], axis=a)).max() for m in sums for a in (0, 1))
         interp = g1 * raw * h.sum(-1) / 4.0 * probe.weights[0]

@@ -10,9 +10,11 @@ multiplies by ``above``: the height handling is exact, the only errors are the m
 format.
 
 Grid: one ``N × 2N`` image (``N = MAP_SIZE``), rows [0, N) the near cascade, [N, 2N) the far one.
-Near: ``r`` map texels per volume cell (the largest integer fitting the volume and a margin), texel
-centres on the column centres, so the piecewise-bilinear column sums are reproduced exactly (only the
-edge fade and the far field between texels are interpolated). Far: centred on the camera's own
+Near: ``r`` map texels per volume cell (the largest integer fitting the volume and a margin, at most
+NEAR_RATIO), texel centres on the column centres, so the piecewise-bilinear column sums are reproduced
+exactly (only the edge fade, a cloud type's shape of the sum and the far field between texels are
+interpolated); it uses the first ``near`` texels of its rows and columns (the rest hold 0 and are never
+read), so a small volume bakes no more texels than it needs. Far: centred on the camera's own
 projection, ``FAR_REACH × camera.far`` each way (lookups past it clamp to its edge): the far field at
 coarse resolution. Format: rg16f, relative rounding 2⁻¹¹, so ``|Δ exp(−τ)| ≤ τ e^{−τ} 2⁻¹¹ ≤ 2⁻¹¹/e``
 (1.8e-4, far below the 8-bit output step); sums of up to thousands of cells fit its range (65504).
@@ -33,19 +35,22 @@ SHADOW_SPACE = "cloud_shadow_space"    # the map's ShadowMapSpace (imported; the
 MAP_SIZE = 1024                        # N: texels per cascade side
 FAR_REACH = 1.25                       # the far cascade reaches this × camera.far from the camera's projection
 MIN_SUN_HEIGHT = 1e-4                  # as column.glsl's
+NEAR_RATIO = 2                         # the near cascade's map texels per volume cell at most
 FORMAT_ERROR = 2.0 ** -11              # rg16f's relative rounding (half an ulp of an 11-bit significand)
 
 
 @dataclass
 class ShadowMapSpace:
     """Where the map lies: ``cascades`` (2, 4) per cascade the volume texel coordinate of its texel
-    (0, 0) and its volume texels per map texel (x, z); the layer's heights and placement."""
+    (0, 0) and its volume texels per map texel (x, z); ``near`` the near cascade's texels per side in
+    use; the layer's heights and placement."""
     size: int = MAP_SIZE
     cascades: np.ndarray = field(default_factory=lambda: np.zeros((2, 4)))
     lo: np.ndarray = field(default_factory=lambda: np.zeros(3))
     cell: np.ndarray = field(default_factory=lambda: np.ones(3))
     shape: tuple = (1, 1, 1)
     frame: int = -1                    # bumped by every bake
+    near: int = MAP_SIZE               # texels per side of the near cascade in use (<= size)
 
     @property
     def mid(self) -> float:
@@ -66,14 +71,15 @@ class ShadowMapSpace:
         lookup = np.concatenate([c[:, :2], 1.0 / c[:, 2:]], axis=1).astype("f4")
         write_uniforms(program, shadow_cascades=lookup.tobytes(),
                        shadow_plane=(float(self.lo[0]), float(self.lo[2]), 1.0 / self.cell[0], 1.0 / self.cell[2]),
-                       shadow_heights=(self.mid, float(self.lo[1]) + self.thickness, 1.0 / self.thickness),
+                       shadow_heights=(self.mid, float(self.lo[1]) + self.thickness, 1.0 / self.thickness,
+                                       float(self.near - 1)),
                        shadow_weights=(float(extinction), float(field_tau)))
 
 
 def near_ratio(shape, size: int, pad: int) -> int:
-    """Map texels per volume cell of the near cascade: the largest integer with the volume and ``pad``
-    cells each side within ``size`` texels (1 when even that does not fit)."""
-    return max(1, (size - 1) // (max(shape[0], shape[2]) + 1 + 2 * pad))
+    """Map texels per volume cell of the near cascade: the largest integer up to NEAR_RATIO with the
+    volume and ``pad`` cells each side within ``size`` texels (1 when even that does not fit)."""
+    return max(1, min(NEAR_RATIO, (size - 1) // (max(shape[0], shape[2]) + 1 + 2 * pad)))
 
 
 def shadow_space(layout, camera_position, sun_dir, camera_far: float, size: int = MAP_SIZE,
@@ -91,8 +97,9 @@ def shadow_space(layout, camera_position, sun_dir, camera_far: float, size: int 
     far_step = 2.0 * half / (size - 1) / cell[[0, 2]]                   # volume texels per far texel
     pad = 1 + int(np.ceil(far_step.max()))           # far lookups past the near cascade never reach the volume
     r = near_ratio(shape, size, pad)
+    space.near = min(int(size), r * (max(shape[0], shape[2]) + 1 + 2 * pad) + 1)
     centre = (np.array([shape[0], shape[2]], np.float64) - 1.0) / 2.0
-    near0 = np.floor(centre - (size - 1) / (2.0 * r))                   # integer: texel centres on columns
+    near0 = np.floor(centre - (space.near - 1) / (2.0 * r))             # integer: texel centres on columns
     far0 = (q - lo[[0, 2]]) / cell[[0, 2]] - 0.5 - 0.5 * (size - 1) * far_step
     space.cascades = np.array([[near0[0], near0[1], 1.0 / r, 1.0 / r],
                                [far0[0], far0[1], far_step[0], far_step[1]]])
@@ -144,7 +151,7 @@ class CloudShadowMapPass(ComputePass):
         column_uniforms(p, sim, layout, 1.0)
         if layer is not None:
             layer.use(p, view, sim)
-        write_uniforms(p, cascades=self.space.cascades.astype("f4").tobytes())
+        write_uniforms(p, cascades=self.space.cascades.astype("f4").tobytes(), near_size=self.space.near)
         image = frame.image(SHADOW_MAP)
         frame.dispatch(p, self.groups(image.size), images={"shadow_map": image})
 
@@ -196,6 +203,8 @@ def bake_reference(space: ShadowMapSpace, sums_a, sums_b, t: float, layout, a_sh
     out[..., 0] = typed_column(zero_border_bilinear(sums, v), x, z, ny, cloud_type, type_map) * fade
     if far is not None:
         out[..., 1] = typed_column(far(xz), x, z, ny, cloud_type, type_map) * (1.0 - fade)
+    out[:space.size][space.near:] = 0.0             # the near cascade's texels not in use
+    out[:space.size, space.near:] = 0.0
     return out
 
 
@@ -209,7 +218,7 @@ def lookup_reference(space: ShadowMapSpace, baked: np.ndarray, points, sun_dir, 
     above = np.clip((space.lo[1] + space.thickness - p[..., 1]) / space.thickness, 0.0, 1.0)
     c = space.cascades
     j = (v - c[0, :2]) / c[0, 2:]
-    near = np.all((j >= 0.0) & (j <= n - 1.0), axis=-1)
+    near = np.all((j >= 0.0) & (j <= space.near - 1.0), axis=-1)
     j = np.where(near[..., None], j, np.clip((v - c[1, :2]) / c[1, 2:], 0.0, n - 1.0))
     row0 = np.where(near, 0, n)
     i0 = np.minimum(np.floor(j).astype(np.int64), n - 2)

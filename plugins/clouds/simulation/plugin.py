@@ -74,6 +74,8 @@ class CloudsPlugin(Plugin):
 
     def cleanup(self, app) -> None:
         if self.simulation is not None:
+            if self.simulation.drawn is not None:
+                self.simulation.drawn.release()
             app.graph.remove_import(CLOUD_SETS)
             if isinstance(self.simulation, CloudSimulation) and self.simulation.job in app.frames:      # a scene may have paused the simulation
                 app.frames.remove(self.simulation.job)

@@ -25,6 +25,7 @@ def column_uniforms(program, sim: CloudSets, layout: CloudLayout, extinction: fl
         return
     cloud_type, type_map, texture = drawn
     write_uniforms(program, shape_uniforms(cloud_type, type_map))
+    bind_textures(program, typed_columns=sim.drawn.columns(program.ctx))
     if texture is not None:
         bind_textures(program, cloud_type_map=texture)
 

@@ -2,12 +2,13 @@
 // The cloud shadow map (plugins/clouds/shadows/shadow_map.py): once per frame, the sun's columns over
 // the layer's middle plane (clouds/volume/column.glsl sun_columns: the volume's column × edge fade, the
 // far field's × (1 − fade), per unit extinction) at the texel centres of two cascades stacked in one
-// rg16f image, rows [0, N) near, [N, 2N) far; cascade k's texel j lies at volume texel coordinate
-// cascades[k].xy + j * cascades[k].zw. Read with one fetch by clouds/shadows/shadow_map.glsl.
+// rg16f image, rows [0, N) near (its first near_size texels each way), [N, 2N) far; cascade k's texel
+// j lies at volume texel coordinate cascades[k].xy + j * cascades[k].zw. Read with one fetch by clouds/shadows/shadow_map.glsl.
 #include "clouds/volume/column.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0, rg16f) writeonly uniform image2D shadow_map;
 uniform vec4 cascades[2];      // (first texel's volume texel coordinate, volume texels per map texel)
+uniform int near_size;         // the near cascade's texels per side in use: the rest hold 0
 
 void main() {
     ivec2 j = ivec2(gl_GlobalInvocationID.xy);
@@ -15,6 +16,10 @@ void main() {
     if (any(greaterThanEqual(j, size))) return;
     int n = size.x;
     int k = j.y < n ? 0 : 1;
+    if (k == 0 && any(greaterThanEqual(j, ivec2(near_size)))) {
+        imageStore(shadow_map, j, vec4(0.0));
+        return;
+    }
     vec2 v = cascades[k].xy + vec2(j.x, j.y - k * n) * cascades[k].zw;
     vec2 xz = layer_min.xz + (v + 0.5) * cell_size.xz;
     imageStore(shadow_map, j, vec4(sun_columns(v, xz), 0.0, 0.0));

@@ -29,19 +29,23 @@ uniform float edge_fade;       // CloudSettings.edge_fade: columns fade with the
 #endif
 
 const float MIN_SUN_HEIGHT = 1e-4;
-const int TYPED_STEPS = 32;    // column.py TYPED_STEPS: midpoint samples of the type's profile
+layout(binding = 27) uniform sampler2D typed_columns;   // shape.py column_table: (sqrt(m / COLUMN_FULL), t) -> G
 
 // The column sum (summed density over the layer's shape.y cells) of the shape drawn over world point
-// xz for a simulated column sum `sum`: shape.y x the integral over the height fraction h in [0, top]
-// of type_density(sum / shape.y, h, t) (midpoint rule; top the type's highest point, towers
-// included); `sum` itself where no type is drawn (cloud_type < 0).
+// xz for a simulated column sum `sum`: shape.y x G(sum / shape.y, t), G the mean of the type's shaped
+// density over its height (shape.py column_mean), read from its table with 4 fetches (bilinear in
+// float32: the hardware filter's weights have 8 bits on some GPUs); `sum` itself where no type is drawn
+// (cloud_type < 0).
 float typed_column(float sum, vec2 xz) {
     if (cloud_type < 0.0 || sum <= 0.0) return sum;
-    float t = cloud_type_at(xz);
-    float ny = float(shape.y), dh = max(type_breakpoints(t).z, 1.0) / float(TYPED_STEPS), s = 0.0;
-    for (int k = 0; k < TYPED_STEPS; ++k)
-        s += type_density(sum / ny, (float(k) + 0.5) * dh, t);
-    return ny * dh * s;
+    float ny = float(shape.y);
+    ivec2 n = textureSize(typed_columns, 0);
+    vec2 x = vec2(sqrt(clamp(sum / (ny * COLUMN_FULL), 0.0, 1.0)), clamp(cloud_type_at(xz), 0.0, 1.0)) * vec2(n - 1);
+    ivec2 i = min(ivec2(x), n - 2);
+    vec2 f = x - vec2(i);
+    float g = mix(mix(texelFetch(typed_columns, i, 0).r, texelFetch(typed_columns, i + ivec2(1, 0), 0).r, f.x),
+                  mix(texelFetch(typed_columns, i + ivec2(0, 1), 0).r, texelFetch(typed_columns, i + ivec2(1, 1), 0).r, f.x), f.y);
+    return ny * g;
 }
 
 bool outside(ivec2 c) {
@@ -71,10 +75,10 @@ float column_sum(vec2 p) {
 // map (clouds/shadows/bake.comp) bakes exactly this.
 vec2 sun_columns(vec2 v, vec2 xz) {
     float fade = cloud_edge_weight((v + 0.5) / vec2(shape.xz), edge_fade);
-    vec2 c = vec2(typed_column(column_sum(v), xz) * fade, 0.0);
+    vec2 c = vec2(fade > 0.0 ? typed_column(column_sum(v), xz) * fade : 0.0, 0.0);
 #ifdef CLOUD_FAR_FIELD
     // beyond the volume the far field's cover continues with the complementary weight (field.glsl)
-    c.y = typed_column(far_quantile(far_field_rank(xz, 0.0).x), xz) * (1.0 - fade);
+    if (fade < 1.0) c.y = typed_column(far_quantile(far_field_rank(xz, 0.0).x), xz) * (1.0 - fade);
 #endif
     return c;
 }
