@@ -198,8 +198,14 @@ def luminance(img):
 
 
 def cloud_change(app, img):
-    """|luminance − the same view without clouds| (the bare view rendered for the current camera)."""
-    return np.abs(luminance(img) - luminance(render(app, clouds=False)))
+    """|luminance − the same view without clouds| (the bare view rendered for the current camera, once
+    per pose: the far field's seed, which the seam tests vary, draws nothing in it)."""
+    cam = app.resource(Camera)
+    bare = app.__dict__.setdefault("bare_views_in_test", {})      # camera pose -> the view without clouds
+    key = (tuple(cam.position), cam.yaw, cam.pitch, cam.roll)
+    if key not in bare:
+        bare[key] = luminance(render(app, clouds=False))
+    return np.abs(luminance(img) - bare[key])
 
 
 SEEDS = range(4)              # realisations of the far field's pattern the outside band is averaged over (at most
