@@ -93,7 +93,7 @@ class MapCapture(RenderPass):
         w, h = texture.size
         self.map = np.frombuffer(texture.read(), "f2").reshape(h, w, 2).astype(np.float64)
         s = frame.resource(SHADOW_SPACE)
-        self.space = type(s)(s.size, s.cascades.copy(), s.lo.copy(), s.cell.copy(), s.shape, s.frame, s.near)
+        self.space = type(s)(s.size, s.cascades.copy(), s.lo.copy(), s.cell.copy(), s.shape, s.frame, s.near, s.sun.copy())
 
 
 @pytest.mark.parametrize("typed", [None, "type", "map"])

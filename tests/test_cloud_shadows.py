@@ -389,3 +389,47 @@ def test_shadows_continue_with_the_far_field_beyond_the_volume(gpu, ctx):
     assert beyond.mean() > 0.5
     assert np.abs(probe.color[..., 0][beyond] - 1.0).max() < 2e-3, "far_field=False: fully lit past the volume"
     app.close()
+
+
+@pytest.mark.parametrize("kind", ["stratus", "cumulus", "congestus"])
+def test_a_typed_clouds_shadow_falls_where_the_sun_meets_the_cloud_drawn(kind):
+    """With a cloud type, the sun's optical depth (reference.sun_optical_depth, column.glsl's twin; the GPU
+    bake and the exact path match it in test_cloud_shadow_map) is read where the sun's ray meets the
+    height of the shape's mass centre, not the layer's middle: the shadow of one full column on the ground
+    under a 25° sun is centred within 1.5 cells of the drawn density's own shadow (the shaped density
+    integrated along each slanted ray; the column's bilinear edges are thinner, lower clouds, which the
+    full column's centre does not follow: 0.05 / 0.2 / 1.0 cells here), where the middle plane put it
+    3.7 (cumulus) to 7 (congestus) cells away, and at least 3 times as far."""
+    from atmos.plugins.clouds.volume.shape import CLOUD_TYPES, type_breakpoints, type_density, typed_column
+    t = CLOUD_TYPES[kind]
+    layout = CloudLayout(shape=(48, 8, 8), cell=(40.0, 40.0, 40.0), origin_xz=(-24.0, -4.0), base=1000.0, group=(8, 8))
+    nx, ny, nz = layout.shape
+    sums = np.zeros((nx, nz))
+    sums[30:32, 3:5] = 0.35 * ny                                   # one full column (2 x 2 cells)
+    e = math.radians(25.0)
+    sun = np.array([math.cos(e), math.sin(e), 0.0])
+    centre_z = 0.5 * (layout.lo[2] + layout.hi[2]) - 0.5 * layout.cell[2]
+    x = np.linspace(-4000.0, 0.0, 1601)
+    ground = np.stack([x, np.zeros_like(x), np.full_like(x, centre_z)], -1)
+    tau = reference.sun_optical_depth(ground, sums, sums, 0.0, sun, 1.0, layout, cloud_type=t)
+
+    def texel(xz):
+        return (xz - layout.lo[[0, 2]]) / np.asarray(layout.cell)[[0, 2]] - 0.5
+    thickness = layout.hi[1] - layout.lo[1]
+    top = max(float(type_breakpoints(t)[2]), 1.0)
+    h = (np.arange(256) + 0.5) / 256 * top                        # the drawn density along each slanted ray
+    y = layout.lo[1] + h * thickness
+    xz = ground[:, None, [0, 2]] + (y[None, :, None] / sun[1]) * sun[[0, 2]]
+    m = reference.zero_border_bilinear(sums, texel(xz)) / ny
+    drawn = (type_density(m, h[None, :], t) * top / 256 * ny).sum(-1)
+    mid = ground[:, [0, 2]] + (0.5 * (layout.lo[1] + layout.hi[1]) / sun[1]) * sun[[0, 2]]
+    middle = typed_column(reference.zero_border_bilinear(sums, texel(mid)), mid[:, 0], mid[:, 1], ny, t)
+
+    def centre(w):
+        return float((w * x).sum() / w.sum())
+    cell = layout.cell[0]
+    assert drawn.max() > 0 and tau.max() > 0
+    err, moved = abs(centre(tau) - centre(drawn)) / cell, abs(centre(middle) - centre(drawn)) / cell
+    print(f"{kind}: shadow {centre(tau):.0f} m, drawn {centre(drawn):.0f} m, middle plane {centre(middle):.0f} m")
+    assert err < 1.5, f"{kind}: shadow at {centre(tau):.0f} m, the cloud's at {centre(drawn):.0f} m"
+    assert moved > max(3.0, 3.0 * err), f"{kind}: the middle plane was {moved:.1f} cells off"

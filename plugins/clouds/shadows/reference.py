@@ -13,7 +13,7 @@ import numpy as np
 
 from atmos.plugins.clouds.volume.edge import edge_weight, footprint_uv
 from atmos.plugins.clouds.volume.layout import CloudLayout
-from atmos.plugins.clouds.volume.shape import typed_column
+from atmos.plugins.clouds.volume.shape import centre_shift, typed_column
 from atmos.plugins.clouds.light.reference import bilinear
 from atmos.lighting import unit_sun
 from atmos.plugins.clouds.shadows.plugin import direct_weight  # noqa: F401  (the pass's own)
@@ -64,19 +64,21 @@ def sun_optical_depth(points, sums_a, sums_b, t: float, sun_dir, extinction: flo
     :func:`atmos.plugins.clouds.far_field.reference.far_field_alpha`),
     added with the complementary edge weight ``(1 − edge)·above``. ``cloud_type``/``type_map``: the shape the
     clouds are drawn with (column.glsl typed_column, :func:`~atmos.plugins.clouds.volume.shape.typed_column`;
-    both None: as simulated) turns the volume's column (``far`` gives its own, shaped by the caller)."""
+    both None: as simulated) turns the volume's column (``far`` gives its own, shaped by the caller), read
+    where the sun's ray meets the shape's mass centre (:func:`~atmos.plugins.clouds.volume.shape.centre_shift`)."""
     points, s = np.asarray(points, np.float64), np.asarray(sun_dir, np.float64)
     sums = (1.0 - t) * shifted(np.asarray(sums_a, np.float64), a_shift) + t * np.asarray(sums_b, np.float64)
     lo, hi, cell = layout.lo, layout.hi, np.asarray(layout.cell, np.float64)
     y = points[..., 1]
     run = np.maximum(0.5 * (lo[1] + hi[1]) - y, 0.0) / max(s[1], MIN_SUN_HEIGHT)
     q = points + run[..., None] * s
-    texel = (q[..., [0, 2]] - lo[[0, 2]]) / cell[[0, 2]] - 0.5        # map texel (i, k) centred at (i, k)
-    edge = edge_weight(footprint_uv(layout, q[..., [0, 2]]), edge_fade)
-    column = typed_column(zero_border_bilinear(sums, texel), q[..., 0], q[..., 2], layout.shape[1], cloud_type,
+    xz = q[..., [0, 2]] + centre_shift(q[..., 0], q[..., 2], s, hi[1] - lo[1], cloud_type, type_map, MIN_SUN_HEIGHT)
+    texel = (xz - lo[[0, 2]]) / cell[[0, 2]] - 0.5        # map texel (i, k) centred at (i, k)
+    edge = edge_weight(footprint_uv(layout, xz), edge_fade)
+    column = typed_column(zero_border_bilinear(sums, texel), xz[..., 0], xz[..., 1], layout.shape[1], cloud_type,
                           type_map) * edge
     above = np.clip((hi[1] - y) / (hi[1] - lo[1]), 0.0, 1.0)
     tau = extinction * column * above
     if far is not None:
-        tau = tau + far(q[..., [0, 2]]) * (1.0 - edge) * above
+        tau = tau + far(xz) * (1.0 - edge) * above
     return tau

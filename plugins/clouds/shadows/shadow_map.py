@@ -2,8 +2,9 @@
 
 ``sun_optical_depth`` (:mod:`.reference`, ``clouds/volume/column.glsl``) is ``above(p.y) · T(q)``: ``q``
 the point's projection along the sun onto the layer's middle plane, ``above`` the fraction of the
-layer over the point, and ``T(q) = extinction · column(q) · fade(q) + field_tau · far(q) · (1 − fade(q))``.
-So the map stores, over the middle plane (the image plane of a parallel projection along the sun),
+layer over the point, and ``T(q) = extinction · column(q') · fade(q') + field_tau · far(q') · (1 − fade(q'))``,
+``q'`` where the sun's ray through ``q`` meets the height of the mass centre of the cloud type drawn
+(``shape.centre_shift``; ``q`` itself untyped), a function of ``q`` alone. So the map stores, over the middle plane (the image plane of a parallel projection along the sun),
 the two columns per unit extinction (rg16f: volume, far field); a lookup projects the point as the
 exact form does, reads both with one bilinear fetch, weights them by the caller's extinctions and
 multiplies by ``above``: the height handling is exact, the only errors are the map's sampling and
@@ -51,6 +52,7 @@ class ShadowMapSpace:
     shape: tuple = (1, 1, 1)
     frame: int = -1                    # bumped by every bake
     near: int = MAP_SIZE               # texels per side of the near cascade in use (<= size)
+    sun: np.ndarray = field(default_factory=lambda: np.array([0.0, 1.0, 0.0]))   # the sun baked for (unit)
 
     @property
     def mid(self) -> float:
@@ -90,6 +92,7 @@ def shadow_space(layout, camera_position, sun_dir, camera_far: float, size: int 
     lo, cell = np.asarray(layout.lo, np.float64), np.asarray(layout.cell, np.float64)
     shape = tuple(map(int, layout.shape))
     space.size, space.lo, space.cell, space.shape = int(size), lo, cell, shape
+    space.sun = np.asarray(sun_dir, np.float64).copy()
     mid = lo[1] + 0.5 * shape[1] * cell[1]
     cam, s = np.asarray(camera_position, np.float64), np.asarray(sun_dir, np.float64)
     q = cam[[0, 2]] + max(mid - cam[1], 0.0) / max(s[1], MIN_SUN_HEIGHT) * s[[0, 2]]
@@ -151,7 +154,8 @@ class CloudShadowMapPass(ComputePass):
         column_uniforms(p, sim, layout, 1.0)
         if layer is not None:
             layer.use(p, view, sim)
-        write_uniforms(p, cascades=self.space.cascades.astype("f4").tobytes(), near_size=self.space.near)
+        write_uniforms(p, cascades=self.space.cascades.astype("f4").tobytes(), near_size=self.space.near,
+                       bake_sun=tuple(map(float, sun)))
         image = frame.image(SHADOW_MAP)
         frame.dispatch(p, self.groups(image.size), images={"shadow_map": image})
 
@@ -192,13 +196,15 @@ def bake_reference(space: ShadowMapSpace, sums_a, sums_b, t: float, layout, a_sh
     with ``cloud_type``/``type_map`` (:func:`~atmos.plugins.clouds.volume.shape.typed_column`)."""
     from atmos.plugins.clouds.shadows.reference import shifted, zero_border_bilinear
     from atmos.plugins.clouds.volume.edge import edge_weight
-    from atmos.plugins.clouds.volume.shape import typed_column
+    from atmos.plugins.clouds.volume.shape import centre_shift, typed_column
     v = texel_positions(space)
     sums = (1.0 - t) * shifted(np.asarray(sums_a, np.float64), a_shift) + t * np.asarray(sums_b, np.float64)
     shape = np.array([space.shape[0], space.shape[2]], np.float64)
-    fade = edge_weight((v + 0.5) / shape, edge_fade)
     out = np.zeros(v.shape)
     xz = space.lo[[0, 2]] + (v + 0.5) * space.cell[[0, 2]]
+    shift = centre_shift(xz[..., 0], xz[..., 1], space.sun, space.thickness, cloud_type, type_map, MIN_SUN_HEIGHT)
+    v, xz = v + shift / space.cell[[0, 2]], xz + shift       # where the sun's ray meets the shape drawn
+    fade = edge_weight((v + 0.5) / shape, edge_fade)
     ny, x, z = space.shape[1], xz[..., 0], xz[..., 1]
     out[..., 0] = typed_column(zero_border_bilinear(sums, v), x, z, ny, cloud_type, type_map) * fade
     if far is not None:

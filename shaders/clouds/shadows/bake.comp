@@ -9,6 +9,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0, rg16f) writeonly uniform image2D shadow_map;
 uniform vec4 cascades[2];      // (first texel's volume texel coordinate, volume texels per map texel)
 uniform int near_size;         // the near cascade's texels per side in use: the rest hold 0
+uniform vec3 bake_sun;         // unit, toward the sun (straight up while it is down)
 
 void main() {
     ivec2 j = ivec2(gl_GlobalInvocationID.xy);
@@ -22,5 +23,5 @@ void main() {
     }
     vec2 v = cascades[k].xy + vec2(j.x, j.y - k * n) * cascades[k].zw;
     vec2 xz = layer_min.xz + (v + 0.5) * cell_size.xz;
-    imageStore(shadow_map, j, vec4(sun_columns(v, xz), 0.0, 0.0));
+    imageStore(shadow_map, j, vec4(sun_columns(v, xz, bake_sun), 0.0, 0.0));
 }

@@ -1,5 +1,6 @@
 // Optical depth toward the sun through the cloud layer from the density maps (thesis 7.3.1): a point
-// is projected along the direction toward the sun onto the middle of the layer, where the top-view
+// is projected along the direction toward the sun onto the middle of the layer (with a cloud type, on
+// to the height of the shape's mass centre: centre_shift), where the top-view
 // summed density mix(A, B, t) (layer 0 of the density maps, each set at its own placement) is read
 // bilinearly, zero outside the volume, times the volume's edge fade there, times the fraction of the layer above the point;
 // with CLOUD_FAR_FIELD defined the far field's column (clouds/far_field/field.glsl) adds its optical depth
@@ -48,6 +49,23 @@ float typed_column(float sum, vec2 xz) {
     return ny * g;
 }
 
+// The height fraction of the mass centre of a full column of type t's shape (shape.py type_centre).
+float type_centre(float t) {
+    vec3 b = type_breakpoints(t);
+    float fall = b.z - b.y;
+    float moment = b.x * b.x / 3.0 + (b.y * b.y - b.x * b.x) / 2.0 + fall * (2.0 * b.y / 3.0 + fall / 4.0);
+    return moment / (b.x / 2.0 + (b.y - b.x) + 2.0 * fall / 3.0);
+}
+
+// Metres (x, z) from middle-plane point xz along the sun's ray to the height of the mass centre of the
+// shape drawn there (shape.py centre_shift): the columns are read there, so a stratus sheet's shadow
+// and a congestus tower's fall where their clouds are; 0 untyped.
+vec2 centre_shift(vec2 xz, vec3 sun_dir) {
+    if (cloud_type < 0.0) return vec2(0.0);
+    float rise = (type_centre(cloud_type_at(xz)) - 0.5) * float(shape.y) * cell_size.y;
+    return rise / max(sun_dir.y, MIN_SUN_HEIGHT) * sun_dir.xz;
+}
+
 bool outside(ivec2 c) {
     return any(lessThan(c, ivec2(0))) || any(greaterThanEqual(c, shape.xz));
 }
@@ -70,10 +88,13 @@ float column_sum(vec2 p) {
                mix(column(i + ivec2(0, 1)), column(i + ivec2(1, 1)), f.x), f.y);
 }
 
-// The sun's columns over volume texel v (texel i centred at i) whose middle-plane point is world xz:
-// (column sum × edge fade, far-field column sum × (1 − fade)), per unit extinction; the cloud shadow
-// map (clouds/shadows/bake.comp) bakes exactly this.
-vec2 sun_columns(vec2 v, vec2 xz) {
+// The sun's columns through volume texel v (texel i centred at i) whose middle-plane point is world xz,
+// read where that ray meets the shape drawn (centre_shift): (column sum × edge fade, far-field column
+// sum × (1 − fade)), per unit extinction; the cloud shadow map (clouds/shadows/bake.comp) bakes exactly this.
+vec2 sun_columns(vec2 v, vec2 xz, vec3 sun_dir) {
+    vec2 shift = centre_shift(xz, sun_dir);
+    v += shift / cell_size.xz;
+    xz += shift;
     float fade = cloud_edge_weight((v + 0.5) / vec2(shape.xz), edge_fade);
     vec2 c = vec2(fade > 0.0 ? typed_column(column_sum(v), xz) * fade : 0.0, 0.0);
 #ifdef CLOUD_FAR_FIELD
@@ -90,7 +111,7 @@ float sun_optical_depth(vec3 p, vec3 sun_dir) {
     vec3 q = p + run * sun_dir;
     vec2 texel = (q.xz - layer_min.xz) / cell_size.xz - 0.5;
     float above = clamp((layer_min.y + thickness - p.y) / thickness, 0.0, 1.0);
-    vec2 c = sun_columns(texel, q.xz);
+    vec2 c = sun_columns(texel, q.xz, sun_dir);
 #ifdef CLOUD_FAR_FIELD
     return (extinction * c.x + field_column_tau * c.y) * above;
 #else
