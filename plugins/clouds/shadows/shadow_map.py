@@ -36,7 +36,7 @@ SHADOW_SPACE = "cloud_shadow_space"    # the map's ShadowMapSpace (imported; the
 MAP_SIZE = 1024                        # N: texels per cascade side
 FAR_REACH = 1.25                       # the far cascade reaches this × camera.far from the camera's projection
 MIN_SUN_HEIGHT = 1e-4                  # as column.glsl's
-NEAR_RATIO = 2                         # the near cascade's map texels per volume cell at most
+NEAR_RATIO = 8                         # the near cascade's map texels per volume cell at most (a small volume's)
 FORMAT_ERROR = 2.0 ** -11              # rg16f's relative rounding (half an ulp of an 11-bit significand)
 
 
