@@ -209,8 +209,8 @@ def bake_reference(space: ShadowMapSpace, sums_a, sums_b, t: float, layout, a_sh
     out[..., 0] = typed_column(zero_border_bilinear(sums, v), x, z, ny, cloud_type, type_map) * fade
     if far is not None:
         out[..., 1] = typed_column(far(xz), x, z, ny, cloud_type, type_map) * (1.0 - fade)
-    out[:space.size][space.near:] = 0.0             # the near cascade's texels not in use
-    out[:space.size, space.near:] = 0.0
+    out[space.near:space.size] = 0.0                # the near cascade's texels not in use: its last rows,
+    out[:space.size, space.near:] = 0.0             # and its last columns
     return out
 
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 from atmos.gpu.uniforms import bind_textures, write_uniforms
 from atmos.plugins.clouds.volume.layout import CloudLayout
 from atmos.plugins.clouds.volume.sets import CloudSets
-from atmos.plugins.clouds.volume.shape import shape_uniforms
+from atmos.plugins.clouds.volume.shape import centre_rise, shape_uniforms
 
 
 UNTYPED = shape_uniforms(None, None)      # shape.glsl's uniforms where no type is drawn (worked out once)
@@ -21,10 +21,10 @@ def column_uniforms(program, sim: CloudSets, layout: CloudLayout, extinction: fl
                    edge_fade=float(sim.settings.edge_fade))
     drawn = sim.drawn.current() if sim.drawn is not None else None
     if drawn is None:
-        write_uniforms(program, UNTYPED)
+        write_uniforms(program, UNTYPED, type_rise=0.0)
         return
     cloud_type, type_map, texture = drawn
-    write_uniforms(program, shape_uniforms(cloud_type, type_map))
+    write_uniforms(program, shape_uniforms(cloud_type, type_map), type_rise=centre_rise(cloud_type, type_map))
     bind_textures(program, typed_columns=sim.drawn.columns(program.ctx))
     if texture is not None:
         bind_textures(program, cloud_type_map=texture)

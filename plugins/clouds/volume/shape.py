@@ -80,28 +80,38 @@ def type_centre(t) -> np.ndarray:
     """The height fraction of the mass centre of a full column of type ``t``'s shape (density P(h, t)):
     ∫ h P dh / ∫ P dh over the rise (linear), the plateau and the fall (1 − x²), in closed form. Stratus
     0.13, cumulus 0.30, congestus 0.97 of the layer: where the sun's ray meets the cloud drawn, for its
-    shadow (:func:`centre_shift`)."""
+    shadow (:func:`centre_rise`)."""
     b = type_breakpoints(t)
     a, top, fall = b[..., 0], b[..., 1], b[..., 2] - b[..., 1]
     moment = a * a / 3.0 + (top * top - a * a) / 2.0 + fall * (2.0 * top / 3.0 + fall / 4.0)
     return moment / (a / 2.0 + (top - a) + 2.0 * fall / 3.0)
 
 
+def centre_rise(cloud_type, type_map) -> float:
+    """Layer heights above the layer's middle at which the sun's columns are read for clouds drawn with
+    ``cloud_type``/``type_map``: the mass centre of the type's full column (:func:`type_centre`), of the
+    map's mean type with a map (one height for the whole layer: a height following the type would fold
+    the shadows wherever the type changes faster than the sun's slant); 0 untyped."""
+    if cloud_type is None and type_map is None:
+        return 0.0
+    return _rise(float(type_map.mean if type_map is not None else cloud_type))
+
+
+@lru_cache(maxsize=64)
+def _rise(t: float) -> float:
+    return float(type_centre(t)) - 0.5
+
+
 def centre_shift(x, z, sun_dir, thickness: float, cloud_type=None, type_map=None,
                  min_sun_height: float = 1e-4) -> np.ndarray:
-    """(..., 2) metres (x, z) from a point of the layer's middle plane along the sun's ray to where it meets
-    the height of the mass centre of the shape drawn there (:func:`type_centre` of the type at (x, z));
-    0 untyped (the simulation's own shape, centred). ``column.glsl`` centre_shift's twin: the sun's
-    columns are read there, so a stratus sheet's shadow and a congestus tower's fall where their clouds
-    are, not where the layer's middle would put them."""
+    """(..., 2) metres (x, z) from points (x, z) of the layer's middle plane along the sun's ray to the
+    height :func:`centre_rise` (0 untyped). ``column.glsl`` centre_shift's twin: the sun's columns are read
+    there, so a stratus sheet's shadow and a congestus tower's fall where their clouds are, not where the
+    layer's middle would put them."""
     x = np.asarray(x, np.float64)
-    if cloud_type is None and type_map is None:
-        return np.zeros(x.shape + (2,))
-    t = np.broadcast_to(np.asarray(type_at(0.5 if cloud_type is None else cloud_type, type_map, x, z),
-                                   np.float64), x.shape)
     s = np.asarray(sun_dir, np.float64)
-    run = (type_centre(t) - 0.5) * thickness / max(float(s[1]), min_sun_height)
-    return run[..., None] * s[[0, 2]]
+    run = centre_rise(cloud_type, type_map) * thickness / max(float(s[1]), min_sun_height)
+    return np.broadcast_to(run * s[[0, 2]], x.shape + (2,)).copy()
 
 
 def march_top(types) -> float:
@@ -151,6 +161,7 @@ class CloudTypeMap:
         t.setflags(write=False)
         object.__setattr__(self, "types", t)
         object.__setattr__(self, "highest", float(t.max()))     # the tallest type (march_top): read per frame
+        object.__setattr__(self, "mean", float(t.mean()))       # the mean type (centre_rise)
         object.__setattr__(self, "origin", check_vec("CloudTypeMap", "origin", self.origin, 2))
         object.__setattr__(self, "size", check_vec("CloudTypeMap", "size", self.size, 2, "positive"))
 

@@ -1,6 +1,6 @@
 // Optical depth toward the sun through the cloud layer from the density maps (thesis 7.3.1): a point
 // is projected along the direction toward the sun onto the middle of the layer (with a cloud type, on
-// to the height of the shape's mass centre: centre_shift), where the top-view
+// to the height of the type's mass centre: centre_shift), where the top-view
 // summed density mix(A, B, t) (layer 0 of the density maps, each set at its own placement) is read
 // bilinearly, zero outside the volume, times the volume's edge fade there, times the fraction of the layer above the point;
 // with CLOUD_FAR_FIELD defined the far field's column (clouds/far_field/field.glsl) adds its optical depth
@@ -23,6 +23,7 @@ uniform vec3 layer_min;        // world corner of cell (0, 0, 0): (origin.x·cx,
 uniform vec3 cell_size;
 uniform ivec3 shape;
 uniform float edge_fade;       // CloudSettings.edge_fade: columns fade with the volume's edge (clouds/volume/edge.glsl)
+uniform float type_rise;       // layer heights above the middle the columns are read at (shape.py centre_rise)
 #include "clouds/volume/edge.glsl"
 #include "clouds/volume/shape.glsl"
 #ifdef CLOUD_FAR_FIELD
@@ -49,21 +50,11 @@ float typed_column(float sum, vec2 xz) {
     return ny * g;
 }
 
-// The height fraction of the mass centre of a full column of type t's shape (shape.py type_centre).
-float type_centre(float t) {
-    vec3 b = type_breakpoints(t);
-    float fall = b.z - b.y;
-    float moment = b.x * b.x / 3.0 + (b.y * b.y - b.x * b.x) / 2.0 + fall * (2.0 * b.y / 3.0 + fall / 4.0);
-    return moment / (b.x / 2.0 + (b.y - b.x) + 2.0 * fall / 3.0);
-}
-
-// Metres (x, z) from middle-plane point xz along the sun's ray to the height of the mass centre of the
-// shape drawn there (shape.py centre_shift): the columns are read there, so a stratus sheet's shadow
-// and a congestus tower's fall where their clouds are; 0 untyped.
-vec2 centre_shift(vec2 xz, vec3 sun_dir) {
-    if (cloud_type < 0.0) return vec2(0.0);
-    float rise = (type_centre(cloud_type_at(xz)) - 0.5) * float(shape.y) * cell_size.y;
-    return rise / max(sun_dir.y, MIN_SUN_HEIGHT) * sun_dir.xz;
+// Metres (x, z) from a middle-plane point along the sun's ray to the height type_rise layers above the
+// middle (shape.py centre_rise: the mass centre of the type drawn; 0 untyped): the columns are read
+// there, so a stratus sheet's shadow and a congestus tower's fall where their clouds are.
+vec2 centre_shift(vec3 sun_dir) {
+    return type_rise * float(shape.y) * cell_size.y / max(sun_dir.y, MIN_SUN_HEIGHT) * sun_dir.xz;
 }
 
 bool outside(ivec2 c) {
@@ -92,7 +83,7 @@ float column_sum(vec2 p) {
 // read where that ray meets the shape drawn (centre_shift): (column sum × edge fade, far-field column
 // sum × (1 − fade)), per unit extinction; the cloud shadow map (clouds/shadows/bake.comp) bakes exactly this.
 vec2 sun_columns(vec2 v, vec2 xz, vec3 sun_dir) {
-    vec2 shift = centre_shift(xz, sun_dir);
+    vec2 shift = centre_shift(sun_dir);
     v += shift / cell_size.xz;
     xz += shift;
     float fade = cloud_edge_weight((v + 0.5) / vec2(shape.xz), edge_fade);
