@@ -13,6 +13,7 @@ volume's (exp(−σ · column sum)) and the far field's (exp(−column_tau · co
 transmittance agree for the same measured cover.
 """
 import math
+import weakref
 
 import numpy as np
 import pytest
@@ -197,11 +198,14 @@ def luminance(img):
     return img[..., :3] @ np.array([0.2126, 0.7152, 0.0722])
 
 
+BARE_VIEWS = weakref.WeakKeyDictionary()     # App -> {camera pose: its luminance without clouds}
+
+
 def cloud_change(app, img):
     """|luminance − the same view without clouds| (the bare view rendered for the current camera, once
     per pose: the far field's seed, which the seam tests vary, draws nothing in it)."""
     cam = app.resource(Camera)
-    bare = app.__dict__.setdefault("bare_views_in_test", {})      # camera pose -> the view without clouds
+    bare = BARE_VIEWS.setdefault(app, {})
     key = (tuple(cam.position), cam.yaw, cam.pitch, cam.roll)
     if key not in bare:
         bare[key] = luminance(render(app, clouds=False))
