@@ -35,9 +35,9 @@ def shaft_points(cam, aspect: float, steps: int, reach: float, factor: int = 4) 
     return (cam.position + d[..., None, :] * (far[..., None, None] * s[:, None])).reshape(-1, 3)
 
 
-def ground_points(cam, n: int, reach: float, rng) -> np.ndarray:
-    """Points on the ground (y in [0, 500], the terrain's relief) within ``reach`` of the camera."""
-    r, a = reach * np.sqrt(rng.uniform(0, 1, n)), rng.uniform(0, 2 * math.pi, n)
+def ground_points(cam, n: int, near: float, reach: float, rng) -> np.ndarray:
+    """Points on the ground (y in [0, 500], the terrain's relief) from ``near`` to ``reach`` from the camera."""
+    r, a = np.sqrt(rng.uniform(near ** 2, reach ** 2, n)), rng.uniform(0, 2 * math.pi, n)
     return np.stack([cam.position[0] + r * np.cos(a), rng.uniform(0, 500, n), cam.position[2] + r * np.sin(a)], -1)
 
 
@@ -53,30 +53,45 @@ def accuracy(frames: int = 4) -> None:
     app.run_frames(frames, 1 / 30)
     cam, sun = app.resource(Camera), unit_sun(app.resource(Sun).direction)
     steps = LightShaftSettings().steps
-    sets = {"shaft steps (8 km)": shaft_points(cam, SIZE[0] / SIZE[1], steps, LightShaftSettings().max_distance),
-            "ground (20 km)": ground_points(cam, 100000, cam.far, np.random.default_rng(7))}
+    reach = LightShaftSettings().max_distance
+    sets = {f"shaft steps ({reach / 1000:.0f} km)": shaft_points(cam, SIZE[0] / SIZE[1], steps, reach)}
+    for r0, r1 in ((0.0, 5e3), (5e3, 20e3), (20e3, cam.far)):
+        sets[f"ground {r0 / 1000:.0f}-{r1 / 1000:.0f} km"] = ground_points(cam, 50000, r0, r1, np.random.default_rng(7))
     print(f"sunset, sun elevation {math.degrees(math.asin(sun[1])):.1f} deg; error of exp(-tau), map - exact:")
-    print(f"{'points':22s} {'n':>7s} {'near: max':>10s} {'rms':>8s} {'far: max':>10s} {'rms':>8s}")
+    print(f"{'points':22s} {'n':>7s} {'near: max':>10s} {'rms':>8s} {'far: max':>10s} {'rms':>8s} {'far texel':>10s}")
+    far_widths = []
     for name, pts in sets.items():
         probe.points = pts
         app.run_frames(1, 1 / 30)
         r = probe.result
         space = next(p for p in app.graph.passes if p.name == "cloud_shadow_map").space
         near = in_near(space, pts, sun)
+        far_widths.append(space.read_at(projected(space, pts, sun))[2][~near].mean() * space.cell[0])
         cells = [errors(r[m]) if m.any() else (0.0, 0.0) for m in (near, ~near)]
-        print(f"{name:22s} {len(pts):7d} {cells[0][0]:10.4f} {cells[0][1]:8.4f} {cells[1][0]:10.4f} {cells[1][1]:8.4f}")
+        print(f"{name:22s} {len(pts):7d} {cells[0][0]:10.4f} {cells[0][1]:8.4f} {cells[1][0]:10.4f} {cells[1][1]:8.4f} {far_widths[-1]:8.1f} m")
     n = space.size
     print(f"map {n}x{2 * n} rg16f; near {1 / space.cascades[0, 2]:.0f} texels per cell, {space.near}x{space.near} in use "
-          f"({space.cell[0] * space.cascades[0, 2]:.1f} m), far {space.cell[0] * space.cascades[1, 2]:.1f} m texels")
+          f"({space.cell[0] * space.cascades[0, 2]:.1f} m), far {far_width(space, 0.0):.1f} m texels at its centre, "
+          f"{far_width(space, 1.0):.1f} m at its edge ({space.cell[0] * space.far_offsets(np.full(2, n - 1.0))[0] / 1000:.0f} km)")
     app.close()
     gpu.release()
 
 
-def in_near(space, pts, sun) -> np.ndarray:
+def projected(space, pts, sun) -> np.ndarray:
+    """Volume texel coordinates (n, 2) where the lookups of ``pts`` read (the middle plane along the sun)."""
     run = np.maximum(space.mid - pts[:, 1], 0.0) / max(sun[1], 1e-4)
-    v = (pts[:, [0, 2]] + run[:, None] * sun[[0, 2]] - space.lo[[0, 2]]) / space.cell[[0, 2]] - 0.5
-    j = (v - space.cascades[0, :2]) / space.cascades[0, 2:]
-    return np.all((j >= 0) & (j <= space.near - 1), axis=-1)
+    return (pts[:, [0, 2]] + run[:, None] * sun[[0, 2]] - space.lo[[0, 2]]) / space.cell[[0, 2]] - 0.5
+
+
+def in_near(space, pts, sun) -> np.ndarray:
+    return space.read_at(projected(space, pts, sun))[1]
+
+
+def far_width(space, u: float) -> float:
+    """The far cascade's texel width in metres (x) at ``u`` of its half-width from its centre."""
+    c = space.far_centre_index
+    j = np.array([[c + u * c - 1.0] * 2, [c + u * c] * 2]) if u > 0 else np.array([[c] * 2, [c + 1.0] * 2])
+    return float(np.diff(space.far_offsets(j)[:, 0])[0] * space.cell[0])
 
 
 def work() -> None:

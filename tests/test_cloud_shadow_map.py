@@ -1,6 +1,7 @@
 """The cloud shadow map (plugins/clouds/shadows/shadow_map.py): its float64 lookup against the exact
 sun_optical_depth within the derived interpolation bound, the GPU's bake and lookup against float64, and
 the shadow pass on the map against lookup_reference."""
+import copy
 import math
 
 import numpy as np
@@ -54,10 +55,9 @@ def test_float64_lookup_matches_sun_optical_depth_within_the_derived_bound(rng):
     # which cascade each point read, and its texel size h (volume texels); points past the far one clamp
     run = np.maximum(space.mid - pts[:, 1], 0.0) / sun[1]
     v = (pts[:, [0, 2]] + run[:, None] * sun[[0, 2]] - space.lo[[0, 2]]) / space.cell[[0, 2]] - 0.5
-    j = [(v - c[:2]) / c[2:] for c in space.cascades]
-    near = np.all((j[0] >= 0) & (j[0] <= space.near - 1), axis=-1)
-    inside = near | np.all((j[1] >= 0) & (j[1] <= space.size - 1), axis=-1)
-    h = np.where(near[:, None], space.cascades[0, 2:], space.cascades[1, 2:])
+    _, near, h = space.read_at(v)           # h: the width of the (warped) map cell each point falls in
+    far = space.far_index(v)
+    inside = near | np.all((far >= 0) & (far <= space.size - 1), axis=-1)
     sums = (1 - t) * reference.shifted(sums_a, a_shift) + t * sums_b
     c_max = sums.max()
     c_a = np.array([np.abs(np.diff(sums, axis=0)).max(), np.abs(np.diff(sums, axis=1)).max()])
@@ -93,7 +93,7 @@ class MapCapture(RenderPass):
         w, h = texture.size
         self.map = np.frombuffer(texture.read(), "f2").reshape(h, w, 2).astype(np.float64)
         s = frame.resource(SHADOW_SPACE)
-        self.space = type(s)(s.size, s.cascades.copy(), s.lo.copy(), s.cell.copy(), s.shape, s.frame, s.near, s.sun.copy())
+        self.space = copy.deepcopy(s)
 
 
 @pytest.mark.parametrize("typed", [None, "type", "map"])
@@ -135,9 +135,10 @@ def test_gpu_bake_and_lookup_match_float64(gpu, ctx, rng, typed):
     space = capture.space
     want = bake_reference(space, sums[0][0], sums[1][0], t, layout, sets.a_shift, sim.settings.edge_fade, **types)
     scale = want[..., 0].max()
-    # float32 texel positions v0 + j step (v0 and step rounded to float32 on upload) move a sample by a few
-    # ulps of |v0| + |j step|, which for the far cascade (v0 thousands of texels off) exceeds |v|'s: times
-    # the columns' steepest slope per texel (their largest neighbour difference)
+    # float32 texel positions v0 + offset (v0, the step or K and w / c rounded to float32 on upload) move a
+    # sample by a few ulps of |v0| + |offset|, which for the far cascade (v0 thousands of texels off)
+    # exceeds |v|'s, and the far one's sinh(x) (two exps of 3 + 2|x| ulps each, and x's rounding) by
+    # K cosh(x) (6 + 2|x|) ulps: times the columns' steepest slope per texel (their largest neighbour difference)
     from atmos.plugins.clouds.shadows.shadow_map import texel_positions
     slope = max(np.abs(np.diff(m[0], axis=a)).max() for m in sums for a in (0, 1))
     if typed is not None:     # a typed column moves by its steepest derivative in the sum times that
@@ -146,8 +147,10 @@ def test_gpu_bake_and_lookup_match_float64(gpu, ctx, rng, typed):
         tt = [types["cloud_type"]] if typed == "type" else np.linspace(0.0, 1.0, 21)
         slope *= max(np.abs(np.diff(typed_column(col, 0.0, 0.0, ny, t_, None))).max() / (col[1] - col[0]) for t_ in tt)
     v = texel_positions(space)
-    start = np.repeat(space.cascades[:, :2], space.size, axis=0)[:, None, :]       # each row's cascade's v0
-    moved = 4 * 2.0 ** -24 * (np.abs(start) + np.abs(v - start)).max(-1, keepdims=True) * slope
+    start = np.repeat(space.cascades[:, :2], space.size, axis=0)[:, None, :]       # near: texel 0; far: the centre
+    x = np.arcsinh((v - start) / space.cascades[1, 2:]) * (np.arange(2 * space.size) >= space.size)[:, None, None]
+    sinh = space.cascades[1, 2:] * np.cosh(x) * (6.0 + 2.0 * np.abs(x))
+    moved = 2.0 ** -24 * (4 * (np.abs(start) + np.abs(v - start)) + sinh).max(-1, keepdims=True) * slope
     # (typed: 32 float32 terms of the profile, each a few roundings: 2^-16 of the column)
     error = np.abs(capture.map - want) - (2 * FORMAT_ERROR + (2.0 ** -16 if typed else 0.0)) * np.abs(want) - 1e-5 * scale - moved
     assert error.max() <= 0.0, f"bake error over the bound by {error.max()} at {np.unravel_index(error.argmax(), error.shape)}"
@@ -165,9 +168,7 @@ def test_gpu_bake_and_lookup_match_float64(gpu, ctx, rng, typed):
         g1 = max(np.abs(np.diff(typed_column(col, 0.0, 0.0, ny, t_, None))).max() / (col[1] - col[0]) for t_ in tt)
         run = np.maximum(space.mid - points[:, 1], 0.0) / s[1]
         v = (points[:, [0, 2]] + run[:, None] * s[[0, 2]] - space.lo[[0, 2]]) / space.cell[[0, 2]] - 0.5
-        j = (v - space.cascades[0, :2]) / space.cascades[0, 2:]
-        near = np.all((j >= 0) & (j <= space.near - 1), axis=-1)
-        h = np.where(near[:, None], space.cascades[0, 2:], space.cascades[1, 2:])
+        h = space.read_at(v)[2]
         raw = max(np.abs(np.diff(m[0], axis=a)).max() for m in sums for a in (0, 1))
         interp = g1 * raw * h.sum(-1) / 4.0 * probe.weights[0]
         print(f"typed: |map - exact| max {np.abs(got - exact).max():.3g}, bound median {np.median(interp):.3g}")

@@ -16,8 +16,12 @@ NEAR_RATIO), texel centres on the column centres, so the piecewise-bilinear colu
 exactly (only the edge fade, a cloud type's shape of the sum and the far field between texels are
 interpolated); it uses the first ``near`` texels of its rows and columns (the rest hold 0 and are never
 read), so a small volume bakes no more texels than it needs. Far: centred on the camera's own
-projection, ``FAR_REACH × camera.far`` each way (lookups past it clamp to its edge): the far field at
-coarse resolution. Format: rg16f, relative rounding 2⁻¹¹, so ``|Δ exp(−τ)| ≤ τ e^{−τ} 2⁻¹¹ ≤ 2⁻¹¹/e``
+projection, ``FAR_REACH × camera.far`` each way (lookups past it clamp to its edge): the far field,
+on a grid warped per axis, ``offset = K sinh(FAR_WARP (j − c) / c)`` (``c = (N − 1) / 2``), so its
+texels are ``sinh(w) / w`` (3.3) times finer than an even grid's around the camera, where shadows and
+shafts are seen large, and ``w coth(w)`` (3.0) times coarser at its edge; a lookup inverts it with one
+``asinh``, the fetch stays one bilinear tap (a separable warp keeps the grid rectilinear).
+Format: rg16f, relative rounding 2⁻¹¹, so ``|Δ exp(−τ)| ≤ τ e^{−τ} 2⁻¹¹ ≤ 2⁻¹¹/e``
 (1.8e-4, far below the 8-bit output step); sums of up to thousands of cells fit its range (65504).
 """
 from __future__ import annotations
@@ -37,14 +41,17 @@ MAP_SIZE = 1024                        # N: texels per cascade side
 FAR_REACH = 1.25                       # the far cascade reaches this × camera.far from the camera's projection
 MIN_SUN_HEIGHT = 1e-4                  # as column.glsl's
 NEAR_RATIO = 8                         # the near cascade's map texels per volume cell at most (a small volume's)
+FAR_WARP = 3.0                         # w: the far cascade's warp (offset = K sinh(w u), u in [-1, 1])
 FORMAT_ERROR = 2.0 ** -11              # rg16f's relative rounding (half an ulp of an 11-bit significand)
 
 
 @dataclass
 class ShadowMapSpace:
-    """Where the map lies: ``cascades`` (2, 4) per cascade the volume texel coordinate of its texel
-    (0, 0) and its volume texels per map texel (x, z); ``near`` the near cascade's texels per side in
-    use; the layer's heights and placement."""
+    """Where the map lies: ``cascades`` (2, 4): the near cascade's volume texel coordinate of its texel
+    (0, 0) and its volume texels per map texel (x, z); the far one's centre (the camera's projection, in
+    volume texel coordinates) and its warp's scale K per axis (volume texels: texel j lies at
+    ``centre + K sinh(warp (j − c) / c)``); ``near`` the near cascade's texels per side in use; the
+    layer's heights and placement."""
     size: int = MAP_SIZE
     cascades: np.ndarray = field(default_factory=lambda: np.zeros((2, 4)))
     lo: np.ndarray = field(default_factory=lambda: np.zeros(3))
@@ -53,6 +60,36 @@ class ShadowMapSpace:
     frame: int = -1                    # bumped by every bake
     near: int = MAP_SIZE               # texels per side of the near cascade in use (<= size)
     sun: np.ndarray = field(default_factory=lambda: np.array([0.0, 1.0, 0.0]))   # the sun baked for (unit)
+    warp: float = FAR_WARP
+
+    @property
+    def far_centre_index(self) -> float:
+        """c: the far cascade's centre texel index, (N − 1) / 2."""
+        return 0.5 * (self.size - 1)
+
+    def far_offsets(self, j) -> np.ndarray:
+        """Volume texel offsets (..., 2) of the far cascade's texel indices ``j`` (..., 2) from its centre."""
+        c = self.far_centre_index
+        return self.cascades[1, 2:] * np.sinh(self.warp * (np.asarray(j, np.float64) - c) / c)
+
+    def far_index(self, v) -> np.ndarray:
+        """The far cascade's continuous texel index (..., 2) of volume texel coordinates ``v`` (unclamped)."""
+        c = self.far_centre_index
+        return c + c / self.warp * np.arcsinh((np.asarray(v, np.float64) - self.cascades[1, :2]) / self.cascades[1, 2:])
+
+    def read_at(self, v) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Where a lookup at volume texel coordinates ``v`` (..., 2) reads, as shadow_map.glsl: (the map
+        texel index (..., 2) in its cascade, clamped; whether that is the near cascade (...,); the width
+        of the map cell it falls in, in volume texels (..., 2))."""
+        v = np.asarray(v, np.float64)
+        c = self.cascades
+        j = (v - c[0, :2]) / c[0, 2:]
+        near = np.all((j >= 0.0) & (j <= self.near - 1.0), axis=-1)
+        far = np.clip(self.far_index(v), 0.0, self.size - 1.0)
+        j = np.where(near[..., None], j, far)
+        i0 = np.minimum(np.floor(far), self.size - 2)
+        width = np.where(near[..., None], c[0, 2:], self.far_offsets(i0 + 1) - self.far_offsets(i0))
+        return j, near, width
 
     @property
     def mid(self) -> float:
@@ -70,7 +107,8 @@ class ShadowMapSpace:
     def uniforms(self, program, extinction: float, field_tau: float = 0.0) -> None:
         """Set ``clouds/shadows/shadow_map.glsl``'s uniforms (the map itself is bound by the caller)."""
         c = self.cascades
-        lookup = np.concatenate([c[:, :2], 1.0 / c[:, 2:]], axis=1).astype("f4")
+        lookup = np.array([[c[0, 0], c[0, 1], 1.0 / c[0, 2], 1.0 / c[0, 3]], [c[1, 0], c[1, 1], 1.0 / c[1, 2], 1.0 / c[1, 3]],
+                           [self.far_centre_index / self.warp, self.far_centre_index, 0.0, 0.0]], "f4")
         write_uniforms(program, shadow_cascades=lookup.tobytes(),
                        shadow_plane=(float(self.lo[0]), float(self.lo[2]), 1.0 / self.cell[0], 1.0 / self.cell[2]),
                        shadow_heights=(self.mid, float(self.lo[1]) + self.thickness, 1.0 / self.thickness,
@@ -97,15 +135,21 @@ def shadow_space(layout, camera_position, sun_dir, camera_far: float, size: int 
     cam, s = np.asarray(camera_position, np.float64), np.asarray(sun_dir, np.float64)
     q = cam[[0, 2]] + max(mid - cam[1], 0.0) / max(s[1], MIN_SUN_HEIGHT) * s[[0, 2]]
     half = reach * float(camera_far)
-    far_step = 2.0 * half / (size - 1) / cell[[0, 2]]                   # volume texels per far texel
-    pad = 1 + int(np.ceil(far_step.max()))           # far lookups past the near cascade never reach the volume
+    vq = (q - lo[[0, 2]]) / cell[[0, 2]] - 0.5                   # the camera's projection, volume texels
+    scale = half / np.sinh(space.warp) / cell[[0, 2]]             # K per axis, volume texels
+    c = 0.5 * (size - 1)
+    lo_v, hi_v = np.full(2, -0.5), np.array([shape[0], shape[2]], np.float64) - 0.5
+    pad = 1
+    for _ in range(3):      # far lookups past the near cascade never reach the volume: pad > the far texels there
+        reach_v = np.maximum(np.abs(lo_v - pad - vq), np.abs(hi_v + pad - vq))
+        far_step = scale * space.warp / c * np.sqrt(1.0 + (reach_v / scale) ** 2)    # dv/dj = K w/c cosh
+        pad = max(pad, 1 + int(np.ceil(far_step.max())))
     r = near_ratio(shape, size, pad)
     space.near = min(int(size), r * (max(shape[0], shape[2]) + 1 + 2 * pad) + 1)
     centre = (np.array([shape[0], shape[2]], np.float64) - 1.0) / 2.0
     near0 = np.floor(centre - (space.near - 1) / (2.0 * r))             # integer: texel centres on columns
-    far0 = (q - lo[[0, 2]]) / cell[[0, 2]] - 0.5 - 0.5 * (size - 1) * far_step
     space.cascades = np.array([[near0[0], near0[1], 1.0 / r, 1.0 / r],
-                               [far0[0], far0[1], far_step[0], far_step[1]]])
+                               [vq[0], vq[1], scale[0], scale[1]]])
     return space
 
 
@@ -154,7 +198,9 @@ class CloudShadowMapPass(ComputePass):
         column_uniforms(p, sim, layout, 1.0)
         if layer is not None:
             layer.use(p, view, sim)
-        write_uniforms(p, cascades=self.space.cascades.astype("f4").tobytes(), near_size=self.space.near,
+        c = self.space.far_centre_index
+        cascades = np.concatenate([self.space.cascades, [[self.space.warp / c, c, 0.0, 0.0]]]).astype("f4")
+        write_uniforms(p, cascades=cascades.tobytes(), near_size=self.space.near,
                        bake_sun=tuple(map(float, sun)))
         image = frame.image(SHADOW_MAP)
         frame.dispatch(p, self.groups(image.size), images={"shadow_map": image})
@@ -182,10 +228,12 @@ def texel_positions(space: ShadowMapSpace) -> np.ndarray:
     n = space.size
     j = np.arange(n, dtype=np.float64)
     out = np.empty((2 * n, n, 2))
-    for k in range(2):
-        c = space.cascades[k]
-        out[k * n:(k + 1) * n, :, 0] = c[0] + j[None, :] * c[2]
-        out[k * n:(k + 1) * n, :, 1] = c[1] + j[:, None] * c[3]
+    c = space.cascades
+    out[:n, :, 0] = c[0, 0] + j[None, :] * c[0, 2]
+    out[:n, :, 1] = c[0, 1] + j[:, None] * c[0, 3]
+    far = space.far_offsets(np.stack([j, j], -1)) + c[1, :2]
+    out[n:, :, 0] = far[None, :, 0]
+    out[n:, :, 1] = far[:, None, 1]
     return out
 
 
@@ -222,10 +270,7 @@ def lookup_reference(space: ShadowMapSpace, baked: np.ndarray, points, sun_dir, 
     run = np.maximum(space.mid - p[..., 1], 0.0) / max(s[1], MIN_SUN_HEIGHT)
     v = (p[..., [0, 2]] + run[..., None] * s[[0, 2]] - space.lo[[0, 2]]) / space.cell[[0, 2]] - 0.5
     above = np.clip((space.lo[1] + space.thickness - p[..., 1]) / space.thickness, 0.0, 1.0)
-    c = space.cascades
-    j = (v - c[0, :2]) / c[0, 2:]
-    near = np.all((j >= 0.0) & (j <= space.near - 1.0), axis=-1)
-    j = np.where(near[..., None], j, np.clip((v - c[1, :2]) / c[1, 2:], 0.0, n - 1.0))
+    j, near, _ = space.read_at(v)
     row0 = np.where(near, 0, n)
     i0 = np.minimum(np.floor(j).astype(np.int64), n - 2)
     f = j - i0
