@@ -89,7 +89,8 @@ def write_uniforms(program, values: Mapping[str, object] | None = None, /, **mor
 
 def has_member(program, name: str) -> bool:
     """Whether ``program`` has a uniform, sampler or block ``name`` (``name in program`` walks every member)."""
-    members, _ = _tables(program)
+    extra = program.extra                      # _tables, inlined (per pass, per frame)
+    members = extra["members"] if type(extra) is dict and "members" in extra else _tables(program)[0]
     if members is None:
         return program.get(name, None) is not None
     try:

@@ -146,8 +146,8 @@ def bilinear(lut: np.ndarray, u, v) -> np.ndarray:
     """(..., C) of ``lut`` (H, W, C) at texture coordinates u, v in [0, 1] (texel centres at (i + ½)/n,
     clamped at the edges), as a GPU's linear filter with clamp-to-edge."""
     h, w = lut.shape[:2]
-    x = np.clip(np.asarray(u, np.float64) * w - 0.5, 0.0, w - 1.0)
-    y = np.clip(np.asarray(v, np.float64) * h - 0.5, 0.0, h - 1.0)
+    x = np.minimum(np.maximum(np.asarray(u, np.float64) * w - 0.5, 0.0), w - 1.0)     # clips in ufuncs (per frame)
+    y = np.minimum(np.maximum(np.asarray(v, np.float64) * h - 0.5, 0.0), h - 1.0)
     x0, y0 = np.minimum(np.floor(x).astype(int), w - 2), np.minimum(np.floor(y).astype(int), h - 2)
     fx, fy = (x - x0)[..., None], (y - y0)[..., None]
     return ((1 - fy) * ((1 - fx) * lut[y0, x0] + fx * lut[y0, x0 + 1])
@@ -165,7 +165,8 @@ def transmittance_uv(m: dict, r, mu, size=TRANSMITTANCE_SIZE):
     d_min, d_max = rt - np.asarray(r, np.float64), rho + big_h
     x_mu = np.where(d_max > d_min, (d - d_min) / np.maximum(d_max - d_min, 1e-9), 0.0)
     w, h = size
-    return to_sub_uv(np.clip(x_mu, 0.0, 1.0), w), to_sub_uv(np.clip(rho / big_h, 0.0, 1.0), h)
+    return (to_sub_uv(np.minimum(np.maximum(x_mu, 0.0), 1.0), w),
+            to_sub_uv(np.minimum(np.maximum(rho / big_h, 0.0), 1.0), h))
 
 
 def transmittance_params(m: dict, u, v, size=TRANSMITTANCE_SIZE):
@@ -220,9 +221,9 @@ def ms_mu_s(x):
 
 
 def ms_uv(m: dict, r, mu_s, n: int = MS_SIZE):
-    mu_s = np.clip(np.asarray(mu_s, np.float64), -1.0, 1.0)
-    return (to_sub_uv(np.clip(0.5 * np.sign(mu_s) * np.sqrt(np.abs(mu_s)) + 0.5, 0, 1), n),
-            to_sub_uv(np.clip((np.asarray(r, np.float64) - m["rg"]) / (m["rt"] - m["rg"]), 0, 1), n))
+    mu_s = np.minimum(np.maximum(np.asarray(mu_s, np.float64), -1.0), 1.0)
+    return (to_sub_uv(np.minimum(np.maximum(0.5 * np.sign(mu_s) * np.sqrt(np.abs(mu_s)) + 0.5, 0.0), 1.0), n),
+            to_sub_uv(np.minimum(np.maximum((np.asarray(r, np.float64) - m["rg"]) / (m["rt"] - m["rg"]), 0.0), 1.0), n))
 
 
 def clamp_radius(m: dict, r):
@@ -247,7 +248,7 @@ def march(m: dict, tlut: np.ndarray, r, mu, mu_s, nu, t_max, steps: int, mslut: 
         t0, t1 = t_max * (i / steps) ** 2, t_max * ((i + 1) / steps) ** 2
         t, dt = 0.5 * (t0 + t1), (t1 - t0)[..., None]
         ri = np.sqrt(np.maximum(r * r + t * t + 2.0 * r * mu * t, 0.0))
-        mus_i = np.clip((r * mu_s + t * nu) / np.maximum(ri, 1.0), -1.0, 1.0)
+        mus_i = np.minimum(np.maximum((r * mu_s + t * nu) / np.maximum(ri, 1.0), -1.0), 1.0)
         s_ray, s_mie, ext = coefficients(m, ri)
         seg = np.exp(-ext * dt)
         spread = np.where(ext > 0, (1.0 - seg) / np.where(ext > 0, ext, 1.0), dt)   # ∫ e^(−σt s) ds over dt
@@ -377,7 +378,7 @@ def sky_view_lut(settings: AtmosphereSettings, tlut, mslut, altitude: float, sun
     w, h = SKY_VIEW_SIZE
     u, v = np.meshgrid(texel_centres(w), texel_centres(h))
     mu, cos_az = sky_view_params(m, r, u, v)
-    mu_s = float(np.clip(sun_y, -1.0, 1.0))
+    mu_s = min(max(float(sun_y), -1.0), 1.0)
     nu = mu * mu_s + np.sqrt(np.maximum(1.0 - mu * mu, 0.0)) * cos_az * math.sqrt(max(1.0 - mu_s * mu_s, 0.0))
     return integrate(m, tlut, np.full(mu.shape, r), mu, mu_s, nu, steps, mslut)[0]
 

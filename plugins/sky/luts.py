@@ -96,7 +96,7 @@ class AtmosphereLuts:
             self.builds[1] += 1
             self._medium_key, self._view_key = settings, None
         r = ref.camera_radius(ref.medium(settings), altitude)
-        sun_y = float(np.clip(sun_y, -1.0, 1.0))
+        sun_y = min(max(float(sun_y), -1.0), 1.0)
         last = self._view_key
         if (last is None or abs(sun_y - last[1]) > SUN_TOLERANCE
                 or abs(r - last[0]) > max(ALTITUDE_TOLERANCE[0], ALTITUDE_TOLERANCE[1] * (last[0] - ref.medium(settings)["rg"]))):

@@ -57,7 +57,7 @@ def unit_vectors(v, name: str) -> np.ndarray:
         raise ValueError(f"{name} must be 3-vectors (shape (..., 3)); got {v!r:.80}")
     if not np.isfinite(a).all():
         raise ValueError(f"{name} must be finite")
-    n = np.linalg.norm(a, axis=-1, keepdims=True)
+    n = np.sqrt(np.add.reduce(a * a, axis=-1, keepdims=True))     # a norm in ufuncs (per frame)
     if (n == 0).any():
         raise ValueError(f"{name} must have a length > 0; got a zero vector")
     return a / n

@@ -85,20 +85,18 @@ def _bake_horizon(settings: AtmosphereSettings, i_elevation: int, k_altitude: in
 
 
 def _nodes(sun_y: float, altitude: float):
-    """[(weight, elevation node, altitude node)] of the bilinear interpolation."""
+    """[(weight, elevation node, altitude node)] of the bilinear interpolation (elevation nodes clamped
+    to the zenith's and the nadir's)."""
     e = math.degrees(math.asin(min(max(sun_y, -1.0), 1.0))) / ELEVATION_STEP
     k = math.sqrt(max(altitude, 0.0)) / ALTITUDE_ROOT_STEP
     e0, k0 = math.floor(e), math.floor(k)
     fe, fk = e - e0, k - k0
-    return [(w, i, j) for w, i, j in (((1 - fe) * (1 - fk), e0, k0), (fe * (1 - fk), e0 + 1, k0),
-                                      ((1 - fe) * fk, e0, k0 + 1), (fe * fk, e0 + 1, k0 + 1)) if w > 0]
+    lo, hi = min(max(e0, -_ELEVATION_LIMIT), _ELEVATION_LIMIT), min(max(e0 + 1, -_ELEVATION_LIMIT), _ELEVATION_LIMIT)
+    return [(w, i, j) for w, i, j in (((1 - fe) * (1 - fk), lo, k0), (fe * (1 - fk), hi, k0),
+                                      ((1 - fe) * fk, lo, k0 + 1), (fe * fk, hi, k0 + 1)) if w > 0]
 
 
 _ELEVATION_LIMIT = round(90.0 / ELEVATION_STEP)     # the nodes at the zenith and the nadir
-
-
-def _clamped(i: int) -> int:
-    return min(max(i, -_ELEVATION_LIMIT), _ELEVATION_LIMIT)
 
 
 def sun_color(sun_dir, altitude, settings: AtmosphereSettings) -> np.ndarray:
@@ -121,7 +119,7 @@ def sky_ambient(sun_dir, altitude: float, settings: AtmosphereSettings, night=(0
     s = ref.unit(sun_dir)
     total = 0.0
     for w, i, j in _nodes(s[1], altitude):
-        total = total + w * _node(_bake_ambient, settings, _clamped(i), j)
+        total = total + w * _node(_bake_ambient, settings, i, j)
     return total + np.asarray(night, np.float64) * (1.0 - float(daylight(s[1])))
 
 
@@ -139,6 +137,6 @@ def horizon_radiance(directions, sun_dir, altitude: float, settings: AtmosphereS
     f = (x - i0)[:, None]
     total = 0.0
     for w, i, j in _nodes(s[1], altitude):
-        table = _node(_bake_horizon, settings, _clamped(i), j, elevation)
+        table = _node(_bake_horizon, settings, i, j, elevation)
         total = total + w * ((1 - f) * table[i0] + f * table[i0 + 1])
     return total + np.asarray(night, np.float64) * (1.0 - float(daylight(s[1])))

@@ -294,7 +294,7 @@ class RaymarchPass(RenderPass):
         grid = (layout.grid[0], -(-layout.shape[1] // maps.band_height), layout.grid[1])
         return {"layer_min": tuple(layout.lo.tolist()), "layer_max": tuple(layout.hi.tolist()),
                 "cell_size": tuple(cell.tolist()), "sigma_t": self.plugin.sigma_t(sim),
-                "steps": s.steps, "step_base": float(s.step * cell.min()), "step_growth": s.step_growth,
+                "steps": s.steps, "step_base": float(s.step * min(cell)), "step_growth": s.step_growth,
                 "min_transmittance": s.min_transmittance, "skipping": int(s.empty_space_skipping),
                 "skip_cells": skip_cells, "max_skips": int(sum(grid)) + 3, "factor": s.resolution,
                 "frame_size": tuple(map(int, view.size)), "jittered": int(s.jitter), "sun_growth": SUN_GROWTH,
@@ -309,7 +309,7 @@ class RaymarchPass(RenderPass):
         """march.glsl's March block: the sun march's first step, the jitter's turn (per frame only where
         the resolve averages: r > 1 with reprojection) and the pixel marched in each r × r block."""
         s = self.plugin.settings
-        sun = unit_direction(frame.view.sun) * (SUN_SPACING * float(np.min(cell)))
+        sun = unit_direction(frame.view.sun) * (SUN_SPACING * float(min(cell)))
         shift = jitter_shift(self.frame_index, s.resolution) if s.resolution > 1 and s.reprojection else 0.0
         return _MARCH_LAYOUT.pack(*sun.tolist(), shift, int(offset[0]), int(offset[1]))
 
@@ -346,7 +346,7 @@ class RaymarchPass(RenderPass):
             self._bind_far(frame, p, sim)
         if s.detail_octaves:
             layout = sim.layout(s.base_altitude)
-            self._detail().bind(p, view.time, self.plugin.wind(sim), s.detail_scale * float(np.min(layout.cell)),
+            self._detail().bind(p, view.time, self.plugin.wind(sim), s.detail_scale * float(min(layout.cell)),
                                 s.detail_strength, layer=(float(layout.lo[1]), float(layout.hi[1] - layout.lo[1])))
         if r == 1:                          # straight onto the frame
             images = {"color_image": COLOR, **({"distance_image": CLOUD_DISTANCE} if distance else {})}

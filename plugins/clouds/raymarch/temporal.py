@@ -163,7 +163,7 @@ def camera_state(camera, aspect: float) -> tuple:
 def forward_of(camera) -> np.ndarray:
     """The unit view direction of ``camera`` (what :meth:`TemporalClouds.is_cut` compares)."""
     f = np.asarray(camera.forward(), np.float64)
-    return f / max(float(np.linalg.norm(f)), 1e-30)
+    return f / max(math.hypot(*f), 1e-30)
 
 
 class TemporalClouds:
@@ -199,8 +199,8 @@ class TemporalClouds:
     def is_cut(camera, prev_position, prev_forward) -> bool:
         """Whether ``camera`` jumped since the last resolve: moved more than :data:`CUT_DISTANCE` m
         or turned its view more than :data:`CUT_TURN` (a teleport or a cut; reprojecting would smear)."""
-        moved = float(np.linalg.norm(np.asarray(camera.position, np.float64) - prev_position))
-        cos = float(np.clip(np.dot(forward_of(camera), prev_forward), -1.0, 1.0))
+        moved = math.dist(np.asarray(camera.position, np.float64), prev_position)
+        cos = min(max(float(forward_of(camera) @ prev_forward), -1.0), 1.0)
         return not (moved <= CUT_DISTANCE and math.acos(cos) <= CUT_TURN)
 
     def reset(self) -> None:

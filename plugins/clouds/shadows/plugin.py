@@ -22,7 +22,7 @@ def direct_weight(sun_direction, sun_color, settings) -> float:
     s = unit_sun(sun_direction)
     if s is None or not max(map(float, sun_color)) > 0.0:
         return 0.0
-    x = float(np.clip(s[1] / settings.horizon_fade, 0.0, 1.0))
+    x = min(max(float(s[1]) / settings.horizon_fade, 0.0), 1.0)
     return settings.direct_fraction * x * x * (3.0 - 2.0 * x)
 
 

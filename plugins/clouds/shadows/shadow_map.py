@@ -26,6 +26,8 @@ Format: rg16f, relative rounding 2⁻¹¹, so ``|Δ exp(−τ)| ≤ τ e^{−τ}
 """
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -108,7 +110,7 @@ class ShadowMapSpace:
         """Set ``clouds/shadows/shadow_map.glsl``'s uniforms (the map itself is bound by the caller)."""
         c = self.cascades
         lookup = np.array([[c[0, 0], c[0, 1], 1.0 / c[0, 2], 1.0 / c[0, 3]], [c[1, 0], c[1, 1], 1.0 / c[1, 2], 1.0 / c[1, 3]],
-                           [self.far_centre_index / self.warp, self.far_centre_index, 0.0, 0.0]], "f4")
+                           [0.5 * (self.size - 1) / self.warp, 0.5 * (self.size - 1), 0.0, 0.0]], "f4")
         write_uniforms(program, shadow_cascades=lookup.tobytes(),
                        shadow_plane=(float(self.lo[0]), float(self.lo[2]), 1.0 / self.cell[0], 1.0 / self.cell[2]),
                        shadow_heights=(self.mid, float(self.lo[1]) + self.thickness, 1.0 / self.thickness,
@@ -138,12 +140,12 @@ def shadow_space(layout, camera_position, sun_dir, camera_far: float, size: int 
     vq = (q - lo[[0, 2]]) / cell[[0, 2]] - 0.5                   # the camera's projection, volume texels
     scale = half / np.sinh(space.warp) / cell[[0, 2]]             # K per axis, volume texels
     c = 0.5 * (size - 1)
-    lo_v, hi_v = np.full(2, -0.5), np.array([shape[0], shape[2]], np.float64) - 0.5
+    lo_v, hi_v = np.array([-0.5, -0.5]), np.array([shape[0], shape[2]], np.float64) - 0.5
     pad = 1
     for _ in range(3):      # far lookups past the near cascade never reach the volume: pad > the far texels there
         reach_v = np.maximum(np.abs(lo_v - pad - vq), np.abs(hi_v + pad - vq))
         far_step = scale * space.warp / c * np.sqrt(1.0 + (reach_v / scale) ** 2)    # dv/dj = K w/c cosh
-        pad = max(pad, 1 + int(np.ceil(far_step.max())))
+        pad = max(pad, 1 + math.ceil(max(far_step)))
     r = near_ratio(shape, size, pad)
     space.near = min(int(size), r * (max(shape[0], shape[2]) + 1 + 2 * pad) + 1)
     centre = (np.array([shape[0], shape[2]], np.float64) - 1.0) / 2.0
@@ -198,8 +200,9 @@ class CloudShadowMapPass(ComputePass):
         column_uniforms(p, sim, layout, 1.0)
         if layer is not None:
             layer.use(p, view, sim)
-        c = self.space.far_centre_index
-        cascades = np.concatenate([self.space.cascades, [[self.space.warp / c, c, 0.0, 0.0]]]).astype("f4")
+        c = 0.5 * (self.space.size - 1)
+        cascades = np.empty((3, 4), "f4")
+        cascades[:2], cascades[2] = self.space.cascades, (self.space.warp / c, c, 0.0, 0.0)
         write_uniforms(p, cascades=cascades.tobytes(), near_size=self.space.near,
                        bake_sun=tuple(map(float, sun)))
         image = frame.image(SHADOW_MAP)
