@@ -1,8 +1,6 @@
 """CloudShadowsPlugin: darkens the scene's surfaces where the cloud layer blocks the sun (thesis 7.3.1)."""
 from __future__ import annotations
 
-import numpy as np
-
 from atmos.graph import ComputePass, PassContext
 from atmos.lighting import unit_sun
 from atmos.plugin import Plugin
