@@ -327,12 +327,14 @@ SPECS = {
         dict(center=(3.0, 0.0, -12.0), scale=(4.0, 3.0, 4.0), bias=0.6, falloff=0.2, frequency=0.5, octaves=5,
              seed=9, wind=(-4.0, 1.0, 3.0), absorption=0.05, steps=40, light_steps=6, light_step=0.5,
              max_distance=12.0, ambient=(0.9, 0.1, 0.1), scattering=(0.1, 0.1, 0.9), animate=False,
-             ambient_from="sky", froxels=(8, 6, 12), froxel_history=0.5, noise="filtered"),
+             ambient_from="sky", froxels=(8, 6, 12), froxel_history=0.5, noise="filtered", cloud_shadows=False),
         # from froxels whose frames stand alone (froxel_history 1) to a history, which jitters the next frame
         before={"froxel_history": configure_first(froxels=(8, 6, 12), froxel_history=1.0)},
         # Mesa's texture unit blends in float: the hashed and the filtered noise give the same pixels there;
         # the frame compiles (and runs) the filtered variant
-        observe={"noise": lambda app, plugin: {dict(key[1]).get("FOG_NOISE_FILTERED") for key in app.gpu._programs}}),
+        observe={"noise": lambda app, plugin: {dict(key[1]).get("FOG_NOISE_FILTERED") for key in app.gpu._programs},
+                 # cloud_shadows acts only under clouds (tests/test_volumetric_fog.py renders it): the setting read
+                 "cloud_shadows": lambda app, plugin: plugin.settings.cloud_shadows}),
     "fog": Spec(
         lambda: [DefaultPlugins(overlay=False), SkyGradientPlugin(), GroundPlugin(),
                  FogPlugin(mode="hetero_exp2", density=0.06, resolutions=(4, 8, 8, 16), tile_size=32.0)],

@@ -476,3 +476,72 @@ def test_a_scene_with_froxel_fog_is_the_twin_read_at_each_pixel(fresh_gpu):
     spread = np.abs(np.diff(volume, axis=2)).max() / 256
     tol = 4e-3 + spread + filtered_tolerance(params, Sun.from_angles(30.0, 60.0), fresh_gpu)[:3]   # the default noise
     assert np.allclose(got, want, atol=tol, rtol=2e-2), np.abs(got - want).max()
+
+
+def test_the_fogs_sunlight_passes_through_the_clouds_shadow_map(gpu, ctx, rng):
+    """With clouds in the scene the sunlight of each fog sample is its own light march's times the clouds'
+    exp(−τ) from the cloud shadow map: the per-pixel pass against the float64 march whose τ is
+    lookup_reference on the GPU's own map (random column sums); the froxel volume darkens likewise, and
+    ``cloud_shadows=False`` gives the unshadowed fog back."""
+    from atmos.plugins.clouds import CloudSettings, CloudSimulation, CloudsPlugin
+    from atmos.plugins.clouds.shadows.shadow_map import lookup_reference
+    from atmos.plugins.clouds.weather import VolumeOrigin
+    from atmos.lighting import unit_sun
+    from test_cloud_shadow_map import MapCapture
+    from test_cloud_shadows import FillPass, pass_plugin, ray_dirs, weather, write_sums
+    fill, probe, capture = FillPass(), CapturePass(), MapCapture()
+    clouds = CloudsPlugin(CloudSettings(smoothing_slices=2, group_size=(8, 8), shading=False, cell_size=(6.0, 2.0, 6.0)),
+                          weather=weather(), seed=5)
+    fog = VolumetricFogPlugin(VolumetricFogSettings(scale=(3.0, 0.5, 3.0), bias=0.3, falloff=0.05, frequency=0.05,
+                                                    octaves=3, absorption=0.05, steps=32, light_steps=2, light_step=2.0,
+                                                    max_distance=600.0, ambient=(0.0, 0.0, 0.0),
+                                                    scattering=(1.0, 1.0, 1.0), animate=False, noise="hash"))
+    app = App(gpu).insert_resource(VolumeOrigin(0.0, 0.0, 0.0))
+    app.add_plugins(DefaultPlugins(overlay=False), clouds, pass_plugin(fill), fog, pass_plugin(probe), pass_plugin(capture))
+    app.startup()
+    sim = app.resource(CloudSimulation)
+    for _ in range(2):
+        app.update(1 / 30)
+    a, b, _ = sim.view()
+    nx, ny, nz = sim.shape
+    for s in (a, b):
+        write_sums(sim, s, rng.uniform(0, ny, (1 + sim.maps_of(s).bands, nx, nz)))
+    layout = sim.sets().layout()
+    sun = Sun.from_angles(float(rng.uniform(30, 70)), float(rng.uniform(0, 360)))
+    app.insert_resource(sun)
+    s = unit_sun(sun.direction)
+    centre = layout.lo + 0.5 * (layout.hi - layout.lo)
+    shadow = centre - s * centre[1] / s[1]                   # where the layer's shadow falls on the ground
+    shadow[1] = 6.0
+    fog.configure(center=tuple(shadow))
+    cam = app.resource(Camera)
+    cam.near, cam.far = 1.0, 1000.0
+    cam.position = shadow + np.array([rng.uniform(-160, -120), rng.uniform(50, 90), rng.uniform(-30, 30)])
+    cam.look_at(shadow)
+    size = gpu.size
+    fill.color, fill.depth = np.zeros((size[1], size[0], 4)), np.ones((size[1], size[0]))
+    app.render()                                # render only: the sets stay as written
+    got = probe.color[..., :3].reshape(-1, 3)
+    params = fog.settings
+    s_dir, sun_light, ambient_light = sun_terms(sun, params)
+    dirs = ray_dirs(cam, size).reshape(-1, 3)
+    origins = np.broadcast_to(cam.position, dirs.shape)
+    sigma = float(sim.settings.sigma)
+    tau = lambda p: lookup_reference(capture.space, capture.map, p, s, (sigma, 0.0))
+    want = reference.march(origins, dirs, np.full(len(dirs), 1e30), params, s_dir, sun_light, ambient_light, 0.0, tau)
+    bare = reference.march(origins, dirs, np.full(len(dirs), 1e30), params, s_dir, sun_light, ambient_light, 0.0)
+    tol = 4e-3 + 2e-2 * np.abs(want[:, :3])      # f16 colour, float32 noise's early exits (as the pass's test)
+    assert np.isfinite(got).all()
+    assert np.all(np.abs(got - want[:, :3]) <= tol), f"max error {np.abs(got - want[:, :3]).max()}"
+    shaded = np.abs(bare[:, :3] - want[:, :3]).max(-1) > 10 * tol.max(-1)
+    assert shaded.sum() > 100, "the clouds' shadows fall through the fog"
+    fog.configure(froxels=(32, 18, 32), froxel_history=1.0)
+    app.render()
+    froxel = probe.color[..., :3].mean()
+    fog.configure(cloud_shadows=False)
+    app.render()
+    assert froxel < 0.9 * probe.color[..., :3].mean(), "the froxels' fog is shadowed too"
+    fog.configure(froxels=None)
+    app.render()
+    assert np.all(np.abs(probe.color[..., :3].reshape(-1, 3) - bare[:, :3]) <= 4e-3 + 2e-2 * np.abs(bare[:, :3]))
+    app.close()

@@ -11,8 +11,7 @@ from atmos.composition import CLOUD_DISTANCE
 from atmos.graph import PassBuilder, PassContext, work_groups
 from atmos.lighting import unit_sun
 from atmos.plugins.clouds import CLOUD_SETS, FAR_FIELD, CloudSets, column_uniforms
-from atmos.plugins.clouds.far_field.layer import column_tau
-from atmos.plugins.clouds.shadows.shadow_map import SHADOW_MAP, SHADOW_SPACE, use_shadow_map
+from atmos.plugins.clouds.shadows.shadow_map import SHADOW_MAP, SHADOW_SPACE, cloud_extinctions, use_shadow_map
 from atmos.offscreen import OffscreenLayer
 from atmos.plugins.light_shafts.settings import FLOAT32_MAX
 from atmos.render_core import COLOR, DEPTH
@@ -122,9 +121,7 @@ class MarchedShafts:
         view = frame.view
         far_field = clouds and frame.declares(FAR_FIELD)
         if clouds and frame.declares(SHADOW_MAP):
-            sim: CloudSets = frame.resource(CLOUD_SETS)
-            field_tau = column_tau(frame.resource(FAR_FIELD).settings, sim) if far_field else 0.0
-            use_shadow_map(frame, p, sim.settings.sigma, field_tau)
+            use_shadow_map(frame, p, *cloud_extinctions(frame))
         elif clouds:
             sim: CloudSets = frame.resource(CLOUD_SETS)
             layer = frame.resource(FAR_FIELD) if far_field else None

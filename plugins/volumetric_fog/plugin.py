@@ -10,6 +10,8 @@ from atmos.graph import ComputePass, PassContext, work_groups
 from atmos.lighting import Sun, sun_and_day
 from atmos.plugin import Plugin
 from atmos.render_core import COLOR, DEPTH
+from atmos.plugins.clouds import CLOUD_SETS
+from atmos.plugins.clouds.shadows.shadow_map import SHADOW_MAP, cloud_extinctions, read_shadow_map, shadow_map_pass, use_shadow_map
 from atmos.plugins.sky import SkyLight
 from atmos.plugins.volumetric_fog.noise import Lattice, noise_defines, noise_kind
 from atmos.plugins.volumetric_fog.settings import VolumetricFogSettings
@@ -48,7 +50,8 @@ class VolumetricFogPass(ComputePass):
     """A compute pass, one invocation per pixel: reads ``depth``, composites (in-scattered light,
     transmittance) onto ``color`` in place, rgb = light + T · rgb, alpha (the sky occlusion of
     :mod:`atmos.render_core`) kept: the medium tints the sky, it does not hide it. Where the aerial
-    perspective mixes the air with the local media, onto the media targets too."""
+    perspective mixes the air with the local media, onto the media targets too. With clouds in the
+    scene (``cloud_shadows``) the sunlight each sample receives passes through their shadow map."""
     name = "volumetric_fog"
     phase = "media"
     compute = "volumetric_fog/fog.comp"
@@ -60,13 +63,25 @@ class VolumetricFogPass(ComputePass):
         froxels = self.plugin.settings.froxels
         if froxels is not None:                    # layer 0 is the camera: D slices, D + 1 layers
             builder.create(FOG_VOLUME, volume_desc(froxels), access="storage")
+        if self.cloud_shadows():
+            read_shadow_map(builder, self.plugin.graph)
         if self.plugin.composition.media:          # the aerial perspective mixes the air with it
             for name in (MEDIA_LIGHT, MEDIA_TRANSMITTANCE):
                 builder.read(name, access="storage")
                 builder.write(name, access="storage")
 
+    def cloud_shadows(self) -> bool:
+        """Whether the sunlight passes through the clouds' shadow map: ``cloud_shadows`` and a clouds plugin
+        imported "cloud_sets"."""
+        return self.plugin.settings.cloud_shadows and self.plugin.graph.imports(CLOUD_SETS)
+
+    def medium_defines(self) -> dict:
+        """volumetric_fog/medium.glsl's defines: the noise's, and FOG_CLOUD_SHADOWS (:meth:`cloud_shadows`)."""
+        defines = noise_defines(self.plugin.settings, self.gpu)
+        return {**defines, "FOG_CLOUD_SHADOWS": 1} if self.cloud_shadows() else defines
+
     def defines(self) -> dict:
-        return {"LOCAL_MEDIA": int(self.plugin.composition.media), **noise_defines(self.plugin.settings, self.gpu)}
+        return {"LOCAL_MEDIA": int(self.plugin.composition.media), **self.medium_defines()}
 
     def prepare(self, gpu) -> None:
         super().prepare(gpu)
@@ -92,16 +107,20 @@ class VolumetricFogPass(ComputePass):
             self.history.release()                     # no volume to accumulate: no history kept
             p = self.program
             set_medium_uniforms(p, settings, view.sun, self.plugin.time(view), self.plugin.sky_ambient(view))
+            if frame.declares(SHADOW_MAP):
+                use_shadow_map(frame, p, *cloud_extinctions(frame))
             frame.dispatch(p, self.groups(color.size), textures={"scene_depth": DEPTH, **noise},
                            images=images)
             return
-        fill = self.gpu.program(compute_shader="volumetric_fog/froxels.comp", defines=noise_defines(settings, self.gpu))
+        fill = self.gpu.program(compute_shader="volumetric_fog/froxels.comp", defines=self.medium_defines())
         apply = self.gpu.program(compute_shader="volumetric_fog/froxel_apply.comp",
                                  defines={"LOCAL_MEDIA": int(self.plugin.composition.media)})
         volume = volume_image(frame, FOG_VOLUME)
         for p in (fill, apply):
             write_uniforms(p, froxel_knee=froxel_knee(settings.max_distance), max_distance=settings.max_distance)
         set_medium_uniforms(fill, settings, view.sun, self.plugin.time(view), self.plugin.sky_ambient(view))
+        if frame.declares(SHADOW_MAP):
+            use_shadow_map(frame, fill, *cloud_extinctions(frame))
         write_uniforms(fill, froxel_jittered=int(self.history.jittered(view.clock.frame, settings.froxel_history)))
         frame.dispatch(fill, work_groups(volume.size[:2], (8, 8)), images={"fog_volume": volume}, textures=noise)
         volume = self.history.resolve(frame, volume, settings.max_distance, froxel_knee(settings.max_distance),
@@ -133,6 +152,8 @@ class VolumetricFogPlugin(Plugin):
         return self._sky.horizon(view.sun, max(float(view.camera.position[1]), 0.0), HORIZON_SAMPLES).mean(0)
 
     def build(self, app) -> None:
+        self.graph = app.graph
+        shadow_map_pass(app.graph)                 # baked when clouds are there (culled otherwise)
         self.composition = composition(app)
         self.composition.media_writers.add(VolumetricFogPass.name)   # a local medium (atmos.composition)
         app.graph.add_pass(VolumetricFogPass(self))

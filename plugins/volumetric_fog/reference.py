@@ -37,10 +37,12 @@ def march_range(origins, dirs, limits, settings: VolumetricFogSettings):
     return np.where(disc > 0, enter, 0.0), np.where(disc > 0, leave, -1.0)
 
 
-def march(origins, dirs, limits, settings: VolumetricFogSettings, sun_dir, sun_light, ambient_light, time: float = 0.0):
+def march(origins, dirs, limits, settings: VolumetricFogSettings, sun_dir, sun_light, ambient_light, time: float = 0.0,
+          cloud_tau=None):
     """(N, 4): in-scattered light rgb and transmittance of N rays, exactly the GLSL march in float64.
 
-    ``dirs`` are normalized here; ``sun_dir`` is the unit vector toward the sun.
+    ``dirs`` are normalized here; ``sun_dir`` is the unit vector toward the sun; ``cloud_tau``: None, or
+    the clouds' optical depth toward the sun at points (n, 3) (the cloud shadow map's, FOG_CLOUD_SHADOWS).
     """
     origins = np.asarray(origins, np.float64).reshape(-1, 3)
     dirs = np.asarray(dirs, np.float64).reshape(-1, 3)
@@ -63,13 +65,7 @@ def march(origins, dirs, limits, settings: VolumetricFogSettings, sun_dir, sun_l
         inside = d > 0
         idx, p, d = idx[inside], p[inside], d[inside]
         step_t = np.exp(-sigma * d * dt[idx])
-        tl = np.ones(len(idx))
-        lit = np.ones(len(idx), bool)       # still marching toward the sun
-        for j in range(settings.light_steps):
-            dl = density(p + sun_dir * (j * settings.light_step), settings, time)
-            hit = lit & (dl > 0)
-            tl = np.where(hit, tl * np.exp(-sigma * np.maximum(dl, 0) * settings.light_step), tl)
-            lit &= ~(hit & (tl <= 0.01))
+        tl = sun_transmittance(p, settings, sun_dir, time, cloud_tau)
         light[idx] += (trans[idx] * (1 - step_t))[:, None] * (ambient_light + sun_light * tl[:, None])
         trans[idx] *= step_t
         active[idx[trans[idx] <= 0.01]] = False
@@ -77,7 +73,7 @@ def march(origins, dirs, limits, settings: VolumetricFogSettings, sun_dir, sun_l
 
 
 def froxel_volume(camera_pos, basis, froxels, settings: VolumetricFogSettings, sun_dir, sun_light, ambient_light,
-                  knee: float, time: float = 0.0, jitter: float = 0.5) -> np.ndarray:
+                  knee: float, time: float = 0.0, jitter: float = 0.5, cloud_tau=None) -> np.ndarray:
     """(W, H, D + 1, 4) float64: volumetric_fog/froxels.comp — each column's ray through uv = ((x, y) + 0.5)
     / (W, H) (``basis``: atmos.camera.view_basis) marched one sample per slice, at the share ``jitter`` of
     the slice's part inside the envelope; layer k holds (light,
@@ -101,15 +97,16 @@ def froxel_volume(camera_pos, basis, froxels, settings: VolumetricFogSettings, s
         inside = dens > 0
         idx, p, dens = idx[inside], p[inside], dens[inside]
         step_t = np.exp(-sigma * dens * (b[idx] - a[idx]))
-        tl = sun_transmittance(p, settings, sun_dir, time)
+        tl = sun_transmittance(p, settings, sun_dir, time, cloud_tau)
         light[idx] += (trans[idx] * (1 - step_t))[:, None] * (ambient_light + sun_light * tl[:, None])
         trans[idx] *= step_t
         out[:, k, :3], out[:, k, 3] = light, trans
     return out.reshape(w, h, d + 1, 4)
 
 
-def sun_transmittance(p, settings: VolumetricFogSettings, sun_dir, time: float = 0.0) -> np.ndarray:
-    """medium.glsl fog_sun_transmittance at points p (n, 3): light_steps samples toward the sun, stopping at 0.01."""
+def sun_transmittance(p, settings: VolumetricFogSettings, sun_dir, time: float = 0.0, cloud_tau=None) -> np.ndarray:
+    """medium.glsl fog_sun_transmittance at points p (n, 3): light_steps samples toward the sun, stopping at
+    0.01; times exp(−cloud_tau(p)) when given (the clouds' shadow)."""
     tl = np.ones(len(p))
     lit = np.ones(len(p), bool)
     for j in range(settings.light_steps):
@@ -117,4 +114,4 @@ def sun_transmittance(p, settings: VolumetricFogSettings, sun_dir, time: float =
         hit = lit & (dl > 0)
         tl = np.where(hit, tl * np.exp(-settings.absorption * np.maximum(dl, 0) * settings.light_step), tl)
         lit &= ~(hit & (tl <= 0.01))
-    return tl
+    return tl if cloud_tau is None else tl * np.exp(-cloud_tau(p))

@@ -54,6 +54,8 @@ class VolumetricFogSettings(CheckedSettings):
                               "noise.filtered_error of the hashed FBM: the texture unit's blend weights); hash: "
                               "8 corners hashed per octave; auto: filtered on a GPU, hash on a software "
                               "renderer")
+    cloud_shadows: bool = bool_field(True, "the clouds' shadows darken the fog's sunlight (their shadow map, one "
+                                     "fetch per light sample); a scene without clouds has none to read")
     froxels: tuple | None = None
     froxel_history: float = history_field()
 

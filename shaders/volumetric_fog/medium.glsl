@@ -1,11 +1,15 @@
 // The FBM fog medium and its ray march (fbm-raymarched-fog.txt); mirrored in float64 by
 // atmos/plugins/volumetric_fog/reference.py. Needs lib/hash.glsl and lib/value_noise.glsl first; the sun's
-// direction is the frame block's (lib/frame.glsl); the noise is volumetric_fog/lattice.glsl's.
+// direction is the frame block's (lib/frame.glsl); the noise is volumetric_fog/lattice.glsl's; with
+// FOG_CLOUD_SHADOWS the sunlight is the clouds' shadow map's too (clouds/shadows/shadow_map.glsl).
 //   density(p) = bias - falloff * |(p - center) / scale| + fbm(frequency * (p - center - wind * fog_time))
 // Positive density only inside the ellipsoid |(p - center) / scale| < (bias + 1 - 2^-octaves) / falloff,
 // so the march covers the part of the ray inside it (and before the scene surface / max_distance).
 #include "lib/frame.glsl"
 #include "volumetric_fog/lattice.glsl"
+#ifdef FOG_CLOUD_SHADOWS
+#include "clouds/shadows/shadow_map.glsl"
+#endif
 
 uniform vec3 center;
 uniform vec3 scale;
@@ -42,7 +46,8 @@ vec2 fog_range(vec3 ro, vec3 dir, float limit) {
     return vec2(max((-b - r) / a, 0.0), min((-b + r) / a, limit));
 }
 
-// The sun's transmittance from p: light_steps samples light_step apart toward the sun (stops at 0.01).
+// The sun's transmittance from p: light_steps samples light_step apart toward the sun (stops at 0.01);
+// with FOG_CLOUD_SHADOWS times the clouds' exp(-tau) there (the cloud shadow map, one fetch).
 float fog_sun_transmittance(vec3 p) {
     float tl = 1.0;
     for (int j = 0; j < light_steps; ++j) {
@@ -52,6 +57,9 @@ float fog_sun_transmittance(vec3 p) {
             if (tl <= 0.01) break;
         }
     }
+#ifdef FOG_CLOUD_SHADOWS
+    tl *= exp(-cloud_shadow_tau(p, sun_dir));
+#endif
     return tl;
 }
 

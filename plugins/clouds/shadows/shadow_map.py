@@ -217,6 +217,25 @@ def shadow_map_pass(graph) -> CloudShadowMapPass:
     return p
 
 
+def read_shadow_map(builder, graph) -> None:
+    """Declare, in a pass's setup, what :func:`use_shadow_map` with :func:`cloud_extinctions` reads: the
+    map, its space, the clouds' sets and, when the graph imports one, the far field (its column's depth)."""
+    builder.read(SHADOW_MAP)
+    builder.read(SHADOW_SPACE)
+    builder.read(CLOUD_SETS)
+    if graph.imports(FAR_FIELD):
+        builder.read(FAR_FIELD)
+
+
+def cloud_extinctions(frame) -> tuple[float, float]:
+    """(the volume's extinction per summed cell, the far field's column optical depth: 0 without one) in
+    a pass that declared CLOUD_SETS (and FAR_FIELD): the clouds' own, as the ground shadows and the
+    clouds' light take them."""
+    from atmos.plugins.clouds.far_field.layer import column_tau
+    sim = frame.resource(CLOUD_SETS)
+    return float(sim.settings.sigma), column_tau(frame.resource(FAR_FIELD).settings, sim) if frame.declares(FAR_FIELD) else 0.0
+
+
 def use_shadow_map(frame, program, extinction: float, field_tau: float = 0.0) -> None:
     """Bind the map and set shadow_map.glsl's uniforms in a pass that declared SHADOW_MAP and SHADOW_SPACE."""
     from atmos.gpu.uniforms import bind_textures
