@@ -24,10 +24,13 @@ EPS32 = 2.0 ** -24
 
 
 # -- GPU helpers -----------------------------------------------------------------------------------
-def medium_program(gpu, shader, params):
+def medium_program(gpu, shader, params, shadows=None):
     """``shader`` compiled for ``params``'s noise; the filtered noise's: the lattice of its seed bound
-    (kept on ``gpu`` per seed)."""
-    prog = gpu.program(compute_shader=shader, defines=noise_defines(params, gpu))
+    (kept on ``gpu`` per seed). ``shadows``: a :class:`CloudShadowStub` the sunlight passes through."""
+    defines = noise_defines(params, gpu)
+    prog = gpu.program(compute_shader=shader, defines={**defines, "FOG_CLOUD_SHADOWS": 1} if shadows else defines)
+    if shadows is not None:
+        shadows.bind(prog)
     if noise_kind(params, gpu) != "filtered":
         return prog
     lattices = gpu.__dict__.setdefault("_test_fog_lattices", {})
@@ -374,13 +377,43 @@ def test_the_fog_can_take_its_ambient_light_from_the_sky():
 
 
 # -- the froxel volume (VolumetricFogSettings.froxels) ------------------------------------------------
-def gpu_froxels(gpu, camera, aspect, froxels, params, sun, time=0.0, frame=None):
+class CloudShadowStub:
+    """A cloud shadow map of random columns (rg16f) over a layer above the fog, as the bake would lay it out
+    for ``camera`` and ``sun``: bound to a program, and its float64 optical depth (``tau``)."""
+
+    def __init__(self, gpu, rng, params, camera, sun):
+        from atmos.lighting import unit_sun
+        from atmos.plugins.clouds.shadows.shadow_map import shadow_space
+        from atmos.plugins.clouds.volume.layout import CloudLayout
+        centre = np.asarray(params.center, np.float64)
+        self.sun = unit_sun(sun.direction)
+        shape, cell = (16, 4, 16), (6.0, 3.0, 6.0)
+        layout = CloudLayout(shape, cell, ((centre[0] - 48.0) / 6.0, (centre[2] - 48.0) / 6.0), 60.0, (8, 8), 0.0)   # over the fog
+        self.space = shadow_space(layout, camera.position, self.sun, 400.0, size=64)
+        n = self.space.size
+        self.map = rng.uniform(0.0, 4.0, (2 * n, n, 2)).astype(np.float16).astype(np.float64)
+        self.weights = (float(rng.uniform(0.2, 1.0)), float(rng.uniform(0.0, 0.5)))
+        self.texture = gpu.ctx.texture((n, 2 * n), 2, self.map.astype(np.float16).tobytes(), dtype="f2")
+
+    def bind(self, program) -> None:
+        import moderngl
+        self.texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
+        self.texture.repeat_x = self.texture.repeat_y = False
+        bind_textures(program, cloud_shadow_map=self.texture)
+        self.space.uniforms(program, *self.weights)
+
+    def tau(self, points) -> np.ndarray:
+        from atmos.plugins.clouds.shadows.shadow_map import lookup_reference
+        return lookup_reference(self.space, self.map, points, self.sun, self.weights)
+
+
+def gpu_froxels(gpu, camera, aspect, froxels, params, sun, time=0.0, frame=None, shadows=None):
     """(W, H, D + 1, 4): volumetric_fog/froxels.comp for ``camera``, its slices sampled at the middles or at
-    froxel_jitter of ``frame`` (read back as float64)."""
+    froxel_jitter of ``frame`` (read back as float64); ``shadows``: a CloudShadowStub."""
     from atmos.gpu.uniforms import bind_images, write_uniforms
     from atmos.froxels import froxel_knee
     w, h, d = froxels
-    prog = medium_program(gpu, "volumetric_fog/froxels.comp", params)
+    prog = medium_program(gpu, "volumetric_fog/froxels.comp", params, shadows)
     volume = gpu.ctx.texture3d((w, h, d + 1), 4, dtype="f2")
     try:
         bind_frame(gpu, camera, sun, (aspect, 1.0), frame_index=frame or 0)     # camera (its aspect), sun, frame
@@ -394,12 +427,13 @@ def gpu_froxels(gpu, camera, aspect, froxels, params, sun, time=0.0, frame=None)
         volume.release()
 
 
-def ref_froxels(camera, aspect, froxels, params, sun, time=0.0, jitter=0.5):
+def ref_froxels(camera, aspect, froxels, params, sun, time=0.0, jitter=0.5, shadows=None):
     from atmos.camera import view_basis
     from atmos.froxels import froxel_knee
     s, sun_light, ambient_light = sun_terms(sun, params)
     return reference.froxel_volume(camera.position, view_basis(camera, aspect), froxels, params, s, sun_light,
-                                   ambient_light, froxel_knee(params.max_distance), time, jitter)
+                                   ambient_light, froxel_knee(params.max_distance), time, jitter,
+                                   None if shadows is None else shadows.tau)
 
 
 def froxel_camera(rng, params):
@@ -410,7 +444,10 @@ def froxel_camera(rng, params):
     return cam
 
 
-def test_gpu_froxel_volume_matches_its_float64_twin(gpu, ctx, rng):
+@pytest.mark.parametrize("clouds", [False, True])
+def test_gpu_froxel_volume_matches_its_float64_twin(gpu, ctx, rng, clouds):
+    """froxels.comp against reference.froxel_volume; ``clouds``: the sunlight through a random cloud
+    shadow map (FOG_CLOUD_SHADOWS), τ from lookup_reference on the same map."""
     params = VolumetricFogSettings(center=tuple(rng.uniform(-5, 5, 3)), scale=(1.5, 0.6, 1.2), bias=0.1, falloff=0.05,
                                    frequency=float(rng.uniform(0.1, 0.3)), octaves=5, seed=int(rng.integers(0, 2**32)),
                                    absorption=float(rng.uniform(0.1, 0.4)), light_steps=4, light_step=2.5,
@@ -418,8 +455,14 @@ def test_gpu_froxel_volume_matches_its_float64_twin(gpu, ctx, rng):
     sun = Sun.from_angles(float(rng.uniform(10, 70)), float(rng.uniform(0, 360)))
     cam = froxel_camera(rng, params)
     index = int(rng.integers(0, 2**32))           # the frame: where in each slice the sample lies (froxel_jitter)
-    got = gpu_froxels(gpu, cam, 16 / 9, params.froxels, params, sun, time=0.75, frame=index)
-    want = ref_froxels(cam, 16 / 9, params.froxels, params, sun, time=0.75, jitter=froxel_jitter(index))
+    shadows = CloudShadowStub(gpu, rng, params, cam, sun) if clouds else None
+    got = gpu_froxels(gpu, cam, 16 / 9, params.froxels, params, sun, time=0.75, frame=index, shadows=shadows)
+    want = ref_froxels(cam, 16 / 9, params.froxels, params, sun, time=0.75, jitter=froxel_jitter(index), shadows=shadows)
+    if clouds:
+        bare = ref_froxels(cam, 16 / 9, params.froxels, params, sun, time=0.75, jitter=froxel_jitter(index))
+        top = np.abs(bare[..., :3]).max()
+        lit = bare[..., :3].max(-1) > 0.1 * top
+        assert (np.abs(bare - want)[..., :3].max(-1)[lit] > 0.05 * top).mean() > 0.3, "the clouds shadow the fog"
     assert np.isfinite(got).all() and got.shape == want.shape == (24, 14, 41, 4)
     assert (want[..., -1, 3] < 0.9).sum() >= 10 and (want[..., -1, 3] > 0.999).sum() >= 5, "columns in and past the fog"
     assert np.allclose(got[:, :, 0], [0, 0, 0, 1]), "layer 0 is the camera"
