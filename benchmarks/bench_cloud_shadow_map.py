@@ -66,7 +66,7 @@ def accuracy(frames: int = 4) -> None:
         r = probe.result
         space = next(p for p in app.graph.passes if p.name == "cloud_shadow_map").space
         near = in_near(space, pts, sun)
-        far_widths.append(space.read_at(projected(space, pts, sun))[2][~near].mean() * space.cell[0])
+        far_widths.append(space.read_at(space.plane_texel(pts, sun))[2][~near].mean() * space.cell[0])
         cells = [errors(r[m]) if m.any() else (0.0, 0.0) for m in (near, ~near)]
         print(f"{name:22s} {len(pts):7d} {cells[0][0]:10.4f} {cells[0][1]:8.4f} {cells[1][0]:10.4f} {cells[1][1]:8.4f} {far_widths[-1]:8.1f} m")
     n = space.size
@@ -77,14 +77,8 @@ def accuracy(frames: int = 4) -> None:
     gpu.release()
 
 
-def projected(space, pts, sun) -> np.ndarray:
-    """Volume texel coordinates (n, 2) where the lookups of ``pts`` read (the middle plane along the sun)."""
-    run = np.maximum(space.mid - pts[:, 1], 0.0) / max(sun[1], 1e-4)
-    return (pts[:, [0, 2]] + run[:, None] * sun[[0, 2]] - space.lo[[0, 2]]) / space.cell[[0, 2]] - 0.5
-
-
 def in_near(space, pts, sun) -> np.ndarray:
-    return space.read_at(projected(space, pts, sun))[1]
+    return space.read_at(space.plane_texel(pts, sun))[1]
 
 
 def far_width(space, u: float) -> float:

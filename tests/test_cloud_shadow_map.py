@@ -53,8 +53,7 @@ def test_float64_lookup_matches_sun_optical_depth_within_the_derived_bound(rng):
                                         far=lambda xz: field_tau * far(xz))
     got = lookup_reference(space, baked, pts, sun, (ext, field_tau))
     # which cascade each point read, and its texel size h (volume texels); points past the far one clamp
-    run = np.maximum(space.mid - pts[:, 1], 0.0) / sun[1]
-    v = (pts[:, [0, 2]] + run[:, None] * sun[[0, 2]] - space.lo[[0, 2]]) / space.cell[[0, 2]] - 0.5
+    v = space.plane_texel(pts, sun)
     _, near, h = space.read_at(v)           # h: the width of the (warped) map cell each point falls in
     far = space.far_index(v)
     inside = near | np.all((far >= 0) & (far <= space.size - 1), axis=-1)
@@ -166,8 +165,7 @@ def test_gpu_bake_and_lookup_match_float64(gpu, ctx, rng, typed):
     interp = 0.0
     if typed is not None:
         g1 = max(np.abs(np.diff(typed_column(col, 0.0, 0.0, ny, t_, None))).max() / (col[1] - col[0]) for t_ in tt)
-        run = np.maximum(space.mid - points[:, 1], 0.0) / s[1]
-        v = (points[:, [0, 2]] + run[:, None] * s[[0, 2]] - space.lo[[0, 2]]) / space.cell[[0, 2]] - 0.5
+        v = space.plane_texel(points, s)
         h = space.read_at(v)[2]
         raw = max(np.abs(np.diff(m[0], axis=a)).max() for m in sums for a in (0, 1))
         interp = g1 * raw * h.sum(-1) / 4.0 * probe.weights[0]

@@ -382,6 +382,7 @@ class CloudShadowStub:
     for ``camera`` and ``sun``: bound to a program, and its float64 optical depth (``tau``)."""
 
     def __init__(self, gpu, rng, params, camera, sun):
+        import moderngl
         from atmos.lighting import unit_sun
         from atmos.plugins.clouds.shadows.shadow_map import shadow_space
         from atmos.plugins.clouds.volume.layout import CloudLayout
@@ -394,11 +395,10 @@ class CloudShadowStub:
         self.map = rng.uniform(0.0, 4.0, (2 * n, n, 2)).astype(np.float16).astype(np.float64)
         self.weights = (float(rng.uniform(0.2, 1.0)), float(rng.uniform(0.0, 0.5)))
         self.texture = gpu.ctx.texture((n, 2 * n), 2, self.map.astype(np.float16).tobytes(), dtype="f2")
-
-    def bind(self, program) -> None:
-        import moderngl
         self.texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
         self.texture.repeat_x = self.texture.repeat_y = False
+
+    def bind(self, program) -> None:
         bind_textures(program, cloud_shadow_map=self.texture)
         self.space.uniforms(program, *self.weights)
 

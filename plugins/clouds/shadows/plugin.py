@@ -5,9 +5,9 @@ from atmos.graph import ComputePass, PassContext
 from atmos.lighting import unit_sun
 from atmos.plugin import Plugin
 from atmos.plugins.clouds.volume.layout import CloudLayout
-from atmos.plugins.clouds.far_field.layer import column_tau
 from atmos.plugins.clouds.shadows.settings import CloudShadowSettings
-from atmos.plugins.clouds.shadows.shadow_map import SHADOW_MAP, SHADOW_SPACE, shadow_map_pass, use_shadow_map
+from atmos.plugins.clouds.shadows.shadow_map import (SHADOW_MAP, SHADOW_SPACE, cloud_extinctions, shadow_map_pass,
+                                                     use_shadow_map)
 from atmos.plugins.clouds.volume.column import column_uniforms
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS, FAR_FIELD, CloudSets
 from atmos.render_core import COLOR, DEPTH
@@ -78,10 +78,10 @@ class CloudShadowsPass(ComputePass):
             return                                  # no direct light to take away: nothing to do
         sim: CloudSets = frame.resource(CLOUD_SETS)
         layout = cloud_layout(sim, params)
-        sigma = sim.settings.sigma if params.sigma is None else params.sigma
+        own_sigma, field_tau = cloud_extinctions(frame)
+        sigma = own_sigma if params.sigma is None else params.sigma
         write_uniforms(p, weight=weight)
         if frame.declares(SHADOW_MAP):
-            field_tau = column_tau(frame.resource(FAR_FIELD).settings, sim) if frame.declares(FAR_FIELD) else 0.0
             use_shadow_map(frame, p, sigma * params.strength, field_tau * params.strength)
         else:
             layer = frame.resource(FAR_FIELD) if frame.declares(FAR_FIELD) else None
@@ -90,7 +90,7 @@ class CloudShadowsPass(ComputePass):
             column_uniforms(p, sim, layout, sigma * params.strength)
             if layer is not None:
                 layer.use(p, view, sim)
-                write_uniforms(p, field_column_tau=column_tau(layer.settings, sim) * params.strength)
+                write_uniforms(p, field_column_tau=field_tau * params.strength)
         frame.dispatch(p, self.groups(frame.image(COLOR).size), textures={"scene_depth": DEPTH},
                        images={"color_image": COLOR})
 

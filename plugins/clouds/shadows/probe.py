@@ -7,8 +7,7 @@ import numpy as np
 from atmos.graph import ComputePass
 from atmos.gpu.uniforms import write_uniforms
 from atmos.lighting import unit_sun
-from atmos.plugins.clouds.far_field.layer import column_tau
-from atmos.plugins.clouds.shadows.shadow_map import SHADOW_MAP, SHADOW_SPACE, use_shadow_map
+from atmos.plugins.clouds.shadows.shadow_map import cloud_extinctions, read_shadow_map, use_shadow_map
 from atmos.plugins.clouds.volume.column import column_uniforms
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS, FAR_FIELD
 
@@ -31,11 +30,7 @@ class ShadowMapProbe(ComputePass):
         return {"CLOUD_FAR_FIELD": 1} if self.graph.imports(FAR_FIELD) else {}
 
     def setup(self, builder) -> None:
-        builder.read(SHADOW_MAP)
-        builder.read(SHADOW_SPACE)
-        builder.read(CLOUD_SETS)
-        if self.graph.imports(FAR_FIELD):
-            builder.read(FAR_FIELD)
+        read_shadow_map(builder, self.graph)
         builder.side_effect()
 
     def execute(self, frame) -> None:
@@ -43,16 +38,16 @@ class ShadowMapProbe(ComputePass):
             return
         ctx, p = self.gpu.ctx, self.program
         sim = frame.resource(CLOUD_SETS)
-        field_tau = column_tau(frame.resource(FAR_FIELD).settings, sim) if frame.declares(FAR_FIELD) else 0.0
+        sigma, field_tau = cloud_extinctions(frame)
         layer = frame.resource(FAR_FIELD) if frame.declares(FAR_FIELD) else None
         if layer is not None:                   # first: its measure dispatches programs of its own
             layer.prepare(frame.view, sim)
-        column_uniforms(p, sim, sim.layout(), sim.settings.sigma)
+        column_uniforms(p, sim, sim.layout(), sigma)
         if layer is not None:
             layer.use(p, frame.view, sim)
             p["field_column_tau"].value = field_tau
-        use_shadow_map(frame, p, sim.settings.sigma, field_tau)
-        self.weights = (float(sim.settings.sigma), float(field_tau))
+        use_shadow_map(frame, p, sigma, field_tau)
+        self.weights = (sigma, float(field_tau))
         n = len(self.points)
         pts = np.zeros((n, 4), "f4")
         pts[:, :3] = self.points

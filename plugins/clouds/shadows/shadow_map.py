@@ -33,6 +33,7 @@ import numpy as np
 
 from atmos.graph import ComputePass, TextureDesc
 from atmos.gpu.uniforms import write_uniforms
+from atmos.plugins.clouds.far_field.layer import column_tau
 from atmos.plugins.clouds.volume.column import column_uniforms
 from atmos.plugins.clouds.volume.sets import CLOUD_SETS, FAR_FIELD
 
@@ -78,6 +79,13 @@ class ShadowMapSpace:
         c = self.far_centre_index
         return c + c / self.warp * np.arcsinh((np.asarray(v, np.float64) - self.cascades[1, :2]) / self.cascades[1, 2:])
 
+    def plane_texel(self, points, sun_dir) -> np.ndarray:
+        """Volume texel coordinates (..., 2) where a lookup at world ``points`` (..., 3) reads: their
+        projection along the sun (unit ``sun_dir``) onto the layer's middle plane, as shadow_map.glsl."""
+        p, s = np.asarray(points, np.float64), np.asarray(sun_dir, np.float64)
+        run = np.maximum(self.mid - p[..., 1], 0.0) / max(s[1], MIN_SUN_HEIGHT)
+        return (p[..., [0, 2]] + run[..., None] * s[[0, 2]] - self.lo[[0, 2]]) / self.cell[[0, 2]] - 0.5
+
     def read_at(self, v) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Where a lookup at volume texel coordinates ``v`` (..., 2) reads, as shadow_map.glsl: (the map
         texel index (..., 2) in its cascade, clamped; whether that is the near cascade (...,); the width
@@ -107,9 +115,9 @@ class ShadowMapSpace:
 
     def uniforms(self, program, extinction: float, field_tau: float = 0.0) -> None:
         """Set ``clouds/shadows/shadow_map.glsl``'s uniforms (the map itself is bound by the caller)."""
-        c = self.cascades
+        c, centre = self.cascades, self.far_centre_index
         lookup = np.array([[c[0, 0], c[0, 1], 1.0 / c[0, 2], 1.0 / c[0, 3]], [c[1, 0], c[1, 1], 1.0 / c[1, 2], 1.0 / c[1, 3]],
-                           [0.5 * (self.size - 1) / self.warp, 0.5 * (self.size - 1), 0.0, 0.0]], "f4")
+                           [centre / self.warp, centre, 0.0, 0.0]], "f4")
         write_uniforms(program, shadow_cascades=lookup.tobytes(),
                        shadow_plane=(float(self.lo[0]), float(self.lo[2]), 1.0 / self.cell[0], 1.0 / self.cell[2]),
                        shadow_heights=(self.mid, float(self.lo[1]) + self.thickness, 1.0 / self.thickness,
@@ -138,7 +146,7 @@ def shadow_space(layout, camera_position, sun_dir, camera_far: float, size: int 
     half = reach * float(camera_far)
     vq = (q - lo[[0, 2]]) / cell[[0, 2]] - 0.5                   # the camera's projection, volume texels
     scale = half / np.sinh(space.warp) / cell[[0, 2]]             # K per axis, volume texels
-    c = 0.5 * (size - 1)
+    c = space.far_centre_index
     lo_v, hi_v = np.array([-0.5, -0.5]), np.array([shape[0], shape[2]], np.float64) - 0.5
     pad = 1
     for _ in range(3):      # far lookups past the near cascade never reach the volume: pad > the far texels there
@@ -199,7 +207,7 @@ class CloudShadowMapPass(ComputePass):
         column_uniforms(p, sim, layout, 1.0)
         if layer is not None:
             layer.use(p, view, sim)
-        c = 0.5 * (self.space.size - 1)
+        c = self.space.far_centre_index
         cascades = np.empty((3, 4), "f4")
         cascades[:2], cascades[2] = self.space.cascades, (self.space.warp / c, c, 0.0, 0.0)
         write_uniforms(p, cascades=cascades.tobytes(), near_size=self.space.near,
@@ -230,7 +238,6 @@ def cloud_extinctions(frame) -> tuple[float, float]:
     """(the volume's extinction per summed cell, the far field's column optical depth: 0 without one) in
     a pass that declared CLOUD_SETS (and FAR_FIELD): the clouds' own, as the ground shadows and the
     clouds' light take them."""
-    from atmos.plugins.clouds.far_field.layer import column_tau
     sim = frame.resource(CLOUD_SETS)
     return float(sim.settings.sigma), column_tau(frame.resource(FAR_FIELD).settings, sim) if frame.declares(FAR_FIELD) else 0.0
 
@@ -288,8 +295,7 @@ def lookup_reference(space: ShadowMapSpace, baked: np.ndarray, points, sun_dir, 
     (2N, N, 2), with ``weights`` (volume extinction, far field's column optical depth)."""
     p, s = np.asarray(points, np.float64), np.asarray(sun_dir, np.float64)
     n = space.size
-    run = np.maximum(space.mid - p[..., 1], 0.0) / max(s[1], MIN_SUN_HEIGHT)
-    v = (p[..., [0, 2]] + run[..., None] * s[[0, 2]] - space.lo[[0, 2]]) / space.cell[[0, 2]] - 0.5
+    v = space.plane_texel(p, s)
     above = np.clip((space.lo[1] + space.thickness - p[..., 1]) / space.thickness, 0.0, 1.0)
     j, near, _ = space.read_at(v)
     row0 = np.where(near, 0, n)

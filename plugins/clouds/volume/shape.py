@@ -211,11 +211,7 @@ def column_lookup(m, t) -> np.ndarray:
     nt, nu = table.shape
     m, t = np.broadcast_arrays(np.asarray(m, np.float64), np.asarray(t, np.float64))
     x = np.sqrt(np.clip(np.nan_to_num(m) / COLUMN_FULL, 0.0, 1.0)) * (nu - 1)
-    y = np.clip(t, 0.0, 1.0) * (nt - 1)
-    i, j = np.minimum(x.astype(int), nu - 2), np.minimum(y.astype(int), nt - 2)
-    fx, fy = x - i, y - j
-    return ((1 - fy) * ((1 - fx) * table[j, i] + fx * table[j, i + 1])
-            + fy * ((1 - fx) * table[j + 1, i] + fx * table[j + 1, i + 1]))
+    return bilinear(table, np.stack([np.clip(t, 0.0, 1.0) * (nt - 1), x], -1))
 
 
 def typed_column(sums, x, z, ny: int, cloud_type=None, type_map=None) -> np.ndarray:
